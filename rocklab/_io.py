@@ -1,0 +1,76 @@
+"""Atomic output writing: write to a temp file in the same folder, then rename.
+
+A crash or a bad input never leaves a half-written output, and inputs are never
+opened for writing.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import os
+import tempfile
+from pathlib import Path
+
+__all__ = ["atomic_path", "write_text_atomic", "write_json_atomic", "write_frame_atomic"]
+
+
+@contextlib.contextmanager
+def atomic_path(path, suffix: str | None = None):
+    """Yield a temporary path next to ``path``; rename it onto ``path`` on success.
+
+    On an exception the temporary file is removed and ``path`` is untouched.
+    """
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=suffix or path.suffix or ".tmp",
+                               dir=path.parent)
+    os.close(fd)
+    try:
+        yield Path(tmp)
+        os.replace(tmp, path)
+    except BaseException:
+        with contextlib.suppress(FileNotFoundError):
+            os.unlink(tmp)
+        raise
+
+
+def write_text_atomic(path, text: str) -> Path:
+    """Write ``text`` (UTF-8) to ``path`` atomically and return the path."""
+    with atomic_path(path) as tmp:
+        Path(tmp).write_text(text, encoding="utf-8")
+    return Path(path)
+
+
+def write_json_atomic(path, obj, indent: int = 2) -> Path:
+    """Write ``obj`` as JSON to ``path`` atomically (NaN written as null)."""
+    return write_text_atomic(path, json.dumps(_nan_to_none(obj), indent=indent) + "\n")
+
+
+def write_frame_atomic(path, frame, **kwargs) -> Path:
+    """Write a pandas DataFrame to CSV atomically (``index=False`` by default)."""
+    kwargs.setdefault("index", False)
+    with atomic_path(path) as tmp:
+        frame.to_csv(tmp, **kwargs)
+    return Path(path)
+
+
+def _nan_to_none(obj):
+    import math
+
+    if isinstance(obj, float) and not math.isfinite(obj):
+        return None
+    if isinstance(obj, dict):
+        return {k: _nan_to_none(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_nan_to_none(v) for v in obj]
+    try:
+        import numpy as np
+
+        if isinstance(obj, np.generic):
+            return _nan_to_none(obj.item())
+        if isinstance(obj, np.ndarray):
+            return _nan_to_none(obj.tolist())
+    except ImportError:  # pragma: no cover
+        pass
+    return obj

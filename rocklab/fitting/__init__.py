@@ -1,0 +1,3 @@
+"""rocklab.fitting (see the package docs)."""
+
+__all__: list[str] = []

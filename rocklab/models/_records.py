@@ -1,0 +1,309 @@
+"""Base-motion records: horizontal ground/table acceleration histories.
+
+Readers convert to SI once, at the file boundary: every :class:`BaseMotion`
+holds ``t_s`` (s) and ``acc_m_s2`` (m/s^2) on a uniform grid.
+
+Formats
+-------
+- PEER ``.AT2``, NGA-West2 header (``NPTS=   5372, DT=   .0100 SEC``) and the
+  older style (``NPTS=  1559, DT= .02000 SEC`` with free text above), units g
+  unless the header says otherwise.
+- CSV with a header ``t_s,acc_m_s2`` (or ``acc_g`` / ``acc_cm_s2``).
+- Two-column whitespace text ``t a`` without header; ``units`` is required
+  (``g``, ``m/s2``, ``cm/s2``).
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .._errors import InputError
+from ..blocks import G
+
+__all__ = ["BaseMotion", "load_base_motion", "UNITS_TO_M_S2"]
+
+#: Factors from accepted acceleration units to m/s^2.
+UNITS_TO_M_S2 = {"g": G, "m/s2": 1.0, "m/s^2": 1.0, "m_s2": 1.0, "cm/s2": 0.01,
+                 "cm/s^2": 0.01, "cm_s2": 0.01, "gal": 0.01, "mm/s2": 0.001}
+
+_NUM = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eEdD][-+]?\d+)?")
+
+
+def _unit_factor(units: str, source: str = "") -> float:
+    key = str(units).strip().lower().replace(" ", "")
+    if key not in UNITS_TO_M_S2:
+        raise InputError(f"{source}units={units!r}: unknown acceleration unit; use one of "
+                         f"{', '.join(sorted(set(UNITS_TO_M_S2)))}")
+    return UNITS_TO_M_S2[key]
+
+
+@dataclass(frozen=True)
+class BaseMotion:
+    """A horizontal base acceleration history on a uniform time grid.
+
+    Attributes
+    ----------
+    t_s : ndarray, shape (n,)
+        Times, s, uniform spacing ``dt_s``, starting at ``t_s[0]``.
+    acc_m_s2 : ndarray, shape (n,)
+        Base acceleration, m/s^2 (positive pushes the base towards +x).
+    name : str
+        Label (file stem or user given).
+    source : str
+        File it came from, or ``"array"``.
+    """
+
+    t_s: np.ndarray
+    acc_m_s2: np.ndarray
+    name: str = "record"
+    source: str = "array"
+    meta: dict = field(default_factory=dict, compare=False)
+
+    def __post_init__(self):
+        t = np.asarray(self.t_s, dtype=float).ravel()
+        a = np.asarray(self.acc_m_s2, dtype=float).ravel()
+        src = f"{self.source}: " if self.source != "array" else ""
+        if t.size != a.size:
+            raise InputError(f"{src}t_s has {t.size} samples but acc_m_s2 has {a.size}; give equal lengths")
+        if t.size < 2:
+            raise InputError(f"{src}record has {t.size} samples; a base motion needs at least 2")
+        bad = ~np.isfinite(t) | ~np.isfinite(a)
+        if bad.any():
+            i = int(np.flatnonzero(bad)[0])
+            raise InputError(f"{src}sample {i} is NaN/inf (t={t[i]}, a={a[i]}); clean the record")
+        d = np.diff(t)
+        if (d <= 0).any():
+            i = int(np.flatnonzero(d <= 0)[0])
+            raise InputError(f"{src}time is not strictly increasing at sample {i + 1} "
+                             f"(t={t[i]} then {t[i + 1]}); sort or de-duplicate the record")
+        dt = float(np.median(d))
+        if np.max(np.abs(d - dt)) > 1e-6 * max(dt, 1e-12) + 1e-9:
+            i = int(np.argmax(np.abs(d - dt)))
+            raise InputError(f"{src}non-uniform time step at sample {i + 1} (dt={d[i]:g} s vs median "
+                             f"{dt:g} s): gap or jitter; resample with BaseMotion.resample() first")
+        t.setflags(write=False)
+        a.setflags(write=False)
+        object.__setattr__(self, "t_s", t)
+        object.__setattr__(self, "acc_m_s2", a)
+
+    # -- construction -------------------------------------------------------
+    @classmethod
+    def from_arrays(cls, t_s, acc, units: str = "m/s2", name: str = "record") -> "BaseMotion":
+        """From arrays of times (s) and accelerations in ``units``."""
+        f = _unit_factor(units)
+        return cls(np.asarray(t_s, float), np.asarray(acc, float) * f, name=name)
+
+    @classmethod
+    def from_samples(cls, acc, dt_s: float, units: str = "m/s2", t0_s: float = 0.0,
+                     name: str = "record") -> "BaseMotion":
+        """From equally spaced samples ``acc`` (in ``units``) at step ``dt_s`` (s)."""
+        if not (math.isfinite(dt_s) and dt_s > 0):
+            raise InputError(f"dt_s={dt_s!r}: time step must be positive (s)")
+        acc = np.asarray(acc, float).ravel()
+        return cls.from_arrays(t0_s + dt_s * np.arange(acc.size), acc, units=units, name=name)
+
+    # -- derived ------------------------------------------------------------
+    @property
+    def dt_s(self) -> float:
+        """Sample spacing, s."""
+        return float(self.t_s[1] - self.t_s[0])
+
+    @property
+    def duration_s(self) -> float:
+        """t_s[-1] - t_s[0], s."""
+        return float(self.t_s[-1] - self.t_s[0])
+
+    @property
+    def pga_m_s2(self) -> float:
+        """Peak absolute acceleration, m/s^2."""
+        return float(np.max(np.abs(self.acc_m_s2)))
+
+    def scaled(self, factor: float) -> "BaseMotion":
+        """This record times ``factor``."""
+        return BaseMotion(self.t_s, self.acc_m_s2 * float(factor), self.name, self.source, dict(self.meta))
+
+    def scaled_to_pga(self, pga: float, units: str = "g") -> "BaseMotion":
+        """This record scaled so that its PGA equals ``pga`` (in ``units``)."""
+        target = float(pga) * _unit_factor(units)
+        if not (math.isfinite(target) and target > 0):
+            raise InputError(f"scale-pga={pga!r}: target PGA must be positive")
+        if self.pga_m_s2 == 0:
+            raise InputError(f"{self.source}: record is all zeros; cannot scale to a PGA")
+        return self.scaled(target / self.pga_m_s2)
+
+    def resample(self, dt_s: float, t_end_s: float | None = None) -> "BaseMotion":
+        """Linear interpolation onto a uniform grid of step ``dt_s`` (s)."""
+        t_end = self.t_s[-1] if t_end_s is None else float(t_end_s)
+        t = self.t_s[0] + dt_s * np.arange(int(math.floor((t_end - self.t_s[0]) / dt_s + 1e-9)) + 1)
+        return BaseMotion(t, self.at(t), self.name, self.source, dict(self.meta))
+
+    def at(self, t_s) -> np.ndarray:
+        """Acceleration (m/s^2) at times ``t_s`` by linear interpolation, 0 outside the record."""
+        return np.interp(np.asarray(t_s, float), self.t_s, self.acc_m_s2, left=0.0, right=0.0)
+
+    def to_frame(self):
+        """DataFrame with columns ``t_s, acc_m_s2``."""
+        import pandas as pd
+
+        return pd.DataFrame({"t_s": self.t_s, "acc_m_s2": self.acc_m_s2})
+
+
+# -- readers ------------------------------------------------------------------
+
+def load_base_motion(path, units: str | None = None, dt_s: float | None = None,
+                     name: str | None = None) -> BaseMotion:
+    """Read a base-motion record file into SI units.
+
+    Parameters
+    ----------
+    path : str or Path
+        ``.AT2`` (PEER), ``.csv`` with header, or two-column text ``t a``.
+    units : str, optional
+        Acceleration units of the file (``g``, ``m/s2``, ``cm/s2``). Required for
+        headerless text; for ``.AT2`` overrides the header's units.
+    dt_s : float, optional
+        Only for single-column text files: the sample spacing, s.
+    name : str, optional
+        Label; defaults to the file stem.
+
+    Raises
+    ------
+    InputError
+        Unreadable file, NPTS disagreeing with the data, NaN, non-monotonic or
+        non-uniform time, unknown units.
+    """
+    path = Path(path)
+    if units is not None:
+        _unit_factor(units, f"{path}: ")  # fail on a bad option before reading anything
+    if not path.is_file():
+        raise InputError(f"{path}: base-motion file not found; check the path")
+    try:
+        text = path.read_text(encoding="utf-8", errors="replace")
+    except OSError as e:
+        raise InputError(f"{path}: cannot read ({e.strerror})") from None
+    if not text.strip():
+        raise InputError(f"{path}: file is empty; give a record with samples")
+    nm = name or path.stem
+    if re.search(r"NPTS\s*=", text[:4000], re.I):
+        return _read_at2(path, text, units, nm)
+    if path.suffix.lower() == ".csv" or re.match(r"\s*[A-Za-z_]", text):
+        return _read_csv(path, units, nm)
+    return _read_columns(path, text, units, dt_s, nm)
+
+
+def _read_at2(path: Path, text: str, units: str | None, name: str) -> BaseMotion:
+    lines = text.splitlines()
+    hdr_i = next(i for i, ln in enumerate(lines) if re.search(r"NPTS\s*=", ln, re.I))
+    hdr = lines[hdr_i]
+    m_n = re.search(r"NPTS\s*=\s*(\d+)", hdr, re.I)
+    m_dt = re.search(r"DT\s*=\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)", hdr, re.I)
+    if not (m_n and m_dt):
+        raise InputError(f"{path}, line {hdr_i + 1}: AT2 header must hold 'NPTS=<n>, DT=<s> SEC'; "
+                         "fix the header")
+    npts, dt = int(m_n.group(1)), float(m_dt.group(1))
+    if dt <= 0:
+        raise InputError(f"{path}, line {hdr_i + 1}: DT={dt} must be positive")
+    head = "\n".join(lines[:hdr_i]).upper()
+    if units is None:
+        if "CM/S" in head or "CM/SEC" in head or "GAL" in head:
+            units = "cm/s2"
+        elif "M/S" in head:
+            units = "m/s2"
+        else:
+            units = "g"  # PEER's convention; both headers here say "units ... g"
+    f = _unit_factor(units, f"{path}: ")
+    vals = []
+    for j, ln in enumerate(lines[hdr_i + 1:], start=hdr_i + 2):
+        toks = ln.split()
+        for tok in toks:
+            if not _NUM.fullmatch(tok):
+                # fixed-width Fortran fields can run together ("0.000000.00000")
+                parts = _NUM.findall(tok)
+                if not parts or "".join(parts) != tok:
+                    raise InputError(f"{path}, line {j}: {tok!r} is not a number; fix or remove it")
+                vals.extend(float(p.replace("D", "E").replace("d", "e")) for p in parts)
+            else:
+                vals.append(float(tok.replace("D", "E").replace("d", "e")))
+    a = np.asarray(vals, float)
+    if a.size != npts:
+        raise InputError(f"{path}: header says NPTS={npts} but the file holds {a.size} values; "
+                         "the file is truncated or the header is wrong")
+    bm = BaseMotion(dt * np.arange(npts), a * f, name=name, source=str(path),
+                    meta={"format": "AT2", "units_in_file": units, "header": lines[:hdr_i + 1]})
+    return bm
+
+
+def _read_csv(path: Path, units: str | None, name: str) -> BaseMotion:
+    import pandas as pd
+
+    try:
+        df = pd.read_csv(path, comment="#")
+    except Exception as e:  # pandas raises several types for malformed CSV
+        raise InputError(f"{path}: not a readable CSV ({type(e).__name__}: {str(e).splitlines()[0]})") from None
+    cols = {c.strip(): c for c in df.columns}
+    if "t_s" not in cols:
+        raise InputError(f"{path}, line 1: missing column 't_s'; header must be 't_s,acc_m_s2' "
+                         "(or acc_g / acc_cm_s2)")
+    acc_col, file_units = None, None
+    for c, u in (("acc_m_s2", "m/s2"), ("acc_g", "g"), ("acc_cm_s2", "cm/s2")):
+        if c in cols:
+            acc_col, file_units = cols[c], u
+            break
+    if acc_col is None:
+        raise InputError(f"{path}, line 1: no acceleration column; name it acc_m_s2, acc_g or acc_cm_s2")
+    t = pd.to_numeric(df[cols["t_s"]], errors="coerce").to_numpy(float)
+    a = pd.to_numeric(df[acc_col], errors="coerce").to_numpy(float)
+    bad = ~np.isfinite(t) | ~np.isfinite(a)
+    if bad.any():
+        i = int(np.flatnonzero(bad)[0])
+        raise InputError(f"{path}, line {i + 2}: NaN or non-numeric value; clean the record")
+    _check_time(path, t, first_line=2)
+    f = _unit_factor(units or file_units, f"{path}: ")
+    return BaseMotion(t, a * f, name=name, source=str(path), meta={"format": "csv"})
+
+
+def _read_columns(path: Path, text: str, units: str | None, dt_s: float | None,
+                  name: str) -> BaseMotion:
+    rows, linenos = [], []
+    for j, ln in enumerate(text.splitlines(), start=1):
+        s = ln.strip()
+        if not s or s.startswith("#"):
+            continue
+        toks = s.replace(",", " ").split()
+        try:
+            rows.append([float(x) for x in toks])
+        except ValueError:
+            raise InputError(f"{path}, line {j}: {s[:40]!r} is not numeric; expected 't a' columns") from None
+        linenos.append(j)
+    ncol = {len(r) for r in rows}
+    if len(ncol) != 1:
+        raise InputError(f"{path}: rows have {sorted(ncol)} columns; expected the same number on every line")
+    if units is None:
+        raise InputError(f"{path}: headerless record; say its units (--units g|m/s2|cm/s2)")
+    f = _unit_factor(units, f"{path}: ")
+    arr = np.asarray(rows, float)
+    if arr.shape[1] == 1:
+        if dt_s is None:
+            raise InputError(f"{path}: one column of accelerations; give the sample spacing dt_s")
+        return BaseMotion.from_samples(arr[:, 0] * f, dt_s, name=name)
+    t, a = arr[:, 0], arr[:, 1]
+    bad = ~np.isfinite(t) | ~np.isfinite(a)
+    if bad.any():
+        i = int(np.flatnonzero(bad)[0])
+        raise InputError(f"{path}, line {linenos[i]}: NaN value; clean the record")
+    _check_time(path, t, linenos=linenos)
+    return BaseMotion(t, a * f, name=name, source=str(path), meta={"format": "columns"})
+
+
+def _check_time(path, t, first_line: int = 1, linenos=None):
+    d = np.diff(t)
+    if (d <= 0).any():
+        i = int(np.flatnonzero(d <= 0)[0]) + 1
+        ln = linenos[i] if linenos is not None else i + first_line
+        raise InputError(f"{path}, line {ln}: time {t[i]} does not increase (previous {t[i - 1]}); "
+                         "sort or remove duplicate rows")

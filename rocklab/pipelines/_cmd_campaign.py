@@ -1,0 +1,14 @@
+"""``rocklab campaign``: not implemented yet (its issue is open)."""
+
+from __future__ import annotations
+
+from .._errors import InputError
+
+
+def register(sub):
+    p = sub.add_parser("campaign", help="(not implemented yet)")
+    p.set_defaults(func=run)
+
+
+def run(args) -> int:
+    raise InputError("'rocklab campaign' is not implemented yet; see the open issue")

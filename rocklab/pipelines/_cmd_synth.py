@@ -1,0 +1,14 @@
+"""``rocklab synth``: not implemented yet (its issue is open)."""
+
+from __future__ import annotations
+
+from .._errors import InputError
+
+
+def register(sub):
+    p = sub.add_parser("synth", help="(not implemented yet)")
+    p.set_defaults(func=run)
+
+
+def run(args) -> int:
+    raise InputError("'rocklab synth' is not implemented yet; see the open issue")

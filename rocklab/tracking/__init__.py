@@ -1,0 +1,3 @@
+"""rocklab.tracking (see the package docs)."""
+
+__all__: list[str] = []

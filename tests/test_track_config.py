@@ -1,0 +1,71 @@
+"""Tracking config (track.toml) schema: the brief's example, round trip, one-line errors."""
+
+from __future__ import annotations
+
+import pytest
+
+from rocklab import InputError
+from rocklab.tracking import TrackConfig, load_track_config
+
+EXAMPLE = """\
+[video]
+fps = 50                     # optional when the container has it
+[targets]
+style = "aruco"              # aruco | apriltag | dots | edges | region
+dictionary = "DICT_4X4_50"   # aruco/apriltag
+marker_size_m = 0.03         # side length of the printed marker (gives the scale)
+[reference]
+level = "table"
+[[objects]]
+id = "block_1"
+kind = "block"
+markers = [1]
+[[objects]]
+id = "table"
+kind = "table"
+markers = [0]
+"""
+
+
+def test_brief_example_loads_and_round_trips(tmp_path):
+    p = tmp_path / "track.toml"
+    p.write_text(EXAMPLE)
+    cfg = load_track_config(p)
+    assert cfg.video.fps == 50.0
+    assert cfg.targets.marker_size_m == 0.03
+    assert [o.id for o in cfg.objects] == ["block_1", "table"]
+    assert cfg.table.markers == (0,)
+    q = tmp_path / "again.toml"
+    q.write_text(cfg.to_toml())
+    again = load_track_config(q)
+    assert again.objects == cfg.objects and again.targets == cfg.targets
+    assert again.reference == cfg.reference and again.video == cfg.video
+
+
+@pytest.mark.parametrize("edit, key, line", [
+    (("markers = [0]", "markers = [0]\nfoo = 3"), "objects[1].foo", 17),
+    (('style = "aruco"', 'style = "qr"'), "targets.style", 4),
+    (('dictionary = "DICT_4X4_50"', 'dictionary = "DICT_9X9"'), "targets.dictionary", 5),
+    (("markers = [1]", "markers = [0]"), "objects[1].markers", 16),
+    (("fps = 50", "fps = -5"), "video.fps", 2),
+])
+def test_errors_name_key_and_line(tmp_path, edit, key, line):
+    p = tmp_path / "track.toml"
+    p.write_text(EXAMPLE.replace(*edit, 1) if edit[0] != "markers = [0]" else
+                 EXAMPLE.replace(*edit))
+    with pytest.raises(InputError) as e:
+        load_track_config(p)
+    msg = str(e.value)
+    assert "\n" not in msg and f"'{key}'" in msg and f"line {line}" in msg
+
+
+def test_dots_need_two_and_edges_need_roi():
+    with pytest.raises(InputError, match="at least two"):
+        TrackConfig.from_dict({"targets": {"style": "dots"},
+                               "objects": [{"id": "b", "dots": [[0.0, 0.0]]}]})
+    with pytest.raises(InputError, match="roi"):
+        TrackConfig.from_dict({"targets": {"style": "edges"}, "objects": [{"id": "b"}]})
+    cfg = TrackConfig.from_dict({"targets": {"style": "dots"},
+                                 "objects": [{"id": "b", "dots": [[0, 0], [0.1, 0.05]]}]})
+    assert cfg.objects[0].dots == ((0.0, 0.0), (0.1, 0.05))
+    assert cfg.reference.level == "none"  # no table to level from

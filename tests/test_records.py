@@ -56,3 +56,15 @@ def test_bad_records(tmp_path):
     (tmp_path / "empty.txt").write_text("")
     with pytest.raises(InputError, match="empty"):
         load_base_motion(tmp_path / "empty.txt")
+
+
+def test_bundled_elcentro_matches_shared_copy(shared_data):
+    from rocklab.models import bundled_record
+
+    a = bundled_record("elcentro")
+    b = load_base_motion(shared_data / "records/RSN6_IMPVALL.I_I-ELC180.AT2")
+    assert np.array_equal(a.acc_m_s2, b.acc_m_s2)
+    # El Centro Array #9 180° (NGA-West2): PGA about 0.28 g
+    assert a.pga_m_s2 / G == pytest.approx(0.28, abs=0.02)
+    with pytest.raises(InputError, match="not bundled"):
+        bundled_record("kobe")

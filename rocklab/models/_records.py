@@ -25,7 +25,7 @@ import numpy as np
 from .._errors import InputError
 from ..blocks import G
 
-__all__ = ["BaseMotion", "load_base_motion", "UNITS_TO_M_S2"]
+__all__ = ["BaseMotion", "load_base_motion", "UNITS_TO_M_S2", "bundled_record", "BUNDLED_RECORDS"]
 
 #: Factors from accepted acceleration units to m/s^2.
 UNITS_TO_M_S2 = {"g": G, "m/s2": 1.0, "m/s^2": 1.0, "m_s2": 1.0, "cm/s2": 0.01,
@@ -307,3 +307,21 @@ def _check_time(path, t, first_line: int = 1, linenos=None):
         ln = linenos[i] if linenos is not None else i + first_line
         raise InputError(f"{path}, line {ln}: time {t[i]} does not increase (previous {t[i - 1]}); "
                          "sort or remove duplicate rows")
+
+
+#: Records bundled in ``rocklab/data/records`` (see PROVENANCE.md there).
+BUNDLED_RECORDS = {"elcentro": "RSN6_IMPVALL.I_I-ELC180.AT2"}
+
+
+def bundled_record(name: str = "elcentro") -> BaseMotion:
+    """A record shipped with rocklab, in SI units.
+
+    ``"elcentro"``: 1940 Imperial Valley, El Centro Array #9, 180° (PEER NGA-West2,
+    via NHERI-SimCenter/EE-UQ, BSD-2).
+    """
+    from importlib.resources import files
+
+    if name not in BUNDLED_RECORDS:
+        raise InputError(f"record {name!r} is not bundled; choose one of {', '.join(BUNDLED_RECORDS)}")
+    path = files("rocklab") / "data" / "records" / BUNDLED_RECORDS[name]
+    return load_base_motion(str(path), units="g", name=name)

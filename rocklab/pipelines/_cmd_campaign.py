@@ -1,14 +1,29 @@
-"""``rocklab campaign``: not implemented yet (its issue is open)."""
+"""``rocklab campaign DIR --out OUT``: every experiment under DIR, then the campaign fits."""
 
 from __future__ import annotations
 
-from .._errors import InputError
+import json
 
 
 def register(sub):
-    p = sub.add_parser("campaign", help="(not implemented yet)")
+    p = sub.add_parser("campaign", help="run every experiment.toml under DIR in parallel, then campaign fits")
+    p.add_argument("dir", help="folder searched recursively for experiment*.toml")
+    p.add_argument("--out", required=True, help="output folder")
+    p.add_argument("--workers", type=int, default=2, help="local processes (default 2)")
+    p.add_argument("--scheduler", metavar="ADDR", help="run the experiments on a Dask distributed cluster")
+    p.add_argument("--force", action="store_true", help="re-run unchanged experiments too")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    p.add_argument("--json", action="store_true", help="print the campaign summary as one JSON object")
     p.set_defaults(func=run)
 
 
 def run(args) -> int:
-    raise InputError("'rocklab campaign' is not implemented yet; see the open issue")
+    from ._campaign import run_campaign
+
+    res = run_campaign(args.dir, args.out, workers=args.workers, scheduler=args.scheduler,
+                       force=args.force, progress=not args.no_progress)
+    if args.json:
+        print(json.dumps(res.to_dict(), default=str))
+    else:
+        print(res.summary_text())
+    return 0 if res.n_ok > 0 else 1

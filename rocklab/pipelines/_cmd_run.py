@@ -1,14 +1,37 @@
-"""``rocklab run``: not implemented yet (its issue is open)."""
+"""``rocklab run EXPERIMENT.toml --out DIR``: one experiment end to end."""
 
 from __future__ import annotations
 
-from .._errors import InputError
+import json
+import sys
 
 
 def register(sub):
-    p = sub.add_parser("run", help="(not implemented yet)")
+    p = sub.add_parser("run", help="run one experiment: track, IMU, sync, fit, simulate, report, Rerun")
+    p.add_argument("config", help="experiment.toml")
+    p.add_argument("--out", required=True, help="output folder (replaced atomically)")
+    p.add_argument("--force", action="store_true", help="re-run even if inputs and config are unchanged")
+    p.add_argument("--spawn", action="store_true", help="also stream to a newly spawned Rerun viewer")
+    p.add_argument("--connect", metavar="ADDR", help="also stream to a Rerun viewer at this gRPC address")
+    p.add_argument("--progress", action="store_true", help="progress bars on stderr")
+    p.add_argument("--json", action="store_true", help="print report.json's main numbers as one JSON object")
     p.set_defaults(func=run)
 
 
 def run(args) -> int:
-    raise InputError("'rocklab run' is not implemented yet; see the open issue")
+    from ._experiment import run_experiment
+
+    report, ran = run_experiment(args.config, args.out, force=args.force, spawn=args.spawn,
+                                 connect=args.connect, progress=args.progress)
+    if args.json:
+        keys = ("name", "status", "fit", "simulations", "sync", "video_vs_imu_rms_rad", "truth")
+        out = {k: report.get(k) for k in keys}
+        out["ran"] = ran
+        print(json.dumps(out, default=str))
+    elif not ran:
+        print(f"{args.out}: inputs and config unchanged; nothing to do (use --force to re-run)")
+    else:
+        f = report.get("fit") or {}
+        print(f"{report['name']}: {report['status']}; eta_e = {f.get('eta_e')}, "
+              f"outputs in {args.out} (summary.md, report.json, session.rrd)", file=sys.stdout)
+    return 0 if report.get("status") != "failed" else 1

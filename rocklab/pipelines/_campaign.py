@@ -1,0 +1,246 @@
+"""``rocklab campaign``: many experiments in parallel, then the campaign-level fits.
+
+Each experiment runs in its own process (``concurrent.futures``) or on a Dask
+distributed cluster (``scheduler=ADDR``); a failing experiment is reported and
+the rest continue. Then: η_mat from edge-contact runs (Čeh Eq. 16), k per block
+from full-contact runs (Eq. 17–18), the Eq. 19 regression when the campaign
+spans enough blocks, ``campaign.csv``, figures and ``campaign.rrd``.
+"""
+
+from __future__ import annotations
+
+import json
+import traceback
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .._errors import InputError
+from .._io import write_frame_atomic, write_json_atomic
+
+__all__ = ["CampaignResult", "run_campaign", "find_experiments"]
+
+
+def find_experiments(root) -> list[Path]:
+    """Every ``experiment*.toml`` below ``root`` (sorted)."""
+    root = Path(root)
+    if not root.is_dir():
+        raise InputError(f"{root}: campaign folder not found; give a folder holding experiment.toml files")
+    found = sorted(p for p in root.rglob("experiment*.toml") if p.is_file())
+    if not found:
+        raise InputError(f"{root}: no experiment*.toml below this folder; nothing to run")
+    return found
+
+
+def _one(config: str, out: str, force: bool) -> dict:
+    """Worker: run one experiment; never raises (the failure is the result)."""
+    from .._errors import InputError as _IE
+    from ._experiment import run_experiment
+
+    try:
+        report, ran = run_experiment(config, out, force=force)
+        return {"config": config, "out": out, "ok": report.get("status") != "failed", "ran": ran,
+                "report": report, "error": None}
+    except _IE as e:
+        return {"config": config, "out": out, "ok": False, "ran": True, "report": None, "error": str(e)}
+    except Exception as e:  # noqa: BLE001 - one broken experiment must not stop the campaign
+        tb = traceback.format_exc(limit=3).strip().splitlines()[-1]
+        return {"config": config, "out": out, "ok": False, "ran": True, "report": None,
+                "error": f"{type(e).__name__}: {e} ({tb})"}
+
+
+@dataclass(frozen=True)
+class CampaignResult:
+    """Outcome of a campaign.
+
+    Attributes
+    ----------
+    out_dir : Path
+    runs : list[dict]
+        Per experiment: config, out, ok, error.
+    table : pandas.DataFrame
+        One row per successful experiment (block, b_m, h_m, contact, eta_e, ci_lo, ci_hi,
+        eta_H, eta_M, eta_true, ...).
+    eta_mat : dict or None
+        Edge-contact η_mat fit (:meth:`to_dict` of the fitting result).
+    k_table : dict or None
+        Full-contact inverse k per block and the regression.
+    """
+
+    out_dir: Path
+    runs: list
+    table: object
+    eta_mat: dict | None = None
+    k_table: dict | None = None
+    messages: list = field(default_factory=list)
+
+    @property
+    def n_ok(self) -> int:
+        return sum(1 for r in self.runs if r["ok"])
+
+    def to_dict(self) -> dict:
+        return {"out_dir": str(self.out_dir), "n_experiments": len(self.runs), "n_ok": self.n_ok,
+                "failures": [{"config": r["config"], "error": r["error"]} for r in self.runs if not r["ok"]],
+                "experiments": self.table.to_dict(orient="records") if self.table is not None else [],
+                "eta_mat": self.eta_mat, "k_table": self.k_table, "messages": list(self.messages)}
+
+    def summary_text(self) -> str:
+        lines = [f"campaign: {self.n_ok}/{len(self.runs)} experiments ok; outputs in {self.out_dir}"]
+        t = self.table
+        if t is not None and len(t):
+            lines.append(f"{'experiment':<22}{'block':<7}{'contact':<8}{'eta_H':>8}{'eta_e':>8}"
+                         f"{'95% CI':>18}{'eta_M':>8}{'truth':>8}")
+            for _, r in t.iterrows():
+                ci = (f"[{r['ci_lo']:.3f}, {r['ci_hi']:.3f}]" if np.isfinite(r.get("ci_lo", np.nan))
+                      else "")
+                lines.append(f"{str(r['experiment'])[:21]:<22}{str(r['block']):<7}{r['contact']:<8}"
+                             f"{r['eta_H']:>8.3f}{r['eta_e']:>8.3f}{ci:>18}"
+                             f"{r.get('eta_M', np.nan):>8.3f}{r.get('eta_true', np.nan):>8.3f}")
+        if self.eta_mat:
+            lines.append(f"eta_mat (edge contact) = {self.eta_mat.get('eta_mat')}")
+        for r in self.runs:
+            if not r["ok"]:
+                lines.append(f"FAILED {r['config']}: {r['error']}")
+        for m in self.messages:
+            lines.append(f"note: {m}")
+        lines.append(f"look: {self.out_dir / 'campaign.csv'}, {self.out_dir / 'figures'}, "
+                     f"rerun {self.out_dir / 'campaign.rrd'}")
+        return "\n".join(lines)
+
+
+def _row(run: dict) -> dict | None:
+    rep = run.get("report")
+    if not rep:
+        return None
+    b = rep["block"]
+    fit = rep.get("fit") or {}
+    ci = fit.get("ci95_eta_e") or [np.nan, np.nan]
+    sims = rep.get("simulations") or {}
+    truth = rep.get("truth") or {}
+    return {"experiment": rep["name"], "block": b.get("name") or rep["name"], "b_m": b["b_m"], "h_m": b["h_m"],
+            "hb": b["h_m"] / b["b_m"], "contact": rep["contact"]["type"], "l_c_m": rep["contact"]["l_c_m"],
+            "eta_H": b["eta_H"], "eta_e": fit.get("eta_e", np.nan),
+            "ci_lo": ci[0] if ci[0] is not None else np.nan, "ci_hi": ci[1] if ci[1] is not None else np.nan,
+            "eta_e_first": fit.get("eta_e_first", np.nan),
+            "eta_M": (sims.get("modified") or {}).get("eta", np.nan),
+            "eta_true": truth.get("eta") if truth.get("eta") is not None else np.nan,
+            "fit_status": fit.get("status"), "out": run["out"]}
+
+
+def _campaign_fits(table, msgs):
+    from .. import fitting as F
+
+    eta_mat = k_tab = None
+    edge = table[(table["contact"] == "edge") & np.isfinite(table["eta_e"])]
+    full = table[(table["contact"] == "full") & np.isfinite(table["eta_e"])]
+    if len(edge):
+        etab = edge.rename(columns={"experiment": "run"})[["block", "b_m", "h_m", "eta_e", "l_c_m"]]
+        r = F.fit_eta_mat(etab, l_c_m=float(edge["l_c_m"].iloc[0]))
+        eta_mat = r.to_dict()
+    else:
+        msgs.append("no edge-contact experiments: η_mat not fitted (0.989 of Čeh et al. used for k)")
+    if len(full):
+        em = eta_mat["eta_mat"] if eta_mat else 0.989
+        ftab = full[["block", "b_m", "h_m", "eta_e"]]
+        k_tab = F.k_table(ftab, eta_mat=em).to_dict()
+    return eta_mat, k_tab
+
+
+def run_campaign(root, out_dir, *, workers: int = 2, scheduler: str | None = None, force: bool = False,
+                 progress: bool = True) -> CampaignResult:
+    """Run every experiment under ``root`` into ``out_dir/experiments/<name>/`` and fit the campaign."""
+    import pandas as pd
+    from tqdm import tqdm
+
+    configs = find_experiments(root)
+    out_dir = Path(out_dir).resolve()
+    root = Path(root).resolve()
+    jobs = []
+    for c in configs:
+        rel = c.parent.relative_to(root) if c.parent != root else Path(c.stem)
+        jobs.append((str(c), str(out_dir / "experiments" / "__".join(rel.parts or (c.stem,))), force))
+    runs = []
+    bar = tqdm(total=len(jobs), desc="campaign", unit="exp", disable=not progress)
+    if scheduler:
+        try:
+            from dask.distributed import Client, as_completed as das_completed
+        except ImportError:
+            raise InputError("--scheduler needs dask[distributed]: pip install 'rocklab[dask]'") from None
+        with Client(scheduler) as client:
+            futs = [client.submit(_one, *j, pure=False) for j in jobs]
+            for f in das_completed(futs):
+                runs.append(f.result())
+                bar.update(1)
+    elif workers <= 1 or len(jobs) == 1:
+        for j in jobs:
+            runs.append(_one(*j))
+            bar.update(1)
+    else:
+        import multiprocessing as mp
+
+        with ProcessPoolExecutor(max_workers=workers, mp_context=mp.get_context("spawn")) as ex:
+            futs = [ex.submit(_one, *j) for j in jobs]
+            for f in as_completed(futs):
+                runs.append(f.result())
+                bar.update(1)
+    bar.close()
+    runs.sort(key=lambda r: r["config"])
+    rows = [r for r in (_row(x) for x in runs) if r is not None]
+    table = pd.DataFrame(rows)
+    msgs: list[str] = []
+    eta_mat = k_tab = None
+    if len(table):
+        try:
+            eta_mat, k_tab = _campaign_fits(table, msgs)
+        except InputError as e:
+            msgs.append(f"campaign fits not done: {e}")
+    res = CampaignResult(out_dir=out_dir, runs=runs, table=table, eta_mat=eta_mat, k_table=k_tab, messages=msgs)
+    _write_campaign(res)
+    return res
+
+
+def _write_campaign(res: CampaignResult) -> None:
+    from ._figures import campaign_figures
+
+    out = res.out_dir
+    out.mkdir(parents=True, exist_ok=True)
+    if res.table is not None and len(res.table):
+        write_frame_atomic(out / "campaign.csv", res.table)
+        reg = None
+        try:
+            from ..fitting import default_k_regression
+
+            reg = default_k_regression()
+        except ImportError:
+            pass
+        campaign_figures(res.table, out / "figures", regression=reg)
+        _campaign_rrd(res, out / "campaign.rrd")
+    write_json_atomic(out / "campaign.json", json.loads(json.dumps(res.to_dict(), default=str)))
+
+
+def _campaign_rrd(res: CampaignResult, path: Path) -> None:
+    import rerun as rr
+
+    from .._io import atomic_path
+    from ._rerun import campaign_blueprint, open_recording
+
+    with atomic_path(path, suffix=".rrd") as tmp:
+        rec = open_recording("rocklab", tmp, recording_id="campaign")
+        t = res.table
+        for _, r in t.iterrows():
+            # h/b on a sequence timeline so the viewer plots η against slenderness
+            rec.set_time("h_over_b_x1000", sequence=int(round(1000 * r["hb"])))
+            base = f"campaign/eta/{r['contact']}/b_{int(round(1000 * r['b_m']))}mm"
+            rec.log(f"{base}/eta_e", rr.Scalars(float(r["eta_e"])))
+            rec.log(f"{base}/eta_H", rr.Scalars(float(r["eta_H"])))
+            if np.isfinite(r.get("eta_true", np.nan)):
+                rec.log(f"{base}/eta_true", rr.Scalars(float(r["eta_true"])))
+            rec.log("campaign/experiments", rr.TextLog(
+                f"{r['experiment']}: block {r['block']} ({r['contact']}), η_e = {r['eta_e']:.4f}, "
+                f"η_H = {r['eta_H']:.4f}"))
+        rec.reset_time()
+        rec.send_blueprint(campaign_blueprint())
+        rec.flush()
+        rec.disconnect()

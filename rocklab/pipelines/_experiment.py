@@ -1,0 +1,469 @@
+"""``rocklab run``: one experiment from raw sources to report, figures and ``session.rrd``.
+
+Stages: track video → ingest IMU → sync → compare video vs IMU θ → fit η_e →
+simulate with η_H, η_M(k) and η_e (driven by the measured table motion when
+there is one) → write outputs.
+
+Outputs are staged in a hidden sibling folder and swapped into place at the
+end, so a failure leaves no partial output. A fingerprint of the inputs and
+the config is stored in ``report.json``; re-running with the same inputs is a
+no-op unless ``force=True``.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import shutil
+import tempfile
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .. import __version__
+from .._errors import InputError
+from .._io import write_frame_atomic, write_json_atomic, write_text_atomic
+from ._config import ExperimentConfig, load_experiment
+
+__all__ = ["ExperimentResult", "run_experiment", "analyse_experiment", "fingerprint"]
+
+
+@dataclass(frozen=True)
+class ExperimentResult:
+    """Everything one experiment produced. SI units; θ in rad, t in s.
+
+    Attributes
+    ----------
+    name : str
+    config : ExperimentConfig
+    block : rocklab.Block
+    measured : dict[str, tuple[ndarray, ndarray]]
+        Source name ("video", "imu", "track") → (t_s, theta_rad), on the primary clock.
+    primary : str
+        The source the fit used.
+    sync : dict or None
+        ``offset_s, drift, residual_ms`` of the IMU relative to the video.
+    video_imu_residual : (t_s, residual_rad) or None
+    fit : dict or None
+        :meth:`RestitutionFit.to_dict` of the η_e fit.
+    per_impact_eta : ndarray
+    simulations : dict[str, dict]
+        Law → {t_s, theta_rad, energy_J, eta, impacts (DataFrame), status}.
+    table : dict or None
+        Table motion {t_s, disp_m, vel_m_s, acc_m_s2}.
+    truth : dict or None
+        Synthetic truth {t_s, theta_rad, eta} when the session has one.
+    status : str
+        "ok", "failed" or "partial".
+    messages : list[str]
+        What went wrong or was noticed, one line each.
+    """
+
+    name: str
+    config: ExperimentConfig
+    block: object
+    measured: dict
+    primary: str
+    sync: dict | None
+    video_imu_residual: tuple | None
+    fit: dict | None
+    per_impact_eta: np.ndarray
+    simulations: dict
+    table: dict | None
+    truth: dict | None
+    status: str
+    messages: list = field(default_factory=list)
+    timings_s: dict = field(default_factory=dict)
+    frames: object = None  # optional per-frame overlay data from the tracker
+
+    def to_dict(self) -> dict:
+        """The numbers of ``report.json`` (units in keys)."""
+        b = self.block
+        d = {
+            "name": self.name,
+            "status": self.status,
+            "messages": list(self.messages),
+            "block": {k: v for k, v in b.to_dict().items()},
+            "contact": {"type": self.config.contact, "l_c_m": self.config.l_c_m, "k": self.config.k},
+            "primary_source": self.primary,
+            "sources": sorted(self.measured),
+            "sync": self.sync,
+            "video_vs_imu_rms_rad": (float(np.sqrt(np.nanmean(np.square(self.video_imu_residual[1]))))
+                                     if self.video_imu_residual is not None else None),
+            "fit": self.fit,
+            "per_impact_eta": [float(x) for x in self.per_impact_eta],
+            "simulations": {
+                law: {"eta": float(s["eta"]), "status": s.get("status"),
+                      "n_impacts": int(len(s["impacts"])) if s.get("impacts") is not None else 0,
+                      "rms_vs_measured_rad": s.get("rms_vs_measured_rad")}
+                for law, s in self.simulations.items()},
+            "table": None if self.table is None else {
+                "peak_disp_m": float(np.nanmax(np.abs(self.table["disp_m"]))) if "disp_m" in self.table else None,
+                "peak_acc_m_s2": float(np.nanmax(np.abs(self.table["acc_m_s2"]))),
+            },
+            "truth": None if self.truth is None else {"eta": self.truth.get("eta"),
+                                                      "theta_rms_error_rad": self.truth.get("theta_rms_error_rad")},
+            "timings_s": self.timings_s,
+            "units": {"t": "s", "theta": "rad", "omega": "rad/s", "length": "m", "energy": "J",
+                      "acceleration": "m/s^2"},
+            "versions": _versions(),
+        }
+        return d
+
+
+def _versions() -> dict:
+    import importlib.metadata as md
+
+    out = {"rocklab": __version__}
+    for pkg in ("numpy", "scipy", "pandas", "numba", "opencv-python-headless", "rerun-sdk", "imufusion"):
+        try:
+            out[pkg] = md.version(pkg)
+        except md.PackageNotFoundError:
+            out[pkg] = None
+    return out
+
+
+def fingerprint(cfg: ExperimentConfig) -> str:
+    """SHA-256 over the rocklab version, the config text and every input file's bytes."""
+    h = hashlib.sha256(__version__.encode())
+    for p in cfg.input_files():
+        h.update(str(p.name).encode())
+        with open(p, "rb") as f:
+            for chunk in iter(lambda: f.read(1 << 20), b""):
+                h.update(chunk)
+    return h.hexdigest()
+
+
+# ---------------------------------------------------------------------------
+# measurement stages
+
+def _read_track_csv(path: Path, obj: str | None):
+    import pandas as pd
+
+    try:
+        df = pd.read_csv(path)
+    except Exception as e:  # noqa: BLE001 - pandas raises many types
+        raise InputError(f"{path}: not a readable CSV ({type(e).__name__})") from None
+    for c in ("t_s", "theta_rad"):
+        if c not in df.columns:
+            raise InputError(f"{path}, line 1: missing column {c!r}; a track CSV needs t_s, theta_rad")
+    if obj is not None and "object" in df.columns:
+        df = df[df["object"].astype(str) == obj]
+        if df.empty:
+            raise InputError(f"{path}: no rows for object {obj!r}; check [sources.track] object")
+    return df["t_s"].to_numpy(float), df["theta_rad"].to_numpy(float)
+
+
+def _measure_video(cfg: ExperimentConfig, progress: bool):
+    from ..tracking import load_track_config, track_video
+
+    tcfg = load_track_config(cfg.video.track_config) if cfg.video.track_config else None
+    tr = track_video(cfg.video.path, tcfg, fps=cfg.video.fps, progress=progress)
+    df = tr.to_frame()
+    sel = df[df["object"] == cfg.video.object]
+    if sel.empty:
+        raise InputError(f"{cfg.path}: [sources.video] object {cfg.video.object!r} was never tracked in "
+                         f"{cfg.video.path.name}; objects seen: {sorted(set(df['object']))}")
+    table = None
+    if cfg.table.source == "video":
+        tm = tr.table_motion(cfg.table.object)
+        table = {"t_s": np.asarray(tm.t_s), "disp_m": np.asarray(tm.disp_m),
+                 "vel_m_s": np.asarray(tm.vel_m_s), "acc_m_s2": np.asarray(tm.acc_m_s2)}
+    return (sel["t_s"].to_numpy(float), sel["theta_rad"].to_numpy(float)), table, tr
+
+
+def _measure_imu(cfg: ExperimentConfig):
+    from ..tracking import block_rotation, read_imu
+
+    log = read_imu(cfg.imu.path, rate_hz=cfg.imu.rate_hz)
+    axis = None if cfg.imu.axis == "auto" else cfg.imu.axis
+    rot = block_rotation(log, axis=axis)
+    return (np.asarray(rot.t_s, float), np.asarray(rot.theta_rad, float)), rot
+
+
+def _table_from_imu(cfg: ExperimentConfig):
+    from ..tracking import read_imu, table_acceleration
+
+    log = read_imu(cfg.table.imu)
+    ta = table_acceleration(log)
+    return {"t_s": np.asarray(ta.t_s, float), "acc_m_s2": np.asarray(ta.acc_m_s2, float)}
+
+
+def _sync(video, imu, max_offset_s):
+    from ..tracking import sync_offset
+
+    s = sync_offset(video[0], video[1], imu[0], imu[1], max_offset_s=max_offset_s)
+    return s
+
+
+def analyse_experiment(cfg: ExperimentConfig, progress: bool = False) -> ExperimentResult:
+    """Run every stage of one experiment in memory (no files written)."""
+    msgs: list[str] = []
+    timings: dict[str, float] = {}
+    measured: dict = {}
+    table = None
+    tr = None
+    t0 = time.perf_counter()
+    if cfg.video is not None:
+        measured["video"], table, tr = _measure_video(cfg, progress)
+        timings["track_s"] = time.perf_counter() - t0
+    if cfg.track is not None:
+        measured["track"] = _read_track_csv(cfg.track.path, cfg.track.object)
+    rot = None
+    if cfg.imu is not None:
+        t1 = time.perf_counter()
+        measured["imu"], rot = _measure_imu(cfg)
+        timings["imu_s"] = time.perf_counter() - t1
+    if cfg.table.source == "imu":
+        table = _table_from_imu(cfg)
+    elif cfg.table.source == "record":
+        from ..models import load_base_motion
+
+        bm = load_base_motion(cfg.table.record, units=cfg.table.units)
+        table = {"t_s": bm.t_s, "acc_m_s2": bm.acc_m_s2}
+
+    sync = None
+    residual = None
+    if "imu" in measured and ("video" in measured or "track" in measured) and cfg.sync_method == "xcorr":
+        ref = measured.get("video") or measured.get("track")
+        s = _sync(ref, measured["imu"], cfg.max_offset_s)
+        sync = s.to_dict() if hasattr(s, "to_dict") else dict(s)
+        ti, thi = measured["imu"]
+        measured["imu"] = (s.apply(ti) if hasattr(s, "apply") else ti + sync["offset_s"], thi)
+        tv, thv = ref
+        thi_on_v = np.interp(tv, measured["imu"][0], thi, left=np.nan, right=np.nan)
+        residual = (tv, thv - thi_on_v)
+
+    block = cfg.block()
+    prim = measured[cfg.primary]
+    fit_d = None
+    per_imp = np.empty(0)
+    sims: dict = {}
+    status = "ok"
+    if cfg.fit_restitution:
+        from ..fitting import fit_restitution
+
+        t2 = time.perf_counter()
+        fit = fit_restitution(prim[0], prim[1], block, window=cfg.fit_window)
+        timings["fit_s"] = time.perf_counter() - t2
+        fit_d = fit.to_dict()
+        per_imp = np.asarray(fit_d.get("per_impact_eta") or [], float)
+        if fit_d.get("status") != "ok":
+            status = "partial"
+            msgs.append(f"restitution fit {fit_d.get('status')}: {fit_d.get('message')}")
+    t3 = time.perf_counter()
+    sims = _simulate_laws(cfg, block, prim, fit_d, table, msgs)
+    timings["simulate_s"] = time.perf_counter() - t3
+
+    truth = None
+    if cfg.truth is not None:
+        truth = _truth(cfg, prim, msgs)
+    return ExperimentResult(name=cfg.name, config=cfg, block=block, measured=measured,
+                            primary=cfg.primary, sync=sync, video_imu_residual=residual, fit=fit_d,
+                            per_impact_eta=per_imp, simulations=sims, table=table, truth=truth,
+                            status=status, messages=msgs, timings_s=timings, frames=tr)
+
+
+def _eta_for_law(law, cfg, block, fit_d, msgs):
+    if law == "housner":
+        return block.eta_H
+    if law in ("eta_e", "eta_e_first"):
+        key = "eta_e" if law == "eta_e" else "eta_e_first"
+        v = (fit_d or {}).get(key)
+        return float(v) if v is not None and np.isfinite(v) else None
+    if law == "modified":
+        from ..fitting import eta_M, k_edge, predict_k
+
+        if cfg.k is not None:
+            k = cfg.k
+        elif cfg.contact == "edge":
+            k = k_edge(cfg.b_m, cfg.l_c_m)
+        else:
+            pk = predict_k(cfg.h_m / cfg.b_m, cfg.b_m)
+            k = pk.k
+            if getattr(pk, "extrapolated", False):
+                msgs.append(f"k = {k:.3f} from the Eq. 19 regression is extrapolated for this block")
+        return float(eta_M(block.alpha_rad, k))
+    raise AssertionError(law)
+
+
+def _simulate_laws(cfg, block, prim, fit_d, table, msgs) -> dict:
+    from ..models import BaseMotion, simulate
+
+    t_meas, th_meas = prim
+    ok = np.isfinite(th_meas)
+    if fit_d and np.isfinite(fit_d.get("theta0_rad") or np.nan):
+        theta0, t_rel = float(fit_d["theta0_rad"]), float(fit_d["release_t_s"])
+    else:  # no fit: release at the first sample, θ0 measured there
+        theta0, t_rel = float(th_meas[ok][0]), float(t_meas[ok][0])
+    dur = cfg.duration_s or float(np.nanmax(t_meas) - t_rel)
+    base = None
+    if table is not None and "acc_m_s2" in table:
+        tt = np.asarray(table["t_s"], float)
+        aa = np.nan_to_num(np.asarray(table["acc_m_s2"], float))
+        dt = float(np.median(np.diff(tt)))
+        base = BaseMotion.from_samples(aa, dt, t0_s=float(tt[0]) - t_rel, units="m/s2", name="table")
+    sims = {}
+    for law in cfg.laws:
+        eta = _eta_for_law(law, cfg, block, fit_d, msgs)
+        if eta is None:
+            msgs.append(f"simulation with {law} skipped: no fitted value")
+            continue
+        if abs(theta0) >= block.alpha_rad:
+            msgs.append(f"simulation skipped: θ0 = {theta0:.4f} rad is not below α")
+            break
+        r = simulate(block, theta0_rad=theta0, duration_s=max(dur, 1e-3), dt_s=1e-4,
+                     restitution="constant", eta=eta, base=base, output_dt_s=1e-3)
+        ts = np.asarray(r.t_s) + t_rel
+        th_on_meas = np.interp(t_meas, ts, np.asarray(r.theta_rad), left=np.nan, right=np.nan)
+        w = ok & (t_meas >= t_rel) & np.isfinite(th_on_meas)
+        rms = float(np.sqrt(np.mean((th_meas[w] - th_on_meas[w]) ** 2))) if w.any() else None
+        imp = r.impacts.copy()
+        imp["t_s"] = imp["t_s"] + t_rel
+        sims[law] = {"t_s": ts, "theta_rad": np.asarray(r.theta_rad), "energy_J": np.asarray(r.energy_J),
+                     "eta": eta, "impacts": imp, "status": r.status, "rms_vs_measured_rad": rms}
+    return sims
+
+
+def _truth(cfg, prim, msgs):
+    import pandas as pd
+
+    df = pd.read_csv(cfg.truth)
+    obj = cfg.video.object if cfg.video else (cfg.track.object if cfg.track else None)
+    if obj is not None and "object" in df.columns:
+        df = df[df["object"] == obj]
+    t, th = df["t_s"].to_numpy(float), df["theta_rad"].to_numpy(float)
+    meas = np.interp(t, prim[0], prim[1], left=np.nan, right=np.nan)
+    err = meas - th
+    sess = cfg.truth.parent / "session.json"
+    eta = None
+    if sess.is_file():
+        meta = json.loads(sess.read_text())
+        eta = meta.get("eta") or meta.get("true_eta")
+        if isinstance(eta, dict):
+            eta = eta.get(obj)
+    return {"t_s": t, "theta_rad": th, "eta": eta,
+            "theta_rms_error_rad": float(np.sqrt(np.nanmean(err ** 2))) if np.isfinite(err).any() else None}
+
+
+# ---------------------------------------------------------------------------
+# outputs
+
+def series_frame(res: ExperimentResult):
+    """All time series on one table: measured sources and simulations on the primary time base."""
+    import pandas as pd
+
+    t, th = res.measured[res.primary]
+    cols = {"t_s": t, f"theta_{res.primary}_rad": th}
+    for name, (tn, thn) in res.measured.items():
+        if name != res.primary:
+            cols[f"theta_{name}_rad"] = np.interp(t, tn, thn, left=np.nan, right=np.nan)
+    for law, s in res.simulations.items():
+        cols[f"theta_sim_{law}_rad"] = np.interp(t, s["t_s"], s["theta_rad"], left=np.nan, right=np.nan)
+    if res.truth is not None:
+        cols["theta_truth_rad"] = np.interp(t, res.truth["t_s"], res.truth["theta_rad"], left=np.nan, right=np.nan)
+    if res.table is not None:
+        for k in ("disp_m", "vel_m_s", "acc_m_s2"):
+            if k in res.table:
+                cols[f"table_{k}"] = np.interp(t, res.table["t_s"], res.table[k], left=np.nan, right=np.nan)
+    return pd.DataFrame(cols)
+
+
+def _summary_md(res: ExperimentResult, figs: dict, rrd: bool) -> str:
+    f = res.fit or {}
+    lines = [f"# {res.name}", "", f"Status: **{res.status}**", "",
+             f"Block: b = {res.block.b_m:.4f} m, h = {res.block.h_m:.4f} m, α = {res.block.alpha_rad:.4f} rad, "
+             f"p = {res.block.p_rad_s:.3f} rad/s, η_H = {res.block.eta_H:.4f}; contact: {res.config.contact}", ""]
+    if f:
+        ci = f.get("ci95_eta_e") or [None, None]
+        lines += [f"η_e = {f.get('eta_e', float('nan')):.4f} (95 % CI {ci[0]} – {ci[1]}), "
+                  f"η'_e = {f.get('eta_e_first')}, θ0 = {f.get('theta0_rad')} rad, "
+                  f"release at {f.get('release_t_s')} s, residual RMS {f.get('rms_residual_rad')} rad", ""]
+    if res.sync:
+        lines += [f"IMU sync: offset {1000 * res.sync.get('offset_s', float('nan')):.2f} ms, "
+                  f"drift {res.sync.get('drift')}, residual {res.sync.get('residual_ms')} ms", ""]
+    lines += ["| simulation | η | RMS vs measured (rad) | impacts |", "|---|---|---|---|"]
+    for law, s in res.simulations.items():
+        rms = s.get("rms_vs_measured_rad")
+        lines.append(f"| {law} | {s['eta']:.4f} | {rms:.5f} | {len(s['impacts'])} |" if rms is not None
+                     else f"| {law} | {s['eta']:.4f} | – | {len(s['impacts'])} |")
+    lines.append("")
+    if res.truth is not None:
+        lines += [f"Synthetic truth: η = {res.truth.get('eta')}, measured θ RMS error "
+                  f"{res.truth.get('theta_rms_error_rad')} rad", ""]
+    for m in res.messages:
+        lines.append(f"- note: {m}")
+    lines += ["", "## Figures", ""] + [f"![{k}](figures/{p.name})" for k, p in figs.items()]
+    lines += ["", "Data: [report.json](report.json), [series.csv](series.csv)"]
+    if rrd:
+        lines += ["", "Visual review: `rerun session.rrd`"]
+    return "\n".join(lines) + "\n"
+
+
+def write_outputs(res: ExperimentResult, out_dir: Path, fp: str, *, spawn=False, connect=None,
+                  progress=False) -> dict:
+    """Write report.json, series.csv, figures, summary.md and session.rrd into ``out_dir``."""
+    from ._figures import experiment_figures
+    from ._log_experiment import log_experiment
+
+    out_dir.mkdir(parents=True, exist_ok=True)
+    figs = experiment_figures(res, out_dir / "figures") if res.config.figures else {}
+    write_frame_atomic(out_dir / "series.csv", series_frame(res))
+    rrd_rows = None
+    if res.config.rrd or spawn or connect:
+        rrd_path = out_dir / "session.rrd" if res.config.rrd else None
+        rrd_rows = log_experiment(res, rrd_path, spawn=spawn, connect=connect, progress=progress)
+    report = res.to_dict()
+    report["fingerprint"] = fp
+    report["outputs"] = {"figures": {k: f"figures/{p.name}" for k, p in figs.items()},
+                         "series": "series.csv", "rrd": "session.rrd" if res.config.rrd else None,
+                         "rrd_rows": rrd_rows}
+    write_text_atomic(out_dir / "summary.md", _summary_md(res, figs, bool(res.config.rrd)))
+    write_json_atomic(out_dir / "report.json", report)
+    return report
+
+
+def run_experiment(config_path, out_dir, *, force: bool = False, spawn: bool = False,
+                   connect: str | None = None, progress: bool = False) -> tuple[dict, bool]:
+    """Run one experiment and write its outputs into ``out_dir`` atomically.
+
+    Returns
+    -------
+    report : dict
+        The content of ``report.json``.
+    ran : bool
+        False when the inputs and config were unchanged and nothing was done.
+    """
+    cfg = load_experiment(config_path)
+    out_dir = Path(out_dir).resolve()
+    fp = fingerprint(cfg)
+    rep_path = out_dir / "report.json"
+    if not force and rep_path.is_file():
+        try:
+            old = json.loads(rep_path.read_text())
+        except (OSError, json.JSONDecodeError):
+            old = {}
+        if old.get("fingerprint") == fp:
+            return old, False
+    res = analyse_experiment(cfg, progress=progress)
+    out_dir.parent.mkdir(parents=True, exist_ok=True)
+    stage = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.tmp-", dir=out_dir.parent))
+    try:
+        report = write_outputs(res, stage, fp, spawn=spawn, connect=connect, progress=progress)
+        _swap_into_place(stage, out_dir)
+    except BaseException:
+        shutil.rmtree(stage, ignore_errors=True)
+        raise
+    return report, True
+
+
+def _swap_into_place(stage: Path, out_dir: Path) -> None:
+    if out_dir.exists():
+        old = out_dir.with_name(f".{out_dir.name}.old-{int(time.time() * 1e6)}")
+        out_dir.rename(old)
+        stage.rename(out_dir)
+        shutil.rmtree(old, ignore_errors=True)
+    else:
+        stage.rename(out_dir)

@@ -1,0 +1,115 @@
+"""Log one :class:`ExperimentResult` to Rerun (file and/or live viewer)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ._rerun import experiment_blueprint, log_events, log_series, log_video_frames, open_recording
+
+__all__ = ["log_experiment"]
+
+ROOT = "experiment"
+
+
+def _video_frames(path: Path, fps: float | None):
+    import cv2
+
+    cap = cv2.VideoCapture(str(path))
+    if not cap.isOpened():
+        return
+    f = fps or cap.get(cv2.CAP_PROP_FPS) or 0.0
+    i = 0
+    try:
+        while True:
+            ok, img = cap.read()
+            if not ok:
+                break
+            yield i, (i / f if f else float(i)), img
+            i += 1
+    finally:
+        cap.release()
+
+
+def _overlay_fn(res):
+    """Per-frame overlays from the tracker (target points, block outline) plus a θ label."""
+    tr = res.frames
+    t, th = res.measured.get("video", (None, None))
+    get = getattr(tr, "overlay", None) if tr is not None else None
+
+    def fn(idx):
+        ov = {}
+        if get is not None:
+            try:
+                ov = dict(get(idx) or {})
+            except (IndexError, KeyError):
+                ov = {}
+        if th is not None and idx < len(th) and np.isfinite(th[idx]):
+            ov["label"] = f"θ = {np.degrees(th[idx]):+.2f}°"
+        return ov
+
+    return fn
+
+
+def log_experiment(res, rrd_path=None, *, spawn: bool = False, connect: str | None = None,
+                   progress: bool = False) -> dict:
+    """Write the experiment to ``rrd_path`` (and/or a live viewer). Returns rows per entity sent."""
+    import rerun as rr
+
+    rec = open_recording("rocklab", rrd_path, spawn=spawn, connect=connect,
+                         recording_id=f"experiment-{res.name}")
+    rows: dict[str, int] = {}
+    blk = f"{ROOT}/block_1"
+    b = res.block
+    rec.log(f"{ROOT}/geometry", rr.TextDocument(
+        f"block {b.name}: b = {b.b_m} m, h = {b.h_m} m, alpha = {b.alpha_rad:.5f} rad, "
+        f"R = {b.R_m:.5f} m, p = {b.p_rad_s:.4f} rad/s, eta_H = {b.eta_H:.4f}; "
+        f"contact {res.config.contact}", media_type="text/markdown"), static=True)
+
+    for name, (t, th) in res.measured.items():
+        rows[f"{blk}/theta/measured_{name}"] = log_series(rec, f"{blk}/theta/measured_{name}", t, th,
+                                                          name=f"measured ({name})")
+    for law, s in res.simulations.items():
+        p = f"{blk}/theta/sim_{law}"
+        rows[p] = log_series(rec, p, s["t_s"], s["theta_rad"], name=f"sim {law} η={s['eta']:.3f}")
+        rows[f"{blk}/energy/sim_{law}"] = log_series(rec, f"{blk}/energy/sim_{law}", s["t_s"], s["energy_J"])
+    if res.truth is not None:
+        rows[f"{blk}/theta/truth"] = log_series(rec, f"{blk}/theta/truth", res.truth["t_s"],
+                                                res.truth["theta_rad"], name="truth")
+    if res.video_imu_residual is not None:
+        rows[f"{blk}/residual/video_minus_imu"] = log_series(
+            rec, f"{blk}/residual/video_minus_imu", *res.video_imu_residual)
+    t_p, th_p = res.measured[res.primary]
+    for law, s in res.simulations.items():
+        sim_on = np.interp(t_p, s["t_s"], s["theta_rad"], left=np.nan, right=np.nan)
+        rows[f"{blk}/residual/measured_minus_sim_{law}"] = log_series(
+            rec, f"{blk}/residual/measured_minus_sim_{law}", t_p, th_p - sim_on)
+    ref = res.simulations.get("eta_e") or next(iter(res.simulations.values()), None)
+    if ref is not None and len(ref["impacts"]):
+        imp = ref["impacts"]
+        txt = [f"impact {i + 1}: ω⁻ = {a:+.3f} rad/s → ω⁺ = {c:+.3f} rad/s (η = {e:.3f})"
+               for i, (a, c, e) in enumerate(zip(imp["omega_before_rad_s"], imp["omega_after_rad_s"], imp["eta"]))]
+        log_events(rec, f"{blk}/impacts", imp["t_s"].to_numpy(float), txt, values=np.zeros(len(imp)))
+        rows[f"{blk}/impacts"] = len(imp)
+    if res.table is not None:
+        for k in ("disp_m", "vel_m_s", "acc_m_s2"):
+            if k in res.table:
+                rows[f"{ROOT}/table/{k}"] = log_series(rec, f"{ROOT}/table/{k}", res.table["t_s"], res.table[k])
+
+    has_video = res.config.video is not None
+    if has_video:
+        bar = None
+        if progress:
+            from tqdm import tqdm
+
+            bar = tqdm(desc="rerun: video frames", unit="frame", leave=False)
+        rows[f"{ROOT}/video"] = log_video_frames(
+            rec, f"{ROOT}/video", _video_frames(res.config.video.path, res.config.video.fps),
+            decimation=res.config.video_decimation, overlays=_overlay_fn(res), progress=bar)
+        if bar is not None:
+            bar.close()
+    rec.send_blueprint(experiment_blueprint([blk], has_video=has_video))
+    rec.flush()
+    rec.disconnect()
+    return rows

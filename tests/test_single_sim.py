@@ -1,0 +1,199 @@
+"""Single-block simulator: integrators agree, laws are applied, closed forms hold."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from rocklab import Block, G, InputError
+from rocklab.models import BaseMotion, simulate
+
+B6M = Block(0.045, 0.2025, name="B6M")
+
+
+@pytest.fixture(scope="module")
+def b6m_pair():
+    a = B6M.alpha_rad
+    nm = simulate(B6M, 0.8 * a, duration_s=6.0, dt_s=1e-4)
+    ev = simulate(B6M, 0.8 * a, duration_s=6.0, dt_s=1e-4, method="event")
+    return nm, ev
+
+
+def test_impact_times_newmark_vs_event(b6m_pair):
+    nm, ev = b6m_pair
+    assert nm.n_impacts >= 20 and ev.n_impacts >= 20
+    d = np.abs(nm.impacts.t_s.to_numpy()[:20] - ev.impacts.t_s.to_numpy()[:20])
+    assert d.max() <= 1e-6
+    # pre-impact velocities agree too (same physics, independent integrators)
+    wb = nm.impacts.omega_before_rad_s.to_numpy()[:20]
+    assert np.allclose(wb, ev.impacts.omega_before_rad_s.to_numpy()[:20], rtol=1e-6)
+    # first impact: quarter period of the nonlinear pendulum-like motion, alternating sides
+    assert np.all(np.sign(wb[:-1]) == -np.sign(wb[1:]))
+
+
+def test_every_impact_applies_housner(b6m_pair):
+    for r in b6m_pair:
+        imp = r.impacts
+        ratio = imp.omega_after_rad_s / imp.omega_before_rad_s
+        assert np.allclose(ratio, B6M.eta_H, rtol=1e-12, atol=0)
+        assert np.allclose(imp.eta, B6M.eta_H)
+
+
+def test_energy_constant_between_impacts_and_drops_by_eta2(b6m_pair):
+    nm, _ = b6m_pair
+    t, E = nm.t_s, nm.energy_J
+    ti = nm.impacts.t_s.to_numpy()[:15]
+    E0 = E[0]
+    # thread-burn release: E(0) = m g R [cos(alpha - theta0) - cos(alpha)]
+    a = B6M.alpha_rad
+    assert E0 == pytest.approx(B6M.mass_kg * G * B6M.R_m * (math.cos(0.2 * a) - math.cos(a)), rel=1e-12)
+    edges = np.concatenate([[0.0], ti])
+    for k in range(len(ti)):
+        m = (t > edges[k] + 2e-4) & (t < edges[k + 1] - 2e-4)
+        seg = E[m]
+        expect = E0 * B6M.eta_H ** (2 * k)
+        # trapezoidal Newmark conserves energy to O((p dt)^2)
+        assert np.max(np.abs(seg - expect)) <= 1e-6 * E0
+
+
+def test_housner_linearised_period():
+    a = B6M.alpha_rad
+    p = B6M.p_rad_s
+    for f in (0.3, 0.8):
+        r = simulate(B6M, f * a, duration_s=3.0, dt_s=1e-4, restitution="constant", eta=1.0,
+                     linearized=True, stop_at_rest=False)
+        ti = r.impacts.t_s.to_numpy()
+        T = 4.0 / p * math.acosh(1.0 / (1.0 - f))
+        # first impact after a quarter period, then one every half period
+        assert ti[0] == pytest.approx(T / 4, abs=1e-7)
+        assert np.diff(ti) == pytest.approx(np.full(len(ti) - 1, T / 2), abs=2e-7)
+        ev = simulate(B6M, f * a, duration_s=3.0, dt_s=1e-3, restitution="constant", eta=1.0,
+                      linearized=True, stop_at_rest=False, method="event")
+        # the adaptive reference is closer still (Newmark drifts ~(p dt)^2/12 per unit time)
+        tk = T / 4 + T / 2 * np.arange(4)
+        assert ev.impacts.t_s.to_numpy()[:4] == pytest.approx(tk, abs=1e-9)
+
+
+def _pulse(A_g, tp_s, dt_s, T_s):
+    """Rectangular base pulse -A (to the left), samples on the step grid."""
+    n = int(round(T_s / dt_s)) + 1
+    acc = np.zeros(n)
+    k = int(round(tp_s / dt_s))
+    acc[:k] = -A_g  # last nonzero sample at tp - dt: the record ramps to 0 over [tp - dt, tp]
+    return BaseMotion.from_samples(acc, dt_s, "g")
+
+
+def test_rectangular_pulse_linearised_closed_form():
+    blk = Block(0.2, 1.0)
+    a, p = blk.alpha_rad, blk.p_rad_s
+    A, tp, dt = 0.35, 0.15, 1e-4  # A > tan(alpha) = 0.2: uplift at t = 0 towards theta > 0
+    base = _pulse(A, tp, dt, 3.0)
+    r = simulate(blk, 0.0, duration_s=2.5, dt_s=dt, base=base, linearized=True, restitution="constant",
+                 eta=1.0, stop_at_rest=False)
+    # A linear ramp over [tp - dt, tp] equals a sharp end at tp - dt/2 to O(dt^2).
+    te = tp - dt / 2
+    c = A - a
+    during = r.t_s < tp - dt
+    th_exact = c * (np.cosh(p * r.t_s[during]) - 1.0)
+    # trapezoidal rate error ~ (p dt)^2 / 12 ~ 1e-8 of the exponential growth
+    assert np.all(np.abs(r.theta_rad[during] - th_exact) <= 1e-7 * th_exact + 1e-12)
+    psi_p = c * (math.cosh(p * te) - 1.0) - a
+    w_p = c * p * math.sinh(p * te)
+    assert abs(psi_p) > w_p / p  # below the overturning threshold of this pulse
+    th_max = a - math.sqrt(psi_p ** 2 - (w_p / p) ** 2)
+    t_max = te + math.atanh(-w_p / (p * psi_p)) / p
+    k = int(np.argmax(r.theta_rad[r.t_s < 1.5]))
+    assert r.theta_rad[k] == pytest.approx(th_max, abs=1e-6 * a)
+    assert r.t_s[k] == pytest.approx(t_max, abs=2 * dt)
+    assert r.status == "rocking" and not r.overturned and math.isnan(r.overturn_t_s)
+
+
+def test_constant_push_overturns_at_closed_form_time():
+    blk = Block(0.2, 1.0)
+    a, p = blk.alpha_rad, blk.p_rad_s
+    A = 0.3
+    base = BaseMotion.from_samples(np.full(40001, -A), 1e-4, "g")
+    for method in ("newmark", "event"):
+        r = simulate(blk, 0.0, duration_s=4.0, dt_s=1e-4, base=base, linearized=True, method=method)
+        t_over = math.acosh(A / (A - a)) / p  # theta = alpha when cosh(pt) = A/(A - alpha)
+        assert r.overturn_t_s == pytest.approx(t_over, abs=1e-6 if method == "event" else 2e-5)
+        assert r.overturned and r.status == "overturned"
+        assert r.fall_t_s > r.overturn_t_s
+
+
+@pytest.mark.parametrize("sign", [1.0, -1.0])
+def test_uplift_direction_and_threshold(sign):
+    blk = Block(0.2, 1.0)  # tan(alpha) = 0.2
+    dt = 1e-3
+    acc = np.zeros(2001)
+    acc[100:300] = sign * 0.25  # above uplift: block rotates away from the push
+    base = BaseMotion.from_samples(acc, dt, "g")
+    r = simulate(blk, 0.0, duration_s=2.0, dt_s=1e-4, base=base)
+    moved = np.flatnonzero(np.abs(r.theta_rad) > 1e-9)
+    assert r.t_s[moved[0]] == pytest.approx(0.099, abs=2e-3)  # record ramps up over [0.099, 0.1]
+    # a_g > 0 (base pushed to +x) tips the block onto corner B: theta < 0
+    assert np.sign(r.theta_rad[moved[0]]) == -sign
+    below = simulate(blk, 0.0, duration_s=2.0, dt_s=1e-4,
+                     base=BaseMotion.from_samples(acc * 0.19 / 0.25, dt, "g"))
+    assert below.status == "no_uplift" and below.max_abs_theta_rad == 0.0
+
+
+def test_post_impact_patterns():
+    a = B6M.alpha_rad
+    still = simulate(B6M, 0.5 * a, duration_s=2.0, restitution="constant", eta=0.0)
+    assert still.n_impacts == 1 and still.status == "rest"
+    assert still.impacts.omega_after_rad_s.iloc[0] == 0.0
+    back = simulate(B6M, 0.5 * a, duration_s=2.0, restitution="constant", eta=-0.5)
+    # bouncing back: theta stays >= 0, omega flips sign at each impact
+    assert back.n_impacts > 3 and np.all(back.theta_rad >= -1e-15)
+    w = back.impacts
+    assert np.all(w.omega_after_rad_s > 0) and np.all(w.omega_before_rad_s < 0)
+    stocky = Block(0.3, 0.2)  # h/b < 1/sqrt(2): Housner eta < 0
+    assert stocky.eta_H < 0
+    r = simulate(stocky, 0.3 * stocky.alpha_rad, duration_s=1.0)
+    assert np.all(r.theta_rad >= -1e-15) and r.impacts.eta.iloc[0] == pytest.approx(stocky.eta_H)
+
+
+def test_per_impact_eta_table_applied_in_both_methods():
+    a = B6M.alpha_rad
+    table = [0.9, 0.8, 0.95, 0.7]
+    for method in ("newmark", "event"):
+        r = simulate(B6M, 0.6 * a, duration_s=3.0, restitution="per_impact", eta=table, method=method)
+        ratio = (r.impacts.omega_after_rad_s / r.impacts.omega_before_rad_s).to_numpy()
+        expect = np.array(table + [0.7] * (len(ratio) - 4))
+        assert ratio == pytest.approx(expect, rel=1e-12)
+
+
+def test_eta_function_of_velocity():
+    a = B6M.alpha_rad
+    r = simulate(B6M, 0.6 * a, duration_s=3.0, restitution="per_impact",
+                 omega_rad_s=[0.0, 2.0], eta=[0.6, 0.99])
+    wb = np.abs(r.impacts.omega_before_rad_s.to_numpy())
+    assert r.impacts.eta.to_numpy() == pytest.approx(0.6 + 0.39 * wb / 2.0, rel=1e-12)
+
+
+def test_rest_and_output_fields(b6m_pair):
+    nm, ev = b6m_pair
+    assert nm.status == ev.status == "rest"
+    # Housner free rocking: impacts accumulate geometrically, total time converges
+    assert nm.t_s[-1] == pytest.approx(ev.t_s[-1], abs=2e-4)
+    assert nm.theta_rad[-1] == 0.0 and nm.omega_rad_s[-1] == 0.0
+    f = nm.to_frame()
+    assert list(f.columns) == ["t_s", "theta_rad", "omega_rad_s", "energy_J"]
+    d = nm.to_dict()
+    assert d["max_abs_theta_over_alpha"] == pytest.approx(0.8)
+    assert len(d["impacts"]) == nm.n_impacts
+
+
+@pytest.mark.parametrize("kw", [
+    {"theta0_rad": 0.3}, {"theta0_rad": -0.3}, {"theta0_rad": float("nan")}, {"dt_s": 0.0},
+    {"duration_s": -1.0}, {"restitution": "nope"}, {"method": "rk4"},
+    {"restitution": "constant", "eta": 1.5}, {"restitution": "constant"},
+    {"restitution": "modified", "k": 2.0}, {"base": np.zeros(10)},
+])
+def test_bad_input_raises_one_line(kw):
+    with pytest.raises(InputError) as e:
+        simulate(B6M, **({"theta0_rad": 0.05} | kw))
+    assert "\n" not in str(e.value)

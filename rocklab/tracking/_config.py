@@ -195,15 +195,16 @@ class MotionConfig:
     ----------
     sg_window_s : float or None
         Savitzky-Golay window (s); ``None`` chooses it from the noise.
-    sg_polyorder : int
-        Savitzky-Golay polynomial order (>= 2 for acceleration).
+    sg_polyorder : int or None
+        Savitzky-Golay polynomial order (>= 2 for acceleration); ``None``
+        chooses it with the window (3 when only the window is given).
     interpolate_max_gap_frames : int
         Fill NaN gaps up to this many frames by interpolation (status
         ``"interpolated"``); 0 (default) never invents samples.
     """
 
     sg_window_s: float | None = None
-    sg_polyorder: int = 3
+    sg_polyorder: int | None = None
     interpolate_max_gap_frames: int = 0
 
 
@@ -230,6 +231,8 @@ class ObjectConfig:
         Block outline width and height (m), for ``edges`` (gives the scale).
     theta0_rad : float or None
         Object angle at the first frame for ``edges``/``region`` (default 0).
+    marker_size_m : float or None
+        This object's marker side (m) when it differs from ``targets.marker_size_m``.
     """
 
     id: str
@@ -240,6 +243,7 @@ class ObjectConfig:
     roi: tuple | None = None
     size_m: tuple | None = None
     theta0_rad: float | None = None
+    marker_size_m: float | None = None
 
 
 @dataclass(frozen=True)
@@ -458,7 +462,7 @@ class _Parser:
             # No table to level from: fall back to the image rows (documented).
             reference = dataclasses.replace(reference, level="none")
         if targets.style in ("aruco", "apriltag") and targets.marker_size_m is None and \
-                reference.m_per_px is None and reference.homography is None and reference.board is None:
+                any(o.marker_size_m is None for o in objects) and reference.m_per_px is None and reference.homography is None and reference.board is None:
             self.err("targets", "marker_size_m", "needed for the scale (or give reference.m_per_px, "
                      "reference.homography or [reference.board])")
         return TrackConfig(objects=objects, video=video, targets=targets, reference=reference,
@@ -536,8 +540,8 @@ class _Parser:
     def motion(self, d):
         s = "motion"
         self._take(d, s, MotionConfig)
-        order = self.num(d.get("sg_polyorder", 3), s, "sg_polyorder", integer=True, allow_none=False)
-        if order < 2:
+        order = self.num(d.get("sg_polyorder"), s, "sg_polyorder", integer=True)
+        if order is not None and order < 2:
             self.err(s, "sg_polyorder", "must be >= 2 so acceleration is defined")
         gap = self.num(d.get("interpolate_max_gap_frames", 0), s, "interpolate_max_gap_frames",
                        integer=True, allow_none=False)
@@ -577,4 +581,6 @@ class _Parser:
             self.err(s, "roi", f"style {style!r} needs roi = [u, v, width, height] (px, first frame)", i)
         return ObjectConfig(id=oid, kind=kind, markers=markers, marker_positions_m=mpos, dots=dots,
                             roi=roi, size_m=size,
-                            theta0_rad=self.num(d.get("theta0_rad"), s, "theta0_rad", i))
+                            theta0_rad=self.num(d.get("theta0_rad"), s, "theta0_rad", i),
+                            marker_size_m=self.num(d.get("marker_size_m"), s, "marker_size_m", i,
+                                                   positive=True))

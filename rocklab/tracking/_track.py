@@ -1,0 +1,427 @@
+"""Video tracking core: a streaming per-frame tracker and the file wrapper.
+
+:func:`track_frames` works on any iterator of grey images and yields, per
+frame, one :class:`Observation` per object in *plane units* (pixels about the
+image centre, y up, or metres with a homography). :func:`assemble_tracks`
+turns them into metres and a levelled angle once, at the end, where the scale
+(median over all frames) and the level (median table angle) are known.
+:func:`track_video` is the thin file wrapper.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .._errors import InputError
+from ._config import TrackConfig
+from ._geometry import PlaneMap, board_homography, fit_similarity, load_calibration
+from ._motion import TableMotion, table_motion
+
+__all__ = ["Observation", "ObjectTrack", "TrackResult", "track_frames", "assemble_tracks",
+           "track_video", "make_plane_map", "TRACK_COLUMNS"]
+
+TRACK_COLUMNS = ("frame", "t_s", "object", "x_m", "y_m", "theta_rad", "sigma_theta_rad",
+                 "quality", "status")
+#: Largest believable rotation between consecutive frames (rad); bigger steps are outliers.
+MAX_STEP_RAD = 0.35
+#: A lost target whose window's sharpness fell below this fraction of the last good one is "blur".
+BLUR_RATIO = 0.35
+
+
+@dataclass(frozen=True, slots=True)
+class Observation:
+    """One object in one frame, in plane units (before scale and levelling).
+
+    Attributes
+    ----------
+    frame : int
+    object : str
+    X, Y : float
+        Object-frame origin in the plane (px about the image centre, y up; or m).
+    theta_rad : float
+        Counter-clockwise angle in the (unlevelled) plane.
+    sigma_theta_rad : float
+    scale : float
+        Plane units per object unit (px/m for metric targets).
+    rms : float
+        Fit residual per coordinate, plane units.
+    quality : float
+        0..1: fraction of expected points found / (1 + residual / (0.2 % of the point spread)).
+    status : str
+        "ok" or the reason the values are NaN ("lost", "blur", "low_quality").
+    metric : bool
+        Whether ``scale`` is plane units per metre.
+    """
+
+    frame: int
+    object: str
+    X: float
+    Y: float
+    theta_rad: float
+    sigma_theta_rad: float
+    scale: float
+    rms: float
+    quality: float
+    status: str
+    metric: bool = True
+
+
+def make_plane_map(config: TrackConfig, width_px: int, height_px: int, first_gray=None) -> PlaneMap:
+    """The image -> plane mapping the config asks for (lens model, homography or board)."""
+    v = config.video
+    K, dist = v.camera_matrix, v.dist_coeffs
+    if v.calibration:
+        K, dist = load_calibration(v.calibration)
+    H = config.reference.homography
+    pm = PlaneMap(width_px, height_px, K, dist, H)
+    if H is None and config.reference.board is not None:
+        if first_gray is None:
+            raise InputError("reference.board: needs the board frame; use track_video")
+        pm = PlaneMap(width_px, height_px, K, dist, board_homography(first_gray, config.reference.board, pm))
+    return pm
+
+
+def _make_detector(config, pm, first_gray):
+    style = config.targets.style
+    if style in ("aruco", "apriltag"):
+        from ._aruco import ArucoDetector
+
+        return ArucoDetector(config, pm)
+    if style == "dots":
+        from ._dots import DotDetector
+
+        return DotDetector(config, pm, first_gray)
+    if style == "edges":
+        from ._edges import EdgeDetector
+
+        return EdgeDetector(config, pm, first_gray)
+    from ._region import RegionDetector
+
+    return RegionDetector(config, pm, first_gray)
+
+
+def _sharpness(gray, box):
+    import cv2
+
+    x0, y0, x1, y1 = box
+    crop = gray[y0:y1, x0:x1]
+    if crop.size < 64:
+        return np.nan
+    return float(cv2.Laplacian(crop, cv2.CV_32F).var())
+
+
+def track_frames(frames, config: TrackConfig, plane_map: PlaneMap | None = None):
+    """Track every configured object through a stream of frames.
+
+    Parameters
+    ----------
+    frames : iterable of (index, gray) or of gray images
+        Grey uint8 images, shape (height, width); bare images are numbered from 0.
+    config : TrackConfig
+    plane_map : PlaneMap, optional
+        Default: built from ``config`` and the first frame.
+
+    Yields
+    ------
+    list of Observation
+        One per object (config order) for each frame.
+    """
+    det = None
+    min_q = config.targets.min_quality
+    boxes, sharp_ref = {}, {}
+    for k, item in enumerate(frames):
+        idx, gray = item if isinstance(item, tuple) else (k, item)
+        if gray.ndim != 2:
+            raise InputError("track_frames: frames must be grey images of shape (height, width)")
+        if det is None:
+            if plane_map is None:
+                plane_map = make_plane_map(config, gray.shape[1], gray.shape[0], gray)
+            det = _make_detector(config, plane_map, gray)
+        dets = det.detect(gray, idx)
+        obs = []
+        for o in config.objects:
+            d = dets.get(o.id)
+            if d is not None and len(d.img_pts) >= 2:
+                q = plane_map.to_plane(d.img_pts)
+                f = fit_similarity(d.obj_pts, q)
+                spread = math.sqrt(np.sum((q - q.mean(0)) ** 2) / len(q))
+                qual = (len(q) / d.n_expected) / (1.0 + f.rms / (0.002 * spread + 1e-12))
+                if qual < min_q:
+                    obs.append(Observation(idx, o.id, *(np.nan,) * 4, f.scale, f.rms, qual,
+                                           "low_quality", d.metric))
+                    continue
+                obs.append(Observation(idx, o.id, float(f.t[0]), float(f.t[1]), f.theta_rad,
+                                       f.sigma_theta_rad, f.scale, f.rms, qual, "ok", d.metric))
+                u, v = d.img_pts[:, 0], d.img_pts[:, 1]
+                box = (int(max(u.min(), 0)), int(max(v.min(), 0)), int(u.max()) + 1, int(v.max()) + 1)
+                boxes[o.id] = box
+                if o.id not in sharp_ref or k % 25 == 0:
+                    sharp_ref[o.id] = _sharpness(gray, box)
+            else:
+                status = "lost"
+                if o.id in boxes:
+                    s = _sharpness(gray, boxes[o.id])
+                    if s < BLUR_RATIO * sharp_ref.get(o.id, np.nan):
+                        status = "blur"
+                obs.append(Observation(idx, o.id, *(np.nan,) * 7, status,
+                                       getattr(d, "metric", True)))
+        yield obs
+
+
+@dataclass(frozen=True)
+class ObjectTrack:
+    """One object's samples on the frame grid (metres, levelled radians).
+
+    Attributes
+    ----------
+    object, kind : str
+    frame : ndarray (n,) int
+    t_s : ndarray (n,)
+    x_m, y_m : ndarray (n,)
+        Object origin in the world plane (x right, y up), m.
+    theta_rad, sigma_theta_rad : ndarray (n,)
+        Levelled counter-clockwise angle and its 1-σ uncertainty.
+    quality : ndarray (n,)
+    status : ndarray (n,) of str
+    m_per_unit : float
+        Metres per plane unit used for this object.
+    """
+
+    object: str
+    kind: str
+    frame: np.ndarray
+    t_s: np.ndarray
+    x_m: np.ndarray
+    y_m: np.ndarray
+    theta_rad: np.ndarray
+    sigma_theta_rad: np.ndarray
+    quality: np.ndarray
+    status: np.ndarray
+    m_per_unit: float
+
+    @property
+    def ok(self) -> np.ndarray:
+        return self.status == "ok"
+
+
+@dataclass(frozen=True)
+class TrackResult:
+    """Tracks of every object of one video.
+
+    Attributes
+    ----------
+    tracks : tuple of ObjectTrack
+    fps : float
+    level_rad : float
+        Camera roll removed from every angle (rad, counter-clockwise).
+    n_frames : int
+    width_px, height_px : int
+    source : str or None
+    config : TrackConfig
+    """
+
+    tracks: tuple
+    fps: float
+    level_rad: float
+    n_frames: int
+    width_px: int
+    height_px: int
+    source: str | None
+    config: TrackConfig = field(repr=False)
+
+    def __getitem__(self, oid: str) -> ObjectTrack:
+        for t in self.tracks:
+            if t.object == oid:
+                return t
+        raise KeyError(oid)
+
+    @property
+    def objects(self) -> tuple:
+        return tuple(t.object for t in self.tracks)
+
+    def to_frame(self):
+        """Long table with :data:`TRACK_COLUMNS` (the ``tracks.csv`` layout)."""
+        import pandas as pd
+
+        parts = [pd.DataFrame({"frame": t.frame, "t_s": t.t_s, "object": t.object, "x_m": t.x_m,
+                               "y_m": t.y_m, "theta_rad": t.theta_rad,
+                               "sigma_theta_rad": t.sigma_theta_rad, "quality": t.quality,
+                               "status": t.status}) for t in self.tracks]
+        df = pd.concat(parts, ignore_index=True)
+        return df.sort_values(["frame", "object"], kind="stable").reset_index(drop=True)
+
+    def table_motion(self, object: str | None = None, window_s: float | None = None,
+                     polyorder: int | None = None) -> TableMotion:
+        """Table displacement/velocity/acceleration (x, m; SG derivatives; window from the noise)."""
+        if object is None:
+            tab = self.config.table
+            if tab is None:
+                raise InputError("no object of kind 'table' in the tracking config; name one")
+            object = tab.id
+        tr = self[object]
+        m = self.config.motion
+        return table_motion(tr.t_s, tr.x_m, window_s if window_s is not None else m.sg_window_s,
+                            polyorder if polyorder is not None else m.sg_polyorder, object)
+
+    def to_dict(self) -> dict:
+        per = {}
+        for t in self.tracks:
+            st, cnt = np.unique(t.status, return_counts=True)
+            per[t.object] = {"kind": t.kind, "n_ok": int(np.sum(t.ok)), "m_per_unit": t.m_per_unit,
+                             "status_counts": {str(a): int(b) for a, b in zip(st, cnt)},
+                             "median_sigma_theta_rad": float(np.nanmedian(t.sigma_theta_rad))
+                             if np.any(t.ok) else np.nan}
+        return {"source": self.source, "fps": self.fps, "n_frames": self.n_frames,
+                "width_px": self.width_px, "height_px": self.height_px,
+                "level_rad": self.level_rad, "objects": per}
+
+
+def _interpolate(arrs, status, max_gap):
+    ok = status == "ok"
+    idx = np.flatnonzero(ok)
+    if len(idx) < 2:
+        return
+    for a, b in zip(idx[:-1], idx[1:]):
+        if 1 < b - a <= max_gap + 1:
+            for arr in arrs:
+                arr[a + 1:b] = np.interp(np.arange(a + 1, b), [a, b], [arr[a], arr[b]])
+            status[a + 1:b] = "interpolated"
+
+
+def assemble_tracks(observations, config: TrackConfig, fps: float, width_px: int, height_px: int,
+                    plane_map: PlaneMap | None = None, source=None) -> TrackResult:
+    """Convert per-frame observations (plane units) into a :class:`TrackResult` (m, levelled rad).
+
+    Parameters
+    ----------
+    observations : iterable of list of Observation
+        As yielded by :func:`track_frames`.
+    fps : float
+        Frame rate; ``t_s = frame / fps``.
+    """
+    rows = [o for frame_obs in observations for o in frame_obs]
+    if not rows:
+        raise InputError(f"{source or 'video'}: no frames to track; check the file or the frame range")
+    metric_plane = plane_map is not None and plane_map.metric
+    by = {o.id: [r for r in rows if r.object == o.id] for o in config.objects}
+    frames = np.array(sorted({r.frame for r in rows}), int)
+    pos = {f: i for i, f in enumerate(frames)}
+    n = len(frames)
+    raw = {}
+    for o in config.objects:
+        a = {k: np.full(n, np.nan) for k in ("X", "Y", "th", "sig", "scale", "q")}
+        st = np.full(n, "lost", dtype=object)
+        metric = True
+        for r in by[o.id]:
+            i = pos[r.frame]
+            a["X"][i], a["Y"][i], a["th"][i], a["sig"][i] = r.X, r.Y, r.theta_rad, r.sigma_theta_rad
+            a["scale"][i], a["q"][i] = r.scale, r.quality
+            st[i] = r.status
+            metric = r.metric
+        # An angle step no rocking block makes between frames is a misdetection, not motion.
+        th = a["th"]
+        okk = np.flatnonzero(st == "ok")
+        for j0, j1 in zip(okk[:-1], okk[1:]):
+            if j1 - j0 == 1 and abs(math.remainder(th[j1] - th[j0], 2 * math.pi)) > MAX_STEP_RAD:
+                st[j1] = "outlier"
+        bad = st != "ok"
+        for k in ("X", "Y", "th", "sig"):
+            a[k][bad] = np.nan
+        raw[o.id] = (a, st, metric)
+    unseen = [o.id for o in config.objects if not np.any(raw[o.id][1] == "ok")]
+    if len(unseen) == len(config.objects) or (unseen and n > 1):
+        o = unseen[0]
+        raise InputError(f"{config.source or 'config'}: object {o!r} is never seen in "
+                         f"{source or 'the video'}; check its markers/dots/roi and the dictionary")
+    # Scale: metres per plane unit, per object (objects may sit at different depths).
+    m_per = {}
+    fallback = config.reference.m_per_px
+    if fallback is None and not metric_plane:
+        metric_scales = [1.0 / np.nanmedian(raw[o.id][0]["scale"][raw[o.id][1] == "ok"])
+                         for o in config.objects if raw[o.id][2]]
+        fallback = float(np.median(metric_scales)) if metric_scales else None
+    for o in config.objects:
+        a, st, metric = raw[o.id]
+        if metric_plane:
+            m_per[o.id] = 1.0
+        elif metric and config.reference.m_per_px is None:
+            m_per[o.id] = 1.0 / float(np.nanmedian(a["scale"][st == "ok"]))
+        elif fallback is not None:
+            m_per[o.id] = float(fallback)
+        else:
+            raise InputError(f"{config.source or 'config'}: no scale for object {o.id!r}; give "
+                             "targets.marker_size_m, objects.size_m or reference.m_per_px")
+    ref = config.reference
+    level = 0.0
+    if ref.level == "value":
+        level = ref.level_rad
+    elif ref.level == "table" and config.table is not None:
+        ta, tst, _ = raw[config.table.id]
+        if np.any(tst == "ok"):
+            level = float(np.nanmedian(ta["th"][tst == "ok"]))
+    c, s = math.cos(-level), math.sin(-level)
+    tracks = []
+    for o in config.objects:
+        a, st, _ = raw[o.id]
+        x = (c * a["X"] - s * a["Y"]) * m_per[o.id]
+        y = (s * a["X"] + c * a["Y"]) * m_per[o.id]
+        th = a["th"] - level
+        sig = a["sig"].copy()
+        q = np.where(st == "ok", a["q"], np.nan)
+        if config.motion.interpolate_max_gap_frames:
+            _interpolate([x, y, th], st, config.motion.interpolate_max_gap_frames)
+        tracks.append(ObjectTrack(o.id, o.kind, frames.copy(), frames / float(fps), x, y, th, sig,
+                                  q, st.astype(str), m_per[o.id]))
+    return TrackResult(tuple(tracks), float(fps), level, n, int(width_px), int(height_px),
+                       None if source is None else str(source), config)
+
+
+def track_video(path, config: TrackConfig, fps: float | None = None, progress: bool = False
+                ) -> TrackResult:
+    """Track a video file.
+
+    Parameters
+    ----------
+    path : path-like
+        Video file (any container OpenCV reads) or image-sequence pattern.
+    config : TrackConfig
+    fps : float, optional
+        Overrides ``config.video.fps`` and the container's rate.
+    progress : bool
+        tqdm progress bar on stderr.
+
+    Raises
+    ------
+    InputError
+        Unreadable/empty video, no frame rate, unknown marker id, an object never seen.
+    """
+    from ._video import iter_video_frames, probe_video
+
+    info = probe_video(path)
+    rate = fps or config.video.fps or info.fps
+    if rate is None:
+        raise InputError(f"{path}: the container has no frame rate; pass --fps N "
+                         "(or set [video] fps in the config)")
+    v = config.video
+    start, stop = v.start_frame, v.stop_frame
+    first = None
+    if config.reference.board is not None:
+        for _, g in iter_video_frames(path, config.reference.board.frame,
+                                      config.reference.board.frame + 1, prefetch=0):
+            first = g
+        if first is None:
+            raise InputError(f"reference.board.frame={config.reference.board.frame}: past the end "
+                             f"of {path}")
+    pm = make_plane_map(config, info.width_px, info.height_px, first)
+    frames = iter_video_frames(path, start, stop)
+    if progress:
+        from tqdm import tqdm
+
+        total = (min(stop, info.n_frames) if stop else info.n_frames) - start
+        frames = tqdm(frames, total=total if total > 0 else None, unit="frame", desc="track",
+                      leave=False)
+    obs = track_frames(frames, config, pm)
+    return assemble_tracks(obs, config, rate, info.width_px, info.height_px, pm, path)

@@ -1,0 +1,357 @@
+"""Block rotation about the rocking axis from an IMU log (offline tilt).
+
+Method (``block_rotation``)
+---------------------------
+1. Motion: a sample moves when, over 50 ms, the gyro norm (minus the median
+   rate of the first 0.5 s) exceeds 2 deg/s or the accelerometer norm departs
+   from gravity by 0.03 g.  The rest window before release is the still
+   stretch before the first motion (>= 0.1 s); the rest window after stop is
+   the still stretch after the last motion.
+2. Gyro bias: mean rate in the rest window before release.
+3. Axis: named by the user (``"y"``, ``"-y"`` ...) or the principal axis of the
+   bias-free rate during motion; an automatic axis is signed so the initial
+   tilt (or, without one, the largest excursion) is positive.
+4. Tilt: integral (trapezoid over the sample times) of the bias-free rate
+   about the axis, anchored to the accelerometer tilt in both rest windows:
+   the angle is zero where the block rests upright at the end (or, without an
+   end rest, where the sensor axis nearest to gravity is vertical); the
+   remaining linear drift (residual bias) is removed so both rest windows
+   match their accelerometer tilt.
+5. Release: the first motion, refined by extrapolating the initial
+   (constant-acceleration) rate ramp back to zero.
+6. Impacts: the block passes theta = 0 with a drop of |omega| and an
+   acceleration spike.  Note: in the rocking model the angular velocity keeps
+   its sign through an impact (omega+ = eta * omega-); it is the *angle* that
+   changes sign.  The impact instant inside a sample comes from the fraction
+   of the sample's mean rate between the extrapolated pre- and post-impact
+   rates.
+7. Optional second estimate: imufusion's AHRS (1.3 API, no magnetometer),
+   its twist about the axis, and the RMS difference to the gyro estimate.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .._errors import InputError
+from ..blocks import G
+from ._imu_motion import (axis_vector, cumtrapz, first_motion, last_motion_end, motion_mask,
+                          quat_mul, tilt_about, twist_angle)
+from ._imu_read import ImuLog
+
+__all__ = ["ImuRotation", "block_rotation", "ahrs_rotation", "ahrs_quaternions"]
+
+
+@dataclass(frozen=True)
+class ImuRotation:
+    """Block rotation about its rocking axis estimated from one IMU.
+
+    Attributes
+    ----------
+    t_s : ndarray (n,)
+        Sample times, s (the log's clock).
+    theta_rad : ndarray (n,)
+        Rotation about the rocking axis, rad; 0 = upright (rest at the end).
+    omega_rad_s : ndarray (n,)
+        Bias-corrected angular rate about the axis, rad/s.
+    acc_m_s2 : ndarray (n, 3)
+        Accelerometer, sensor frame, m/s^2 (copied from the log for export).
+    axis : ndarray (3,)
+        Rocking axis, unit vector in the sensor frame.
+    gyro_bias_rad_s : ndarray (3,)
+        Gyro bias, rad/s: rest-window mean plus the drift correction along the axis.
+    theta0_rad : float
+        Accelerometer tilt in the rest window before release, rad.
+    drift_rad_s : float
+        Residual bias along the axis removed by the two-window anchoring, rad/s.
+    release_t_s : float
+        Release instant, s (NaN if the log shows no rest then motion).
+    impact_t_s : ndarray (k,)
+        Impact instants, s.
+    rest_t_s : float
+        Start of the final rest, s (NaN if still moving at the end).
+    rate_hz, dropped_samples, format, source : from the log.
+    ahrs_theta_rad : ndarray (n,) or None
+        imufusion AHRS estimate about the same axis, rad (``ahrs=True``).
+    ahrs_rms_diff_rad : float
+        RMS of ``ahrs_theta_rad - theta_rad`` from release to rest, rad (NaN without AHRS).
+    status : str
+        ``"ok"``, ``"no_rest_before"`` (bias from the first 0.5 s), ``"no_rest_after"``
+        (drift not anchored at the end) or ``"no_motion"``.
+    message : str
+        Human-readable note on the status.
+    """
+
+    t_s: np.ndarray
+    theta_rad: np.ndarray
+    omega_rad_s: np.ndarray
+    acc_m_s2: np.ndarray
+    axis: np.ndarray
+    gyro_bias_rad_s: np.ndarray
+    theta0_rad: float
+    drift_rad_s: float
+    release_t_s: float
+    impact_t_s: np.ndarray
+    rest_t_s: float
+    rate_hz: float
+    dropped_samples: int = 0
+    format: str = ""
+    source: str = ""
+    ahrs_theta_rad: np.ndarray | None = field(default=None, repr=False)
+    ahrs_rms_diff_rad: float = float("nan")
+    status: str = "ok"
+    message: str = ""
+
+    def to_frame(self):
+        """``t_s, theta_rad, omega_rad_s, acc_{x,y,z}_m_s2`` (+ ``theta_ahrs_rad``)."""
+        import pandas as pd
+
+        d = {"t_s": self.t_s, "theta_rad": self.theta_rad, "omega_rad_s": self.omega_rad_s,
+             "acc_x_m_s2": self.acc_m_s2[:, 0], "acc_y_m_s2": self.acc_m_s2[:, 1],
+             "acc_z_m_s2": self.acc_m_s2[:, 2]}
+        if self.ahrs_theta_rad is not None:
+            d["theta_ahrs_rad"] = self.ahrs_theta_rad
+        return pd.DataFrame(d)
+
+    def to_dict(self) -> dict:
+        """JSON-ready summary (the ``rocklab imu --json`` keys)."""
+        return {"format": self.format, "sample_rate_hz": float(self.rate_hz),
+                "n_samples": int(len(self.t_s)), "dropped_samples": int(self.dropped_samples),
+                "gyro_bias_rad_s": [float(v) for v in self.gyro_bias_rad_s],
+                "axis": [float(v) for v in self.axis],
+                "theta0_rad": float(self.theta0_rad), "drift_rad_s": float(self.drift_rad_s),
+                "release_t_s": float(self.release_t_s),
+                "impact_t_s": [float(v) for v in self.impact_t_s],
+                "rest_t_s": float(self.rest_t_s),
+                "ahrs_rms_diff_rad": float(self.ahrs_rms_diff_rad),
+                "status": self.status, "message": self.message, "source": self.source}
+
+
+def _vertical_axis(f: np.ndarray) -> np.ndarray:
+    k = int(np.argmax(np.abs(f)))
+    v = np.zeros(3)
+    v[k] = np.sign(f[k])
+    return v
+
+
+def block_rotation(log: ImuLog, axis: str | None = None, *, ahrs: bool = False,
+                   still_gyro_deg_s: float = 2.0, still_acc_g: float = 0.03,
+                   min_rest_s: float = 0.1) -> ImuRotation:
+    """Rotation of a rocking block about its rocking axis from its IMU log.
+
+    Parameters
+    ----------
+    log : ImuLog
+        Block IMU samples; the log should start at rest (block held before
+        release) and, for drift anchoring, end at rest.
+    axis : {"x", "y", "z", "-x", "-y", "-z"} or None
+        Rocking axis in the sensor frame; None finds it (principal axis of the
+        rate during motion, signed so the initial tilt is positive).
+    ahrs : bool
+        Also run imufusion's AHRS (slower: a Python loop over samples).
+    still_gyro_deg_s, still_acc_g : float
+        Stillness thresholds (50 ms averages): gyro norm, deg/s; |acc| - g, g.
+    min_rest_s : float
+        Shortest rest window used for bias / anchoring, s.
+
+    Returns
+    -------
+    ImuRotation
+    """
+    n = log.n
+    if n < 8:
+        raise InputError(f"{log.source}: {n} samples; need at least 8 to estimate a rotation")
+    t, gyro, acc, fs = log.t_s, log.gyro_rad_s, log.acc_m_s2, float(log.rate_hz)
+    moving = motion_mask(t, gyro, acc, fs, np.deg2rad(still_gyro_deg_s), still_acc_g * G)
+    min_run = max(2, int(round(0.1 * fs)))
+    i_move = first_motion(moving, min_run)
+    status, msg = "ok", ""
+    if i_move is None:
+        i_move, i_end = n, n
+        status, msg = "no_motion", "no motion found above the stillness thresholds"
+    else:
+        # Decaying rocking fragments the motion mask; the last moving sample ends it.
+        i_end = last_motion_end(moving, 1)
+    # Rest windows (trim 50 ms next to motion: the smoothing widens motion edges).
+    guard = max(1, int(round(0.05 * fs)))
+    min_rest = max(3, int(round(min_rest_s * fs)))
+    s0, s1 = 0, max(0, i_move - guard)
+    if s1 - s0 < min_rest:
+        s0, s1 = 0, max(3, min(n, int(0.5 * fs)))
+        status = "no_rest_before" if status == "ok" else status
+        msg = msg or "no rest before the first motion: bias from the first 0.5 s"
+    e0, e1 = min(n, i_end + guard), n
+    has_end = (e1 - e0) >= min_rest and status != "no_motion"
+    if not has_end and status == "ok":
+        status, msg = "no_rest_after", "still moving at the end: drift not anchored"
+    bias = gyro[s0:s1].mean(axis=0)
+    w = gyro - bias
+    if axis is None:
+        mv = w[moving] if moving.any() else w
+        u = np.linalg.svd(mv - 0.0, full_matrices=False)[2][0]
+    else:
+        u = axis_vector(axis)
+    f_start = acc[s0:s1].mean(axis=0)
+    f_end = acc[e0:e1].mean(axis=0) if has_end else None
+    f_ref = f_end if has_end else _vertical_axis(f_start)
+    omega = w @ u
+    integ = cumtrapz(t, omega)
+    th_start = float(tilt_about(u, f_ref, f_start))
+    ts_mid, is_mean = t[s0:s1].mean(), integ[s0:s1].mean()
+    drift = 0.0
+    if has_end:
+        th_end = float(tilt_about(u, f_ref, f_end))
+        te_mid, ie_mean = t[e0:e1].mean(), integ[e0:e1].mean()
+        drift = ((ie_mean - is_mean) - (th_end - th_start)) / (te_mid - ts_mid)
+    theta = th_start + (integ - is_mean) - drift * (t - ts_mid)
+    omega = omega - drift
+    if axis is None:
+        ref = th_start if abs(th_start) > np.deg2rad(1.0) else theta[np.argmax(np.abs(theta))]
+        if ref < 0:
+            u, theta, omega, th_start, drift = -u, -theta, -omega, -th_start, -drift
+    bias_total = bias + drift * u
+    release = _release_time(t, omega, i_move, s0, s1) if status != "no_motion" else np.nan
+    impacts = (_impacts(t, theta, omega, acc, moving, i_move, i_end, fs)
+               if status != "no_motion" else np.empty(0))
+    rest_t = float(t[e0]) if has_end else np.nan
+    ahrs_theta, ahrs_rms = None, np.nan
+    if ahrs:
+        ahrs_theta = ahrs_rotation(log, u, bias, ref_slice=(e0, e1) if has_end else (s0, s1),
+                                   ref_theta=float(theta[e0:e1].mean() if has_end else th_start))
+        a, b = (i_move, i_end) if status != "no_motion" else (0, n)
+        ahrs_rms = float(np.sqrt(np.mean((ahrs_theta[a:b] - theta[a:b]) ** 2)))
+    return ImuRotation(t, theta, omega, acc, u, bias_total, th_start, float(drift), release,
+                       impacts, rest_t, fs, log.dropped_samples, log.format, log.source,
+                       ahrs_theta, ahrs_rms, status, msg)
+
+
+def _release_time(t, omega, i_move, s0, s1) -> float:
+    """Back-extrapolate the initial rate ramp to zero rate."""
+    sigma = float(np.std(omega[s0:s1])) if s1 - s0 > 2 else 0.0
+    lo = max(4 * sigma, np.deg2rad(0.5))
+    n = len(t)
+    j0 = max(0, i_move - int(0.2 * (n / max(t[-1] - t[0], 1e-9))))
+    seg = np.abs(omega[j0:])
+    above = np.flatnonzero(seg > lo)
+    if above.size == 0:
+        return float(t[i_move])
+    a = j0 + int(above[0])
+    # Fit the ramp until the rate reaches 5x the start level or 40 ms, whichever first.
+    hi = max(5 * lo, np.deg2rad(3.0))
+    b = a + 1
+    while b < n and abs(omega[b]) < hi and t[b] - t[a] < 0.04:
+        b += 1
+    b = min(n, max(b + 1, a + 4))
+    tt, ww = t[a:b], omega[a:b]
+    slope, icpt = np.polyfit(tt - tt[0], ww, 1)
+    if slope == 0 or np.sign(slope) != np.sign(ww[-1]):
+        return float(t[a])
+    tr = tt[0] - icpt / slope
+    return float(np.clip(tr, t[max(0, a - 50)], t[a]))
+
+
+def _impacts(t, theta, omega, acc, moving, i_move, i_end, fs) -> np.ndarray:
+    """Impact instants: theta sign changes marked by an acceleration spike (see module doc).
+
+    The spike is the second difference of the accelerometer vector (an impact
+    changes the mounting point's velocity within one sample); without a clear
+    spike the largest rate step near the crossing is used.
+    """
+    a, b = i_move, min(i_end, len(t) - 1)
+    if b - a < 4:
+        return np.empty(0)
+    th = theta[a:b + 1]
+    cross = a + np.flatnonzero(np.signbit(th[1:]) != np.signbit(th[:-1]))
+    if cross.size == 0:
+        return np.empty(0)
+    n = len(t)
+    spike = np.zeros(n)
+    spike[1:-1] = np.linalg.norm(acc[1:-1] - 0.5 * (acc[:-2] + acc[2:]), axis=1)
+    spike_thr = max(8.0 * float(np.median(spike[a:b])), 0.05 * G)
+    jumps = np.abs(np.diff(omega))
+    jump_thr = max(4.0 * float(np.median(jumps[a:b])), np.deg2rad(0.3))
+    half = max(3, int(round(0.05 * fs)))
+    out: list[float] = []
+    last = -np.inf
+    for c in cross:
+        lo, hi = max(2, c - half), min(n - 3, c + half + 1)
+        if hi <= lo:
+            continue
+        j = lo + int(np.argmax(spike[lo:hi]))
+        if spike[j] >= spike_thr:
+            tk = _subsample(t, omega, j)
+        else:
+            k = lo + int(np.argmax(jumps[lo:hi]))
+            if jumps[k] < jump_thr:
+                continue
+            tk = 0.5 * (t[k] + t[k + 1])
+        if tk - last > 1.5 / fs:
+            out.append(tk)
+            last = tk
+    return np.asarray(out)
+
+
+def _subsample(t, omega, j) -> float:
+    """Impact instant inside sample ``j`` (the one holding the acceleration spike).
+
+    Samples are means over their interval, so the impact sample mixes the
+    pre- and post-impact rates: the share of the pre-impact rate (each side
+    extrapolated linearly from its two neighbours) places the impact inside
+    the interval; clipped to the interval.
+    """
+    wm = omega[j - 1] + (omega[j - 1] - omega[j - 2]) * (t[j] - t[j - 1]) / (t[j - 1] - t[j - 2])
+    wp = omega[j + 1] - (omega[j + 2] - omega[j + 1]) * (t[j + 1] - t[j]) / (t[j + 2] - t[j + 1])
+    dt = 0.5 * (t[j + 1] - t[j - 1])
+    f = 0.5 if wm == wp else float(np.clip((omega[j] - wp) / (wm - wp), 0.0, 1.0))
+    return float(t[j] - 0.5 * dt + f * dt)
+
+
+def ahrs_quaternions(log: ImuLog, bias_rad_s=None, gain: float = 0.5,
+                     acceleration_rejection_deg: float = 10.0) -> np.ndarray:
+    """imufusion AHRS orientation (gyro + accelerometer, no magnetometer), (n, 4) w, x, y, z.
+
+    imufusion 1.3 API: ``Ahrs().set_settings(AhrsSettings(...))`` then
+    ``update_no_magnetometer(gyro_deg_s, acc_g)`` per sample (NWU earth frame;
+    the quaternion turns sensor-frame vectors into earth-frame vectors).
+    Uneven sample spacing is passed on with ``set_sample_period``.
+    """
+    import imufusion
+
+    fs = float(log.rate_hz)
+    ahrs = imufusion.Ahrs()
+    ahrs.set_settings(imufusion.AhrsSettings(
+        sample_rate=fs, convention=imufusion.CONVENTION_NWU, gain=gain,
+        gyroscope_range=2000.0, acceleration_rejection=acceleration_rejection_deg,
+        magnetic_rejection=0.0, rejection_timeout=int(5 * fs)))
+    bias = np.zeros(3) if bias_rad_s is None else np.asarray(bias_rad_s, float)
+    gyro_dps = np.rad2deg(log.gyro_rad_s - bias)
+    acc_g = log.acc_m_s2 / G
+    n = log.n
+    q = np.empty((n, 4))
+    dt = np.diff(log.t_s, prepend=log.t_s[0] - 1.0 / fs)
+    uneven = not np.allclose(dt, 1.0 / fs, rtol=1e-3)
+    for i in range(n):
+        if uneven:
+            ahrs.set_sample_period(float(dt[i]))
+        ahrs.update_no_magnetometer(gyro_dps[i], acc_g[i])
+        q[i] = ahrs.get_quaternion()
+    return q
+
+
+def ahrs_rotation(log: ImuLog, u: np.ndarray, bias: np.ndarray, ref_slice: tuple[int, int],
+                  ref_theta: float = 0.0, gain: float = 0.5,
+                  acceleration_rejection_deg: float = 10.0) -> np.ndarray:
+    """imufusion AHRS estimate of the rotation about ``u``, rad (n,).
+
+    The AHRS quaternion is made relative to its mean over ``ref_slice`` and
+    the twist about ``u`` is taken (swing-twist), then offset by ``ref_theta``.
+    """
+    q = ahrs_quaternions(log, bias, gain, acceleration_rejection_deg)
+    a, b = ref_slice
+    qr = q[a:b].mean(axis=0)
+    qr /= np.linalg.norm(qr)
+    conj = qr * np.array([1, -1, -1, -1])
+    rel = quat_mul(conj[None, :], q)
+    return twist_angle(rel, u) + ref_theta

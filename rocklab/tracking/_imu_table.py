@@ -1,0 +1,143 @@
+"""Shake-table IMU: base acceleration along the shaking direction, gravity removed.
+
+Method (``table_acceleration``): the rest window before shaking (still
+stretch before the first motion, same thresholds as ``block_rotation``) gives
+the gravity direction in the sensor frame.  The smallest rotation taking it to
+vertical corrects a mis-mounted (tilted) sensor; gravity is subtracted; the
+named sensor axis, turned by that rotation and projected on the horizontal
+plane, is the shaking direction (or the principal horizontal direction of the
+acceleration during motion).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .._errors import InputError
+from ..blocks import G
+from ._imu_motion import axis_vector, first_motion, motion_mask, rotation_between
+from ._imu_read import ImuLog
+
+__all__ = ["TableAcceleration", "table_acceleration"]
+
+
+@dataclass(frozen=True)
+class TableAcceleration:
+    """Table (base) acceleration from a table-mounted IMU.
+
+    Attributes
+    ----------
+    t_s : ndarray (n,)
+        Sample times, s (the log's clock).
+    acc_m_s2 : ndarray (n,)
+        Horizontal acceleration along the shaking direction, m/s^2, gravity removed.
+    direction : ndarray (3,)
+        Shaking direction in the sensor frame (unit vector).
+    tilt_rad : float
+        Mis-mount tilt: angle between the sensor's gravity reading at rest and
+        its nearest axis, rad (corrected).
+    rest_s : (float, float)
+        Rest window used for the gravity direction, s.
+    rate_hz : float
+        Sample rate, Hz.
+    source : str
+        Log file.
+    """
+
+    t_s: np.ndarray
+    acc_m_s2: np.ndarray
+    direction: np.ndarray
+    tilt_rad: float
+    rest_s: tuple
+    rate_hz: float
+    source: str = ""
+
+    def to_frame(self):
+        """``t_s, acc_m_s2`` DataFrame."""
+        import pandas as pd
+
+        return pd.DataFrame({"t_s": self.t_s, "acc_m_s2": self.acc_m_s2})
+
+    def to_dict(self) -> dict:
+        """Summary: direction, tilt, rest window, peak acceleration, rate, source."""
+        return {"direction": [float(v) for v in self.direction], "tilt_rad": float(self.tilt_rad),
+                "rest_s": [float(v) for v in self.rest_s],
+                "pga_m_s2": float(np.max(np.abs(self.acc_m_s2))) if len(self.acc_m_s2) else 0.0,
+                "sample_rate_hz": float(self.rate_hz), "source": self.source}
+
+    def to_base_motion(self, name: str = "table_imu"):
+        """As a :class:`rocklab.models.BaseMotion`: uniform grid at the log rate, time from 0.
+
+        Dropped samples are filled by linear interpolation.
+        """
+        from ..models import BaseMotion
+
+        n = int(np.floor((self.t_s[-1] - self.t_s[0]) * self.rate_hz)) + 1
+        t = self.t_s[0] + np.arange(n) / self.rate_hz
+        return BaseMotion.from_samples(np.interp(t, self.t_s, self.acc_m_s2), 1.0 / self.rate_hz,
+                                       "m/s2", name=name)
+
+
+def table_acceleration(log: ImuLog, axis: str | None = "x", *, still_gyro_deg_s: float = 2.0,
+                       still_acc_g: float = 0.03, min_rest_s: float = 0.2) -> TableAcceleration:
+    """Base acceleration along the shaking direction from a table IMU.
+
+    Parameters
+    ----------
+    log : ImuLog
+        Table IMU samples; the log must start at rest (>= ``min_rest_s``).
+    axis : {"x", "y", "z", "-x", ...} or None
+        Sensor axis closest to the shaking direction; None: the principal
+        horizontal direction of the acceleration during motion (sign: positive
+        along the sensor axis it is closest to).
+    still_gyro_deg_s, still_acc_g : float
+        Stillness thresholds (50 ms averages).
+    min_rest_s : float
+        Shortest acceptable rest window, s.
+
+    Returns
+    -------
+    TableAcceleration
+
+    Raises
+    ------
+    InputError
+        No rest window at the start of the log.
+    """
+    fs = float(log.rate_hz)
+    moving = motion_mask(log.t_s, log.gyro_rad_s, log.acc_m_s2, fs,
+                         np.deg2rad(still_gyro_deg_s), still_acc_g * G)
+    i_move = first_motion(moving, max(2, int(round(0.1 * fs))))
+    i_move = log.n if i_move is None else i_move
+    s1 = max(0, i_move - max(1, int(round(0.05 * fs))))
+    if s1 < max(3, int(round(min_rest_s * fs))):
+        raise InputError(f"{log.source}: no rest of {min_rest_s:g} s before the shaking starts "
+                         f"(first motion at {log.t_s[i_move]:.3f} s); log a still table first")
+    g_s = log.acc_m_s2[:s1].mean(axis=0)
+    R = rotation_between(g_s, np.array([0.0, 0.0, 1.0]))
+    nearest = np.zeros(3)
+    k = int(np.argmax(np.abs(g_s)))
+    nearest[k] = np.sign(g_s[k])
+    tilt = float(np.arccos(np.clip(abs(g_s[k]) / np.linalg.norm(g_s), -1, 1)))
+    a_w = log.acc_m_s2 @ R.T
+    a_w[:, 2] -= np.linalg.norm(g_s)
+    if axis is None:
+        mv = a_w[moving, :2] if moving.any() else a_w[:, :2]
+        d2 = np.linalg.svd(mv - mv.mean(axis=0), full_matrices=False)[2][0]
+        d = np.array([d2[0], d2[1], 0.0])
+        back = R.T @ d
+        j = int(np.argmax(np.abs(back)))
+        if back[j] < 0:
+            d = -d
+    else:
+        d = R @ axis_vector(axis)
+        d[2] = 0.0
+        if np.linalg.norm(d) < 0.2:
+            raise InputError(f"axis={axis!r}: that sensor axis is (nearly) vertical on the "
+                             "table; name a horizontal sensor axis")
+    d /= np.linalg.norm(d)
+    acc = a_w @ d
+    return TableAcceleration(log.t_s, acc, R.T @ d, tilt,
+                             (float(log.t_s[0]), float(log.t_s[s1 - 1])), fs, log.source)

@@ -1,0 +1,248 @@
+"""Clock synchronisation of two angular-rate signals (IMU vs video track, or two IMUs).
+
+Convention: signal b at its time ``t_b`` corresponds to signal a at
+``t_a = t_b + offset_s + drift * t_b`` (``SyncResult.to_a``).
+
+Method (``sync_offset``)
+------------------------
+1. Coarse: both rates resampled on a common 1 kHz grid (a box-filtered to
+   b's differentiation window), normalised cross-correlation, parabolic
+   interpolation of the peak.
+2. Fine: least squares on the *integrated* rates (angles, which do not amplify
+   a video track's noise the way differences do): minimise over the offset
+   the residual of ``B(t_b) - A_w(t_b + offset)`` after removing a constant and
+   a linear trend (integration constant, gyro bias residual), with ``A_w`` the
+   integral of a's rate smoothed by b's window.
+3. Drift (long logs): the fine fit in consecutive windows, a straight line
+   through the window offsets; ``residual_ms`` is the RMS scatter of the
+   window offsets about the fitted clock model.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .._errors import InputError
+from ._imu_motion import cumtrapz
+
+__all__ = ["SyncResult", "sync_offset", "track_rate", "sync_imu_to_track"]
+
+
+@dataclass(frozen=True)
+class SyncResult:
+    """Clock model between two recordings: ``t_a = t_b + offset_s + drift * t_b``.
+
+    Attributes
+    ----------
+    offset_s : float
+        Offset at ``t_b = 0``, s.
+    drift : float
+        Clock-rate difference, s/s (0 when not fitted).
+    residual_ms : float
+        RMS scatter of the window offsets about the clock model, ms (NaN with
+        fewer than 3 usable windows).
+    correlation : float
+        Peak normalised cross-correlation of the rates (0..1).
+    n_windows : int
+        Windows with enough motion used for the drift / residual.
+    window_t_s, window_offset_s : ndarray
+        Window centres (b clock) and their offsets, s.
+    sign : int
+        +1, or -1 when b's rate is a's with the opposite sign convention
+        (b was flipped before the fit).
+    """
+
+    offset_s: float
+    drift: float
+    residual_ms: float
+    correlation: float
+    n_windows: int = 0
+    window_t_s: np.ndarray = field(default_factory=lambda: np.empty(0), repr=False)
+    window_offset_s: np.ndarray = field(default_factory=lambda: np.empty(0), repr=False)
+    sign: int = 1
+
+    def to_a(self, t_b):
+        """Map times on clock b to clock a, s."""
+        t_b = np.asarray(t_b, float)
+        return t_b + self.offset_s + self.drift * t_b
+
+    def to_dict(self) -> dict:
+        """``offset_s, offset_ms, drift, drift_ppm, residual_ms, correlation, n_windows``."""
+        return {"offset_s": float(self.offset_s), "offset_ms": 1e3 * float(self.offset_s),
+                "drift": float(self.drift), "drift_ppm": 1e6 * float(self.drift),
+                "residual_ms": float(self.residual_ms), "correlation": float(self.correlation),
+                "n_windows": int(self.n_windows), "sign": int(self.sign)}
+
+
+def _clean(t, y, name):
+    t = np.asarray(t, float).ravel()
+    y = np.asarray(y, float).ravel()
+    if t.shape != y.shape:
+        raise InputError(f"sync: t_{name} and rate_{name} differ in length ({t.size} vs {y.size}); "
+                         "pass matching arrays")
+    ok = np.isfinite(t) & np.isfinite(y)
+    t, y = t[ok], y[ok]
+    if t.size < 8:
+        raise InputError(f"sync: signal {name} has {t.size} finite samples; need at least 8")
+    if np.any(np.diff(t) <= 0):
+        raise InputError(f"sync: t_{name} must increase strictly; sort and de-duplicate the times")
+    return t, y
+
+
+def _box(t, y, w):
+    """Rate box-filtered over width ``w`` (s), via the integral; returns a callable."""
+    Y = cumtrapz(t, y)
+    if w <= 0:
+        return lambda x: np.interp(x, t, y)
+    return lambda x: (np.interp(x + 0.5 * w, t, Y) - np.interp(x - 0.5 * w, t, Y)) / w
+
+
+def _coarse(ta, fa, tb, yb, fs, max_offset_s):
+    from scipy.signal import correlate, correlation_lags
+
+    ga = np.arange(ta[0], ta[-1], 1.0 / fs)
+    gb = np.arange(tb[0], tb[-1], 1.0 / fs)
+    a = fa(ga)
+    b = np.interp(gb, tb, yb)
+    a = a - a.mean()
+    b = b - b.mean()
+    c = correlate(a, b, mode="full", method="fft")
+    lags = correlation_lags(a.size, b.size, mode="full")
+    off = ga[0] - gb[0] + lags / fs
+    if max_offset_s is not None:
+        c = np.where(np.abs(off) <= max_offset_s, c, -np.inf)
+    k = int(np.argmax(np.where(np.isfinite(c), np.abs(c), -np.inf)))
+    den = np.sqrt(np.sum(a * a) * np.sum(b * b)) or 1.0
+    corr = float(c[k] / den)
+    if corr < 0:
+        c = -c
+    frac = 0.0
+    if 0 < k < c.size - 1 and np.isfinite(c[k - 1]) and np.isfinite(c[k + 1]):
+        d = c[k - 1] - 2 * c[k] + c[k + 1]
+        frac = 0.5 * (c[k - 1] - c[k + 1]) / d if d < 0 else 0.0
+    return float(off[k] + frac / fs), corr
+
+
+def _fine(ta, A, tb, B, guess, half):
+    """Offset minimising the detrended angle residual near ``guess`` (+- ``half``)."""
+    from scipy.optimize import minimize_scalar
+
+    def cost(off):
+        m = (tb + off > ta[0]) & (tb + off < ta[-1])
+        if m.sum() < 8:
+            return np.inf
+        r = B[m] - A(tb[m] + off)
+        x = tb[m] - tb[m].mean()
+        r = r - r.mean()
+        r = r - x * (x @ r) / (x @ x)
+        return float(r @ r) / m.sum()
+
+    res = minimize_scalar(cost, bounds=(guess - half, guess + half), method="bounded",
+                          options={"xatol": 1e-6})
+    return float(res.x), float(res.fun)
+
+
+def sync_offset(t_a, rate_a, t_b, rate_b, *, max_offset_s: float | None = None,
+                window_b_s: float = 0.0, drift: bool | str = "auto", window_s: float | None = None,
+                grid_hz: float = 1000.0) -> SyncResult:
+    """Clock offset (and drift) between two angular-rate recordings.
+
+    Parameters
+    ----------
+    t_a, rate_a : array_like (n,)
+        Reference signal (e.g. the IMU rate about the rocking axis), s and rad/s.
+    t_b, rate_b : array_like (m,)
+        Signal to align (e.g. a video track's rate), s and rad/s; NaNs skipped.
+    max_offset_s : float, optional
+        Largest plausible |offset|, s (default: unrestricted).
+    window_b_s : float
+        Width of the differentiation window of b, s (``2 / fps`` for central
+        differences of a track); a is smoothed the same way before comparing.
+    drift : bool or "auto"
+        Fit a linear clock drift (``"auto"``: when the overlap exceeds 120 s).
+    window_s : float, optional
+        Window length for drift / residual, s (default: overlap / 6, >= 1 s).
+    grid_hz : float
+        Grid rate of the coarse cross-correlation, Hz.
+
+    Returns
+    -------
+    SyncResult
+    """
+    ta, ya = _clean(t_a, rate_a, "a")
+    tb, yb = _clean(t_b, rate_b, "b")
+    fa = _box(ta, ya, window_b_s)
+    off0, corr = _coarse(ta, fa, tb, yb, grid_hz, max_offset_s)
+    sign = -1 if corr < 0 else 1
+    yb = sign * yb
+    # Angles: a's smoothed rate integrated on a's grid, b's rate integrated on its own.
+    A_rate = fa(ta)
+    Aint = cumtrapz(ta, A_rate)
+
+    def A(x):
+        return np.interp(x, ta, Aint)
+
+    B = cumtrapz(tb, yb)
+    off, _ = _fine(ta, A, tb, B, off0, 3.0 / grid_hz)
+    lo, hi = max(tb[0], ta[0] - off), min(tb[-1], ta[-1] - off)
+    overlap = hi - lo
+    fit_drift = (overlap > 120.0) if drift == "auto" else bool(drift)
+    w = window_s or max(1.0, overlap / 6.0)
+    edges = np.arange(lo, hi - 0.5 * w + 1e-9, w)
+    wt, wo = [], []
+    thr = 0.2 * np.std(yb[(tb >= lo) & (tb <= hi)]) if overlap > 0 else 0.0
+    for e in edges:
+        m = (tb >= e) & (tb < e + w)
+        if m.sum() < 16 or np.std(yb[m]) < thr:
+            continue
+        o, _ = _fine(ta, A, tb[m], B[m], off, 0.05 * w if fit_drift else 10.0 / grid_hz)
+        wt.append(tb[m].mean())
+        wo.append(o)
+    wt, wo = np.asarray(wt), np.asarray(wo)
+    d = 0.0
+    resid = np.nan
+    if fit_drift and wt.size >= 2:
+        d, c0 = np.polyfit(wt, wo, 1)
+        off = float(c0)
+        model = off + d * wt
+    else:
+        model = np.full(wt.shape, off)
+    if wt.size >= 3:
+        resid = 1e3 * float(np.sqrt(np.mean((wo - model) ** 2)))
+    return SyncResult(float(off), float(d), resid, abs(corr), int(wt.size), wt, wo, sign)
+
+
+def track_rate(t_s, theta_rad):
+    """Angular rate of a video track by central differences, rad/s.
+
+    Parameters
+    ----------
+    t_s, theta_rad : array_like (n,)
+        Track times (s) and angles (rad); NaN where the tracker lost the object.
+
+    Returns
+    -------
+    (ndarray, ndarray)
+        Times and rates (n,); NaN where a neighbour is missing.
+    """
+    t = np.asarray(t_s, float)
+    th = np.asarray(theta_rad, float)
+    w = np.full(t.shape, np.nan)
+    if t.size >= 3:
+        w[1:-1] = (th[2:] - th[:-2]) / (t[2:] - t[:-2])
+    return t, w
+
+
+def sync_imu_to_track(rotation, t_s, theta_rad, **kwargs) -> SyncResult:
+    """Offset of a video track's clock onto an IMU's clock from the rocking rates.
+
+    ``rotation`` is an :class:`ImuRotation` (or any object with ``t_s`` and
+    ``omega_rad_s``); the track gives ``t_s, theta_rad``.  Returns the clock
+    model with a = IMU and b = video: ``t_imu = t_video + offset_s + drift * t_video``.
+    """
+    t, w = track_rate(t_s, theta_rad)
+    dt = float(np.nanmedian(np.diff(t))) if len(t) > 1 else 0.0
+    kwargs.setdefault("window_b_s", 2.0 * dt)
+    return sync_offset(rotation.t_s, rotation.omega_rad_s, t, w, **kwargs)

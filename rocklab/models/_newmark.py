@@ -39,19 +39,19 @@ _HALF_PI = 0.5 * math.pi
 
 
 @njit(cache=True, inline="always")
-def _ug_at(t, acc, t0, dta, scale):
-    """Base acceleration / g at time t: linear interpolation, 0 outside the record."""
+def _ug_at(t, acc, t0, inv_dta, fac):
+    """Base acceleration * fac at time t (fac = scale/g): linear interpolation, 0 outside."""
     n = acc.shape[0]
     if n == 0:
         return 0.0
-    x = (t - t0) / dta
+    x = (t - t0) * inv_dta
     if x < 0.0 or x > n - 1:
         return 0.0
     i = int(x)
     if i >= n - 1:
-        return acc[n - 1] * scale / G
+        return acc[n - 1] * fac
     f = x - i
-    return (acc[i] * (1.0 - f) + acc[i + 1] * f) * scale / G
+    return (acc[i] * (1.0 - f) + acc[i + 1] * f) * fac
 
 
 @njit(cache=True, inline="always")
@@ -170,7 +170,7 @@ def _contact_tau(th0, w0, a0, s, h, u0, u1, p2, alpha, lin):
 @njit(cache=True)
 def run_block(p, alpha, theta0, omega0, h, n_steps, acc, acc_t0, acc_dt, scale,
               eta_mode, eta_x, eta_y, lin, rest_w2, t_last_uplift, stop_at_rest,
-              out_every, imp_cap):
+              out_every, imp_cap, fall_rad=_HALF_PI, stop_on_fall=True):
     """Integrate one block for n_steps steps of h (s).
 
     Returns
@@ -178,10 +178,14 @@ def run_block(p, alpha, theta0, omega0, h, n_steps, acc, acc_t0, acc_dt, scale,
     out_theta, out_omega : (n_out,) samples at every ``out_every``-th step (t = i*h*out_every),
     n_out, imp (4, n_imp) rows t_s, omega_before, omega_after, eta (first imp_cap impacts),
     n_imp (all impacts), status, t_over (first |theta| >= alpha outward, nan),
-    t_fall (|theta| >= pi/2, nan), max_abs_theta, t_end (s, last time integrated).
+    t_fall (first step end with |theta| >= fall_rad, nan), max_abs_theta, t_end (s, last time
+    integrated). The run always ends at |theta| = pi/2 (the side hits the ground) and at
+    fall_rad when stop_on_fall.
     """
     p2 = p * p
     tan_a = math.tan(alpha)
+    inv_dta = 1.0 / acc_dt
+    fac = scale / G
     c1h = 4.0 / (h * h)
     c4h = 4.0 / h
     n_out_max = n_steps // out_every + 1 if out_every > 0 else 0
@@ -204,12 +208,13 @@ def run_block(p, alpha, theta0, omega0, h, n_steps, acc, acc_t0, acc_dt, scale,
     else:
         s = 1.0
         resting = True
-    ug = _ug_at(0.0, acc, acc_t0, acc_dt, scale)
+    ug = _ug_at(0.0, acc, acc_t0, inv_dta, fac)
     if resting and abs(ug) > tan_a:
         resting = False
         s = -1.0 if ug > 0.0 else 1.0
     if not resting:
         ever_moved = True
+    u_prev = ug
     a = _f(th, s, ug, p2, alpha, lin) if not resting else 0.0
     max_abs = abs(th)
     n_out = 0
@@ -222,10 +227,10 @@ def run_block(p, alpha, theta0, omega0, h, n_steps, acc, acc_t0, acc_dt, scale,
     while step < n_steps:
         t0 = step * h
         t1 = (step + 1) * h
-        u1 = _ug_at(t1, acc, acc_t0, acc_dt, scale)
+        u1 = _ug_at(t1, acc, acc_t0, inv_dta, fac)
         tc = t0  # current time within the step
         th_beg = th
-        u_c = _ug_at(t0, acc, acc_t0, acc_dt, scale)
+        u_c = u_prev
         n_sub = 0
         while tc < t1:
             rem = t1 - tc
@@ -304,6 +309,7 @@ def run_block(p, alpha, theta0, omega0, h, n_steps, acc, acc_t0, acc_dt, scale,
                     w = 0.0
                     a = 0.0
         step += 1
+        u_prev = u1
         t_end = t1
         ath = abs(th)
         if ath > max_abs:
@@ -316,9 +322,16 @@ def run_block(p, alpha, theta0, omega0, h, n_steps, acc, acc_t0, acc_dt, scale,
             # linear interpolation of the crossing inside the step (O(h^2))
             fr = (alpha - abs(th_beg)) / (ath - abs(th_beg)) if ath != abs(th_beg) else 1.0
             t_over = t1 - h + min(max(fr, 0.0), 1.0) * h
-        if ath >= _HALF_PI:
+        if ath >= fall_rad and t_fall != t_fall:
             t_fall = t1
             status = OVERTURNED
+            if stop_on_fall:
+                break
+        if ath >= _HALF_PI:
+            # the side of the block hits the ground: the rocking model ends here
+            status = OVERTURNED
+            if t_fall != t_fall:
+                t_fall = t1
             break
         if resting and stop_at_rest and t1 >= t_last_uplift:
             status = REST

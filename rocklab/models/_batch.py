@@ -1,0 +1,156 @@
+"""``simulate_batch``: many independent rocking runs in one parallel numba call.
+
+Made for overturning spectra and fits: thousands of (size, slenderness,
+amplitude) combinations under one base record. Each entry runs the same
+Newmark kernel as :func:`~rocklab.models.simulate` (exact contact, same rest
+and overturning rules) without storing histories.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit, prange
+
+from .._errors import InputError
+from ..blocks import G
+from ._newmark import run_block
+from ._records import BaseMotion
+from ._result import BatchResult
+
+__all__ = ["simulate_batch"]
+
+_HALF_PI = 0.5 * math.pi
+
+
+@njit(cache=True)
+def _last_over(acc, t0, dta, thr):
+    """Time of the last record sample with |acc| > thr (m/s^2); -inf if none."""
+    for k in range(acc.shape[0] - 1, -1, -1):
+        if abs(acc[k]) > thr:
+            return t0 + k * dta
+    return -np.inf
+
+
+@njit(cache=True, parallel=True)
+def _batch(p, alpha, th0, w0, eta, h, n_steps, acc, acc_t0, acc_dt, scale, rest_tol, fall_rad,
+           stop_on_fall):
+    m = p.shape[0]
+    over = np.zeros(m, np.bool_)
+    t_over = np.empty(m)
+    mx = np.empty(m)
+    nimp = np.zeros(m, np.int64)
+    status = np.zeros(m, np.int8)
+    steps = np.zeros(m, np.int64)
+    ex = np.zeros(1)
+    for i in prange(m):
+        a = alpha[i]
+        p2 = p[i] * p[i]
+        rest_w2 = 2.0 * p2 * (math.cos(a - rest_tol * a) - math.cos(a))
+        sc = abs(scale[i])
+        t_last = _last_over(acc, acc_t0, acc_dt, G * math.tan(a) / sc) if sc > 0 else -np.inf
+        ey = np.empty(1)
+        ey[0] = eta[i]
+        fr = fall_rad[i]
+        r = run_block(p[i], a, th0[i], w0[i], h[i], n_steps[i], acc, acc_t0, acc_dt, scale[i],
+                      0, ex, ey, False, rest_w2, t_last, True, 0, 0, fr, stop_on_fall)
+        nimp[i] = r[4]
+        status[i] = r[5]
+        t_over[i] = r[6]
+        over[i] = r[5] == 2
+        mx[i] = r[8] / a
+        steps[i] = int(r[9] / h[i] + 0.5)
+    return over, t_over, mx, nimp, status, steps
+
+
+def simulate_batch(p_rad_s, alpha_rad, *, base: BaseMotion | None = None, scale=1.0, theta0_rad=0.0,
+                   omega0_rad_s=0.0, eta=None, alpha_I=4.0 / 3.0, dt_s: float = 1e-3,
+                   duration_s: float | None = None, free_after_s: float = 0.0,
+                   stop_on_overturn: bool = True, fall_rad=None, max_p_dt: float = 0.02,
+                   rest_tol: float = 1e-6) -> BatchResult:
+    """Run m independent blocks (broadcast arrays) in parallel; summaries only.
+
+    Parameters
+    ----------
+    p_rad_s, alpha_rad : array_like
+        Frequency parameter (rad/s) and slenderness angle (rad) per entry.
+    base : BaseMotion, optional
+        One base record (m/s^2) shared by all entries, multiplied by ``scale``.
+    scale : array_like
+        Factor on the record per entry (dimensionless; e.g. PGA / record PGA).
+    theta0_rad, omega0_rad_s : array_like
+        Initial conditions (|theta0| < alpha).
+    eta : array_like, optional
+        Constant restitution per entry; default Housner ``1 - 2 sin^2(alpha)/alpha_I``.
+    alpha_I : array_like
+        Corner inertia coefficient (only for the default eta).
+    dt_s : float
+        Time step, s. Each entry is sub-stepped so that ``p h <= max_p_dt``; the
+        trapezoidal rule's rate error is ~(p h)^2/12 (3e-5 at 0.02), small beside
+        the sensitivity of overturning to the record itself.
+    duration_s : float, optional
+        Simulated time, s. Default: end of the record + ``free_after_s``.
+    free_after_s : float
+        Free-rocking time added after the record when ``duration_s`` is None, s.
+    stop_on_overturn : bool
+        Stop an entry once it is deemed fallen (|theta| >= ``fall_rad``). Runs
+        always end when |theta| reaches pi/2 (the side hits the ground).
+    fall_rad : array_like, optional
+        Overturning criterion, rad; default pi/2 (the block actually falls). Pass
+        ``alpha_rad`` for the common "|theta| > alpha" criterion.
+    max_p_dt : float
+        Largest p * h allowed (sub-stepping of small blocks).
+    rest_tol : float
+        Rest threshold as a fraction of alpha (see :func:`simulate`).
+
+    Returns
+    -------
+    BatchResult
+        ``overturned`` (m,) bool, ``overturn_t_s`` (m,) first |theta| >= alpha
+        outward (NaN if never), ``max_abs_theta_over_alpha`` (m,), ``n_impacts`` (m,).
+    """
+    try:
+        arrs = np.broadcast_arrays(*(np.asarray(x, float) for x in (
+            p_rad_s, alpha_rad, scale, theta0_rad, omega0_rad_s, alpha_I,
+            np.nan if eta is None else eta, np.nan if fall_rad is None else fall_rad)))
+    except (ValueError, TypeError) as e:
+        raise InputError(f"simulate_batch: array arguments do not broadcast ({e}); give equal "
+                         "lengths or scalars") from None
+    p, al, sc, th0, w0, aI, et, fr = (np.array(a, dtype=float).ravel() for a in arrs)
+    for name, v in (("p_rad_s", p), ("alpha_rad", al), ("alpha_I", aI)):
+        if not np.all(np.isfinite(v) & (v > 0)):
+            raise InputError(f"simulate_batch: {name} must be finite and positive everywhere")
+    if np.any(al >= _HALF_PI):
+        raise InputError("simulate_batch: alpha_rad must be < pi/2")
+    for name, v in (("scale", sc), ("theta0_rad", th0), ("omega0_rad_s", w0)):
+        if not np.all(np.isfinite(v)):
+            raise InputError(f"simulate_batch: {name} must be finite")
+    if np.any(np.abs(th0) >= al):
+        raise InputError("simulate_batch: |theta0_rad| must be < alpha_rad for every entry")
+    et = np.where(np.isnan(et), 1.0 - 2.0 * np.sin(al) ** 2 / aI, et)
+    if np.any(np.abs(et) > 1):
+        raise InputError("simulate_batch: |eta| must be <= 1")
+    fr = np.where(np.isnan(fr), _HALF_PI, fr)
+    if not (math.isfinite(dt_s) and dt_s > 0):
+        raise InputError(f"simulate_batch: dt_s={dt_s!r} must be positive (s)")
+    if base is not None and not isinstance(base, BaseMotion):
+        raise InputError("simulate_batch: base must be a rocklab.models.BaseMotion or None")
+    if duration_s is None:
+        if base is None:
+            raise InputError("simulate_batch: give duration_s for free rocking (no base record)")
+        duration_s = float(base.t_s[-1]) + float(free_after_s)
+    if not (math.isfinite(duration_s) and duration_s > 0):
+        raise InputError(f"simulate_batch: duration_s={duration_s!r} must be positive (s)")
+    n_sub = np.maximum(1, np.ceil(p * dt_s / max_p_dt - 1e-12)).astype(np.int64)
+    h = dt_s / n_sub
+    n_steps = np.ceil(duration_s / h - 1e-9).astype(np.int64)
+    if base is None:
+        acc, t0, dta = np.zeros(0), 0.0, 1.0
+    else:
+        acc, t0, dta = np.ascontiguousarray(base.acc_m_s2, float), float(base.t_s[0]), base.dt_s
+    over, t_over, mx, nimp, status, steps = _batch(p, al, th0, w0, et, h, n_steps, acc, t0, dta, sc,
+                                                   float(rest_tol), fr, bool(stop_on_overturn))
+    return BatchResult(overturned=over, overturn_t_s=t_over, max_abs_theta_over_alpha=mx,
+                       n_impacts=nimp, status=status, p_rad_s=p, alpha_rad=al, scale=sc, eta=et,
+                       dt_s=h, n_steps=int(steps.sum()))

@@ -43,7 +43,9 @@ class Detection:
         self.n_expected = int(n_expected)
 
 
-def make_cv_detector(targets):
+def make_cv_detector(targets, win: int | None = None):
+    """OpenCV detector; ``win`` fixes a single adaptive-threshold window (px), as used in
+    the tracking windows where the marker size is known (one pass instead of three)."""
     import cv2
 
     d = cv2.aruco.getPredefinedDictionary(getattr(cv2.aruco, targets.dictionary))
@@ -52,6 +54,9 @@ def make_cv_detector(targets):
     p.cornerRefinementWinSize = 5
     p.cornerRefinementMaxIterations = 50
     p.cornerRefinementMinAccuracy = 0.005
+    if win is not None:
+        p.adaptiveThreshWinSizeMin = win
+        p.adaptiveThreshWinSizeMax = win
     return cv2.aruco.ArucoDetector(d, p), d
 
 
@@ -69,6 +74,8 @@ class ArucoDetector:
         self.cfg = config
         self.pm = plane_map
         self.det, dictionary = make_cv_detector(config.targets)
+        self._win_dets = {}
+        self.cells = int(dictionary.markerSize) + 2  # bits plus the black border
         n_dict = int(dictionary.bytesList.shape[0])
         for i, o in enumerate(config.objects):
             bad = [m for m in o.markers if m >= n_dict]
@@ -90,8 +97,17 @@ class ArucoDetector:
         self.ever_seen = set()
 
     # ---------------------------------------------------------------- search
-    def _detect(self, gray, x0=0, y0=0):
-        corners, ids, _ = self.det.detectMarkers(gray)
+    def _windowed(self, side_px):
+        """Detector with one threshold window of ~1.5 marker cells (cached per size)."""
+        cell = side_px / self.cells
+        win = int(np.clip(2 * round(0.75 * cell) + 1, 5, 61))
+        det = self._win_dets.get(win)
+        if det is None:
+            det = self._win_dets[win] = make_cv_detector(self.cfg.targets, win)[0]
+        return det
+
+    def _detect(self, gray, x0=0, y0=0, det=None):
+        corners, ids, _ = (det or self.det).detectMarkers(gray)
         out = {}
         if ids is None:
             return out
@@ -128,7 +144,7 @@ class ArucoDetector:
             if x1 - x0 < 16 or y1 - y0 < 16:
                 need_full = True
                 continue
-            got = self._detect(gray[y0:y1, x0:x1], x0, y0)
+            got = self._detect(gray[y0:y1, x0:x1], x0, y0, self._windowed(side))
             found.update({k: v for k, v in got.items() if k not in found})
             if not any(m in found for m in o.markers):
                 need_full = True

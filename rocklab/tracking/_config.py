@@ -123,7 +123,7 @@ class TargetsConfig:
     dictionary: str = "DICT_4X4_50"
     marker_size_m: float | None = None
     corner_refinement: str = "subpix"
-    search_margin: float = 1.0
+    search_margin: float = 0.5
     dot_diameter_m: float | None = None
     dot_color: str = "dark"
     edge_threshold: float | None = None
@@ -505,7 +505,7 @@ class _Parser:
             marker_size_m=self.num(d.get("marker_size_m"), s, "marker_size_m", positive=True),
             corner_refinement=self.choice(d.get("corner_refinement", "subpix"), CORNER_REFINEMENTS,
                                           s, "corner_refinement"),
-            search_margin=self.num(d.get("search_margin", 1.0), s, "search_margin", positive=True),
+            search_margin=self.num(d.get("search_margin", 0.5), s, "search_margin", positive=True),
             dot_diameter_m=self.num(d.get("dot_diameter_m"), s, "dot_diameter_m", positive=True),
             dot_color=self.choice(d.get("dot_color", "dark"), ("dark", "light"), s, "dot_color"),
             edge_threshold=self.num(d.get("edge_threshold"), s, "edge_threshold"),

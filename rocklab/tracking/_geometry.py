@@ -114,9 +114,9 @@ class PlaneMap:
         """Plane coordinates (px about the centre, or metres with a homography), shape (n, 2)."""
         uv = self.undistort(uv)
         if self.H is not None:
-            h = np.c_[uv, np.ones(len(uv))] @ self.H.T
+            h = uv @ self.H[:, :2].T + self.H[:, 2]
             return h[:, :2] / h[:, 2:3]
-        return np.c_[uv[:, 0] - self.cx, self.cy - uv[:, 1]]
+        return np.column_stack((uv[:, 0] - self.cx, self.cy - uv[:, 1]))
 
 
 def load_calibration(path):

@@ -12,6 +12,7 @@ from ._motion import TableMotion, choose_sg_window, estimate_noise, table_motion
 from ._track import (TRACK_COLUMNS, ObjectTrack, Observation, TrackResult, assemble_tracks,
                      track_frames, track_video)
 from ._video import VideoInfo, iter_video_frames, probe_video
+from ._synth import SynthSession, load_synth_session, synth_session
 
 __all__: list[str] = [
     # video tracking (helper "track")
@@ -26,4 +27,6 @@ __all__: list[str] = [
     "ImuRotation", "block_rotation", "ahrs_quaternions", "TableAcceleration", "table_acceleration",
     "SyncResult", "sync_offset", "sync_imu_to_track", "track_rate",
     "simulate_imu_log", "write_ximu_csv", "write_ximu3_csv",
+    # synthetic lab sessions (helper "synth")
+    "synth_session", "SynthSession", "load_synth_session",
 ]

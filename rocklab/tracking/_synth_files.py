@@ -1,0 +1,147 @@
+"""Writers for synthetic sessions: video containers, ``track.toml``, ``experiment.toml``.
+
+Each file type has one writer function here so its format can change (or be
+handed to the owner of the format) in one place.
+"""
+
+from __future__ import annotations
+
+import queue
+import threading
+from pathlib import Path
+
+import numpy as np
+
+__all__ = ["VideoPair", "write_track_toml", "write_experiment_toml"]
+
+
+class VideoPair:
+    """Write the same grey frames to ``video.mkv`` (FFV1, lossless) and ``video.mp4`` (mp4v).
+
+    Encoding runs in a background thread (OpenCV releases the GIL while
+    encoding), overlapping with the rendering of the next frame. If this
+    OpenCV build cannot write FFV1, the lossless file falls back to PNG in
+    Matroska (``codec`` says which was used).
+    """
+
+    def __init__(self, folder: Path, fps: float, size, mp4: bool = True):
+        import cv2
+
+        W, H = size
+        self.codec = None
+        self.paths = {}
+        self.writers = []
+        for fourcc in ("FFV1", "png "):
+            w = cv2.VideoWriter(str(folder / "video.mkv"), cv2.VideoWriter_fourcc(*fourcc), float(fps),
+                                (W, H), isColor=False)
+            if w.isOpened():
+                self.codec = fourcc.strip()
+                self.writers.append(w)
+                self.paths["mkv"] = folder / "video.mkv"
+                break
+            w.release()
+        if self.codec is None:
+            raise RuntimeError("this OpenCV build writes neither FFV1 nor PNG into .mkv; "
+                               "install an opencv build with FFmpeg")
+        if mp4:
+            w = cv2.VideoWriter(str(folder / "video.mp4"), cv2.VideoWriter_fourcc(*"mp4v"), float(fps),
+                                (W, H), isColor=False)
+            if w.isOpened():
+                self.writers.append(w)
+                self.paths["mp4"] = folder / "video.mp4"
+        self._q: queue.Queue = queue.Queue(maxsize=4)
+        self._err: list = []
+        self._t = threading.Thread(target=self._run, daemon=True)
+        self._t.start()
+
+    def _run(self):
+        while True:
+            f = self._q.get()
+            if f is None:
+                return
+            try:
+                for w in self.writers:
+                    w.write(f)
+            except Exception as e:  # pragma: no cover - surfaced in close()
+                self._err.append(e)
+
+    def write(self, frame: np.ndarray):
+        if self._err:
+            raise self._err[0]
+        self._q.put(frame)
+
+    def close(self):
+        self._q.put(None)
+        self._t.join()
+        for w in self.writers:
+            w.release()
+        if self._err:
+            raise self._err[0]
+
+
+def write_track_toml(path: Path, *, style, fps, camera, objects, marker_size_m, dot_diameter_m,
+                     calibrated=True) -> str:
+    """``track.toml`` through the tracker's own schema (:class:`TrackConfig`).
+
+    ``objects``: list of dicts with ``id, kind`` and ``markers`` +
+    ``marker_positions_m`` / ``dots`` / ``roi`` + ``size_m`` + ``theta0_rad``.
+    Validated by parsing it back with :func:`load_track_config`.
+    """
+    from .._io import write_text_atomic
+    from ._config import TrackConfig, load_track_config
+
+    d = {"video": {"fps": float(fps)},
+         "targets": {"style": style},
+         "reference": {"level": "table"},
+         "objects": []}
+    if calibrated:
+        d["video"]["camera_matrix"] = camera.K.tolist()
+        d["video"]["dist_coeffs"] = camera.dist.tolist()
+    if style == "aruco":
+        d["targets"].update(dictionary="DICT_4X4_50", marker_size_m=float(marker_size_m))
+    elif style == "dots":
+        d["targets"].update(dot_diameter_m=float(dot_diameter_m), dot_color="dark")
+    for o in objects:
+        e = {"id": o["id"], "kind": o["kind"]}
+        for k in ("markers", "marker_positions_m", "dots", "roi", "size_m", "theta0_rad"):
+            if o.get(k) is not None:
+                v = o[k]
+                e[k] = v.tolist() if isinstance(v, np.ndarray) else v
+        d["objects"].append(e)
+    cfg = TrackConfig.from_dict(d)
+    text = ("# Tracking config written by 'rocklab synth' (schema: rocklab/tracking/_config.py).\n"
+            "# Object origins: block = centre of its front face, table = top centre of its front face.\n"
+            + cfg.to_toml())
+    write_text_atomic(path, text)
+    load_track_config(path)           # round-trip check: the tracker can read what we wrote
+    return text
+
+
+def write_experiment_toml(path: Path, *, name, block, table_kind, imu_objects, column=None) -> str:
+    """``experiment.toml`` for ``rocklab run`` (schema: ``rocklab/pipelines/_config.py``).
+
+    ``block``: dict with ``id, b_m, h_m, mass_kg`` of the block the run fits;
+    ``imu_objects``: object ids that have ``imu/<id>/`` logs; ``column``: object
+    ids bottom to top for a stacked column (or None).
+    """
+    from .._io import write_text_atomic
+
+    lines = [f'name = "{name}"', 'truth = "truth.csv"', "",
+             "[block]", f"b_m = {block['b_m']!r}", f"h_m = {block['h_m']!r}",
+             f"mass_kg = {block['mass_kg']!r}", "",
+             "[contact]", 'type = "full"', "",
+             "[sources]", 'primary = "video"', "",
+             "[sources.video]", 'path = "video.mkv"', 'track_config = "track.toml"',
+             f'object = "{block["id"]}"', ""]
+    if block["id"] in imu_objects:
+        lines += ["[sources.imu]", f'path = "imu/{block["id"]}"', 'axis = "y"', ""]
+    if table_kind == "none":
+        lines += ["[sources.table]", 'from = "none"', ""]
+    else:
+        lines += ["[sources.table]", 'from = "video"', 'object = "table"', ""]
+    if column:
+        lines += ["[column]", "objects = [" + ", ".join(f'"{c}"' for c in column) + "]", ""]
+    text = "# Experiment config written by 'rocklab synth' (schema: rocklab/pipelines/_config.py).\n" \
+        + "\n".join(lines)
+    write_text_atomic(path, text)
+    return text

@@ -1,0 +1,337 @@
+"""Scene set-up for synthetic sessions: motions, layout, camera, textures, truth files."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .._errors import InputError
+
+__all__ = ["build_scene", "Scene"]
+
+TABLE_THICK_M = 0.06
+_MOUNT_FRAC = 0.85          # IMU height on the block, fraction of h
+
+
+def _blocks(block, n):
+    from ..blocks import Block
+
+    if block is None:
+        heights = (0.20, 0.22, 0.21) if n == 3 else (0.20,)   # all survive the 45 mm sine pulse
+        return [Block(0.1, h, depth_m=0.3, density_kg_m3=2700.0, name=f"block_{i + 1}")
+                for i, h in enumerate(heights)]
+    bl = list(block) if isinstance(block, (list, tuple)) else [block] * n
+    if len(bl) != n or not all(isinstance(b, Block) for b in bl):
+        raise InputError(f"block: give one rocklab.Block or a list of {n} Blocks")
+    return bl
+
+
+def _simulate(blk, *, theta0_sim, base, horizon_s, restitution, eta):
+    from ..models import simulate
+
+    law = {"eta": eta} if restitution == "constant" else {}
+    return simulate(blk, theta0_rad=theta0_sim, duration_s=horizon_s, dt_s=1e-4,
+                    restitution=restitution, base=base, **law)
+
+
+def _table_motion(kind, seed_rng, *, record, amplitude, period, stroke, blocks, start_s, horizon_s):
+    from ._synth_motion import record_table, sine_pulse_table, still_table
+
+    if kind == "none":
+        return still_table()
+    if kind == "sine":
+        return sine_pulse_table(start_s, period, amplitude)
+    from ..models import BaseMotion, bundled_record, load_base_motion
+
+    if record is None:
+        base, name = bundled_record("elcentro"), "elcentro"
+    elif isinstance(record, BaseMotion):
+        base, name = record, record.name
+    else:
+        base, name = load_base_motion(record), Path(record).name
+    uplift = max(b.uplift_acc_m_s2 for b in blocks)
+    return record_table(base, start_s, horizon_s - start_s - 0.5, stroke, 1.6 * uplift, name=name)
+
+
+@dataclass
+class Scene:
+    """Everything needed to render and describe a session (internal)."""
+
+    seed: int
+    fps: float
+    size: tuple
+    n_frames: int
+    targets: str
+    camera: object
+    plane_maps: tuple
+    objects: list                 # RenderObject, table first
+    block_motions: list
+    table: object
+    sims: list
+    params: dict
+    occluders: list
+    background: np.ndarray
+    illumination: np.ndarray
+    exposure_s: float
+    readout_s: float
+    noise_dn: float
+    noise_seed: object
+    imu_seed: object
+    features: dict
+    table_width_m: float
+    video_info: dict = field(default_factory=dict)
+
+    def renderer(self):
+        from ._render import Renderer
+
+        return Renderer(self.camera, self.objects, self.background, self.illumination,
+                        exposure_s=self.exposure_s, readout_s=self.readout_s, noise_dn=self.noise_dn,
+                        rng=np.random.default_rng(self.noise_seed), occluders=self.occluders,
+                        plane_maps=self.plane_maps)
+
+    # ------------------------------------------------------------------ truth
+    def truth_frame(self):
+        import pandas as pd
+
+        t = np.arange(self.n_frames) / self.fps
+        parts = []
+        for bm in self.block_motions:
+            x, y = bm.centre(t)
+            parts.append(pd.DataFrame({"frame": np.arange(self.n_frames), "t_s": t, "object": bm.id,
+                                       "x_m": x, "y_m": y, "theta_rad": bm.phi(t),
+                                       "vx_m_s": np.nan, "ax_m_s2": np.nan}))
+        tb = self.table
+        parts.append(pd.DataFrame({"frame": np.arange(self.n_frames), "t_s": t, "object": "table",
+                                   "x_m": tb.u(t), "y_m": 0.0, "theta_rad": 0.0,
+                                   "vx_m_s": tb.v(t), "ax_m_s2": tb.a(t)}))
+        df = pd.concat(parts, ignore_index=True)
+        return df.sort_values(["frame", "object"], kind="stable").reset_index(drop=True)
+
+    def _track_objects(self):
+        objs = []
+        first = np.array([0.0])
+        for o in self.objects:
+            f = self.features[o.id]
+            e = {"id": o.id, "kind": "table" if o.id == "table" else "block"}
+            if self.targets == "aruco":
+                e["markers"] = [int(k) for k in f["markers"]]
+                e["marker_positions_m"] = [np.mean(c, axis=0).round(12).tolist() for c in f["markers"].values()]
+            elif self.targets == "dots":
+                e["dots"] = np.asarray(f["dots"]).round(12).tolist()
+            else:
+                ox, oy, phi = (np.asarray(v, float) for v in o.pose(first))
+                from ._render import _to_world
+
+                px = self.camera.project(_to_world(o.texture.outline_m, ox, oy, phi).reshape(-1, 2))
+                W, H = self.size
+                u0, v0 = max(0.0, px[:, 0].min() - 8), max(0.0, px[:, 1].min() - 8)
+                u1, v1 = min(W - 1.0, px[:, 0].max() + 8), min(H - 1.0, px[:, 1].max() + 8)
+                e["roi"] = [round(u0, 1), round(v0, 1), round(u1 - u0, 1), round(v1 - v0, 1)]
+                e["size_m"] = list(f["size_m"])
+                e["theta0_rad"] = float(phi[0])
+            objs.append(e)
+        return objs
+
+    def write_files(self, folder: Path, *, imu: bool, imu_rate_hz: float, calibrated: bool) -> dict:
+        """Write truth.csv, track.toml, experiment.toml, imu/ and return session.json's content."""
+        from .._io import write_frame_atomic
+        from ._synth_files import write_experiment_toml, write_track_toml
+
+        write_frame_atomic(folder / "truth.csv", self.truth_frame())
+        f1 = self.features[self.block_motions[0].id]
+        write_track_toml(folder / "track.toml", style=self.targets, fps=self.fps, camera=self.camera,
+                         objects=self._track_objects(), marker_size_m=f1.get("marker_size_m"),
+                         dot_diameter_m=f1.get("dot_diameter_m"), calibrated=calibrated)
+        b0 = self.sims[0]["block"]
+        imu_info = self._write_imu(folder, imu_rate_hz) if imu else {}
+        write_experiment_toml(folder / "experiment.toml", name=f"synth-seed{self.seed}",
+                              block={"id": self.block_motions[0].id, "b_m": b0["b_m"], "h_m": b0["h_m"],
+                                     "mass_kg": b0["mass_kg"]},
+                              table_kind=self.table.kind, imu_objects=set(imu_info), column=None)
+        return self._meta(imu_info)
+
+    def _write_imu(self, folder: Path, rate_hz: float) -> dict:
+        from ._synth_imu import write_object_imu
+
+        out = {}
+        seqs = self.imu_seed.spawn(len(self.block_motions) + 1)
+        t_end = self.n_frames / self.fps + 0.5
+        blocks = {s["id"]: s["block"] for s in self.sims}
+        for k, bm in enumerate(self.block_motions):
+            from ..blocks import Block
+
+            bd = blocks[bm.id]
+            blk = Block(bd["b_m"], bd["h_m"], depth_m=bd["depth_m"], mass_kg=bd["mass_kg"],
+                        alpha_I=bd["alpha_I"])
+            out[bm.id] = write_object_imu(folder / "imu" / bm.id, bm.id, block_motion=bm, block=blk,
+                                          mount_m=(0.0, _MOUNT_FRAC * bm.h_m), t_end_s=t_end,
+                                          rate_hz=rate_hz, rng=np.random.default_rng(seqs[k]))
+        out["table"] = write_object_imu(folder / "imu" / "table", "table", table=self.table,
+                                        t_end_s=t_end, rate_hz=rate_hz,
+                                        rng=np.random.default_rng(seqs[-1]))
+        return out
+
+    def _meta(self, imu_info) -> dict:
+        from .. import __version__
+
+        cam = self.camera.to_dict()
+        K, R, t = self.camera.K, self.camera.R, self.camera.t
+        Hm = K @ np.column_stack([R[:, 0], R[:, 1], t])
+        Hinv = np.linalg.inv(Hm)
+        cam["homography_undistorted_px_to_plane_m"] = (Hinv / Hinv[2, 2]).tolist()
+        feats = {}
+        for oid, f in self.features.items():
+            g = {k: v for k, v in f.items() if k not in ("markers", "dots")}
+            if "markers" in f:
+                g["markers"] = {str(k): np.asarray(c).tolist() for k, c in f["markers"].items()}
+            if "dots" in f:
+                g["dots"] = np.asarray(f["dots"]).tolist()
+            feats[oid] = g
+        return {
+            "rocklab_version": __version__, "seed": self.seed, "params": self.params,
+            "fps": self.fps, "size_px": list(self.size), "n_frames": self.n_frames,
+            "duration_s": self.n_frames / self.fps, "targets": self.targets,
+            "exposure_s": self.exposure_s, "rolling_shutter_readout_s": self.readout_s,
+            "noise_dn": self.noise_dn, "psf_sigma_px": 0.5,
+            "blocks": self.sims, "table": self.table.info | {"width_m": self.table_width_m,
+                                                              "thickness_m": TABLE_THICK_M},
+            "occlusions": [o.__dict__ for o in self.occluders],
+            "camera": cam, "features_object_frame": feats, "video": self.video_info, "imu": imu_info,
+            "conventions": {
+                "world": "rocking plane, x right, y up as seen by the camera, table top y = 0, m",
+                "theta_rad": "counter-clockwise angle seen by the camera (tracker convention) = "
+                             "-theta of rocklab.models.simulate with base = table ax_m_s2",
+                "t_s": "frame i is centred on t_s = i / fps (with rolling shutter: the middle row)",
+                "x_m, y_m": "blocks: centre of the front face; table: top centre of its front face",
+                "object_frame": "origin as x_m, y_m; x right, y up when upright",
+            },
+        }
+
+
+def build_scene(*, seed, blocks, table, fps, size, targets, duration_s, occlusion, rolling_shutter,
+                block, restitution, eta, theta0_rad, record, table_amplitude_m, table_period_s,
+                table_stroke_m, exposure_s, noise_dn, distortion) -> Scene:
+    from ._render import Occluder, RenderObject
+    from ._render_targets import block_texture, table_texture
+    from ._synth_camera import make_camera
+    from ._synth_motion import BlockMotion
+
+    ss = np.random.SeedSequence(seed)
+    s_cam, s_motion, s_tex, s_noise, s_imu, s_bg = ss.spawn(6)
+    rng_m = np.random.default_rng(s_motion)
+    blks = _blocks(block, blocks)
+    n = len(blks)
+    rest_s = 0.6
+    horizon = float(duration_s) if duration_s is not None else 12.0
+    tbl = _table_motion(table, rng_m, record=record, amplitude=table_amplitude_m, period=table_period_s,
+                        stroke=table_stroke_m, blocks=blks, start_s=rest_s, horizon_s=max(horizon, 3.0))
+    base = tbl.base_motion(horizon + 0.1)
+    spacing = 0.35
+    xs = [0.0] if n == 1 else [-spacing, 0.0, spacing]
+    if theta0_rad is None:
+        phi0 = [s * 0.5 * b.alpha_rad for s, b in zip((1, -1, 1), blks)]
+    else:
+        phi0 = list(np.broadcast_to(np.asarray(theta0_rad, float), (n,)))
+        for p, b in zip(phi0, blks):
+            if not abs(p) < b.alpha_rad:
+                raise InputError(f"theta0_rad={p!r}: must be within ±alpha = ±{b.alpha_rad:.4f} rad")
+    motions, sims, ends = [], [], [tbl.end_s]
+    for k, blk in enumerate(blks):
+        oid = f"block_{k + 1}"
+        if table == "none":
+            release = round(rest_s + 0.3 * k + float(rng_m.uniform(0.0, 0.1)), 4)
+            res = _simulate(blk, theta0_sim=-phi0[k], base=None, horizon_s=max(horizon - release, 0.5),
+                            restitution=restitution, eta=eta)
+            t = np.concatenate(([0.0], release + res.t_s))
+            ph = np.concatenate(([phi0[k]], -res.theta_rad))
+        else:
+            release = None
+            res = _simulate(blk, theta0_sim=0.0, base=base, horizon_s=horizon + 0.1,
+                            restitution=restitution, eta=eta)
+            t, ph = res.t_s, -res.theta_rad
+        ends.append(float(t[-1]))
+        motions.append(BlockMotion(oid, blk.b_m, blk.h_m, xs[k], t, ph, tbl, release))
+        imp = res.impacts
+        sims.append({"id": oid, "block": blk.to_dict() | {"alpha_rad": blk.alpha_rad, "R_m": blk.R_m,
+                                                         "p_rad_s": blk.p_rad_s, "eta_H": blk.eta_H},
+                     "x0_m": xs[k], "release_s": release,
+                     "theta0_rad": phi0[k] if table == "none" else 0.0,
+                     "restitution": restitution,
+                     "eta_true": (float(eta) if restitution == "constant" else
+                                  (blk.eta_H if restitution == "housner" else None)),
+                     "sim_status": res.status, "overturned": bool(res.overturned),
+                     "n_impacts": int(res.n_impacts),
+                     "impact_t_s": [float(v) + (release or 0.0) for v in imp["t_s"]] if len(imp) else [],
+                     "impact_eta": [float(v) for v in imp["eta"]] if len(imp) else [],
+                     "max_abs_theta_rad": float(res.max_abs_theta_rad)})
+    if duration_s is None:
+        duration_s = float(np.clip(max(ends) + 0.6, 2.0, 12.0))
+    n_frames = max(2, int(round(duration_s * fps)))
+    W, H = size
+    h_max = max(b.h_m for b in blks)
+    table_w = 0.8 if n == 1 else 1.2
+    stroke = {"none": 0.0, "sine": table_amplitude_m, "record": table_stroke_m}[table]
+    view_h = max(3.0 * h_max, (table_w + 2 * stroke + 0.1) * H / W)
+    cam = make_camera(size, (0.0, 0.4 * h_max), view_h, np.random.default_rng(s_cam), distortion=distortion)
+    maps = cam.plane_maps()
+    mpp = cam.m_per_px((0.0, 0.5 * h_max))
+    texel, psf_m = mpp / 4.0, 0.5 * mpp
+    rng_t = np.random.default_rng(s_tex)
+    objects, feats = [], {}
+    tt = table_texture(table_w, TABLE_THICK_M, targets, marker_ids=(0, 7), marker_size_m=0.75 * TABLE_THICK_M,
+                       texel_m=texel, psf_px_m=psf_m, rng=rng_t)
+    objects.append(RenderObject("table", tt, lambda t, _tb=tbl: (_tb.u(t), np.zeros_like(np.asarray(t, float)),
+                                                                np.zeros_like(np.asarray(t, float))),
+                                static=(table == "none")))
+    feats["table"] = dict(tt.features, size_m=[table_w, TABLE_THICK_M], origin="top centre of the front face")
+    for k, (blk, bm) in enumerate(zip(blks, motions)):
+        tex = block_texture(blk.b_m, blk.h_m, targets, marker_ids=(2 * k + 1, 2 * k + 2),
+                            marker_size_m=min(0.6 * blk.b_m, 0.3 * blk.h_m), texel_m=texel,
+                            psf_px_m=psf_m, rng=rng_t)
+        objects.append(RenderObject(bm.id, tex, bm.pose))
+        f = dict(tex.features, size_m=[blk.b_m, blk.h_m], origin="centre of the front face")
+        shift = np.array([0.0, blk.h_m / 2])         # body (bottom centre) -> face centre origin
+        if "markers" in f:
+            f["markers"] = {m: c - shift for m, c in f["markers"].items()}
+        if "dots" in f:
+            f["dots"] = f["dots"] - shift
+        feats[bm.id] = f
+    background, illum = _background(maps, size, targets, np.random.default_rng(s_bg))
+    occl = []
+    if occlusion is not None:
+        if isinstance(occlusion, dict):
+            occl.append(Occluder(str(occlusion.get("object", "block_1")), float(occlusion["t0_s"]),
+                                 float(occlusion["t1_s"])))
+        else:
+            t0, t1 = (float(v) for v in occlusion)
+            occl.append(Occluder("block_1", t0, t1))
+    exposure = 0.5 / fps if exposure_s is None else float(exposure_s)
+    params = {"blocks": blocks, "table": table, "fps": fps, "size": list(size), "targets": targets,
+              "duration_s": duration_s, "rolling_shutter": rolling_shutter, "restitution": restitution,
+              "eta": eta, "table_amplitude_m": table_amplitude_m, "table_period_s": table_period_s,
+              "table_stroke_m": table_stroke_m, "noise_dn": noise_dn, "distortion": distortion,
+              "layout": "independent blocks side by side" if n == 3 else "single block"}
+    return Scene(seed, fps, tuple(size), n_frames, targets, cam, maps, objects, motions, tbl, sims,
+                 params, occl, background, illum, exposure, (0.8 / fps) if rolling_shutter else 0.0,
+                 float(noise_dn), s_noise, s_imu, feats, table_w)
+
+
+def _background(maps, size, targets, rng):
+    """Wall (with faint blotches) above the table, the table's steel frame below; lighting field."""
+    import cv2
+
+    W, H = size
+    X, Y = maps
+    wall = 50.0 if targets == "edges" else 150.0
+    blot = cv2.resize(rng.standard_normal((6, 10)).astype(np.float32), (W, H), interpolation=cv2.INTER_CUBIC)
+    bg = wall + (3.0 if targets == "edges" else 6.0) * blot
+    bg = np.where(Y < -TABLE_THICK_M - 0.004, np.float32(72.0), bg).astype(np.float32)
+    u = (np.arange(W, dtype=np.float32) - W / 2) / (W / 2)
+    v = (np.arange(H, dtype=np.float32) - H / 2) / (W / 2)
+    psi = rng.uniform(0, 2 * np.pi)
+    grad = 0.92 + 0.1 * (np.cos(psi) * u[None, :] + np.sin(psi) * v[:, None])
+    vign = 1.0 - 0.12 * (u[None, :] ** 2 + v[:, None] ** 2)
+    return bg, (grad * vign).astype(np.float32)

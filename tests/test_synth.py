@@ -1,0 +1,209 @@
+"""Synthetic lab sessions: determinism, truth consistency, sub-pixel rendering, files, CLI."""
+
+from __future__ import annotations
+
+import json
+
+import cv2
+import numpy as np
+import pandas as pd
+import pytest
+
+from rocklab import Block, InputError
+from rocklab.tracking import load_synth_session, synth_session
+
+SMALL = (320, 180)
+
+
+def _frames(path, n):
+    cap = cv2.VideoCapture(str(path))
+    out = []
+    for _ in range(n):
+        ok, f = cap.read()
+        assert ok
+        out.append(f[..., 0].copy())
+    cap.release()
+    return out
+
+
+@pytest.fixture(scope="module")
+def free_session(tmp_path_factory):
+    """One free-rocking block, 2.2 s, small frames (shared by several tests)."""
+    return synth_session(tmp_path_factory.mktemp("s") / "free", seed=5, size=SMALL, duration_s=2.2)
+
+
+def test_same_seed_same_session_other_seed_differs(tmp_path, free_session):
+    a = free_session
+    b = synth_session(tmp_path / "b", seed=5, size=SMALL, duration_s=2.2)
+    c = synth_session(tmp_path / "c", seed=6, size=SMALL, duration_s=2.2)
+    pd.testing.assert_frame_equal(a.truth, b.truth)
+    fa, fb, fc = _frames(a.video_mkv, 3), _frames(b.video_mkv, 3), _frames(c.video_mkv, 3)
+    assert all(np.array_equal(x, y) for x, y in zip(fa, fb))
+    assert a.meta["camera"] == b.meta["camera"]
+    # A different seed moves the camera, the release and the noise.
+    assert not np.array_equal(fa[0], fc[0])
+    assert a.meta["blocks"][0]["release_s"] != c.meta["blocks"][0]["release_s"]
+    assert not np.allclose(a.truth["theta_rad"], c.truth["theta_rad"])
+    # The FFV1 file is lossless: two reads of the same session give the same pixels,
+    # and the lossy mp4 differs from it but not by much.
+    fm = _frames(a.video_mp4, 1)[0].astype(float)
+    d = np.abs(fm - fa[0])
+    assert 0 < d.mean() < 4.0
+
+
+def test_truth_theta_is_the_simulator_with_the_sign_convention(free_session):
+    from rocklab.models import simulate
+
+    s = free_session
+    b = s.meta["blocks"][0]
+    blk = Block(b["block"]["b_m"], b["block"]["h_m"])
+    rel = b["release_s"]
+    res = simulate(blk, theta0_rad=-b["theta0_rad"], duration_s=5.0, dt_s=1e-4,
+                   restitution="constant", eta=b["eta_true"])
+    tr = s.truth[s.truth.object == "block_1"]
+    t = tr["t_s"].to_numpy()
+    expect = np.where(t < rel, b["theta0_rad"],
+                      -np.interp(t - rel, res.t_s, res.theta_rad, right=0.0))
+    np.testing.assert_allclose(tr["theta_rad"].to_numpy(), expect, rtol=0, atol=1e-12)
+    # It rocks (impacts recorded with the true constant eta) and the held block is tilted by +alpha/2.
+    assert b["n_impacts"] >= 3 and np.allclose(b["impact_eta"], 0.75)
+    assert b["theta0_rad"] == pytest.approx(0.5 * blk.alpha_rad)
+    # Pivoting on a bottom corner: the face centre sits at (b/2)|sin|+(h/2)cos above the table.
+    phi = tr["theta_rad"].to_numpy()
+    np.testing.assert_allclose(tr["y_m"], blk.b_m / 2 * np.abs(np.sin(phi)) + blk.h_m / 2 * np.cos(phi),
+                               atol=1e-12)
+
+
+def test_rendered_targets_sit_where_the_camera_projects_them(tmp_path):
+    """ArUco corners (cv2 detector, sub-pixel refinement) and dot centroids in a static
+    frame land on the truth projected with the camera saved in session.json."""
+    s = synth_session(tmp_path / "a", seed=2, size=(960, 540), duration_s=0.1, imu=False, mp4=False,
+                      noise_dn=0.5)
+    cam = s.camera
+    img = _frames(s.video_mkv, 1)[0]
+    params = cv2.aruco.DetectorParameters()
+    params.cornerRefinementMethod = cv2.aruco.CORNER_REFINE_SUBPIX
+    params.cornerRefinementWinSize = 4
+    params.cornerRefinementMinAccuracy = 1e-3
+    det = cv2.aruco.ArucoDetector(cv2.aruco.getPredefinedDictionary(cv2.aruco.DICT_4X4_50), params)
+    corners, ids, _ = det.detectMarkers(img)
+    assert ids is not None and sorted(ids.ravel().tolist()) == [0, 1, 2, 7]
+    truth0 = s.truth[s.truth.frame == 0].set_index("object")
+    feats = s.meta["features_object_frame"]
+    errs = []
+    for c, mid in zip(corners, ids.ravel()):
+        oid = next(o for o, f in feats.items() if str(mid) in f.get("markers", {}))
+        r = truth0.loc[oid]
+        ph = r.theta_rad
+        rot = np.array([[np.cos(ph), -np.sin(ph)], [np.sin(ph), np.cos(ph)]])
+        world = np.array(feats[oid]["markers"][str(mid)]) @ rot.T + [r.x_m, r.y_m]
+        errs.append(c.reshape(-1, 2) - cam.project(world))
+    e = np.concatenate(errs)
+    assert np.abs(e).max() < 0.3
+    assert np.abs(e.mean(axis=0)).max() < 0.05         # no systematic offset
+
+    d = synth_session(tmp_path / "d", seed=2, size=(960, 540), duration_s=0.1, imu=False, mp4=False,
+                      targets="dots", noise_dn=0.5)
+    img = _frames(d.video_mkv, 1)[0].astype(float)
+    truth0 = d.truth[d.truth.frame == 0].set_index("object")
+    f = d.meta["features_object_frame"]["block_1"]
+    r = truth0.loc["block_1"]
+    rot = np.array([[np.cos(r.theta_rad), -np.sin(r.theta_rad)], [np.sin(r.theta_rad), np.cos(r.theta_rad)]])
+    px = d.camera.project(np.array(f["dots"]) @ rot.T + [r.x_m, r.y_m])
+    rad = f["dot_diameter_m"] / 2 / d.camera.m_per_px((r.x_m, r.y_m))
+    for u, v in px:   # darkness-weighted centroid in a window of 1.6 dot radii
+        uu, vv = np.meshgrid(np.arange(img.shape[1]), np.arange(img.shape[0]))
+        m = np.hypot(uu - u, vv - v) < 1.6 * rad
+        w = np.clip(235.0 * 0.9 - img, 0, None) * m   # white paper ~ 238 * lighting
+        w = np.where(w > 20, w, 0)
+        cu, cv = (w * uu).sum() / w.sum(), (w * vv).sum() / w.sum()
+        assert np.hypot(cu - u, cv - v) < 0.08
+
+
+def test_table_sine_pulse_truth_is_kinematically_consistent(tmp_path):
+    s = synth_session(tmp_path / "t", seed=1, size=SMALL, table="sine", duration_s=2.0, fps=100,
+                      imu=False, mp4=False)
+    tb = s.truth[s.truth.object == "table"]
+    x, v, a = (tb[c].to_numpy() for c in ("x_m", "vx_m_s", "ax_m_s2"))
+    dt = 1 / s.fps
+    # Thesis Fig. 31: 45 mm amplitude, 0.6 s, starting and ending at rest.
+    assert np.abs(x).max() == pytest.approx(0.045, rel=1e-3)
+    assert x[0] == 0 and x[-1] == pytest.approx(0.0, abs=1e-12) and v[-1] == pytest.approx(0.0, abs=1e-12)
+    a_fd = (x[2:] - 2 * x[1:-1] + x[:-2]) / dt**2
+    assert np.sqrt(np.mean((a_fd - a[1:-1]) ** 2)) < 0.02 * np.abs(a).max()
+    np.testing.assert_allclose(np.gradient(x, dt)[5:-5], v[5:-5], atol=0.01 * np.abs(v).max())
+    # The block rode the pulse: it rocked, did not fall, and moved with the table when at rest.
+    b = s.meta["blocks"][0]
+    assert b["n_impacts"] > 0 and not b["overturned"]
+    blk = s.truth[s.truth.object == "block_1"]
+    still = np.abs(blk["theta_rad"].to_numpy()) < 1e-12
+    np.testing.assert_allclose(blk["x_m"].to_numpy()[still], x[still], atol=1e-12)
+
+
+def test_record_table_fits_the_stroke_and_three_blocks(tmp_path):
+    s = synth_session(tmp_path / "r", seed=0, size=SMALL, blocks=3, table="record", duration_s=4.0,
+                      fps=25, imu=False, mp4=False, table_stroke_m=0.05)
+    tb = s.truth[s.truth.object == "table"]
+    assert np.abs(tb["x_m"]).max() <= 0.05 + 1e-9
+    assert s.meta["table"]["record"] == "elcentro"
+    assert sorted(s.truth["object"].unique()) == ["block_1", "block_2", "block_3", "table"]
+    import tomllib
+
+    cfg = tomllib.loads(s.track_toml.read_text())
+    ids = [m for o in cfg["objects"] for m in o["markers"]]
+    assert len(ids) == len(set(ids)) == 8
+
+
+def test_imu_logs_read_back_with_the_x_imu_reader(free_session, shared_data):
+    from rocklab.tracking import block_rotation, read_imu
+
+    s = free_session
+    real = shared_data / "imu" / "x-imu-matlab-library-example" / "00000_CalInertialAndMag.csv"
+    ours = s.imu["block_1"] / "block_1_CalInertialAndMag.csv"
+    assert ours.read_text().splitlines()[0] == real.read_text().splitlines()[0]
+    info = s.meta["imu"]["block_1"]
+    log = read_imu(s.imu["block_1"])
+    assert log.rate_hz == 256 and log.dropped_samples == info["dropped_samples"] > 0
+    rot = block_rotation(log, axis="y")
+    tr = s.truth[s.truth.object == "block_1"]
+    th = np.interp(tr["t_s"], rot.t_s + info["t0_video_s"], rot.theta_rad)
+    # IMU y is the rocking axis away from the camera: its angle is -theta_rad.
+    assert np.max(np.abs(th + tr["theta_rad"])) < np.deg2rad(0.5)
+    assert rot.release_t_s + info["t0_video_s"] == pytest.approx(s.meta["blocks"][0]["release_s"], abs=0.01)
+
+
+def test_configs_load_with_their_readers(free_session):
+    from rocklab.pipelines._config import load_experiment
+    from rocklab.tracking import load_track_config
+
+    s = free_session
+    cfg = load_track_config(s.track_toml)
+    assert cfg.targets.marker_size_m == pytest.approx(0.06)
+    assert [o.id for o in cfg.objects] == ["table", "block_1"]
+    assert cfg.object("block_1").marker_positions_m == ((0.0, -0.05), (0.0, 0.05))
+    np.testing.assert_allclose(cfg.video.camera_matrix, s.meta["camera"]["camera_matrix"])
+    exp = load_experiment(s.experiment_toml)
+    assert (exp.b_m, exp.h_m) == (0.1, 0.2) and exp.video.object == "block_1"
+    assert load_synth_session(s.out_dir).truth.equals(s.truth)
+
+
+def test_bad_input_and_overwrite_protection(tmp_path, run_cli, capsys):
+    rc, out, err = run_cli("synth", "--out", tmp_path / "x", "--size", "big")
+    assert rc == 2 and len(err.strip().splitlines()) == 1 and "size" in err
+    with pytest.raises(SystemExit) as e:          # argparse choices: one line, status 2
+        run_cli("synth", "--out", tmp_path / "x", "--targets", "qr")
+    err = capsys.readouterr().err
+    assert e.value.code == 2 and len(err.strip().splitlines()) == 1 and "targets" in err
+    assert not (tmp_path / "x").exists()
+    with pytest.raises(InputError, match="table"):
+        synth_session(tmp_path / "y", table="shake", size=SMALL)
+    (tmp_path / "full").mkdir()
+    (tmp_path / "full" / "keep.txt").write_text("mine")
+    rc, out, err = run_cli("synth", "--out", tmp_path / "full", "--size", "160x90", "--duration", "0.1")
+    assert rc == 2 and "--force" in err and (tmp_path / "full" / "keep.txt").read_text() == "mine"
+    rc, out, err = run_cli("synth", "--out", tmp_path / "ok", "--size", "160x90", "--duration", "0.2",
+                           "--json", "--no-imu")
+    assert rc == 0
+    d = json.loads(out)
+    assert d["n_frames"] == 10 and d["size"] == [160, 90]
+    assert not [p for p in tmp_path.iterdir() if p.name.startswith(".ok.")]   # temp folder renamed

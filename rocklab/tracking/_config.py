@@ -38,8 +38,14 @@ matching truth):
   ``edges``/``region`` the centre of ``roi`` in the first frame.
 * ``theta_rad``: counter-clockwise rotation of the object frame relative to
   the world frame as seen by the camera (levelled). A marker printed upright
-  reads 0; ``dots`` read 0 when laid out as given; ``edges``/``region`` read
-  0 at the first frame, unless ``theta0_rad`` is given.
+  reads 0; ``dots`` read 0 when laid out as given; ``edges`` read 0 when the
+  outline's sides are vertical/horizontal; ``region`` reads ``theta0_rad``
+  (default 0) at the first frame. In the ``edges`` style a ``table`` object is
+  followed by the region tracker and its angle is the image angle of the
+  strongest near-horizontal edge in its ``roi`` (the table top), so levelling
+  from the table works.
+* ``roi = [u, v, w, h]`` is in continuous pixel coordinates (pixel centres at
+  integers); its centre is ``(u + w/2, v + h/2)``.
 """
 
 from __future__ import annotations

@@ -1,0 +1,250 @@
+"""Markerless blocks: the outline against a contrasting background.
+
+Per frame, inside a window around the predicted outline: threshold (Otsu or
+``targets.edge_threshold``), take the block's connected region, get a first
+rectangle from ``cv2.minAreaRect``, then locate each side to sub-pixel
+precision from grey-level profiles across it (the crossing of the level midway
+between block and background) and fit a robust (Huber) line per side. The four
+line intersections are the corners handed to the rigid fit. Binary contours
+alone would quantise a near-vertical side to a pixel column and bias θ by up
+to 1 px / side length.
+
+``table`` objects in this style are followed with the region tracker
+(:mod:`._region`): give their ``roi`` on the textured table edge.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ._aruco import Detection
+from ._region import RegionTracker
+
+__all__ = ["EdgeDetector", "refine_rectangle"]
+
+_SIGNS = np.array([[-1, 1], [1, 1], [1, -1], [-1, -1]], float)  # TL, TR, BR, BL (y up)
+
+
+def _line_intersection(l1, l2):
+    (p1, d1), (p2, d2) = l1, l2
+    A = np.array([d1, -d2]).T
+    t = np.linalg.solve(A, p2 - p1)
+    return p1 + t[0] * d1
+
+
+def refine_rectangle(gray, corners, half=6.0, step=2.0, trim=0.15):
+    """Sub-pixel rectangle from an approximate one.
+
+    Parameters
+    ----------
+    gray : ndarray (H, W) uint8
+    corners : ndarray (4, 2)
+        Approximate corners (px) in order around the outline.
+    half : float
+        Half-length of each grey profile across a side (px).
+    step : float
+        Spacing of profiles along a side (px).
+    trim : float
+        Fraction of each side ignored at both ends (corners are rounded by blur).
+
+    Returns
+    -------
+    corners : ndarray (4, 2) or None
+    rms_px : float
+        RMS distance of the edge points from their fitted lines.
+    n_points : int
+    """
+    import cv2
+
+    c = np.asarray(corners, float)
+    centre = c.mean(0)
+    lines, res, npts = [], [], 0
+    offs = np.arange(-half, half + 0.5, 0.5)
+    for k in range(4):
+        a, b = c[k], c[(k + 1) % 4]
+        L = np.hypot(*(b - a))
+        if L < 8:
+            return None, np.inf, 0
+        d = (b - a) / L
+        nrm = np.array([-d[1], d[0]])
+        if np.dot(centre - a, nrm) > 0:
+            nrm = -nrm  # outward normal
+        s = np.arange(trim * L, (1 - trim) * L, step)
+        base = a + s[:, None] * d
+        pts = base[:, None, :] + offs[None, :, None] * nrm  # (m, p, 2), inside -> outside
+        mx = pts[..., 0].astype(np.float32)
+        my = pts[..., 1].astype(np.float32)
+        prof = cv2.remap(gray, mx, my, cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE
+                         ).astype(float)
+        inside = prof[:, :3].mean(1, keepdims=True)
+        outside = prof[:, -3:].mean(1, keepdims=True)
+        contrast = outside - inside
+        ok = np.abs(contrast[:, 0]) > 15
+        f = (prof - inside) / np.where(np.abs(contrast) > 1e-9, contrast, 1.0)  # 0 inside .. 1 out
+        # first crossing of 0.5 from inside
+        above = f >= 0.5
+        j = np.argmax(above, axis=1)
+        ok &= above.any(axis=1) & (j > 0)
+        j = np.clip(j, 1, len(offs) - 1)
+        r = np.arange(len(j))
+        f0, f1 = f[r, j - 1], f[r, j]
+        den = f1 - f0
+        frac = np.divide(0.5 - f0, den, out=np.full_like(den, 0.5), where=den != 0)
+        off = offs[j - 1] + frac * 0.5
+        edge = base + off[:, None] * nrm
+        edge = edge[ok]
+        if len(edge) < 5:
+            return None, np.inf, 0
+        vx, vy, x0, y0 = cv2.fitLine(edge.astype(np.float32), cv2.DIST_HUBER, 0, 0.01, 0.01).ravel()
+        dvec = np.array([vx, vy], float)
+        p0 = np.array([x0, y0], float)
+        dist = (edge - p0) @ np.array([-dvec[1], dvec[0]])
+        res.append(dist)
+        npts += len(edge)
+        lines.append((p0, dvec))
+    out = np.array([_line_intersection(lines[(k - 1) % 4], lines[k]) for k in range(4)])
+    r = np.concatenate(res)
+    return out, float(np.sqrt(np.mean(r ** 2))), npts
+
+
+def horizontal_edge_angle(gray, roi, plane_map):
+    """Plane angle (rad, ccw) of the strongest near-horizontal edge in ``roi`` (u, v, w, h px).
+
+    Per column, the sub-pixel row of the largest vertical grey gradient
+    (parabola through the peak), then a Huber line fit.
+    """
+    import cv2
+
+    u, v, w, h = (int(round(x)) for x in roi)
+    crop = gray[max(v, 0):v + h, max(u, 0):u + w].astype(np.float32)
+    gy = np.abs(cv2.Sobel(crop, cv2.CV_32F, 0, 1, ksize=3))
+    rows = np.argmax(gy[1:-1], axis=0) + 1
+    cols = np.arange(gy.shape[1])
+    g0, g1, g2 = gy[rows - 1, cols], gy[rows, cols], gy[rows + 1, cols]
+    den = g0 - 2 * g1 + g2
+    sub = rows + np.divide(0.5 * (g0 - g2), den, out=np.zeros_like(den), where=den != 0)
+    strong = g1 > 0.5 * np.median(g1)
+    pts = np.column_stack((cols[strong] + max(u, 0), sub[strong] + max(v, 0))).astype(np.float32)
+    if len(pts) < 5:
+        return 0.0
+    vx, vy, x0, y0 = cv2.fitLine(pts, cv2.DIST_HUBER, 0, 0.01, 0.01).ravel()
+    q = plane_map.to_plane(np.array([[x0, y0], [x0 + 100 * vx, y0 + 100 * vy]]))
+    d = q[1] - q[0]
+    if d[0] < 0:
+        d = -d
+    return float(np.arctan2(d[1], d[0]))
+
+
+class EdgeDetector:
+    """Stateful detector for the ``edges`` style (blocks; tables via :class:`RegionTracker`)."""
+
+    def __init__(self, config, plane_map, first_gray):
+        self.cfg = config
+        self.pm = plane_map
+        self.thr = config.targets.edge_threshold
+        self.state = {}
+        self.regions = {}
+        for o in config.objects:
+            if o.kind == "table":
+                if o.theta0_rad is None:
+                    import dataclasses
+
+                    # The table top's image angle, so that levelling from the table works.
+                    o = dataclasses.replace(o, theta0_rad=horizontal_edge_angle(first_gray, o.roi,
+                                                                               plane_map))
+                self.regions[o.id] = RegionTracker(o, plane_map, first_gray)
+        self.size = {o.id: o.size_m for o in config.objects}
+        self.polarity = {}
+        self.ref_px = {}
+
+    def _outline(self, gray, box, oid):
+        """Approximate corners (4, 2) of the block region inside ``box``."""
+        import cv2
+
+        H, W = gray.shape
+        x0, y0, x1, y1 = (int(max(box[0], 0)), int(max(box[1], 0)), int(min(box[2], W)),
+                          int(min(box[3], H)))
+        if x1 - x0 < 8 or y1 - y0 < 8:
+            return None
+        crop = gray[y0:y1, x0:x1]
+        if oid not in self.polarity:
+            h, w = crop.shape
+            centre = np.median(crop[h // 3:2 * h // 3, w // 3:2 * w // 3])
+            border = np.median(np.r_[crop[0], crop[-1], crop[:, 0], crop[:, -1]])
+            self.polarity[oid] = centre > border
+        if self.thr is None:
+            _, binary = cv2.threshold(crop, 0, 255, cv2.THRESH_BINARY + cv2.THRESH_OTSU)
+        else:
+            _, binary = cv2.threshold(crop, self.thr, 255, cv2.THRESH_BINARY)
+        if not self.polarity[oid]:
+            binary = 255 - binary
+        n, lab, stats, _ = cv2.connectedComponentsWithStats(binary, connectivity=4)
+        if n < 2:
+            return None
+        k = 1 + int(np.argmax(stats[1:, cv2.CC_STAT_AREA]))
+        pts = np.column_stack(np.nonzero(lab == k)[::-1]).astype(np.float32)
+        if len(pts) < 50:
+            return None
+        rect = cv2.minAreaRect(pts)
+        return cv2.boxPoints(rect).astype(float) + (x0, y0)
+
+    def _order(self, corners, theta_prev):
+        """Corners as TL, TR, BR, BL of the object (plane y up), given the previous angle."""
+        q = self.pm.to_plane(corners)
+        cq = q - q.mean(0)
+        c, s = np.cos(-theta_prev), np.sin(-theta_prev)
+        rq = cq @ np.array([[c, s], [-s, c]])
+        order = [int(np.argmax(rq @ sgn)) for sgn in _SIGNS]
+        if len(set(order)) < 4:
+            return None
+        return corners[order]
+
+    def detect(self, gray, frame):
+        out = {}
+        for o in self.cfg.objects:
+            if o.id in self.regions:
+                out[o.id] = self.regions[o.id].detect(gray, frame)
+                continue
+            st = self.state.get(o.id)
+            if st is None:
+                u, v, w, h = o.roi
+                box = (u - 0.1 * w, v - 0.1 * h, u + 1.1 * w, v + 1.1 * h)
+                theta_prev = o.theta0_rad or 0.0
+            else:
+                pc = st["corners"]
+                span = np.ptp(pc, axis=0).max()
+                m = 0.15 * span
+                box = (pc[:, 0].min() - m, pc[:, 1].min() - m, pc[:, 0].max() + m, pc[:, 1].max() + m)
+                theta_prev = st["theta"]
+            approx = self._outline(gray, box, o.id)
+            if approx is None:
+                out[o.id] = None
+                continue
+            approx = self._order(approx, theta_prev)
+            if approx is None:
+                out[o.id] = None
+                continue
+            corners, rms, npts = refine_rectangle(gray, approx)
+            if corners is not None:
+                corners2, rms, npts = refine_rectangle(gray, corners, half=4.0)
+                corners = corners2 if corners2 is not None else corners
+            if corners is None:
+                out[o.id] = None
+                continue
+            q = self.pm.to_plane(corners)
+            d = q[1] - q[0]
+            theta = float(np.arctan2(d[1], d[0]))
+            self.state[o.id] = {"corners": corners, "theta": theta}
+            if self.size[o.id] is not None:
+                b, h = self.size[o.id]
+                obj = _SIGNS * (b / 2, h / 2)
+                metric = True
+            else:
+                if o.id not in self.ref_px:
+                    self.ref_px[o.id] = (np.hypot(*(q[1] - q[0])) + np.hypot(*(q[2] - q[3]))) / 2, \
+                        (np.hypot(*(q[0] - q[3])) + np.hypot(*(q[1] - q[2]))) / 2
+                bw, bh = self.ref_px[o.id]
+                obj = _SIGNS * (bw / 2, bh / 2)
+                metric = False
+            out[o.id] = Detection(corners, obj, metric, 4)
+        return out

@@ -168,6 +168,8 @@ class Renderer:
 
     def render(self, t_s: float) -> np.ndarray:
         """The frame centred on time ``t_s`` (s) as uint8 (H, W)."""
+        import cv2
+
         frame = self.bg_u8.copy()
         t_lo, t_hi = self._span(t_s)
         span = np.linspace(t_lo, t_hi, 9)
@@ -207,7 +209,7 @@ class Renderer:
             k = int(self.rng.integers(len(self.noise_bank)))
             dy, dx = (int(v) for v in self.rng.integers(0, 17, 2))
             noise = self.noise_bank[k][dy:dy + self.H, dx:dx + self.W]
-            frame = np.clip(frame.astype(np.int16) + noise, 0, 255).astype(np.uint8)
+            frame = cv2.add(frame, noise, dtype=cv2.CV_8U)      # saturating, one pass
         return frame
 
     def _occluder_boxes(self, t_s):

@@ -131,6 +131,12 @@ class SynthCamera:
             Y[r0:r0 + len(v)] = yy
         return X, Y
 
+    def plane_homography(self) -> np.ndarray:
+        """3x3 homography from *undistorted* pixel coordinates (same ``K``) to the plane, m."""
+        Hm = self.K @ np.column_stack([self.R[:, 0], self.R[:, 1], self.t])
+        Hinv = np.linalg.inv(Hm)
+        return Hinv / Hinv[2, 2]
+
     def m_per_px(self, xy_m=(0.0, 0.0)) -> float:
         """Approximate plane scale at ``xy_m``, m/px."""
         p = self.project(np.array([xy_m, (xy_m[0] + 0.01, xy_m[1])]))
@@ -141,6 +147,7 @@ class SynthCamera:
         return {"size_px": [int(self.size[0]), int(self.size[1])],
                 "camera_matrix": self.K.tolist(), "dist_coeffs": self.dist.tolist(),
                 "rvec": self.rvec.tolist(), "tvec_m": self.t.tolist(), "R": self.R.tolist(),
+                "homography_undistorted_px_to_plane_m": self.plane_homography().tolist(),
                 "model": "OpenCV pinhole + (k1, k2, p1, p2, k3); world plane z=0, x right, "
                          "y up, z towards the camera; x_cam = R x_world + t"}
 

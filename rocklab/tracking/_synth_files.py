@@ -83,6 +83,8 @@ def write_track_toml(path: Path, *, style, fps, camera, objects, marker_size_m, 
                      calibrated=True) -> str:
     """``track.toml`` through the tracker's own schema (:class:`TrackConfig`).
 
+    ``calibrated``: write the camera matrix, distortion and plane homography
+    (else the tracker works from the marker size / dot layout alone).
     ``objects``: list of dicts with ``id, kind`` and ``markers`` +
     ``marker_positions_m`` / ``dots`` / ``roi`` + ``size_m`` + ``theta0_rad``.
     Validated by parsing it back with :func:`load_track_config`.
@@ -95,8 +97,12 @@ def write_track_toml(path: Path, *, style, fps, camera, objects, marker_size_m, 
          "reference": {"level": "table"},
          "objects": []}
     if calibrated:
+        # A calibrated lab: lens model plus the plane homography (undistorted px -> m), so
+        # tracked positions are absolute in the session's world frame and perspective does
+        # not bias angles.
         d["video"]["camera_matrix"] = camera.K.tolist()
         d["video"]["dist_coeffs"] = camera.dist.tolist()
+        d["reference"]["homography"] = camera.plane_homography().tolist()
     if style == "aruco":
         d["targets"].update(dictionary="DICT_4X4_50", marker_size_m=float(marker_size_m))
     elif style == "dots":

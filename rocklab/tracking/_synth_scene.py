@@ -178,10 +178,6 @@ class Scene:
         from .. import __version__
 
         cam = self.camera.to_dict()
-        K, R, t = self.camera.K, self.camera.R, self.camera.t
-        Hm = K @ np.column_stack([R[:, 0], R[:, 1], t])
-        Hinv = np.linalg.inv(Hm)
-        cam["homography_undistorted_px_to_plane_m"] = (Hinv / Hinv[2, 2]).tolist()
         feats = {}
         for oid, f in self.features.items():
             g = {k: v for k, v in f.items() if k not in ("markers", "dots")}

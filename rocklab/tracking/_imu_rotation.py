@@ -38,7 +38,7 @@ import numpy as np
 from .._errors import InputError
 from ..blocks import G
 from ._imu_motion import (axis_vector, cumtrapz, first_motion, last_motion_end, motion_mask,
-                          quat_mul, tilt_about, twist_angle)
+                          moving_average, quat_mul, tilt_about, twist_angle)
 from ._imu_read import ImuLog
 
 __all__ = ["ImuRotation", "block_rotation", "ahrs_rotation", "ahrs_quaternions"]
@@ -193,10 +193,12 @@ def block_rotation(log: ImuLog, axis: str | None = None, *, ahrs: bool = False,
         u = np.linalg.svd(mv - 0.0, full_matrices=False)[2][0]
     else:
         u = axis_vector(axis)
+    omega = w @ u
+    if has_end:
+        e0 = _strict_rest_start(omega, e0, e1, float(np.std(omega[s0:s1])), fs, min_rest)
     f_start = acc[s0:s1].mean(axis=0)
     f_end = acc[e0:e1].mean(axis=0) if has_end else None
     f_ref = f_end if has_end else _vertical_axis(f_start)
-    omega = w @ u
     integ = cumtrapz(t, omega)
     th_start = float(tilt_about(u, f_ref, f_start))
     ts_mid, is_mean = t[s0:s1].mean(), integ[s0:s1].mean()
@@ -225,6 +227,24 @@ def block_rotation(log: ImuLog, axis: str | None = None, *, ahrs: bool = False,
     return ImuRotation(t, theta, omega, acc, u, bias_total, th_start, float(drift), release,
                        impacts, rest_t, fs, log.dropped_samples, log.format, log.source,
                        ahrs_theta, ahrs_rms, status, msg)
+
+
+def _strict_rest_start(omega, e0, e1, sigma, fs, min_rest) -> int:
+    """Start of the final rest by a stricter test than the motion mask.
+
+    Decaying rocking wobbles below the 2 deg/s motion threshold for a while;
+    anchoring on that would bias the upright reference.  Rest here means the
+    0.25 s mean square of omega stays below ``sigma^2 (1 + 6 sqrt(2 / w)) +
+    (0.02 deg/s)^2`` (``sigma``: rate noise in the first rest window, ``w`` the
+    window in samples: 6 standard deviations of a noise-only mean square)
+    until the end of the log.
+    """
+    w = max(2, int(round(0.25 * fs)))
+    thr = sigma ** 2 * (1.0 + 6.0 * np.sqrt(2.0 / w)) + np.deg2rad(0.02) ** 2
+    busy = moving_average(omega[e0:e1] ** 2, w) >= thr
+    hits = np.flatnonzero(busy)
+    start = e0 if hits.size == 0 else e0 + int(hits[-1]) + 1 + w // 2
+    return start if e1 - start >= min_rest else e0
 
 
 def _release_time(t, omega, i_move, s0, s1) -> float:

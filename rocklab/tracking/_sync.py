@@ -8,14 +8,17 @@ Method (``sync_offset``)
 1. Coarse: both rates resampled on a common 1 kHz grid (a box-filtered to
    b's differentiation window), normalised cross-correlation, parabolic
    interpolation of the peak.
-2. Fine: least squares on the *integrated* rates (angles, which do not amplify
-   a video track's noise the way differences do): minimise over the offset
-   the residual of ``B(t_b) - A_w(t_b + offset)`` after removing a constant and
-   a linear trend (integration constant, gyro bias residual), with ``A_w`` the
-   integral of a's rate smoothed by b's window.
-3. Drift (long logs): the fine fit in consecutive windows, a straight line
-   through the window offsets; ``residual_ms`` is the RMS scatter of the
-   window offsets about the fitted clock model.
+2. Fine: least squares.  With a differentiated track (``window_b_s > 0``) on
+   the *integrated* rates (angles, which do not amplify the track's noise the
+   way differences do): minimise over the offset the residual of
+   ``B(t_b) - A_w(t_b + offset)`` after removing a constant and a linear trend
+   (integration constant, gyro bias residual), with ``A_w`` the integral of
+   a's rate smoothed by b's window.  Two gyros: on the rates themselves.
+3. Windows: the fine fit in consecutive windows (101-point scan over +-max(50 ms,
+   1000 ppm of the overlap) around the global offset, kept when the fit
+   explains half of the window's variance); with drift (long logs) a straight
+   line through the window offsets.  ``residual_ms`` is the RMS scatter of
+   the window offsets about the clock model.
 """
 
 from __future__ import annotations
@@ -48,7 +51,7 @@ class SyncResult:
     n_windows : int
         Windows with enough motion used for the drift / residual.
     window_t_s, window_offset_s : ndarray
-        Window centres (b clock) and their offsets, s.
+        Window times (b clock; slope-weighted centroids) and their offsets, s.
     sign : int
         +1, or -1 when b's rate is a's with the opposite sign convention
         (b was flipped before the fit).
@@ -92,17 +95,32 @@ def _clean(t, y, name):
 
 
 def _box(t, y, w):
-    """Rate box-filtered over width ``w`` (s), via the integral; returns a callable."""
-    Y = cumtrapz(t, y)
+    """Rate box-filtered over width ``w`` (s), via the integral; returns a callable.
+
+    Cubic interpolation: linear interpolation of a band-limited signal biases
+    sub-sample offsets towards the sample grid (a ripple in the cost).
+    """
+    from scipy.interpolate import make_interp_spline
+
     if w <= 0:
-        return lambda x: np.interp(x, t, y)
-    return lambda x: (np.interp(x + 0.5 * w, t, Y) - np.interp(x - 0.5 * w, t, Y)) / w
+        return make_interp_spline(t, y, k=3)
+    Y = make_interp_spline(t, cumtrapz(t, y), k=3)
+    return lambda x: (Y(x + 0.5 * w) - Y(x - 0.5 * w)) / w
 
 
-def _coarse(ta, fa, tb, yb, fs, max_offset_s):
+def _lowpass(t, y, fc):
+    from scipy.signal import butter, sosfiltfilt
+
+    fs = 1.0 / float(np.median(np.diff(t)))
+    if fc >= 0.45 * fs or y.size < 30:
+        return y
+    return sosfiltfilt(butter(4, fc, fs=fs, output="sos"), y)
+
+
+def _coarse(span_a, fa, tb, yb, fs, max_offset_s, center=0.0):
     from scipy.signal import correlate, correlation_lags
 
-    ga = np.arange(ta[0], ta[-1], 1.0 / fs)
+    ga = np.arange(span_a[0], span_a[1], 1.0 / fs)
     gb = np.arange(tb[0], tb[-1], 1.0 / fs)
     a = fa(ga)
     b = np.interp(gb, tb, yb)
@@ -112,7 +130,7 @@ def _coarse(ta, fa, tb, yb, fs, max_offset_s):
     lags = correlation_lags(a.size, b.size, mode="full")
     off = ga[0] - gb[0] + lags / fs
     if max_offset_s is not None:
-        c = np.where(np.abs(off) <= max_offset_s, c, -np.inf)
+        c = np.where(np.abs(off - center) <= max_offset_s, c, np.nan)
     k = int(np.argmax(np.where(np.isfinite(c), np.abs(c), -np.inf)))
     den = np.sqrt(np.sum(a * a) * np.sum(b * b)) or 1.0
     corr = float(c[k] / den)
@@ -125,28 +143,53 @@ def _coarse(ta, fa, tb, yb, fs, max_offset_s):
     return float(off[k] + frac / fs), corr
 
 
-def _fine(ta, A, tb, B, guess, half):
-    """Offset minimising the detrended angle residual near ``guess`` (+- ``half``)."""
+def _fine(ta, A, tb, B, guess, half, detrend=True, scan=None):
+    """Offset minimising the residual ``B - A(t + offset)`` near ``guess`` (+- ``half``).
+
+    The mean is always removed; ``detrend`` also removes a linear trend
+    (integration constant and residual gyro bias of angles).  ``scan``: first
+    evaluate the cost on these candidate offsets and start from the best.
+    Returns ``(offset, explained, t_c)``: ``explained`` = 1 - cost / variance
+    of B; ``t_c`` the time the offset refers to, the centroid of the samples
+    weighted by the squared slope of the model (where the timing information
+    is; with drift inside the window this, not the window middle, is the time
+    the fitted offset belongs to).
+    """
     from scipy.optimize import minimize_scalar
+
+    x_all = tb - tb.mean()
+
+    def resid0(y, x):
+        y = y - y.mean()
+        if detrend and x @ x > 0:
+            y = y - x * (x @ y) / (x @ x)
+        return y
 
     def cost(off):
         m = (tb + off > ta[0]) & (tb + off < ta[-1])
         if m.sum() < 8:
             return np.inf
-        r = B[m] - A(tb[m] + off)
-        x = tb[m] - tb[m].mean()
-        r = r - r.mean()
-        r = r - x * (x @ r) / (x @ x)
+        r = resid0(B[m] - A(tb[m] + off), x_all[m])
         return float(r @ r) / m.sum()
 
+    if scan is not None and len(scan):
+        c = np.array([cost(o) for o in scan])
+        guess = float(scan[int(np.argmin(c))])
     res = minimize_scalar(cost, bounds=(guess - half, guess + half), method="bounded",
                           options={"xatol": 1e-6})
-    return float(res.x), float(res.fun)
+    r0 = resid0(B, x_all)
+    var = float(r0 @ r0) / max(1, B.size)
+    off = float(res.x)
+    m = (tb + off > ta[0]) & (tb + off < ta[-1])
+    slope = A.derivative()(tb[m] + off) if hasattr(A, "derivative") else np.gradient(A(tb[m] + off), tb[m])
+    wgt = slope ** 2
+    t_c = float(wgt @ tb[m] / wgt.sum()) if wgt.sum() > 0 else float(tb[m].mean())
+    return off, (1.0 - float(res.fun) / var) if var > 0 else 0.0, t_c
 
 
 def sync_offset(t_a, rate_a, t_b, rate_b, *, max_offset_s: float | None = None,
                 window_b_s: float = 0.0, drift: bool | str = "auto", window_s: float | None = None,
-                grid_hz: float = 1000.0) -> SyncResult:
+                grid_hz: float = 1000.0, theta_b=None) -> SyncResult:
     """Clock offset (and drift) between two angular-rate recordings.
 
     Parameters
@@ -166,26 +209,55 @@ def sync_offset(t_a, rate_a, t_b, rate_b, *, max_offset_s: float | None = None,
         Window length for drift / residual, s (default: overlap / 6, >= 1 s).
     grid_hz : float
         Grid rate of the coarse cross-correlation, Hz.
+    theta_b : array_like (m,), optional
+        b's angles (rad) when b is a track: the fine fit then compares them
+        with a's integrated rate directly (no gap-bridging integration of b).
 
     Returns
     -------
     SyncResult
     """
     ta, ya = _clean(t_a, rate_a, "a")
+    if theta_b is not None:
+        th_all = np.asarray(theta_b, float).ravel()
+        if th_all.shape != np.shape(np.ravel(t_b)):
+            raise InputError("sync: theta_b and t_b differ in length; pass matching arrays")
     tb, yb = _clean(t_b, rate_b, "b")
+    if window_b_s <= 0 and theta_b is None:
+        # Two gyros: the same zero-phase low-pass on both (a quarter of the lower
+        # rate).  Interpolating white noise lowers its variance between samples,
+        # which would pull the offset towards half-sample shifts.
+        fc = 0.25 / max(np.median(np.diff(ta)), np.median(np.diff(tb)))
+        ya, yb = _lowpass(ta, ya, fc), _lowpass(tb, yb, fc)
     fa = _box(ta, ya, window_b_s)
-    off0, corr = _coarse(ta, fa, tb, yb, grid_hz, max_offset_s)
+    off0, corr = _coarse((ta[0], ta[-1]), fa, tb, yb, grid_hz, max_offset_s)
     sign = -1 if corr < 0 else 1
     yb = sign * yb
-    # Angles: a's smoothed rate integrated on a's grid, b's rate integrated on its own.
-    A_rate = fa(ta)
-    Aint = cumtrapz(ta, A_rate)
+    use_angle = window_b_s > 0 or theta_b is not None
+    if theta_b is not None:
+        # Fine fit on b's own angles (finite samples) against a's integrated rate.
+        tt = np.asarray(t_b, float).ravel()
+        ok = np.isfinite(tt) & np.isfinite(th_all)
+        tB, B = tt[ok], sign * th_all[ok]
+        Aint = cumtrapz(ta, ya)
+    else:
+        # Angles suit a noisy differentiated track (no noise amplification); two
+        # gyros compare best on the rates themselves.
+        tB, B = tb, cumtrapz(tb, yb)
+        Aint = cumtrapz(ta, fa(ta))
 
-    def A(x):
-        return np.interp(x, ta, Aint)
+    from scipy.interpolate import make_interp_spline
 
-    B = cumtrapz(tb, yb)
-    off, _ = _fine(ta, A, tb, B, off0, 3.0 / grid_hz)
+    A = make_interp_spline(ta, Aint, k=3)
+
+    def fine(mask_t0, mask_t1, guess, half, scan=None):
+        if use_angle:
+            m = (tB >= mask_t0) & (tB < mask_t1)
+            return _fine(ta, A, tB[m], B[m], guess, half, True, scan)
+        m = (tb >= mask_t0) & (tb < mask_t1)
+        return _fine(ta, fa, tb[m], yb[m], guess, half, False, scan)
+
+    off = fine(-np.inf, np.inf, off0, 3.0 / grid_hz)[0]
     lo, hi = max(tb[0], ta[0] - off), min(tb[-1], ta[-1] - off)
     overlap = hi - lo
     fit_drift = (overlap > 120.0) if drift == "auto" else bool(drift)
@@ -193,12 +265,19 @@ def sync_offset(t_a, rate_a, t_b, rate_b, *, max_offset_s: float | None = None,
     edges = np.arange(lo, hi - 0.5 * w + 1e-9, w)
     wt, wo = [], []
     thr = 0.2 * np.std(yb[(tb >= lo) & (tb <= hi)]) if overlap > 0 else 0.0
+    # Windows may drift from the global offset by up to 1000 ppm of the overlap.
+    dev = max(0.05, 1e-3 * overlap)
     for e in edges:
         m = (tb >= e) & (tb < e + w)
         if m.sum() < 16 or np.std(yb[m]) < thr:
             continue
-        o, _ = _fine(ta, A, tb[m], B[m], off, 0.05 * w if fit_drift else 10.0 / grid_hz)
-        wt.append(tb[m].mean())
+        # Scan +-dev on the grid step, then refine: robust against the other
+        # peaks of a quasi-periodic (rocking) signal.
+        scan = off + np.linspace(-dev, dev, 101)
+        o, explained, t_c = fine(e, e + w, off, 1.5 * (scan[1] - scan[0]), scan)
+        if explained < 0.5:  # too little common motion in this window to time it
+            continue
+        wt.append(t_c)
         wo.append(o)
     wt, wo = np.asarray(wt), np.asarray(wo)
     d = 0.0
@@ -245,4 +324,4 @@ def sync_imu_to_track(rotation, t_s, theta_rad, **kwargs) -> SyncResult:
     t, w = track_rate(t_s, theta_rad)
     dt = float(np.nanmedian(np.diff(t))) if len(t) > 1 else 0.0
     kwargs.setdefault("window_b_s", 2.0 * dt)
-    return sync_offset(rotation.t_s, rotation.omega_rad_s, t, w, **kwargs)
+    return sync_offset(rotation.t_s, rotation.omega_rad_s, t, w, theta_b=theta_rad, **kwargs)

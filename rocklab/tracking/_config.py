@@ -35,7 +35,8 @@ matching truth):
   the point reported as ``x_m, y_m``: for ``markers`` the centre of the first
   marker unless ``marker_positions_m`` (marker centres in the object frame)
   says otherwise; for ``dots`` the origin of the ``dots`` coordinates; for
-  ``edges``/``region`` the centre of ``roi`` in the first frame.
+  ``edges`` the centre of the block outline; for ``region`` the centre of
+  ``roi`` in the first frame.
 * ``theta_rad``: counter-clockwise rotation of the object frame relative to
   the world frame as seen by the camera (levelled). A marker printed upright
   reads 0; ``dots`` read 0 when laid out as given; ``edges`` read 0 when the
@@ -184,6 +185,16 @@ class ReferenceConfig:
     homography : 3x3 tuple or None
         Image (px) -> plane (m, y up) homography; overrides the scale.
     board : BoardConfig or None
+    plane : {"auto", "table", "image"}
+        Where the image -> plane homography comes from when neither
+        ``homography`` nor ``board`` is given. ``"table"``: from the table's
+        markers in the first frame (their corners are known in the table frame:
+        with ``video.camera_matrix`` by a planar PnP pose, else a homography
+        fit, which needs two or more markers); positions are then metres in the
+        table frame at the first frame. ``"image"``: centred pixels times the
+        measured scale. ``"auto"``: ``"table"`` when possible (aruco/apriltag,
+        a table with known marker layout and a camera matrix or >= 2 markers),
+        else ``"image"``.
     """
 
     level: str = "table"
@@ -191,6 +202,7 @@ class ReferenceConfig:
     m_per_px: float | None = None
     homography: tuple | None = None
     board: BoardConfig | None = None
+    plane: str = "auto"
 
 
 @dataclass(frozen=True)
@@ -236,7 +248,8 @@ class ObjectConfig:
     size_m : (b, h) or None
         Block outline width and height (m), for ``edges`` (gives the scale).
     theta0_rad : float or None
-        Object angle at the first frame for ``edges``/``region`` (default 0).
+        ``region``: the object's angle at the first frame (default 0);
+        ``edges``: a hint (default 0) to tell the outline's top from its side.
     marker_size_m : float or None
         This object's marker side (m) when it differs from ``targets.marker_size_m``.
     """
@@ -541,7 +554,8 @@ class _Parser:
             level_rad=self.num(d.get("level_rad", 0.0), s, "level_rad", allow_none=False),
             m_per_px=self.num(d.get("m_per_px"), s, "m_per_px", positive=True),
             homography=self.matrix(d.get("homography"), (3, 3), s, "homography"),
-            board=board)
+            board=board,
+            plane=self.choice(d.get("plane", "auto"), ("auto", "table", "image"), s, "plane"))
 
     def motion(self, d):
         s = "motion"

@@ -16,7 +16,7 @@ import numpy as np
 from .._errors import InputError
 
 __all__ = ["PlaneMap", "SimilarityFit", "fit_similarity", "calibrate_camera",
-           "board_homography", "load_calibration"]
+           "board_homography", "load_calibration", "plane_homography_from_points"]
 
 
 @dataclass(frozen=True)
@@ -100,6 +100,8 @@ class PlaneMap:
         self.dist = None if dist_coeffs is None else np.asarray(dist_coeffs, float)
         self.H = None if homography is None else np.asarray(homography, float)
         self.metric = self.H is not None
+        #: where the mapping came from: "image", "homography", "board" or "table"
+        self.source = "image" if self.H is None else "homography"
 
     def undistort(self, uv):
         """Undistorted pixel positions, shape (n, 2)."""
@@ -117,6 +119,40 @@ class PlaneMap:
             h = uv @ self.H[:, :2].T + self.H[:, 2]
             return h[:, :2] / h[:, 2:3]
         return np.column_stack((uv[:, 0] - self.cx, self.cy - uv[:, 1]))
+
+
+def plane_homography_from_points(img_px, obj_m, plane_map: PlaneMap):
+    """Homography undistorted px -> plane (m) from points of known plane position.
+
+    With a camera matrix: planar PnP (IPPE, 6 unknowns, robust with few points),
+    ``H = (K [r1 r2 t])^-1``. Without: a direct homography fit (needs >= 4
+    points spread over the field for the 8 unknowns).
+
+    Parameters
+    ----------
+    img_px : ndarray (n, 2)
+        Measured (distorted) image points.
+    obj_m : ndarray (n, 2)
+        Their plane coordinates, m (y up).
+    """
+    import cv2
+
+    img = np.asarray(img_px, float).reshape(-1, 2)
+    obj = np.asarray(obj_m, float).reshape(-1, 2)
+    if plane_map.K is not None:
+        obj3 = np.column_stack((obj, np.zeros(len(obj))))
+        dist = plane_map.dist if plane_map.dist is not None else np.zeros(5)
+        ok, rvec, tvec = cv2.solvePnP(obj3, img, plane_map.K, dist, flags=cv2.SOLVEPNP_IPPE)
+        if not ok:
+            return None
+        ok, rvec, tvec = cv2.solvePnP(obj3, img, plane_map.K, dist, rvec, tvec, True,
+                                      flags=cv2.SOLVEPNP_ITERATIVE)
+        R, _ = cv2.Rodrigues(rvec)
+        G = plane_map.K @ np.column_stack((R[:, 0], R[:, 1], tvec.ravel()))
+        H = np.linalg.inv(G)
+        return H / H[2, 2]
+    H, _ = cv2.findHomography(plane_map.undistort(img), obj, 0)
+    return H
 
 
 def load_calibration(path):

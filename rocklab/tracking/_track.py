@@ -17,7 +17,8 @@ import numpy as np
 
 from .._errors import InputError
 from ._config import TrackConfig
-from ._geometry import PlaneMap, board_homography, fit_similarity, load_calibration
+from ._geometry import (PlaneMap, board_homography, fit_similarity, load_calibration,
+                        plane_homography_from_points)
 from ._motion import TableMotion, table_motion
 
 __all__ = ["Observation", "ObjectTrack", "TrackResult", "track_frames", "assemble_tracks",
@@ -54,6 +55,9 @@ class Observation:
         "ok" or the reason the values are NaN ("lost", "blur", "low_quality").
     metric : bool
         Whether ``scale`` is plane units per metre.
+    plane : str
+        Source of the image -> plane mapping ("image": centred pixels; "homography",
+        "board", "table": metres).
     """
 
     frame: int
@@ -67,21 +71,70 @@ class Observation:
     quality: float
     status: str
     metric: bool = True
+    plane: str = "image"
 
 
 def make_plane_map(config: TrackConfig, width_px: int, height_px: int, first_gray=None) -> PlaneMap:
-    """The image -> plane mapping the config asks for (lens model, homography or board)."""
+    """The image -> plane mapping the config asks for: lens model, then a given homography,
+    a board, the table's markers (``reference.plane``), or centred pixels."""
     v = config.video
     K, dist = v.camera_matrix, v.dist_coeffs
     if v.calibration:
         K, dist = load_calibration(v.calibration)
-    H = config.reference.homography
-    pm = PlaneMap(width_px, height_px, K, dist, H)
-    if H is None and config.reference.board is not None:
+    ref = config.reference
+    pm = PlaneMap(width_px, height_px, K, dist, ref.homography)
+    if ref.homography is not None:
+        pm.source = "homography"
+        return pm
+    if ref.board is not None:
         if first_gray is None:
             raise InputError("reference.board: needs the board frame; use track_video")
-        pm = PlaneMap(width_px, height_px, K, dist, board_homography(first_gray, config.reference.board, pm))
+        pm = PlaneMap(width_px, height_px, K, dist, board_homography(first_gray, ref.board, pm))
+        pm.source = "board"
+        return pm
+    H = _table_plane(config, pm, first_gray) if ref.plane != "image" else None
+    if H is not None:
+        pm = PlaneMap(width_px, height_px, K, dist, H)
+        pm.source = "table"
     return pm
+
+
+def _table_plane(config, pm, gray):
+    """Homography from the table markers seen in ``gray``, or None (``plane = "auto"``)."""
+    tab = config.table
+    style = config.targets.style
+    strict = config.reference.plane == "table"
+    why = None
+    if style not in ("aruco", "apriltag") or tab is None:
+        why = "needs the aruco/apriltag style and a table object"
+    elif tab.marker_positions_m is None and len(tab.markers) > 1:
+        why = "needs the table's marker_positions_m"
+    elif (tab.marker_size_m or config.targets.marker_size_m) is None:
+        why = "needs the marker size"
+    elif pm.K is None and len(tab.markers) < 2:
+        why = "needs video.camera_matrix or two or more table markers"
+    elif gray is None:
+        why = "needs the first frame"
+    if why is None:
+        from ._aruco import _UNIT_CORNERS, make_cv_detector
+
+        det, _ = make_cv_detector(config.targets)
+        corners, ids, _ = det.detectMarkers(gray)
+        size = tab.marker_size_m or config.targets.marker_size_m
+        pos = tab.marker_positions_m or ((0.0, 0.0),)
+        img, obj = [], []
+        for c, i in zip(corners, [] if ids is None else ids.ravel()):
+            if int(i) in tab.markers:
+                k = tab.markers.index(int(i))
+                img.append(c.reshape(4, 2))
+                obj.append(np.asarray(pos[k], float) + _UNIT_CORNERS * size)
+        if len(img) == len(tab.markers):
+            return plane_homography_from_points(np.vstack(img), np.vstack(obj), pm)
+        why = "not every table marker is visible in the first frame"
+    if strict:
+        raise InputError(f"{config.source or 'config'}: 'reference.plane' = \"table\" {why}; "
+                         "fix it or use plane = \"image\"")
+    return None
 
 
 def _make_detector(config, pm, first_gray):
@@ -151,10 +204,11 @@ def track_frames(frames, config: TrackConfig, plane_map: PlaneMap | None = None)
                 qual = (len(q) / d.n_expected) / (1.0 + f.rms / (0.002 * spread + 1e-12))
                 if qual < min_q:
                     obs.append(Observation(idx, o.id, *(np.nan,) * 4, f.scale, f.rms, qual,
-                                           "low_quality", d.metric))
+                                           "low_quality", d.metric, plane_map.source))
                     continue
                 obs.append(Observation(idx, o.id, float(f.t[0]), float(f.t[1]), f.theta_rad,
-                                       f.sigma_theta_rad, f.scale, f.rms, qual, "ok", d.metric))
+                                       f.sigma_theta_rad, f.scale, f.rms, qual, "ok", d.metric,
+                                       plane_map.source))
                 u, v = d.img_pts[:, 0], d.img_pts[:, 1]
                 box = (int(max(u.min(), 0)), int(max(v.min(), 0)), int(u.max()) + 1, int(v.max()) + 1)
                 boxes[o.id] = box
@@ -167,7 +221,7 @@ def track_frames(frames, config: TrackConfig, plane_map: PlaneMap | None = None)
                     if s < BLUR_RATIO * sharp_ref.get(o.id, np.nan):
                         status = "blur"
                 obs.append(Observation(idx, o.id, *(np.nan,) * 7, status,
-                                       getattr(d, "metric", True)))
+                                       getattr(d, "metric", True), plane_map.source))
         yield obs
 
 
@@ -221,6 +275,10 @@ class TrackResult:
     width_px, height_px : int
     source : str or None
     config : TrackConfig
+    plane : str
+        Where the image -> plane mapping came from: "image" (centred pixels times the
+        measured scale; compare positions as displacements), "homography", "board" or
+        "table" (metres in that plane).
     """
 
     tracks: tuple
@@ -231,6 +289,7 @@ class TrackResult:
     height_px: int
     source: str | None
     config: TrackConfig = field(repr=False)
+    plane: str = "image"
 
     def __getitem__(self, oid: str) -> ObjectTrack:
         for t in self.tracks:
@@ -275,7 +334,7 @@ class TrackResult:
                              "median_sigma_theta_rad": float(np.nanmedian(t.sigma_theta_rad))
                              if np.any(t.ok) else np.nan}
         return {"source": self.source, "fps": self.fps, "n_frames": self.n_frames,
-                "width_px": self.width_px, "height_px": self.height_px,
+                "width_px": self.width_px, "height_px": self.height_px, "plane": self.plane,
                 "level_rad": self.level_rad, "objects": per}
 
 
@@ -305,7 +364,8 @@ def assemble_tracks(observations, config: TrackConfig, fps: float, width_px: int
     rows = [o for frame_obs in observations for o in frame_obs]
     if not rows:
         raise InputError(f"{source or 'video'}: no frames to track; check the file or the frame range")
-    metric_plane = plane_map is not None and plane_map.metric
+    plane = plane_map.source if plane_map is not None else rows[0].plane
+    metric_plane = plane != "image"
     by = {o.id: [r for r in rows if r.object == o.id] for o in config.objects}
     frames = np.array(sorted({r.frame for r in rows}), int)
     pos = {f: i for i, f in enumerate(frames)}
@@ -376,7 +436,7 @@ def assemble_tracks(observations, config: TrackConfig, fps: float, width_px: int
         tracks.append(ObjectTrack(o.id, o.kind, frames.copy(), frames / float(fps), x, y, th, sig,
                                   q, st.astype(str), m_per[o.id]))
     return TrackResult(tuple(tracks), float(fps), level, n, int(width_px), int(height_px),
-                       None if source is None else str(source), config)
+                       None if source is None else str(source), config, plane)
 
 
 def track_video(path, config: TrackConfig, fps: float | None = None, progress: bool = False
@@ -407,14 +467,13 @@ def track_video(path, config: TrackConfig, fps: float | None = None, progress: b
                          "(or set [video] fps in the config)")
     v = config.video
     start, stop = v.start_frame, v.stop_frame
+    ref_frame = config.reference.board.frame if config.reference.board is not None else start
     first = None
-    if config.reference.board is not None:
-        for _, g in iter_video_frames(path, config.reference.board.frame,
-                                      config.reference.board.frame + 1, prefetch=0):
-            first = g
-        if first is None:
-            raise InputError(f"reference.board.frame={config.reference.board.frame}: past the end "
-                             f"of {path}")
+    for _, g in iter_video_frames(path, ref_frame, ref_frame + 1, prefetch=0):
+        first = g
+    if first is None:
+        raise InputError(f"{path}: frame {ref_frame} is past the end of the video "
+                         f"({info.n_frames} frames); check start_frame / reference.board.frame")
     pm = make_plane_map(config, info.width_px, info.height_px, first)
     frames = iter_video_frames(path, start, stop)
     if progress:

@@ -1,3 +1,34 @@
-"""rocklab.fitting (see the package docs)."""
+"""rocklab.fitting: restitution calibration from measured free rocking (Čeh et al. 2018 §5, Ther thesis §4).
 
-__all__: list[str] = []
+Per experiment: :func:`fit_restitution` (constant η_e, η′_e, profile interval, suspicious-run
+flags), :func:`per_impact_eta` (data-only per-impact η), :func:`energy_loss_from_peaks`
+(thesis Eq. 12). Repeats: :func:`fit_many`, :func:`summarize_repeats`. Campaign:
+:func:`fit_eta_mat` (Eq. 16), :func:`k_table` (Eq. 17–18), :func:`fit_k_regression`
+(Eq. 19) and :meth:`KRegression.predict`. Čeh's tables ship as package data
+(:func:`ceh_catalogue`, :func:`catalogue_block`).
+"""
+
+from ._campaign import ETA_MAT_RULES, EtaMatResult, KTableResult, fit_eta_mat, k_table, read_block_table
+from ._catalogue import catalogue_block, ceh_catalogue, ceh_full_contact, ceh_table5
+from ._impacts import (EnergyLoss, ReleaseInfo, arch_peaks, check_record, detect_release, energy_loss_from_peaks,
+                       find_crossings, per_impact_eta)
+from ._laws import alpha_from_hb, edge_contact_k, eta_housner, eta_modified, k_from_eta
+from ._regression import CEH_EQ19, REGRESSION_FORMS, KPrediction, KRegression, fit_k_regression
+from ._repeats import RepeatSummary, fit_many, summarize_repeats
+from ._restitution import OBJECTIVES, WINDOWS, RestitutionFit, fit_restitution
+
+__all__ = [
+    # per experiment
+    "fit_restitution", "RestitutionFit", "WINDOWS", "OBJECTIVES",
+    "per_impact_eta", "energy_loss_from_peaks", "EnergyLoss", "detect_release", "ReleaseInfo",
+    "find_crossings", "arch_peaks", "check_record",
+    # repeats
+    "fit_many", "summarize_repeats", "RepeatSummary",
+    # campaign
+    "fit_eta_mat", "EtaMatResult", "ETA_MAT_RULES", "k_table", "KTableResult", "read_block_table",
+    "fit_k_regression", "KRegression", "KPrediction", "REGRESSION_FORMS", "CEH_EQ19",
+    # closed forms
+    "eta_housner", "eta_modified", "k_from_eta", "edge_contact_k", "alpha_from_hb",
+    # Čeh 2018 package data
+    "ceh_catalogue", "catalogue_block", "ceh_full_contact", "ceh_table5",
+]

@@ -1,0 +1,542 @@
+"""Constant-restitution calibration of a measured free-rocking record (Čeh §5.1).
+
+``fit_restitution`` finds the η_e whose simulation (same block, θ0 from the data,
+thread-burn release at a fitted time) best matches θ(t): by least squares on θ in a
+window chosen by impact count (default: the middle 50 % of the response, as Čeh judged
+amplitudes and periods), or by matching arch amplitudes and half-periods. η′_e is the
+same fit on the first post-impact half-period only.
+
+Uncertainty: a profile-likelihood interval. For each η the release time is re-fitted
+(profiled out) and the 95 % interval is where SSE(η) − SSE_min ≤ χ²₁(0.95)·σ̂²·f, with
+σ̂² = SSE_min/(n − 2) and f = (1 + ρ₁)/(1 − ρ₁) ≥ 1 a correction for lag-one
+autocorrelation ρ₁ of the residuals (f = 1 for white measurement noise; model misfit
+widens the interval instead of hiding in it).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+import pandas as pd
+from scipy.optimize import brentq, minimize_scalar
+from scipy.stats import chi2
+
+from .._errors import InputError
+from ._impacts import _crossings, arch_peaks, check_record, detect_release, per_impact_eta
+
+__all__ = ["RestitutionFit", "fit_restitution", "WINDOWS", "OBJECTIVES"]
+
+WINDOWS = ("middle50", "all", "first")
+OBJECTIVES = ("theta", "peaks")
+
+
+@dataclass(frozen=True)
+class RestitutionFit:
+    """Result of :func:`fit_restitution`.
+
+    Attributes
+    ----------
+    eta_e : float
+        Fitted constant restitution (ω⁺/ω⁻), NaN if the fit failed.
+    eta_e_first : float
+        η′_e fitted on the first post-impact half-period only (Čeh §5.1).
+    ci95_eta_e : tuple (lo, hi)
+        95 % profile-likelihood interval of η_e (see module doc).
+    theta0_rad : float
+        Initial angle, median of the rest plateau before release, rad (sign as measured).
+    release_t_s : float
+        Fitted release time, s (record clock).
+    rms_residual_rad : float
+        RMS of θ_data − θ_sim over the fitted window (objective "theta") or of the
+        amplitude/half-period residuals in rad (objective "peaks").
+    sigma_theta_rad : float
+        Measurement noise σ estimated on the rest plateau, rad.
+    per_impact_eta : tuple of float
+        Per-impact restitution from the data alone (``eta_peaks``, see
+        :func:`~rocklab.fitting.per_impact_eta`); the full table is ``per_impact``.
+    n_impacts : int
+        Impacts detected in the record.
+    window : str, objective : str
+    window_t_s : tuple (t0, t1)
+        Fitted window on the record clock, s.
+    n_points : int
+        Residuals in the objective.
+    eta_bounds : tuple
+        Search bounds; ``at_bound`` lists parameters that ended on one.
+    suspicious : bool
+        True when slip/jump/misfit symptoms were found; ``flags`` says which.
+    status : "ok" | "failed";  message : reason when failed, notes otherwise
+    """
+
+    eta_e: float
+    eta_e_first: float
+    ci95_eta_e: tuple
+    theta0_rad: float
+    release_t_s: float
+    rms_residual_rad: float
+    sigma_theta_rad: float
+    per_impact_eta: tuple
+    n_impacts: int
+    window: str
+    objective: str
+    window_t_s: tuple
+    n_points: int
+    eta_bounds: tuple
+    block_name: str = ""
+    suspicious: bool = False
+    flags: tuple = ()
+    at_bound: tuple = ()
+    n_skipped: int = 0
+    n_evaluations: int = 0
+    status: str = "ok"
+    message: str = ""
+    per_impact: pd.DataFrame | None = field(default=None, repr=False)
+
+    @property
+    def ok(self) -> bool:
+        return self.status == "ok"
+
+    def to_dict(self) -> dict:
+        """Plain-JSON dict (NaN kept as float NaN; the CLI writes null)."""
+        d = {k: getattr(self, k) for k in (
+            "eta_e", "eta_e_first", "theta0_rad", "release_t_s", "rms_residual_rad", "sigma_theta_rad",
+            "n_impacts", "window", "objective", "n_points", "block_name", "suspicious", "n_skipped",
+            "n_evaluations", "status", "message")}
+        d["ci95_eta_e"] = [float(x) for x in self.ci95_eta_e]
+        d["window_t_s"] = [float(x) for x in self.window_t_s]
+        d["eta_bounds"] = [float(x) for x in self.eta_bounds]
+        d["per_impact_eta"] = [float(x) for x in self.per_impact_eta]
+        d["flags"] = list(self.flags)
+        d["at_bound"] = list(self.at_bound)
+        return d
+
+    def report(self) -> str:
+        """lmfit-style text report."""
+        if not self.ok:
+            return f"[[Restitution fit: FAILED]]\n    {self.message}"
+        lo, hi = self.ci95_eta_e
+        ab = set(self.at_bound)
+
+        def b(name):
+            return "  (at bound!)" if name in ab else ""
+
+        lines = [
+            "[[Fit Statistics]]",
+            "    # fitting method   = bounded scalar search on eta (coarse grid + Brent), release time profiled",
+            f"    # function evals   = {self.n_evaluations}",
+            f"    # data points      = {self.n_points}",
+            f"    # impacts (data)   = {self.n_impacts}",
+            f"    window             = {self.window} ({self.window_t_s[0]:.3f}-{self.window_t_s[1]:.3f} s)",
+            f"    objective          = {self.objective}",
+            f"    residual RMS       = {self.rms_residual_rad:.3e} rad ({math.degrees(self.rms_residual_rad):.4f} deg)",
+            f"    noise sigma        = {self.sigma_theta_rad:.3e} rad (rest plateau)",
+            "[[Variables]]",
+            f"    eta_e:        {self.eta_e:.5f}  95% CI [{lo:.5f}, {hi:.5f}] (profile likelihood){b('eta_e')}",
+            f"    eta_e_first:  {self.eta_e_first:.5f}  (first post-impact half-period){b('eta_e_first')}",
+            f"    release_t_s:  {self.release_t_s:.5f}{b('release_t_s')}",
+            f"    theta0_rad:   {self.theta0_rad:.5f}  (fixed, rest plateau)",
+            f"    search bounds eta in [{self.eta_bounds[0]:g}, {self.eta_bounds[1]:g}]",
+        ]
+        if len(self.per_impact_eta):
+            pe = np.asarray(self.per_impact_eta, float)
+            lines.append(f"[[Per-impact eta (peaks)]]  n = {pe.size}, first: "
+                         + ", ".join(f"{x:.4f}" for x in pe[:6]))
+        if self.flags:
+            lines.append("[[Warnings]]")
+            lines += [f"    {f}" for f in self.flags]
+        if self.message:
+            lines.append(f"note: {self.message}")
+        return "\n".join(lines)
+
+
+def _failed(reason, window, objective, bounds, theta0=np.nan, sigma=np.nan, n_imp=0, n_skip=0, name=""):
+    nan = float("nan")
+    return RestitutionFit(eta_e=nan, eta_e_first=nan, ci95_eta_e=(nan, nan), theta0_rad=float(theta0),
+                          release_t_s=nan, rms_residual_rad=nan, sigma_theta_rad=float(sigma), per_impact_eta=(),
+                          n_impacts=int(n_imp), window=window, objective=objective, window_t_s=(nan, nan),
+                          n_points=0, eta_bounds=tuple(bounds), block_name=name, n_skipped=n_skip,
+                          status="failed", message=reason)
+
+
+class _Problem:
+    """Simulation-backed objective for one record (θ0 > 0 after sign normalisation).
+
+    For each η the release time is profiled by bounded Brent and θ0 by linear least
+    squares on the sensitivity ∂θ/∂θ0 (a second simulation at θ0 + h): both cost no
+    extra simulation per release-time trial.
+    """
+
+    def __init__(self, t, y, block, theta0, dt_s, duration_s):
+        from ..models import simulate
+
+        self._simulate = simulate
+        self.t, self.y, self.block = t, y, block
+        self.theta0 = theta0
+        self.h = min(1e-3 * theta0, 0.5 * (block.alpha_rad - theta0))
+        self.dt = dt_s
+        self.duration = duration_s
+        self.cache = {}
+        self.n_sim = 0
+
+    def _run(self, th0, eta):
+        self.n_sim += 1
+        # output every 2nd step: linear interpolation error ~ θ'' (2 dt)² / 8, far below noise
+        return self._simulate(self.block, theta0_rad=th0, omega0_rad_s=0.0, duration_s=self.duration,
+                              dt_s=self.dt, restitution="constant", eta=float(eta), stop_at_rest=True,
+                              output_dt_s=2 * self.dt)
+
+    def sim(self, eta, sens=True):
+        key = (round(float(eta), 12), bool(sens))
+        r = self.cache.get(key)
+        if r is None:
+            r0 = self._run(self.theta0, eta)
+            r1 = self._run(self.theta0 + self.h, eta) if sens else None
+            r = (r0, r1)
+            if len(self.cache) > 256:
+                self.cache.clear()
+            self.cache[key] = r
+        return r
+
+    @staticmethod
+    def _at(r, tau, th0):
+        right = 0.0 if r.status == "rest" else float(r.theta_rad[-1])
+        return np.interp(tau, r.t_s, r.theta_rad, left=th0, right=right)
+
+    def model(self, eta, tt, tr, sens=True):
+        """(θ_sim at tt for release tr, sensitivity to θ0 or None)."""
+        r0, r1 = self.sim(eta, sens)
+        tau = tt - tr
+        m0 = self._at(r0, tau, self.theta0)
+        if r1 is None:
+            return m0, None
+        return m0, (self._at(r1, tau, self.theta0 + self.h) - m0) / self.h
+
+    def profile(self, eta, idx, t_r_bounds, sens=True):
+        """min over release time (and θ0 if sens) of Σ (y − θ_sim)²: (sse, t_r, θ0)."""
+        tt, yy = self.t[idx], self.y[idx]
+
+        def inner(tr):
+            m0, S = self.model(eta, tt, tr, sens)
+            rr = yy - m0
+            if S is None:
+                return float(rr @ rr), 0.0
+            ss = float(S @ S)
+            dl = float(S @ rr) / ss if ss > 0 else 0.0
+            d = rr - dl * S
+            return float(d @ d), dl
+
+        res = minimize_scalar(lambda tr: inner(tr)[0], bounds=t_r_bounds, method="bounded",
+                              options=dict(xatol=1e-7))
+        sse, dl = inner(float(res.x))
+        return sse, float(res.x), self.theta0 + dl
+
+    def residual(self, eta, idx, t_r, theta0, sens=True):
+        """y − θ_sim at samples idx; θ0 enters linearly (sens) or exactly via a fresh run."""
+        if not sens:
+            key = ("fixed", round(float(eta), 12), float(theta0))
+            r = self.cache.get(key)
+            if r is None:
+                r = self.cache[key] = self._run(theta0, eta)
+            return self.y[idx] - self._at(r, self.t[idx] - t_r, theta0)
+        m0, S = self.model(eta, self.t[idx], t_r, True)
+        return self.y[idx] - (m0 + (theta0 - self.theta0) * S)
+
+    def peaks_residual(self, eta, data_amp, data_half, arch_ids):
+        """Amplitude (rad) and half-period (scaled to rad by 2A/T) residuals of arches arch_ids."""
+        r = self.sim(eta, sens=False)[0]
+        imp = r.impacts
+        p2 = self.block.p_rad_s ** 2
+        a = self.block.alpha_rad
+        w = np.abs(imp["omega_after_rad_s"].to_numpy())
+        amp = a - np.arccos(np.clip(math.cos(a) + w * w / (2 * p2), -1, 1))
+        half = np.diff(imp["t_s"].to_numpy())
+        res = []
+        for j, k in enumerate(arch_ids):  # arch k follows impact k (0-based)
+            A_s = amp[k] if k < amp.size else 0.0
+            T_s = half[k] if k < half.size else 0.0
+            res.append(data_amp[j] - A_s)
+            res.append((data_half[j] - T_s) * 2.0 * data_amp[j] / max(data_half[j], 1e-9))
+        return np.asarray(res)
+
+
+def _grid_then_brent(fun_grid, fun, lo, hi, n_grid=5, xtol=1e-6):
+    """1-D minimisation: coarse grid with a cheap objective, then bounded Brent around its best node."""
+    xs = np.linspace(lo, hi, n_grid)
+    fs = np.array([fun_grid(x) for x in xs])
+    i = int(np.nanargmin(fs))
+    a, b = xs[max(i - 1, 0)], xs[min(i + 1, n_grid - 1)]
+    res = minimize_scalar(fun, bounds=(a, b), method="bounded", options=dict(xatol=xtol))
+    return float(res.x), float(res.fun), (i == 0 or i == n_grid - 1)
+
+
+def _profile_ci(fun, x_hat, f_hat, thresh, lo, hi):
+    """Interval where fun(x) − f_hat ≤ thresh, searched outward from x_hat within [lo, hi].
+
+    The profile is nearly quadratic near its minimum, so each side is first solved by the
+    fixed-point step d ← d·sqrt(thresh/Δf(d)) (exact for a parabola, 2–3 evaluations);
+    if that does not settle, the crossing is bracketed and refined by Brent's method.
+    """
+    h = max(1e-5, 1e-4 * abs(x_hat))
+    fp, fm = fun(min(x_hat + h, hi)), fun(max(x_hat - h, lo))
+    curv = (fp + fm - 2 * f_hat) / (h * h)
+    guess = math.sqrt(2 * thresh / curv) if curv > 0 else 1e-3
+    out = []
+    for direction, bound in ((-1, lo), (+1, hi)):
+        room = abs(bound - x_hat)
+        d = min(guess, room)
+        edge = None
+        for _ in range(4):
+            D = fun(x_hat + direction * d) - f_hat
+            if D <= 0:
+                break
+            if abs(D / thresh - 1) < 0.02:
+                edge = x_hat + direction * d
+                break
+            d_new = d * math.sqrt(thresh / D)
+            if d_new >= room:
+                d = room
+                if fun(bound) - f_hat <= thresh:
+                    edge = bound
+                break
+            d = d_new
+        if edge is None:  # fall back: bracket outward, then Brent
+            x_in, step = x_hat, max(guess, 2 * h)
+            edge = bound
+            for _ in range(40):
+                x = x_hat + direction * min(step, room)
+                if fun(x) - f_hat > thresh:
+                    edge = brentq(lambda z: fun(z) - f_hat - thresh, *sorted((x_in, x)),
+                                  xtol=max(0.02 * guess, 1e-8), rtol=1e-12)
+                    break
+                if step >= room:
+                    break
+                x_in, step = x, step * 1.5
+        out.append(float(edge))
+    return tuple(out)
+
+
+def _ac_factor(res):
+    if res.size < 8:
+        return 1.0
+    r = res - res.mean()
+    den = float(r @ r)
+    if den <= 0:
+        return 1.0
+    rho = float(r[1:] @ r[:-1]) / den
+    rho = min(max(rho, 0.0), 0.95)
+    return (1 + rho) / (1 - rho)
+
+
+def fit_restitution(t_s, theta_rad, block, window: str = "middle50", objective: str = "theta", *,
+                    eta_bounds=(0.05, 0.9995), dt_s: float | None = None, nan: str = "raise",
+                    level: float = 0.95, eta_guess: float | None = None,
+                    theta0_rad: float | None = None) -> RestitutionFit:
+    """Fit a constant restitution η_e to a measured free-rocking record.
+
+    Parameters
+    ----------
+    t_s, theta_rad : array (n,)
+        Record times (s, increasing) and rotation (rad), including a rest plateau before
+        the thread-burn release (the plateau gives θ0 and the noise level).
+    block : rocklab.Block
+    window : {"middle50", "all", "first"}
+        Samples compared: between the impacts at 25 % and 75 % of the detected impact
+        count (Čeh's middle 50 %), the whole response, or the first post-impact
+        half-period. The release quarter-cycle is always included (it fixes the release
+        time and does not depend on η).
+    objective : {"theta", "peaks"}
+        Least squares on θ(t), or on arch amplitudes and half-periods (rad-scaled).
+    eta_bounds : (lo, hi)
+        Search interval for η (0 < lo < hi < 1).
+    dt_s : float, optional
+        Simulation step, s (default min(2e-4, 2e-3/p); the trapezoidal rule with exact
+        contact detection then puts impact times within ~1e-6 s).
+    nan : {"raise", "skip"}
+        NaN samples: InputError naming the first, or dropped (counted in ``n_skipped``).
+    level : float
+        Confidence level of the interval (default 0.95).
+    eta_guess : float, optional
+        Start of the search (default: median per-impact η from the data).
+
+    Returns
+    -------
+    RestitutionFit
+        ``status="failed"`` with the reason when no release is found, fewer than 3
+        impacts are detected, or θ0 is beyond the block's slenderness angle.
+    """
+    if window not in WINDOWS:
+        raise InputError(f"window={window!r}: use one of {WINDOWS}")
+    if objective not in OBJECTIVES:
+        raise InputError(f"objective={objective!r}: use one of {OBJECTIVES}")
+    lo_b, hi_b = (float(x) for x in eta_bounds)
+    if not (0 < lo_b < hi_b < 1):
+        raise InputError(f"eta_bounds={eta_bounds}: need 0 < lo < hi < 1 (a restitution >= 1 gains energy)")
+    t, y, n_skip = check_record(t_s, theta_rad, nan=nan)
+    name = getattr(block, "name", "")
+    rel = detect_release(t, y)
+    fail = dict(window=window, objective=objective, bounds=(lo_b, hi_b), n_skip=n_skip, name=name)
+    if not rel.found:
+        return _failed(f"no release found: {rel.message}", theta0=rel.theta0_rad, sigma=rel.sigma_rad, **fail)
+    s0 = 1.0 if rel.theta0_rad > 0 else -1.0
+    y = s0 * y  # symmetric block: fit with θ0 > 0
+    theta0 = abs(rel.theta0_rad) if theta0_rad is None else abs(float(theta0_rad))
+    alpha = block.alpha_rad
+    if theta0 >= alpha:
+        return _failed(f"theta0 = {theta0:.4g} rad >= alpha = {alpha:.4g} rad: the block would overturn, "
+                       "not rock", theta0=rel.theta0_rad, sigma=rel.sigma_rad, **fail)
+    tc = _crossings(t, y, rel)
+    n_imp = int(tc.size)
+    if n_imp < 3:
+        return _failed(f"only {n_imp} impact(s) detected after release: need at least 3",
+                       theta0=rel.theta0_rad, sigma=rel.sigma_rad, n_imp=n_imp, **fail)
+    sigma = max(rel.sigma_rad, 1e-12)
+    dt_data = float(np.median(np.diff(t)))
+    p = block.p_rad_s
+    dt_sim = float(dt_s) if dt_s is not None else min(2e-4, 2e-3 / p)
+    rel_info = rel.__class__(**{**rel.__dict__, "theta0_rad": theta0})
+    pie = per_impact_eta(t, y, block, release=rel_info, crossings_t_s=tc)
+    half_last = tc[-1] - tc[-2]
+    t_motion_end = tc[-1] + half_last
+
+    def window_span(kind):
+        if kind == "all":
+            return rel.t_s, t_motion_end
+        if kind == "first":
+            return tc[0], tc[1]
+        i0 = int(math.floor(0.25 * n_imp))
+        i1 = int(math.ceil(0.75 * n_imp)) - 1
+        i1 = min(max(i1, i0 + 2), n_imp - 1)
+        return tc[i0], tc[i1]
+
+    w0, w1 = window_span(window)
+    objective_used = "theta" if window == "first" else objective
+    # plateau and release quarter-cycle: fix θ0 and the release time, independent of η
+    rel_idx = np.flatnonzero(t < tc[0])
+    tr_bounds = (rel.t_s - 4 * dt_data, rel.t_s + 3 * dt_data)
+    ok_eta = pie.loc[pie["ok"], "eta_peaks"].to_numpy() if len(pie) else np.array([])
+    g = float(np.median(ok_eta)) if ok_eta.size else float(block.eta_H)
+    g = min(max(g if eta_guess is None else float(eta_guess), lo_b), hi_b)
+    probs = {}
+
+    def problem(kind):
+        a, b = window_span(kind)
+        if kind not in probs:
+            probs[kind] = _Problem(t, y, block, theta0, dt_sim, max(b, tc[1]) - rel.t_s + 0.2)
+        return probs[kind]
+
+    def fit_window(kind, obj, fixed=None):
+        """Fit η on a window. ``fixed=(t_r, θ0)`` holds the release fixed (cheap η′_e fit)."""
+        a, b = window_span(kind)
+        prob = problem(kind)
+        if obj == "theta":
+            idx = np.union1d(rel_idx, np.flatnonzero((t >= a) & (t <= b)))
+            if fixed is None:
+                def f(eta):
+                    return prob.profile(eta, idx, tr_bounds)[0]
+
+                def f_grid(eta):  # grid nodes only bracket the optimum: θ0 held, no sensitivity run
+                    return prob.profile(eta, idx, tr_bounds, sens=False)[0]
+            else:
+                def f(eta):
+                    d = prob.residual(eta, idx, *fixed, sens=False)
+                    return float(d @ d)
+                f_grid = f
+        else:
+            pk = arch_peaks(t, y, tc, release=None, sigma_rad=sigma)  # row k: arch after impact k
+            ids = [k for k in range(len(pk)) if a - 1e-9 <= tc[k] and tc[k + 1] <= b + 1e-9
+                   and np.isfinite(pk.theta_rad.iloc[k])]
+            amp = np.abs(pk.theta_rad.to_numpy())[ids]
+            half = np.diff(tc)[ids]
+            idx = (np.asarray(ids, int), amp, half)
+
+            def f(eta):
+                r = prob.peaks_residual(eta, amp, half, ids)
+                return float(r @ r)
+            f_grid = f
+
+        # coarse-to-fine: a grid around the data-based guess (widened while the best node is
+        # on its edge), then bounded Brent between the neighbours of the best node
+        span = 0.025
+        while True:
+            lo, hi = max(lo_b, g - span), min(hi_b, g + span)
+            x, fx, on_edge = _grid_then_brent(f_grid, f, lo, hi)
+            on_edge = on_edge and ((x - lo < 0.5 * span and lo > lo_b) or (hi - x < 0.5 * span and hi < hi_b))
+            if not on_edge or span >= 1.0:
+                break
+            span *= 3.0
+        return x, fx, f, idx, prob
+
+    eta_hat, f_hat, f_main, idx_main, prob = fit_window(window, objective_used)
+    theta0_hat = theta0
+    if objective_used == "theta":
+        _, tr_hat, theta0_hat = prob.profile(eta_hat, idx_main, tr_bounds)
+        res = prob.residual(eta_hat, idx_main, tr_hat, theta0_hat)
+        win_res = res[t[idx_main] >= w0]
+    else:
+        q = problem("first")
+        _, tr_hat, theta0_hat = q.profile(eta_hat, np.flatnonzero(t < tc[0]), tr_bounds)
+        ids, amp, half = idx_main
+        res = win_res = prob.peaks_residual(eta_hat, amp, half, list(ids))
+    eta_first = eta_hat if window == "first" else fit_window("first", "theta", fixed=(tr_hat, theta0_hat))[0]
+    n_pts = int(res.size)
+    rms = float(np.sqrt(np.mean(win_res ** 2))) if win_res.size else float("nan")
+    n_par = 4 if objective_used == "theta" else 1
+    s2 = f_hat / max(n_pts - n_par, 1)
+    thresh = float(chi2.ppf(level, 1)) * s2 * _ac_factor(win_res)
+    ci = _profile_ci(f_main, eta_hat, f_hat, thresh, lo_b, hi_b)
+    at_bound = []
+    if min(eta_hat - lo_b, hi_b - eta_hat) < 1e-4:
+        at_bound.append("eta_e")
+    if min(eta_first - lo_b, hi_b - eta_first) < 1e-4:
+        at_bound.append("eta_e_first")
+    if min(tr_hat - tr_bounds[0], tr_bounds[1] - tr_hat) < 1e-6:
+        at_bound.append("release_t_s")
+    flags = _suspicion(t, y, win_res if objective_used == "theta" else np.array([]), rms, sigma, pie, tc, alpha)
+    msg = f"{n_skip} NaN sample(s) skipped" if n_skip else ""
+    return RestitutionFit(
+        eta_e=float(eta_hat), eta_e_first=float(eta_first), ci95_eta_e=ci, theta0_rad=float(s0 * theta0_hat),
+        release_t_s=float(tr_hat), rms_residual_rad=rms, sigma_theta_rad=float(rel.sigma_rad),
+        per_impact_eta=tuple(float(x) for x in pie["eta_peaks"]), n_impacts=n_imp, window=window,
+        objective=objective_used, window_t_s=(float(w0), float(w1)), n_points=n_pts, eta_bounds=(lo_b, hi_b),
+        block_name=name, suspicious=bool(flags), flags=tuple(flags), at_bound=tuple(at_bound), n_skipped=n_skip,
+        n_evaluations=sum(q.n_sim for q in probs.values()), status="ok", message=msg, per_impact=pie)
+
+
+def _suspicion(t, y, res, rms, sigma, pie, tc, alpha):
+    """Symptoms of slip or jumping: structured residuals, asymmetric decay, offset rest, jumps."""
+    flags = []
+    if res.size >= 20 and rms > 3.0 * sigma:
+        s = np.sign(res)
+        s = s[s != 0]
+        runs = 1 + int(np.sum(s[1:] != s[:-1]))
+        n1, n2 = int(np.sum(s > 0)), int(np.sum(s < 0))
+        n = n1 + n2
+        if n1 and n2:
+            mu = 2.0 * n1 * n2 / n + 1
+            var = (mu - 1) * (mu - 2) / (n - 1)
+            z = (runs - mu) / math.sqrt(max(var, 1e-12))
+            if z < -4:
+                flags.append(f"structured residuals: RMS {rms / sigma:.1f}x the noise and a runs test z = {z:.1f} "
+                             "(misfit: slip, jump or a restitution that changes during rocking)")
+        big = np.abs(res) > 8.0 * max(rms, sigma)
+        if big.any():
+            flags.append(f"{int(big.sum())} residual(s) above 8x RMS: isolated jump or tracking glitch")
+    ok = pie[pie["ok"]] if len(pie) else pie
+    if len(ok) >= 4:
+        e = ok["eta_peaks"].to_numpy()
+        se = ok["eta_peaks_se"].to_numpy()
+        odd = ok["impact"].to_numpy() % 2 == 1
+        if odd.any() and (~odd).any():
+            d = float(np.mean(e[odd]) - np.mean(e[~odd]))
+            sd = float(np.sqrt(np.mean(se[odd] ** 2) / odd.sum() + np.mean(se[~odd] ** 2) / (~odd).sum()))
+            if abs(d) > max(4 * sd, 0.01):
+                flags.append(f"asymmetric amplitudes: per-impact eta differs by {d:+.3f} between the two corners "
+                             "(tilted base, slip or unequal corners)")
+    after = t > tc[-1] + 2 * (tc[-1] - tc[-2]) if tc.size >= 2 else np.zeros_like(t, bool)
+    if after.sum() >= 10:
+        rest = float(np.median(y[after]))
+        if abs(rest) > max(10 * sigma / math.sqrt(after.sum()) + 3 * sigma, 0.01 * alpha):
+            flags.append(f"block came to rest at {rest:+.4f} rad, not 0: it slipped or jumped")
+    return flags

@@ -209,12 +209,11 @@ def _write_campaign(res: CampaignResult) -> None:
     if res.table is not None and len(res.table):
         write_frame_atomic(out / "campaign.csv", res.table)
         reg = None
-        try:
-            from ..fitting import default_k_regression
+        from ..fitting import KRegression
 
-            reg = default_k_regression()
-        except ImportError:
-            pass
+        reg = KRegression.ceh2018()
+        if res.k_table and res.k_table.get("coefficients"):
+            reg = KRegression.from_coefficients(res.k_table["coefficients"])
         campaign_figures(res.table, out / "figures", regression=reg)
         _campaign_rrd(res, out / "campaign.rrd")
     write_json_atomic(out / "campaign.json", json.loads(json.dumps(res.to_dict(), default=str)))

@@ -371,15 +371,10 @@ def load_experiment(path) -> ExperimentConfig:
 
 def _catalogue() -> dict:
     """Čeh Table 2 as {id: {b_m, h_m, mass_kg}} (from rocklab.fitting's package data)."""
-    try:
-        from ..fitting import block_catalogue
-    except ImportError:  # fitting issue not landed: fall back to nothing
-        return {}
-    cat = block_catalogue()
-    if hasattr(cat, "to_dict") and hasattr(cat, "columns"):  # DataFrame
-        return {str(r["block"]): {"b_m": float(r["b_m"]), "h_m": float(r["h_m"]),
-                                  "mass_kg": float(r["mass_kg"])} for _, r in cat.iterrows()}
-    return {k: {"b_m": v.b_m, "h_m": v.h_m, "mass_kg": v.mass_kg} for k, v in dict(cat).items()}
+    from ..fitting import ceh_catalogue
+
+    return {str(r["block"]): {"b_m": float(r["b_m"]), "h_m": float(r["h_m"]), "mass_kg": float(r["mass_kg"])}
+            for _, r in ceh_catalogue().iterrows()}
 
 
 EXAMPLE_TOML = textwrap.dedent(__doc__.split("Schema (all lengths in m, times in s, angles in rad)::\n\n", 1)[1])

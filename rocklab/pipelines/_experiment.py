@@ -169,8 +169,8 @@ def _measure_video(cfg: ExperimentConfig, progress: bool):
     table = None
     if cfg.table.source == "video":
         tm = tr.table_motion(cfg.table.object)
-        table = {"t_s": np.asarray(tm.t_s), "disp_m": np.asarray(tm.disp_m),
-                 "vel_m_s": np.asarray(tm.vel_m_s), "acc_m_s2": np.asarray(tm.acc_m_s2)}
+        table = {"t_s": np.asarray(tm.t_s), "disp_m": np.asarray(tm.x_m),
+                 "vel_m_s": np.asarray(tm.vx_m_s), "acc_m_s2": np.asarray(tm.ax_m_s2)}
     return (sel["t_s"].to_numpy(float), sel["theta_rad"].to_numpy(float)), table, tr
 
 
@@ -187,15 +187,15 @@ def _table_from_imu(cfg: ExperimentConfig):
     from ..tracking import read_imu, table_acceleration
 
     log = read_imu(cfg.table.imu)
-    ta = table_acceleration(log)
+    ta = table_acceleration(log, axis=None)
     return {"t_s": np.asarray(ta.t_s, float), "acc_m_s2": np.asarray(ta.acc_m_s2, float)}
 
 
-def _sync(video, imu, max_offset_s):
-    from ..tracking import sync_offset
+def _sync(ref, rot, max_offset_s):
+    """Clock model t_imu = t_ref + offset + drift * t_ref from the rocking rates."""
+    from ..tracking import sync_imu_to_track
 
-    s = sync_offset(video[0], video[1], imu[0], imu[1], max_offset_s=max_offset_s)
-    return s
+    return sync_imu_to_track(rot, ref[0], ref[1], max_offset_s=max_offset_s)
 
 
 def analyse_experiment(cfg: ExperimentConfig, progress: bool = False) -> ExperimentResult:
@@ -228,10 +228,11 @@ def analyse_experiment(cfg: ExperimentConfig, progress: bool = False) -> Experim
     residual = None
     if "imu" in measured and ("video" in measured or "track" in measured) and cfg.sync_method == "xcorr":
         ref = measured.get("video") or measured.get("track")
-        s = _sync(ref, measured["imu"], cfg.max_offset_s)
-        sync = s.to_dict() if hasattr(s, "to_dict") else dict(s)
+        s = _sync(ref, rot, cfg.max_offset_s)
+        sync = s.to_dict()
         ti, thi = measured["imu"]
-        measured["imu"] = (s.apply(ti) if hasattr(s, "apply") else ti + sync["offset_s"], thi)
+        # invert t_imu = t_ref + offset + drift t_ref: the IMU series on the reference clock
+        measured["imu"] = ((ti - s.offset_s) / (1.0 + s.drift), thi)
         tv, thv = ref
         thi_on_v = np.interp(tv, measured["imu"][0], thi, left=np.nan, right=np.nan)
         residual = (tv, thv - thi_on_v)
@@ -274,18 +275,18 @@ def _eta_for_law(law, cfg, block, fit_d, msgs):
         v = (fit_d or {}).get(key)
         return float(v) if v is not None and np.isfinite(v) else None
     if law == "modified":
-        from ..fitting import eta_M, k_edge, predict_k
+        from ..fitting import KRegression, edge_contact_k, eta_modified
 
         if cfg.k is not None:
             k = cfg.k
         elif cfg.contact == "edge":
-            k = k_edge(cfg.b_m, cfg.l_c_m)
+            k = edge_contact_k(cfg.b_m, cfg.l_c_m)
         else:
-            pk = predict_k(cfg.h_m / cfg.b_m, cfg.b_m)
+            pk = KRegression.ceh2018().predict(cfg.h_m / cfg.b_m, cfg.b_m)
             k = pk.k
-            if getattr(pk, "extrapolated", False):
-                msgs.append(f"k = {k:.3f} from the Eq. 19 regression is extrapolated for this block")
-        return float(eta_M(block.alpha_rad, k))
+            if pk.extrapolated:
+                msgs.append(f"k = {k:.3f} from Čeh Eq. 19 is extrapolated for this block: {pk.message}")
+        return float(eta_modified(block.alpha_rad, k))
     raise AssertionError(law)
 
 

@@ -1,0 +1,101 @@
+"""``rocklab run`` end to end on a synthetic track CSV with known truth."""
+
+import json
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from rocklab import Block
+from rocklab.models import simulate
+from rocklab.pipelines._rerun import read_rrd_scalars, read_rrd_summary
+
+ETA_TRUE = 0.93
+FPS = 150.0
+
+
+def _session(tmp_path, seed=0, eta=ETA_TRUE, contact="full"):
+    blk = Block(0.045, 0.2025)
+    theta0 = 0.8 * blk.alpha_rad
+    sim = simulate(blk, theta0_rad=theta0, duration_s=8.0, restitution="constant", eta=eta)
+    t_rel = 0.5
+    t = np.arange(0, 8.0, 1 / FPS)
+    th = np.where(t < t_rel, theta0, np.interp(t - t_rel, sim.t_s, sim.theta_rad))
+    rng = np.random.default_rng(seed)
+    th_meas = th + rng.normal(0, np.radians(0.02), t.size)
+    d = tmp_path / "exp"
+    d.mkdir()
+    pd.DataFrame({"t_s": t, "object": "block_1", "theta_rad": th_meas}).to_csv(d / "tracks.csv", index=False)
+    pd.DataFrame({"frame": np.arange(t.size), "t_s": t, "object": "block_1", "theta_rad": th}).to_csv(
+        d / "truth.csv", index=False)
+    (d / "session.json").write_text(json.dumps({"eta": eta}))
+    extra = '[contact]\ntype = "edge"\nl_c_m = 0.0015\n' if contact == "edge" else ""
+    (d / "experiment.toml").write_text(
+        f'name = "b6m_{contact}"\ntruth = "truth.csv"\n[block]\nid = "B6M"\n{extra}'
+        '[sources.track]\npath = "tracks.csv"\nobject = "block_1"\n[output]\nrrd = true\n')
+    return d / "experiment.toml"
+
+
+def test_run_writes_report_figures_and_rrd(tmp_path, run_cli):
+    cfg = _session(tmp_path)
+    out = tmp_path / "out"
+    rc, stdout, err = run_cli("run", cfg, "--out", out, "--json")
+    assert rc == 0, err
+    js = json.loads(stdout)
+    assert js["ran"] is True
+    rep = json.loads((out / "report.json").read_text())
+    # the catalogue id resolved to Čeh Table 2's B6M
+    assert rep["block"]["b_m"] == pytest.approx(0.045) and rep["block"]["mass_kg"] == pytest.approx(1.0896)
+    assert rep["fit"]["eta_e"] == pytest.approx(ETA_TRUE, abs=0.002)
+    lo, hi = rep["fit"]["ci95_eta_e"]
+    assert lo < rep["fit"]["eta_e"] < hi
+    # the eta_e simulation reproduces the measured response much better than Housner's
+    sims = rep["simulations"]
+    assert sims["eta_e"]["rms_vs_measured_rad"] < 0.2 * sims["housner"]["rms_vs_measured_rad"]
+    assert sims["housner"]["eta"] == pytest.approx(Block(0.045, 0.2025).eta_H)
+    assert rep["truth"]["theta_rms_error_rad"] == pytest.approx(np.radians(0.02), rel=0.2)
+    assert rep["versions"]["rocklab"] and rep["units"]["theta"] == "rad"
+    for f in ("summary.md", "series.csv", "figures/theta.png", "figures/per_impact_eta.png", "session.rrd"):
+        assert (out / f).is_file(), f
+    ser = pd.read_csv(out / "series.csv")
+    assert {"t_s", "theta_track_rad", "theta_sim_eta_e_rad", "theta_truth_rad"} <= set(ser.columns)
+
+    rows = read_rrd_summary(out / "session.rrd")
+    n_ok = int(np.isfinite(ser["theta_track_rad"]).sum())
+    assert rows["/experiment/block_1/theta/measured_track"] == n_ok + 1  # + static series style
+    assert "/experiment/block_1/theta/sim_eta_e" in rows and "/experiment/block_1/impacts" in rows
+    tt, vv = read_rrd_scalars(out / "session.rrd", "experiment/block_1/theta/measured_track")
+    assert np.allclose(vv, ser["theta_track_rad"].to_numpy()[np.isfinite(ser["theta_track_rad"])])
+
+    # unchanged inputs: a no-op; --force re-runs
+    mtime = (out / "report.json").stat().st_mtime_ns
+    rc, stdout, _ = run_cli("run", cfg, "--out", out)
+    assert rc == 0 and "nothing to do" in stdout and (out / "report.json").stat().st_mtime_ns == mtime
+    rc, _, _ = run_cli("run", cfg, "--out", out, "--force")
+    assert rc == 0 and (out / "report.json").stat().st_mtime_ns != mtime
+
+
+def test_run_bad_config_leaves_nothing(tmp_path, run_cli):
+    cfg = _session(tmp_path)
+    cfg.write_text(cfg.read_text().replace('id = "B6M"', 'id = "B66X"'))
+    out = tmp_path / "out"
+    rc, _, err = run_cli("run", cfg, "--out", out)
+    assert rc == 2 and "line 4" in err and "B66X" in err and len(err.strip().splitlines()) == 1
+    assert not out.exists() and not [p for p in tmp_path.iterdir() if p.name.startswith(".out")]
+
+
+def test_failing_stage_leaves_previous_output_intact(tmp_path, run_cli, monkeypatch):
+    cfg = _session(tmp_path)
+    out = tmp_path / "out"
+    assert run_cli("run", cfg, "--out", out)[0] == 0
+    before = (out / "report.json").read_text()
+    import rocklab.pipelines._experiment as E
+
+    def boom(*a, **k):
+        raise RuntimeError("figure backend exploded")
+
+    monkeypatch.setattr(E, "series_frame", boom)
+    with pytest.raises(RuntimeError):
+        E.run_experiment(cfg, out, force=True)
+    assert (out / "report.json").read_text() == before
+    assert not [p for p in tmp_path.iterdir() if p.name.startswith(".out")]

@@ -251,3 +251,32 @@ def test_cli_bad_input_exit_2(run_cli, tmp_path):
     p = _gui(tmp_path, ROWS, regs=None)
     rc, so, se = run_cli("imu", p)
     assert rc == 2 and se.count("\n") == 1 and "--rate" in se
+
+
+def test_fast_numeric_scanner_matches_pandas(shared_data):
+    from rocklab.tracking._imu_fastcsv import parse_numeric_csv
+
+    p = shared_data / XIMU / "00000_CalInertialAndMag.csv"
+    names, vals = parse_numeric_csv(p)
+    ref = pd.read_csv(p)
+    assert names == list(ref.columns) and vals.shape == ref.shape
+    # Correctly rounded for short decimals: identical doubles.
+    assert np.array_equal(vals, ref.to_numpy(dtype=float))
+    # Not all-numeric (the registers file has names and NaN): declined, pandas takes over.
+    assert parse_numeric_csv(shared_data / XIMU / "00000_Registers.csv") is None
+
+
+def test_cli_table_mode(run_cli, tmp_path):
+    t = np.arange(0.0, 8.0, 1e-3)
+    a = np.where(t > 2, 1.0 * np.sin(2 * np.pi * 2.0 * (t - 2)), 0.0)
+    log = simulate_imu_log(t, np.zeros_like(t), None, base=(t, a), rate_hz=400.0, seed=9)
+    write_ximu3_csv(log, tmp_path)
+    out = tmp_path / "table.csv"
+    rc, so, se = run_cli("imu", tmp_path, "--table", "--axis", "x", "-o", out, "--json")
+    assert rc == 0, se
+    d = json.loads(so)
+    assert d["format"] == "ximu3" and d["pga_m_s2"] == pytest.approx(1.0, abs=0.25)  # peak incl. 5 mg noise
+    df = pd.read_csv(out)
+    assert list(df.columns) == ["t_s", "acc_m_s2"]
+    err = df["acc_m_s2"] - np.interp(df["t_s"] - df["t_s"][0], t, a)
+    assert np.sqrt(np.mean(err ** 2)) < 0.06

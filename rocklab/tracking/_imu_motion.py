@@ -18,6 +18,11 @@ STILL_ACC_M_S2 = 0.03 * G
 SMOOTH_S = 0.05
 
 
+def rownorm(v: np.ndarray) -> np.ndarray:
+    """Euclidean norm of each row of an (n, 3) array (faster than ``np.linalg.norm``)."""
+    return np.sqrt(np.einsum("ij,ij->i", v, v))
+
+
 def moving_average(x: np.ndarray, w: int) -> np.ndarray:
     """Centred running mean of ``x`` along axis 0 over ``w`` samples (edges shrink)."""
     if w <= 1:
@@ -44,8 +49,8 @@ def motion_mask(t_s, gyro, acc, rate_hz, gyro_thr=STILL_GYRO_RAD_S, acc_thr=STIL
     w = max(1, int(round(smooth_s * rate_hz)))
     if bias is None:
         bias = np.median(gyro[: max(3, int(0.5 * rate_hz))], axis=0)
-    gm = moving_average(np.linalg.norm(gyro - bias, axis=1), w)
-    an = np.linalg.norm(acc, axis=1)
+    gm = moving_average(rownorm(gyro - bias), w)
+    an = rownorm(acc)
     g_level = np.median(an[: max(3, int(0.5 * rate_hz))]) if n else G
     am = moving_average(np.abs(an - g_level), w)
     return (gm > gyro_thr) | (am > acc_thr)

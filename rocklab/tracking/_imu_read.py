@@ -145,12 +145,28 @@ class ImuLog:
 
 
 # --------------------------------------------------------------------------- helpers
+def _skip_mag(col: str) -> bool:
+    return not str(col).strip().lower().startswith("magnetometer")
+
+
 def _read_csv(path: Path):
-    """Parse a CSV with pandas' C parser; numeric errors name the first bad line."""
+    """Parse a CSV with pandas' C parser; numeric errors name the first bad line.
+
+    All-numeric files go through the numba scanner (``_imu_fastcsv``); the
+    rest (text, NaN, malformed rows) through pandas.  Magnetometer columns
+    are dropped (unused).
+    """
     import pandas as pd
 
+    from ._imu_fastcsv import parse_numeric_csv
+
+    fast = parse_numeric_csv(path) if path.is_file() else None
+    if fast is not None:
+        names, values = fast
+        keep = [i for i, c in enumerate(names) if _skip_mag(c)]
+        return pd.DataFrame(values[:, keep], columns=[names[i] for i in keep], copy=False)
     try:
-        df = pd.read_csv(path, engine="c", skipinitialspace=True)
+        df = pd.read_csv(path, engine="c", usecols=_skip_mag)
     except pd.errors.EmptyDataError:
         raise InputError(f"{where(path)}empty file; an IMU CSV needs a header and data rows") from None
     if len(df) == 0:

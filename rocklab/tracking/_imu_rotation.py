@@ -38,7 +38,7 @@ import numpy as np
 from .._errors import InputError
 from ..blocks import G
 from ._imu_motion import (axis_vector, cumtrapz, first_motion, last_motion_end, motion_mask,
-                          moving_average, quat_mul, tilt_about, twist_angle)
+                          moving_average, quat_mul, rownorm, tilt_about, twist_angle)
 from ._imu_read import ImuLog
 
 __all__ = ["ImuRotation", "block_rotation", "ahrs_rotation", "ahrs_quaternions"]
@@ -288,7 +288,8 @@ def _impacts(t, theta, omega, acc, moving, i_move, i_end, fs) -> np.ndarray:
         return np.empty(0)
     n = len(t)
     spike = np.zeros(n)
-    spike[1:-1] = np.linalg.norm(acc[1:-1] - 0.5 * (acc[:-2] + acc[2:]), axis=1)
+    i0, i1 = max(1, a - 1), min(n - 1, b + 2)  # only where impacts can be
+    spike[i0:i1] = rownorm(acc[i0:i1] - 0.5 * (acc[i0 - 1:i1 - 1] + acc[i0 + 1:i1 + 1]))
     spike_thr = max(8.0 * float(np.median(spike[a:b])), 0.05 * G)
     jumps = np.abs(np.diff(omega))
     jump_thr = max(4.0 * float(np.median(jumps[a:b])), np.deg2rad(0.3))

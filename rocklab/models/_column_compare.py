@@ -1,0 +1,153 @@
+"""Opening/closing sequences of a column: from block angles, and their comparison.
+
+For the shake-table validation (thesis §4.3): which joint opens, in which
+direction, and when — measured (tracked block angles) against simulated. Apply
+:func:`joint_sequence` with the SAME threshold to both the measured and the
+simulated block angles, then :func:`compare_sequences`.
+
+Signs: block angles clockwise positive (the convention of
+:func:`rocklab.models.simulate_column`); pass ``sign=-1`` for counter-clockwise data.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .._errors import InputError
+
+__all__ = ["joint_sequence", "compare_sequences", "SequenceComparison"]
+
+
+def joint_sequence(t_s, theta_rad, threshold_rad: float = 0.005, *, base_theta_rad=None, sign: float = 1.0,
+                   min_duration_s: float = 0.0) -> list[tuple[float, int, str]]:
+    """Configuration changes ``(t_s, joint, state)`` from absolute block angles.
+
+    Parameters
+    ----------
+    t_s : array (m,)
+        Sample times, s (NaN rows of ``theta_rad`` are skipped).
+    theta_rad : array (m, n)
+        Absolute block angles, bottom block first, rad.
+    threshold_rad : float
+        A joint is open when its relative rotation ``|θ_j - θ_{j-1}|`` exceeds
+        this (rad) and closes again below half of it (hysteresis against noise).
+    base_theta_rad : array (m,), optional
+        Angle of the base (e.g. the tracked table), subtracted from block 0.
+    sign : float
+        -1 for counter-clockwise-positive angles.
+    min_duration_s : float
+        Ignore states that last shorter than this, s (debounce).
+
+    Returns
+    -------
+    list of (t_s, joint, state)
+        ``state`` in ``closed | cw | ccw``; the time is the first sample in the
+        new state. Joints are numbered from the base (joint 0 under block 0).
+    """
+    t = np.asarray(t_s, float).ravel()
+    th = np.asarray(theta_rad, float)
+    if th.ndim == 1:
+        th = th[:, None]
+    if th.ndim != 2 or th.shape[0] != t.size:
+        raise InputError(f"theta_rad has shape {th.shape} for {t.size} times; give (n_samples, n_blocks)")
+    if not threshold_rad > 0:
+        raise InputError(f"threshold_rad={threshold_rad!r}: must be positive (rad)")
+    th = sign * th
+    if base_theta_rad is not None:
+        th = th - sign * np.asarray(base_theta_rad, float).reshape(-1, 1)
+    phi = np.diff(np.concatenate([np.zeros((th.shape[0], 1)), th], axis=1), axis=1)
+    out = []
+    for j in range(phi.shape[1]):
+        state = "closed"
+        cand = None  # (t, state) waiting for its minimum duration
+        for k in range(t.size):
+            x = phi[k, j]
+            if not np.isfinite(x):
+                continue
+            if state == "closed":
+                new = "cw" if x > threshold_rad else ("ccw" if x < -threshold_rad else "closed")
+            elif state == "cw":
+                new = "cw" if x > threshold_rad / 2 else ("ccw" if x < -threshold_rad else "closed")
+            else:
+                new = "ccw" if x < -threshold_rad / 2 else ("cw" if x > threshold_rad else "closed")
+            if cand is not None and new != cand[1]:
+                cand = None if new == state else (t[k], new)
+            elif cand is None and new != state:
+                cand = (t[k], new)
+            if cand is not None and t[k] - cand[0] >= min_duration_s:
+                out.append((float(cand[0]), j, cand[1]))
+                state = cand[1]
+                cand = None
+    out.sort(key=lambda e: (e[0], e[1]))
+    return out
+
+
+@dataclass(frozen=True)
+class SequenceComparison:
+    """Agreement of two opening/closing sequences.
+
+    Attributes
+    ----------
+    n_measured, n_simulated, n_matched : int
+        Events in each sequence, and events matched in order (same joint and
+        state, times within ``tol_s``; longest common subsequence).
+    pairs : list of (t_measured_s, t_simulated_s, joint, state)
+    timing_error_s : float
+        Median |t_measured - t_simulated| of the matched events, s (nan if none).
+    same_sequence : bool
+        Every event of both sequences matched.
+    tol_s : float
+    """
+
+    n_measured: int
+    n_simulated: int
+    n_matched: int
+    pairs: list
+    timing_error_s: float
+    same_sequence: bool
+    tol_s: float
+
+    def to_dict(self) -> dict:
+        return {"n_measured": self.n_measured, "n_simulated": self.n_simulated, "n_matched": self.n_matched,
+                "timing_error_s": self.timing_error_s, "same_sequence": self.same_sequence, "tol_s": self.tol_s,
+                "pairs": [list(p) for p in self.pairs]}
+
+
+def compare_sequences(measured, simulated, tol_s: float = 0.05, t_max_s: float | None = None) -> SequenceComparison:
+    """Match two sequences of ``(t_s, joint, state)`` in order (LCS with a time tolerance).
+
+    Parameters
+    ----------
+    measured, simulated : list of (t_s, joint, state)
+        E.g. from :func:`joint_sequence`.
+    tol_s : float
+        Largest time difference of matched events, s.
+    t_max_s : float, optional
+        Compare only events before this time, s.
+    """
+    if not tol_s > 0:
+        raise InputError(f"tol_s={tol_s!r}: time tolerance must be positive (s)")
+    a = [e for e in measured if t_max_s is None or e[0] <= t_max_s]
+    b = [e for e in simulated if t_max_s is None or e[0] <= t_max_s]
+    na, nb = len(a), len(b)
+    L = np.zeros((na + 1, nb + 1), int)
+    for i in range(na - 1, -1, -1):
+        for k in range(nb - 1, -1, -1):
+            ok = a[i][1] == b[k][1] and a[i][2] == b[k][2] and abs(a[i][0] - b[k][0]) <= tol_s
+            L[i, k] = L[i + 1, k + 1] + 1 if ok else max(L[i + 1, k], L[i, k + 1])
+    pairs = []
+    i = k = 0
+    while i < na and k < nb:
+        ok = a[i][1] == b[k][1] and a[i][2] == b[k][2] and abs(a[i][0] - b[k][0]) <= tol_s
+        if ok and L[i, k] == L[i + 1, k + 1] + 1:
+            pairs.append((float(a[i][0]), float(b[k][0]), int(a[i][1]), str(a[i][2])))
+            i += 1
+            k += 1
+        elif L[i + 1, k] >= L[i, k + 1]:
+            i += 1
+        else:
+            k += 1
+    err = float(np.median([abs(p[0] - p[1]) for p in pairs])) if pairs else float("nan")
+    return SequenceComparison(na, nb, len(pairs), pairs, err, len(pairs) == na == nb, float(tol_s))

@@ -1,0 +1,309 @@
+"""Event-driven time-stepping loop of the column model (Ther thesis §3.3).
+
+One loop, plain Python registered with numba; :data:`run_core_jit` is its
+compiled form (``cache=True``) and :func:`run_core` the pure-Python baseline.
+Within a step: closings are located exactly (the step length that lands the
+joint on zero, Čeh et al. Eq. 8), openings by linear interpolation of the
+eccentricity excess (thesis §3.3); the earliest event wins, the opening or
+impact model sets the new configuration and stepping resumes with full steps.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+from numba.extending import register_jitable
+
+from ._column_events import impact_model, opening_model
+from ._column_kernels import active_dofs, geometry, kinetic_energy, pivots
+from ._column_step import evaluate, locate_closing, nm_step, state_checks
+
+__all__: list[str] = []
+
+# status codes returned by the loop
+ST_END, ST_REST, ST_OVERTURN, ST_TENSION, ST_SLIDING, ST_CAPACITY, ST_NUMERIC = 0, 1, 2, 3, 4, 5, 6
+# event kinds
+EV_START, EV_OPEN, EV_IMPACT = 0, 1, 2
+
+
+@register_jitable
+def _energy(phi, v, s, blk, g, y0):
+    n = phi.shape[0]
+    theta = np.empty(n)
+    thlow = np.empty(n)
+    C = np.empty((n, 2))
+    G = np.empty((n, 2))
+    geometry(phi, s, blk, theta, thlow, C, G)
+    dj = np.empty(n, np.int64)
+    dpx = np.empty(n)
+    k = active_dofs(s, blk, dj, dpx)
+    PP = np.empty((max(k, 1), 2))
+    pivots(dj, dpx, k, C, thlow, PP)
+    vk = np.empty(max(k, 1))
+    for q in range(k):
+        vk[q] = v[dj[q]]
+    ke = kinetic_energy(dj, k, PP, vk, G, blk)
+    pe = 0.0
+    for i in range(n):
+        pe += blk[i, 0] * g * (G[i, 1] - y0[i])
+    return ke, pe, theta, G, C, thlow
+
+
+@register_jitable
+def _overturned(phi, v, s, blk, g, y0, ovt_angle):
+    """Static instability of the part above an opening joint, moving outwards.
+
+    The centre of mass of blocks j..n lies beyond the pivot of open joint j
+    (gravity now drives the opening) while the joint still opens; for one block
+    this is |θ| ≥ α with outward velocity. With ``ovt_angle > 0`` any block
+    angle beyond it counts instead.
+    """
+    n = phi.shape[0]
+    ke, pe, theta, G, C, thlow = _energy(phi, v, s, blk, g, y0)
+    if ovt_angle > 0.0:
+        for i in range(n):
+            if abs(theta[i]) >= ovt_angle:
+                return True
+        return False
+    for j in range(n):
+        if s[j] == 0 or s[j] * v[j] <= 0.0:
+            continue
+        px = -s[j] * blk[j, 4]
+        pxw = C[j, 0] + math.cos(thlow[j]) * px
+        mx = 0.0
+        mt = 0.0
+        for i in range(j, n):
+            mx += blk[i, 0] * G[i, 0]
+            mt += blk[i, 0]
+        if s[j] * (mx / mt - pxw) <= 0.0:
+            return True
+    return False
+
+
+@register_jitable
+def _apply_opening(t, s, px, s_new, px_new, EVT, EVI, ne):
+    ecap = EVT.shape[0]
+    for j in range(s.shape[0]):
+        if s_new[j] != s[j] and ne < ecap:
+            EVT[ne] = t
+            EVI[ne, 0] = j
+            EVI[ne, 1] = s_new[j]
+            EVI[ne, 2] = EV_OPEN
+            ne += 1
+        s[j] = s_new[j]
+        px[j] = px_new[j]
+    return ne
+
+
+@register_jitable
+def run_core(phi0, v0, s0, blk, par, accb, n_steps, dt, max_enum, n_imp, v_tol, stop_at_rest, ovt_angle,
+             PHI, VEL, EN, EVT, EVI, IMP):
+    """Integrate ``n_steps`` steps of ``dt`` (s) from t = 0.
+
+    The grid ``t_k = k dt`` is kept: an event inside a step is followed by the
+    rest of that step (as in the single-block kernel). Records the state at every
+    grid time in ``PHI, VEL, EN (ke, pe)``; configuration changes in
+    ``EVT (t) / EVI (joint, new state, kind)``; impacts in ``IMP`` rows
+    ``(t, joint, v_before, ke_before, ke_after, state after)``.
+    Returns ``(n_rec, n_ev, n_imp_rec, status, t_status)``.
+    """
+    n = phi0.shape[0]
+    g = par[0]
+    t_quiet = par[6]
+    ecap = EVT.shape[0]
+    icap = IMP.shape[0]
+    phi = phi0.copy()
+    v = v0.copy()
+    s = s0.copy()
+    px = np.empty(n)
+    for j in range(n):
+        px[j] = -s[j] * blk[j, 4]
+    zeros = np.zeros(n)
+    zs = np.zeros(n, np.int64)
+    y0 = np.empty(n)
+    ke0, pe0, th0, G0, C0, tl0 = _energy(zeros, zeros, zs, blk, g, zeros)
+    for i in range(n):
+        y0[i] = G0[i, 1]
+    acc = np.zeros(n)
+    N = np.empty(n)
+    V = np.empty(n)
+    Mc = np.empty(n)
+    phi1 = np.empty(n)
+    v1 = np.empty(n)
+    acc1 = np.empty(n)
+    N1 = np.empty(n)
+    V1 = np.empty(n)
+    Mc1 = np.empty(n)
+    viol0 = np.empty(n)
+    viol1 = np.empty(n)
+    s_new = np.empty(n, np.int64)
+    px_new = np.empty(n)
+    v_new = np.empty(n)
+    nr = 0
+    ne = 0
+    ni = 0
+    status = ST_END
+    t_status = math.nan
+    for j in range(n):
+        if s[j] != 0 and ne < ecap:
+            EVT[ne] = 0.0
+            EVI[ne, 0] = j
+            EVI[ne, 1] = s[j]
+            EVI[ne, 2] = EV_START
+            ne += 1
+    if not evaluate(phi, v, s, 0.0, blk, par, accb, acc, N, V, Mc):
+        return nr, ne, ni, ST_NUMERIC, 0.0
+    code = state_checks(s, phi, v, blk, par, N, V, Mc, viol0)
+    for j in range(n):
+        if viol0[j] > 0.0 and code == 0:
+            if opening_model(phi, v, s, px, 0.0, dt, blk, par, accb, max_enum, s_new, px_new) > 0:
+                ne = _apply_opening(0.0, s, px, s_new, px_new, EVT, EVI, ne)
+                evaluate(phi, v, s, 0.0, blk, par, accb, acc, N, V, Mc)
+                code = state_checks(s, phi, v, blk, par, N, V, Mc, viol0)
+            break
+    ke, pe, th, G, C, tl = _energy(phi, v, s, blk, g, y0)
+    PHI[0, :] = phi
+    VEL[0, :] = v
+    EN[0, 0] = ke
+    EN[0, 1] = pe
+    nr = 1
+    if code != 0:
+        return nr, ne, ni, ST_TENSION if code == 1 else ST_SLIDING, 0.0
+    step = 0
+    while step < n_steps:
+        t1 = (step + 1) * dt
+        tc = step * dt
+        n_sub = 0
+        retry = False
+        while t1 - tc > 1e-12 * dt:
+            rem = t1 - tc
+            n_sub += 1
+            if n_sub > 100000 or not nm_step(phi, v, acc, s, tc, rem, blk, par, accb, phi1, v1, acc1,
+                                             N1, V1, Mc1):
+                status = ST_NUMERIC
+                break
+            # earliest closing (exact) and opening (linear interpolation) inside the sub-step
+            tau_c = math.inf
+            jc = -1
+            for j in range(n):
+                if s[j] != 0 and s[j] * phi1[j] < 0.0:
+                    tj = locate_closing(phi, v, acc, s, tc, rem, j, blk, par, accb, phi1, v1, acc1, N1, V1, Mc1)
+                    if tj < tau_c:
+                        tau_c = tj
+                        jc = j
+            if jc >= 0:
+                locate_closing(phi, v, acc, s, tc, rem, jc, blk, par, accb, phi1, v1, acc1, N1, V1, Mc1)
+            code = state_checks(s, phi1, v1, blk, par, N1, V1, Mc1, viol1)
+            tau_o = math.inf
+            if not retry:
+                for j in range(n):
+                    if s[j] == 0 and viol1[j] > 0.0:
+                        tt = rem if jc < 0 else tau_c
+                        den = viol0[j] - viol1[j]
+                        frac = viol0[j] / den if (den < 0.0 and viol0[j] < 0.0) else 0.0
+                        if frac * tt < tau_o:
+                            tau_o = frac * tt
+            if tau_o < math.inf and (jc < 0 or tau_o < tau_c):
+                # opening: step to the interpolated instant and ask the opening model
+                if tau_o > 0.0:
+                    nm_step(phi, v, acc, s, tc, tau_o, blk, par, accb, phi1, v1, acc1, N1, V1, Mc1)
+                else:
+                    for j in range(n):
+                        phi1[j] = phi[j]
+                        v1[j] = v[j]
+                found = opening_model(phi1, v1, s, px, tc + tau_o, dt, blk, par, accb, max_enum, s_new, px_new)
+                if found == 0:
+                    # thrust not yet outside the section there: take the step, decide at its end
+                    retry = True
+                    continue
+                tc = tc + tau_o
+                for j in range(n):
+                    phi[j] = phi1[j]
+                    v[j] = v1[j]
+                ne = _apply_opening(tc, s, px, s_new, px_new, EVT, EVI, ne)
+            elif jc >= 0:
+                tc = tc + tau_c
+                for j in range(n):
+                    phi[j] = phi1[j]
+                    v[j] = v1[j]
+                phi[jc] = 0.0
+                ke_b, pe_b, th, G, C, tl = _energy(phi, v, s, blk, g, y0)
+                vb = v[jc]
+                px0 = px[jc]
+                sgn = 1.0 if vb > 0.0 else -1.0
+                s_before = s.copy()
+                ke_a = ke_b
+                for k_imp in range(1, n_imp + 1):
+                    px_to = -px0 if k_imp == n_imp else px0 * (1.0 - 2.0 * k_imp / n_imp)
+                    ke_a = impact_model(phi, v, s, px, jc, px_to, sgn, blk, par, max_enum, v_tol,
+                                        s_new, px_new, v_new)
+                    for j in range(n):
+                        s[j] = s_new[j]
+                        px[j] = px_new[j]
+                        v[j] = v_new[j]
+                    if s[jc] == 0:
+                        break
+                if ni < icap:
+                    IMP[ni, 0] = tc
+                    IMP[ni, 1] = jc
+                    IMP[ni, 2] = vb
+                    IMP[ni, 3] = ke_b
+                    IMP[ni, 4] = ke_a
+                    IMP[ni, 5] = s[jc]
+                    ni += 1
+                for j in range(n):
+                    if (s[j] != s_before[j] or j == jc) and ne < ecap:
+                        EVT[ne] = tc
+                        EVI[ne, 0] = j
+                        EVI[ne, 1] = s[j]
+                        EVI[ne, 2] = EV_IMPACT
+                        ne += 1
+                if ni >= icap or ne >= ecap:
+                    status = ST_CAPACITY
+                    break
+            else:
+                tc = t1
+                for j in range(n):
+                    phi[j] = phi1[j]
+                    v[j] = v1[j]
+                if retry and code == 0:
+                    found = opening_model(phi, v, s, px, tc, dt, blk, par, accb, max_enum, s_new, px_new)
+                    if found > 0:
+                        ne = _apply_opening(tc, s, px, s_new, px_new, EVT, EVI, ne)
+            retry = False
+            if not evaluate(phi, v, s, tc, blk, par, accb, acc, N, V, Mc):
+                status = ST_NUMERIC
+                break
+            code = state_checks(s, phi, v, blk, par, N, V, Mc, viol0)
+            if code != 0:
+                status = ST_TENSION if code == 1 else ST_SLIDING
+                break
+        step += 1
+        if status != ST_END:
+            t_status = tc
+            break
+        ke, pe, th, G, C, tl = _energy(phi, v, s, blk, g, y0)
+        PHI[nr, :] = phi
+        VEL[nr, :] = v
+        EN[nr, 0] = ke
+        EN[nr, 1] = pe
+        nr += 1
+        if _overturned(phi, v, s, blk, g, y0, ovt_angle):
+            status = ST_OVERTURN
+            t_status = t1
+            break
+        if stop_at_rest and t1 >= t_quiet:
+            rest = True
+            for j in range(n):
+                if s[j] != 0:
+                    rest = False
+            if rest:
+                status = ST_REST
+                t_status = t1
+                break
+    return nr, ne, ni, status, t_status
+
+
+run_core_jit = njit(cache=True)(run_core)

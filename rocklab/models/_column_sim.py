@@ -1,0 +1,382 @@
+"""Multi-block rocking columns: public API (Ther thesis §3.2–3.3, App. B–C).
+
+A planar column of rigid blocks stacked on a rigid base; every joint is closed,
+open clockwise or open counter-clockwise, and both directions are unknowns of
+the formulation. Mass matrix and load vector follow the App. C reduction for
+the current geometry (plus the velocity terms ``BᵀMḂφ̇`` the thesis drops,
+switchable); openings and impacts by the enumeration models of §3.2.2–3.2.3.
+
+Sign convention (public)
+------------------------
+x to the right, base acceleration positive to the right. Block angles
+``theta_rad`` and joint rotations ``phi_rad`` are positive CLOCKWISE, which is
+the single-block convention of :func:`rocklab.models.simulate` (θ > 0 turns
+about the right-hand corner): a one-block column's ``theta_rad[:, 0]`` is the
+single-block ``theta_rad``. Joint states: ``"closed"``, ``"cw"`` (turning about
+the right corner, phi >= 0) and ``"ccw"`` (left corner, phi <= 0).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .._errors import InputError
+from ..blocks import G as G_STD
+from ..blocks import Block
+from ._records import BaseMotion
+
+__all__ = ["Column", "ColumnResult", "simulate_column", "uplift_acc_m_s2", "STATE_NAMES"]
+
+#: Public names of the internal joint states (-1 internal = clockwise).
+STATE_NAMES = {0: "closed", -1: "cw", 1: "ccw"}
+_STATUS = {0: "end", 1: "rest", 2: "overturned", 3: "tension", 4: "sliding", 5: "capacity", 6: "numerical"}
+_KIND = {0: "start", 1: "opening", 2: "impact"}
+
+
+@dataclass(frozen=True)
+class Column:
+    """A column of rigid blocks on a rigid base.
+
+    Parameters
+    ----------
+    blocks : sequence of Block
+        Bottom to top. Width ``b_m``, height ``h_m``, mass ``mass_kg`` and the
+        corner-inertia coefficient ``alpha_I`` (centroidal inertia
+        ``(alpha_I - 1) m R²``) are used.
+    cut_m : float or sequence of float
+        Cut (chamfered) edge size per joint, m; joint ``j`` is under block ``j``
+        (joint 0 is the base joint). The pivot sits ``cut_m`` inside the
+        narrower of the two faces.
+    mu : float
+        Friction coefficient of every joint; ``inf`` disables the sliding check.
+
+    Attributes
+    ----------
+    n : int
+        Number of blocks (= joints).
+    half_width_m : ndarray (n,)
+        Pivot offset from the joint centre, ``min(b_below, b_above)/2 - cut``, m.
+    """
+
+    blocks: tuple
+    cut_m: tuple = 0.0
+    mu: float = math.inf
+
+    def __post_init__(self):
+        blocks = tuple(self.blocks)
+        if not blocks:
+            raise InputError("blocks: a column needs at least one block; give e.g. --blocks 0.1x0.2")
+        for i, b in enumerate(blocks):
+            if not isinstance(b, Block):
+                raise InputError(f"blocks[{i}]={b!r}: must be a rocklab.Block")
+        object.__setattr__(self, "blocks", blocks)
+        cut = np.broadcast_to(np.asarray(self.cut_m, float), (len(blocks),)).copy() \
+            if np.ndim(self.cut_m) == 0 else np.asarray(self.cut_m, float)
+        if cut.shape != (len(blocks),):
+            raise InputError(f"cut_m has {cut.size} values for {len(blocks)} joints; give one per joint or one for all")
+        for j, c in enumerate(cut):
+            lim = min(blocks[j].b_m, blocks[j - 1].b_m if j else np.inf) / 2
+            if not (np.isfinite(c) and 0 <= c < lim):
+                raise InputError(f"cut_m[{j}]={c}: cut edge must be in [0, {lim:g}) m (half the joint width)")
+        object.__setattr__(self, "cut_m", tuple(float(c) for c in cut))
+        mu = float(self.mu)
+        if not mu > 0:
+            raise InputError(f"mu={self.mu!r}: friction coefficient must be positive (inf disables sliding)")
+        object.__setattr__(self, "mu", mu)
+
+    @classmethod
+    def uniform(cls, b_m: float, H_m: float, n: int, mass_kg: float | None = None, cut_m: float = 0.0,
+                mu: float = math.inf) -> "Column":
+        """``n`` equal blocks of width ``b_m`` and total height ``H_m`` (m); ``mass_kg`` per block."""
+        if int(n) < 1:
+            raise InputError(f"n={n}: number of blocks must be >= 1")
+        return cls(tuple(Block(b_m, H_m / int(n), mass_kg=mass_kg) for _ in range(int(n))), cut_m, mu)
+
+    @property
+    def n(self) -> int:
+        return len(self.blocks)
+
+    @property
+    def half_width_m(self) -> np.ndarray:
+        b = np.array([blk.b_m for blk in self.blocks])
+        lower = np.concatenate([[np.inf], b[:-1]])
+        return np.minimum(b, lower) / 2 - np.asarray(self.cut_m)
+
+    @property
+    def height_m(self) -> float:
+        return float(sum(b.h_m for b in self.blocks))
+
+    def block_array(self) -> np.ndarray:
+        """Packed parameters ``(n, 5)``: m kg, I_G kg m², h m, h/2 m, pivot half-width m."""
+        out = np.empty((self.n, 5))
+        for i, b in enumerate(self.blocks):
+            out[i] = (b.mass_kg, (b.alpha_I - 1.0) * b.mass_kg * b.R_m ** 2, b.h_m, b.h_m / 2, 0.0)
+        out[:, 4] = self.half_width_m
+        return out
+
+    def to_dict(self) -> dict:
+        return {"blocks": [b.to_dict() for b in self.blocks], "cut_m": list(self.cut_m), "mu": self.mu}
+
+
+@dataclass(frozen=True)
+class ColumnResult:
+    """Response of a column.
+
+    Attributes
+    ----------
+    column : Column
+    t_s : ndarray (m,)
+        Uniform output times ``k * dt_s``, s (events fall between them).
+    phi_rad, omega_rad_s : ndarray (m, n)
+        Joint rotations (block j relative to block j-1, clockwise positive), rad,
+        and their rates, rad/s.
+    theta_rad : ndarray (m, n)
+        Absolute block angles (cumulative sums of ``phi_rad``), rad.
+    energy_J : ndarray (m,)
+        Kinetic + potential energy relative to the base frame (zero at rest), J.
+    kinetic_J : ndarray (m,)
+    configurations : DataFrame
+        ``t_s, joint, state, event``: every change of a joint's state
+        (``closed | cw | ccw``) and why (``start | opening | impact``).
+    impacts : DataFrame
+        ``t_s, joint, omega_before_rad_s, ke_before_J, ke_after_J, state_after``.
+    status : str
+        As :func:`rocklab.models.simulate`: ``rest`` (all joints closed and the
+        base no longer able to open one), ``rocking`` (still moving at the end),
+        ``no_uplift`` (never opened), ``overturned`` (run stops: the centre of
+        mass above an opening joint passed its pivot); and for columns
+        ``tension`` / ``sliding`` (terminated: the column may disintegrate,
+        thesis §3.3), ``capacity`` / ``numerical`` (failures).
+    t_status_s : float
+        Time of the terminating event (nan if the duration was reached), s.
+    message : str
+    params : dict
+        Solver settings used.
+    """
+
+    column: Column
+    t_s: np.ndarray
+    phi_rad: np.ndarray
+    omega_rad_s: np.ndarray
+    theta_rad: np.ndarray
+    energy_J: np.ndarray
+    kinetic_J: np.ndarray
+    configurations: object
+    impacts: object
+    status: str
+    t_status_s: float
+    message: str = ""
+    params: dict = field(default_factory=dict)
+
+    @property
+    def overturned(self) -> bool:
+        return self.status == "overturned"
+
+    @property
+    def max_abs_theta_rad(self) -> np.ndarray:
+        """Peak |θ| per block, rad, shape (n,)."""
+        return np.max(np.abs(self.theta_rad), axis=0)
+
+    def joint_sequence(self, threshold_rad: float = 0.005, min_duration_s: float = 0.0) -> list:
+        """Opening/closing sequence read from the block angles, as for measured data.
+
+        See :func:`rocklab.models.joint_sequence`; the exact model events are in
+        :attr:`configurations`.
+        """
+        from ._column_compare import joint_sequence
+
+        return joint_sequence(self.t_s, self.theta_rad, threshold_rad, min_duration_s=min_duration_s)
+
+    def to_frame(self):
+        """Time history: ``t_s``, ``theta_<i>_rad``, ``phi_<j>_rad``, ``omega_<j>_rad_s``, ``energy_J``."""
+        import pandas as pd
+
+        d = {"t_s": self.t_s}
+        for i in range(self.column.n):
+            d[f"theta_{i}_rad"] = self.theta_rad[:, i]
+        for j in range(self.column.n):
+            d[f"phi_{j}_rad"] = self.phi_rad[:, j]
+            d[f"omega_{j}_rad_s"] = self.omega_rad_s[:, j]
+        d["energy_J"] = self.energy_J
+        d["kinetic_J"] = self.kinetic_J
+        return pd.DataFrame(d)
+
+    def to_dict(self) -> dict:
+        """Summary: status, peak rotations per block, configuration changes, impact count."""
+        return {
+            "status": self.status, "t_status_s": self.t_status_s, "message": self.message,
+            "n_blocks": self.column.n,
+            "max_abs_theta_rad": [float(x) for x in self.max_abs_theta_rad],
+            "n_impacts": int(len(self.impacts)),
+            "configurations": [
+                {"t_s": float(r.t_s), "joint": int(r.joint), "state": r.state, "event": r.event}
+                for r in self.configurations.itertuples()],
+            "params": dict(self.params),
+            "column": self.column.to_dict(),
+        }
+
+
+def _initial_state(column: Column, theta0, omega0):
+    n = column.n
+    th = np.zeros(n) if theta0 is None else np.broadcast_to(np.asarray(theta0, float), (n,)).copy()
+    om = np.zeros(n) if omega0 is None else np.broadcast_to(np.asarray(omega0, float), (n,)).copy()
+    if not (np.all(np.isfinite(th)) and np.all(np.isfinite(om))):
+        raise InputError("theta0_rad/omega0_rad_s: initial block angles and rates must be finite")
+    phi = np.diff(np.concatenate([[0.0], th]))
+    v = np.diff(np.concatenate([[0.0], om]))
+    # internal convention is counter-clockwise positive
+    phi_i, v_i = -phi, -v
+    s = np.sign(phi_i).astype(np.int64)
+    for j in range(n):
+        if s[j] == 0 and v_i[j] != 0.0:
+            s[j] = int(np.sign(v_i[j]))
+    return phi_i, v_i, s
+
+
+def uplift_acc_m_s2(column: Column, g_m_s2: float = G_STD) -> float:
+    """Smallest base acceleration (m/s²) that opens a joint of the column at rest.
+
+    The rigid column moves with the base; joint j opens when the thrust of the
+    part above it leaves the section: ``|a_g| > g a_j / z_j`` with ``z_j`` the
+    height of that part's centre of mass above joint j.
+    """
+    blk = column.block_array()
+    m, h = blk[:, 0], blk[:, 2]
+    z_bottom = np.concatenate([[0.0], np.cumsum(h)[:-1]])
+    out = math.inf
+    for j in range(column.n):
+        zc = np.sum(m[j:] * (z_bottom[j:] + h[j:] / 2)) / np.sum(m[j:]) - z_bottom[j]
+        out = min(out, g_m_s2 * blk[j, 4] / zc)
+    return out
+
+
+def _quiet_time(column, base, g_m_s2):
+    """Last time the base could open or slide the resting column (s); -inf without base."""
+    if base is None:
+        return -math.inf
+    over = np.abs(base.acc_m_s2) > min(uplift_acc_m_s2(column, g_m_s2), column.mu * g_m_s2)
+    return float(base.t_s[np.flatnonzero(over)[-1]]) if over.any() else -math.inf
+
+
+def simulate_column(column: Column, base: BaseMotion | None = None, *, theta0_rad=None, omega0_rad_s=None,
+                    duration_s: float | None = None, dt_s: float = 1e-4, n_impacts: int = 1,
+                    velocity_terms: bool = True, max_enum_closed: int = 9, stop_at_rest: bool = True,
+                    overturn_angle_rad: float | None = None, rest_omega_rad_s: float = 1e-6,
+                    g_m_s2: float = G_STD, jit: bool = True) -> ColumnResult:
+    """Simulate a multi-block column under gravity and a horizontal base acceleration.
+
+    Parameters
+    ----------
+    column : Column
+    base : BaseMotion, optional
+        Horizontal base acceleration (m/s², positive to the right); zero after
+        its last sample. None: free rocking from ``theta0_rad``.
+    theta0_rad, omega0_rad_s : float or array (n,), optional
+        Initial absolute block angles (rad, clockwise positive) and rates (rad/s).
+    duration_s : float, optional
+        End time, s; default: the record's end + 5 s (or 10 s without a record).
+    dt_s : float
+        Time step, s (Newmark trapezoidal, events located inside the step).
+    n_impacts : int
+        Consecutive impacts per closing (1 = Housner; 2 = one mid-joint bump, the
+        thesis's recommendation; k: k-1 evenly spaced bumps).
+    velocity_terms : bool
+        Include the centripetal terms of the App. C reduction (exact rigid-body
+        dynamics). False reproduces the thesis's ``M̃(φ) φ̈ = p̃(φ)``.
+    max_enum_closed : int
+        Largest number of closed joints for which all configurations are
+        enumerated at an opening or impact (thesis: 9); beyond it the most
+        loaded joint opens alone (opening) or only the closing joint's options
+        are tried (impact).
+    stop_at_rest : bool
+        Stop when every joint is closed after the record has ended.
+    overturn_angle_rad : float, optional
+        If given, overturning = any |block angle| beyond it; default: the centre
+        of mass above an open joint passes its pivot while the joint opens.
+    rest_omega_rad_s : float
+        Post-impact joint rates below this close the joint (ends the accumulation
+        of ever smaller impacts), rad/s.
+    jit : bool
+        Use the compiled loop (False: pure Python, slow; the benchmark baseline).
+
+    Returns
+    -------
+    ColumnResult
+    """
+    import pandas as pd
+
+    from ._column_core import run_core, run_core_jit
+
+    if not isinstance(column, Column):
+        raise InputError("column: must be a rocklab.models.Column")
+    if not (math.isfinite(dt_s) and dt_s > 0):
+        raise InputError(f"dt_s={dt_s!r}: time step must be positive (s)")
+    if int(n_impacts) < 1:
+        raise InputError(f"n_impacts={n_impacts}: number of consecutive impacts must be >= 1")
+    if base is not None and not isinstance(base, BaseMotion):
+        raise InputError("base: must be a BaseMotion (see rocklab.models.load_base_motion)")
+    if duration_s is None:
+        duration_s = (float(base.t_s[-1]) + 5.0) if base is not None else 10.0
+    if not (math.isfinite(duration_s) and duration_s > 0):
+        raise InputError(f"duration_s={duration_s!r}: must be positive (s)")
+    phi0, v0, s0 = _initial_state(column, theta0_rad, omega0_rad_s)
+    blk = column.block_array()
+    if base is not None:
+        accb = np.array(base.acc_m_s2, dtype=float)  # writable: numba types read-only arrays apart
+        t0b, dtb = float(base.t_s[0]), base.dt_s
+    else:
+        accb, t0b, dtb = np.zeros(0), 0.0, 1.0
+    n = column.n
+    n_steps = int(math.ceil(duration_s / dt_s - 1e-9))
+    par = np.array([g_m_s2, column.mu, t0b, dtb, 1.0 if velocity_terms else 0.0, 1e-14,
+                    _quiet_time(column, base, g_m_s2), 0.0])
+    ecap = 20000
+    fn = run_core_jit if jit else run_core
+    ovt = float(overturn_angle_rad) if overturn_angle_rad else -1.0
+    PHI = np.empty((n_steps + 1, n))
+    VEL = np.empty((n_steps + 1, n))
+    EN = np.empty((n_steps + 1, 2))
+    while True:
+        EVT = np.empty(ecap)
+        EVI = np.empty((ecap, 3), np.int64)
+        IMP = np.empty((ecap, 6))
+        nr, ne, ni, st, t_st = fn(phi0, v0, s0, blk, par, accb, n_steps, float(dt_s),
+                                  int(max_enum_closed), int(n_impacts), float(rest_omega_rad_s),
+                                  bool(stop_at_rest), ovt, PHI, VEL, EN, EVT, EVI, IMP)
+        if st != 5 or ecap >= 5_000_000:
+            break
+        ecap *= 10
+    status = _STATUS[int(st)]
+    phi = -PHI[:nr]
+    om = -VEL[:nr]
+    conf = pd.DataFrame({"t_s": EVT[:ne], "joint": EVI[:ne, 0],
+                         "state": [STATE_NAMES[int(x)] for x in EVI[:ne, 1]],
+                         "event": [_KIND[int(x)] for x in EVI[:ne, 2]]})
+    imp = pd.DataFrame({"t_s": IMP[:ni, 0], "joint": IMP[:ni, 1].astype(int),
+                        "omega_before_rad_s": -IMP[:ni, 2], "ke_before_J": IMP[:ni, 3],
+                        "ke_after_J": IMP[:ni, 4],
+                        "state_after": [STATE_NAMES[int(x)] for x in IMP[:ni, 5]]})
+    never_moved = ne == 0
+    msg = ""
+    if status == "end":
+        moving = bool(np.any(om[-1] != 0.0)) or bool(np.any(phi[-1] != 0.0))
+        status = "rocking" if moving else ("no_uplift" if never_moved else "rest")
+        t_st = math.nan
+    elif status == "rest" and never_moved:
+        status = "no_uplift"
+    elif status in ("tension", "sliding"):
+        msg = f"terminated at t={t_st:.6g} s: {status} at a joint (the column may disintegrate)"
+    elif status in ("capacity", "numerical"):
+        msg = f"integration failed at t={t_st:.6g} s ({status}); reduce dt_s or check the input"
+    params = dict(dt_s=dt_s, duration_s=float(duration_s), n_impacts=int(n_impacts),
+                  velocity_terms=bool(velocity_terms), max_enum_closed=int(max_enum_closed),
+                  overturn_angle_rad=overturn_angle_rad, g_m_s2=g_m_s2, rest_omega_rad_s=rest_omega_rad_s,
+                  base=None if base is None else base.name)
+    t = np.arange(nr) * dt_s
+    return ColumnResult(column=column, t_s=t, phi_rad=phi, omega_rad_s=om,
+                        theta_rad=np.cumsum(phi, axis=1), energy_J=EN[:nr].sum(axis=1), kinetic_J=EN[:nr, 0].copy(),
+                        configurations=conf, impacts=imp, status=status, t_status_s=float(t_st), message=msg,
+                        params=params)

@@ -1,0 +1,146 @@
+"""CSV helpers shared by the IMU readers: parsing, unit headers, validation.
+
+Unit factors convert to SI at the file boundary (deg/s -> rad/s, g -> m/s^2).
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from pathlib import Path
+
+import numpy as np
+
+from .._errors import InputError, where
+from ..blocks import G
+
+__all__ = []
+
+_GYRO_UNITS = {"deg/s": math.pi / 180.0, "dps": math.pi / 180.0, "°/s": math.pi / 180.0,
+               "rad/s": 1.0}
+_ACC_UNITS = {"g": G, "m/s2": 1.0, "m/s^2": 1.0, "m/s²": 1.0}
+_TIME_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "µs": 1e-6}
+_ROLES = ("gyro_x", "gyro_y", "gyro_z", "acc_x", "acc_y", "acc_z")
+_HEAD = re.compile(r"^\s*(gyroscope|accelerometer)\s+([xyz])\s*\(([^)]*)\)\s*$", re.I)
+
+#: Full scale of the x-IMU3 main accelerometer, g (HighGAccelerometer covers impacts).
+XIMU3_FULL_SCALE_G = 16.0
+
+
+def _skip_mag(col: str) -> bool:
+    return not str(col).strip().lower().startswith("magnetometer")
+
+
+def _read_csv(path: Path):
+    """Parse a CSV with pandas' C parser; numeric errors name the first bad line.
+
+    All-numeric files go through the numba scanner (``_imu_fastcsv``); the
+    rest (text, NaN, malformed rows) through pandas.  Magnetometer columns
+    are dropped (unused).
+    """
+    import pandas as pd
+
+    from ._imu_fastcsv import parse_numeric_csv
+
+    fast = parse_numeric_csv(path) if path.is_file() else None
+    if fast is not None:
+        names, values = fast
+        keep = [i for i, c in enumerate(names) if _skip_mag(c)]
+        return pd.DataFrame(values[:, keep], columns=[names[i] for i in keep], copy=False)
+    try:
+        df = pd.read_csv(path, engine="c", usecols=_skip_mag)
+    except pd.errors.EmptyDataError:
+        raise InputError(f"{where(path)}empty file; an IMU CSV needs a header and data rows") from None
+    if len(df) == 0:
+        raise InputError(f"{where(path, 2)}no data rows after the header; "
+                         "log some samples or pick another file")
+    df.columns = [str(c).strip() for c in df.columns]
+    return df
+
+
+def _numeric(df, col, path: Path) -> np.ndarray:
+    v = df[col].to_numpy()
+    if v.dtype.kind not in "fiu":
+        import pandas as pd
+
+        num = pd.to_numeric(df[col], errors="coerce").to_numpy(dtype=float)
+        bad = np.flatnonzero(~np.isfinite(num))
+        line = int(bad[0]) + 2 if bad.size else None
+        raise InputError(f"{where(path, line, col)}value {df[col].iloc[bad[0]]!r} is not a "
+                         "number; fix or delete that row")
+    v = v.astype(float, copy=False)
+    bad = np.flatnonzero(~np.isfinite(v))
+    if bad.size:
+        raise InputError(f"{where(path, int(bad[0]) + 2, col)}missing or non-finite value; "
+                         "fix or delete that row")
+    return v
+
+
+def _inertial_columns(df, path: Path) -> dict[str, tuple[str, float]]:
+    """Find ``Gyroscope X (deg/s)`` ... ``Accelerometer Z (g)`` columns and unit factors."""
+    found: dict[str, tuple[str, float]] = {}
+    for col in df.columns:
+        m = _HEAD.match(col)
+        if not m:
+            continue
+        kind, ax, unit = m.group(1).lower(), m.group(2).lower(), m.group(3).strip().lower()
+        table = _GYRO_UNITS if kind == "gyroscope" else _ACC_UNITS
+        if unit not in table:
+            raise InputError(f"{where(path, 1, col)}unknown unit {unit!r}; use one of "
+                             f"{', '.join(table)} in the header")
+        role = ("gyro_" if kind == "gyroscope" else "acc_") + ax
+        found[role] = (col, table[unit])
+    missing = [r for r in _ROLES if r not in found]
+    if missing:
+        names = ", ".join(("Gyroscope " if r.startswith("gyro") else "Accelerometer ")
+                          + r[-1].upper() for r in missing)
+        raise InputError(f"{where(path, 1)}missing columns {names}; expected x-io headers "
+                         "like 'Gyroscope X (deg/s)', 'Accelerometer X (g)' or pass a mapping")
+    return found
+
+
+def _stack(df, cols, path) -> tuple[np.ndarray, np.ndarray]:
+    gyro = np.empty((len(df), 3))
+    acc = np.empty((len(df), 3))
+    for i, ax in enumerate("xyz"):
+        c, f = cols["gyro_" + ax]
+        gyro[:, i] = _numeric(df, c, path) * f
+        c, f = cols["acc_" + ax]
+        acc[:, i] = _numeric(df, c, path) * f
+    return gyro, acc
+
+
+def _check_increasing(t: np.ndarray, path: Path, col: str) -> None:
+    d = np.diff(t)
+    bad = np.flatnonzero(d <= 0)
+    if bad.size:
+        i = int(bad[0]) + 1
+        what = "duplicate" if d[bad[0]] == 0 else "decreasing"
+        raise InputError(f"{where(path, i + 2, col)}{what} time ({t[i]!r} after {t[i - 1]!r}); "
+                         "times must increase strictly: remove repeated rows or split the log")
+
+
+def _gap_drops(t: np.ndarray, period: float) -> int:
+    """Samples missing from gaps longer than 1.5 nominal periods."""
+    d = np.diff(t)
+    big = d > 1.5 * period
+    return int(np.sum(np.rint(d[big] / period) - 1)) if big.any() else 0
+
+
+def _saturation(acc_m_s2: np.ndarray, full_scale_g: float | None) -> np.ndarray:
+    """Samples with an axis at full scale.
+
+    With a known full scale, |a| >= 0.99 FS.  Otherwise a clipping plateau: an
+    axis' extreme value (>= 2 g) repeated on >= 2 samples.
+    """
+    a = np.abs(acc_m_s2)
+    if full_scale_g is not None:
+        return np.any(a >= 0.99 * full_scale_g * G, axis=1)
+    sat = np.zeros(len(a), dtype=bool)
+    for k in range(3):
+        m = a[:, k].max(initial=0.0)
+        if m >= 2 * G:
+            hit = a[:, k] >= m * (1 - 1e-6)
+            if np.count_nonzero(hit) >= 2:
+                sat |= hit
+    return sat

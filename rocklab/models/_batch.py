@@ -11,58 +11,15 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit, prange
 
 from .._errors import InputError
-from ..blocks import G
-from ._newmark import run_block
+from ._newmark import run_batch
 from ._records import BaseMotion
 from ._result import BatchResult
 
 __all__ = ["simulate_batch"]
 
 _HALF_PI = 0.5 * math.pi
-
-
-@njit(cache=True)
-def _last_over(acc, t0, dta, thr):
-    """Time of the last record sample with |acc| > thr (m/s^2); -inf if none."""
-    for k in range(acc.shape[0] - 1, -1, -1):
-        if abs(acc[k]) > thr:
-            return t0 + k * dta
-    return -np.inf
-
-
-@njit(cache=True, parallel=True)
-def _batch(p, alpha, th0, w0, eta, h, n_steps, acc, acc_t0, acc_dt, scale, rest_tol, fall_rad,
-           stop_on_fall):
-    m = p.shape[0]
-    over = np.zeros(m, np.bool_)
-    t_over = np.empty(m)
-    mx = np.empty(m)
-    nimp = np.zeros(m, np.int64)
-    status = np.zeros(m, np.int8)
-    steps = np.zeros(m, np.int64)
-    ex = np.zeros(1)
-    for i in prange(m):
-        a = alpha[i]
-        p2 = p[i] * p[i]
-        rest_w2 = 2.0 * p2 * (math.cos(a - rest_tol * a) - math.cos(a))
-        sc = abs(scale[i])
-        t_last = _last_over(acc, acc_t0, acc_dt, G * math.tan(a) / sc) if sc > 0 else -np.inf
-        ey = np.empty(1)
-        ey[0] = eta[i]
-        fr = fall_rad[i]
-        r = run_block(p[i], a, th0[i], w0[i], h[i], n_steps[i], acc, acc_t0, acc_dt, scale[i],
-                      0, ex, ey, False, rest_w2, t_last, True, 0, 0, fr, stop_on_fall)
-        nimp[i] = r[4]
-        status[i] = r[5]
-        t_over[i] = r[6]
-        over[i] = r[5] == 2
-        mx[i] = r[8] / a
-        steps[i] = int(r[9] / h[i] + 0.5)
-    return over, t_over, mx, nimp, status, steps
-
 
 def simulate_batch(p_rad_s, alpha_rad, *, base: BaseMotion | None = None, scale=1.0, theta0_rad=0.0,
                    omega0_rad_s=0.0, eta=None, alpha_I=4.0 / 3.0, dt_s: float = 1e-3,
@@ -149,7 +106,7 @@ def simulate_batch(p_rad_s, alpha_rad, *, base: BaseMotion | None = None, scale=
         acc, t0, dta = np.zeros(0), 0.0, 1.0
     else:
         acc, t0, dta = np.ascontiguousarray(base.acc_m_s2, float), float(base.t_s[0]), base.dt_s
-    over, t_over, mx, nimp, status, steps = _batch(p, al, th0, w0, et, h, n_steps, acc, t0, dta, sc,
+    over, t_over, mx, nimp, status, steps = run_batch(p, al, th0, w0, et, h, n_steps, acc, t0, dta, sc,
                                                    float(rest_tol), fr, bool(stop_on_overturn))
     return BatchResult(overturned=over, overturn_t_s=t_over, max_abs_theta_over_alpha=mx,
                        n_impacts=nimp, status=status, p_rad_s=p, alpha_rad=al, scale=sc, eta=et,

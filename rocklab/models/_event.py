@@ -42,7 +42,7 @@ def _next_uplift(t_now, rec_t, rec_a, thr, t_stop):
 
 
 def run_event(block, theta0, omega0, duration_s, law, base, linearized, rest_tol, stop_at_rest,
-              t_out, rtol=1e-10, atol=1e-13, ode_method="DOP853"):
+              t_out, rtol=1e-10, atol=1e-13, ode_method="DOP853", fall_rad=0.5 * math.pi):
     """Event-driven integration; returns a dict like the Newmark kernel's output.
 
     ``t_out`` (n,) are the output times (s); samples after a stop are dropped.
@@ -110,7 +110,7 @@ def run_event(block, theta0, omega0, duration_s, law, base, linearized, rest_tol
         over.direction = s
 
         def fall(tt, y, s=s):
-            return y[0] - s * 0.5 * math.pi
+            return y[0] - s * fall_rad
         fall.terminal = True
         fall.direction = s
 
@@ -126,7 +126,7 @@ def run_event(block, theta0, omega0, duration_s, law, base, linearized, rest_tol
             t_over = float(sol.t_events[1][0])
         if sol.t_events[2].size:
             t_fall = float(sol.t_events[2][0])
-            max_abs = max(max_abs, 0.5 * math.pi)
+            max_abs = max(max_abs, fall_rad)
             status = "overturned"
             t_end = t_fall
             break

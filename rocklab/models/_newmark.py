@@ -28,7 +28,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
 from ..blocks import G
 
@@ -71,16 +71,41 @@ def _df(th, s, ug, p2, alpha, lin):
 
 
 @njit(cache=True, inline="always")
-def _newmark(th0, w0, a0, s, h, c1, c4h, ug1, p2, alpha, lin):
-    """One trapezoidal step of length h; returns theta1, omega1, acc1.
+def _shift(sc0, cc0, d):
+    """sin and cos of (c0 - d) from sin c0, cos c0 for a small increment d (|d| < 0.2).
 
-    Newton–Raphson on the residual of Čeh Eq. 6–7. The predictor
-    ``th0 + h w0 + h^2 a0 / 2`` is O(h^3) off, and Newton's next error is bounded by
-    ``|f''| / (2 R') d^2 <= p^2 (1 + |ug|) h^2 d^2 / 8`` (R' ~ 4/h^2), so the loop stops
-    as soon as that bound is below the tolerance: one sin/cos pair per step in
-    practice instead of a confirming extra iteration.
+    Taylor series of sin d, cos d to d^11 / d^12 (truncation < 1e-16 for |d| < 0.2):
+    a few multiplications instead of two libm calls per Newton iteration.
     """
-    rhs0 = c4h * w0 + a0  # c1 = 4/h^2, c4h = 4/h (precomputed for full steps)
+    d2 = d * d
+    sd = d * (1.0 - d2 * (1.0 / 6.0) * (1.0 - d2 * (1.0 / 20.0) * (1.0 - d2 * (1.0 / 42.0) * (
+        1.0 - d2 * (1.0 / 72.0) * (1.0 - d2 * (1.0 / 110.0))))))
+    cd = 1.0 - d2 * 0.5 * (1.0 - d2 * (1.0 / 12.0) * (1.0 - d2 * (1.0 / 30.0) * (1.0 - d2 * (1.0 / 56.0) * (
+        1.0 - d2 * (1.0 / 90.0) * (1.0 - d2 * (1.0 / 132.0))))))
+    return sc0 * cd - cc0 * sd, cc0 * cd + sc0 * sd
+
+
+@njit(cache=True, inline="always")
+def _sincos(th0, th, s, alpha, sc0, cc0):
+    d = th - th0
+    if abs(d) < 0.2:
+        return _shift(sc0, cc0, d)
+    c = alpha * s - th
+    return math.sin(c), math.cos(c)
+
+
+@njit(cache=True, inline="always")
+def _newmark(th0, w0, a0, s, h, c1, c4h, ug1, p2, alpha, lin, sc0, cc0):
+    """One trapezoidal step of length h; returns theta1, omega1, acc1, sin c1, cos c1.
+
+    Newton–Raphson on the residual of Čeh Eq. 6–7 (``c = alpha s - theta``; sc0,
+    cc0 = sin/cos of c at th0). The predictor ``th0 + h w0 + h^2 a0 / 2`` is O(h^3)
+    off, and Newton's next error is bounded by
+    ``|f''| / (2 R') d^2 <= p^2 (1 + |ug|) h^2 d^2 / 8`` (R' ~ 4/h^2), so the loop stops
+    as soon as that bound is below the tolerance: one Newton update per step in
+    practice. c1 = 4/h^2 and c4h = 4/h are precomputed for full steps.
+    """
+    rhs0 = c4h * w0 + a0
     th = th0 + h * w0 + 0.5 * h * h * a0
     tol = 1e-15 * (abs(th0) + h * abs(w0) + h * h * abs(a0)) + 1e-300
     k2 = 0.125 * p2 * (1.0 + abs(ug1)) * h * h
@@ -89,9 +114,7 @@ def _newmark(th0, w0, a0, s, h, c1, c4h, ug1, p2, alpha, lin):
             f = p2 * (th - alpha * s) - p2 * ug1
             df = p2
         else:
-            c = alpha * s - th
-            sc = math.sin(c)
-            cc = math.cos(c)
+            sc, cc = _sincos(th0, th, s, alpha, sc0, cc0)
             f = -p2 * (sc + ug1 * cc)
             df = p2 * (cc - ug1 * sc)
         d = (c1 * (th - th0) - rhs0 - f) / (c1 - df)
@@ -99,7 +122,49 @@ def _newmark(th0, w0, a0, s, h, c1, c4h, ug1, p2, alpha, lin):
         if abs(d) <= tol or k2 * d * d <= tol:
             break
     a1 = c1 * (th - th0) - rhs0
-    return th, w0 + 0.5 * h * (a0 + a1), a1
+    if lin:
+        sc1, cc1 = sc0, cc0
+    else:
+        sc1, cc1 = _sincos(th0, th, s, alpha, sc0, cc0)
+    return th, w0 + 0.5 * h * (a0 + a1), a1, sc1, cc1
+
+
+@njit(cache=True)
+def _cross(x0, v0, x1, v1, h, level):
+    """Fraction u in [0, 1] of a step where the cubic Hermite of (x, v) reaches ``level``.
+
+    x0, v0 / x1, v1: position and velocity at the step ends (on one side, x > 0
+    outward). Falls back to linear interpolation when the step started on the other
+    side (an impact inside the step).
+    """
+    if x1 == x0:
+        return 1.0
+    u = min(max((level - x0) / (x1 - x0), 0.0), 1.0)
+    if x0 < 0.0:
+        return u
+    for _ in range(20):
+        u2 = u * u
+        u3 = u2 * u
+        x = (2 * u3 - 3 * u2 + 1) * x0 + (u3 - 2 * u2 + u) * h * v0 + (-2 * u3 + 3 * u2) * x1 \
+            + (u3 - u2) * h * v1
+        dx = (6 * u2 - 6 * u) * x0 + (3 * u2 - 4 * u + 1) * h * v0 + (6 * u - 6 * u2) * x1 \
+            + (3 * u2 - 2 * u) * h * v1
+        if dx <= 0.0:
+            break
+        du = (x - level) / dx
+        u = min(max(u - du, 0.0), 1.0)
+        if abs(du) < 1e-15:
+            break
+    return u
+
+
+@njit(cache=True, inline="always")
+def _energy(th, w, cc, cos_a, p2, alpha, lin):
+    """Energy above rest per unit I_O (rad^2/s^2); cc = cos(alpha - |theta|)."""
+    if lin:
+        ath = abs(th)
+        return 0.5 * w * w + p2 * (alpha * ath - 0.5 * ath * ath)
+    return 0.5 * w * w + p2 * (cc - cos_a)
 
 
 @njit(cache=True)
@@ -175,8 +240,8 @@ def run_block(p, alpha, theta0, omega0, h, n_steps, acc, acc_t0, acc_dt, scale,
 
     Returns
     -------
-    out_theta, out_omega : (n_out,) samples at every ``out_every``-th step (t = i*h*out_every),
-    n_out, imp (4, n_imp) rows t_s, omega_before, omega_after, eta (first imp_cap impacts),
+    out_theta, out_omega, out_energy : (n_out,) samples at every ``out_every``-th step
+    (t = i*h*out_every); energy above rest per unit I_O, rad^2/s^2 (J = I_O * this), n_out, imp (4, n_imp) rows t_s, omega_before, omega_after, eta (first imp_cap impacts),
     n_imp (all impacts), status, t_over (first |theta| >= alpha outward, nan),
     t_fall (first step end with |theta| >= fall_rad, nan), max_abs_theta, t_end (s, last time
     integrated). The run always ends at |theta| = pi/2 (the side hits the ground) and at
@@ -191,6 +256,7 @@ def run_block(p, alpha, theta0, omega0, h, n_steps, acc, acc_t0, acc_dt, scale,
     n_out_max = n_steps // out_every + 1 if out_every > 0 else 0
     out_th = np.empty(n_out_max)
     out_w = np.empty(n_out_max)
+    out_e = np.empty(n_out_max)
     imp = np.empty((4, imp_cap))
     n_imp = 0
     t_over = np.nan
@@ -216,11 +282,16 @@ def run_block(p, alpha, theta0, omega0, h, n_steps, acc, acc_t0, acc_dt, scale,
         ever_moved = True
     u_prev = ug
     a = _f(th, s, ug, p2, alpha, lin) if not resting else 0.0
+    sc = math.sin(alpha * s - th)
+    cc = math.cos(alpha * s - th)
+    sin_a = math.sin(alpha)
+    cos_a = math.cos(alpha)
     max_abs = abs(th)
     n_out = 0
     if out_every > 0:
         out_th[0] = th
         out_w[0] = w
+        out_e[0] = _energy(th, w, cc, cos_a, p2, alpha, lin)
         n_out = 1
     step = 0
     t_end = 0.0
@@ -230,6 +301,7 @@ def run_block(p, alpha, theta0, omega0, h, n_steps, acc, acc_t0, acc_dt, scale,
         u1 = _ug_at(t1, acc, acc_t0, inv_dta, fac)
         tc = t0  # current time within the step
         th_beg = th
+        w_beg = w
         u_c = u_prev
         n_sub = 0
         while tc < t1:
@@ -251,16 +323,18 @@ def run_block(p, alpha, theta0, omega0, h, n_steps, acc, acc_t0, acc_dt, scale,
                     th = 0.0
                     w = 0.0
                     a = _f(0.0, s, u_c, p2, alpha, lin)
+                    sc = s * sin_a
+                    cc = cos_a
                     continue
                 break
             if tc == t0:
                 rem = h  # a full step: reuse the constants
-                th1, w1, a1 = _newmark(th, w, a, s, h, c1h, c4h, u1, p2, alpha, lin)
+                th1, w1, a1, sc1, cc1 = _newmark(th, w, a, s, h, c1h, c4h, u1, p2, alpha, lin, sc, cc)
             else:
-                th1, w1, a1 = _newmark(th, w, a, s, rem, 4.0 / (rem * rem), 4.0 / rem, u1, p2, alpha,
-                                       lin)
+                th1, w1, a1, sc1, cc1 = _newmark(th, w, a, s, rem, 4.0 / (rem * rem), 4.0 / rem, u1, p2,
+                                                 alpha, lin, sc, cc)
             if th1 * s > 0.0 or (th1 == 0.0 and w1 * s > 0.0):
-                th, w, a = th1, w1, a1
+                th, w, a, sc, cc = th1, w1, a1, sc1, cc1
                 tc = t1
             else:
                 # contact within the (rest of the) step
@@ -304,6 +378,8 @@ def run_block(p, alpha, theta0, omega0, h, n_steps, acc, acc_t0, acc_dt, scale,
                     s = s_base
                 w = w_p
                 a = _f(0.0, s, u_i, p2, alpha, lin)
+                sc = s * sin_a
+                cc = cos_a
                 if n_sub > 100000:
                     resting = True
                     w = 0.0
@@ -314,16 +390,19 @@ def run_block(p, alpha, theta0, omega0, h, n_steps, acc, acc_t0, acc_dt, scale,
         ath = abs(th)
         if ath > max_abs:
             max_abs = ath
+        if (step & 1023) == 0 and not resting and not lin:
+            # re-anchor the incremental sin/cos against rounding drift
+            sc = math.sin(alpha * s - th)
+            cc = math.cos(alpha * s - th)
         if out_every > 0 and step % out_every == 0:
             out_th[n_out] = th
             out_w[n_out] = w
+            out_e[n_out] = 0.0 if resting else _energy(th, w, cc, cos_a, p2, alpha, lin)
             n_out += 1
         if ath >= alpha and th * w > 0.0 and t_over != t_over:
-            # linear interpolation of the crossing inside the step (O(h^2))
-            fr = (alpha - abs(th_beg)) / (ath - abs(th_beg)) if ath != abs(th_beg) else 1.0
-            t_over = t1 - h + min(max(fr, 0.0), 1.0) * h
+            t_over = t1 - h + h * _cross(th_beg * s, w_beg * s, th * s, w * s, h, alpha)
         if ath >= fall_rad and t_fall != t_fall:
-            t_fall = t1
+            t_fall = t1 - h + h * _cross(th_beg * s, w_beg * s, th * s, w * s, h, fall_rad)
             status = OVERTURNED
             if stop_on_fall:
                 break
@@ -341,5 +420,51 @@ def run_block(p, alpha, theta0, omega0, h, n_steps, acc, acc_t0, acc_dt, scale,
             status = REST if ever_moved else NO_UPLIFT
         else:
             status = ROCKING
-    return (out_th[:n_out], out_w[:n_out], n_out, imp[:, :min(n_imp, imp_cap)], n_imp, status,
+    return (out_th[:n_out], out_w[:n_out], out_e[:n_out], n_out, imp[:, :min(n_imp, imp_cap)], n_imp, status,
             t_over, t_fall, max_abs, t_end)
+
+
+@njit(cache=True)
+def _last_over(acc, t0, dta, thr):
+    """Time of the last record sample with |acc| > thr (m/s^2); -inf if none."""
+    for k in range(acc.shape[0] - 1, -1, -1):
+        if abs(acc[k]) > thr:
+            return t0 + k * dta
+    return -np.inf
+
+
+@njit(cache=True, parallel=True)
+def run_batch(p, alpha, th0, w0, eta, h, n_steps, acc, acc_t0, acc_dt, scale, rest_tol, fall_rad,
+              stop_on_fall):
+    """m independent blocks in parallel (summaries only); see ``simulate_batch``.
+
+    Lives in this module so that numba's on-disk cache of this caller is
+    invalidated together with :func:`run_block` (the cache only tracks the
+    caller's own source file).
+    """
+    m = p.shape[0]
+    over = np.zeros(m, np.bool_)
+    t_over = np.empty(m)
+    mx = np.empty(m)
+    nimp = np.zeros(m, np.int64)
+    status = np.zeros(m, np.int8)
+    steps = np.zeros(m, np.int64)
+    ex = np.zeros(1)
+    for i in prange(m):
+        a = alpha[i]
+        p2 = p[i] * p[i]
+        rest_w2 = 2.0 * p2 * (math.cos(a - rest_tol * a) - math.cos(a))
+        sc = abs(scale[i])
+        t_last = _last_over(acc, acc_t0, acc_dt, G * math.tan(a) / sc) if sc > 0 else -np.inf
+        ey = np.empty(1)
+        ey[0] = eta[i]
+        fr = fall_rad[i]
+        r = run_block(p[i], a, th0[i], w0[i], h[i], n_steps[i], acc, acc_t0, acc_dt, scale[i],
+                      0, ex, ey, False, rest_w2, t_last, True, 0, 0, fr, stop_on_fall)
+        nimp[i] = r[5]
+        status[i] = r[6]
+        t_over[i] = r[7]
+        over[i] = r[6] == 2
+        mx[i] = r[9] / a
+        steps[i] = int(r[10] / h[i] + 0.5)
+    return over, t_over, mx, nimp, status, steps

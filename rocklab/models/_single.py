@@ -17,8 +17,10 @@ Rules (both integrators):
   uplifts again when |a_g| exceeds g tan(alpha). With ``stop_at_rest`` the run
   stops once at rest and no later base sample exceeds the uplift level.
 - **overturning**: ``overturn_t_s`` is the first time |theta| >= alpha with
-  outward velocity; the block *falls* (``overturned``, run stops) when |theta|
-  reaches pi/2, its side touching the ground.
+  outward velocity (cubic Hermite interpolation inside the step); the block
+  *falls* (``overturned``, run stops) when |theta| reaches ``fall_rad`` (default
+  pi/2: its side touches the ground). Under base motion a block past alpha can
+  still come back, so ``overturn_t_s`` may be finite for a block that stays up.
 """
 
 from __future__ import annotations
@@ -70,7 +72,7 @@ def simulate(block, theta0_rad: float = 0.0, omega0_rad_s: float = 0.0, duration
              dt_s: float = 1e-4, restitution="housner", base: BaseMotion | None = None,
              method: str = "newmark", stop_at_rest: bool = True, output_dt_s: float | None = None,
              *, linearized: bool = False, rest_tol: float = 1e-6, max_impacts: int = 100_000,
-             rtol: float = 1e-10, **law_params) -> RockingResult:
+             rtol: float = 1e-10, fall_rad: float | None = None, **law_params) -> RockingResult:
     """Simulate one rocking block.
 
     Parameters
@@ -105,6 +107,14 @@ def simulate(block, theta0_rad: float = 0.0, omega0_rad_s: float = 0.0, duration
         Integrate the linearised equation (DeJong Eq. 5), e.g. for closed forms.
     rest_tol : float
         Rest threshold as a fraction of alpha (amplitude), default 1e-6.
+    rtol : float
+        Relative tolerance of the event method (default 1e-10). With a base record
+        the forcing has a kink at every sample that DOP853's error estimate does
+        not see; use 1e-12 there for impact times to ~1e-8 s.
+    fall_rad : float, optional
+        |theta| at which the block counts as fallen and the run stops (default
+        pi/2, the side hits the ground; e.g. ``block.alpha_rad`` for the common
+        "|theta| > alpha" criterion).
     max_impacts : int
         Impacts stored in the table (all are counted).
     **law_params
@@ -130,6 +140,9 @@ def simulate(block, theta0_rad: float = 0.0, omega0_rad_s: float = 0.0, duration
                          "(the block would fall at release); give a smaller initial rotation")
     if dt > T:
         raise InputError(f"dt_s={dt}: time step longer than duration_s={T}; use a smaller dt")
+    fall = 0.5 * math.pi if fall_rad is None else _finite("fall_rad", fall_rad, positive=True)
+    if not (alpha <= fall <= 0.5 * math.pi):
+        raise InputError(f"fall_rad={fall}: must be between alpha = {alpha:.6g} and pi/2 rad")
     law = make_restitution(restitution, block, **law_params)
     acc, acc_t0, acc_dt = _base_arrays(base)
     if output_dt_s is None:
@@ -145,22 +158,24 @@ def simulate(block, theta0_rad: float = 0.0, omega0_rad_s: float = 0.0, duration
     t_last = _last_uplift_t(base, alpha)
     meth = str(method).lower()
     if meth == "newmark":
-        th, w, n_out, imp, n_imp, st, t_over, t_fall, max_abs, t_end = run_block(
+        th, w, e, n_out, imp, n_imp, st, t_over, t_fall, max_abs, t_end = run_block(
             p, alpha, th0, w0, dt, n_steps, acc, acc_t0, acc_dt, 1.0, law.mode, law.eta_x, law.eta_y,
-            bool(linearized), rest_w2, t_last, bool(stop_at_rest), every, int(max_impacts))
+            bool(linearized), rest_w2, t_last, bool(stop_at_rest), every, int(max_impacts), fall, True)
         t = np.arange(n_out) * (dt * every)
         status = STATUS_NAMES[st]
         imp_cols = imp
+        E = e * block.I_O_kg_m2
     elif meth == "event":
         from ._event import run_event
 
         t_grid = np.arange(int(math.floor(T / (dt * every) + 1e-9)) + 1) * (dt * every)
         r = run_event(block, th0, w0, T, law, base, bool(linearized), rest_tol, bool(stop_at_rest),
-                      t_grid, rtol=rtol)
+                      t_grid, rtol=rtol, fall_rad=fall)
         t, th, w = r["t"], r["theta"], r["omega"]
         status, t_over, t_fall, max_abs = r["status"], r["t_over"], r["t_fall"], r["max_abs"]
         n_imp = len(r["impacts"])
         imp_cols = np.array(r["impacts"], float).reshape(-1, 4).T[:, :max_impacts]
+        E = block_energy(block, th, w, linearized)
     else:
         raise InputError(f"method={method!r}: use 'newmark' or 'event'")
     import pandas as pd
@@ -169,7 +184,6 @@ def simulate(block, theta0_rad: float = 0.0, omega0_rad_s: float = 0.0, duration
                             "omega_after_rad_s": imp_cols[2], "eta": imp_cols[3]})
     for a in (t, th, w):
         a.setflags(write=False)
-    E = block_energy(block, th, w, linearized)
     E.setflags(write=False)
     return RockingResult(t_s=t, theta_rad=th, omega_rad_s=w, energy_J=E, impacts=impacts,
                          status=status, overturned=status == "overturned",

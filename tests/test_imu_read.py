@@ -280,3 +280,17 @@ def test_cli_table_mode(run_cli, tmp_path):
     assert list(df.columns) == ["t_s", "acc_m_s2"]
     err = df["acc_m_s2"] - np.interp(df["t_s"] - df["t_s"][0], t, a)
     assert np.sqrt(np.mean(err ** 2)) < 0.06
+
+
+def test_fusion_example_rest_bias_and_first_motion(shared_data):
+    from rocklab.tracking import block_rotation
+
+    p = shared_data / "imu/fusion-example/sensor_data.csv"
+    raw = pd.read_csv(p)
+    t = raw.iloc[:, 0].to_numpy()
+    # Independent look at the raw file: still (std ~0.1 deg/s) until ~12.7 s, then
+    # motion (std 17 deg/s in the 13th second).
+    rest_mean = raw.iloc[:, 1:4].to_numpy()[t < 12.0].mean(axis=0)
+    rot = block_rotation(read_imu(p))
+    assert 12.0 < rot.release_t_s < 13.0
+    assert np.allclose(np.rad2deg(rot.gyro_bias_rad_s), rest_mean, atol=0.02)

@@ -61,11 +61,12 @@ class ImuRotation:
     axis : ndarray (3,)
         Rocking axis, unit vector in the sensor frame.
     gyro_bias_rad_s : ndarray (3,)
-        Gyro bias, rad/s: rest-window mean plus the drift correction along the axis.
+        Gyro bias, rad/s: mean rate in the rest window before release.
     theta0_rad : float
         Accelerometer tilt in the rest window before release, rad.
     drift_rad_s : float
-        Residual bias along the axis removed by the two-window anchoring, rad/s.
+        Residual bias along the axis removed by the two-window anchoring, rad/s
+        (the total bias along the axis is ``gyro_bias_rad_s @ axis + drift_rad_s``).
     release_t_s : float
         Release instant, s (NaN if the log shows no rest then motion).
     impact_t_s : ndarray (k,)
@@ -76,7 +77,8 @@ class ImuRotation:
     ahrs_theta_rad : ndarray (n,) or None
         imufusion AHRS estimate about the same axis, rad (``ahrs=True``).
     ahrs_rms_diff_rad : float
-        RMS of ``ahrs_theta_rad - theta_rad`` from release to rest, rad (NaN without AHRS).
+        RMS of ``ahrs_theta_rad - theta_rad`` (wrapped to +-pi) from release to
+        rest, rad (NaN without AHRS).
     status : str
         ``"ok"``, ``"no_rest_before"`` (bias from the first 0.5 s), ``"no_rest_after"``
         (drift not anchored at the end) or ``"no_motion"``.
@@ -213,7 +215,6 @@ def block_rotation(log: ImuLog, axis: str | None = None, *, ahrs: bool = False,
         ref = th_start if abs(th_start) > np.deg2rad(1.0) else theta[np.argmax(np.abs(theta))]
         if ref < 0:
             u, theta, omega, th_start, drift = -u, -theta, -omega, -th_start, -drift
-    bias_total = bias + drift * u
     release = _release_time(t, omega, i_move, s0, s1) if status != "no_motion" else np.nan
     impacts = (_impacts(t, theta, omega, acc, moving, i_move, i_end, fs)
                if status != "no_motion" else np.empty(0))
@@ -223,8 +224,9 @@ def block_rotation(log: ImuLog, axis: str | None = None, *, ahrs: bool = False,
         ahrs_theta = ahrs_rotation(log, u, bias, ref_slice=(e0, e1) if has_end else (s0, s1),
                                    ref_theta=float(theta[e0:e1].mean() if has_end else th_start))
         a, b = (i_move, i_end) if status != "no_motion" else (0, n)
-        ahrs_rms = float(np.sqrt(np.mean((ahrs_theta[a:b] - theta[a:b]) ** 2)))
-    return ImuRotation(t, theta, omega, acc, u, bias_total, th_start, float(drift), release,
+        diff = (ahrs_theta[a:b] - theta[a:b] + np.pi) % (2 * np.pi) - np.pi
+        ahrs_rms = float(np.sqrt(np.mean(diff ** 2)))
+    return ImuRotation(t, theta, omega, acc, u, bias, th_start, float(drift), release,
                        impacts, rest_t, fs, log.dropped_samples, log.format, log.source,
                        ahrs_theta, ahrs_rms, status, msg)
 

@@ -7,8 +7,8 @@ import pytest
 
 from rocklab import Block, InputError
 from rocklab.models import simulate
-from rocklab.tracking import (block_rotation, simulate_imu_log, sync_imu_to_track, sync_offset,
-                              track_rate)
+from rocklab.tracking import (block_rotation, simulate_imu_log, sync_events, sync_imu_to_track,
+                              sync_offset, track_rate)
 
 
 @pytest.fixture(scope="module")
@@ -88,3 +88,20 @@ def test_sync_bad_input():
         sync_offset(np.arange(10.0), np.zeros(9), np.arange(10.0), np.zeros(10))
     with pytest.raises(InputError, match="increase strictly"):
         sync_offset(np.arange(10.0), np.zeros(10), np.r_[np.arange(9.0), 3.0], np.zeros(10))
+
+
+def test_sync_events_from_impacts_of_two_imus(rocking):
+    res, rot_a = rocking
+    block = Block(b_m=0.1, h_m=0.8)
+    # Second IMU on the same block, clock 2.3456 s late and on another seed.
+    log_b = simulate_imu_log(res.t_s, res.theta_rad, block, omega_rad_s=res.omega_rad_s,
+                             rate_hz=256.0, rest_before_s=3.0, rest_after_s=3.0, seed=8,
+                             clock_offset_s=-2.3456)
+    rot_b = block_rotation(log_b, "y")
+    s = sync_events(rot_a.impact_t_s, rot_b.impact_t_s, tol_s=0.01)
+    # Each impact time is within one sample (3.9 ms); ~90 matches average that down.
+    assert s.n_windows >= 60 and s.correlation > 0.9
+    assert s.offset_s == pytest.approx(2.3456, abs=1e-3)
+    assert s.residual_ms < 3.0
+    with pytest.raises(InputError, match=">= 2 events"):
+        sync_events([1.0], [1.0, 2.0])

@@ -6,7 +6,7 @@ from ._imu_read import ImuLog, read_imu, read_ximu_registers, ximu_rate_from_reg
 from ._imu_rotation import ImuRotation, ahrs_quaternions, block_rotation
 from ._imu_sim import simulate_imu_log, write_ximu3_csv, write_ximu_csv
 from ._imu_table import TableAcceleration, table_acceleration
-from ._sync import SyncResult, sync_imu_to_track, sync_offset, track_rate
+from ._sync import SyncResult, sync_events, sync_imu_to_track, sync_offset, track_rate
 from ._geometry import PlaneMap, SimilarityFit, calibrate_camera, fit_similarity
 from ._motion import TableMotion, choose_sg_window, estimate_noise, table_motion
 from ._track import (TRACK_COLUMNS, ObjectTrack, Observation, TrackResult, assemble_tracks,
@@ -25,7 +25,7 @@ __all__: list[str] = [
     # IMU and clock sync (helper "imu")
     "ImuLog", "read_imu", "read_ximu_registers", "ximu_rate_from_registers",
     "ImuRotation", "block_rotation", "ahrs_quaternions", "TableAcceleration", "table_acceleration",
-    "SyncResult", "sync_offset", "sync_imu_to_track", "track_rate",
+    "SyncResult", "sync_offset", "sync_events", "sync_imu_to_track", "track_rate",
     "simulate_imu_log", "write_ximu_csv", "write_ximu3_csv",
     # synthetic lab sessions (helper "synth")
     "synth_session", "SynthSession", "load_synth_session",

@@ -30,7 +30,7 @@ import numpy as np
 from .._errors import InputError
 from ._imu_motion import cumtrapz
 
-__all__ = ["SyncResult", "sync_offset", "track_rate", "sync_imu_to_track"]
+__all__ = ["SyncResult", "sync_offset", "sync_events", "track_rate", "sync_imu_to_track"]
 
 
 @dataclass(frozen=True)
@@ -325,3 +325,70 @@ def sync_imu_to_track(rotation, t_s, theta_rad, **kwargs) -> SyncResult:
     dt = float(np.nanmedian(np.diff(t))) if len(t) > 1 else 0.0
     kwargs.setdefault("window_b_s", 2.0 * dt)
     return sync_offset(rotation.t_s, rotation.omega_rad_s, t, w, theta_b=theta_rad, **kwargs)
+
+
+def sync_events(t_a, t_b, *, max_offset_s: float | None = None, tol_s: float = 0.02,
+                drift: bool | str = "auto") -> SyncResult:
+    """Clock model from matched event instants (e.g. impacts seen by two sensors).
+
+    Parameters
+    ----------
+    t_a, t_b : array_like
+        Event times on clocks a and b, s (e.g. ``ImuRotation.impact_t_s``).
+    max_offset_s : float, optional
+        Largest plausible |offset|, s.
+    tol_s : float
+        Events match when within ``tol_s`` after applying the offset, s.
+    drift : bool or "auto"
+        Fit a clock drift (``"auto"``: with >= 10 matches spanning > 120 s).
+
+    Returns
+    -------
+    SyncResult
+        ``correlation`` is the fraction of b's events matched; ``n_windows``
+        the number of matches; ``window_t_s``/``window_offset_s`` the matched b
+        events and their individual offsets; ``residual_ms`` their RMS scatter
+        about the clock model.
+
+    Notes
+    -----
+    The coarse offset is the pairwise difference ``t_a - t_b`` that matches
+    the most events within ``tol_s``; the fine model is least squares on the
+    matched pairs (two passes of matching).
+    """
+    a = np.sort(np.asarray(t_a, float)[np.isfinite(t_a)])
+    b = np.sort(np.asarray(t_b, float)[np.isfinite(t_b)])
+    if a.size < 2 or b.size < 2:
+        raise InputError(f"sync_events: need >= 2 events on each clock (got {a.size}, {b.size})")
+    cand = (a[:, None] - b[None, :]).ravel()
+    if max_offset_s is not None:
+        cand = cand[np.abs(cand) <= max_offset_s]
+    if cand.size == 0:
+        raise InputError("sync_events: no event pair within max_offset_s; raise max_offset_s")
+    if cand.size > 20000:  # keep the vote cheap on long event lists
+        cand = cand[np.random.default_rng(0).choice(cand.size, 20000, replace=False)]
+
+    def matches(off, d=0.0):
+        x = b + off + d * b
+        k = np.clip(np.searchsorted(a, x), 1, a.size - 1)
+        near = np.where(np.abs(a[k - 1] - x) < np.abs(a[k] - x), k - 1, k)
+        ok = np.abs(a[near] - x) <= tol_s
+        return ok, a[near] - b
+
+    votes = np.array([np.count_nonzero(matches(c)[0]) for c in cand])
+    off, d = float(cand[int(np.argmax(votes))]), 0.0
+    ok = np.zeros(b.size, dtype=bool)
+    for _ in range(2):
+        ok, diff = matches(off, d)
+        if ok.sum() == 0:
+            break
+        span = np.ptp(b[ok]) if ok.sum() > 1 else 0.0
+        fit = (ok.sum() >= 10 and span > 120.0) if drift == "auto" else bool(drift)
+        if fit and ok.sum() >= 3:
+            d, off = np.polyfit(b[ok], diff[ok], 1)
+        else:
+            d, off = 0.0, float(np.mean(diff[ok]))
+    model = off + d * b[ok]
+    resid = 1e3 * float(np.sqrt(np.mean((diff[ok] - model) ** 2))) if ok.sum() >= 3 else np.nan
+    return SyncResult(float(off), float(d), resid, float(ok.mean()), int(ok.sum()), b[ok],
+                      diff[ok])

@@ -142,7 +142,7 @@ def test_table_sine_pulse_truth_is_kinematically_consistent(tmp_path):
 
 def test_record_table_fits_the_stroke_and_three_blocks(tmp_path):
     s = synth_session(tmp_path / "r", seed=0, size=SMALL, blocks=3, table="record", duration_s=4.0,
-                      fps=25, imu=False, mp4=False, table_stroke_m=0.05)
+                      layout="side", fps=25, imu=False, mp4=False, table_stroke_m=0.05)
     tb = s.truth[s.truth.object == "table"]
     assert np.abs(tb["x_m"]).max() <= 0.05 + 1e-9
     assert s.meta["table"]["record"] == "elcentro"

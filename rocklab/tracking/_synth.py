@@ -151,11 +151,12 @@ def synth_session(out_dir, seed: int = 0, blocks: int = 1, table: str = "none", 
                   size=(1920, 1080), targets: str = "aruco", duration_s: float | None = None,
                   occlusion=None, rolling_shutter: bool = False, *, block=None,
                   restitution: str = "constant", eta: float | None = 0.75, theta0_rad=None,
-                  record=None, table_amplitude_m: float = 0.045, table_period_s: float = 0.6,
+                  record=None, table_amplitude_m: float | None = None, table_period_s: float = 0.6,
                   table_stroke_m: float = 0.05, exposure_s: float | None = None,
                   noise_dn: float = 1.0, distortion: bool = True, imu: bool = True,
                   imu_rate_hz: float = 256.0, mp4: bool = True, calibrated: bool = True,
-                  force: bool = False, progress: bool = False) -> SynthSession:
+                  layout: str | None = None, force: bool = False,
+                  progress: bool = False) -> SynthSession:
     """Render a synthetic lab session into ``out_dir`` (see the module doc for the layout).
 
     Parameters
@@ -167,12 +168,15 @@ def synth_session(out_dir, seed: int = 0, blocks: int = 1, table: str = "none", 
         Everything random (camera pose and lens, release times, textures,
         noise, IMU errors) derives from it: same seed, identical files.
     blocks : {1, 3}
-        One block, or three independent blocks side by side on the table
-        (the 3-block *column* is used once ``rocklab.models`` offers it).
+        One block, or three blocks: a stacked column (thesis §4.3: three
+        0.1 x 0.2 m granite blocks, ``rocklab.models.simulate_column``) when
+        the column model is available, else independent blocks side by side
+        (``layout`` forces one: ``"column"`` or ``"side"``).
     table : {"none", "sine", "record"}
         ``none``: free rocking after a thread-burn release from ``theta0_rad``
         at a known time; ``sine``: blocks at rest on a table doing one smooth
-        sine cycle (``table_period_s``, ``table_amplitude_m``; thesis Fig. 31);
+        sine cycle (``table_period_s``, ``table_amplitude_m``, default 45 mm
+        as thesis Fig. 31, 20 mm for the column which overturns at 45 mm);
         ``record``: ``record`` (path of an .AT2/CSV record or a BaseMotion;
         default the bundled El Centro 1940) scaled and high-passed to the
         table stroke ``table_stroke_m``.
@@ -227,7 +231,8 @@ def synth_session(out_dir, seed: int = 0, blocks: int = 1, table: str = "none", 
                             block=block, restitution=restitution, eta=eta, theta0_rad=theta0_rad,
                             record=record, table_amplitude_m=table_amplitude_m,
                             table_period_s=table_period_s, table_stroke_m=table_stroke_m,
-                            exposure_s=exposure_s, noise_dn=noise_dn, distortion=distortion)
+                            exposure_s=exposure_s, noise_dn=noise_dn, distortion=distortion,
+                            layout=layout)
         _render_video(scene, tmp, mp4, progress)
         meta = scene.write_files(tmp, imu=imu, imu_rate_hz=imu_rate_hz, calibrated=calibrated)
         render_s = time.perf_counter() - t_start

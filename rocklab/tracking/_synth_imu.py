@@ -41,15 +41,16 @@ def write_object_imu(folder: Path, oid: str, *, block_motion=None, block=None, t
     tb = table if table is not None else block_motion.table
     tg = np.arange(min(t0, 0.0) - 0.1, t_end_s + 0.1, 1e-3)
     base = (tg, tb.a(tg)) if tb.kind != "none" else None
-    if block_motion is not None:
-        t = block_motion.t_s
-        th = -block_motion.phi_rad
-        blk = block
+    if block_motion is not None and hasattr(block_motion, "column"):
+        log = _rigid_body_log(block_motion, mount_m, t0, t_end_s, rate_hz, bias, seed, bursts)
     else:
-        t, th, blk = np.array([0.0, t_end_s]), np.zeros(2), None
-    log = simulate_imu_log(t, th, blk, mount_m=mount_m, rate_hz=rate_hz, t_start_s=t0,
-                           rest_after_s=max(0.0, t_end_s - float(t[-1])), gyro_bias_deg_s=bias,
-                           base=base, drop_bursts=bursts, seed=seed)
+        if block_motion is not None:
+            t, th, blk = block_motion.t_s, -block_motion.phi_rad, block
+        else:
+            t, th, blk = np.array([0.0, t_end_s]), np.zeros(2), None
+        log = simulate_imu_log(t, th, blk, mount_m=mount_m, rate_hz=rate_hz, t_start_s=t0,
+                               rest_after_s=max(0.0, t_end_s - float(t[-1])), gyro_bias_deg_s=bias,
+                               base=base, drop_bursts=bursts, seed=seed)
     folder.mkdir(parents=True, exist_ok=True)
     inertial, regs = write_ximu_csv(log, folder / oid)
     return {"files": [inertial.name, regs.name], "rate_hz": float(rate_hz),
@@ -61,3 +62,43 @@ def write_object_imu(folder: Path, oid: str, *, block_motion=None, block=None, t
             "axes": "x along the width (+x world when upright), z up, y away from the camera "
                     "(rocking axis); gyro_y = -d(theta_rad)/dt",
             "writer": "rocklab.tracking._imu_sim.simulate_imu_log + write_ximu_csv"}
+
+
+def _rigid_body_log(view, mount_m, t0, t_end_s, rate_hz, bias_deg_s, seed, bursts):
+    """IMU samples of a sensor on any planar rigid body given by ``view.pose(t)``
+    (column blocks, which do not pivot on their own corners); same error model
+    and axes as ``simulate_imu_log``: interval-mean rate and specific force."""
+    from ..blocks import G
+    from ._imu_read import ImuLog
+
+    rng = np.random.default_rng(seed)
+    dt = 1.0 / rate_hz
+    n = int(np.floor((t_end_s - t0) * rate_hz)) + 1
+    tk = t0 + np.arange(n) * dt
+    rx, ry = float(mount_m[0]), float(mount_m[1])
+
+    def pos(t):
+        ox, oy, phi = view.pose(t)
+        c, s = np.cos(phi), np.sin(phi)
+        return np.stack([ox + c * rx - s * ry, oy + s * rx + c * ry], -1)
+
+    h = 1e-4
+    vel = lambda t: (pos(t + h / 2) - pos(t - h / 2)) / h  # noqa: E731
+    acc_w = (vel(tk + dt / 2) - vel(tk - dt / 2)) / dt
+    phi = view.phi(tk)
+    c, s = np.cos(phi), np.sin(phi)
+    fx, fy = acc_w[:, 0], acc_w[:, 1] + G
+    acc = np.zeros((n, 3))
+    acc[:, 0] = c * fx + s * fy                 # sensor x = (cos, sin) in the world
+    acc[:, 2] = -s * fx + c * fy                # sensor z = (-sin, cos)
+    gyro = np.zeros((n, 3))
+    gyro[:, 1] = -(view.phi(tk + dt / 2) - view.phi(tk - dt / 2)) / dt   # y away from the camera
+    gyro += np.deg2rad(bias_deg_s) + rng.normal(0.0, np.deg2rad(0.1), (n, 3))
+    acc += rng.normal(0.0, 0.005 * G, (n, 3))
+    keep = np.ones(n, dtype=bool)
+    for _ in range(bursts):
+        length = int(rng.integers(3, 9))
+        start = int(rng.integers(int(0.2 * n), max(int(0.2 * n) + 1, n - length - int(0.2 * n))))
+        keep[start:start + length] = False
+    return ImuLog(tk[keep], gyro[keep], acc[keep], float(rate_hz), int(n - keep.sum()), None,
+                  "simulated", "simulated")

@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from .._errors import InputError
+from ..blocks import Block
 
 __all__ = ["build_scene", "Scene"]
 
@@ -27,6 +28,21 @@ def _blocks(block, n):
     if len(bl) != n or not all(isinstance(b, Block) for b in bl):
         raise InputError(f"block: give one rocklab.Block or a list of {n} Blocks")
     return bl
+
+
+def _layout(layout, n):
+    from ._synth_column import column_api
+
+    if n == 1:
+        return "single"
+    if layout is None:
+        return "column" if column_api() is not None else "side"
+    if layout not in ("column", "side"):
+        raise InputError(f"layout={layout!r}: use 'column' (stacked) or 'side' (side by side)")
+    if layout == "column" and column_api() is None:
+        raise InputError("layout='column': this rocklab has no column model (rocklab.models.simulate_column); "
+                         "use layout='side'")
+    return layout
 
 
 def _simulate(blk, *, theta0_sim, base, horizon_s, restitution, eta):
@@ -83,6 +99,7 @@ class Scene:
     features: dict
     table_width_m: float
     video_info: dict = field(default_factory=dict)
+    layout: str = "single"
 
     def renderer(self):
         from ._render import Renderer
@@ -150,7 +167,8 @@ class Scene:
         write_experiment_toml(folder / "experiment.toml", name=f"synth-seed{self.seed}",
                               block={"id": self.block_motions[0].id, "b_m": b0["b_m"], "h_m": b0["h_m"],
                                      "mass_kg": b0["mass_kg"]},
-                              table_kind=self.table.kind, imu_objects=set(imu_info), column=None)
+                              table_kind=self.table.kind, imu_objects=set(imu_info),
+                              column=[m.id for m in self.block_motions] if self.layout == "column" else None)
         return self._meta(imu_info)
 
     def _write_imu(self, folder: Path, rate_hz: float) -> dict:
@@ -209,7 +227,7 @@ class Scene:
 
 def build_scene(*, seed, blocks, table, fps, size, targets, duration_s, occlusion, rolling_shutter,
                 block, restitution, eta, theta0_rad, record, table_amplitude_m, table_period_s,
-                table_stroke_m, exposure_s, noise_dn, distortion) -> Scene:
+                table_stroke_m, exposure_s, noise_dn, distortion, layout=None) -> Scene:
     from ._render import Occluder, RenderObject
     from ._render_targets import block_texture, table_texture
     from ._synth_camera import make_camera
@@ -220,6 +238,13 @@ def build_scene(*, seed, blocks, table, fps, size, targets, duration_s, occlusio
     rng_m = np.random.default_rng(s_motion)
     blks = _blocks(block, blocks)
     n = len(blks)
+    layout = _layout(layout, n)
+    if layout == "column" and block is None:      # thesis §4.3: three 100 x 200 mm granite blocks
+        blks = [Block(0.1, 0.2, depth_m=0.3, density_kg_m3=2700.0, name=f"block_{i + 1}") for i in range(n)]
+    if table_amplitude_m is None:
+        # The column overturns under the full 45 mm smooth pulse (its peak acceleration is
+        # ~2.1 A w^2 = 10 m/s^2); 20 mm keeps it rocking, as the thesis column did.
+        table_amplitude_m = 0.02 if layout == "column" else 0.045
     rest_s = 0.6
     horizon = float(duration_s) if duration_s is not None else 12.0
     tbl = _table_motion(table, rng_m, record=record, amplitude=table_amplitude_m, period=table_period_s,
@@ -234,44 +259,21 @@ def build_scene(*, seed, blocks, table, fps, size, targets, duration_s, occlusio
         for p, b in zip(phi0, blks):
             if not abs(p) < b.alpha_rad:
                 raise InputError(f"theta0_rad={p!r}: must be within ±alpha = ±{b.alpha_rad:.4f} rad")
-    motions, sims, ends = [], [], [tbl.end_s]
-    for k, blk in enumerate(blks):
-        oid = f"block_{k + 1}"
-        if table == "none":
-            release = round(rest_s + 0.3 * k + float(rng_m.uniform(0.0, 0.1)), 4)
-            res = _simulate(blk, theta0_sim=-phi0[k], base=None, horizon_s=max(horizon - release, 0.5),
-                            restitution=restitution, eta=eta)
-            t = np.concatenate(([0.0], release + res.t_s))
-            ph = np.concatenate(([phi0[k]], -res.theta_rad))
-        else:
-            release = None
-            res = _simulate(blk, theta0_sim=0.0, base=base, horizon_s=horizon + 0.1,
-                            restitution=restitution, eta=eta)
-            t, ph = res.t_s, -res.theta_rad
-        ends.append(float(t[-1]))
-        motions.append(BlockMotion(oid, blk.b_m, blk.h_m, xs[k], t, ph, tbl, release))
-        imp = res.impacts
-        sims.append({"id": oid, "block": blk.to_dict() | {"alpha_rad": blk.alpha_rad, "R_m": blk.R_m,
-                                                         "p_rad_s": blk.p_rad_s, "eta_H": blk.eta_H},
-                     "x0_m": xs[k], "release_s": release,
-                     "theta0_rad": phi0[k] if table == "none" else 0.0,
-                     "restitution": restitution,
-                     "eta_true": (float(eta) if restitution == "constant" else
-                                  (blk.eta_H if restitution == "housner" else None)),
-                     "sim_status": res.status, "overturned": bool(res.overturned),
-                     "n_impacts": int(res.n_impacts),
-                     "impact_t_s": [float(v) + (release or 0.0) for v in imp["t_s"]] if len(imp) else [],
-                     "impact_eta": [float(v) for v in imp["eta"]] if len(imp) else [],
-                     "max_abs_theta_rad": float(res.max_abs_theta_rad)})
+    if layout == "column":
+        motions, sims, ends = _column_motions(blks, tbl, base, table, rest_s, horizon, rng_m)
+    else:
+        motions, sims, ends = _single_motions(blks, xs, phi0, tbl, base, table, rest_s, horizon, rng_m,
+                                              restitution, eta)
     if duration_s is None:
         duration_s = float(np.clip(max(ends) + 0.6, 2.0, 12.0))
     n_frames = max(2, int(round(duration_s * fps)))
     W, H = size
     h_max = max(b.h_m for b in blks)
-    table_w = 0.8 if n == 1 else 1.2
+    stack = sum(b.h_m for b in blks) if layout == "column" else h_max
+    table_w = 1.2 if layout == "side" else 0.8
     stroke = {"none": 0.0, "sine": table_amplitude_m, "record": table_stroke_m}[table]
-    view_h = max(3.0 * h_max, (table_w + 2 * stroke + 0.1) * H / W)
-    cam = make_camera(size, (0.0, 0.4 * h_max), view_h, np.random.default_rng(s_cam), distortion=distortion)
+    view_h = max(3.0 * h_max, 1.4 * stack, (table_w + 2 * stroke + 0.1) * H / W)
+    cam = make_camera(size, (0.0, 0.4 * stack), view_h, np.random.default_rng(s_cam), distortion=distortion)
     maps = cam.plane_maps()
     mpp = cam.m_per_px((0.0, 0.5 * h_max))
     texel, psf_m = mpp / 4.0, 0.5 * mpp
@@ -309,10 +311,88 @@ def build_scene(*, seed, blocks, table, fps, size, targets, duration_s, occlusio
               "duration_s": duration_s, "rolling_shutter": rolling_shutter, "restitution": restitution,
               "eta": eta, "table_amplitude_m": table_amplitude_m, "table_period_s": table_period_s,
               "table_stroke_m": table_stroke_m, "noise_dn": noise_dn, "distortion": distortion,
-              "layout": "independent blocks side by side" if n == 3 else "single block"}
+              "layout": {"single": "single block", "side": "independent blocks side by side",
+                         "column": "stacked column (rocklab.models.simulate_column)"}[layout]}
     return Scene(seed, fps, tuple(size), n_frames, targets, cam, maps, objects, motions, tbl, sims,
                  params, occl, background, illum, exposure, (0.8 / fps) if rolling_shutter else 0.0,
-                 float(noise_dn), s_noise, s_imu, feats, table_w)
+                 float(noise_dn), s_noise, s_imu, feats, table_w, layout=layout)
+
+
+def _block_info(blk) -> dict:
+    return blk.to_dict() | {"alpha_rad": blk.alpha_rad, "R_m": blk.R_m, "p_rad_s": blk.p_rad_s,
+                            "eta_H": blk.eta_H}
+
+
+def _single_motions(blks, xs, phi0, tbl, base, table, rest_s, horizon, rng_m, restitution, eta):
+    """Independent blocks side by side: one ``simulate`` run each."""
+    from ._synth_motion import BlockMotion
+
+    motions, sims, ends = [], [], [tbl.end_s]
+    for k, blk in enumerate(blks):
+        oid = f"block_{k + 1}"
+        if table == "none":
+            release = round(rest_s + 0.3 * k + float(rng_m.uniform(0.0, 0.1)), 4)
+            res = _simulate(blk, theta0_sim=-phi0[k], base=None, horizon_s=max(horizon - release, 0.5),
+                            restitution=restitution, eta=eta)
+            t = np.concatenate(([0.0], release + res.t_s))
+            ph = np.concatenate(([phi0[k]], -res.theta_rad))
+        else:
+            release = None
+            res = _simulate(blk, theta0_sim=0.0, base=base, horizon_s=horizon + 0.1,
+                            restitution=restitution, eta=eta)
+            t, ph = res.t_s, -res.theta_rad
+        ends.append(float(t[-1]))
+        motions.append(BlockMotion(oid, blk.b_m, blk.h_m, xs[k], t, ph, tbl, release))
+        imp = res.impacts
+        sims.append({"id": oid, "block": _block_info(blk), "x0_m": xs[k], "release_s": release,
+                     "theta0_rad": phi0[k] if table == "none" else 0.0,
+                     "restitution": restitution,
+                     "eta_true": (float(eta) if restitution == "constant" else
+                                  (blk.eta_H if restitution == "housner" else None)),
+                     "sim_status": res.status, "overturned": bool(res.overturned),
+                     "n_impacts": int(res.n_impacts),
+                     "impact_t_s": [float(v) + (release or 0.0) for v in imp["t_s"]] if len(imp) else [],
+                     "impact_eta": [float(v) for v in imp["eta"]] if len(imp) else [],
+                     "max_abs_theta_rad": float(res.max_abs_theta_rad)})
+    return motions, sims, ends
+
+
+def _column_motions(blks, tbl, base, table, rest_s, horizon, rng_m):
+    """A stacked column (``rocklab.models.simulate_column``): free rocking after a
+    thread-burn release of the whole column tilted by half its slenderness angle,
+    or standing on the moving table."""
+    from ._synth_column import ColumnBlockView, ColumnMotion, column_api
+
+    Column, simulate_column = column_api()
+    col = Column(tuple(blks))
+    n = len(blks)
+    H = sum(b.h_m for b in blks)
+    if table == "none":
+        phi0 = 0.5 * float(np.arctan(min(b.b_m for b in blks) / H))
+        release = round(rest_s + float(rng_m.uniform(0.0, 0.1)), 4)
+        res = simulate_column(col, None, theta0_rad=[-phi0] * n, duration_s=max(horizon - release, 0.5))
+        psi0 = np.zeros((1, n))
+        psi0[0, 0] = phi0
+        t = np.concatenate(([0.0], release + res.t_s))
+        psi = np.vstack([psi0, -res.phi_rad])
+    else:
+        phi0, release = 0.0, None
+        res = simulate_column(col, base, duration_s=horizon + 0.1)
+        t, psi = res.t_s, -res.phi_rad
+    cm = ColumnMotion(np.array([b.b_m for b in blks]), np.array([b.h_m for b in blks]),
+                      np.asarray(col.half_width_m, float), 0.0, t, psi, tbl, release)
+    motions = [ColumnBlockView(f"block_{k + 1}", cm, k) for k in range(n)]
+    imp = res.impacts
+    common = {"x0_m": 0.0, "release_s": release, "restitution": "column impact model (rocklab.models)",
+              "eta_true": None, "sim_status": res.status, "overturned": bool(res.overturned),
+              "n_impacts": int(len(imp)),
+              "impact_t_s": [float(v) + (release or 0.0) for v in imp["t_s"]] if len(imp) else [],
+              "impact_joint": [int(v) for v in imp["joint"]] if len(imp) else [],
+              "column_status_t_s": float(res.t_status_s)}
+    sims = [{"id": m.id, "block": _block_info(b), "theta0_rad": phi0, "layout": "column",
+             "max_abs_theta_rad": float(res.max_abs_theta_rad[k])} | common
+            for k, (m, b) in enumerate(zip(motions, blks))]
+    return motions, sims, [tbl.end_s, float(t[-1])]
 
 
 def _background(maps, size, targets, rng):

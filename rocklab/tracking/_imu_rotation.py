@@ -14,7 +14,8 @@ Method (``block_rotation``)
 4. Tilt: integral (trapezoid over the sample times) of the bias-free rate
    about the axis, anchored to the accelerometer tilt in both rest windows:
    the angle is zero where the block rests upright at the end (or, without an
-   end rest, where the sensor axis nearest to gravity is vertical); the
+   end rest or when it ends > 20 deg away from it -- overturned -- where the
+   sensor axis nearest to gravity at the start is vertical); the
    remaining linear drift (residual bias) is removed so both rest windows
    match their accelerometer tilt.
 5. Release: the first motion, refined by extrapolating the initial
@@ -201,6 +202,12 @@ def block_rotation(log: ImuLog, axis: str | None = None, *, ahrs: bool = False,
     f_start = acc[s0:s1].mean(axis=0)
     f_end = acc[e0:e1].mean(axis=0) if has_end else None
     f_ref = f_end if has_end else _vertical_axis(f_start)
+    if has_end and abs(float(tilt_about(u, _vertical_axis(f_start), f_end))) > np.deg2rad(20.0):
+        # Ended far from upright (overturned, or stopped leaning on something):
+        # upright is then the sensor axis nearest to gravity at the start
+        # (square mounting); both windows still anchor the drift.
+        f_ref = _vertical_axis(f_start)
+        msg = "ended > 20 deg from upright: upright = sensor axis nearest gravity at start"
     integ = cumtrapz(t, omega)
     th_start = float(tilt_about(u, f_ref, f_start))
     ts_mid, is_mean = t[s0:s1].mean(), integ[s0:s1].mean()

@@ -17,6 +17,9 @@ def register(sub):
     p.add_argument("--out", required=True, metavar="DIR", help="output folder (new or empty)")
     p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     p.add_argument("--blocks", type=int, choices=(1, 3), default=1, help="number of blocks")
+    p.add_argument("--layout", choices=("column", "side"), default=None,
+                   help="with --blocks 3: stacked column (default when the column model is "
+                        "available) or independent blocks side by side")
     p.add_argument("--table", choices=("none", "sine", "record"), default="none",
                    help="none: free rocking after a thread-burn release; sine: 0.6 s / 45 mm pulse; "
                         "record: an earthquake record scaled to the table stroke")
@@ -56,7 +59,7 @@ def run(args) -> int:
     s = synth_session(args.out, seed=args.seed, blocks=args.blocks, table=args.table, fps=args.fps,
                       size=size, targets=args.targets, duration_s=args.duration, occlusion=occ,
                       rolling_shutter=args.rolling_shutter, record=args.record, imu=not args.no_imu,
-                      force=args.force, progress=args.progress)
+                      layout=args.layout, force=args.force, progress=args.progress)
     d = s.to_dict()
     if args.json:
         sys.stdout.write(json.dumps(d, allow_nan=False, default=str) + "\n")

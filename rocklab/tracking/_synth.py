@@ -240,6 +240,9 @@ def synth_session(out_dir, seed: int = 0, blocks: int = 1, table: str = "none", 
         from .._io import write_json_atomic
 
         write_json_atomic(tmp / "session.json", meta)
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o777 & ~umask)          # mkdtemp made it private
         if out_dir.exists():
             shutil.rmtree(out_dir)
         os.replace(tmp, out_dir)

@@ -262,7 +262,8 @@ class _Problem:
 
 
 def _grid_then_brent(fun_grid, fun, lo, hi, n_grid=5, xtol=1e-6):
-    """1-D minimisation: coarse grid with a cheap objective, then bounded Brent around its best node."""
+    """1-D minimisation: coarse grid with a cheap objective, then bounded Brent on ``fun``
+    between the neighbours of the best node. Returns (x, f(x), best node on the grid edge)."""
     xs = np.linspace(lo, hi, n_grid)
     fs = np.array([fun_grid(x) for x in xs])
     i = int(np.nanargmin(fs))
@@ -479,7 +480,14 @@ def fit_restitution(t_s, theta_rad, block, window: str = "middle50", objective: 
         _, tr_hat, theta0_hat = q.profile(eta_hat, np.flatnonzero(t < tc[0]), tr_bounds)
         ids, amp, half = idx_main
         res = win_res = prob.peaks_residual(eta_hat, amp, half, list(ids))
-    eta_first = eta_hat if window == "first" else fit_window("first", "theta", fixed=(tr_hat, theta0_hat))[0]
+    if window == "first":
+        eta_first = eta_hat
+    else:
+        # release and θ0 from the plateau and release quarter-cycle only (η-independent), so that
+        # a misfit of the main window (η changing during rocking) cannot leak into η′_e
+        q = problem("first")
+        _, tr_1, th0_1 = q.profile(eta_hat, np.flatnonzero(t < tc[0]), tr_bounds)
+        eta_first = fit_window("first", "theta", fixed=(tr_1, th0_1))[0]
     n_pts = int(res.size)
     rms = float(np.sqrt(np.mean(win_res ** 2))) if win_res.size else float("nan")
     n_par = 4 if objective_used == "theta" else 1
@@ -525,15 +533,19 @@ def _suspicion(t, y, res, rms, sigma, pie, tc, alpha):
             flags.append(f"{int(big.sum())} residual(s) above 8x RMS: isolated jump or tracking glitch")
     ok = pie[pie["ok"]] if len(pie) else pie
     if len(ok) >= 4:
+        # alternation between the two corners: median of (−1)^k (η_k − η_{k+1}) / 2 over consecutive
+        # impacts; a steady trend or a single odd impact drops out, unequal corners do not
         e = ok["eta_peaks"].to_numpy()
+        k = ok["impact"].to_numpy()
         se = ok["eta_peaks_se"].to_numpy()
-        odd = ok["impact"].to_numpy() % 2 == 1
-        if odd.any() and (~odd).any():
-            d = float(np.mean(e[odd]) - np.mean(e[~odd]))
-            sd = float(np.sqrt(np.mean(se[odd] ** 2) / odd.sum() + np.mean(se[~odd] ** 2) / (~odd).sum()))
-            if abs(d) > max(4 * sd, 0.01):
-                flags.append(f"asymmetric amplitudes: per-impact eta differs by {d:+.3f} between the two corners "
-                             "(tilted base, slip or unequal corners)")
+        pair = np.flatnonzero(np.diff(k) == 1)
+        if pair.size >= 3:
+            a = ((-1.0) ** k[pair]) * (e[pair] - e[pair + 1]) / 2
+            sd = float(np.sqrt(np.mean(se[pair] ** 2 + se[pair + 1] ** 2) / 4 / pair.size) + 1e-12)
+            d = float(np.median(a))
+            if abs(d) > max(4 * sd, 0.005):
+                flags.append(f"asymmetric amplitudes: per-impact eta alternates by {2 * d:+.3f} between the two "
+                             "corners (tilted base, slip or unequal corners)")
     after = t > tc[-1] + 2 * (tc[-1] - tc[-2]) if tc.size >= 2 else np.zeros_like(t, bool)
     if after.sum() >= 10:
         rest = float(np.median(y[after]))

@@ -193,7 +193,7 @@ def block_rotation(log: ImuLog, axis: str | None = None, *, ahrs: bool = False,
     w = gyro - bias
     if axis is None:
         mv = w[moving] if moving.any() else w
-        u = np.linalg.svd(mv - 0.0, full_matrices=False)[2][0]
+        u = np.linalg.svd(mv, full_matrices=False)[2][0]
     else:
         u = axis_vector(axis)
     omega = w @ u

@@ -125,7 +125,9 @@ def _ximu_sample_index(pk: np.ndarray) -> tuple[np.ndarray, int]:
     packet number measured against the local phase of the packet/sample line
     (mean of ``pk - per * index`` over the preceding 64 samples, ``per`` the
     mean packets per inertial sample on normal gaps), rounded: exact while
-    the interleaving jitter stays within +-0.5 sample.
+    the interleaving jitter stays within +-0.5 sample.  Limitation: a loss of
+    one or two inertial packets looks like interleaved battery/date packets
+    and is not detected (only runs of about 3 or more lost samples are).
     """
     n = len(pk)
     if n < 3:

@@ -13,7 +13,7 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
-TEX = 1500.0  # texture px per m
+TEX = 2000.0  # texture px per m (even marker sides and mm positions land on whole texels)
 
 
 def marker_texture(ids, positions_m, size_m, face_m, face_grey=200, dictionary="DICT_4X4_50",
@@ -28,16 +28,16 @@ def marker_texture(ids, positions_m, size_m, face_m, face_grey=200, dictionary="
     tex = np.full((int(round(h * TEX)), int(round(w * TEX))), face_grey, np.uint8)
     ox, oy = _origin(tex, origin_m)
     for i, (cx, cy) in zip(ids, positions_m):
-        quiet = 1.25
         s = int(round(size_m * TEX))
-        sq = int(round(size_m * quiet * TEX))
+        q = int(round(size_m * 0.125 * TEX))  # white quiet zone
         img = cv2.aruco.generateImageMarker(d, int(i), s)
-        pad = np.full((sq, sq), 255, np.uint8)
-        o = (sq - s) // 2
-        pad[o:o + s, o:o + s] = img
-        u0 = int(round(ox + 0.5 + cx * TEX - sq / 2))
-        v0 = int(round(oy + 0.5 - cy * TEX - sq / 2))
-        tex[v0:v0 + sq, u0:u0 + sq] = pad
+        # marker texels u0..u0+s-1 span [u0 - 0.5, u0 + s - 0.5]: centred on the requested point
+        u0 = ox + 0.5 + cx * TEX - s / 2
+        v0 = oy + 0.5 - cy * TEX - s / 2
+        assert abs(u0 - round(u0)) < 1e-6 and abs(v0 - round(v0)) < 1e-6, "off-texel marker"
+        u0, v0 = int(round(u0)), int(round(v0))
+        tex[v0 - q:v0 + s + q, u0 - q:u0 + s + q] = 255
+        tex[v0:v0 + s, u0:u0 + s] = img
     return tex, (ox, oy)
 
 
@@ -65,9 +65,20 @@ def _origin(tex, origin_m):
     return -0.5 - origin_m[0] * TEX, tex.shape[0] - 0.5 + origin_m[1] * TEX
 
 
+def _rot(ax, ay, az):
+    cx, sx, cy, sy, cz, sz = np.cos(ax), np.sin(ax), np.cos(ay), np.sin(ay), np.cos(az), np.sin(az)
+    Rx = np.array([[1, 0, 0], [0, cx, -sx], [0, sx, cx]])
+    Ry = np.array([[cy, 0, sy], [0, 1, 0], [-sy, 0, cy]])
+    Rz = np.array([[cz, -sz, 0], [sz, cz, 0], [0, 0, 1]])
+    return Rz @ Ry @ Rx
+
+
 class Scene:
+    """``tilt_rad = (about x, about y)``: a pinhole camera at 1 m looking at the plane with
+    that pitch/yaw (``K`` in :attr:`K`); 0 gives a fronto-parallel view."""
+
     def __init__(self, width=640, height=400, px_per_m=1500.0, roll_rad=0.0, noise=2.0,
-                 blur=0.6, seed=0, background=(90, 140)):
+                 blur=0.6, seed=0, background=(90, 140), tilt_rad=(0.0, 0.0)):
         self.W, self.H, self.k, self.roll = width, height, px_per_m, roll_rad
         self.noise, self.blur = noise, blur
         self.rng = np.random.default_rng(seed)
@@ -75,35 +86,41 @@ class Scene:
         lo, hi = background
         self.bg = (lo + (hi - lo) * xx / width).astype(np.float32)
         self.objects = []
+        cx, cy = (width - 1) / 2, (height - 1) / 2
+        self.K = np.array([[px_per_m, 0, cx], [0, px_per_m, cy], [0, 0, 1.0]])
+        # world (x right, y up, z to the camera) -> camera (x right, y down, z forward)
+        R = _rot(tilt_rad[0], tilt_rad[1], 0.0) @ np.diag([1.0, -1.0, -1.0]) @ _rot(0, 0, roll_rad)
+        t = np.array([0.0, 0.0, 1.0])
+        t = t - R @ np.zeros(3)
+        self.G = self.K @ np.column_stack((R[:, 0], R[:, 1], t))  # plane (x, y, 1) -> image
 
     def add(self, tex, origin_px):
-        t = cv2.GaussianBlur(tex.astype(np.float32), (0, 0), 0.5 * TEX / self.k)
+        # band-limit the texture (0.8 image px) so the bilinear warp does not alias edges
+        t = cv2.GaussianBlur(tex.astype(np.float32), (0, 0), 0.8 * TEX / self.k)
         self.objects.append((t, origin_px))
 
     def world_to_image(self, xy):
-        xy = np.atleast_2d(xy)
-        c, s = np.cos(self.roll), np.sin(self.roll)
-        X = c * xy[:, 0] - s * xy[:, 1]
-        Y = s * xy[:, 0] + c * xy[:, 1]
-        return np.c_[(self.W - 1) / 2 + self.k * X, (self.H - 1) / 2 - self.k * Y]
+        xy = np.atleast_2d(np.asarray(xy, float))
+        h = np.column_stack((xy, np.ones(len(xy)))) @ self.G.T
+        return h[:, :2] / h[:, 2:3]
 
     def render(self, poses):
         """``poses``: per object ``(x_m, y_m, theta_rad)`` of its origin. Returns uint8 (H, W)."""
         img = self.bg.copy()
         for (tex, (ox, oy)), (x, y, th) in zip(self.objects, poses):
             # texture px -> object m: P = ((u-ox)/TEX, (oy-v)/TEX); world = R(th) P + (x, y);
-            # image = camera(world). Compose the affine texture px -> image px.
-            c, s = np.cos(th + self.roll), np.sin(th + self.roll)
-            k = self.k / TEX
-            A = np.array([[k * c, k * s], [-k * s, k * c]])
-            # image of object origin:
-            o_img = self.world_to_image([x, y])[0]
-            b = o_img - A @ np.array([ox, oy])
-            M = np.c_[A, b].astype(np.float64)
-            warped = cv2.warpAffine(tex, M, (self.W, self.H), flags=cv2.INTER_LINEAR,
-                                    borderMode=cv2.BORDER_CONSTANT, borderValue=0)
-            alpha = cv2.warpAffine(np.ones_like(tex), M, (self.W, self.H), flags=cv2.INTER_LINEAR,
-                                   borderMode=cv2.BORDER_CONSTANT, borderValue=0)
+            # image = G world.
+            c, s = np.cos(th), np.sin(th)
+            L = np.array([[c, -s], [s, c]]) @ np.diag([1 / TEX, -1 / TEX])
+            T = np.eye(3)
+            T[:2, :2] = L
+            T[:2, 2] = np.array([x, y]) - L @ np.array([ox, oy])
+            M = self.G @ T
+            warped = cv2.warpPerspective(tex, M, (self.W, self.H), flags=cv2.INTER_LINEAR,
+                                         borderMode=cv2.BORDER_CONSTANT, borderValue=0)
+            alpha = cv2.warpPerspective(np.ones_like(tex), M, (self.W, self.H),
+                                        flags=cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT,
+                                        borderValue=0)
             img = img * (1 - alpha) + warped
         if self.blur:
             img = cv2.GaussianBlur(img, (0, 0), self.blur)

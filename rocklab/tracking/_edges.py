@@ -53,18 +53,33 @@ def refine_rectangle(gray, corners, half=6.0, step=2.0, trim=0.15):
     rms_px : float
         RMS distance of the edge points from their fitted lines.
     n_points : int
+    sigma_theta_rad : float
+        1-σ uncertainty of the rectangle's orientation (mean of the four side
+        directions), from each line fit's scatter: ``σ_k = rms_k / sqrt(Σ(s - s̄)²)``
+        along the side (inflated by ``2 px / step`` for profiles correlated by the
+        blur), combined as ``sqrt(Σ σ_k²) / 4``.
     """
     import cv2
 
     c = np.asarray(corners, float)
     centre = c.mean(0)
-    lines, res, npts = [], [], 0
+    # Work on a float crop: remap of uint8 would round the profiles to whole grey levels.
+    H, W = gray.shape[:2]
+    pad = half + 4
+    x0 = int(max(np.floor(c[:, 0].min() - pad), 0))
+    y0 = int(max(np.floor(c[:, 1].min() - pad), 0))
+    x1 = int(min(np.ceil(c[:, 0].max() + pad) + 1, W))
+    y1 = int(min(np.ceil(c[:, 1].max() + pad) + 1, H))
+    if x1 - x0 < 4 or y1 - y0 < 4:
+        return None, np.inf, 0, np.inf
+    img = gray[y0:y1, x0:x1].astype(np.float32)
+    lines, res, npts, var_phi = [], [], 0, []
     offs = np.arange(-half, half + 0.5, 0.5)
     for k in range(4):
         a, b = c[k], c[(k + 1) % 4]
         L = np.hypot(*(b - a))
         if L < 8:
-            return None, np.inf, 0
+            return None, np.inf, 0, np.inf
         d = (b - a) / L
         nrm = np.array([-d[1], d[0]])
         if np.dot(centre - a, nrm) > 0:
@@ -72,9 +87,10 @@ def refine_rectangle(gray, corners, half=6.0, step=2.0, trim=0.15):
         s = np.arange(trim * L, (1 - trim) * L, step)
         base = a + s[:, None] * d
         pts = base[:, None, :] + offs[None, :, None] * nrm  # (m, p, 2), inside -> outside
-        mx = pts[..., 0].astype(np.float32)
-        my = pts[..., 1].astype(np.float32)
-        prof = cv2.remap(gray, mx, my, cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE
+        mx = (pts[..., 0] - x0).astype(np.float32)
+        my = (pts[..., 1] - y0).astype(np.float32)
+        # bicubic: linear interpolation "pixel-locks" the crossings of near-axis edges
+        prof = cv2.remap(img, mx, my, cv2.INTER_CUBIC, borderMode=cv2.BORDER_REPLICATE
                          ).astype(float)
         inside = prof[:, :3].mean(1, keepdims=True)
         outside = prof[:, -3:].mean(1, keepdims=True)
@@ -94,17 +110,23 @@ def refine_rectangle(gray, corners, half=6.0, step=2.0, trim=0.15):
         edge = base + off[:, None] * nrm
         edge = edge[ok]
         if len(edge) < 5:
-            return None, np.inf, 0
-        vx, vy, x0, y0 = cv2.fitLine(edge.astype(np.float32), cv2.DIST_HUBER, 0, 0.01, 0.01).ravel()
+            return None, np.inf, 0, np.inf
+        vx, vy, lx, ly = cv2.fitLine(edge.astype(np.float32), cv2.DIST_HUBER, 0, 0.01, 0.01).ravel()
         dvec = np.array([vx, vy], float)
-        p0 = np.array([x0, y0], float)
+        p0 = np.array([lx, ly], float)
         dist = (edge - p0) @ np.array([-dvec[1], dvec[0]])
         res.append(dist)
         npts += len(edge)
+        along = (edge - p0) @ dvec
+        dof = max(len(edge) - 2, 1)
+        # profiles closer than ~2 px share their noise through the blur: count them as
+        # one independent sample per 2 px
+        corr = max(1.0, 2.0 / step)
+        var_phi.append(corr * np.sum(dist ** 2) / dof / max(np.sum((along - along.mean()) ** 2), 1e-12))
         lines.append((p0, dvec))
     out = np.array([_line_intersection(lines[(k - 1) % 4], lines[k]) for k in range(4)])
     r = np.concatenate(res)
-    return out, float(np.sqrt(np.mean(r ** 2))), npts
+    return out, float(np.sqrt(np.mean(r ** 2))), npts, float(np.sqrt(np.sum(var_phi)) / 4)
 
 
 def horizontal_edge_angle(gray, roi, plane_map):
@@ -224,10 +246,11 @@ class EdgeDetector:
             if approx is None:
                 out[o.id] = None
                 continue
-            corners, rms, npts = refine_rectangle(gray, approx)
+            corners, rms, npts, sig = refine_rectangle(gray, approx)
             if corners is not None:
-                corners2, rms, npts = refine_rectangle(gray, corners, half=4.0)
-                corners = corners2 if corners2 is not None else corners
+                corners2, rms2, npts2, sig2 = refine_rectangle(gray, corners, half=4.0)
+                if corners2 is not None:
+                    corners, sig = corners2, sig2
             if corners is None:
                 out[o.id] = None
                 continue
@@ -246,5 +269,5 @@ class EdgeDetector:
                 bw, bh = self.ref_px[o.id]
                 obj = _SIGNS * (bw / 2, bh / 2)
                 metric = False
-            out[o.id] = Detection(corners, obj, metric, 4)
+            out[o.id] = Detection(corners, obj, metric, 4, sig)
         return out

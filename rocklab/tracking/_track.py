@@ -116,7 +116,7 @@ def _table_plane(config, pm, gray):
     elif gray is None:
         why = "needs the first frame"
     if why is None:
-        from ._aruco import _UNIT_CORNERS, make_cv_detector
+        from ._aruco import _UNIT_CORNERS, make_cv_detector, refine_marker_corners
 
         det, _ = make_cv_detector(config.targets)
         corners, ids, _ = det.detectMarkers(gray)
@@ -126,7 +126,10 @@ def _table_plane(config, pm, gray):
         for c, i in zip(corners, [] if ids is None else ids.ravel()):
             if int(i) in tab.markers:
                 k = tab.markers.index(int(i))
-                img.append(c.reshape(4, 2))
+                c = c.reshape(4, 2).astype(float)
+                if config.targets.corner_refinement == "edges":
+                    c, _ = refine_marker_corners(gray, c)
+                img.append(c)
                 obj.append(np.asarray(pos[k], float) + _UNIT_CORNERS * size)
         if len(img) == len(tab.markers):
             return plane_homography_from_points(np.vstack(img), np.vstack(obj), pm)
@@ -206,8 +209,9 @@ def track_frames(frames, config: TrackConfig, plane_map: PlaneMap | None = None)
                     obs.append(Observation(idx, o.id, *(np.nan,) * 4, f.scale, f.rms, qual,
                                            "low_quality", d.metric, plane_map.source))
                     continue
+                sig = d.combined_sigma(f.sigma_theta_rad)
                 obs.append(Observation(idx, o.id, float(f.t[0]), float(f.t[1]), f.theta_rad,
-                                       f.sigma_theta_rad, f.scale, f.rms, qual, "ok", d.metric,
+                                       sig, f.scale, f.rms, qual, "ok", d.metric,
                                        plane_map.source))
                 u, v = d.img_pts[:, 0], d.img_pts[:, 1]
                 box = (int(max(u.min(), 0)), int(max(v.min(), 0)), int(u.max()) + 1, int(v.max()) + 1)

@@ -225,3 +225,17 @@ def test_general_body_alpha_I():
     T = 4.0 / math.sqrt(G / 0.5) * math.acosh(2.0)
     assert r.impacts.t_s.iloc[0] == pytest.approx(T / 4, abs=1e-7)
     assert r.impacts.eta.iloc[0] == pytest.approx(1 - 2 * math.sin(0.2) ** 2)
+
+
+def test_output_decimation_and_no_stop(b6m_pair):
+    nm, _ = b6m_pair
+    a = B6M.alpha_rad
+    dec = simulate(B6M, 0.8 * a, duration_s=6.0, dt_s=1e-4, output_dt_s=1e-2)
+    k = np.arange(len(dec.t_s)) * 100
+    assert np.array_equal(dec.theta_rad, nm.theta_rad[k]) and np.allclose(dec.t_s, nm.t_s[k])
+    full = simulate(B6M, 0.8 * a, duration_s=6.0, dt_s=1e-4, stop_at_rest=False)
+    assert len(full.t_s) == 60001 and full.status == "rest"
+    after = full.t_s > nm.t_s[-1]
+    assert np.all(full.theta_rad[after] == 0.0) and np.all(full.energy_J[after] == 0.0)
+    with pytest.raises(InputError):
+        simulate(B6M, 0.1, dt_s=1e-4, output_dt_s=1.5e-4)

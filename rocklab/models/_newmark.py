@@ -294,6 +294,7 @@ def run_block(p, alpha, theta0, omega0, h, n_steps, acc, acc_t0, acc_dt, scale,
         out_e[0] = _energy(th, w, cc, cos_a, p2, alpha, lin)
         n_out = 1
     step = 0
+    countdown = out_every  # output every out_every steps (no integer modulo in the hot loop)
     t_end = 0.0
     while step < n_steps:
         t0 = step * h
@@ -394,7 +395,9 @@ def run_block(p, alpha, theta0, omega0, h, n_steps, acc, acc_t0, acc_dt, scale,
             # re-anchor the incremental sin/cos against rounding drift
             sc = math.sin(alpha * s - th)
             cc = math.cos(alpha * s - th)
-        if out_every > 0 and step % out_every == 0:
+        countdown -= 1
+        if countdown == 0:
+            countdown = out_every
             out_th[n_out] = th
             out_w[n_out] = w
             out_e[n_out] = 0.0 if resting else _energy(th, w, cc, cos_a, p2, alpha, lin)

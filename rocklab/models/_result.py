@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 
@@ -39,7 +40,10 @@ class RockingResult:
         Output times (s), rotation (rad, > 0 about corner A, Čeh Fig. 1), angular
         velocity (rad/s), and energy above rest (J, see :func:`block_energy`).
     impacts : pandas.DataFrame
-        One row per impact: ``t_s, omega_before_rad_s, omega_after_rad_s, eta``.
+        One row per impact: ``t_s, omega_before_rad_s, omega_after_rad_s, eta``
+        (built on first access from ``impacts_array``).
+    impacts_array : ndarray, shape (4, n_impacts)
+        The same table as rows t_s, omega_before_rad_s, omega_after_rad_s, eta.
     status : str
         ``"rest"`` (came to rest: amplitude below ``rest_tol * alpha`` with the base
         below uplift), ``"rocking"`` (still moving at the end), ``"overturned"``
@@ -70,7 +74,7 @@ class RockingResult:
     theta_rad: np.ndarray
     omega_rad_s: np.ndarray
     energy_J: np.ndarray
-    impacts: object
+    impacts_array: np.ndarray
     status: str
     overturned: bool
     overturn_t_s: float
@@ -84,6 +88,15 @@ class RockingResult:
     linearized: bool = False
     base_name: str = ""
     meta: dict = field(default_factory=dict, compare=False)
+
+    @cached_property
+    def impacts(self):
+        """DataFrame ``t_s, omega_before_rad_s, omega_after_rad_s, eta``, one row per impact."""
+        import pandas as pd
+
+        a = self.impacts_array
+        return pd.DataFrame({"t_s": a[0], "omega_before_rad_s": a[1], "omega_after_rad_s": a[2],
+                             "eta": a[3]})
 
     @property
     def max_abs_theta_over_alpha(self) -> float:

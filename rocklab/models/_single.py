@@ -178,14 +178,11 @@ def simulate(block, theta0_rad: float = 0.0, omega0_rad_s: float = 0.0, duration
         E = block_energy(block, th, w, linearized)
     else:
         raise InputError(f"method={method!r}: use 'newmark' or 'event'")
-    import pandas as pd
-
-    impacts = pd.DataFrame({"t_s": imp_cols[0], "omega_before_rad_s": imp_cols[1],
-                            "omega_after_rad_s": imp_cols[2], "eta": imp_cols[3]})
-    for a in (t, th, w):
+    imp_cols = np.ascontiguousarray(imp_cols)
+    for a in (t, th, w, imp_cols):
         a.setflags(write=False)
     E.setflags(write=False)
-    return RockingResult(t_s=t, theta_rad=th, omega_rad_s=w, energy_J=E, impacts=impacts,
+    return RockingResult(t_s=t, theta_rad=th, omega_rad_s=w, energy_J=E, impacts_array=imp_cols,
                          status=status, overturned=status == "overturned",
                          overturn_t_s=float(t_over), fall_t_s=float(t_fall),
                          max_abs_theta_rad=float(max_abs), block=block, restitution=law, method=meth,

@@ -139,7 +139,7 @@ def _marker_corners(x0, y0, size):
 
 
 def block_texture(b_m, h_m, style, *, marker_ids=(), dictionary="DICT_4X4_50", marker_size_m=None,
-                  texel_m, psf_px_m, rng, face_value=None) -> Texture:
+                  dot_diameter_m=None, texel_m, psf_px_m, rng, face_value=None) -> Texture:
     """Front face of a block ``b_m`` x ``h_m`` (m) with its targets.
 
     ``style``: ``"aruco"`` (markers stacked on the centre line, each on a white
@@ -170,7 +170,7 @@ def block_texture(b_m, h_m, style, *, marker_ids=(), dictionary="DICT_4X4_50", m
         feats["marker_size_m"] = s
     elif style == "dots":
         p.rect(-b_m / 2, b_m / 2, 0, h_m, WHITE, opaque=True)
-        dia = min(0.16 * b_m, 0.08 * h_m)
+        dia = dot_diameter_m or min(0.16 * b_m, 0.08 * h_m)
         dots = np.array([[-0.28 * b_m, 0.15 * h_m], [0.28 * b_m, 0.15 * h_m],
                          [-0.28 * b_m, 0.85 * h_m], [0.28 * b_m, 0.62 * h_m]])
         for x, y in dots:
@@ -183,7 +183,7 @@ def block_texture(b_m, h_m, style, *, marker_ids=(), dictionary="DICT_4X4_50", m
 
 
 def table_texture(width_m, thick_m, style, *, marker_ids=(), dictionary="DICT_4X4_50",
-                  marker_size_m=None, texel_m, psf_px_m, rng) -> Texture:
+                  marker_size_m=None, dot_diameter_m=None, texel_m, psf_px_m, rng) -> Texture:
     """Front face of the table top (body frame: origin at the top centre, y up).
 
     Markers (or dots) sit near both ends so the tracker can level from the
@@ -209,10 +209,11 @@ def table_texture(width_m, thick_m, style, *, marker_ids=(), dictionary="DICT_4X
             feats["markers"][int(mid)] = _marker_corners(x - s / 2, yc - s / 2, s)
         feats["marker_size_m"] = s
     elif style == "dots":
-        dia = 0.5 * thick_m
+        # Same printed dot size as on the blocks (trackers filter by one size), on white labels.
+        dia = dot_diameter_m or 0.3 * thick_m
         dots = np.array([[xs[0], yc], [0.0, yc], [xs[1], yc]])
         for x, y in dots:
-            p.circle(x, y, 0.62 * dia, WHITE)
+            p.rect(x - 1.2 * dia, x + 1.2 * dia, y - 1.2 * dia, y + 1.2 * dia, WHITE)
             p.circle(x, y, dia / 2, BLACK)
         feats["dots"] = dots
         feats["dot_diameter_m"] = dia

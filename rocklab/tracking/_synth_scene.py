@@ -279,15 +279,17 @@ def build_scene(*, seed, blocks, table, fps, size, targets, duration_s, occlusio
     texel, psf_m = mpp / 4.0, 0.5 * mpp
     rng_t = np.random.default_rng(s_tex)
     objects, feats = [], {}
+    dot_dia = min(min(0.16 * b.b_m, 0.08 * b.h_m) for b in blks)
     tt = table_texture(table_w, TABLE_THICK_M, targets, marker_ids=(0, 7), marker_size_m=0.75 * TABLE_THICK_M,
-                       texel_m=texel, psf_px_m=psf_m, rng=rng_t)
+                       dot_diameter_m=dot_dia, texel_m=texel, psf_px_m=psf_m, rng=rng_t)
     objects.append(RenderObject("table", tt, lambda t, _tb=tbl: (_tb.u(t), np.zeros_like(np.asarray(t, float)),
                                                                 np.zeros_like(np.asarray(t, float))),
                                 static=(table == "none")))
     feats["table"] = dict(tt.features, size_m=[table_w, TABLE_THICK_M], origin="top centre of the front face")
     for k, (blk, bm) in enumerate(zip(blks, motions)):
         tex = block_texture(blk.b_m, blk.h_m, targets, marker_ids=(2 * k + 1, 2 * k + 2),
-                            marker_size_m=min(0.6 * blk.b_m, 0.3 * blk.h_m), texel_m=texel,
+                            marker_size_m=min(0.6 * blk.b_m, 0.3 * blk.h_m), dot_diameter_m=dot_dia,
+                            texel_m=texel,
                             psf_px_m=psf_m, rng=rng_t)
         objects.append(RenderObject(bm.id, tex, bm.pose))
         f = dict(tex.features, size_m=[blk.b_m, blk.h_m], origin="centre of the front face")

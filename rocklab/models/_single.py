@@ -72,7 +72,8 @@ def simulate(block, theta0_rad: float = 0.0, omega0_rad_s: float = 0.0, duration
              dt_s: float = 1e-4, restitution="housner", base: BaseMotion | None = None,
              method: str = "newmark", stop_at_rest: bool = True, output_dt_s: float | None = None,
              *, linearized: bool = False, rest_tol: float = 1e-6, max_impacts: int = 100_000,
-             rtol: float = 1e-10, fall_rad: float | None = None, **law_params) -> RockingResult:
+             rtol: float = 1e-10, ode_method: str = "DOP853", fall_rad: float | None = None,
+             **law_params) -> RockingResult:
     """Simulate one rocking block.
 
     Parameters
@@ -111,6 +112,8 @@ def simulate(block, theta0_rad: float = 0.0, omega0_rad_s: float = 0.0, duration
         Relative tolerance of the event method (default 1e-10). With a base record
         the forcing has a kink at every sample that DOP853's error estimate does
         not see; use 1e-12 there for impact times to ~1e-8 s.
+    ode_method : str
+        ``solve_ivp`` method of the event integrator (``"DOP853"``, ``"Radau"``, ...).
     fall_rad : float, optional
         |theta| at which the block counts as fallen and the run stops (default
         pi/2, the side hits the ground; e.g. ``block.alpha_rad`` for the common
@@ -170,7 +173,7 @@ def simulate(block, theta0_rad: float = 0.0, omega0_rad_s: float = 0.0, duration
 
         t_grid = np.arange(int(math.floor(T / (dt * every) + 1e-9)) + 1) * (dt * every)
         r = run_event(block, th0, w0, T, law, base, bool(linearized), rest_tol, bool(stop_at_rest),
-                      t_grid, rtol=rtol, fall_rad=fall)
+                      t_grid, rtol=rtol, ode_method=ode_method, fall_rad=fall)
         t, th, w = r["t"], r["theta"], r["omega"]
         status, t_over, t_fall, max_abs = r["status"], r["t_over"], r["t_fall"], r["max_abs"]
         n_imp = len(r["impacts"])

@@ -288,3 +288,21 @@ def test_joint_sequence_recovers_model_events_and_comparison(three_block_free):
     assert c.n_matched >= 0.9 * len(seq) and 0.0 < c.timing_error_s < 0.02
     swapped = [(t, 2 - j, s) for t, j, s in seq]
     assert compare_sequences(swapped, seq).n_matched < len(seq)
+
+
+# -- thesis §5.2, Fig. 40 ----------------------------------------------------------------------------
+
+def test_fig40_single_block_overturns_over_a_wider_region():
+    """H = 12 m, B = 1 m, full-sine pulses: monolithic columns are the more vulnerable ones."""
+    from rocklab.models import column_overturning_maps
+
+    m = column_overturning_maps(12.0, 1.0, (1, 2, 3), ap_m_s2=[2.0, 3.5, 5.0, 6.5, 8.0, 12.0],
+                                tp_s=[0.3, 0.5, 0.7, 0.9, 1.2, 2.0], dt_s=2e-3, free_s=8.0)
+    one, two, three = m.overturned
+    # a_p,min = g B/H = 0.82 m/s2: every column needs several times that, and long pulses topple all
+    assert not one[:, 0].any() and one[:, -1].all()
+    # wherever a 2- or 3-block column overturns, the monolith does too, and it overturns in more cells
+    assert not (two & ~one).any() and not (three & ~one).any()
+    assert one.sum() > two.sum() and one.sum() > three.sum()
+    f = m.to_frame()
+    assert len(f) == 108 and f.overturned.sum() == m.overturned.sum()

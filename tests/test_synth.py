@@ -293,3 +293,47 @@ def test_full_hd_markers_give_theta_to_a_few_hundredths_of_a_degree():
         err.append(th - th_true)
     assert np.ptp(truth) > 0.1                              # it did rock during the clip
     assert np.degrees(np.sqrt(np.mean(np.square(err)))) < 0.05
+
+
+def test_three_blocks_make_a_column_that_follows_the_column_model(tmp_path):
+    """--blocks 3 stacks the thesis §4.3 column; truth angles are the column simulator's
+    (negated: counter-clockwise), and every open joint keeps its pivot corners together."""
+    from rocklab.models import Column, simulate_column
+    from rocklab.tracking import read_imu
+
+    s = synth_session(tmp_path / "c", seed=3, size=SMALL, blocks=3, duration_s=1.6, mp4=False)
+    assert s.meta["params"]["layout"].startswith("stacked column")
+    b = s.meta["blocks"]
+    rel, phi0 = b[0]["release_s"], b[0]["theta0_rad"]
+    col = Column(tuple(Block(x["block"]["b_m"], x["block"]["h_m"]) for x in b))
+    res = simulate_column(col, None, theta0_rad=[-phi0] * 3, duration_s=1.6 - rel)
+    tr = {o: g.reset_index(drop=True) for o, g in s.truth.groupby("object")}
+    t = tr["block_1"]["t_s"].to_numpy()
+    moving = t >= rel
+    for j in range(3):
+        th = tr[f"block_{j + 1}"]["theta_rad"].to_numpy()
+        np.testing.assert_allclose(th[~moving], phi0, atol=1e-12)
+        np.testing.assert_allclose(th[moving], -np.interp(t[moving] - rel, res.t_s, res.theta_rad[:, j]),
+                                   atol=1e-9)
+    assert np.ptp(tr["block_3"]["theta_rad"]) > 0.05
+    # Shared pivot corners: block j's bottom corners against block j-1's top corners.
+    bb, hh = 0.1, 0.2
+    for j in (1, 2):
+        lo, up = tr[f"block_{j}"], tr[f"block_{j + 1}"]
+
+        def corner(g, sx, sy):
+            th = g["theta_rad"].to_numpy()
+            return np.c_[g["x_m"] + np.cos(th) * sx - np.sin(th) * sy,
+                         g["y_m"] + np.sin(th) * sx + np.cos(th) * sy]
+        gap = np.minimum(np.hypot(*(corner(lo, -bb / 2, hh / 2) - corner(up, -bb / 2, -hh / 2)).T),
+                         np.hypot(*(corner(lo, bb / 2, hh / 2) - corner(up, bb / 2, -hh / 2)).T))
+        assert gap.max() < 1e-9
+    assert 'objects = ["block_1", "block_2", "block_3"]' in s.experiment_toml.read_text()
+    # The top block's IMU (rigid-body kinematics, not a corner pivot) integrates to its angle.
+    info = s.meta["imu"]["block_3"]
+    log = read_imu(s.imu["block_3"])
+    rate = log.gyro_rad_s[:, 1] - np.deg2rad(info["gyro_bias_deg_s"][1])
+    ang = np.concatenate(([0.0], np.cumsum(0.5 * (rate[1:] + rate[:-1]) * np.diff(log.t_s))))  # spans gaps
+    th3 = tr["block_3"]["theta_rad"].to_numpy()
+    est = np.interp(t, log.t_s + info["t0_video_s"], ang)
+    assert np.max(np.abs((est - est[0]) + (th3 - th3[0]))) < np.deg2rad(0.3)

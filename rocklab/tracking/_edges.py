@@ -22,18 +22,18 @@ from ._region import RegionTracker
 
 __all__ = ["EdgeDetector", "refine_rectangle"]
 
+_NEXT = np.array([1, 2, 3, 0])
+_PREV = np.array([3, 0, 1, 2])
 _SIGNS = np.array([[-1, 1], [1, 1], [1, -1], [-1, -1]], float)  # TL, TR, BR, BL (y up)
 
 
-def _line_intersection(l1, l2):
-    (p1, d1), (p2, d2) = l1, l2
-    A = np.array([d1, -d2]).T
-    t = np.linalg.solve(A, p2 - p1)
-    return p1 + t[0] * d1
-
-
 def refine_rectangle(gray, corners, half=6.0, step=2.0, trim=0.15):
-    """Sub-pixel rectangle from an approximate one.
+    """Sub-pixel quadrilateral (rectangle, marker square) from an approximate one.
+
+    Grey profiles across each side (bicubic samples every 0.5 px over
+    ``±half``) give the crossing of the level midway between the inside and
+    outside grey; a total-least-squares line per side (one re-fit without
+    points beyond 3 rms) and the line intersections give the corners.
 
     Parameters
     ----------
@@ -54,79 +54,93 @@ def refine_rectangle(gray, corners, half=6.0, step=2.0, trim=0.15):
         RMS distance of the edge points from their fitted lines.
     n_points : int
     sigma_theta_rad : float
-        1-σ uncertainty of the rectangle's orientation (mean of the four side
-        directions), from each line fit's scatter: ``σ_k = rms_k / sqrt(Σ(s - s̄)²)``
-        along the side (inflated by ``2 px / step`` for profiles correlated by the
-        blur), combined as ``sqrt(Σ σ_k²) / 4``.
+        1-σ uncertainty of the quadrilateral's orientation (mean of the four
+        side directions), from each line fit's scatter: ``σ_k = rms_k /
+        sqrt(Σ(s - s̄)²)`` along the side (inflated by ``2 px / step`` for
+        profiles correlated by the blur), combined as ``sqrt(Σ σ_k²) / 4``.
     """
     import cv2
 
+    fail = (None, np.inf, 0, np.inf)
     c = np.asarray(corners, float)
-    centre = c.mean(0)
+    b = c[_NEXT]
+    L = np.hypot(*(b - c).T)
+    if L.min() < 8:
+        return fail
+    d = (b - c) / L[:, None]
+    nrm = np.column_stack((-d[:, 1], d[:, 0]))
+    inward = np.einsum("ij,ij->i", c.mean(0) - c, nrm) > 0
+    nrm[inward] *= -1.0  # outward normals
+    m = max(5, int((1 - 2 * trim) * L.max() / step))
+    frac = np.linspace(trim, 1 - trim, m)
+    offs = np.arange(-half, half + 0.25, 0.5)
+    base = c[:, None, :] + (frac[None, :, None] * L[:, None, None]) * d[:, None, :]   # (4, m, 2)
+    pts = base[:, :, None, :] + offs[None, None, :, None] * nrm[:, None, None, :]    # (4, m, p, 2)
     # Work on a float crop: remap of uint8 would round the profiles to whole grey levels.
     H, W = gray.shape[:2]
-    pad = half + 4
-    x0 = int(max(np.floor(c[:, 0].min() - pad), 0))
-    y0 = int(max(np.floor(c[:, 1].min() - pad), 0))
-    x1 = int(min(np.ceil(c[:, 0].max() + pad) + 1, W))
-    y1 = int(min(np.ceil(c[:, 1].max() + pad) + 1, H))
+    x0 = int(max(np.floor(pts[..., 0].min()) - 3, 0))
+    y0 = int(max(np.floor(pts[..., 1].min()) - 3, 0))
+    x1 = int(min(np.ceil(pts[..., 0].max()) + 4, W))
+    y1 = int(min(np.ceil(pts[..., 1].max()) + 4, H))
     if x1 - x0 < 4 or y1 - y0 < 4:
-        return None, np.inf, 0, np.inf
+        return fail
     img = gray[y0:y1, x0:x1].astype(np.float32)
-    lines, res, npts, var_phi = [], [], 0, []
-    offs = np.arange(-half, half + 0.5, 0.5)
-    for k in range(4):
-        a, b = c[k], c[(k + 1) % 4]
-        L = np.hypot(*(b - a))
-        if L < 8:
-            return None, np.inf, 0, np.inf
-        d = (b - a) / L
-        nrm = np.array([-d[1], d[0]])
-        if np.dot(centre - a, nrm) > 0:
-            nrm = -nrm  # outward normal
-        s = np.arange(trim * L, (1 - trim) * L, step)
-        base = a + s[:, None] * d
-        pts = base[:, None, :] + offs[None, :, None] * nrm  # (m, p, 2), inside -> outside
-        mx = (pts[..., 0] - x0).astype(np.float32)
-        my = (pts[..., 1] - y0).astype(np.float32)
-        # bicubic: linear interpolation "pixel-locks" the crossings of near-axis edges
-        prof = cv2.remap(img, mx, my, cv2.INTER_CUBIC, borderMode=cv2.BORDER_REPLICATE
-                         ).astype(float)
-        inside = prof[:, :3].mean(1, keepdims=True)
-        outside = prof[:, -3:].mean(1, keepdims=True)
-        contrast = outside - inside
-        ok = np.abs(contrast[:, 0]) > 15
-        f = (prof - inside) / np.where(np.abs(contrast) > 1e-9, contrast, 1.0)  # 0 inside .. 1 out
-        # first crossing of 0.5 from inside
-        above = f >= 0.5
-        j = np.argmax(above, axis=1)
-        ok &= above.any(axis=1) & (j > 0)
-        j = np.clip(j, 1, len(offs) - 1)
-        r = np.arange(len(j))
-        f0, f1 = f[r, j - 1], f[r, j]
-        den = f1 - f0
-        frac = np.divide(0.5 - f0, den, out=np.full_like(den, 0.5), where=den != 0)
-        off = offs[j - 1] + frac * 0.5
-        edge = base + off[:, None] * nrm
-        edge = edge[ok]
-        if len(edge) < 5:
-            return None, np.inf, 0, np.inf
-        vx, vy, lx, ly = cv2.fitLine(edge.astype(np.float32), cv2.DIST_HUBER, 0, 0.01, 0.01).ravel()
-        dvec = np.array([vx, vy], float)
-        p0 = np.array([lx, ly], float)
-        dist = (edge - p0) @ np.array([-dvec[1], dvec[0]])
-        res.append(dist)
-        npts += len(edge)
-        along = (edge - p0) @ dvec
-        dof = max(len(edge) - 2, 1)
-        # profiles closer than ~2 px share their noise through the blur: count them as
-        # one independent sample per 2 px
-        corr = max(1.0, 2.0 / step)
-        var_phi.append(corr * np.sum(dist ** 2) / dof / max(np.sum((along - along.mean()) ** 2), 1e-12))
-        lines.append((p0, dvec))
-    out = np.array([_line_intersection(lines[(k - 1) % 4], lines[k]) for k in range(4)])
-    r = np.concatenate(res)
-    return out, float(np.sqrt(np.mean(r ** 2))), npts, float(np.sqrt(np.sum(var_phi)) / 4)
+    p = len(offs)
+    mx = (pts[..., 0] - x0).reshape(4 * m, p).astype(np.float32)
+    my = (pts[..., 1] - y0).reshape(4 * m, p).astype(np.float32)
+    # bicubic: linear interpolation "pixel-locks" the crossings of near-axis edges
+    prof = cv2.remap(img, mx, my, cv2.INTER_CUBIC, borderMode=cv2.BORDER_REPLICATE).astype(float)
+    inside = (prof[:, 0] + prof[:, 1] + prof[:, 2]) / 3.0
+    contrast = (prof[:, -1] + prof[:, -2] + prof[:, -3]) / 3.0 - inside
+    ok = np.abs(contrast) > 15
+    f = (prof - inside[:, None]) / np.where(ok, contrast, 1.0)[:, None]  # 0 inside .. 1 outside
+    above = f >= 0.5
+    j = np.argmax(above, axis=1)
+    ok &= above.any(axis=1) & (j > 0)
+    j = np.clip(j, 1, p - 1)
+    r = np.arange(len(j))
+    f0, f1 = f[r, j - 1], f[r, j]
+    den = f1 - f0
+    t = np.divide(0.5 - f0, den, out=np.full_like(den, 0.5), where=den != 0)
+    off = (offs[j - 1] + t * 0.5).reshape(4, m)
+    edge = base + off[..., None] * nrm[:, None, :]                                  # (4, m, 2)
+    w = ok.reshape(4, m).astype(float)
+    for it in range(2):
+        sw = w.sum(1)
+        if np.any(sw < 5):
+            return fail
+        mean = np.einsum("km,kmi->ki", w, edge) / sw[:, None]
+        e = edge - mean[:, None, :]
+        sxx = np.einsum("km,km->k", w, e[..., 0] ** 2)
+        syy = np.einsum("km,km->k", w, e[..., 1] ** 2)
+        sxy = np.einsum("km,km->k", w, e[..., 0] * e[..., 1])
+        phi = 0.5 * np.arctan2(2 * sxy, sxx - syy)
+        dv = np.column_stack((np.cos(phi), np.sin(phi)))
+        nv = np.column_stack((-dv[:, 1], dv[:, 0]))
+        dist = np.einsum("kmi,ki->km", e, nv)
+        if it == 0:
+            # drop outliers (a notch, a neighbouring edge): beyond 3 rms of the first fit
+            rms_k = np.sqrt(np.einsum("km,km->k", w, dist ** 2) / sw)
+            w = w * (np.abs(dist) <= np.maximum(3 * rms_k, 0.05)[:, None])
+    sw = w.sum(1)
+    along = np.einsum("kmi,ki->km", e, dv)
+    a_mean = np.einsum("km,km->k", w, along) / sw
+    s_along = np.einsum("km,km->k", w, (along - a_mean[:, None]) ** 2)
+    ss = np.einsum("km,km->k", w, dist ** 2)
+    # profiles closer than ~2 px share their noise through the blur: one sample per 2 px
+    spacing = (1 - 2 * trim) * L / max(m - 1, 1)
+    corr = np.maximum(1.0, 2.0 / spacing)
+    var_phi = corr * ss / np.maximum(sw - 2, 1) / np.maximum(s_along, 1e-12)
+    # corner k = side (k - 1) ∩ side k
+    p1, d1 = mean[_PREV], dv[_PREV]
+    det = d1[:, 0] * (-dv[:, 1]) - d1[:, 1] * (-dv[:, 0])
+    if np.any(np.abs(det) < 1e-9):
+        return fail
+    rhs = mean - p1
+    t1 = (rhs[:, 0] * (-dv[:, 1]) - rhs[:, 1] * (-dv[:, 0])) / det
+    out = p1 + t1[:, None] * d1
+    n_pts = int(sw.sum())
+    return out, float(np.sqrt(ss.sum() / n_pts)), n_pts, float(np.sqrt(var_phi.sum()) / 4)
 
 
 def horizontal_edge_angle(gray, roi, plane_map):

@@ -64,3 +64,16 @@ def test_bad_input_exit_2_one_line(run_cli, argv):
     rc, out, err = run_cli("simulate", *argv)
     assert rc == 2 and out == ""
     assert err.count("\n") == 1 and err.startswith("rocklab simulate: error:")
+
+
+@pytest.mark.parametrize("argv,expect", [
+    (("--restitution", "modified", "--k", 1.0), lambda b: b.eta_H),
+    (("--restitution", "bumps", "--bumps", 1),
+     lambda b: (2 * (b.h_m / 2) ** 2 + 0.5 * (b.b_m / 2) ** 2) / (2 * (b.h_m / 2) ** 2 + 2 * (b.b_m / 2) ** 2)),
+])
+def test_laws_from_cli(run_cli, argv, expect):
+    rc, out, err = run_cli("simulate", "--width", 0.045, "--height", 0.2025, "--theta0", 0.1,
+                           "--duration", 1, "--json", *argv)
+    assert rc == 0, err
+    imp = json.loads(out)["impacts"][0]
+    assert imp["omega_after_rad_s"] / imp["omega_before_rad_s"] == pytest.approx(expect(Block(0.045, 0.2025)))

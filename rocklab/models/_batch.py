@@ -44,8 +44,12 @@ def simulate_batch(p_rad_s, alpha_rad, *, base: BaseMotion | None = None, scale=
         Corner inertia coefficient (only for the default eta).
     dt_s : float
         Time step, s. Each entry is sub-stepped so that ``p h <= max_p_dt``; the
-        trapezoidal rule's rate error is ~(p h)^2/12 (3e-5 at 0.02), small beside
-        the sensitivity of overturning to the record itself.
+        trapezoidal rule's rate error is ~(p h)^2/12 (3e-5 at 0.02). Measured on
+        El Centro 1940 (1200 runs: R = 0.1–5 m, alpha = 0.2, scale 0.1–1.5,
+        5 s of free rocking after): dt = 1e-3 s against 1e-4 s flips the fall
+        flag of 8 runs (0.7 %, all at the overturning boundary, where the
+        response is chaotic), max |theta|/alpha of the rocking runs differs by
+        3e-5 (median) / 3e-3 (90th percentile), overturn times by ~1e-4 s.
     duration_s : float, optional
         Simulated time, s. Default: end of the record + ``free_after_s``.
     free_after_s : float

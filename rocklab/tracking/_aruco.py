@@ -179,27 +179,41 @@ class ArucoDetector:
         return c1
 
     def find(self, gray, frame):
-        """Detect this object's markers: ``{marker id: corners (4, 2) px}``."""
+        """Detect the configured markers: ``{marker id: corners (4, 2) px}``.
+
+        Each recently seen marker is searched in a window around its predicted
+        corners with a threshold window matched to its size, then (if missed,
+        e.g. under motion blur) with the default three-window detector; the
+        full frame is searched when an object has no recent marker, and every
+        25 frames while some configured marker is missing.
+        """
         H, W = gray.shape[:2]
         found = {}
-        need_full = False
+        need_full = frame % 25 == 0 and any(
+            m not in self.last or frame - self.last[m][0] > 2 for m in self.owner)
         for o in self.cfg.objects:
             ms = [m for m in o.markers if m in self.last and frame - self.last[m][0] <= 2]
             if not ms:
                 need_full = True
                 continue
-            pts = np.vstack([self._predict(m, frame) for m in ms])
-            side = max(np.ptp(pts[:4, 0]), np.ptp(pts[:4, 1]), 8.0)
-            pad = self.margin * side
-            x0 = int(max(np.floor(pts[:, 0].min() - pad), 0))
-            y0 = int(max(np.floor(pts[:, 1].min() - pad), 0))
-            x1 = int(min(np.ceil(pts[:, 0].max() + pad), W))
-            y1 = int(min(np.ceil(pts[:, 1].max() + pad), H))
-            if x1 - x0 < 16 or y1 - y0 < 16:
-                need_full = True
-                continue
-            got = self._detect(gray[y0:y1, x0:x1], x0, y0, self._windowed(side))
-            found.update({k: v for k, v in got.items() if k not in found})
+            for m in ms:
+                if m in found:
+                    continue
+                pts = self._predict(m, frame)
+                side = max(np.ptp(pts[:, 0]), np.ptp(pts[:, 1]), 8.0)
+                pad = self.margin * side + 2
+                x0 = int(max(np.floor(pts[:, 0].min() - pad), 0))
+                y0 = int(max(np.floor(pts[:, 1].min() - pad), 0))
+                x1 = int(min(np.ceil(pts[:, 0].max() + pad), W))
+                y1 = int(min(np.ceil(pts[:, 1].max() + pad), H))
+                if x1 - x0 < 16 or y1 - y0 < 16:
+                    continue  # left the frame
+                crop = gray[y0:y1, x0:x1]
+                got = self._detect(crop, x0, y0, self._windowed(side))
+                if m not in got:
+                    got = self._detect(crop, x0, y0)
+                for k, v in got.items():
+                    found.setdefault(k, v)
             if not any(m in found for m in o.markers):
                 need_full = True
         if need_full:

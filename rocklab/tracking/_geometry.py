@@ -48,7 +48,7 @@ class SimilarityFit:
     n: int
 
 
-def fit_similarity(p, q, weights=None) -> SimilarityFit:
+def fit_similarity(p, q, weights=None, scale=None) -> SimilarityFit:
     """Closed-form 2-D similarity (Umeyama) fit of plane points ``q`` to object points ``p``.
 
     Parameters
@@ -56,6 +56,10 @@ def fit_similarity(p, q, weights=None) -> SimilarityFit:
     p, q : array_like, shape (n, 2)
         Object-frame points and their measured plane positions, ``n >= 2``.
     weights : array_like, shape (n,), optional
+    scale : float, optional
+        Fix the scale ``k`` (a rigid fit when 1): with a metric plane, or a scale
+        known from earlier frames, a partial view of a wide target (one marker
+        of two) cannot turn a size error into a lever-arm error of the origin.
     """
     p = np.asarray(p, float)
     q = np.asarray(q, float)
@@ -70,11 +74,14 @@ def fit_similarity(p, q, weights=None) -> SimilarityFit:
     pc = P[:, 0] + 1j * P[:, 1]
     qc = Q[:, 0] + 1j * Q[:, 1]
     z = np.sum(w * qc * np.conj(pc)) / np.sum(w * np.abs(pc) ** 2)
+    if scale is not None:
+        z = scale * z / abs(z)
     theta = float(np.angle(z))
     k = float(np.abs(z))
     t = qm - np.array([(z * (pm[0] + 1j * pm[1])).real, (z * (pm[0] + 1j * pm[1])).imag])
     r = qc - z * pc
-    dof = 2 * n - 4 if n > 2 else 2 * n
+    n_par = 4 if scale is None else 3
+    dof = 2 * n - n_par if n > 2 else 2 * n
     rms = float(np.sqrt(np.sum(np.abs(r) ** 2) / dof))
     spread = float(np.sqrt(np.sum(np.abs(qc) ** 2)))
     sig = rms / spread if spread > 0 else np.inf

@@ -10,6 +10,7 @@ turns them into metres and a levelled angle once, at the end, where the scale
 
 from __future__ import annotations
 
+import collections
 import math
 from dataclasses import dataclass, field
 
@@ -188,6 +189,7 @@ def track_frames(frames, config: TrackConfig, plane_map: PlaneMap | None = None)
     det = None
     min_q = config.targets.min_quality
     boxes, sharp_ref = {}, {}
+    scales = {}  # object -> recent scales of complete detections
     for k, item in enumerate(frames):
         idx, gray = item if isinstance(item, tuple) else (k, item)
         if gray.ndim != 2:
@@ -202,7 +204,14 @@ def track_frames(frames, config: TrackConfig, plane_map: PlaneMap | None = None)
             d = dets.get(o.id)
             if d is not None and len(d.img_pts) >= 2:
                 q = plane_map.to_plane(d.img_pts)
-                f = fit_similarity(d.obj_pts, q)
+                fixed = None
+                if d.metric and plane_map.source != "image":
+                    fixed = 1.0  # metres on both sides: a rigid fit
+                elif len(q) < d.n_expected and scales.get(o.id):
+                    fixed = float(np.median(scales[o.id]))  # partial view: keep the known scale
+                f = fit_similarity(d.obj_pts, q, scale=fixed)
+                if fixed is None and len(q) == d.n_expected:
+                    scales.setdefault(o.id, collections.deque(maxlen=51)).append(f.scale)
                 spread = math.sqrt(np.sum((q - q.mean(0)) ** 2) / len(q))
                 qual = (len(q) / d.n_expected) / (1.0 + f.rms / (0.002 * spread + 1e-12))
                 if qual < min_q:

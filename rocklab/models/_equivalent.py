@@ -1,0 +1,489 @@
+"""Dynamically equivalent rocking structures (DeJong & Dimitrakopoulos 2014).
+
+Every SDOF rocking mechanism is reduced to an equivalent single block with the
+fundamental parameters (p, theta_cr, lambda, eta) (paper §2, Table I). For
+multi-block mechanisms the Lagrangian ``T = M(phi) phi'^2 / 2``, ``V(phi)`` and
+generalised force ``Q = -B(phi) u_g''`` are linearised about the unstable
+equilibrium phi_cr (Eq. 9–13):
+
+    I_eq = M(phi_cr),  G_eq = -V''(phi_cr)/g,  B_eq = B(phi_cr),
+    p_eq = sqrt(g G_eq / I_eq) (Eq. 17),  lambda = V'(0)/(g B(0)) (Eq. 10),
+    lambda_lin = G_eq phi_cr / B_eq (Eq. 18),  kappa1 = phi_cr/lambda_lin (Eq. 19),
+    kappa2 = phi_cr/lambda (Eq. 20),  theta_cr = phi_cr/kappa.
+
+:class:`Mechanism` holds M, V, B as callables of phi (SI: kg m^2, J, kg m) and
+evaluates these numerically; the closed forms of Table I and the rocking wall
+(Eq. 21–23) are given separately and checked against it in the tests. The
+four-bar linkage (asymmetric frame §5.1, arch §5.2) is built from points.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from .._errors import InputError
+from ..blocks import G
+
+__all__ = ["FundamentalParameters", "Mechanism", "block_parameters", "strut_parameters",
+           "frame_parameters", "wall_parameters", "wall_mechanism", "four_bar_mechanism",
+           "asymmetric_frame", "free_rocking_period_eq24", "overturning_time_eq25",
+           "sine_pulse_max_response", "linear_sine_pulse_response"]
+
+
+def _pos(name, v):
+    try:
+        x = float(v)
+    except (TypeError, ValueError):
+        raise InputError(f"{name}={v!r}: must be a positive number") from None
+    if not (math.isfinite(x) and x > 0):
+        raise InputError(f"{name}={v!r}: must be a finite positive number")
+    return x
+
+
+def _slender(name, a):
+    a = _pos(name, a)
+    if a >= math.pi / 2:
+        raise InputError(f"{name}={a}: slenderness angle must be in (0, pi/2) rad")
+    return a
+
+
+@dataclass(frozen=True)
+class FundamentalParameters:
+    """Equivalent-block parameters of a rocking mechanism (DeJong & Dimitrakopoulos).
+
+    Attributes
+    ----------
+    p_rad_s : float
+        Frequency parameter of the equivalent block, rad/s (Eq. 17).
+    theta_cr_rad : float
+        Critical rotation of the equivalent block phi_cr/kappa1 = lambda_lin, rad.
+    lambda_ : float
+        Exact uplift acceleration / g (Eq. 10).
+    lambda_lin : float
+        Uplift acceleration of the linearised equation / g (Eq. 18).
+    eta : float
+        Restitution (angular momentum, Table I); NaN where the paper gives none.
+    phi_cr_rad : float
+        Critical rotation of the mechanism's own coordinate, rad (Eq. 9).
+    kappa1, kappa2 : float
+        Scaling parameters phi_cr/lambda_lin and phi_cr/lambda (Eq. 19, 20).
+    mechanism : str
+        ``block``, ``strut``, ``frame``, ``wall``, ``asymmetric-frame+``/``-``, ``arch``, ...
+    """
+
+    p_rad_s: float
+    theta_cr_rad: float
+    lambda_: float
+    lambda_lin: float
+    eta: float
+    phi_cr_rad: float
+    kappa1: float
+    kappa2: float
+    mechanism: str = ""
+
+    @property
+    def theta_cr_kappa2_rad(self) -> float:
+        """theta_cr with kappa2 (= lambda), rad."""
+        return self.phi_cr_rad / self.kappa2
+
+    def to_dict(self) -> dict:
+        """Keys as the CLI prints them (``lambda`` rather than ``lambda_``)."""
+        d = asdict(self)
+        d["lambda"] = d.pop("lambda_")
+        return d
+
+
+def _fp(p, phi_cr, lam, lam_lin, eta, name):
+    # theta_cr = phi_cr / kappa1 = lambda_lin (Eq. 17, 19)
+    return FundamentalParameters(p_rad_s=p, theta_cr_rad=lam_lin,
+                                 lambda_=lam, lambda_lin=lam_lin, eta=eta, phi_cr_rad=phi_cr,
+                                 kappa1=phi_cr / lam_lin, kappa2=phi_cr / lam, mechanism=name)
+
+
+# -- closed forms ---------------------------------------------------------------
+
+def block_parameters(R_m: float, alpha_rad: float, alpha_I: float = 4.0 / 3.0) -> FundamentalParameters:
+    """Rocking block (Table I): p = sqrt(g/(alpha_I R)), theta_cr = alpha, lambda = tan(alpha),
+    lambda_lin = alpha, eta = 1 - 2 sin^2(alpha)/alpha_I (Housner)."""
+    R, a = _pos("R_m", R_m), _slender("alpha_rad", alpha_rad)
+    return _fp(math.sqrt(G / (alpha_I * R)), a, math.tan(a), a, 1 - 2 * math.sin(a) ** 2 / alpha_I, "block")
+
+
+def strut_parameters(R_m: float, alpha_rad: float) -> FundamentalParameters:
+    """Point mass on a massless rigid strut with a rigid base (Table I): the block with
+    alpha_I = 1, i.e. p = sqrt(g/R) (a pendulum), eta = 1 - 2 sin^2(alpha) = cos(2 alpha)."""
+    fp = block_parameters(R_m, alpha_rad, 1.0)
+    return FundamentalParameters(**{**asdict(fp), "mechanism": "strut"})
+
+
+def frame_parameters(R_m: float, alpha_rad: float, gamma: float, alpha_I: float = 4.0 / 3.0
+                     ) -> FundamentalParameters:
+    """Symmetric rocking frame: two equal columns (R, alpha) capped by a free beam (Table I).
+
+    ``gamma = m_beam / m_columns`` (both columns together). From Eq. 35:
+    p^2 = g (1 + 2 gamma) / (R (alpha_I + 4 gamma)) (= p_col^2 (1+2g)/(1+3g) for
+    alpha_I = 4/3); theta_cr = alpha, lambda = tan(alpha) (Eq. 36-37);
+    eta = (alpha_I - 2 sin^2 alpha + 4 gamma cos 2 alpha) / (alpha_I + 4 gamma)
+    (angular momentum; Makris & Vassiliou 2013 for alpha_I = 4/3).
+    """
+    R, a = _pos("R_m", R_m), _slender("alpha_rad", alpha_rad)
+    gmm = float(gamma)
+    if not (math.isfinite(gmm) and gmm >= 0):
+        raise InputError(f"gamma={gamma!r}: beam/columns mass ratio must be >= 0")
+    p = math.sqrt(G * (1 + 2 * gmm) / (R * (alpha_I + 4 * gmm)))
+    eta = (alpha_I - 2 * math.sin(a) ** 2 + 4 * gmm * math.cos(2 * a)) / (alpha_I + 4 * gmm)
+    return _fp(p, a, math.tan(a), a, eta, "frame")
+
+
+def wall_parameters(R_m: float, alpha_rad: float, alpha_I: float = 4.0 / 3.0) -> FundamentalParameters:
+    """Rocking (out-of-plane, two-block) wall, Eq. 21–23; R, alpha of ONE of the two blocks.
+
+    p = sqrt(2 g/(alpha_I R)) = sqrt(2) p_block, phi_cr = alpha, lambda = 2 tan(alpha),
+    lambda_lin = 2 alpha, kappa1 = 1/2, kappa2 = alpha/(2 tan alpha), theta_cr = 2 alpha.
+    The paper gives no restitution for the wall: eta is NaN.
+    """
+    R, a = _pos("R_m", R_m), _slender("alpha_rad", alpha_rad)
+    return _fp(math.sqrt(2 * G / (alpha_I * R)), a, 2 * math.tan(a), 2 * a, float("nan"), "wall")
+
+
+# -- generic mechanism ------------------------------------------------------------
+
+@dataclass(frozen=True)
+class Mechanism:
+    """An SDOF rocking mechanism in its own coordinate phi >= 0 (rad).
+
+    Attributes
+    ----------
+    M : callable
+        Generalised mass, T = M(phi) phi'^2 / 2, kg m^2.
+    V : callable
+        Potential energy, J (only differences matter).
+    B : callable
+        Generalised force per base acceleration, Q = -B(phi) u_g'', kg m.
+    phi_max : float
+        Largest phi the mechanism can reach (kinematic limit), rad.
+    name : str
+    eta : float
+        Restitution if known (else NaN).
+    """
+
+    M: object
+    V: object
+    B: object
+    phi_max: float = math.pi / 2
+    name: str = ""
+    eta: float = float("nan")
+
+    def dV(self, phi, h=1e-6):
+        return (self.V(phi + h) - self.V(phi - h)) / (2 * h)
+
+    def dM(self, phi, h=1e-6):
+        return (self.M(phi + h) - self.M(phi - h)) / (2 * h)
+
+    def phi_cr(self) -> float:
+        """Unstable equilibrium V'(phi_cr) = 0 (Eq. 9), rad."""
+        from scipy.optimize import brentq
+
+        xs = np.linspace(1e-5, self.phi_max * (1 - 1e-6), 400)
+        d = np.array([self.dV(x) for x in xs])
+        k = np.flatnonzero(np.sign(d[:-1]) != np.sign(d[1:]))
+        if k.size == 0:
+            raise InputError(f"{self.name}: no unstable equilibrium before the kinematic limit; "
+                             "check the geometry")
+        return brentq(self.dV, xs[k[0]], xs[k[0] + 1], xtol=1e-13)
+
+    def parameters(self) -> FundamentalParameters:
+        """Fundamental parameters by linearisation about phi_cr (Eq. 11–20)."""
+        pc = self.phi_cr()
+        h = 1e-4
+        Geq = -(self.V(pc + h) - 2 * self.V(pc) + self.V(pc - h)) / h ** 2 / G
+        Ieq = self.M(pc)
+        Beq = self.B(pc)
+        lam = self.dV(1e-7, 1e-7) / (G * self.B(0.0))
+        lam_lin = Geq * pc / Beq
+        return _fp(math.sqrt(G * Geq / Ieq), pc, lam, lam_lin, self.eta, self.name)
+
+    def free_rocking_period(self, phi0: float) -> float:
+        """Nonlinear free-rocking period 4 * (time from rest at phi0 to impact), s."""
+        V0 = self.V(phi0)
+
+        # substitution phi = phi0 (1 - s^2) removes the 1/sqrt singularity at phi0
+        lim = math.sqrt(self.M(phi0) / (2 * self.dV(phi0) * phi0)) * 2 * phi0
+
+        def integrand(s):
+            if s < 1e-4:  # V0 - V ~ V'(phi0) phi0 s^2: use the limit, avoid round-off
+                return lim
+            phi = phi0 * (1 - s * s)
+            return math.sqrt(self.M(phi) / (2 * (V0 - self.V(phi)))) * 2 * phi0 * s
+
+        # the substituted integrand is smooth: fixed Gauss-Legendre, no adaptive round-off warnings
+        x, w = np.polynomial.legendre.leggauss(160)
+        val = 0.5 * float(sum(wi * integrand(0.5 * (xi + 1)) for xi, wi in zip(x, w)))
+        return 4 * val
+
+    def overturning_time(self, ug_over_g: float) -> float:
+        """Time from rest to phi_cr under a constant base acceleration (magnitude) ug/g, s."""
+        from scipy.integrate import solve_ivp
+
+        pc = self.phi_cr()
+        # the base accelerates towards -x so that phi grows (Q = -B u'' > 0 for u'' < 0)
+        a = -abs(float(ug_over_g)) * G
+
+        def f(t, y):
+            phi, om = y
+            return [om, (-self.B(phi) * a - self.dV(phi) - 0.5 * self.dM(phi) * om * om) / self.M(phi)]
+
+        def hit(t, y):
+            return y[0] - pc
+        hit.terminal = True
+        sol = solve_ivp(f, (0, 1e4), [0.0, 0.0], events=hit, rtol=1e-10, atol=1e-13)
+        return float(sol.t_events[0][0]) if sol.t_events[0].size else float("inf")
+
+
+def wall_mechanism(R_m: float, alpha_rad: float, mass_kg: float = 1.0, alpha_I: float = 4.0 / 3.0
+                   ) -> Mechanism:
+    """Nonlinear two-block wall (slider-crank, Eq. 21) as a :class:`Mechanism`.
+
+    Derived from the geometry (bottom block pivoting on its base corner, hinge at
+    mid-height, top corner sliding on a vertical restraint): T = (I_O +
+    4 m R^2 sin^2(alpha - phi)) phi'^2, V = 4 m g R cos(alpha - phi),
+    B = 2 m R cos(alpha - phi). Divided by 4 m g R this is Eq. 21, except that the
+    extracted Eq. 21 prints the velocity term as ``-(R/g) sin^2(alpha-phi) phi'^2``;
+    Lagrange gives ``-(R/g) sin(2(alpha-phi)) phi'^2`` (the sin^2 is a typesetting error).
+    """
+    R, a, m = _pos("R_m", R_m), _slender("alpha_rad", alpha_rad), _pos("mass_kg", mass_kg)
+    IO = alpha_I * m * R * R
+    return Mechanism(M=lambda f: 2 * IO + 8 * m * R * R * math.sin(a - f) ** 2,
+                     V=lambda f: 4 * m * G * R * math.cos(a - f),
+                     B=lambda f: 2 * m * R * math.cos(a - f), phi_max=min(2 * a + 0.5, math.pi / 2),
+                     name="wall")
+
+
+# -- four-bar linkages (asymmetric frame §5.1, arch §5.2) ------------------------------
+
+def _cross(u, v) -> float:
+    return float(u[0] * v[1] - u[1] * v[0])
+
+
+def _rot(v, t):
+    c, s = math.cos(t), math.sin(t)
+    return np.array([c * v[0] - s * v[1], s * v[0] + c * v[1]])
+
+
+def four_bar_mechanism(A, B, C, D, bodies, name: str = "four-bar") -> Mechanism:
+    """A three-block mechanism (four-bar linkage) from its rest geometry.
+
+    Parameters
+    ----------
+    A, D : (2,) array_like
+        Ground pivots, m (x right, y up).
+    B, C : (2,) array_like
+        Hinges link1/coupler and coupler/link3 at rest, m.
+    bodies : sequence of three (mass_kg, (x_cm, y_cm), I_c_kg_m2)
+        Rigid bodies attached to link AB, coupler BC and link CD: mass, centre of
+        mass at rest (m) and moment of inertia about it.
+    name : str
+
+    The coordinate phi is the clockwise rotation of AB about A (paper: phi = phi_0 - varphi);
+    C follows from the loop closure on the branch of the rest configuration.
+    Derivatives are central differences of the exact kinematics.
+    """
+    A, B0, C0, D = (np.asarray(x, float) for x in (A, B, C, D))
+    l2 = float(np.linalg.norm(C0 - B0))
+    l3 = float(np.linalg.norm(C0 - D))
+    if min(l2, l3, float(np.linalg.norm(B0 - A))) <= 0:
+        raise InputError(f"{name}: coincident hinge points; check the geometry")
+    side0 = float(np.sign(_cross(D - B0, C0 - B0))) or 1.0
+    ms = np.array([b[0] for b in bodies], float)
+    cms = [np.asarray(b[1], float) for b in bodies]
+    Ic = np.array([b[2] for b in bodies], float)
+    ang_bc0 = math.atan2(*(C0 - B0)[::-1])
+    ang_dc0 = math.atan2(*(C0 - D)[::-1])
+
+    def config(phi):
+        Bp = A + _rot(B0 - A, -phi)
+        d = D - Bp
+        dd = float(np.hypot(*d))
+        if dd > l2 + l3 or dd < abs(l2 - l3):
+            return None
+        x = (l2 * l2 - l3 * l3 + dd * dd) / (2 * dd)
+        y = math.sqrt(max(l2 * l2 - x * x, 0.0))
+        e = d / dd
+        n = np.array([-e[1], e[0]])
+        Cp = Bp + x * e + side0 * y * n  # keep the rest configuration's branch
+        t2 = math.atan2(*(Cp - Bp)[::-1]) - ang_bc0
+        t3 = math.atan2(*(Cp - D)[::-1]) - ang_dc0
+        r = [A + _rot(cms[0] - A, -phi), Bp + _rot(cms[1] - B0, t2), D + _rot(cms[2] - D, t3)]
+        return np.array(r), np.array([-phi, t2, t3])
+
+    # kinematic limit
+    phi_max = math.pi / 2
+    for f in np.linspace(0, math.pi / 2, 2001)[1:]:
+        if config(f) is None:
+            phi_max = f - math.pi / 4000
+            break
+
+    def V(phi):
+        r, _ = config(phi)
+        return G * float(ms @ r[:, 1])
+
+    def _derivs(phi, h=1e-6):
+        rp, tp = config(phi + h)
+        rm, tm = config(phi - h)
+        return (rp - rm) / (2 * h), (tp - tm) / (2 * h)
+
+    def M(phi):
+        dr, dt = _derivs(phi)
+        return float(ms @ (dr ** 2).sum(axis=1) + Ic @ dt ** 2)
+
+    def Bf(phi):
+        dr, _ = _derivs(phi)
+        return float(ms @ dr[:, 0])
+
+    return Mechanism(M=M, V=V, B=Bf, phi_max=phi_max, name=name)
+
+
+def asymmetric_frame(b_m: float, H_m: float, H1_m: float, L_m: float, h_m: float,
+                     m_AB: float, m_BC: float, m_CD: float):
+    """Asymmetric rocking frame (paper §5.1, Fig. 4) in both rocking directions.
+
+    Geometry (half-dimensions as in Eq. 33): the left column AB is 2b wide and 2H
+    high, the right column CD 2b wide and 2H_1 high standing on a step so that both
+    tops are at 2H; the beam (2h deep) rests on both and spans from the left face
+    of the left column to the right face of the right column; L is the distance
+    between the columns' left faces. Rectangles are uniform.
+
+    Returns
+    -------
+    (Mechanism, Mechanism)
+        Positive (clockwise: pivots A bottom-right, B/C top-left corners, D
+        bottom-right) and negative direction (the mirror image; the coordinate is
+        still the left column's rotation).
+    """
+    b, H, H1, L, h = (_pos(n, v) for n, v in (("b_m", b_m), ("H_m", H_m), ("H1_m", H1_m),
+                                               ("L_m", L_m), ("h_m", h_m)))
+    if L <= 2 * b:
+        raise InputError(f"L_m={L}: columns overlap; the left-face distance L must exceed the width 2b")
+    mA, mB, mC = (_pos(n, v) for n, v in (("m_AB", m_AB), ("m_BC", m_BC), ("m_CD", m_CD)))
+    yD = 2 * H - 2 * H1
+    wbeam = L + 2 * b
+    body_ab = (mA, (b, H), mA * (4 * b * b + 4 * H * H) / 12)
+    body_bc = (mB, (wbeam / 2, 2 * H + h), mB * (wbeam ** 2 + 4 * h * h) / 12)
+    body_cd = (mC, (L + b, yD + H1), mC * (4 * b * b + 4 * H1 * H1) / 12)
+
+    def mirror(pt):
+        return (-pt[0], pt[1])
+
+    pos = four_bar_mechanism((2 * b, 0), (0, 2 * H), (L, 2 * H), (L + 2 * b, yD),
+                             [body_ab, body_bc, body_cd], name="asymmetric-frame+")
+    neg = four_bar_mechanism(mirror((0, 0)), mirror((2 * b, 2 * H)), mirror((L + 2 * b, 2 * H)),
+                             mirror((L, yD)),
+                             [(m, mirror(c), i) for m, c, i in (body_ab, body_bc, body_cd)],
+                             name="asymmetric-frame-")
+    return pos, neg
+
+
+# -- closed-form responses ----------------------------------------------------------------
+
+def free_rocking_period_eq24(p_rad_s: float, theta_over_theta_cr) -> np.ndarray:
+    """Free-rocking period of the equivalent (linearised) block, Eq. 24, s:
+    T = (4/p) arccosh(1 / (1 - theta/theta_cr))."""
+    x = np.asarray(theta_over_theta_cr, float)
+    return 4.0 / p_rad_s * np.arccosh(1.0 / (1.0 - x))
+
+
+def overturning_time_eq25(p_rad_s: float, ug_over_g_lambda, lambda_: float, lambda_lin: float,
+                          kappa: str = "kappa1") -> np.ndarray:
+    """Time to reach theta_cr under a constant base acceleration, Eq. 25, s.
+
+    ``ug_over_g_lambda`` is u_g''/(g lambda). With ``kappa1`` the linear block uplifts
+    at lambda_lin (Eq. 25 as printed); with ``kappa2`` at the exact lambda.
+    """
+    r = np.asarray(ug_over_g_lambda, float)
+    q = r * (lambda_ / lambda_lin) if kappa == "kappa1" else r
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(q > 1, np.arccosh(1.0 / (q - 1.0) + 1.0) / p_rad_s, np.inf)
+
+
+def sine_pulse_max_response(omega, a, eta):
+    """Maximum response phi_max/phi_cr after a one-sine pulse, Eq. 41–42.
+
+    Dimensionless groups (Eq. 40): ``omega = omega_g/p``, ``a = a_g/(g lambda)`` (> 1),
+    restitution ``eta``. The pulse u_g'' = -a g lambda sin(omega p t + psi),
+    sin(psi) = 1/a, starts at uplift and ends after (2 pi - psi)/omega; Eq. 41
+    is the peak of the excursion after the first impact that follows it. NaN where
+    D0* lies outside [0, 1] (overturning during the first excursion, D0* < 0).
+    """
+    w = np.asarray(omega, float)
+    a = np.asarray(a, float)
+    s = np.sqrt(a * a - 1.0)
+    x = (2 * np.pi - np.arcsin(1.0 / a)) / w
+    D0 = (w / (w * w + 1)) ** 2 * (w * w - 2 * a * a + 1 + (s + w) * a * np.exp(-x) + (s - w) * a * np.exp(x))
+    with np.errstate(invalid="ignore"):
+        out = 1.0 - np.sqrt(1.0 - eta ** 2 * (1.0 - D0))
+    return np.where((D0 >= 0) & (D0 <= 1), out, np.nan), D0
+
+
+def linear_sine_pulse_response(omega: float, a: float, eta: float, tau_max: float = 60.0):
+    """Linearised equivalent block (Eq. 5/16, x = theta/theta_cr, tau = p t) under the
+    Eq. 41 pulse, integrated with exact impacts (x = 0, x' -> eta x').
+
+    Returns dict: ``x_end``, ``v_end`` (state at the pulse end), ``D_end`` =
+    (x-1)^2 - x'^2 there, ``impact_during_pulse`` (bool), ``overturned`` (|x| >= 1),
+    ``max_after`` = max|x| between the first and second impact after the pulse.
+    """
+    from scipy.integrate import solve_ivp
+
+    psi = math.asin(1.0 / a)
+    t_end = (2 * math.pi - psi) / omega
+    state = np.array([0.0, 0.0])
+    s, t = 1.0, 0.0
+    out = dict(impact_during_pulse=False, overturned=False, max_after=float("nan"))
+    impacts_after = 0
+    peak = 0.0
+
+    def rhs(tt, y, s):
+        # Eq. 5 normalised: x'' = x - sgn(x) - u_g''/(g theta_cr), u_g'' = -a g lambda sin(.)
+        u = a * math.sin(omega * tt + psi) if tt <= t_end else 0.0
+        return [y[1], y[0] - s + u]
+
+    def imp(tt, y, s):
+        return y[0]
+
+    def over(tt, y, s):
+        return abs(y[0]) - 1.0
+    imp.terminal = True
+    over.terminal = True
+    phase_end = True
+    while t < tau_max:
+        stop = t_end if (phase_end and t < t_end) else tau_max
+        imp.direction = -s
+        sol = solve_ivp(rhs, (t, stop), state, args=(s,), events=[imp, over], rtol=1e-11, atol=1e-13,
+                        max_step=0.01)
+        if impacts_after == 1:
+            peak = max(peak, float(np.max(np.abs(sol.y[0]))))
+        t = float(sol.t[-1])
+        state = sol.y[:, -1].copy()
+        if sol.t_events[1].size:
+            out["overturned"] = True
+            break
+        if sol.t_events[0].size:
+            if t <= t_end:
+                out["impact_during_pulse"] = True
+            else:
+                impacts_after += 1
+                if impacts_after == 2:
+                    out["max_after"] = peak
+                    break
+            state = np.array([0.0, eta * state[1]])
+            s = math.copysign(1.0, state[1])
+            t += 1e-12
+            continue
+        if phase_end and abs(t - t_end) < 1e-12:
+            out["x_end"], out["v_end"] = float(state[0]), float(state[1])
+            out["D_end"] = (state[0] - 1.0) ** 2 - state[1] ** 2
+            phase_end = False
+    return out

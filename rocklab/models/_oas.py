@@ -1,0 +1,415 @@
+"""Overturning Acceleration Spectra (OAS) and the replacement impulse duration t_I.
+
+Ther thesis §5.1.3 and §5.3: for a record, the OAS separates safe and unsafe
+blocks in the plane (a_p/a_p,min, p), with a_p the scaled PGA,
+a_p,min = g tan(alpha) (Eq. 3) and p = sqrt(g/(alpha_I R)) (Eq. 13). The
+transformed OAS uses f = p a_p/a_p,min (Eq. 19); its leftmost point f_min gives
+the replacement impulse duration t_I = i_cr / f_min (Eq. 20) with
+i_cr = sqrt(2/(1+cos alpha)) (Eq. 18). The inclined-line fit f = 1/t'_I + A/beta
+(Eq. 28, A = a_p/a_p,min) gives t'_I and beta.
+
+Definition choices the thesis leaves open are options (defaults first):
+
+- ``criterion``: ``"angle"`` (|theta| >= alpha counts as overturned) or
+  ``"fall"`` (|theta| >= pi/2).
+- ``free``: ``"energy"`` (after the record ends the block rocks freely; the
+  exact energy verdict with the restitution decides), ``"none"`` (only what
+  happens during the record counts) or a number of seconds to integrate with
+  zero base motion.
+- ``search``: ``"scan"`` (every grid size is simulated and the largest unsafe
+  one is taken, so unsafe islands at large sizes are not missed) or
+  ``"contiguous"`` (the unsafe region connected to the smallest size only, as a
+  search from small blocks upward would find it).
+- ``levels``, ``sizes``, ``refine``: grid density and bisection steps.
+- ``eta``: restitution; ``None`` = Housner's 1 - 2 sin^2(alpha)/alpha_I.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .._errors import InputError
+from ..blocks import G
+from ._oas_kernel import run_batch, run_grid
+from ._records import BaseMotion
+
+__all__ = ["OASResult", "overturning_spectrum", "OverturningCurve", "overturning_curve", "normalised_critical_impulse", "critical_impulse",
+           "fit_inclined_line", "simplified_oas", "OAS_DEFAULTS"]
+
+#: Defaults of :func:`overturning_spectrum` (thesis §5.3: 80 levels 1..10, 120 sizes 1000..0.1 m).
+OAS_DEFAULTS = dict(levels=80, level_max=10.0, sizes=120, R_max_m=1000.0, R_min_m=0.1, refine=10,
+                    criterion="angle", free="energy", search="scan", alpha_I=4.0 / 3.0, eta=None,
+                    h_ph=0.1)
+
+_CRIT = {"angle": 0, "fall": 1}
+
+
+def normalised_critical_impulse(alpha_rad: float) -> float:
+    """i_cr = p I_cr / a_p,min = sqrt(2/(1+cos alpha)) >= 1 (thesis Eq. 18)."""
+    return math.sqrt(2.0 / (1.0 + math.cos(alpha_rad)))
+
+
+def critical_impulse(R_m: float, alpha_rad: float, alpha_I: float = 4.0 / 3.0) -> float:
+    """Critical impulse of an infinitely short single-lobe pulse, m/s (thesis Eq. 17).
+
+    I_cr = sqrt(2 alpha_I R g (1 - cos alpha)) / cos alpha.
+    """
+    return math.sqrt(2 * alpha_I * R_m * G * (1 - math.cos(alpha_rad))) / math.cos(alpha_rad)
+
+
+def _free_code(free):
+    if isinstance(free, str):
+        if free == "energy":
+            return 1, 0.0
+        if free == "none":
+            return 0, 0.0
+        raise InputError(f"free={free!r}: use 'energy', 'none' or a number of seconds")
+    fs = float(free)
+    if not (math.isfinite(fs) and fs >= 0):
+        raise InputError(f"free={free!r}: seconds of free rocking must be >= 0")
+    return 2, fs
+
+
+@dataclass(frozen=True)
+class OASResult:
+    """An Overturning Acceleration Spectrum of one record.
+
+    Attributes
+    ----------
+    levels : ndarray, shape (n_l,)
+        a_p/a_p,min of each row.
+    R_m, p_rad_s : ndarray, shape (n_s,)
+        Grid block sizes (corner to centre of mass, m; descending) and p (ascending).
+    overturned : ndarray of bool, shape (n_l, n_s)
+        Grid verdicts (bays and islands are visible here).
+    p_min_rad_s : ndarray, shape (n_l,)
+        Refined boundary: smallest unsafe p (largest unsafe R) per level; NaN if none.
+    R_unsafe_max_m : ndarray, shape (n_l,)
+        The same as a size, m.
+    f_rad_s : ndarray, shape (n_l,)
+        Transformed OAS f = p_min a_p/a_p,min (Eq. 19), 1/s.
+    f_min_rad_s, t_I_s, t_I_prime_s, beta : float
+        Leftmost f, t_I = i_cr/f_min (Eq. 20), and the inclined-line fit (Eq. 28).
+    i_cr : float
+        Eq. 18 for the block's slenderness.
+    alpha_rad, alpha_I, eta : float
+        Block slenderness angle, inertia coefficient, restitution used.
+    name : str
+        Record label.
+    options : dict
+        All definition options used.
+    """
+
+    levels: np.ndarray
+    R_m: np.ndarray
+    p_rad_s: np.ndarray
+    overturned: np.ndarray
+    p_min_rad_s: np.ndarray
+    R_unsafe_max_m: np.ndarray
+    f_rad_s: np.ndarray
+    f_min_rad_s: float
+    t_I_s: float
+    t_I_prime_s: float
+    beta: float
+    i_cr: float
+    alpha_rad: float
+    alpha_I: float
+    eta: float
+    name: str = ""
+    options: dict = field(default_factory=dict)
+
+    def to_frame(self):
+        """Boundary per level: ``level, p_min_rad_s, R_unsafe_max_m, f_rad_s``."""
+        import pandas as pd
+
+        return pd.DataFrame({"level": self.levels, "p_min_rad_s": self.p_min_rad_s,
+                             "R_unsafe_max_m": self.R_unsafe_max_m, "f_rad_s": self.f_rad_s})
+
+    def to_dict(self) -> dict:
+        """Scalars and options (JSON-ready; arrays are in :meth:`to_frame`)."""
+        return dict(name=self.name, t_I_s=self.t_I_s, t_I_prime_s=self.t_I_prime_s, beta=self.beta,
+                    f_min=self.f_min_rad_s, i_cr=self.i_cr, alpha_rad=self.alpha_rad,
+                    slenderness=1.0 / math.tan(self.alpha_rad), alpha_I=self.alpha_I, eta=self.eta,
+                    options=dict(self.options))
+
+
+def _check_opts(slenderness, levels, sizes, R_max_m, R_min_m, level_max, alpha_I):
+    try:
+        sl = float(slenderness)
+    except (TypeError, ValueError):
+        raise InputError(f"slenderness={slenderness!r}: must be a number h/b > 0") from None
+    if not (math.isfinite(sl) and sl > 0):
+        raise InputError(f"slenderness={slenderness!r}: h/b must be a positive number (e.g. 12)")
+    if int(levels) < 2 or int(sizes) < 2:
+        raise InputError(f"levels={levels}, sizes={sizes}: need at least 2 of each")
+    if not (R_max_m > R_min_m > 0):
+        raise InputError(f"R_max_m={R_max_m}, R_min_m={R_min_m}: need R_max > R_min > 0 (m)")
+    if not level_max > 1:
+        raise InputError(f"level_max={level_max}: a_p/a_p,min range must go above 1")
+    if not alpha_I >= 1:
+        raise InputError(f"alpha_I={alpha_I}: inertia coefficient must be >= 1")
+    return sl
+
+
+def overturning_spectrum(base: BaseMotion, slenderness: float = 12.0, *, levels: int = 80,
+                         level_max: float = 10.0, sizes: int = 120, R_max_m: float = 1000.0,
+                         R_min_m: float = 0.1, refine: int = 10, criterion: str = "angle",
+                         free="energy", search: str = "scan", alpha_I: float = 4.0 / 3.0,
+                         eta: float | None = None, h_ph: float = 0.1) -> OASResult:
+    """OAS, transformed OAS, t_I, t'_I and beta of a record for one block slenderness.
+
+    Parameters
+    ----------
+    base : BaseMotion
+        The record (SI). Only its shape matters: it is scaled to each level.
+    slenderness : float
+        h/b of the block (thesis uses 12); alpha = atan(1/slenderness).
+    levels, level_max : int, float
+        ``levels`` values of a_p/a_p,min evenly from 1 to ``level_max``.
+    sizes, R_max_m, R_min_m : int, float, float
+        ``sizes`` log-spaced R from ``R_max_m`` down to ``R_min_m``, m.
+    refine : int
+        Bisection steps (in log R) between the largest unsafe grid size and its
+        safe neighbour; 10 steps resolve the boundary to ~0.01 % in p.
+    criterion, free, search, eta : see the module docstring.
+    alpha_I : float
+        Inertia coefficient I_O/(m R^2) (thesis Eq. 22).
+    h_ph : float
+        Largest RK4 step times p (accuracy; 0.1 changes t_I by < 0.1 %).
+
+    Returns
+    -------
+    OASResult
+    """
+    sl = _check_opts(slenderness, levels, sizes, R_max_m, R_min_m, level_max, alpha_I)
+    if not isinstance(base, BaseMotion):
+        raise InputError(f"base={type(base).__name__}: expected a BaseMotion (load_base_motion)")
+    if base.pga_m_s2 == 0:
+        raise InputError(f"{base.source}: record is all zeros; nothing can overturn")
+    if criterion not in _CRIT:
+        raise InputError(f"criterion={criterion!r}: use 'angle' (|theta|>=alpha) or 'fall' (|theta|>=pi/2)")
+    if search not in ("scan", "contiguous"):
+        raise InputError(f"search={search!r}: use 'scan' or 'contiguous'")
+    free_code, free_s = _free_code(free)
+    alpha = math.atan(1.0 / sl)
+    eta_v = 1.0 - 2.0 * math.sin(alpha) ** 2 / alpha_I if eta is None else float(eta)
+    acc = np.ascontiguousarray(base.acc_m_s2 / G)
+    dt = base.dt_s
+    lv = np.linspace(1.0, float(level_max), int(levels))
+    R = np.geomspace(R_max_m, R_min_m, int(sizes))
+    p = np.sqrt(G / (alpha_I * R))
+    scales = lv * math.tan(alpha) / float(np.max(np.abs(acc)))
+    args = (alpha, eta_v, _CRIT[criterion], free_code, free_s, h_ph)
+    over, _ = run_grid(acc, dt, scales, p, *args)
+
+    # largest unsafe grid size per level
+    k = np.full(lv.size, -1)
+    for i, row in enumerate(over):
+        if search == "scan":
+            hit = np.flatnonzero(row)
+            if hit.size:
+                k[i] = hit[0]
+        elif row[-1]:
+            safe = np.flatnonzero(~row)
+            k[i] = safe[-1] + 1 if safe.size else 0
+    p_hi = np.where(k >= 0, p[np.clip(k, 0, None)], np.nan)  # unsafe
+    p_lo = np.where(k > 0, p[np.clip(k - 1, 0, None)], np.nan)  # safe neighbour (larger block)
+    p_hi, p_lo = _bisect(acc, dt, scales, p_hi, p_lo, refine, args)
+
+    f = lv * p_hi
+    icr = normalised_critical_impulse(alpha)
+    f_min = float(np.nanmin(f)) if np.isfinite(f).any() else float("nan")
+    t_I = icr / f_min if math.isfinite(f_min) else float("nan")
+    tIp, beta = fit_inclined_line(f, lv)
+    opts = dict(levels=int(levels), level_max=float(level_max), sizes=int(sizes), R_max_m=float(R_max_m),
+                R_min_m=float(R_min_m), refine=int(refine), criterion=criterion, free=free,
+                search=search, h_ph=h_ph)
+    return OASResult(levels=lv, R_m=R, p_rad_s=p, overturned=over, p_min_rad_s=p_hi,
+                     R_unsafe_max_m=G / (alpha_I * p_hi ** 2), f_rad_s=f, f_min_rad_s=f_min,
+                     t_I_s=t_I, t_I_prime_s=tIp, beta=beta, i_cr=icr, alpha_rad=alpha,
+                     alpha_I=float(alpha_I), eta=eta_v, name=base.name, options=opts)
+
+
+def _bisect(acc, dt, scales, p_hi, p_lo, n, args):
+    """Geometric bisection of every level's bracket [p_lo safe, p_hi unsafe] at once."""
+    p_hi = p_hi.copy()
+    p_lo = p_lo.copy()
+    m = np.isfinite(p_hi) & np.isfinite(p_lo)
+    if not m.any():
+        return p_hi, p_lo
+    alpha, eta = args[0], args[1]
+    idx = np.flatnonzero(m)
+    for _ in range(int(n)):
+        pm = np.sqrt(p_hi[idx] * p_lo[idx])
+        o, _, _, _ = run_batch(acc, dt, scales[idx], pm, np.full(idx.size, alpha), np.full(idx.size, eta),
+                               *args[2:])
+        p_hi[idx] = np.where(o, pm, p_hi[idx])
+        p_lo[idx] = np.where(o, p_lo[idx], pm)
+    return p_hi, p_lo
+
+
+def fit_inclined_line(f, levels):
+    """t'_I and beta of the inclined line f = 1/t'_I + A/beta (thesis Eq. 28).
+
+    The thesis does not say how the line was fitted; here it is the
+    conservative line (left of every transformed-OAS point, like the vertical
+    line of Eq. 20) that is closest to the points on average over the level
+    range: maximise the integral of ``c + s A`` over [A_min, A_max] subject to
+    ``c + s A_i <= f_i``, ``c >= 0``, ``s >= 0`` (a linear programme; the
+    optimum touches the convex hull of the points, thesis Fig. 48).
+
+    Returns
+    -------
+    (t_I_prime_s, beta) : floats; ``inf`` when c or s is 0, NaN with < 2 points.
+    """
+    from scipy.optimize import linprog
+
+    f = np.asarray(f, float)
+    A = np.asarray(levels, float)
+    ok = np.isfinite(f)
+    if ok.sum() < 2:
+        return float("nan"), float("nan")
+    f, A = f[ok], A[ok]
+    a_lo, a_hi = A.min(), A.max()
+    # maximise (a_hi - a_lo) c + (a_hi^2 - a_lo^2)/2 s  -> minimise the negative
+    cost = -np.array([a_hi - a_lo, 0.5 * (a_hi ** 2 - a_lo ** 2)])
+    res = linprog(cost, A_ub=np.c_[np.ones_like(A), A], b_ub=f, bounds=[(0, None), (0, None)],
+                  method="highs")
+    if res.status != 0:
+        return float("nan"), float("nan")
+    c, s = res.x
+    tol = 1e-12 * max(1.0, float(f.max()))
+    return (1.0 / c if c > tol else math.inf), (1.0 / s if s > tol else math.inf)
+
+
+def simplified_oas(p_rad_s, t_I_s: float, t_I_prime_s: float | None = None, beta: float | None = None,
+                   i_cr: float = 1.0, kind: str = "eq21"):
+    """Simplified OAS a_p/a_p,min as a function of p (thesis Eq. 21, 29, 30).
+
+    Parameters
+    ----------
+    p_rad_s : array_like
+        Frequency parameter, rad/s.
+    t_I_s : float
+        Replacement impulse duration (Eq. 21, 30), s.
+    t_I_prime_s, beta : float
+        Inclined-line parameters (Eq. 29, 30).
+    i_cr : float
+        Normalised critical impulse (Eq. 18); the thesis's "≈" form uses 1.
+    kind : {"eq21", "eq29", "eq30"}
+        Eq. 21: max(i_cr/(t_I p), 1); Eq. 29: max(1/(t'_I (p - 1/beta)), 1)
+        (inf for p <= 1/beta); Eq. 30: the larger of the two.
+
+    Returns
+    -------
+    ndarray
+        Smallest a_p/a_p,min that overturns a block of each p.
+    """
+    p = np.asarray(p_rad_s, float)
+    with np.errstate(divide="ignore"):
+        a21 = np.maximum(i_cr / (t_I_s * p), 1.0)
+        if kind == "eq21":
+            return a21
+        if t_I_prime_s is None or beta is None:
+            raise InputError(f"kind={kind!r} needs t_I_prime_s and beta")
+        d = p - 1.0 / beta
+        a29 = np.where(d > 0, 1.0 / (t_I_prime_s * np.where(d > 0, d, 1.0)), np.inf)
+        a29 = np.maximum(a29, 1.0)
+    if kind == "eq29":
+        return a29
+    if kind == "eq30":
+        return np.maximum(a21, a29)
+    raise InputError(f"kind={kind!r}: use eq21, eq29 or eq30")
+
+
+@dataclass(frozen=True)
+class OverturningCurve:
+    """Normalised overturning curve of a simple pulse (thesis Fig. 33a, 34).
+
+    Attributes
+    ----------
+    kind : str
+        Pulse kind (see :func:`rocklab.models.pulse_shape`), ``n`` lobes for n-half-sines.
+    ptp : ndarray, shape (n_x,)
+        p t_p values (t_p = one lobe's duration).
+    levels : ndarray, shape (n_l,)
+        a_p/a_p,min grid.
+    overturned : ndarray of bool, shape (n_l, n_x)
+        Grid verdicts; bays and islands of multi-lobe pulses show here.
+    a_min_ratio : ndarray, shape (n_x,)
+        Refined lowest a_p/a_p,min that overturns (NaN if none on the grid).
+    impulse_ratio : ndarray, shape (n_x,)
+        Overturning impulse curve p I / a_p,min = F a_min_ratio p t_p (Fig. 34b).
+    i_cr : float
+        Its short-pulse limit for a single lobe (Eq. 18).
+    """
+
+    kind: str
+    n: int
+    alpha_rad: float
+    ptp: np.ndarray
+    levels: np.ndarray
+    overturned: np.ndarray
+    a_min_ratio: np.ndarray
+    impulse_ratio: np.ndarray
+    i_cr: float
+
+    def to_frame(self):
+        import pandas as pd
+
+        return pd.DataFrame({"ptp": self.ptp, "a_min_ratio": self.a_min_ratio,
+                             "impulse_ratio": self.impulse_ratio})
+
+
+def overturning_curve(kind: str, slenderness: float, ptp, levels, *, n: int = 1, refine: int = 12,
+                      criterion: str = "angle", free="energy", alpha_I: float = 4.0 / 3.0,
+                      eta: float | None = None, samples_per_lobe: int = 200) -> OverturningCurve:
+    """Overturning curve a_p/a_p,min vs p t_p of a simple pulse, bays and islands resolved.
+
+    Every (level, p t_p) grid point is simulated (dimensionless: p = 1, t_p = p t_p);
+    the lowest overturning level is then refined by bisection against the safe
+    level below it. See :func:`overturning_spectrum` for ``criterion``, ``free``, ``eta``.
+    """
+    from ._pulses import pulse_duration, pulse_fullness, pulse_shape
+
+    alpha = math.atan(1.0 / _check_opts(slenderness, 2, 2, 2.0, 1.0, 2.0, alpha_I))
+    eta_v = 1.0 - 2.0 * math.sin(alpha) ** 2 / alpha_I if eta is None else float(eta)
+    if criterion not in _CRIT:
+        raise InputError(f"criterion={criterion!r}: use 'angle' or 'fall'")
+    fc, fs = _free_code(free)
+    x = np.atleast_1d(np.asarray(ptp, float))
+    lv = np.atleast_1d(np.asarray(levels, float))
+    if (x <= 0).any() or (lv <= 0).any():
+        raise InputError("ptp and levels must be positive")
+    over = np.zeros((lv.size, x.size), bool)
+    amin = np.full(x.size, np.nan)
+    one = np.ones(1)
+    for j, tp in enumerate(x):
+        dt = tp / samples_per_lobe
+        t = np.arange(int(round(pulse_duration(kind, tp, n) / dt)) + 2) * dt
+        acc = np.ascontiguousarray(pulse_shape(kind, t, tp, n))
+        sc = lv * math.tan(alpha)
+        o, _ = run_grid(acc, dt, sc, one, alpha, eta_v, _CRIT[criterion], fc, fs, 0.05)
+        over[:, j] = o[:, 0]
+        hit = np.flatnonzero(o[:, 0])
+        if hit.size == 0:
+            continue
+        k = hit[0]
+        hi = lv[k]
+        lo = lv[k - 1] if k > 0 else 1.0
+        for _ in range(refine if lo < hi else 0):
+            mid = 0.5 * (lo + hi)
+            om, _, _, _ = run_batch(acc, dt, np.array([mid * math.tan(alpha)]), one, np.array([alpha]),
+                                    np.array([eta_v]), _CRIT[criterion], fc, fs, 0.05)
+            if om[0]:
+                hi = mid
+            else:
+                lo = mid
+        amin[j] = hi
+    F = pulse_fullness(kind)
+    return OverturningCurve(kind=kind, n=int(n), alpha_rad=alpha, ptp=x, levels=lv, overturned=over,
+                            a_min_ratio=amin, impulse_ratio=F * amin * x,
+                            i_cr=normalised_critical_impulse(alpha))

@@ -289,8 +289,9 @@ def build_scene(*, seed, blocks, table, fps, size, targets, duration_s, occlusio
     for k, (blk, bm) in enumerate(zip(blks, motions)):
         tex = block_texture(blk.b_m, blk.h_m, targets, marker_ids=(2 * k + 1, 2 * k + 2),
                             marker_size_m=min(0.6 * blk.b_m, 0.3 * blk.h_m), dot_diameter_m=dot_dia,
-                            texel_m=texel,
-                            psf_px_m=psf_m, rng=rng_t)
+                            texel_m=texel, psf_px_m=psf_m, rng=rng_t,
+                            # stacked plain blocks alternate in shade so the joints are visible
+                            face_value=(212.0, 176.0)[k % 2] if targets == "edges" else None)
         objects.append(RenderObject(bm.id, tex, bm.pose))
         f = dict(tex.features, size_m=[blk.b_m, blk.h_m], origin="centre of the front face")
         shift = np.array([0.0, blk.h_m / 2])         # body (bottom centre) -> face centre origin

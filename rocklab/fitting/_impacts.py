@@ -46,14 +46,6 @@ def check_record(t_s, theta_rad, nan: str = "raise", name: str = "theta_rad"):
     return t, y, n_skip
 
 
-def _noise_sigma(y: np.ndarray) -> float:
-    """Robust white-noise σ from second differences (insensitive to smooth motion)."""
-    if y.size < 4:
-        return 0.0
-    d2 = np.diff(y, 2)
-    return float(1.4826 * np.median(np.abs(d2 - np.median(d2))) / np.sqrt(6.0))
-
-
 @dataclass(frozen=True)
 class ReleaseInfo:
     """Where a thread-burn release happens in a record.
@@ -86,9 +78,9 @@ class ReleaseInfo:
 def detect_release(t_s, theta_rad, min_plateau: int = 3) -> ReleaseInfo:
     """Find the initial rest plateau at θ0 and the moment the block starts to move.
 
+    The first samples must be flat (a quadratic fitted to them varies by less than 4 σ).
     The block is at rest until three consecutive samples lie beyond ``max(6 σ, 1e-3 |θ0|)``
-    on the same side of the running plateau median (σ from second differences of the
-    plateau); the release is placed where the departure was ~1 σ and θ0 is the median of
+    on the same side of the running plateau median (σ: standard deviation on the plateau); the release is placed where the departure was ~1 σ and θ0 is the median of
     the samples before it. A record that starts in motion, never moves, or whose plateau
     is at θ ≈ 0 has no release (``found=False`` with the reason).
     """
@@ -96,10 +88,14 @@ def detect_release(t_s, theta_rad, min_plateau: int = 3) -> ReleaseInfo:
     y = np.asarray(theta_rad, float)
     n = y.size
     m0 = max(min(20, n // 3), min_plateau)
-    sig = _noise_sigma(y[:m0])
+    # start: quadratic fit to the first samples; at rest the fitted curve stays within noise
+    x = (t[:m0] - t[0]) / max(t[m0 - 1] - t[0], 1e-12)
+    c = np.polynomial.polynomial.polyfit(x, y[:m0], 2)
+    fit0 = np.polynomial.polynomial.polyval(x, c)
+    sig = float(np.std(y[:m0] - fit0, ddof=3)) if m0 > 3 else 0.0
     med = float(np.median(y[:m0]))
     floor = max(1e-3 * abs(med), 1e-7)
-    if np.any(np.abs(y[:m0] - med) > max(8.0 * sig, floor)):
+    if np.ptp(fit0) > max(4.0 * sig, floor) or np.any(np.abs(y[:m0] - med) > max(8.0 * sig, floor)):
         return ReleaseInfo(False, float("nan"), 0, med, sig, 0, "record starts in motion: no rest plateau before "
                            "release; keep ~0.1 s of the block at rest before the thread burns")
     # grow the plateau until the departure: 3 consecutive samples beyond tolerance on the same
@@ -116,17 +112,18 @@ def detect_release(t_s, theta_rad, min_plateau: int = 3) -> ReleaseInfo:
         i += 1
         if i % 16 == 0:
             med = float(np.median(y[:i]))
-            sig = _noise_sigma(y[:i])
+            sig = float(np.std(y[:i], ddof=1))
             tol = max(6.0 * sig, floor)
     if i >= n:
         return ReleaseInfo(False, float("nan"), n, med, sig, n, "block never moves: no release in the record")
     # the departure is quadratic in time: step back to where |θ − θ0| was ~1 σ
-    sig = _noise_sigma(y[:i])
+    sig = float(np.std(y[:i], ddof=1))
     j = i
     while j > 0 and abs(y[j - 1] - med) > 1.0 * sig:
         j -= 1
-    n_pl = max(j - 1, 1)
+    n_pl = max(j - 1, 2)
     med = float(np.median(y[:n_pl]))  # plateau only: early-motion samples would bias θ0 towards 0
+    sig = float(np.std(y[:n_pl], ddof=1))
     if abs(med) < 10 * max(sig, 1e-6):
         return ReleaseInfo(False, float("nan"), i, med, sig, n_pl, f"initial angle {med:.3g} rad is within noise "
                            "of 0: no tilted start (thread-burn release) found")

@@ -427,46 +427,60 @@ def fit_restitution(t_s, theta_rad, block, window: str = "middle50", objective: 
             probs[kind] = _Problem(t, y, block, theta0, dt_sim, max(b, tc[1]) - rel.t_s + 0.2)
         return probs[kind]
 
+    def peaks_objective(kind, prob):
+        a, b = window_span(kind)
+        pk = arch_peaks(t, y, tc, release=None, sigma_rad=sigma)  # row k: arch after impact k
+        ids = [k for k in range(len(pk)) if a - 1e-9 <= tc[k] and tc[k + 1] <= b + 1e-9
+               and np.isfinite(pk.theta_rad.iloc[k])]
+        amp = np.abs(pk.theta_rad.to_numpy())[ids]
+        half = np.diff(tc)[ids]
+
+        def f(eta):
+            r = prob.peaks_residual(eta, amp, half, ids)
+            return float(r @ r)
+        return f, (np.asarray(ids, int), amp, half)
+
+    def search(f_grid, f, center, span, max_span=1.0):
+        # grid around ``center`` (widened while the best node is on its edge), then Brent
+        while True:
+            lo, hi = max(lo_b, center - span), min(hi_b, center + span)
+            x, fx, on_edge = _grid_then_brent(f_grid, f, lo, hi)
+            on_edge = on_edge and ((x - lo < 0.5 * span and lo > lo_b) or (hi - x < 0.5 * span and hi < hi_b))
+            if not on_edge or span >= max_span:
+                return x, fx
+            span *= 3.0
+
     def fit_window(kind, obj, fixed=None):
         """Fit η on a window. ``fixed=(t_r, θ0)`` holds the release fixed (cheap η′_e fit)."""
         a, b = window_span(kind)
         prob = problem(kind)
-        if obj == "theta":
-            idx = np.union1d(rel_idx, np.flatnonzero((t >= a) & (t <= b)))
-            if fixed is None:
-                def f(eta):
-                    return prob.profile(eta, idx, tr_bounds)[0]
-
-                def f_grid(eta):  # grid nodes only bracket the optimum: θ0 held, no sensitivity run
-                    return prob.profile(eta, idx, tr_bounds, sens=False)[0]
-            else:
-                def f(eta):
-                    d = prob.residual(eta, idx, *fixed, sens=False)
-                    return float(d @ d)
-                f_grid = f
-        else:
-            pk = arch_peaks(t, y, tc, release=None, sigma_rad=sigma)  # row k: arch after impact k
-            ids = [k for k in range(len(pk)) if a - 1e-9 <= tc[k] and tc[k + 1] <= b + 1e-9
-                   and np.isfinite(pk.theta_rad.iloc[k])]
-            amp = np.abs(pk.theta_rad.to_numpy())[ids]
-            half = np.diff(tc)[ids]
-            idx = (np.asarray(ids, int), amp, half)
-
+        if obj == "peaks":
+            f, idx = peaks_objective(kind, prob)
+            x, fx = search(f, f, g, 0.025)
+            return x, fx, f, idx, prob
+        idx = np.union1d(rel_idx, np.flatnonzero((t >= a) & (t <= b)))
+        if fixed is not None:
             def f(eta):
-                r = prob.peaks_residual(eta, amp, half, ids)
-                return float(r @ r)
-            f_grid = f
+                d = prob.residual(eta, idx, *fixed, sens=False)
+                return float(d @ d)
+            x, fx = search(f, f, g, 0.025)
+            return x, fx, f, idx, prob
 
-        # coarse-to-fine: a grid around the data-based guess (widened while the best node is
-        # on its edge), then bounded Brent between the neighbours of the best node
-        span = 0.025
-        while True:
-            lo, hi = max(lo_b, g - span), min(hi_b, g + span)
-            x, fx, on_edge = _grid_then_brent(f_grid, f, lo, hi)
-            on_edge = on_edge and ((x - lo < 0.5 * span and lo > lo_b) or (hi - x < 0.5 * span and hi < hi_b))
-            if not on_edge or span >= 1.0:
-                break
-            span *= 3.0
+        def f(eta):
+            return prob.profile(eta, idx, tr_bounds)[0]
+
+        def f_grid(eta):  # grid nodes only bracket the optimum: θ0 held, no sensitivity run
+            return prob.profile(eta, idx, tr_bounds, sens=False)[0]
+
+        # θ(t) over many cycles is multimodal in η (a wrong η slips whole half-cycles), so
+        # start from the amplitude/half-period objective, which is not, and search narrowly
+        n_win = int(np.sum((tc >= a) & (tc <= b)))
+        if n_win >= 3:
+            fp, _ = peaks_objective(kind, prob)
+            center = search(fp, fp, g, 0.025)[0]
+            x, fx = search(f_grid, f, center, 0.003, max_span=0.03)
+        else:
+            x, fx = search(f_grid, f, g, 0.025)
         return x, fx, f, idx, prob
 
     eta_hat, f_hat, f_main, idx_main, prob = fit_window(window, objective_used)

@@ -114,7 +114,7 @@ def test_constant_push_overturns_at_closed_form_time():
     blk = Block(0.2, 1.0)
     a, p = blk.alpha_rad, blk.p_rad_s
     A = 0.3
-    base = BaseMotion.from_samples(np.full(40001, -A), 1e-4, "g")
+    base = BaseMotion.from_samples(np.full(4001, -A), 1e-3, "g")
     for method in ("newmark", "event"):
         r = simulate(blk, 0.0, duration_s=4.0, dt_s=1e-4, base=base, linearized=True, method=method)
         t_over = math.acosh(A / (A - a)) / p  # theta = alpha when cosh(pt) = A/(A - alpha)

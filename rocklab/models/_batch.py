@@ -108,6 +108,7 @@ def simulate_batch(p_rad_s, alpha_rad, *, base: BaseMotion | None = None, scale=
     n_steps = np.ceil(duration_s / h - 1e-9).astype(np.int64)
     if base is None:
         acc, t0, dta = np.zeros(0), 0.0, 1.0
+        acc.setflags(write=False)  # same numba type as a BaseMotion array: one compile
     else:
         acc, t0, dta = np.ascontiguousarray(base.acc_m_s2, float), float(base.t_s[0]), base.dt_s
     over, t_over, mx, nimp, status, steps = run_batch(p, al, th0, w0, et, h, n_steps, acc, t0, dta, sc,

@@ -39,6 +39,7 @@ from ._result import RockingResult, block_energy
 __all__ = ["simulate"]
 
 _EMPTY = np.zeros(0)
+_EMPTY.setflags(write=False)  # same numba type as a (read-only) BaseMotion array: one compile
 
 
 def _finite(name, v, positive=False):

@@ -136,3 +136,19 @@ def write_video(path, frames, fps):
     for f in frames:
         vw.write(cv2.cvtColor(f, cv2.COLOR_GRAY2BGR))
     vw.release()
+
+
+def checker_texture(squares_x, squares_y, square_m, margin_m=0.01):
+    """Checkerboard (white margin) whose first inner corner (top-left) is the object origin."""
+    w = squares_x * square_m + 2 * margin_m
+    h = squares_y * square_m + 2 * margin_m
+    tex = np.full((int(round(h * TEX)), int(round(w * TEX))), 255, np.uint8)
+    s = int(round(square_m * TEX))
+    m = int(round(margin_m * TEX))
+    for j in range(squares_y):
+        for i in range(squares_x):
+            if (i + j) % 2 == 0:
+                tex[m + j * s:m + (j + 1) * s, m + i * s:m + (i + 1) * s] = 20
+    ox, oy = _origin(tex, (0.0, 0.0))
+    # first inner corner: one square in from the top-left board corner
+    return tex, (m + s - 0.5, m + s - 0.5)

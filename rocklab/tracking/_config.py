@@ -144,7 +144,9 @@ class BoardConfig:
     """``[reference.board]``: a checkerboard/ChArUco board seen in the video, for scale.
 
     The board lies in the rocking plane; its pose gives the homography image ->
-    plane (m).
+    plane (m). The plane origin is then the board's top-left inner corner as
+    seen in the image (checkerboard; for ChArUco OpenCV's board origin), x to
+    the right, y up.
 
     Attributes
     ----------

@@ -109,3 +109,21 @@ def test_sine_pulse_closed_form_vs_linear_simulation(omega, a):
     assert not sim["impact_during_pulse"] and not sim["overturned"]
     assert float(D0) == pytest.approx(sim["D_end"], rel=1e-6)  # Eq. 42 = (x-1)^2 - x'^2 at pulse end
     assert float(mx) == pytest.approx(sim["max_after"], rel=1e-4)  # Eq. 41
+
+
+def test_arch_uplift_vanishes_at_heyman_minimum_thickness():
+    from rocklab.models import arch_mechanism
+
+    lam = {}
+    for t in (0.11, 0.15, 0.2):
+        mech, info = arch_mechanism(math.pi, t, 1.0)
+        fp = mech.parameters()
+        # the Lagrangian lambda (Eq. 10) equals the virtual-work lambda of the hinge search
+        assert fp.lambda_ == pytest.approx(info["lambda"], rel=1e-4)
+        assert 0 < fp.phi_cr_rad < 0.5 and fp.lambda_lin > 0
+        lam[t] = fp.lambda_
+    # a semicircular arch at Heyman's minimum thickness t/r = 0.107 stands with no lateral
+    # load to spare: lambda -> 0; thicker arches need more (paper §5.2.2, Fig. 10)
+    assert lam[0.11] < 0.015 < lam[0.15] < lam[0.2]
+    flatter, _ = arch_mechanism(math.radians(150), 0.15, 1.0)
+    assert flatter.parameters().lambda_ > lam[0.15]  # larger inclusion angle -> smaller lambda

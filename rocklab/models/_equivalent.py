@@ -30,7 +30,7 @@ from ..blocks import G
 __all__ = ["FundamentalParameters", "Mechanism", "block_parameters", "strut_parameters",
            "frame_parameters", "wall_parameters", "wall_mechanism", "four_bar_mechanism",
            "asymmetric_frame", "free_rocking_period_eq24", "overturning_time_eq25",
-           "sine_pulse_max_response", "linear_sine_pulse_response"]
+           "sine_pulse_max_response", "linear_sine_pulse_response", "arch_mechanism"]
 
 
 def _pos(name, v):
@@ -487,3 +487,119 @@ def linear_sine_pulse_response(omega: float, a: float, eta: float, tau_max: floa
             out["D_end"] = (state[0] - 1.0) ** 2 - state[1] ** 2
             phase_end = False
     return out
+
+
+# -- masonry arch (§5.2) -----------------------------------------------------------------
+
+def _sector(r_i, r_e, a1, a2):
+    """Area, centroid and polar moment about its centroid of an annular sector (unit depth, density 1)."""
+    d = a2 - a1
+    area = 0.5 * d * (r_e ** 2 - r_i ** 2)
+    rc = (2.0 / 3.0) * (r_e ** 3 - r_i ** 3) / (r_e ** 2 - r_i ** 2) * math.sin(d / 2) / (d / 2)
+    am = 0.5 * (a1 + a2)
+    cm = np.array([rc * math.cos(am), rc * math.sin(am)])
+    J0 = 0.25 * d * (r_e ** 4 - r_i ** 4)
+    return area, cm, J0 - area * rc * rc
+
+
+def _arch_hinges(beta, t, r, u, faces, mirror=False):
+    """Hinge points and the three moving bodies for hinge fractions u (0 = left springing)."""
+    ri, re = r - t / 2, r + t / 2
+    ang = math.pi / 2 + beta / 2 - np.asarray(u) * beta  # from the left springing clockwise
+    pts = [np.array([(re if f else ri) * math.cos(a), (re if f else ri) * math.sin(a)])
+           for a, f in zip(ang, faces)]
+    bodies = [_sector(ri, re, ang[k + 1], ang[k]) for k in range(3)]
+    if mirror:  # x -> -x: the mechanism for the other direction, still a clockwise coordinate
+        pts = [np.array([-q[0], q[1]]) for q in pts]
+        bodies = [(m, np.array([-c[0], c[1]]), i) for m, c, i in bodies]
+    return pts, bodies
+
+
+def _lambda_at_rest(pts, bodies):
+    """Virtual-work uplift lambda = sum m v_y / sum m v_x for a unit clockwise rotation of AB."""
+    A, B, C, D = pts
+
+    def perp(v):
+        return np.array([-v[1], v[0]])
+    vB = -perp(B - A)  # omega_1 = -1 (clockwise)
+    M = np.column_stack([perp(C - D), -perp(C - B)])
+    if abs(np.linalg.det(M)) < 1e-12:
+        return float("nan")
+    w3, w2 = np.linalg.solve(M, vB)
+    vel = [-perp(bodies[0][1] - A), vB + w2 * perp(bodies[1][1] - B), w3 * perp(bodies[2][1] - D)]
+    num = sum(b[0] * v[1] for b, v in zip(bodies, vel))
+    den = sum(b[0] * v[0] for b, v in zip(bodies, vel))
+    return num / den if den > 0 and num > 0 else float("nan")
+
+
+def arch_mechanism(inclusion_angle_rad: float, thickness_m: float, radius_m: float,
+                   hinges=None, grid: int = 17):
+    """Rocking masonry arch as a three-block mechanism (paper §5.2, Oppenheim's mechanism).
+
+    Parameters
+    ----------
+    inclusion_angle_rad : float
+        Angle beta subtended by the arch (pi = semicircle), rad.
+    thickness_m, radius_m : float
+        Ring thickness t_a and centre-line radius r_a, m (uniform density, unit depth).
+    hinges : sequence of 4 floats, optional
+        Hinge positions as fractions of the arch from the left springing (A < B < C < D);
+        faces alternate extrados/intrados starting at the extrados (A, C on the
+        extrados), or as found by the search (which also tries the other face pattern
+        and the mirror image).
+        Default: the positions with the smallest uplift lambda, found on a ``grid``
+        of positions and refined (a very large number of voussoirs, as in the paper).
+
+    Returns
+    -------
+    (Mechanism, dict)
+        The mechanism (coordinate: clockwise rotation of the left segment) and
+        ``{"hinges": (u_A, u_B, u_C, u_D), "faces": ..., "lambda": ...}``.
+    """
+    beta = _pos("inclusion_angle_rad", inclusion_angle_rad)
+    t, r = _pos("thickness_m", thickness_m), _pos("radius_m", radius_m)
+    if beta > 2 * math.pi * 0.95 or t >= r:
+        raise InputError(f"arch: need inclusion angle < 1.9 pi and thickness < radius (got {beta}, {t}, {r})")
+    faces, mirror = (True, False, True, False), False
+    if hinges is None:
+        best = (math.inf, None)
+        g = np.linspace(0, 1, int(grid))
+        for fc in ((True, False, True, False), (False, True, False, True)):
+            for mir in (False, True):
+                # A in the left half, D in the right half, segments >= 2 grid steps: the
+                # global mechanism of the paper's Fig. 9, not local snaps near a springing
+                for ia in range(g.size // 2):
+                    for ib in range(ia + 2, g.size):
+                        for ic in range(ib + 2, g.size):
+                            for id_ in range(max(ic + 2, g.size // 2 + 1), g.size):
+                                u = (g[ia], g[ib], g[ic], g[id_])
+                                lam = _lambda_at_rest(*_arch_hinges(beta, t, r, u, fc, mir))
+                                if lam < best[0]:
+                                    best, faces, mirror = (lam, u), fc, mir
+        if best[1] is None:
+            raise InputError("arch: no admissible four-hinge mechanism found; check the geometry")
+        u = np.array(best[1])
+        step = 1.0 / (grid - 1)
+        for _ in range(4):  # local refinement of the hinge positions
+            step /= 3
+            cand = u
+            lam0 = best[0]
+            for k in range(4):
+                for sgn in (-1, 1):
+                    v = u.copy()
+                    v[k] = min(1.0, max(0.0, v[k] + sgn * step))
+                    if np.all(np.diff(v) > 0):
+                        lam = _lambda_at_rest(*_arch_hinges(beta, t, r, v, faces, mirror))
+                        if lam < lam0:
+                            lam0, cand = lam, v
+            u = cand
+            best = (lam0, tuple(u))
+        hinges = best[1]
+    u = tuple(float(x) for x in hinges)
+    if len(u) != 4 or not all(0 <= a < b_ for a, b_ in zip(u, u[1:])) or u[-1] > 1:
+        raise InputError(f"hinges={hinges!r}: need 4 increasing fractions in [0, 1]")
+    pts, bodies = _arch_hinges(beta, t, r, u, faces, mirror)
+    mech = four_bar_mechanism(pts[0], pts[1], pts[2], pts[3],
+                              [(b[0], tuple(b[1]), b[2]) for b in bodies], name="arch")
+    return mech, {"hinges": u, "faces": ["extrados" if f else "intrados" for f in faces],
+                  "mirrored": mirror, "lambda": _lambda_at_rest(pts, bodies)}

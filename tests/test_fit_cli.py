@@ -124,3 +124,12 @@ def test_fit_k_table_and_predict(run_cli, tmp_path):
     bad.write_text("{not json")
     rc, out, err = run_cli("fit", "k-predict", "--hb", 4.5, "--b-cm", 9, "--coefficients", bad)
     assert rc == 2 and "JSON" in err
+
+
+def test_text_reports(run_cli, tmp_path):
+    p = tmp_path / "full.csv"
+    ceh_full_contact().to_csv(p, index=False)
+    rc, out, err = run_cli("fit", "k-table", p, "--eta-mat", 0.989)
+    assert rc == 0 and "B10S" in out and "infeasible" in out and "R-squared" in out
+    rc, out, err = run_cli("fit", "eta-mat", p, "--lc-m", 0.0015, "--rule", "lsq")
+    assert rc == 0 and "eta_mat =" in out and "lsq" in out

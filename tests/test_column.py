@@ -215,6 +215,7 @@ def test_configurations_are_admissible(three_block_free):
 def test_opening_model_picks_admissible_and_consistent_configuration():
     """Two blocks pushed hard at rest (thesis Fig. 18-19): the chosen opening accelerates into Eq. (5)."""
     from rocklab.models._column_events import opening_model
+    from rocklab.models._column_kernels import make_work
     from rocklab.models._column_step import evaluate
 
     col = Column((Block(0.2, 0.6, mass_kg=3.0), Block(0.2, 0.4, mass_kg=1.0)))
@@ -227,7 +228,7 @@ def test_opening_model_picks_admissible_and_consistent_configuration():
         n = opening_model(z, z, np.zeros(2, np.int64), z, 0.5, 1e-4, blk, par, accb, 9, s_new, px_new)
         assert n >= 1 and np.any(s_new != 0)
         acc, N, V, Mc = np.zeros(2), np.zeros(2), np.zeros(2), np.zeros(2)
-        evaluate(z, z, s_new, 0.5, blk, par, accb, acc, N, V, Mc)
+        evaluate(z, z, s_new, 0.5, blk, par, accb, acc, N, V, Mc, make_work(2))
         for j in range(2):
             if s_new[j] != 0:
                 assert s_new[j] * acc[j] > 0  # opens in its admissible direction

@@ -17,7 +17,7 @@ from numba import njit
 from numba.extending import register_jitable
 
 from ._column_events import impact_model, opening_model
-from ._column_kernels import active_dofs, geometry, kinetic_energy, pivots
+from ._column_kernels import active_dofs, base_acc, geometry, kinetic_energy, make_work, pivots
 from ._column_step import evaluate, locate_closing, nm_step, state_checks
 
 __all__: list[str] = []
@@ -29,53 +29,45 @@ EV_START, EV_OPEN, EV_IMPACT = 0, 1, 2
 
 
 @register_jitable
-def _energy(phi, v, s, blk, g, y0):
+def _energy(phi, v, s, blk, g, y0, w):
+    """Kinetic and potential energy (J); leaves the geometry in ``w``."""
     n = phi.shape[0]
-    theta = np.empty(n)
-    thlow = np.empty(n)
-    C = np.empty((n, 2))
-    G = np.empty((n, 2))
-    geometry(phi, s, blk, theta, thlow, C, G)
-    dj = np.empty(n, np.int64)
-    dpx = np.empty(n)
-    k = active_dofs(s, blk, dj, dpx)
-    PP = np.empty((max(k, 1), 2))
-    pivots(dj, dpx, k, C, thlow, PP)
-    vk = np.empty(max(k, 1))
+    geometry(phi, s, blk, w.theta, w.thlow, w.C, w.G)
+    k = active_dofs(s, blk, w.dj, w.dpx)
+    pivots(w.dj, w.dpx, k, w.C, w.thlow, w.PP)
     for q in range(k):
-        vk[q] = v[dj[q]]
-    ke = kinetic_energy(dj, k, PP, vk, G, blk)
+        w.vk[q] = v[w.dj[q]]
+    ke = kinetic_energy(w.dj, k, w.PP, w.vk, w.G, blk)
     pe = 0.0
     for i in range(n):
-        pe += blk[i, 0] * g * (G[i, 1] - y0[i])
-    return ke, pe, theta, G, C, thlow
+        pe += blk[i, 0] * g * (w.G[i, 1] - y0[i])
+    return ke, pe
 
 
 @register_jitable
-def _overturned(phi, v, s, blk, g, y0, ovt_angle):
+def _overturned(v, s, blk, ovt_angle, w):
     """Static instability of the part above an opening joint, moving outwards.
 
     The centre of mass of blocks j..n lies beyond the pivot of open joint j
     (gravity now drives the opening) while the joint still opens; for one block
     this is |θ| ≥ α with outward velocity. With ``ovt_angle > 0`` any block
-    angle beyond it counts instead.
+    angle beyond it counts instead. Uses the geometry left in ``w`` by :func:`_energy`.
     """
-    n = phi.shape[0]
-    ke, pe, theta, G, C, thlow = _energy(phi, v, s, blk, g, y0)
+    n = s.shape[0]
     if ovt_angle > 0.0:
         for i in range(n):
-            if abs(theta[i]) >= ovt_angle:
+            if abs(w.theta[i]) >= ovt_angle:
                 return True
         return False
     for j in range(n):
         if s[j] == 0 or s[j] * v[j] <= 0.0:
             continue
         px = -s[j] * blk[j, 4]
-        pxw = C[j, 0] + math.cos(thlow[j]) * px
+        pxw = w.C[j, 0] + math.cos(w.thlow[j]) * px
         mx = 0.0
         mt = 0.0
         for i in range(j, n):
-            mx += blk[i, 0] * G[i, 0]
+            mx += blk[i, 0] * w.G[i, 0]
             mt += blk[i, 0]
         if s[j] * (mx / mt - pxw) <= 0.0:
             return True
@@ -120,12 +112,21 @@ def run_core(phi0, v0, s0, blk, par, accb, n_steps, dt, max_enum, n_imp, v_tol, 
     px = np.empty(n)
     for j in range(n):
         px[j] = -s[j] * blk[j, 4]
+    w = make_work(n)
     zeros = np.zeros(n)
     zs = np.zeros(n, np.int64)
-    y0 = np.empty(n)
-    ke0, pe0, th0, G0, C0, tl0 = _energy(zeros, zeros, zs, blk, g, zeros)
+    y0 = np.zeros(n)
+    _energy(zeros, zeros, zs, blk, g, y0, w)
     for i in range(n):
-        y0[i] = G0[i, 1]
+        y0[i] = w.G[i, 1]
+    # rigid column (all joints closed): thrust moments S_j and masses M_j above each joint
+    Sj = np.zeros(n)
+    Mj = np.zeros(n)
+    for j in range(n):
+        for i in range(j, n):
+            Sj[j] += blk[i, 0] * (w.G[i, 1] - w.C[j, 1])
+            Mj[j] += blk[i, 0]
+    mu = par[1]
     acc = np.zeros(n)
     N = np.empty(n)
     V = np.empty(n)
@@ -153,17 +154,17 @@ def run_core(phi0, v0, s0, blk, par, accb, n_steps, dt, max_enum, n_imp, v_tol, 
             EVI[ne, 1] = s[j]
             EVI[ne, 2] = EV_START
             ne += 1
-    if not evaluate(phi, v, s, 0.0, blk, par, accb, acc, N, V, Mc):
+    if not evaluate(phi, v, s, 0.0, blk, par, accb, acc, N, V, Mc, w):
         return nr, ne, ni, ST_NUMERIC, 0.0
     code = state_checks(s, phi, v, blk, par, N, V, Mc, viol0)
     for j in range(n):
         if viol0[j] > 0.0 and code == 0:
             if opening_model(phi, v, s, px, 0.0, dt, blk, par, accb, max_enum, s_new, px_new) > 0:
                 ne = _apply_opening(0.0, s, px, s_new, px_new, EVT, EVI, ne)
-                evaluate(phi, v, s, 0.0, blk, par, accb, acc, N, V, Mc)
+                evaluate(phi, v, s, 0.0, blk, par, accb, acc, N, V, Mc, w)
                 code = state_checks(s, phi, v, blk, par, N, V, Mc, viol0)
             break
-    ke, pe, th, G, C, tl = _energy(phi, v, s, blk, g, y0)
+    ke, pe = _energy(phi, v, s, blk, g, y0, w)
     PHI[0, :] = phi
     VEL[0, :] = v
     EN[0, 0] = ke
@@ -177,11 +178,27 @@ def run_core(phi0, v0, s0, blk, par, accb, n_steps, dt, max_enum, n_imp, v_tol, 
         tc = step * dt
         n_sub = 0
         retry = False
+        closed = True
+        for j in range(n):
+            if s[j] != 0:
+                closed = False
+        if closed:
+            # the rigid column moves with the base: nothing to integrate unless a joint opens or slides
+            ug1 = abs(base_acc(t1, par[2], par[3], accb))
+            quiet = True
+            for j in range(n):
+                vj = ug1 * Sj[j] - blk[j, 4] * g * Mj[j]
+                if vj > 0.0 or ug1 > mu * g:
+                    quiet = False
+            if quiet:
+                for j in range(n):
+                    viol0[j] = ug1 * Sj[j] - blk[j, 4] * g * Mj[j]
+                tc = t1
         while t1 - tc > 1e-12 * dt:
             rem = t1 - tc
             n_sub += 1
             if n_sub > 100000 or not nm_step(phi, v, acc, s, tc, rem, blk, par, accb, phi1, v1, acc1,
-                                             N1, V1, Mc1):
+                                             N1, V1, Mc1, w):
                 status = ST_NUMERIC
                 break
             # earliest closing (exact) and opening (linear interpolation) inside the sub-step
@@ -189,12 +206,12 @@ def run_core(phi0, v0, s0, blk, par, accb, n_steps, dt, max_enum, n_imp, v_tol, 
             jc = -1
             for j in range(n):
                 if s[j] != 0 and s[j] * phi1[j] < 0.0:
-                    tj = locate_closing(phi, v, acc, s, tc, rem, j, blk, par, accb, phi1, v1, acc1, N1, V1, Mc1)
+                    tj = locate_closing(phi, v, acc, s, tc, rem, j, blk, par, accb, phi1, v1, acc1, N1, V1, Mc1, w)
                     if tj < tau_c:
                         tau_c = tj
                         jc = j
             if jc >= 0:
-                locate_closing(phi, v, acc, s, tc, rem, jc, blk, par, accb, phi1, v1, acc1, N1, V1, Mc1)
+                locate_closing(phi, v, acc, s, tc, rem, jc, blk, par, accb, phi1, v1, acc1, N1, V1, Mc1, w)
             code = state_checks(s, phi1, v1, blk, par, N1, V1, Mc1, viol1)
             tau_o = math.inf
             if not retry:
@@ -208,7 +225,7 @@ def run_core(phi0, v0, s0, blk, par, accb, n_steps, dt, max_enum, n_imp, v_tol, 
             if tau_o < math.inf and (jc < 0 or tau_o < tau_c):
                 # opening: step to the interpolated instant and ask the opening model
                 if tau_o > 0.0:
-                    nm_step(phi, v, acc, s, tc, tau_o, blk, par, accb, phi1, v1, acc1, N1, V1, Mc1)
+                    nm_step(phi, v, acc, s, tc, tau_o, blk, par, accb, phi1, v1, acc1, N1, V1, Mc1, w)
                 else:
                     for j in range(n):
                         phi1[j] = phi[j]
@@ -229,7 +246,7 @@ def run_core(phi0, v0, s0, blk, par, accb, n_steps, dt, max_enum, n_imp, v_tol, 
                     phi[j] = phi1[j]
                     v[j] = v1[j]
                 phi[jc] = 0.0
-                ke_b, pe_b, th, G, C, tl = _energy(phi, v, s, blk, g, y0)
+                ke_b, pe_b = _energy(phi, v, s, blk, g, y0, w)
                 vb = v[jc]
                 px0 = px[jc]
                 sgn = 1.0 if vb > 0.0 else -1.0
@@ -268,12 +285,27 @@ def run_core(phi0, v0, s0, blk, par, accb, n_steps, dt, max_enum, n_imp, v_tol, 
                 for j in range(n):
                     phi[j] = phi1[j]
                     v[j] = v1[j]
+                changed = False
                 if retry and code == 0:
                     found = opening_model(phi, v, s, px, tc, dt, blk, par, accb, max_enum, s_new, px_new)
                     if found > 0:
                         ne = _apply_opening(tc, s, px, s_new, px_new, EVT, EVI, ne)
+                        changed = True
+                if not changed:
+                    # the step's last iterate already holds accelerations and resultants
+                    for j in range(n):
+                        acc[j] = acc1[j]
+                        N[j] = N1[j]
+                        V[j] = V1[j]
+                        Mc[j] = Mc1[j]
+                        viol0[j] = viol1[j]
+                    retry = False
+                    if code != 0:
+                        status = ST_TENSION if code == 1 else ST_SLIDING
+                        break
+                    continue
             retry = False
-            if not evaluate(phi, v, s, tc, blk, par, accb, acc, N, V, Mc):
+            if not evaluate(phi, v, s, tc, blk, par, accb, acc, N, V, Mc, w):
                 status = ST_NUMERIC
                 break
             code = state_checks(s, phi, v, blk, par, N, V, Mc, viol0)
@@ -284,13 +316,13 @@ def run_core(phi0, v0, s0, blk, par, accb, n_steps, dt, max_enum, n_imp, v_tol, 
         if status != ST_END:
             t_status = tc
             break
-        ke, pe, th, G, C, tl = _energy(phi, v, s, blk, g, y0)
+        ke, pe = _energy(phi, v, s, blk, g, y0, w)
         PHI[nr, :] = phi
         VEL[nr, :] = v
         EN[nr, 0] = ke
         EN[nr, 1] = pe
         nr += 1
-        if _overturned(phi, v, s, blk, g, y0, ovt_angle):
+        if _overturned(v, s, blk, ovt_angle, w):
             status = ST_OVERTURN
             t_status = t1
             break

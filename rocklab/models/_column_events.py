@@ -102,6 +102,8 @@ def opening_model(phi, v, s, px, t, dt, blk, par, accb, max_enum, s_out, px_out)
     Ms = np.empty((n, n))
     Qs = np.empty(n)
     x = np.empty(n)
+    Fs = np.empty((n, 3))
+    As = np.empty((n, n + 1))
     digits = np.zeros(max(nc, 1), np.int64)
     hsum = 0.0
     for i in range(n):
@@ -116,7 +118,7 @@ def opening_model(phi, v, s, px, t, dt, blk, par, accb, max_enum, s_out, px_out)
     else:
         cand_range = 0
         # fallback: the closed joint with the largest eccentricity excess opens alone
-        reactions(dj, k_open, PP, np.zeros(max(k_open, 1)), G, C, thlow, blk, aq, ug, g, N, V, Mc)
+        reactions(dj, k_open, PP, np.zeros(max(k_open, 1)), G, C, thlow, blk, aq, ug, g, N, V, Mc, Fs)
         worst = -1
         wv = 0.0
         for c in range(nc):
@@ -152,7 +154,7 @@ def opening_model(phi, v, s, px, t, dt, blk, par, accb, max_enum, s_out, px_out)
             sPP[p, 1] = PP[idx[p], 1]
             for r2 in range(k):
                 Ms[p, r2] = Mf[idx[p], idx[r2]]
-        if not solve_small(Ms, Qs, k, x):
+        if not solve_small(Ms, Qs, k, x, As):
             continue
         ok = True
         p = k_open
@@ -166,7 +168,7 @@ def opening_model(phi, v, s, px, t, dt, blk, par, accb, max_enum, s_out, px_out)
         if not ok:
             continue
         # consistency of the joints that stay closed (thrust inside the section)
-        reactions(sdj, k, sPP, x, G, C, thlow, blk, aq, ug, g, N, V, Mc)
+        reactions(sdj, k, sPP, x, G, C, thlow, blk, aq, ug, g, N, V, Mc, Fs)
         consistent = 1.0
         for c in range(nc):
             j = closed[c]
@@ -247,6 +249,7 @@ def impact_model(phi, v, s, px, jc, px_to, sgn_to, blk, par, max_enum, v_tol, s_
     rhs = np.empty(n + 1)
     dv = np.empty(n + 1)
     vv = np.empty(n + 1)
+    As = np.empty((n + 1, n + 2))
     digits = np.zeros(max(nc, 1), np.int64)
     best = -1.0
     total = 2 * 3 ** nc_enum
@@ -273,7 +276,7 @@ def impact_model(phi, v, s, px, jc, px_to, sgn_to, blk, par, max_enum, v_tol, s_
             rhs[p] = Mf[idx[p], qc] * vc
             for r2 in range(k):
                 Ms[p, r2] = Mf[idx[p], idx[r2]]
-        if k > 0 and not solve_small(Ms, rhs, k, dv):
+        if k > 0 and not solve_small(Ms, rhs, k, dv, As):
             continue
         ok = True
         for p in range(k):

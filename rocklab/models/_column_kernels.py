@@ -25,11 +25,23 @@ Internal conventions (the public API in :mod:`._column_sim` flips the sign)
 from __future__ import annotations
 
 import math
+from collections import namedtuple
 
 import numpy as np
 from numba.extending import register_jitable
 
 __all__: list[str] = []
+
+#: Scratch arrays of the hot path (allocated once per run; numba types the namedtuple).
+Work = namedtuple("Work", "theta thlow C G dj dpx PP vk aq M Q x F A")
+
+
+@register_jitable
+def make_work(n):
+    """Scratch arrays for a column of ``n`` blocks."""
+    return Work(np.empty(n), np.empty(n), np.empty((n, 2)), np.empty((n, 2)), np.empty(n, np.int64),
+                np.empty(n), np.empty((n, 2)), np.empty(n), np.zeros((n, 2)), np.empty((n, n)), np.empty(n),
+                np.zeros(n), np.empty((n, 3)), np.empty((n, n + 1)))
 
 
 @register_jitable
@@ -149,13 +161,12 @@ def system(dj, k, PP, G, blk, aq, ug, g, M, Q):
 
 
 @register_jitable
-def solve_small(M, Q, k, x):
+def solve_small(M, Q, k, x, A):
     """Solve ``M[:k,:k] x = Q[:k]`` by Gaussian elimination with partial pivoting.
 
-    Returns False for a singular matrix. Written out because k <= a few and a
-    LAPACK call costs more than the arithmetic.
+    ``A`` is scratch of at least (k, k+1). Returns False for a singular matrix.
+    Written out because k <= a few and a LAPACK call costs more than the arithmetic.
     """
-    A = np.empty((k, k + 1))
     for i in range(k):
         for j in range(k):
             A[i, j] = M[i, j]
@@ -188,18 +199,19 @@ def solve_small(M, Q, k, x):
 
 
 @register_jitable
-def reactions(dj, k, PP, ddq, G, C, thlow, blk, aq, ug, g, N, V, Mc):
+def reactions(dj, k, PP, ddq, G, C, thlow, blk, aq, ug, g, N, V, Mc, F):
     """Contact resultants at every joint for accelerations ``ddq`` of the DOFs.
 
     For the part above joint ``j``: normal force ``N[j]`` (N, compression
     positive), shear ``V[j]`` (N, along the lower face) and moment ``Mc[j]``
     (N m, counter-clockwise) of the contact forces about the joint centre. The
     eccentricity of the thrust is ``Mc/N`` (positive towards the right corner).
+    ``F`` is scratch of shape (n, 3).
     """
     n = G.shape[0]
-    fx = np.empty(n)
-    fy = np.empty(n)
-    tdd = np.empty(n)
+    fx = F[:, 0]
+    fy = F[:, 1]
+    tdd = F[:, 2]
     for i in range(n):
         ax = aq[i, 0]
         ay = aq[i, 1]

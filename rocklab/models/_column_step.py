@@ -28,48 +28,41 @@ P_G, P_MU, P_T0, P_DT, P_VEL = 0, 1, 2, 3, 4
 
 
 @register_jitable
-def evaluate(phi, v, s, t, blk, par, accb, acc_out, N, V, Mc):
+def evaluate(phi, v, s, t, blk, par, accb, acc_out, N, V, Mc, w):
     """Accelerations of the open joints and the joint resultants at time ``t``.
 
     ``phi, v`` (n,): joint rotations (rad) and velocities (rad/s), zero at closed
     joints. Writes ``acc_out`` (n,) (zero at closed joints) and ``N, V, Mc`` (n,)
-    (see :func:`reactions`). Returns False when the mass matrix is singular.
+    (see :func:`reactions`); ``w`` is the scratch :class:`Work`. Returns False
+    when the mass matrix is singular.
     """
     n = phi.shape[0]
-    theta = np.empty(n)
-    thlow = np.empty(n)
-    C = np.empty((n, 2))
-    G = np.empty((n, 2))
-    geometry(phi, s, blk, theta, thlow, C, G)
-    dj = np.empty(n, np.int64)
-    dpx = np.empty(n)
-    k = active_dofs(s, blk, dj, dpx)
-    PP = np.empty((max(k, 1), 2))
-    pivots(dj, dpx, k, C, thlow, PP)
-    vk = np.empty(max(k, 1))
+    geometry(phi, s, blk, w.theta, w.thlow, w.C, w.G)
+    k = active_dofs(s, blk, w.dj, w.dpx)
+    pivots(w.dj, w.dpx, k, w.C, w.thlow, w.PP)
     for q in range(k):
-        vk[q] = v[dj[q]]
-    aq = np.zeros((n, 2))
-    if par[P_VEL] != 0.0:
-        quad_acc(dj, PP, vk, k, G, aq)
+        w.vk[q] = v[w.dj[q]]
+    aq = w.aq
+    for i in range(n):
+        aq[i, 0] = 0.0
+        aq[i, 1] = 0.0
+    if par[P_VEL] != 0.0 and k > 0:
+        quad_acc(w.dj, w.PP, w.vk, k, w.G, aq)
     ug = base_acc(t, par[P_T0], par[P_DT], accb)
-    M = np.empty((max(k, 1), max(k, 1)))
-    Q = np.empty(max(k, 1))
-    x = np.zeros(max(k, 1))
     ok = True
     if k > 0:
-        system(dj, k, PP, G, blk, aq, ug, par[P_G], M, Q)
-        ok = solve_small(M, Q, k, x)
+        system(w.dj, k, w.PP, w.G, blk, aq, ug, par[P_G], w.M, w.Q)
+        ok = solve_small(w.M, w.Q, k, w.x, w.A)
     for j in range(n):
         acc_out[j] = 0.0
     for q in range(k):
-        acc_out[dj[q]] = x[q]
-    reactions(dj, k, PP, x, G, C, thlow, blk, aq, ug, par[P_G], N, V, Mc)
+        acc_out[w.dj[q]] = w.x[q]
+    reactions(w.dj, k, w.PP, w.x, w.G, w.C, w.thlow, blk, aq, ug, par[P_G], N, V, Mc, w.F)
     return ok
 
 
 @register_jitable
-def nm_step(phi, v, acc, s, t, dt, blk, par, accb, phi1, v1, acc1, N, V, Mc):
+def nm_step(phi, v, acc, s, t, dt, blk, par, accb, phi1, v1, acc1, N, V, Mc, w):
     """One implicit trapezoidal step of length ``dt`` from ``t`` (fixed configuration ``s``).
 
     Solves ``φ1 = φ + dt φ̇ + dt²/4 (φ̈ + φ̈1)``, ``φ̇1 = φ̇ + dt/2 (φ̈ + φ̈1)`` with
@@ -99,7 +92,7 @@ def nm_step(phi, v, acc, s, t, dt, blk, par, accb, phi1, v1, acc1, N, V, Mc):
             v1[j] = v[j] + 0.5 * dt * (acc[j] + acc1[j])
         if it > 0 and diff <= tol:
             break
-        ok = evaluate(phi1, v1, s, t + dt, blk, par, accb, acc1, N, V, Mc)
+        ok = evaluate(phi1, v1, s, t + dt, blk, par, accb, acc1, N, V, Mc, w)
         if not ok:
             return False
     # final update so that (phi1, v1, acc1) satisfy the Newmark relations exactly
@@ -111,7 +104,7 @@ def nm_step(phi, v, acc, s, t, dt, blk, par, accb, phi1, v1, acc1, N, V, Mc):
 
 
 @register_jitable
-def locate_closing(phi, v, acc, s, t, dt, jc, blk, par, accb, phi1, v1, acc1, N, V, Mc):
+def locate_closing(phi, v, acc, s, t, dt, jc, blk, par, accb, phi1, v1, acc1, N, V, Mc, w):
     """Step length ``dt' ∈ (0, dt]`` after which joint ``jc`` is exactly closed.
 
     The step of unknown length with ``φ_jc(t + dt') = 0`` (Čeh et al. Eq. 8,
@@ -122,7 +115,7 @@ def locate_closing(phi, v, acc, s, t, dt, jc, blk, par, accb, phi1, v1, acc1, N,
     lo = 0.0
     glo = s[jc] * phi[jc]
     hi = dt
-    nm_step(phi, v, acc, s, t, hi, blk, par, accb, phi1, v1, acc1, N, V, Mc)
+    nm_step(phi, v, acc, s, t, hi, blk, par, accb, phi1, v1, acc1, N, V, Mc, w)
     ghi = s[jc] * phi1[jc]
     side = 0
     x = hi
@@ -133,7 +126,7 @@ def locate_closing(phi, v, acc, s, t, dt, jc, blk, par, accb, phi1, v1, acc1, N,
             x = (lo * ghi - hi * glo) / (ghi - glo)
         if not (lo < x < hi):
             x = 0.5 * (lo + hi)
-        nm_step(phi, v, acc, s, t, x, blk, par, accb, phi1, v1, acc1, N, V, Mc)
+        nm_step(phi, v, acc, s, t, x, blk, par, accb, phi1, v1, acc1, N, V, Mc, w)
         gx = s[jc] * phi1[jc]
         if gx > 0.0:
             lo = x

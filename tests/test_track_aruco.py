@@ -80,7 +80,7 @@ def test_occlusion_is_nan_and_elsewhere_unchanged():
     occl = assemble_tracks(track_frames(occl_frames, cfg), cfg, FPS, W, H)
     b = occl["block_1"]
     assert np.all(np.isnan(b.theta_rad[gap])) and np.all(np.isnan(b.x_m[gap]))
-    assert np.all(b.status[gap] != "ok") and np.all(b.status[~gap] == "ok")
+    assert np.all(b.status[gap] == "occluded") and np.all(b.status[~gap] == "ok")
     e_clean = clean["block_1"].theta_rad[~gap] - theta[~gap]
     b_err = b.theta_rad[~gap] - theta[~gap]
     # Only the first frame after the gap may differ, by the sub-pixel refinement of a
@@ -178,3 +178,20 @@ def test_tilted_camera_plane_from_table_markers(with_K):
     res_img = assemble_tracks(track_frames(frames, cfg_img), cfg_img, FPS, W, H)
     assert res_img.plane == "image"
     assert np.sqrt(np.mean(np.degrees(res_img["block_1"].theta_rad - theta) ** 2)) > 2 * rms
+
+
+def test_blurred_frames_are_flagged_blur():
+    import cv2
+
+    W, H, k = 400, 300, 800.0
+    sc = _scene(W, H, k, seed=4)
+    n = 14
+    t, theta, xt = _truth(n)
+    frames = [sc.render([(0.0, 0.04, theta[i]), (0.0, -0.11, 0.0)]) for i in range(n)]
+    for i in (6, 7, 8):
+        frames[i] = cv2.GaussianBlur(frames[i], (0, 0), 7.0)  # a camera shake
+    cfg = _config()
+    res = assemble_tracks(track_frames(frames, cfg), cfg, FPS, W, H)
+    st = res["block_1"].status
+    assert list(st[6:9]) == ["blur"] * 3
+    assert np.all(st[:6] == "ok") and np.all(st[9:] == "ok")

@@ -53,7 +53,10 @@ class Observation:
     quality : float
         0..1: fraction of expected points found / (1 + residual / (0.2 % of the point spread)).
     status : str
-        "ok" or the reason the values are NaN ("lost", "blur", "low_quality").
+        "ok" or the reason the values are NaN: "occluded" (the target's last
+        window lost its contrast), "blur" (lost its fine detail but kept its
+        contrast), "lost" (otherwise), "low_quality"; after assembly also
+        "outlier" (an impossible jump) or "interpolated" (when asked).
     metric : bool
         Whether ``scale`` is plane units per metre.
     plane : str
@@ -160,14 +163,32 @@ def _make_detector(config, pm, first_gray):
     return RegionDetector(config, pm, first_gray)
 
 
-def _sharpness(gray, box):
+def _look(gray, box):
+    """(Laplacian variance, grey std) of the window ``box`` = (u0, v0, u1, v1)."""
     import cv2
 
     x0, y0, x1, y1 = box
     crop = gray[y0:y1, x0:x1]
     if crop.size < 64:
-        return np.nan
-    return float(cv2.Laplacian(crop, cv2.CV_32F).var())
+        return np.nan, np.nan
+    return float(cv2.Laplacian(crop, cv2.CV_32F).var()), float(crop.std())
+
+
+def _why_lost(now, ref):
+    """Reason for a lost target from its last window now vs at the last good detection.
+
+    "blur": fine detail gone (Laplacian variance < 35 %) but the black/white
+    contrast still there (grey std > 25 %); "occluded": the contrast itself is
+    gone (something flat or different covers the window); else "lost".
+    """
+    if ref is None or not np.all(np.isfinite(now)):
+        return "lost"
+    sharp, std = now
+    if std < 0.25 * ref[1]:
+        return "occluded"
+    if sharp < BLUR_RATIO * ref[0]:
+        return "blur"
+    return "lost"
 
 
 def track_frames(frames, config: TrackConfig, plane_map: PlaneMap | None = None):
@@ -226,13 +247,11 @@ def track_frames(frames, config: TrackConfig, plane_map: PlaneMap | None = None)
                 box = (int(max(u.min(), 0)), int(max(v.min(), 0)), int(u.max()) + 1, int(v.max()) + 1)
                 boxes[o.id] = box
                 if o.id not in sharp_ref or k % 25 == 0:
-                    sharp_ref[o.id] = _sharpness(gray, box)
+                    sharp_ref[o.id] = _look(gray, box)
             else:
                 status = "lost"
                 if o.id in boxes:
-                    s = _sharpness(gray, boxes[o.id])
-                    if s < BLUR_RATIO * sharp_ref.get(o.id, np.nan):
-                        status = "blur"
+                    status = _why_lost(_look(gray, boxes[o.id]), sharp_ref.get(o.id))
                 obs.append(Observation(idx, o.id, *(np.nan,) * 7, status,
                                        getattr(d, "metric", True), plane_map.source))
         yield obs

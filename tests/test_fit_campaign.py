@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pandas as pd
 import pytest
@@ -123,6 +125,8 @@ def test_table5_reproduced_with_unrounded_eta_mat():
 
 def test_infeasible_k_flagged_b9s_b10s():
     kt = k_table(ceh_full_contact(), eta_mat=0.989)
+    d = json.loads(json.dumps(kt.to_dict()))
+    assert len(d["per_block"]) == 27 and set(d["coefficients"]) == {"hb2", "hb", "const", "b_cm"}
     bad = set(kt.per_block.loc[~kt.per_block.feasible, "block"])
     assert bad == {"B9S", "B10S"}  # Čeh §5.4: k > 1 for B9S and B10S (tape dissipation)
     assert kt.n_infeasible == 2
@@ -183,6 +187,7 @@ def test_prediction_b6xl_and_extrapolation_flag():
     p = reg.predict(4.5, 0.09)
     assert round(p.k, 4) == 0.5341 and p.extrapolated and "outside" in p.message
     assert round(float(eta_modified(alpha_from_hb(4.5), 0.7036)), 4) == 0.9644
+    assert "WARNING" in p.report()
     inside = reg.predict(4.5, 0.045)
     assert not inside.extrapolated and inside.message == ""
     assert inside.b_bar_m == pytest.approx(0.045 * inside.k / 2, rel=1e-14)

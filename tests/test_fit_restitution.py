@@ -144,6 +144,8 @@ def test_thesis_eq12_energy_loss_from_peaks():
     assert el.mean4 == pytest.approx(1 - 0.93 ** 2, abs=0.004)
     assert el.eta_equivalent == pytest.approx(0.93, abs=0.002)
     assert el.mean4 == pytest.approx(np.mean(el.loss[:4]), rel=1e-14)
+    assert "Eq. 12" in el.report()
+    json.dumps(el.to_dict())
     # thesis small-angle variant (u ~ |theta|, no block): first-order approximation, biased low
     approx = energy_loss_from_peaks(t, y)
     assert not approx.exact and 0.5 * el.mean4 < approx.mean4 < 1.5 * el.mean4

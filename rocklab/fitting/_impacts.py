@@ -427,6 +427,15 @@ class EnergyLoss:
         return dict(mean4=self.mean4, start=self.start, eta_equivalent=self.eta_equivalent, exact=self.exact,
                     loss=[float(x) for x in self.loss], peaks=self.peaks.to_dict(orient="records"))
 
+    def report(self) -> str:
+        kind = "exact rise of the centre of mass" if self.exact else "small-angle u ~ |theta|"
+        n = min(4, self.loss.size - self.start)
+        return "\n".join([
+            "[[Energy loss per rocking (thesis Eq. 12)]]",
+            f"    mean of {n} consecutive losses from #{self.start}: {100 * self.mean4:.2f} %  ({kind})",
+            f"    equivalent restitution sqrt(1 - loss) = {self.eta_equivalent:.4f}",
+            "    losses: " + ", ".join(f"{100 * x:.1f}%" for x in self.loss[:8])])
+
 
 def energy_loss_from_peaks(t_s, theta_rad, block=None, start: int = 0, n_avg: int = 4) -> EnergyLoss:
     """Thesis Eq. 12: energy loss between successive amplitude peaks, mean of ``n_avg``.

@@ -62,6 +62,14 @@ class KPrediction:
                     b_bar_m=self.b_bar_m, extrapolated=self.extrapolated, feasible=self.feasible,
                     message=self.message)
 
+    def report(self) -> str:
+        lines = ["[[k prediction (Čeh Eq. 19, Eq. 14)]]",
+                 f"    h/b = {self.hb:g}, b = {100 * self.b_m:g} cm",
+                 f"    k = {self.k:.4f}, eta_M = {self.eta_M:.4f}, b_bar = {1000 * self.b_bar_m:.2f} mm"]
+        if self.message:
+            lines.append(f"    WARNING: {self.message}")
+        return "\n".join(lines)
+
 
 @dataclass(frozen=True)
 class KRegression:

@@ -291,6 +291,9 @@ def fit_restitution(t_s, theta_rad, block, window: str = "middle50", objective: 
                 return x, fx
             span *= 3.0
 
+    e0 = float(pie["eta_peaks"].iloc[0]) if len(pie) else float("nan")
+    g_first = min(max(e0, lo_b), hi_b) if np.isfinite(e0) and eta_guess is None else g
+
     def fit_window(kind, obj, fixed=None):
         """Fit η on a window. ``fixed=(t_r, θ0)`` holds the release fixed (cheap η′_e fit)."""
         a, b = window_span(kind)
@@ -304,7 +307,7 @@ def fit_restitution(t_s, theta_rad, block, window: str = "middle50", objective: 
             def f(eta):
                 d = prob.residual(eta, idx, *fixed, sens=False)
                 return float(d @ d)
-            x, fx = search(f, f, g, 0.025)
+            x, fx = search(f, f, g_first if kind == "first" else g, 0.025)
             return x, fx, f, idx, prob
 
         def f(eta):

@@ -207,10 +207,13 @@ def test_bad_input_and_overwrite_protection(tmp_path, run_cli, capsys):
     rc, out, err = run_cli("synth", "--out", tmp_path / "full", "--size", "160x90", "--duration", "0.1")
     assert rc == 2 and "--force" in err and (tmp_path / "full" / "keep.txt").read_text() == "mine"
     rc, out, err = run_cli("synth", "--out", tmp_path / "ok", "--size", "160x90", "--duration", "0.2",
-                           "--json", "--no-imu")
+                           "--json", "--no-imu", "--uncalibrated")
     assert rc == 0
     d = json.loads(out)
     assert d["n_frames"] == 10 and d["size"] == [160, 90]
+    text = (tmp_path / "ok" / "track.toml").read_text()
+    assert "camera_matrix" not in text and "homography" not in text and "marker_size_m = 0.06" in text
+    assert not (tmp_path / "ok" / "imu").exists()
     assert not [p for p in tmp_path.iterdir() if p.name.startswith(".ok.")]   # temp folder renamed
 
 

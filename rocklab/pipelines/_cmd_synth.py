@@ -34,6 +34,9 @@ def register(sub):
                    help="hide block_1 behind a dark patch from T0 to T1 s")
     p.add_argument("--rolling-shutter", action="store_true", help="rolling-shutter readout")
     p.add_argument("--no-imu", action="store_true", help="do not write IMU logs")
+    p.add_argument("--uncalibrated", action="store_true",
+                   help="leave the camera matrix, distortion and plane homography out of track.toml "
+                        "(they stay in session.json)")
     p.add_argument("--force", action="store_true", help="replace a non-empty --out folder")
     p.add_argument("--json", action="store_true", help="print one JSON object with the paths")
     p.add_argument("--progress", action="store_true", help="progress bar on stderr")
@@ -59,7 +62,8 @@ def run(args) -> int:
     s = synth_session(args.out, seed=args.seed, blocks=args.blocks, table=args.table, fps=args.fps,
                       size=size, targets=args.targets, duration_s=args.duration, occlusion=occ,
                       rolling_shutter=args.rolling_shutter, record=args.record, imu=not args.no_imu,
-                      layout=args.layout, force=args.force, progress=args.progress)
+                      layout=args.layout, calibrated=not args.uncalibrated, force=args.force,
+                      progress=args.progress)
     d = s.to_dict()
     if args.json:
         sys.stdout.write(json.dumps(d, allow_nan=False, default=str) + "\n")

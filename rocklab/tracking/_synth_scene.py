@@ -260,7 +260,8 @@ def build_scene(*, seed, blocks, table, fps, size, targets, duration_s, occlusio
             if not abs(p) < b.alpha_rad:
                 raise InputError(f"theta0_rad={p!r}: must be within ±alpha = ±{b.alpha_rad:.4f} rad")
     if layout == "column":
-        motions, sims, ends = _column_motions(blks, tbl, base, table, rest_s, horizon, rng_m)
+        motions, sims, ends = _column_motions(blks, tbl, base, table, rest_s, horizon, rng_m,
+                                              None if theta0_rad is None else float(np.ravel(theta0_rad)[0]))
     else:
         motions, sims, ends = _single_motions(blks, xs, phi0, tbl, base, table, rest_s, horizon, rng_m,
                                               restitution, eta)
@@ -360,7 +361,7 @@ def _single_motions(blks, xs, phi0, tbl, base, table, rest_s, horizon, rng_m, re
     return motions, sims, ends
 
 
-def _column_motions(blks, tbl, base, table, rest_s, horizon, rng_m):
+def _column_motions(blks, tbl, base, table, rest_s, horizon, rng_m, phi0=None):
     """A stacked column (``rocklab.models.simulate_column``): free rocking after a
     thread-burn release of the whole column tilted by half its slenderness angle,
     or standing on the moving table."""
@@ -371,7 +372,12 @@ def _column_motions(blks, tbl, base, table, rest_s, horizon, rng_m):
     n = len(blks)
     H = sum(b.h_m for b in blks)
     if table == "none":
-        phi0 = 0.5 * float(np.arctan(min(b.b_m for b in blks) / H))
+        alpha_col = float(np.arctan(min(b.b_m for b in blks) / H))
+        if phi0 is None:
+            phi0 = 0.5 * alpha_col
+        elif not abs(phi0) < alpha_col:
+            raise InputError(f"theta0_rad={phi0!r}: the column tips as one body; give |theta0| < "
+                             f"{alpha_col:.4f} rad (its slenderness angle)")
         release = round(rest_s + float(rng_m.uniform(0.0, 0.1)), 4)
         res = simulate_column(col, None, theta0_rad=[-phi0] * n, duration_s=max(horizon - release, 0.5))
         psi0 = np.zeros((1, n))

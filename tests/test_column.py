@@ -307,3 +307,25 @@ def test_fig40_single_block_overturns_over_a_wider_region():
     assert one.sum() > two.sum() and one.sum() > three.sum()
     f = m.to_frame()
     assert len(f) == 108 and f.overturned.sum() == m.overturned.sum()
+
+
+def test_state_checks_flag_tension_and_uplift_level():
+    from rocklab.models import uplift_acc_m_s2
+    from rocklab.models._column_step import state_checks
+
+    col = Column((Block(0.1, 0.2, mass_kg=2.0), Block(0.1, 0.2, mass_kg=1.0)), cut_m=[0.0, 0.01])
+    blk = col.block_array()
+    par = np.array([9.80665, 0.5, 0.0, 1.0, 1.0, 1e-14, 0.0, 0.0])
+    s = np.zeros(2, np.int64)
+    viol = np.zeros(2)
+    # compression inside the section: fine; eccentricity beyond a = b/2 - cut: the joint must open
+    assert state_checks(s, np.zeros(2), np.zeros(2), blk, par, np.array([10.0, 5.0]), np.zeros(2),
+                        np.array([0.3, 0.2]), viol) == 0
+    np.testing.assert_allclose(viol, [0.3 - 0.05 * 10.0, 0.2 - 0.04 * 5.0])
+    assert state_checks(s, np.zeros(2), np.zeros(2), blk, par, np.array([10.0, -1e-3]), np.zeros(2),
+                        np.zeros(2), viol) == 1  # tension at the upper joint
+    assert state_checks(s, np.zeros(2), np.zeros(2), blk, par, np.array([10.0, 5.0]), np.array([0.0, 2.6]),
+                        np.zeros(2), viol) == 2  # |V| > mu N
+    # rigid column: joint j opens at g a_j / z_j (z_j: height of the centre of mass above joint j)
+    z0 = (2.0 * 0.1 + 1.0 * 0.3) / 3.0
+    assert uplift_acc_m_s2(col) == pytest.approx(min(9.80665 * 0.05 / z0, 9.80665 * 0.04 / 0.1), rel=1e-12)

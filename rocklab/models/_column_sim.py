@@ -176,6 +176,11 @@ class ColumnResult:
         return self.status == "overturned"
 
     @property
+    def block_omega_rad_s(self) -> np.ndarray:
+        """Absolute block angular velocities (clockwise positive), rad/s, shape (m, n)."""
+        return np.cumsum(self.omega_rad_s, axis=1)
+
+    @property
     def max_abs_theta_rad(self) -> np.ndarray:
         """Peak |θ| per block, rad, shape (n,)."""
         return np.max(np.abs(self.theta_rad), axis=0)

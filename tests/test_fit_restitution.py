@@ -228,3 +228,15 @@ def test_fit_many_and_summary_of_fits():
     s = summarize_repeats(fits)
     assert fits[0].ok and not fits[1].ok
     assert s.failed == (1,) and s.n_used == 1 and s.mean == fits[0].eta_e and math.isnan(s.std)
+
+
+def test_level_offset_fitted():
+    # a camera levelled 0.2° off: the block impacts at θ_measured = 0.0035 rad
+    t, y, _ = synthetic(14)
+    off = math.radians(0.2)
+    f = fit_restitution(t, y + off, B6M, fit_offset=True)
+    assert f.theta_offset_rad == pytest.approx(off, abs=2e-4)
+    assert abs(f.eta_e - 0.93) < 0.002 and abs(f.eta_e_first - 0.93) < 0.003
+    assert not any("rest" in s for s in f.flags)
+    plain = fit_restitution(t, y + off, B6M)  # without the offset the rest level gives it away
+    assert plain.suspicious and any("fit_offset" in s for s in plain.flags)

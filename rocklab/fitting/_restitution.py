@@ -52,8 +52,9 @@ class RestitutionFit:
     ci95_eta_e : tuple (lo, hi)
         95 % profile-likelihood interval of η_e (see module doc).
     theta0_rad : float
-        Initial angle, rad (sign as measured): profiled with the release time over the rest
-        plateau and the fitted samples.
+        Initial angle, rad (sign as measured, relative to the fitted level when
+        ``fit_offset``): profiled with the release time over the rest plateau and the
+        fitted samples.
     release_t_s : float
         Fitted release time, s (record clock).
     rms_residual_rad : float
@@ -61,6 +62,8 @@ class RestitutionFit:
         amplitude/half-period residuals in rad (objective "peaks").
     sigma_theta_rad : float
         Measurement noise σ estimated on the rest plateau, rad.
+    theta_offset_rad : float
+        Fitted constant offset of the measured angle (0 unless ``fit_offset``), rad.
     per_impact_eta : tuple of float
         Per-impact restitution from the data alone (``eta_peaks``, see
         :func:`~rocklab.fitting.per_impact_eta`); the full table is ``per_impact``.
@@ -92,6 +95,7 @@ class RestitutionFit:
     window_t_s: tuple
     n_points: int
     eta_bounds: tuple
+    theta_offset_rad: float = 0.0
     block_name: str = ""
     suspicious: bool = False
     flags: tuple = ()
@@ -110,6 +114,7 @@ class RestitutionFit:
         """Plain-JSON dict (NaN kept as float NaN; the CLI writes null)."""
         d = {k: getattr(self, k) for k in (
             "eta_e", "eta_e_first", "theta0_rad", "release_t_s", "rms_residual_rad", "sigma_theta_rad",
+            "theta_offset_rad",
             "n_impacts", "window", "objective", "n_points", "block_name", "suspicious", "n_skipped",
             "n_evaluations", "status", "message")}
         d["ci95_eta_e"] = [float(x) for x in self.ci95_eta_e]
@@ -145,6 +150,7 @@ class RestitutionFit:
             f"    eta_e_first:  {self.eta_e_first:.5f}  (first post-impact half-period){b('eta_e_first')}",
             f"    release_t_s:  {self.release_t_s:.5f}{b('release_t_s')}",
             f"    theta0_rad:   {self.theta0_rad:.5f}  (profiled: rest plateau + motion)",
+            f"    theta_offset: {self.theta_offset_rad:.2e} rad" + ("" if self.theta_offset_rad else " (not fitted)"),
             f"    search bounds eta in [{self.eta_bounds[0]:g}, {self.eta_bounds[1]:g}]",
         ]
         if len(self.per_impact_eta):
@@ -171,7 +177,7 @@ def _failed(reason, window, objective, bounds, theta0=np.nan, sigma=np.nan, n_im
 def fit_restitution(t_s, theta_rad, block, window: str = "middle50", objective: str = "theta", *,
                     eta_bounds=(0.05, 0.9995), dt_s: float | None = None, nan: str = "raise",
                     level: float = 0.95, eta_guess: float | None = None,
-                    theta0_rad: float | None = None) -> RestitutionFit:
+                    theta0_rad: float | None = None, fit_offset: bool = False) -> RestitutionFit:
     """Fit a constant restitution η_e to a measured free-rocking record.
 
     Parameters
@@ -201,6 +207,10 @@ def fit_restitution(t_s, theta_rad, block, window: str = "middle50", objective: 
     theta0_rad : float, optional
         Initial angle to linearise about, rad (default: the rest-plateau median). θ0 is
         refined jointly with the release time for every η in either case.
+    fit_offset : bool
+        Also fit a constant offset of the measured angle (camera level error, IMU bias
+        integrated before release): the block then impacts at θ_measured = offset.
+        θ objective only; costs 2–3 refits (the θ0 linearisation is re-centred).
 
     Returns
     -------
@@ -265,7 +275,8 @@ def fit_restitution(t_s, theta_rad, block, window: str = "middle50", objective: 
     def problem(kind):
         a, b = window_span(kind)
         if kind not in probs:
-            probs[kind] = _Problem(t, y, block, theta0, dt_sim, max(b, tc[1]) - rel.t_s + 0.2)
+            probs[kind] = _Problem(t, y, block, theta0, dt_sim, max(b, tc[1]) - rel.t_s + 0.2,
+                                   offset=fit_offset)
         return probs[kind]
 
     def peaks_objective(kind, prob):
@@ -328,14 +339,23 @@ def fit_restitution(t_s, theta_rad, block, window: str = "middle50", objective: 
         return x, fx, f, idx, prob
 
     eta_hat, f_hat, f_main, idx_main, prob = fit_window(window, objective_used)
-    theta0_hat = theta0
+    theta0_hat, offset = theta0, 0.0
     if objective_used == "theta":
-        _, tr_hat, theta0_hat = prob.profile(eta_hat, idx_main, tr_bounds)
-        res = prob.residual(eta_hat, idx_main, tr_hat, theta0_hat)
+        _, tr_hat, theta0_hat, offset = prob.profile(eta_hat, idx_main, tr_bounds)
+        # θ0 enters linearly about the plateau level; a fitted level offset moves it by far more
+        # than the noise, so re-centre the linearisation and refit (outer Gauss-Newton steps)
+        for _ in range(4 if fit_offset else 0):
+            if abs(theta0_hat - theta0) < 2e-6:
+                break
+            theta0, g = theta0_hat, eta_hat
+            probs.clear()
+            eta_hat, f_hat, f_main, idx_main, prob = fit_window(window, objective_used)
+            _, tr_hat, theta0_hat, offset = prob.profile(eta_hat, idx_main, tr_bounds)
+        res = prob.residual(eta_hat, idx_main, tr_hat, theta0_hat, offset)
         win_res = res[t[idx_main] >= w0]
     else:
         q = problem("first")
-        _, tr_hat, theta0_hat = q.profile(eta_hat, np.flatnonzero(t < tc[0]), tr_bounds)
+        _, tr_hat, theta0_hat, offset = q.profile(eta_hat, np.flatnonzero(t < tc[0]), tr_bounds)
         ids, amp, half = idx_main
         res = win_res = prob.peaks_residual(eta_hat, amp, half, list(ids))
     if window == "first":
@@ -344,11 +364,13 @@ def fit_restitution(t_s, theta_rad, block, window: str = "middle50", objective: 
         # release and θ0 from the plateau and release quarter-cycle only (η-independent), so that
         # a misfit of the main window (η changing during rocking) cannot leak into η′_e
         q = problem("first")
-        _, tr_1, th0_1 = q.profile(eta_hat, np.flatnonzero(t < tc[0]), tr_bounds)
-        eta_first = fit_window("first", "theta", fixed=(tr_1, th0_1))[0]
+        _, tr_1, th0_1, c_1 = q.profile(eta_hat, np.flatnonzero(t < tc[0]), tr_bounds)
+        # with a fitted offset, keep the plateau level θ0 + c and take the main fit's offset
+        fixed = (tr_1, th0_1 + c_1 - offset, offset) if fit_offset else (tr_1, th0_1, 0.0)
+        eta_first = fit_window("first", "theta", fixed=fixed)[0]
     n_pts = int(res.size)
     rms = float(np.sqrt(np.mean(win_res ** 2))) if win_res.size else float("nan")
-    n_par = 4 if objective_used == "theta" else 1
+    n_par = (4 + int(fit_offset)) if objective_used == "theta" else 1
     s2 = f_hat / max(n_pts - n_par, 1)
     thresh = float(chi2.ppf(level, 1)) * s2 * _ac_factor(win_res)
     ci = _profile_ci(f_main, eta_hat, f_hat, thresh, lo_b, hi_b)
@@ -359,13 +381,15 @@ def fit_restitution(t_s, theta_rad, block, window: str = "middle50", objective: 
         at_bound.append("eta_e_first")
     if min(tr_hat - tr_bounds[0], tr_bounds[1] - tr_hat) < 1e-6:
         at_bound.append("release_t_s")
-    flags = _suspicion(t, y, win_res if objective_used == "theta" else np.array([]), rms, sigma, pie, tc, alpha)
+    flags = _suspicion(t, y - offset, win_res if objective_used == "theta" else np.array([]), rms, sigma, pie,
+                       tc, alpha)
     msg = f"{n_skip} NaN sample(s) skipped" if n_skip else ""
     return RestitutionFit(
         eta_e=float(eta_hat), eta_e_first=float(eta_first), ci95_eta_e=ci, theta0_rad=float(s0 * theta0_hat),
         release_t_s=float(tr_hat), rms_residual_rad=rms, sigma_theta_rad=float(rel.sigma_rad),
         per_impact_eta=tuple(float(x) for x in pie["eta_peaks"]), n_impacts=n_imp, window=window,
         objective=objective_used, window_t_s=(float(w0), float(w1)), n_points=n_pts, eta_bounds=(lo_b, hi_b),
+        theta_offset_rad=float(s0 * offset),
         block_name=name, suspicious=bool(flags), flags=tuple(flags), at_bound=tuple(at_bound), n_skipped=n_skip,
         n_evaluations=sum(q.n_sim for q in probs.values()), status="ok", message=msg, per_impact=pie)
 
@@ -408,5 +432,6 @@ def _suspicion(t, y, res, rms, sigma, pie, tc, alpha):
     if after.sum() >= 10:
         rest = float(np.median(y[after]))
         if abs(rest) > max(10 * sigma / math.sqrt(after.sum()) + 3 * sigma, 0.01 * alpha):
-            flags.append(f"block came to rest at {rest:+.4f} rad, not 0: it slipped or jumped")
+            flags.append(f"block came to rest at {rest:+.4f} rad, not 0: it slipped or jumped (or the level "
+                         "reference is off: try fit_offset=True)")
     return flags

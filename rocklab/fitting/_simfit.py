@@ -16,12 +16,13 @@ from scipy.optimize import brentq, minimize_scalar
 class _Problem:
     """Simulation-backed objective for one record (θ0 > 0 after sign normalisation).
 
-    For each η the release time is profiled by bounded Brent and θ0 by linear least
-    squares on the sensitivity ∂θ/∂θ0 (a second simulation at θ0 + h): both cost no
-    extra simulation per release-time trial.
+    For each η the release time is profiled by bounded Brent and θ0 (and optionally a
+    constant level offset of the measured angle) by linear least squares on the
+    sensitivity ∂θ/∂θ0 (a second simulation at θ0 + h): no extra simulation per
+    release-time trial.
     """
 
-    def __init__(self, t, y, block, theta0, dt_s, duration_s):
+    def __init__(self, t, y, block, theta0, dt_s, duration_s, offset=False):
         from ..models import simulate
 
         self._simulate = simulate
@@ -30,6 +31,7 @@ class _Problem:
         self.h = min(1e-3 * theta0, 0.5 * (block.alpha_rad - theta0))
         self.dt = dt_s
         self.duration = duration_s
+        self.offset = bool(offset)
         self.cache = {}
         self.n_sim = 0
 
@@ -66,35 +68,44 @@ class _Problem:
             return m0, None
         return m0, (self._at(r1, tau, self.theta0 + self.h) - m0) / self.h
 
+    def _linear(self, rr, S, n):
+        """Least-squares θ0 shift (column S) and level offset (column of ones) for residual rr."""
+        cols = ([S] if S is not None else []) + ([np.ones(n)] if self.offset else [])
+        if not cols:
+            return rr, 0.0, 0.0
+        A = np.column_stack(cols)
+        coef, *_ = np.linalg.lstsq(A, rr, rcond=None)
+        d = rr - A @ coef
+        dl = float(coef[0]) if S is not None else 0.0
+        c = float(coef[-1]) if self.offset else 0.0
+        return d, dl, c
+
     def profile(self, eta, idx, t_r_bounds, sens=True):
-        """min over release time (and θ0 if sens) of Σ (y − θ_sim)²: (sse, t_r, θ0)."""
+        """min over release time (θ0 if sens, level offset if enabled) of Σ (y − θ_sim)².
+
+        Returns (sse, t_r, θ0, offset)."""
         tt, yy = self.t[idx], self.y[idx]
 
         def inner(tr):
             m0, S = self.model(eta, tt, tr, sens)
-            rr = yy - m0
-            if S is None:
-                return float(rr @ rr), 0.0
-            ss = float(S @ S)
-            dl = float(S @ rr) / ss if ss > 0 else 0.0
-            d = rr - dl * S
-            return float(d @ d), dl
+            d, dl, c = self._linear(yy - m0, S, yy.size)
+            return float(d @ d), dl, c
 
         res = minimize_scalar(lambda tr: inner(tr)[0], bounds=t_r_bounds, method="bounded",
                               options=dict(xatol=1e-7))
-        sse, dl = inner(float(res.x))
-        return sse, float(res.x), self.theta0 + dl
+        sse, dl, c = inner(float(res.x))
+        return sse, float(res.x), self.theta0 + dl, c
 
-    def residual(self, eta, idx, t_r, theta0, sens=True):
-        """y − θ_sim at samples idx; θ0 enters linearly (sens) or exactly via a fresh run."""
+    def residual(self, eta, idx, t_r, theta0, offset=0.0, sens=True):
+        """y − offset − θ_sim at samples idx; θ0 enters linearly (sens) or exactly via a fresh run."""
         if not sens:
             key = ("fixed", round(float(eta), 12), float(theta0))
             r = self.cache.get(key)
             if r is None:
                 r = self.cache[key] = self._run(theta0, eta)
-            return self.y[idx] - self._at(r, self.t[idx] - t_r, theta0)
+            return self.y[idx] - offset - self._at(r, self.t[idx] - t_r, theta0)
         m0, S = self.model(eta, self.t[idx], t_r, True)
-        return self.y[idx] - (m0 + (theta0 - self.theta0) * S)
+        return self.y[idx] - offset - (m0 + (theta0 - self.theta0) * S)
 
     def peaks_residual(self, eta, data_amp, data_half, arch_ids):
         """Amplitude (rad) and half-period (scaled to rad by 2A/T) residuals of arches arch_ids."""

@@ -33,6 +33,8 @@ def register(sub):
     r.add_argument("--object", default=None, help="object id in tracks.csv (default: the only block)")
     r.add_argument("--window", choices=("middle50", "all", "first"), default="middle50")
     r.add_argument("--objective", choices=("theta", "peaks"), default="theta")
+    r.add_argument("--fit-offset", action="store_true",
+                   help="also fit a constant level offset of theta (camera level error, IMU bias)")
     r.add_argument("--nan", choices=("raise", "skip"), default="skip",
                    help="rows with NaN/not-ok samples: skip them (counted) or stop with an error")
     _common(r)
@@ -143,14 +145,15 @@ def _run_restitution(args) -> int:
     t, y, n_skip = _read_track(Path(args.track), args.object, args.nan)
     if n_skip:
         sys.stderr.write(f"rocklab fit restitution: skipped {n_skip} NaN/not-ok row(s)\n")
-    fit = fit_restitution(t, y, block, window=args.window, objective=args.objective, nan="raise")
+    fit = fit_restitution(t, y, block, window=args.window, objective=args.objective, nan="raise",
+                          fit_offset=args.fit_offset)
     d = fit.to_dict()
     d["n_skipped"] = n_skip
     keys = ("eta_e", "eta_e_first", "ci95_eta_e", "theta0_rad", "release_t_s", "rms_residual_rad",
             "per_impact_eta", "status")
     payload = {k: d[k] for k in keys}
     payload.update({k: d[k] for k in ("message", "suspicious", "flags", "n_impacts", "window", "objective",
-                                       "n_skipped")})
+                                       "n_skipped", "theta_offset_rad", "sigma_theta_rad", "at_bound")})
     _emit(args, payload, fit.report())
     return 0 if fit.ok else 1
 

@@ -240,3 +240,20 @@ def test_level_offset_fitted():
     assert not any("rest" in s for s in f.flags)
     plain = fit_restitution(t, y + off, B6M)  # without the offset the rest level gives it away
     assert plain.suspicious and any("fit_offset" in s for s in plain.flags)
+
+
+def test_campaign_table_groups_runs_and_feeds_k_table():
+    import dataclasses
+
+    from rocklab.fitting import campaign_table, k_table
+
+    t, y, _ = synthetic(13)
+    f = fit_restitution(t, y, B6M)
+    b2m = catalogue_block("B2M")
+    runs = [(B6M, dataclasses.replace(f, eta_e=v)) for v in (0.941, 0.942, 0.940, 0.99)]
+    runs += [(b2m, dataclasses.replace(f, eta_e=v)) for v in (0.67, 0.672)]
+    tab = campaign_table(runs).set_index("block")
+    assert tab.loc["B6M", "n_outliers"] == 1 and tab.loc["B6M", "eta_e"] == pytest.approx(0.941, abs=1e-12)
+    assert tab.loc["B2M", "eta_e"] == pytest.approx(0.671, abs=1e-12) and tab.loc["B2M", "n_used"] == 2
+    kt = k_table(tab.reset_index(), eta_mat=0.989, form=None)
+    assert set(kt.per_block.block) == {"B6M", "B2M"}

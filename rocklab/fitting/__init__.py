@@ -2,7 +2,8 @@
 
 Per experiment: :func:`fit_restitution` (constant η_e, η′_e, profile interval, suspicious-run
 flags), :func:`per_impact_eta` (data-only per-impact η), :func:`energy_loss_from_peaks`
-(thesis Eq. 12). Repeats: :func:`fit_many`, :func:`summarize_repeats`. Campaign:
+(thesis Eq. 12). Repeats: :func:`fit_many`, :func:`summarize_repeats`, :func:`campaign_table` (per-block
+η_e table for the campaign functions). Campaign:
 :func:`fit_eta_mat` (Eq. 16), :func:`k_table` (Eq. 17–18), :func:`fit_k_regression`
 (Eq. 19) and :meth:`KRegression.predict`. Čeh's tables ship as package data
 (:func:`ceh_catalogue`, :func:`catalogue_block`).
@@ -14,7 +15,7 @@ from ._impacts import (EnergyLoss, ReleaseInfo, arch_peaks, check_record, detect
                        find_crossings, per_impact_eta)
 from ._laws import alpha_from_hb, edge_contact_k, eta_housner, eta_modified, k_from_eta
 from ._regression import CEH_EQ19, REGRESSION_FORMS, KPrediction, KRegression, fit_k_regression
-from ._repeats import RepeatSummary, fit_many, summarize_repeats
+from ._repeats import RepeatSummary, campaign_table, fit_many, summarize_repeats
 from ._restitution import OBJECTIVES, WINDOWS, RestitutionFit, fit_restitution
 
 __all__ = [
@@ -23,7 +24,7 @@ __all__ = [
     "per_impact_eta", "energy_loss_from_peaks", "EnergyLoss", "detect_release", "ReleaseInfo",
     "find_crossings", "arch_peaks", "check_record",
     # repeats
-    "fit_many", "summarize_repeats", "RepeatSummary",
+    "fit_many", "summarize_repeats", "RepeatSummary", "campaign_table",
     # campaign
     "fit_eta_mat", "EtaMatResult", "ETA_MAT_RULES", "k_table", "KTableResult", "read_block_table",
     "fit_k_regression", "KRegression", "KPrediction", "REGRESSION_FORMS", "CEH_EQ19",

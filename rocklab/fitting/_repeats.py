@@ -8,7 +8,7 @@ import numpy as np
 
 from ._restitution import RestitutionFit, fit_restitution
 
-__all__ = ["RepeatSummary", "summarize_repeats", "fit_many"]
+__all__ = ["RepeatSummary", "summarize_repeats", "fit_many", "campaign_table"]
 
 
 @dataclass(frozen=True)
@@ -144,3 +144,34 @@ def fit_many(runs, block=None, progress: bool = False, **kwargs) -> list:
         b = rest[0] if rest else block
         out.append(fit_restitution(t, y, b, **kwargs))
     return out
+
+
+def campaign_table(results, z_max: float = 3.5):
+    """Per-block η_e table from many fitted runs, ready for :func:`fit_eta_mat` / :func:`k_table`.
+
+    Parameters
+    ----------
+    results : iterable of (Block, RestitutionFit)
+        Runs of a campaign; runs of the same block are grouped by ``block.name`` (or by
+        its width and height when unnamed) and averaged with :func:`summarize_repeats`
+        (failed fits and outliers dropped).
+    z_max : float
+        Outlier threshold (robust z-score).
+
+    Returns
+    -------
+    DataFrame ``block, b_m, h_m, eta_e, eta_e_std, n_runs, n_used, n_outliers`` (SI).
+    """
+    import pandas as pd
+
+    groups: dict = {}
+    for blk, fit in results:
+        key = blk.name or f"b{blk.b_m:g}_h{blk.h_m:g}"
+        groups.setdefault(key, (blk, []))[1].append(fit)
+    rows = []
+    for key, (blk, fits) in groups.items():
+        s = summarize_repeats(fits, z_max=z_max)
+        rows.append(dict(block=key, b_m=blk.b_m, h_m=blk.h_m, eta_e=s.mean, eta_e_std=s.std, n_runs=s.n,
+                         n_used=s.n_used, n_outliers=len(s.outliers)))
+    return pd.DataFrame(rows, columns=["block", "b_m", "h_m", "eta_e", "eta_e_std", "n_runs", "n_used",
+                                       "n_outliers"])

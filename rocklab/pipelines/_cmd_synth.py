@@ -33,6 +33,10 @@ def register(sub):
     p.add_argument("--occlusion", default=None, metavar="T0,T1",
                    help="hide block_1 behind a dark patch from T0 to T1 s")
     p.add_argument("--rolling-shutter", action="store_true", help="rolling-shutter readout")
+    p.add_argument("--exposure", type=float, default=None, metavar="S",
+                   help="shutter time, s (default half a frame period; 0: no motion blur)")
+    p.add_argument("--noise", type=float, default=1.0, metavar="DN",
+                   help="sensor noise sigma, grey levels (default 1)")
     p.add_argument("--no-imu", action="store_true", help="do not write IMU logs")
     p.add_argument("--uncalibrated", action="store_true",
                    help="leave the camera matrix, distortion and plane homography out of track.toml "
@@ -63,6 +67,7 @@ def run(args) -> int:
                       size=size, targets=args.targets, duration_s=args.duration, occlusion=occ,
                       rolling_shutter=args.rolling_shutter, record=args.record, imu=not args.no_imu,
                       layout=args.layout, calibrated=not args.uncalibrated, force=args.force,
+                      exposure_s=args.exposure, noise_dn=args.noise,
                       progress=args.progress)
     d = s.to_dict()
     if args.json:

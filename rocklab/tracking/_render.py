@@ -215,7 +215,7 @@ class Renderer:
     def _occluder_boxes(self, t_s):
         out = []
         for oc in self.occluders:
-            obj = next((o for o in self.moving if o.id == oc.object), None)
+            obj = next((o for o in self.order if o.id == oc.object), None)
             if obj is None or not (oc.t0_s <= t_s < oc.t1_s):
                 continue
             box = self._bbox(obj, np.linspace(oc.t0_s, oc.t1_s, 25))

@@ -121,7 +121,7 @@ def parse_size(text) -> tuple[int, int]:
     return size
 
 
-def _check(seed, blocks, table, fps, targets, duration_s, exposure_s):
+def _check(seed, blocks, table, fps, targets, duration_s, exposure_s, noise_dn):
     if not isinstance(seed, (int, np.integer)) or isinstance(seed, bool) or seed < 0:
         raise InputError(f"seed={seed!r}: must be a non-negative integer")
     if blocks not in (1, 3):
@@ -134,6 +134,8 @@ def _check(seed, blocks, table, fps, targets, duration_s, exposure_s):
         raise InputError(f"fps={fps!r}: must be a frame rate between 1 and 2000")
     if duration_s is not None and not (math.isfinite(duration_s) and 0 < duration_s <= 120):
         raise InputError(f"duration={duration_s!r}: must be between 0 and 120 s")
+    if not (isinstance(noise_dn, (int, float)) and 0 <= noise_dn <= 50):
+        raise InputError(f"noise={noise_dn!r}: sensor noise must be between 0 and 50 grey levels")
     if exposure_s is not None and not (0 <= exposure_s <= 1.0 / fps):
         raise InputError(f"exposure_s={exposure_s!r}: must be between 0 and one frame (1/fps s)")
 
@@ -221,7 +223,7 @@ def synth_session(out_dir, seed: int = 0, blocks: int = 1, table: str = "none", 
 
     size = parse_size(size)
     fps = float(fps) if isinstance(fps, (int, float, np.number)) and not isinstance(fps, bool) else fps
-    _check(seed, blocks, table, fps, targets, duration_s, exposure_s)
+    _check(seed, blocks, table, fps, targets, duration_s, exposure_s, noise_dn)
     out_dir = Path(out_dir)
     tmp = _prepare_out(out_dir, force)
     t_start = time.perf_counter()

@@ -310,6 +310,10 @@ def build_scene(*, seed, blocks, table, fps, size, targets, duration_s, occlusio
         else:
             t0, t1 = (float(v) for v in occlusion)
             occl.append(Occluder("block_1", t0, t1))
+    ids = [o.id for o in objects]
+    for oc in occl:
+        if oc.object not in ids or not oc.t1_s > oc.t0_s:
+            raise InputError(f"occlusion={occlusion!r}: needs an object among {', '.join(ids)} and t1_s > t0_s")
     exposure = 0.5 / fps if exposure_s is None else float(exposure_s)
     params = {"blocks": blocks, "table": table, "fps": fps, "size": list(size), "targets": targets,
               "duration_s": duration_s, "rolling_shutter": rolling_shutter, "restitution": restitution,

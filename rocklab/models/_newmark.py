@@ -63,14 +63,6 @@ def _f(th, s, ug, p2, alpha, lin):
 
 
 @njit(cache=True, inline="always")
-def _df(th, s, ug, p2, alpha, lin):
-    if lin:
-        return p2
-    c = alpha * s - th
-    return p2 * (math.cos(c) - ug * math.sin(c))
-
-
-@njit(cache=True, inline="always")
 def _shift(sc0, cc0, d):
     """sin and cos of (c0 - d) from sin c0, cos c0 for an increment |d| < 0.2.
 
@@ -256,12 +248,15 @@ def run_block(p, alpha, theta0, omega0, h, n_steps, acc, acc_t0, acc_dt, scale,
 
     Returns
     -------
-    out_theta, out_omega, out_energy : (n_out,) samples at every ``out_every``-th step
-    (t = i*h*out_every); energy above rest per unit I_O, rad^2/s^2 (J = I_O * this), n_out, imp (4, n_imp) rows t_s, omega_before, omega_after, eta (first imp_cap impacts),
-    n_imp (all impacts), status, t_over (first |theta| >= alpha outward, nan),
-    t_fall (first step end with |theta| >= fall_rad, nan), max_abs_theta, t_end (s, last time
-    integrated). The run always ends at |theta| = pi/2 (the side hits the ground) and at
-    fall_rad when stop_on_fall.
+    tuple
+        ``out_theta, out_omega, out_energy`` (n_out,): samples at every
+        ``out_every``-th step (t = i h out_every), energy above rest per unit I_O
+        (rad^2/s^2, J = I_O * this); ``n_out``; ``imp`` (4, k): rows t_s,
+        omega_before, omega_after, eta of the first ``imp_cap`` impacts; ``n_imp``
+        (all impacts); ``status`` code; ``t_over`` (first |theta| >= alpha outward,
+        NaN); ``t_fall`` (|theta| reached fall_rad, NaN); ``max_abs_theta``;
+        ``t_end`` (s, last time integrated). The run always ends when |theta|
+        reaches pi/2 (the side hits the ground), and at fall_rad when stop_on_fall.
     """
     p2 = p * p
     tan_a = math.tan(alpha)
@@ -358,7 +353,10 @@ def run_block(p, alpha, theta0, omega0, h, n_steps, acc, acc_t0, acc_dt, scale,
                 tau = _contact_tau(th, w, a, s, rem, u_c, u1, p2, alpha, lin)
                 if tau > rem:
                     tau = rem
-                w_m = -2.0 * th / tau - w  # Eq. 10
+                if th == 0.0 or tau <= 0.0:
+                    w_m = -w  # Eq. 10 with theta_n = 0 (back at the corner after a short flight)
+                else:
+                    w_m = -2.0 * th / tau - w  # Eq. 10
                 ti = tc + tau
                 u_i = u_c + (u1 - u_c) * (tau / rem)
                 if eta_mode == 1:

@@ -10,15 +10,15 @@ import pytest
 from rocklab.tracking import load_track_config, track_video
 
 
-@pytest.fixture(scope="module")
-def sine_session(tmp_path_factory):
+@pytest.fixture(scope="module", params=["aruco", "dots", "edges"])
+def sine_session(tmp_path_factory, request):
     from rocklab.tracking import synth_session
 
-    out = tmp_path_factory.mktemp("synth") / "sine"
+    out = tmp_path_factory.mktemp("synth") / request.param
     # 640x360 keeps the test short; the 45 mm / 0.6 s sine pulse of thesis Fig. 31 at 50 fps,
     # block_1 hidden for 0.5 s while the table is at rest.
     synth_session(out, seed=3, table="sine", size=(640, 360), duration_s=1.8, imu=False,
-                  mp4=False, occlusion=(0.05, 0.55))
+                  mp4=False, occlusion=(0.05, 0.55), targets=request.param)
     cfg = load_track_config(out / "track.toml")
     res = track_video(out / "video.mkv", cfg)
     truth = pd.read_csv(out / "truth.csv")

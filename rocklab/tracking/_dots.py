@@ -119,6 +119,10 @@ class DotDetector:
             return None
         q = self.pm.to_plane(blobs[:, :2])
         qc = q[:, 0] + 1j * q[:, 1]
+        # blob diameters in plane units (the plane may be metric, the blobs are in px)
+        half = np.column_stack((blobs[:, 2] / 2, np.zeros(len(blobs))))
+        d_plane = np.hypot(*(self.pm.to_plane(blobs[:, :2] + half)
+                             - self.pm.to_plane(blobs[:, :2] - half)).T)
         pc = lay[:, 0] + 1j * lay[:, 1]
         j = int(np.argmax(np.abs(pc - pc[0])))
         dmed = np.median(blobs[:, 2])
@@ -131,7 +135,7 @@ class DotDetector:
                 z = (qc[b] - qc[a]) / (pc[j] - pc[0])
                 if abs(np.angle(z)) > 0.6:
                     continue  # the block starts near upright
-                if dot_d is not None and not 0.6 < blobs[a, 2] / (abs(z) * dot_d) < 1.6:
+                if dot_d is not None and not 0.6 < d_plane[a] / (abs(z) * dot_d) < 1.6:
                     continue
                 pred = z * (pc - pc[0]) + qc[a]
                 dist = np.abs(pred[:, None] - qc[None, :])

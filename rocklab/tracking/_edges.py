@@ -172,7 +172,15 @@ def horizontal_edge_angle(gray, roi, plane_map):
 
 
 class EdgeDetector:
-    """Stateful detector for the ``edges`` style (blocks; tables via :class:`RegionTracker`)."""
+    """Stateful detector for the ``edges`` style.
+
+    Blocks: outline by threshold (Otsu or ``targets.edge_threshold``). Tables
+    with ``size_m``: outline as the region whose grey stays near the table's
+    own (measured in the middle of its ``roi`` in the first frame), so a
+    brighter block standing on it and the darker surroundings are both
+    excluded; their ends give the horizontal motion, their top the level.
+    Tables without ``size_m``: :class:`RegionTracker`.
+    """
 
     def __init__(self, config, plane_map, first_gray):
         self.cfg = config
@@ -180,8 +188,16 @@ class EdgeDetector:
         self.thr = config.targets.edge_threshold
         self.state = {}
         self.regions = {}
+        self.band = {}
         for o in config.objects:
-            if o.kind == "table":
+            if o.kind == "table" and o.size_m is not None:
+                u, v, w, h = (int(round(x)) for x in o.roi)
+                crop = first_gray[max(v, 0):v + h, max(u, 0):u + w]
+                hh, ww = crop.shape
+                level = float(np.median(crop[hh // 3:2 * hh // 3, ww // 4:3 * ww // 4]))
+                border = float(np.median(np.r_[crop[0], crop[-1]]))
+                self.band[o.id] = (level, max(0.5 * abs(level - border), 8.0))
+            elif o.kind == "table":
                 if o.theta0_rad is None:
                     import dataclasses
 
@@ -203,6 +219,11 @@ class EdgeDetector:
         if x1 - x0 < 8 or y1 - y0 < 8:
             return None
         crop = gray[y0:y1, x0:x1]
+        if oid in self.band:
+            level, band = self.band[oid]
+            binary = (np.abs(crop.astype(np.float32) - level) < band).astype(np.uint8) * 255
+            binary = cv2.morphologyEx(binary, cv2.MORPH_OPEN, np.ones((3, 3), np.uint8))
+            return self._largest_rect(binary, x0, y0)
         if oid not in self.polarity:
             h, w = crop.shape
             centre = np.median(crop[h // 3:2 * h // 3, w // 3:2 * w // 3])
@@ -214,6 +235,12 @@ class EdgeDetector:
             _, binary = cv2.threshold(crop, self.thr, 255, cv2.THRESH_BINARY)
         if not self.polarity[oid]:
             binary = 255 - binary
+        return self._largest_rect(binary, x0, y0)
+
+    @staticmethod
+    def _largest_rect(binary, x0, y0):
+        import cv2
+
         n, lab, stats, _ = cv2.connectedComponentsWithStats(binary, connectivity=4)
         if n < 2:
             return None

@@ -78,6 +78,12 @@ class RestitutionFit:
         Search bounds; ``at_bound`` lists parameters that ended on one.
     suspicious : bool
         True when slip/jump/misfit symptoms were found; ``flags`` says which.
+    n_skipped : int
+        NaN samples dropped (``nan="skip"``).
+    n_evaluations : int
+        Simulations run by the fit.
+    per_impact : DataFrame
+        Full :func:`~rocklab.fitting.per_impact_eta` table (not in ``to_dict``).
     status : "ok" | "failed";  message : reason when failed, notes otherwise
     """
 
@@ -138,7 +144,7 @@ class RestitutionFit:
         lines = [
             "[[Fit Statistics]]",
             "    # fitting method   = peaks start, grid + bounded Brent on eta; release time and theta0 profiled",
-            f"    # function evals   = {self.n_evaluations}",
+            f"    # simulations      = {self.n_evaluations}",
             f"    # data points      = {self.n_points}",
             f"    # impacts (data)   = {self.n_impacts}",
             f"    window             = {self.window} ({self.window_t_s[0]:.3f}-{self.window_t_s[1]:.3f} s)",

@@ -238,4 +238,23 @@ def test_output_decimation_and_no_stop(b6m_pair):
     after = full.t_s > nm.t_s[-1]
     assert np.all(full.theta_rad[after] == 0.0) and np.all(full.energy_J[after] == 0.0)
     with pytest.raises(InputError):
-        simulate(B6M, 0.1, dt_s=1e-4, output_dt_s=1.5e-4)
+        simulate(B6M, 0.1, dt_s=1e-4, output_dt_s=0.5e-4)
+
+
+def test_frame_rate_output_and_at_hermite():
+    # a camera at 60 fps: 1/60 s is no multiple of dt, so samples come from RockingResult.at
+    a = B6M.alpha_rad
+    nm = simulate(B6M, 0.7 * a, duration_s=2.0, dt_s=1e-4, output_dt_s=1 / 60)
+    ev = simulate(B6M, 0.7 * a, duration_s=2.0, dt_s=1 / 60, method="event")  # dense output
+    n = min(len(nm.t_s), len(ev.t_s))
+    assert n >= 100 and np.allclose(nm.t_s[:n], ev.t_s[:n], atol=1e-12)
+    assert np.max(np.abs(nm.theta_rad[:n] - ev.theta_rad[:n])) < 2e-6
+    assert np.median(np.abs(nm.omega_rad_s[:n] - ev.omega_rad_s[:n])) < 1e-5
+    # at() reproduces the stored samples and keeps the impact velocity jump
+    full = simulate(B6M, 0.7 * a, duration_s=2.0, dt_s=1e-4)
+    th, w = full.at(full.t_s[100:110])
+    assert np.allclose(th, full.theta_rad[100:110], rtol=0, atol=1e-15)
+    ti, wb, wa = full.impacts_array[:3, 0]
+    th, w = full.at([ti - 1e-9, ti + 1e-9])
+    assert w == pytest.approx([wb, wa], rel=1e-4) and np.all(np.abs(th) < 1e-8)
+    assert np.isnan(full.at([-1.0])[0][0])

@@ -25,6 +25,7 @@ Rules (both integrators):
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -104,7 +105,9 @@ def simulate(block, theta0_rad: float = 0.0, omega0_rad_s: float = 0.0, duration
     stop_at_rest : bool
         Stop the output when the block is at rest for good (see module doc).
     output_dt_s : float, optional
-        Output spacing, s; a multiple of ``dt_s`` for newmark (default ``dt_s``).
+        Output spacing, s (default ``dt_s``). A whole multiple of ``dt_s`` keeps
+        every k-th step; any other value (a camera frame interval, say) is
+        resampled from every step by :meth:`RockingResult.at`.
     linearized : bool
         Integrate the linearised equation (DeJong Eq. 5), e.g. for closed forms.
     rest_tol : float
@@ -149,13 +152,16 @@ def simulate(block, theta0_rad: float = 0.0, omega0_rad_s: float = 0.0, duration
         raise InputError(f"fall_rad={fall}: must be between alpha = {alpha:.6g} and pi/2 rad")
     law = make_restitution(restitution, block, **law_params)
     acc, acc_t0, acc_dt = _base_arrays(base)
-    if output_dt_s is None:
-        every = 1
-    else:
+    every, resample = 1, None
+    if output_dt_s is not None:
         odt = _finite("output_dt_s", output_dt_s, positive=True)
-        every = int(round(odt / dt))
-        if every < 1 or abs(every * dt - odt) > 1e-9 * odt:
-            raise InputError(f"output_dt_s={odt}: must be a whole multiple of dt_s={dt}")
+        if odt < dt:
+            raise InputError(f"output_dt_s={odt}: must be >= dt_s={dt}")
+        k = int(round(odt / dt))
+        if abs(k * dt - odt) <= 1e-9 * odt:
+            every = k
+        else:
+            resample = odt  # e.g. a camera frame rate: store every step, then Hermite (RockingResult.at)
     p = block.p_rad_s
     rest_w2 = 2.0 * p * p * (math.cos(alpha - rest_tol * alpha) - math.cos(alpha))
     n_steps = int(math.ceil(T / dt - 1e-9))
@@ -186,9 +192,17 @@ def simulate(block, theta0_rad: float = 0.0, omega0_rad_s: float = 0.0, duration
     for a in (t, th, w, imp_cols):
         a.setflags(write=False)
     E.setflags(write=False)
-    return RockingResult(t_s=t, theta_rad=th, omega_rad_s=w, energy_J=E, impacts_array=imp_cols,
-                         status=status, overturned=status == "overturned",
-                         overturn_t_s=float(t_over), fall_t_s=float(t_fall),
-                         max_abs_theta_rad=float(max_abs), block=block, restitution=law, method=meth,
-                         dt_s=dt, n_impacts=int(n_imp), linearized=bool(linearized),
-                         base_name=base.name if base is not None else "")
+    res = RockingResult(t_s=t, theta_rad=th, omega_rad_s=w, energy_J=E, impacts_array=imp_cols,
+                        status=status, overturned=status == "overturned",
+                        overturn_t_s=float(t_over), fall_t_s=float(t_fall),
+                        max_abs_theta_rad=float(max_abs), block=block, restitution=law, method=meth,
+                        dt_s=dt, n_impacts=int(n_imp), linearized=bool(linearized),
+                        base_name=base.name if base is not None else "")
+    if resample is None:
+        return res
+    t2 = np.arange(int(math.floor(t[-1] / resample + 1e-9)) + 1) * resample
+    th2, w2 = res.at(t2)
+    E2 = block_energy(block, th2, w2, linearized)
+    for a in (t2, th2, w2, E2):
+        a.setflags(write=False)
+    return dataclasses.replace(res, t_s=t2, theta_rad=th2, omega_rad_s=w2, energy_J=E2)

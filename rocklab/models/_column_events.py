@@ -120,7 +120,7 @@ def opening_model(phi, v, s, px, t, dt, blk, par, accb, max_enum, s_out, px_out)
         # fallback: the closed joint with the largest eccentricity excess opens alone
         reactions(dj, k_open, PP, np.zeros(max(k_open, 1)), G, C, thlow, blk, aq, ug, g, N, V, Mc, Fs)
         worst = -1
-        wv = 0.0
+        wv = -np.inf  # called because a thrust reached its edge: the largest excess may be ~0
         for c in range(nc):
             j = closed[c]
             # accelerations of the open joints matter little for the choice of joint

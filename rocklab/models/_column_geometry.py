@@ -189,7 +189,6 @@ def column_impact(column, closing_joint: int, omega_rad_s, states, theta_rad=Non
     if s[jc] * v[jc] >= 0:
         raise InputError(f"omega_rad_s[{jc}]: the closing joint must move towards closed")
     par = np.array([G_STD, math.inf, 0.0, 1.0, 1.0, 1e-14, 0.0, 0.0])
-    dj = np.arange(n)
     ke_b = _ke(column, phi, v, s, px)
     v_b = v.copy()
     px0, sgn = px[jc], (1.0 if v[jc] > 0 else -1.0)
@@ -203,7 +202,6 @@ def column_impact(column, closing_joint: int, omega_rad_s, states, theta_rad=Non
         s, px, v = s_new.copy(), px_new.copy(), v_new.copy()
         if s[jc] == 0:
             break
-    del dj
     names = {0: "closed", -1: "cw", 1: "ccw"}
     return ImpactOutcome(tuple(names[int(x)] for x in s_b), tuple(names[int(x)] for x in s), -v_b, -v,
                          np.cumsum(-v), float(ke_b), float(ke_a), float(1 - ke_a / ke_b))

@@ -22,6 +22,16 @@ Definition choices the thesis leaves open are options (defaults first):
   search from small blocks upward would find it).
 - ``levels``, ``sizes``, ``refine``: grid density and bisection steps.
 - ``eta``: restitution; ``None`` = Housner's 1 - 2 sin^2(alpha)/alpha_I.
+- ``engine``: ``"rk4"`` (this module's kernel) or ``"batch"`` (``simulate_batch``).
+
+How much each choice moves t_I (measured, H/B = 12, FEMA FF-1 / FF-2; thesis Table 4
+0.266 / 0.360 s): defaults 0.336 / 0.348 s; ``criterion="fall"``, ``free="none"`` or
+10 s, RK4 step p h = 0.03: no change; ``engine="batch"`` 0.320 / 0.327; ``search=
+"contiguous"`` 0.271 / 0.324; ``refine=0`` 0.324 / 0.348; 160 levels 0.299 / 0.365;
+240 sizes 0.346 / 0.381; ``eta=0.95`` 0.289 / 0.304. t_I is the minimum over a
+fractal-like boundary (bays, islands, chaotic verdicts at the boundary), so grid
+density and integrator alone move it by ~10 %; the overturning criterion and the
+free-rocking rule do not matter for slender blocks.
 """
 
 from __future__ import annotations
@@ -158,7 +168,7 @@ def overturning_spectrum(base: BaseMotion, slenderness: float = 12.0, *, levels:
                          level_max: float = 10.0, sizes: int = 120, R_max_m: float = 1000.0,
                          R_min_m: float = 0.1, refine: int = 10, criterion: str = "angle",
                          free="energy", search: str = "scan", alpha_I: float = 4.0 / 3.0,
-                         eta: float | None = None, h_ph: float = 0.1) -> OASResult:
+                         eta: float | None = None, h_ph: float = 0.1, engine: str = "rk4") -> OASResult:
     """OAS, transformed OAS, t_I, t'_I and beta of a record for one block slenderness.
 
     Parameters
@@ -178,7 +188,13 @@ def overturning_spectrum(base: BaseMotion, slenderness: float = 12.0, *, levels:
     alpha_I : float
         Inertia coefficient I_O/(m R^2) (thesis Eq. 22).
     h_ph : float
-        Largest RK4 step times p (accuracy; 0.1 changes t_I by < 0.1 %).
+        Largest RK4 step times p (engine ``rk4``).
+    engine : {"rk4", "batch"}
+        ``rk4``: the OAS kernel of ``_oas_kernel`` (RK4, exact impacts, early exit and the
+        exact free-rocking verdict at the record end). ``batch``: the general
+        :func:`rocklab.models.simulate_batch` (Newmark, p h <= 0.02); it returns no end
+        state, so ``free="energy"`` becomes 10 s of free rocking there. Both agree on
+        ~99 % of the grid (the rest sits on the chaotic boundary), see benchmarks/bench_oas.py.
 
     Returns
     -------
@@ -202,8 +218,10 @@ def overturning_spectrum(base: BaseMotion, slenderness: float = 12.0, *, levels:
     R = np.geomspace(R_max_m, R_min_m, int(sizes))
     p = np.sqrt(G / (alpha_I * R))
     scales = lv * math.tan(alpha) / float(np.max(np.abs(acc)))
-    args = (alpha, eta_v, _CRIT[criterion], free_code, free_s, h_ph)
-    over, _ = run_grid(acc, dt, scales, p, *args)
+    if engine not in ("rk4", "batch"):
+        raise InputError(f"engine={engine!r}: use 'rk4' or 'batch'")
+    args = (alpha, eta_v, _CRIT[criterion], free_code, free_s, h_ph, engine, base)
+    over = _runs(acc, dt, np.repeat(scales, p.size), np.tile(p, scales.size), args).reshape(scales.size, p.size)
 
     # largest unsafe grid size per level
     k = np.full(lv.size, -1)
@@ -226,11 +244,27 @@ def overturning_spectrum(base: BaseMotion, slenderness: float = 12.0, *, levels:
     tIp, beta = fit_inclined_line(f, lv)
     opts = dict(levels=int(levels), level_max=float(level_max), sizes=int(sizes), R_max_m=float(R_max_m),
                 R_min_m=float(R_min_m), refine=int(refine), criterion=criterion, free=free,
-                search=search, h_ph=h_ph)
+                search=search, h_ph=h_ph, engine=engine)
     return OASResult(levels=lv, R_m=R, p_rad_s=p, overturned=over, p_min_rad_s=p_hi,
                      R_unsafe_max_m=G / (alpha_I * p_hi ** 2), f_rad_s=f, f_min_rad_s=f_min,
                      t_I_s=t_I, t_I_prime_s=tIp, beta=beta, i_cr=icr, alpha_rad=alpha,
                      alpha_I=float(alpha_I), eta=eta_v, name=base.name, options=opts)
+
+
+def _runs(acc, dt, scale, p, args):
+    """Overturned flags of independent runs (record ``acc`` in g times ``scale``, blocks ``p``)."""
+    alpha, eta, crit, free_code, free_s, h_ph, engine, base = args
+    if engine == "rk4":
+        m = scale.size
+        o, _, _, _ = run_batch(acc, dt, scale, p, np.full(m, alpha), np.full(m, eta), crit, free_code,
+                               free_s, h_ph)
+        return o
+    from ._batch import simulate_batch
+
+    after = {0: 0.0, 1: 10.0, 2: free_s}[free_code]
+    # scale multiplies the record in g (rk4) or in m/s^2 (simulate_batch): the same factor
+    b = simulate_batch(p, alpha, base=base, scale=scale, eta=eta, dt_s=dt, free_after_s=after, fall_rad=alpha if crit == 0 else None)
+    return np.asarray(b.overturned, bool)
 
 
 def _bisect(acc, dt, scales, p_hi, p_lo, n, args):
@@ -240,12 +274,10 @@ def _bisect(acc, dt, scales, p_hi, p_lo, n, args):
     m = np.isfinite(p_hi) & np.isfinite(p_lo)
     if not m.any():
         return p_hi, p_lo
-    alpha, eta = args[0], args[1]
     idx = np.flatnonzero(m)
     for _ in range(int(n)):
         pm = np.sqrt(p_hi[idx] * p_lo[idx])
-        o, _, _, _ = run_batch(acc, dt, scales[idx], pm, np.full(idx.size, alpha), np.full(idx.size, eta),
-                               *args[2:])
+        o = _runs(acc, dt, scales[idx], pm, args)
         p_hi[idx] = np.where(o, pm, p_hi[idx])
         p_lo[idx] = np.where(o, p_lo[idx], pm)
     return p_hi, p_lo

@@ -1,15 +1,230 @@
-"""``rocklab pulse|oas|design|equivalent``: not implemented yet (overturning issue open)."""
+"""``rocklab pulse|oas|design|equivalent``: record pulses, OAS and t_I, pier design, equivalent blocks.
+
+- ``rocklab pulse RECORD [--units g]`` → a_max_m_s2, I_max_m_s, t_p_s (thesis Eq. 16, 25)
+- ``rocklab oas RECORD... --slenderness 12 [--levels 80] [--sizes 120] [-o oas.csv] [--plot oas.png]``
+  → t_I_s, t_I_prime_s, beta, f_min (thesis §5.1.3, §5.3); several records run in
+  parallel (``--workers``, or ``--scheduler ADDR`` for Dask) and ``-o`` is then the
+  summary table ``record, t_p_s, t_I_s, t_I_prime_s, beta, f_min, error``.
+- ``rocklab design --height 12 --ag 0.14 --tI 0.7 [--mass-at-top]`` → width_m (Eq. 21/23)
+- ``rocklab equivalent block|strut|frame|wall|asym-frame|arch ...`` → p_rad_s, theta_cr_rad,
+  lambda, eta, kappa1, kappa2 (DeJong & Dimitrakopoulos 2014)
+"""
 
 from __future__ import annotations
+
+import json
+import math
+import sys
 
 from .._errors import InputError
 
 
-def register(sub):
-    for c in ("pulse", "oas", "design", "equivalent"):
-        p = sub.add_parser(c, help="(not implemented yet)")
-        p.set_defaults(func=run)
+def _dumps(obj) -> str:
+    def clean(v):
+        if isinstance(v, float) and not math.isfinite(v):
+            return None
+        if isinstance(v, dict):
+            return {k: clean(x) for k, x in v.items()}
+        if isinstance(v, (list, tuple)):
+            return [clean(x) for x in v]
+        if hasattr(v, "item"):
+            return clean(v.item())
+        return v
+    return json.dumps(clean(obj))
 
+
+def register(sub):
+    p = sub.add_parser("pulse", help="pulse parameters of a record (a_max, I_max, t_p)")
+    p.add_argument("record")
+    p.add_argument("--units", default=None, help="units of a headerless record (g, m/s2, cm/s2)")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.set_defaults(func=run)
+
+    p = sub.add_parser("oas", help="Overturning Acceleration Spectrum and t_I of record(s)")
+    p.add_argument("record", nargs="+")
+    p.add_argument("--units", default=None)
+    p.add_argument("--slenderness", type=float, default=12.0, help="block h/b (default 12)")
+    p.add_argument("--levels", type=int, default=80, help="a_p/a_p,min levels 1..level-max (80)")
+    p.add_argument("--level-max", type=float, default=10.0)
+    p.add_argument("--sizes", type=int, default=120, help="log-spaced R from 1000 m to 0.1 m (120)")
+    p.add_argument("--refine", type=int, default=10, help="bisection steps on the boundary (10)")
+    p.add_argument("--criterion", choices=("angle", "fall"), default="angle")
+    p.add_argument("--free", default="energy", help="after the record: energy | none | SECONDS")
+    p.add_argument("--search", choices=("scan", "contiguous"), default="scan")
+    p.add_argument("--eta", type=float, default=None, help="restitution (default Housner)")
+    p.add_argument("-o", "--out", default=None, help="CSV: OAS boundary (one record) or summary table")
+    p.add_argument("--plot", default=None, help="PNG with OAS, transformed OAS, 1/p view (one record)")
+    p.add_argument("--workers", type=int, default=None, help="local processes for several records")
+    p.add_argument("--scheduler", default=None, help="Dask distributed scheduler address")
+    p.add_argument("--no-progress", action="store_true")
+    p.add_argument("--json", action="store_true")
+    p.set_defaults(func=run)
+
+    p = sub.add_parser("design", help="pier width for a PGA and t_I (thesis Eq. 21/23)")
+    p.add_argument("--height", type=float, required=True, help="pier height H, m")
+    p.add_argument("--ag", type=float, required=True, help="design PGA, g")
+    p.add_argument("--tI", type=float, required=True, help="replacement impulse duration, s")
+    p.add_argument("--mass-at-top", action="store_true", help="mass on top of a weightless pier")
+    p.add_argument("--alpha-I", type=float, default=None, help="I_O/(m R^2) (4/3 solid, 1 mass on top)")
+    p.add_argument("--cm-ratio", type=float, default=None, help="centre-of-mass height / H")
+    p.add_argument("--g", type=float, default=None, help="gravity, m/s^2 (default 9.80665)")
+    p.add_argument("--json", action="store_true")
+    p.set_defaults(func=run)
+
+    p = sub.add_parser("equivalent", help="equivalent-block parameters of a rocking mechanism")
+    p.add_argument("mechanism", choices=("block", "strut", "frame", "wall", "asym-frame", "arch"))
+    p.add_argument("--R", type=float, help="corner-to-centre distance of the (column/wall) block, m")
+    p.add_argument("--alpha", type=float, help="slenderness angle, rad")
+    p.add_argument("--b", type=float, help="width b (block) or half-width (asym-frame), m")
+    p.add_argument("--h", type=float, help="height h (block) or beam half-depth (asym-frame), m")
+    p.add_argument("--alpha-I", type=float, default=4.0 / 3.0)
+    p.add_argument("--gamma", type=float, default=0.0, help="frame: m_beam / m_columns")
+    p.add_argument("--H", type=float, help="asym-frame: half-height of the left column, m")
+    p.add_argument("--H1", type=float, help="asym-frame: half-height of the right column, m")
+    p.add_argument("--L", type=float, help="asym-frame: distance between the columns' left faces, m")
+    p.add_argument("--masses", type=float, nargs=3, default=(1.0, 1.0, 1.0), help="m_AB m_BC m_CD")
+    p.add_argument("--beta", type=float, help="arch inclusion angle, rad")
+    p.add_argument("--thickness", type=float, help="arch thickness t_a, m")
+    p.add_argument("--radius", type=float, help="arch centre-line radius r_a, m")
+    p.add_argument("--json", action="store_true")
+    p.set_defaults(func=run)
+
+
+# -- handlers -------------------------------------------------------------------------
 
 def run(args) -> int:
-    raise InputError(f"'rocklab {args.command}' is not implemented yet; see the open issue")
+    return {"pulse": run_pulse, "oas": run_oas, "design": run_design,
+            "equivalent": run_equivalent}[args.command](args)
+
+
+def run_pulse(args) -> int:
+    from ..models import load_base_motion, pulse_parameters
+
+    pp = pulse_parameters(load_base_motion(args.record, units=args.units))
+    d = pp.to_dict()
+    if args.json:
+        print(_dumps(d))
+    else:
+        print(f"{pp.name}: a_max = {pp.a_max_m_s2:.4f} m/s2, I_max = {pp.I_max_m_s:.4f} m/s, "
+              f"t_p = {pp.t_p_s:.4f} s (lobe {pp.lobe_start_s:.2f}-{pp.lobe_end_s:.2f} s)")
+    return 0
+
+
+def _free(v):
+    if v in ("energy", "none"):
+        return v
+    try:
+        return float(v)
+    except ValueError:
+        raise InputError(f"--free {v!r}: use energy, none or a number of seconds") from None
+
+
+def run_oas(args) -> int:
+    from .._io import write_frame_atomic
+
+    kw = dict(levels=args.levels, level_max=args.level_max, sizes=args.sizes, refine=args.refine,
+              criterion=args.criterion, free=_free(args.free), search=args.search, eta=args.eta)
+    if args.slenderness is None or not (args.slenderness > 0):
+        raise InputError(f"--slenderness {args.slenderness}: h/b must be > 0 (e.g. 12)")
+    if len(args.record) > 1:
+        from ._spectra_batch import oas_many
+
+        if args.plot:
+            raise InputError("--plot needs a single record")
+        tab = oas_many(args.record, units=args.units, slenderness=args.slenderness, oas_kwargs=kw,
+                       workers=args.workers, scheduler=args.scheduler, progress=not args.no_progress)
+        if args.out:
+            write_frame_atomic(args.out, tab)
+        if args.json:
+            print(_dumps({"records": tab.to_dict(orient="records")}))
+        else:
+            print(tab.to_string(index=False))
+        return 0 if (tab["error"] == "").all() else 1
+    from ..models import load_base_motion, overturning_spectrum, pulse_parameters
+
+    rec = load_base_motion(args.record[0], units=args.units)
+    o = overturning_spectrum(rec, args.slenderness, **kw)
+    if args.out:
+        write_frame_atomic(args.out, o.to_frame())
+    if args.plot:
+        from ._plots_spectra import plot_oas
+
+        plot_oas(o, args.plot)
+    d = o.to_dict()
+    d["t_p_s"] = pulse_parameters(rec).t_p_s
+    if args.json:
+        print(_dumps(d))
+    else:
+        print(f"{rec.name}: t_I = {o.t_I_s:.4f} s, t'_I = {o.t_I_prime_s:.4f} s, beta = {o.beta:.3f}, "
+              f"f_min = {o.f_min_rad_s:.4f} 1/s (H/B = {args.slenderness:g})")
+    return 0
+
+
+def run_design(args) -> int:
+    from ..blocks import G
+    from ..models import required_width, required_width_slender
+
+    g = G if args.g is None else args.g
+    c = args.cm_ratio if args.cm_ratio is not None else (1.0 if args.mass_at_top else 0.5)
+    aI = args.alpha_I if args.alpha_I is not None else (1.0 if args.mass_at_top else 4.0 / 3.0)
+    ag = args.ag * g
+    kw = dict(cm_height_ratio=c, alpha_I=aI, g=g)
+    d = dict(width_m=required_width(args.height, ag, args.tI, exact_icr=True, **kw),
+             width_eq31_m=required_width(args.height, ag, args.tI, exact_icr=False, **kw),
+             width_slender_m=required_width_slender(args.height, ag, args.tI, **kw),
+             width_no_uplift_m=2 * c * args.height * args.ag, cm_height_ratio=c, alpha_I=aI, g_m_s2=g)
+    if args.json:
+        print(_dumps(d))
+    else:
+        print(f"required width {d['width_m']:.4f} m (Eq. 21 exact; i_cr = 1: {d['width_eq31_m']:.4f} m, "
+              f"slender: {d['width_slender_m']:.4f} m, no uplift: {d['width_no_uplift_m']:.4f} m)")
+    return 0
+
+
+def _need(args, *names):
+    miss = [n for n in names if getattr(args, n.replace("-", "_")) is None]
+    if miss:
+        raise InputError(f"equivalent {args.mechanism}: missing --{', --'.join(miss)}")
+
+
+def _R_alpha(args):
+    if args.R is not None and args.alpha is not None:
+        return args.R, args.alpha
+    if args.b is not None and args.h is not None:
+        return 0.5 * math.hypot(args.b, args.h), math.atan2(args.b, args.h)
+    raise InputError(f"equivalent {args.mechanism}: give --R and --alpha, or --b and --h (m)")
+
+
+def run_equivalent(args) -> int:
+    from .. import models as m
+
+    mech = args.mechanism
+    extra = {}
+    if mech in ("block", "strut", "frame", "wall"):
+        R, a = _R_alpha(args)
+        fp = {"block": lambda: m.block_parameters(R, a, args.alpha_I),
+              "strut": lambda: m.strut_parameters(R, a),
+              "frame": lambda: m.frame_parameters(R, a, args.gamma, args.alpha_I),
+              "wall": lambda: m.wall_parameters(R, a, args.alpha_I)}[mech]()
+        out = fp.to_dict()
+    elif mech == "asym-frame":
+        _need(args, "b", "H", "H1", "L", "h")
+        pos, neg = m.asymmetric_frame(args.b, args.H, args.H1, args.L, args.h, *args.masses)
+        fpp, fpn = pos.parameters(), neg.parameters()
+        out = fpp.to_dict()
+        extra = {"negative": fpn.to_dict()}
+    else:
+        _need(args, "beta", "thickness", "radius")
+        mm, info = m.arch_mechanism(args.beta, args.thickness, args.radius)
+        out = mm.parameters().to_dict()
+        extra = {"hinges": list(info["hinges"]), "faces": info["faces"]}
+    out.update(extra)
+    if args.json:
+        print(_dumps(out))
+    else:
+        keys = ("p_rad_s", "theta_cr_rad", "lambda", "lambda_lin", "eta", "kappa1", "kappa2", "phi_cr_rad")
+        print(f"{mech}: " + ", ".join(f"{k} = {out[k]:.5g}" for k in keys))
+        if "negative" in out:
+            print("negative direction: " + ", ".join(f"{k} = {out['negative'][k]:.5g}" for k in keys))
+    sys.stdout.flush()
+    return 0

@@ -1,0 +1,116 @@
+"""Figures for overturning spectra and equivalent mechanisms (matplotlib; pipelines only).
+
+- :func:`plot_oas`: OAS with overturned grid points and the refined boundary, the
+  transformed OAS with the vertical (Eq. 20) and inclined (Eq. 28) lines, and the
+  OAS over 1/p with the simplified curves Eq. 21, 29, 30 (thesis Fig. 36–37, 47, 55).
+- :func:`plot_overturning_curve`: overturning curve and impulse curve of a pulse (Fig. 33–34).
+- :func:`plot_wall_error_maps`: rocking wall free-period and overturning-time error maps
+  (DeJong & Dimitrakopoulos Fig. 3 style).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["plot_oas", "plot_overturning_curve", "plot_wall_error_maps"]
+
+
+def _fig(ncols, w=4.2, h=3.6):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt, *plt.subplots(1, ncols, figsize=(w * ncols, h), constrained_layout=True)
+
+
+def _save(plt, fig, path):
+    from .._io import atomic_path
+
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, dpi=120, format="png")
+    plt.close(fig)
+    return path
+
+
+def plot_oas(o, path):
+    """Three-panel OAS figure of an :class:`rocklab.models.OASResult`; writes a PNG to ``path``."""
+    from ..models import simplified_oas
+
+    plt, fig, ax = _fig(3)
+    L, P = np.meshgrid(o.levels, o.p_rad_s, indexing="ij")
+    ov = o.overturned
+    ax[0].plot(P[ov], L[ov], ".", ms=1.5, color="0.6", label="overturns (grid)")
+    ax[0].plot(o.p_min_rad_s, o.levels, "k-", lw=1.2, label="largest unsafe size")
+    ax[0].set(xlabel="p [1/s]", ylabel="a_p / a_p,min", title=f"OAS {o.name}", xscale="log")
+    f = o.f_rad_s
+    ax[1].plot(f, o.levels, "k.-", ms=3, label="transformed OAS")
+    ax[1].axvline(o.f_min_rad_s, ls="--", color="C3", label=f"f_min: t_I = {o.t_I_s:.3f} s")
+    if np.isfinite(o.t_I_prime_s) and np.isfinite(o.beta):
+        A = np.linspace(1, o.levels.max(), 50)
+        ax[1].plot(1 / o.t_I_prime_s + A / o.beta, A, "--", color="C0",
+                   label=f"t'_I = {o.t_I_prime_s:.3f} s, beta = {o.beta:.2f}")
+    ax[1].set(xlabel="f = p a_p/a_p,min [1/s]", ylabel="a_p / a_p,min", title="transformed OAS")
+    ax[1].legend(fontsize=7)
+    p = np.geomspace(max(o.p_rad_s.min(), 0.05), o.p_rad_s.max(), 300)
+    ax[2].plot(1 / o.p_min_rad_s, o.levels, "k-", lw=1.2, label="OAS")
+    ax[2].plot(1 / p, simplified_oas(p, o.t_I_s, i_cr=o.i_cr), "--", color="C3", label="Eq. 21")
+    if np.isfinite(o.t_I_prime_s) and np.isfinite(o.beta):
+        ax[2].plot(1 / p, simplified_oas(p, o.t_I_s, o.t_I_prime_s, o.beta, kind="eq29"), ":", color="C0",
+                   label="Eq. 29")
+        ax[2].plot(1 / p, simplified_oas(p, o.t_I_s, o.t_I_prime_s, o.beta, o.i_cr, kind="eq30"), "-.",
+                   color="C2", label="Eq. 30")
+    xmax = 1.5 * np.nanmax(1 / o.p_min_rad_s) if np.isfinite(o.p_min_rad_s).any() else 1 / p.min()
+    ax[2].set(xlabel="1/p [s]", ylabel="a_p / a_p,min", ylim=(0, o.levels.max() * 1.05), xlim=(0, xmax),
+              title="over 1/p")
+    ax[2].legend(fontsize=7)
+    ax[0].legend(fontsize=7)
+    return _save(plt, fig, path)
+
+
+def plot_overturning_curve(c, path):
+    """Overturning curve (a_p/a_p,min vs p t_p) with the grid map, and the impulse curve."""
+    plt, fig, ax = _fig(2)
+    X, L = np.meshgrid(c.ptp, c.levels)
+    ax[0].plot(X[c.overturned], L[c.overturned], ".", ms=2, color="0.6")
+    ax[0].plot(c.ptp, c.a_min_ratio, "k-")
+    ax[0].set(xlabel="p t_p", ylabel="a_p / a_p,min", title=f"overturning curve: {c.kind}")
+    ax[1].plot(c.ptp, c.impulse_ratio, "k-")
+    ax[1].axhline(c.i_cr, ls="--", color="C3", label=f"i_cr = {c.i_cr:.4f}")
+    ax[1].set(xlabel="p t_p", ylabel="p I / a_p,min", title="overturning impulse curve")
+    ax[1].legend(fontsize=7)
+    return _save(plt, fig, path)
+
+
+def plot_wall_error_maps(path, alphas=None, ratios=None, accs=None, R_m=1.0):
+    """Rocking wall: T_eq24/T_wall over (phi/phi_cr, alpha) and t_eq25/t_wall over (u/(g lambda),
+    alpha) for kappa1 and kappa2 (DeJong & Dimitrakopoulos Fig. 3)."""
+    from ..models import free_rocking_period_eq24, overturning_time_eq25, wall_mechanism
+
+    alphas = np.linspace(0.05, 0.4, 8) if alphas is None else np.asarray(alphas)
+    ratios = np.linspace(0.05, 0.95, 10) if ratios is None else np.asarray(ratios)
+    accs = np.linspace(1.1, 4.0, 8) if accs is None else np.asarray(accs)
+    T = np.zeros((alphas.size, ratios.size))
+    t1 = np.zeros((alphas.size, accs.size))
+    t2 = np.zeros_like(t1)
+    for i, a in enumerate(alphas):
+        m = wall_mechanism(R_m, a)
+        fp = m.parameters()
+        for j, x in enumerate(ratios):
+            T[i, j] = free_rocking_period_eq24(fp.p_rad_s, x) / m.free_rocking_period(x * fp.phi_cr_rad)
+        for j, r in enumerate(accs):
+            tn = m.overturning_time(r * fp.lambda_)
+            t1[i, j] = overturning_time_eq25(fp.p_rad_s, r, fp.lambda_, fp.lambda_lin, "kappa1") / tn
+            t2[i, j] = overturning_time_eq25(fp.p_rad_s, r, fp.lambda_, fp.lambda_lin, "kappa2") / tn
+    plt, fig, ax = _fig(3)
+    for k, (Z, x, lab) in enumerate(((T, ratios, "phi/phi_cr"), (t1, accs, "u_g/(g lambda)  [kappa1]"),
+                                      (t2, accs, "u_g/(g lambda)  [kappa2]"))):
+        cs = ax[k].contourf(x, alphas, Z, levels=15, cmap="viridis")
+        fig.colorbar(cs, ax=ax[k])
+        ax[k].set(xlabel=lab, ylabel="alpha [rad]")
+    ax[0].set_title("T_r,blockeq / T_r,wall")
+    ax[1].set_title("t_over,blockeq / t_over,wall")
+    ax[2].set_title("t_over,blockeq / t_over,wall")
+    _save(plt, fig, path)
+    return dict(alphas=alphas, ratios=ratios, accs=accs, period_ratio=T, t_ratio_kappa1=t1,
+                t_ratio_kappa2=t2)

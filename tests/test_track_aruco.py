@@ -163,6 +163,8 @@ def test_tilted_camera_plane_from_table_markers(with_K):
                       "marker_positions_m": [[-0.2, 0.0], [0.2, 0.0]]}]}
     if with_K:
         d["video"] = {"camera_matrix": sc.K.tolist()}
+    else:
+        d["reference"] = {"plane": "table"}  # "auto" needs K for this; force the homography fit
     cfg = TrackConfig.from_dict(d)
     res = assemble_tracks(track_frames(frames, cfg), cfg, FPS, W, H)
     assert res.plane == "table"
@@ -195,3 +197,13 @@ def test_blurred_frames_are_flagged_blur():
     st = res["block_1"].status
     assert list(st[6:9]) == ["blur"] * 3
     assert np.all(st[:6] == "ok") and np.all(st[9:] == "ok")
+
+
+def test_plane_table_without_what_it_needs_is_an_input_error():
+    from rocklab import InputError
+
+    sc = _scene(320, 240, 600.0)
+    frames = [sc.render([(0.0, 0.04, 0.0), (0.0, -0.11, 0.0)])]
+    cfg = _config(reference={"plane": "table"})  # one table marker, no camera matrix
+    with pytest.raises(InputError, match="'reference.plane'"):
+        list(track_frames(frames, cfg))

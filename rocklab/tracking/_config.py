@@ -196,9 +196,10 @@ class ReferenceConfig:
         with ``video.camera_matrix`` by a planar PnP pose, else a homography
         fit, which needs two or more markers); positions are then metres in the
         table frame at the first frame. ``"image"``: centred pixels times the
-        measured scale. ``"auto"``: ``"table"`` when possible (aruco/apriltag,
-        a table with known marker layout and a camera matrix or >= 2 markers),
-        else ``"image"``.
+        measured scale. ``"auto"``: ``"table"`` when possible with a camera
+        matrix (aruco/apriltag, a table with known marker layout and size),
+        else ``"image"`` (a free homography from markers along one table edge
+        is poorly conditioned; force it with ``"table"``).
     """
 
     level: str = "table"

@@ -115,6 +115,11 @@ def _table_plane(config, pm, gray):
         why = "needs the table's marker_positions_m"
     elif (tab.marker_size_m or config.targets.marker_size_m) is None:
         why = "needs the marker size"
+    elif pm.K is None and not strict:
+        # Without intrinsics a free homography from markers along one table edge is poorly
+        # conditioned across it (and lens distortion is not removed): centred pixels are
+        # the safer default. plane = "table" still forces it (>= 2 markers).
+        why = "needs video.camera_matrix"
     elif pm.K is None and len(tab.markers) < 2:
         why = "needs video.camera_matrix or two or more table markers"
     elif gray is None:

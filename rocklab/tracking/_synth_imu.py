@@ -13,7 +13,6 @@ included) is taken at video time ``t0_video_s + k / rate_hz``.
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
 import numpy as np

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -18,8 +17,6 @@ _MOUNT_FRAC = 0.85          # IMU height on the block, fraction of h
 
 
 def _blocks(block, n):
-    from ..blocks import Block
-
     if block is None:
         heights = (0.20, 0.22, 0.21) if n == 3 else (0.20,)   # all survive the 45 mm sine pulse
         return [Block(0.1, h, depth_m=0.3, density_kg_m3=2700.0, name=f"block_{i + 1}")
@@ -179,8 +176,6 @@ class Scene:
         t_end = self.n_frames / self.fps + 0.5
         blocks = {s["id"]: s["block"] for s in self.sims}
         for k, bm in enumerate(self.block_motions):
-            from ..blocks import Block
-
             bd = blocks[bm.id]
             blk = Block(bd["b_m"], bd["h_m"], depth_m=bd["depth_m"], mass_kg=bd["mass_kg"],
                         alpha_I=bd["alpha_I"])

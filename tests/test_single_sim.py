@@ -258,3 +258,26 @@ def test_frame_rate_output_and_at_hermite():
     th, w = full.at([ti - 1e-9, ti + 1e-9])
     assert w == pytest.approx([wb, wa], rel=1e-4) and np.all(np.abs(th) < 1e-8)
     assert np.isnan(full.at([-1.0])[0][0])
+
+
+def test_rest_then_uplift_again():
+    # two short pulses, opposite directions: rock, come to rest, uplift again the other way
+    blk = Block(0.2, 1.0)
+    t = np.arange(0.0, 8.0, 0.002)
+    a = np.where((t > 0.5) & (t < 0.8), -0.25 * np.sin(2 * np.pi * (t - 0.5) / 0.3), 0.0) \
+        + np.where((t > 4.0) & (t < 4.3), 0.26 * np.sin(2 * np.pi * (t - 4.0) / 0.3), 0.0)
+    base = BaseMotion.from_samples(a, 0.002, "g")
+    law = dict(restitution="constant", eta=0.8)  # settles well before the second pulse
+    nm = simulate(blk, 0.0, duration_s=8.0, dt_s=1e-4, base=base, **law)
+    ev = simulate(blk, 0.0, duration_s=8.0, dt_s=1e-3, base=base, method="event", rtol=1e-12, **law)
+    assert nm.status == ev.status == "rest" and nm.n_impacts == ev.n_impacts
+    ti_nm, ti_ev = nm.impacts.t_s.to_numpy(), ev.impacts.t_s.to_numpy()
+    second = np.flatnonzero(ti_nm > 4.0)[0]
+    assert 10 < second < nm.n_impacts - 10  # the first episode ended at rest before 4 s
+    for k in (0, 1, second, second + 1):
+        assert ti_nm[k] == pytest.approx(ti_ev[k], abs=1e-6)
+    # first uplift towards theta > 0 (a_g < 0), second towards theta < 0
+    first_move = nm.theta_rad[np.flatnonzero(nm.theta_rad != 0)[0]]
+    k4 = np.flatnonzero((nm.t_s > 4.0) & (nm.theta_rad != 0))[0]
+    assert first_move > 0 and nm.theta_rad[k4] < 0
+    assert np.all(nm.theta_rad[(nm.t_s > ti_nm[second - 1] + 1e-3) & (nm.t_s < 4.0)] == 0.0)

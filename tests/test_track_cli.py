@@ -113,3 +113,11 @@ def test_unknown_marker_and_unseen_object(tmp_path, run_cli, session):
     _one_line_error(run_cli, d / "video.mkv", "--config", unseen, "-o", tmp_path / "x.csv",
                     match="'block_1' is never seen")
     assert not (tmp_path / "x.csv").exists()
+
+
+def test_progress_bar_goes_to_stderr(session, run_cli, tmp_path):
+    d = session[0]
+    rc, out, err = run_cli("track", d / "video.mkv", "--progress", "--json", "-o", tmp_path / "t.csv")
+    assert rc == 0
+    json.loads(out)  # stdout stays one JSON object
+    assert "track" in err and "frame" in err

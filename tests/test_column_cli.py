@@ -63,3 +63,15 @@ def test_column_cli_maps_png(run_cli, tmp_path):
     # the strongest, longest pulse (10 m/s2, 3 s) topples every column; the weakest shortest one none
     assert all(np.array(d["overturned"])[:, 1, 1]) and not any(np.array(d["overturned"])[:, 0, 0])
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_plot_column_response_png(tmp_path):
+    from rocklab.blocks import Block
+    from rocklab.models import Column, simulate_column
+    from rocklab.pipelines._plots_column import plot_column_response
+
+    r = simulate_column(Column((Block(0.1, 0.2),) * 2), theta0_rad=[0.0, 0.04], duration_s=0.3, dt_s=1e-3)
+    png = tmp_path / "resp.png"
+    fig = plot_column_response(r, png)
+    assert png.read_bytes()[:4] == b"\x89PNG" and len(fig.axes) == 2
+    assert len(fig.axes[0].lines) == 2  # one angle curve per block

@@ -1,19 +1,23 @@
-"""``rocklab demo``: the main job on the bundled example (placeholder until the pipelines land)."""
+"""``rocklab demo``: render a small synthetic campaign and run it end to end."""
 
 from __future__ import annotations
 
 
 def register(sub):
-    p = sub.add_parser("demo", help="run the main job on the bundled synthetic campaign")
+    p = sub.add_parser("demo", help="render a small synthetic campaign (Čeh blocks, ArUco video, x-IMU logs, "
+                                    "an El Centro shake-table run) and run it end to end")
     p.add_argument("--out", default="demo_out", help="output folder (default: demo_out)")
+    p.add_argument("--workers", type=int, default=2, help="parallel processes (default 2)")
+    p.add_argument("--no-progress", action="store_true", help="no progress bars")
     p.set_defaults(func=run)
 
 
 def run(args) -> int:
-    from ..blocks import Block
+    from ._demo import run_demo
 
-    b = Block(0.045, 0.2025, name="B6M")
-    print("rocklab demo: the pipeline demo lands with the pipelines issue; for now, block B6M:")
-    for k in ("alpha_rad", "R_m", "p_rad_s", "eta_H", "uplift_acc_m_s2"):
-        print(f"  {k:>16} = {getattr(b, k):.4f}")
-    return 0
+    res, t = run_demo(args.out, workers=args.workers, progress=not args.no_progress)
+    print(res.summary_text())
+    print(f"(rendered sessions in {t['render_s']:.0f} s, campaign in {t['campaign_s']:.0f} s)")
+    print(f"look: {args.out}/results/campaign.csv, {args.out}/results/figures/, "
+          f"rerun {args.out}/results/campaign.rrd, rerun {args.out}/results/experiments/<run>/session.rrd")
+    return 0 if res.n_ok == len(res.runs) else 1

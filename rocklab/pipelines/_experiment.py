@@ -231,7 +231,9 @@ def analyse_experiment(cfg: ExperimentConfig, progress: bool = False) -> Experim
         s = _sync(ref, rot, cfg.max_offset_s)
         sync = s.to_dict()
         ti, thi = measured["imu"]
-        # invert t_imu = t_ref + offset + drift t_ref: the IMU series on the reference clock
+        # invert t_imu = t_ref + offset + drift t_ref: the IMU series on the reference clock;
+        # sign -1: the IMU's axis points the other way from the camera's θ convention
+        thi = s.sign * np.asarray(thi)
         measured["imu"] = ((ti - s.offset_s) / (1.0 + s.drift), thi)
         tv, thv = ref
         thi_on_v = np.interp(tv, measured["imu"][0], thi, left=np.nan, right=np.nan)
@@ -342,9 +344,10 @@ def _truth(cfg, prim, msgs):
     eta = None
     if sess.is_file():
         meta = json.loads(sess.read_text())
-        eta = meta.get("eta") or meta.get("true_eta")
-        if isinstance(eta, dict):
-            eta = eta.get(obj)
+        eta = meta.get("eta")
+        for blk in meta.get("blocks", []):  # rocklab synth sessions
+            if blk.get("id") == obj:
+                eta = blk.get("eta_true", eta)
     return {"t_s": t, "theta_rad": th, "eta": eta,
             "theta_rms_error_rad": float(np.sqrt(np.nanmean(err ** 2))) if np.isfinite(err).any() else None}
 

@@ -1,11 +1,35 @@
-def test_demo_exits_zero(run_cli):
-    rc, out, err = run_cli("demo", "--out", "unused")
-    assert rc == 0 and "B6M" in out
+import pytest
 
 
-def test_unknown_option_exit_2(run_cli, capsys):
-    import pytest
-
+def test_unknown_option_exit_2(run_cli):
     with pytest.raises(SystemExit) as e:
         run_cli("simulate", "--no-such-flag")
     assert e.value.code == 2
+
+
+def test_no_command_prints_help_and_exit_2(run_cli):
+    rc, out, _ = run_cli()
+    assert rc == 2 and "demo" in out and "campaign" in out
+
+
+def test_demo_sessions_carry_the_stated_truth(tmp_path):
+    """The demo's synthetic runs: edge-contact truth is η_M(k = 1 − 2 l_c/b)·η_mat (Čeh Eq. 14, 16),
+    full-contact truth is Čeh Table 3, and the configs name the run and contact."""
+    import json
+
+    from rocklab.fitting import catalogue_block, edge_contact_k, eta_modified
+    from rocklab.pipelines._config import load_experiment
+    from rocklab.pipelines._demo import ETA_MAT_TRUE, L_C_M, make_demo_campaign
+
+    runs = (("B3M_edge", "B3M", "edge", "none"), ("B5M_full", "B5M", "full", "none"))
+    cfgs = make_demo_campaign(tmp_path, size=(320, 180), progress=False, runs=runs)
+    edge, full = (load_experiment(c) for c in cfgs)
+    assert edge.name == "B3M_edge" and edge.contact == "edge" and edge.l_c_m == L_C_M
+    assert edge.block_id == "B3M" and edge.video_decimation == 5
+    b3 = catalogue_block("B3M")
+    eta_edge = json.loads((cfgs[0].parent / "session.json").read_text())["blocks"][0]["eta_true"]
+    # k = 1 - 2*1.5/45 = 0.9333 (Čeh Table 4, medium scale) -> η_M(α = 0.4182) = 0.7897
+    assert edge_contact_k(b3.b_m, L_C_M) == pytest.approx(0.93333, abs=1e-5)
+    assert eta_edge == pytest.approx(float(eta_modified(b3.alpha_rad, 0.933333)) * ETA_MAT_TRUE, abs=1e-5)
+    eta_full = json.loads((cfgs[1].parent / "session.json").read_text())["blocks"][0]["eta_true"]
+    assert full.contact == "full" and eta_full == pytest.approx(0.914)  # Čeh Table 3, B5M

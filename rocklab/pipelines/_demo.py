@@ -100,7 +100,8 @@ def make_demo_campaign(root, *, size=(1280, 720), fps: float = 50.0, progress: b
     return out
 
 
-def run_demo(out_dir="demo_out", *, workers: int = 2, progress: bool = True, size=(1280, 720)):
+def run_demo(out_dir="demo_out", *, workers: int = 2, progress: bool = True, size=(1280, 720),
+             runs=DEMO_RUNS):
     """Make the demo campaign under ``out_dir/sessions`` and run it into ``out_dir/results``."""
     from ._campaign import run_campaign
 
@@ -108,7 +109,7 @@ def run_demo(out_dir="demo_out", *, workers: int = 2, progress: bool = True, siz
     if out_dir.exists() and not out_dir.is_dir():
         raise InputError(f"--out {out_dir}: exists and is not a folder; choose another path")
     t0 = time.perf_counter()
-    make_demo_campaign(out_dir / "sessions", size=size, progress=progress)
+    make_demo_campaign(out_dir / "sessions", size=size, progress=progress, runs=runs)
     t1 = time.perf_counter()
     res = run_campaign(out_dir / "sessions", out_dir / "results", workers=workers, progress=progress)
     t2 = time.perf_counter()

@@ -17,7 +17,8 @@ from ._equivalent import (FundamentalParameters, Mechanism, arch_mechanism, asym
 from ._column_sim import STATE_NAMES, Column, ColumnResult, simulate_column, uplift_acc_m_s2
 from ._column_geometry import ImpactOutcome, app_c_reduction, column_impact, full_mass_matrix, mass_points
 from ._column_maps import ColumnMaps, column_overturning_maps, sine_pulse
-from ._column_compare import SequenceComparison, compare_sequences, joint_sequence
+from ._column_compare import (ColumnComparison, SequenceComparison, compare_sequences, compare_to_measurement,
+                              joint_sequence)
 
 __all__ = ["BaseMotion", "load_base_motion", "UNITS_TO_M_S2", "bundled_record", "BUNDLED_RECORDS",
            "simulate", "RockingResult", "block_energy", "simulate_batch", "BatchResult",
@@ -36,4 +37,4 @@ __all__ = ["BaseMotion", "load_base_motion", "UNITS_TO_M_S2", "bundled_record", 
            "Column", "ColumnResult", "simulate_column", "uplift_acc_m_s2", "STATE_NAMES",
            "ImpactOutcome", "app_c_reduction", "column_impact", "full_mass_matrix", "mass_points",
            "ColumnMaps", "column_overturning_maps", "sine_pulse",
-           "SequenceComparison", "compare_sequences", "joint_sequence"]
+           "SequenceComparison", "compare_sequences", "joint_sequence", "ColumnComparison", "compare_to_measurement"]

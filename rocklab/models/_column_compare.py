@@ -17,7 +17,7 @@ import numpy as np
 
 from .._errors import InputError
 
-__all__ = ["joint_sequence", "compare_sequences", "SequenceComparison"]
+__all__ = ["joint_sequence", "compare_sequences", "SequenceComparison", "compare_to_measurement", "ColumnComparison"]
 
 
 def joint_sequence(t_s, theta_rad, threshold_rad: float = 0.005, *, base_theta_rad=None, sign: float = 1.0,
@@ -151,3 +151,73 @@ def compare_sequences(measured, simulated, tol_s: float = 0.05, t_max_s: float |
             k += 1
     err = float(np.median([abs(p[0] - p[1]) for p in pairs])) if pairs else float("nan")
     return SequenceComparison(na, nb, len(pairs), pairs, err, len(pairs) == na == nb, float(tol_s))
+
+
+@dataclass(frozen=True)
+class ColumnComparison:
+    """A simulated column response against measured block angles.
+
+    Attributes
+    ----------
+    sequence : SequenceComparison
+        Opening/closing sequences matched in order (both read with the same threshold).
+    measured_sequence, simulated_sequence : list of (t_s, joint, state)
+    rms_theta_rad : ndarray (n,)
+        RMS of measured minus simulated block angle at the measured times, rad.
+    peak_measured_rad, peak_simulated_rad : ndarray (n,)
+        Peak |block angle| over the compared time span, rad.
+    """
+
+    sequence: SequenceComparison
+    measured_sequence: list
+    simulated_sequence: list
+    rms_theta_rad: np.ndarray
+    peak_measured_rad: np.ndarray
+    peak_simulated_rad: np.ndarray
+
+    def to_dict(self) -> dict:
+        return {"sequence": self.sequence.to_dict(),
+                "measured_sequence": [list(e) for e in self.measured_sequence],
+                "simulated_sequence": [list(e) for e in self.simulated_sequence],
+                "rms_theta_rad": self.rms_theta_rad.tolist(), "peak_measured_rad": self.peak_measured_rad.tolist(),
+                "peak_simulated_rad": self.peak_simulated_rad.tolist()}
+
+
+def compare_to_measurement(result, t_s, theta_rad, *, threshold_rad: float = 0.005, tol_s: float = 0.05,
+                           sign: float = 1.0, base_theta_rad=None, min_duration_s: float = 0.0) -> ColumnComparison:
+    """Compare a :class:`ColumnResult` with tracked block angles (thesis §4.3, Fig. 32).
+
+    Parameters
+    ----------
+    result : ColumnResult
+        Simulation driven by the measured base acceleration, on the measured time axis.
+    t_s : array (m,)
+        Measured sample times, s (same origin as the simulation).
+    theta_rad : array (m, n)
+        Measured absolute block angles, bottom first, rad (NaN where tracking failed).
+    threshold_rad, min_duration_s, sign, base_theta_rad
+        As :func:`joint_sequence` (applied to both histories; ``sign``/``base``
+        only to the measurement).
+    tol_s : float
+        Time tolerance of matched events, s.
+    """
+    t = np.asarray(t_s, float).ravel()
+    th = sign * np.asarray(theta_rad, float).reshape(t.size, -1)
+    if base_theta_rad is not None:
+        th = th - sign * np.asarray(base_theta_rad, float).reshape(-1, 1)
+    n = result.column.n
+    if th.shape[1] != n:
+        raise InputError(f"theta_rad has {th.shape[1]} columns for a column of {n} blocks")
+    inside = (t >= result.t_s[0]) & (t <= result.t_s[-1])
+    sim = np.column_stack([np.interp(t[inside], result.t_s, result.theta_rad[:, i]) for i in range(n)])
+    meas = th[inside]
+    diff = meas - sim
+    ok = np.isfinite(diff)
+    rms = np.sqrt(np.array([np.mean(diff[ok[:, i], i] ** 2) if ok[:, i].any() else np.nan for i in range(n)]))
+    mseq = joint_sequence(t[inside], meas, threshold_rad, min_duration_s=min_duration_s)
+    sseq = result.joint_sequence(threshold_rad, min_duration_s=min_duration_s)
+    t_max = float(t[inside][-1]) if inside.any() else None
+    comp = compare_sequences(mseq, sseq, tol_s=tol_s, t_max_s=t_max)
+    peak_m = np.array([np.max(np.abs(meas[ok[:, i], i])) if ok[:, i].any() else np.nan for i in range(n)])
+    return ColumnComparison(comp, mseq, [e for e in sseq if t_max is None or e[0] <= t_max], rms,
+                            peak_m, np.max(np.abs(sim), axis=0))

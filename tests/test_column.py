@@ -368,3 +368,13 @@ def test_compare_to_measurement_synthetic_tracking(three_block_free):
     assert m.sequence.n_matched < c.sequence.n_matched and m.rms_theta_rad[2] > 10 * c.rms_theta_rad[2]
     assert compare_to_measurement(r, t, -meas, threshold_rad=4e-3, tol_s=0.05, sign=-1.0,
                                   min_duration_s=0.03).sequence.same_sequence
+
+
+def test_events_converge_with_the_time_step():
+    """Events are located inside the step: halving dt moves the first impacts by < 1e-6 s (O(dt^2))."""
+    col = Column((Block(0.1, 0.2, mass_kg=5.4),) * 3, cut_m=0.002)
+    r1, r2 = (simulate_column(col, theta0_rad=[0.0, 0.0, 0.12], duration_s=0.3, dt_s=dt) for dt in (2e-4, 1e-4))
+    assert len(r1.impacts) >= 8
+    np.testing.assert_allclose(r1.impacts.t_s[:8], r2.impacts.t_s[:8], atol=1e-6)
+    assert r1.impacts.joint[:8].tolist() == r2.impacts.joint[:8].tolist()
+    np.testing.assert_allclose(r1.theta_rad, r2.theta_rad[::2], atol=1e-6)

@@ -103,7 +103,8 @@ def test_region_tracker_rotation_and_scale_from_m_per_px():
     tex = cv2.normalize(cv2.GaussianBlur(tex, (0, 0), 5), None, 40, 240, cv2.NORM_MINMAX)
     sc.add(tex, (0.05 * TEX - 0.5, 0.075 * TEX - 0.5))
     n = 25
-    theta, xt = _truth(n)
+    _, xt = _truth(n)
+    theta = 0.35 * np.sin(2 * np.pi * np.arange(n) / FPS / 1.0)  # up to 20°: beyond LK windows
     frames = [sc.render([(xt[i], 0.0, theta[i])]) for i in range(n)]
     roi = _roi(sc, (-0.035, 0.05), (0.035, -0.05))
     cfg = TrackConfig.from_dict({"targets": {"style": "region"},

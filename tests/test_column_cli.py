@@ -60,7 +60,7 @@ def test_column_cli_maps_png(run_cli, tmp_path):
     assert rc == 0, err
     d = json.loads(out)["maps"]
     assert np.array(d["overturned"]).shape == (3, 2, 2)
-    # the strongest, longest pulse (10 m/s2, 3 s) topples every column; the weakest shortest one none
+    # the strongest, longest pulse (12 m/s2, 2.4 s) topples every column; the weakest shortest one none
     assert all(np.array(d["overturned"])[:, 1, 1]) and not any(np.array(d["overturned"])[:, 0, 0])
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 

@@ -5,7 +5,11 @@ compiled form (``cache=True``) and :func:`run_core` the pure-Python baseline.
 Within a step: closings are located exactly (the step length that lands the
 joint on zero, Čeh et al. Eq. 8), openings by linear interpolation of the
 eccentricity excess (thesis §3.3); the earliest event wins, the opening or
-impact model sets the new configuration and stepping resumes with full steps.
+impact model sets the new configuration and the rest of the step follows, so
+the output stays on the grid ``t_k = k dt`` (as in the single-block kernel).
+While every joint is closed the column moves with the base and a step costs
+one check of the base acceleration against the joints' opening and sliding
+levels.
 """
 
 from __future__ import annotations

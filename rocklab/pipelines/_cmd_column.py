@@ -45,7 +45,8 @@ def register(sub):
     p.add_argument("--maps-png", default=None,
                    help="also compute the thesis Fig. 40 overturning maps (H=12 m, B=1 m, 1-3 blocks) "
                         "and write them to this PNG")
-    p.add_argument("--maps-grid", type=int, default=8, help="maps: grid points per axis (default 8)")
+    p.add_argument("--maps-grid", type=int, default=10,
+                   help="maps: grid points per axis over a_p 1-12 m/s2, t_p 0.3-2.4 s (default 10)")
     p.add_argument("--json", action="store_true", help="print one JSON summary object on stdout")
     p.set_defaults(func=run)
 
@@ -159,8 +160,9 @@ def _maps(args):
     from ._plots_column import plot_column_maps
 
     k = max(int(args.maps_grid), 2)
-    ap = np.linspace(1.0, 10.0, k)
-    tp = np.linspace(0.5, 3.0, k)
+    # the region where the columns' overturning boundaries differ (thesis Fig. 40)
+    ap = np.linspace(1.0, 12.0, k)
+    tp = np.linspace(0.3, 2.4, k)
     with tqdm(total=3 * k * k, file=sys.stderr, desc="maps", leave=False) as bar:
         maps = column_overturning_maps(ap_m_s2=ap, tp_s=tp, n_impacts=args.impacts,
                                        progress=lambda i: bar.update(1))

@@ -79,3 +79,32 @@ def test_calibrate_camera_recovers_focal_length(tmp_path):
     assert K[0, 0] == pytest.approx(f, rel=0.01) and K[1, 1] == pytest.approx(f, rel=0.01)
     with np.load(tmp_path / "cal.npz") as z:
         np.testing.assert_allclose(z["camera_matrix"], K)
+
+
+def test_charuco_board_plane():
+    import cv2
+
+    from _render import TEX
+
+    W, H, k = 960, 540, 900.0
+    d = cv2.aruco.getPredefinedDictionary(cv2.aruco.DICT_4X4_50)
+    tex = cv2.aruco.CharucoBoard((7, 5), 0.03, 0.022, d).generateImage(
+        (int(0.21 * TEX), int(0.15 * TEX)))
+    sc = Scene(W, H, px_per_m=k, tilt_rad=(0.04, -0.03), roll_rad=0.01, noise=1.5, blur=0.6,
+               seed=2)
+    sc.add(tex, (-0.5, -0.5))  # origin: the board's top-left corner (OpenCV's board frame)
+    sc.add(*marker_texture([30], [(0.0, 0.0)], 0.08, (0.12, 0.2), origin_m=(-0.06, -0.1)))
+    n = 5
+    theta = np.linspace(-0.05, 0.05, n)
+    frames = [sc.render([(-0.4, 0.2, 0.0) if i == 0 else (5.0, 5.0, 0.0), (0.2, 0.0, theta[i])])
+              for i in range(n)]
+    cfg = TrackConfig.from_dict({
+        "video": {"camera_matrix": sc.K.tolist()}, "targets": {"marker_size_m": 0.08},
+        "reference": {"board": {"kind": "charuco", "squares_x": 7, "squares_y": 5,
+                                "square_m": 0.03, "marker_m": 0.022}},
+        "objects": [{"id": "b", "markers": [30]}]})
+    res = assemble_tracks(track_frames(frames, cfg), cfg, 50.0, W, H)
+    b = res["b"]
+    assert res.plane == "board"
+    assert np.sqrt(np.mean(np.degrees(b.theta_rad - theta) ** 2)) <= 0.05
+    assert np.sqrt(np.mean((b.x_m - 0.6) ** 2 + (b.y_m + 0.2) ** 2)) < 1e-3

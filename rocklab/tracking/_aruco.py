@@ -99,8 +99,8 @@ def refine_marker_corners(gray, corners, cells=6):
     side = float(np.mean(np.hypot(*(np.roll(corners, -1, axis=0) - corners).T)))
     half = float(np.clip(0.5 * side / cells, 1.5, 4.0))
     # One pass: a profile slightly off the normal still crosses the edge on the edge.
-    # About 40 profiles per side: closer ones share their noise through the blur.
-    out, _, _, sig = refine_rectangle(gray, corners, half=half, step=max(1.5, side / 50),
+    # About 30 profiles per side: closer ones share their noise through the blur.
+    out, _, _, sig = refine_rectangle(gray, corners, half=half, step=max(1.5, side / 38),
                                       trim=0.12)
     if out is None or np.max(np.abs(out - corners)) > 0.5 * half + 1.0:
         return corners, np.nan

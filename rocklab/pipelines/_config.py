@@ -54,7 +54,8 @@ Schema (all lengths in m, times in s, angles in rad)::
     window = "middle50"               # middle50 | all | first
 
     [simulate]
-    laws = ["housner", "eta_e", "modified"]
+    laws = ["housner", "eta_e", "modified"]   # also "eta_e_first", "given" (uses eta below)
+    eta = 0.93                        # optional: a known constant restitution, simulated as "given"
     duration_s = 0                    # 0: as long as the measurement
 
     [output]
@@ -75,7 +76,7 @@ from .._errors import InputError
 
 __all__ = ["ExperimentConfig", "load_experiment", "EXAMPLE_TOML"]
 
-_LAWS = ("housner", "eta_e", "modified", "eta_e_first")
+_LAWS = ("housner", "eta_e", "modified", "eta_e_first", "given")
 _WINDOWS = ("middle50", "all", "first")
 
 
@@ -137,6 +138,7 @@ class ExperimentConfig:
     fit_window: str = "middle50"
     laws: tuple = ("housner", "eta_e", "modified")
     duration_s: float = 0.0
+    eta_given: float | None = None
     rrd: bool = True
     video_decimation: int = 1
     figures: bool = True
@@ -350,6 +352,13 @@ def load_experiment(path) -> ExperimentConfig:
     for law in laws:
         if law not in _LAWS:
             r.fail("simulate.laws", f"contains {law!r}; allowed: {', '.join(_LAWS)}")
+    eta_given = r.get("simulate.eta", kind=float)
+    if eta_given is not None and not -1.0 < eta_given < 1.0:
+        r.fail("simulate.eta", f"= {eta_given} must lie in (-1, 1) (ratio of angular velocities)")
+    if eta_given is not None and "given" not in laws:
+        laws = laws + ("given",)
+    if "given" in laws and eta_given is None:
+        r.fail("simulate.laws", "contains 'given' but [simulate] eta is not set")
     columns = tuple(r.get("column.objects", []))
     truth = r.file("truth", required=False)
     return ExperimentConfig(
@@ -361,7 +370,7 @@ def load_experiment(path) -> ExperimentConfig:
         fit_restitution=r.get("fit.restitution", True, kind=bool),
         fit_window=r.get("fit.window", "middle50", kind=str, choices=_WINDOWS),
         laws=laws,
-        duration_s=r.get("simulate.duration_s", 0.0, kind=float),
+        duration_s=r.get("simulate.duration_s", 0.0, kind=float), eta_given=eta_given,
         rrd=r.get("output.rrd", True, kind=bool),
         video_decimation=r.get("output.video_decimation", 1, kind=int, positive=True),
         figures=r.get("output.figures", True, kind=bool),

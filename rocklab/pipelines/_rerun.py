@@ -52,11 +52,12 @@ def open_recording(app_id: str, rrd_path=None, spawn: bool = False, connect: str
     sinks = []
     if rrd_path is not None:
         sinks.append(rr.FileSink(str(rrd_path)))
+    if spawn:
+        # start a local viewer (listening on the default port) and stream to it
+        rec.spawn(connect=False)
+        sinks.append(rr.GrpcSink())
     if connect:
         sinks.append(rr.GrpcSink(connect))
-    if spawn:
-        rec.spawn(connect=False) if not sinks else None
-        sinks.append(rr.GrpcSink())
     if sinks:
         rec.set_sinks(*sinks)
     return rec

@@ -141,6 +141,12 @@ def test_track_video_file_matches_in_memory(tmp_path):
                                 "sigma_theta_rad", "quality", "status"]
     assert len(df) == 2 * n
     np.testing.assert_allclose(df.loc[df.object == "block_1", "t_s"], np.arange(n) / FPS)
+    # a frame range keeps absolute frame numbers and times
+    part = track_video(tmp_path / "v.mkv", _config(video={"start_frame": 4, "stop_frame": 9}))
+    np.testing.assert_array_equal(part["block_1"].frame, np.arange(4, 9))
+    # (the level is the median table angle over the tracked frames, so compare unlevelled)
+    np.testing.assert_allclose(part["block_1"].theta_rad + part.level_rad,
+                               mem["block_1"].theta_rad[4:9] + mem.level_rad, atol=1e-5)
 
 
 @pytest.mark.parametrize("with_K", [True, False])

@@ -125,3 +125,22 @@ def test_region_without_any_scale_is_an_input_error():
                                  "objects": [{"id": "t", "kind": "table", "roi": [60, 40, 80, 60]}]})
     with pytest.raises(InputError, match="no scale"):
         assemble_tracks(track_frames(frames, cfg), cfg, FPS, 200, 150)
+
+
+def test_apriltag_style():
+    from _render import marker_texture
+
+    W, H, k = 640, 400, 900.0
+    sc = Scene(W, H, px_per_m=k, noise=1.5, blur=0.6, seed=1)
+    sc.add(*marker_texture([5], [(0.0, 0.0)], 0.08, (0.12, 0.2), origin_m=(-0.06, -0.1),
+                           dictionary="DICT_APRILTAG_36h11"))
+    n = 10
+    theta = np.linspace(-0.1, 0.1, n)
+    frames = [sc.render([(0.0, 0.0, theta[i])]) for i in range(n)]
+    cfg = TrackConfig.from_dict({"targets": {"style": "apriltag", "marker_size_m": 0.08},
+                                 "objects": [{"id": "b", "markers": [5]}]})
+    assert cfg.targets.dictionary == "DICT_APRILTAG_36h11"  # the style's default
+    res = assemble_tracks(track_frames(frames, cfg), cfg, FPS, W, H)
+    b = res["b"]
+    assert np.sqrt(np.mean(np.degrees(b.theta_rad - theta) ** 2)) <= 0.05
+    assert b.m_per_unit == pytest.approx(1 / k, rel=2e-3)

@@ -58,6 +58,11 @@ Schema (all lengths in m, times in s, angles in rad)::
     eta = 0.93                        # optional: a known constant restitution, simulated as "given"
     duration_s = 0                    # 0: as long as the measurement
 
+    [column]                          # column experiments (thesis §4.3): tracked objects bottom to top
+    objects = ["block_1", "block_2", "block_3"]
+    cut_m = 0.002                     # cut edge at every joint, m
+    impacts = 1                       # consecutive impacts per joint closing (thesis: 2)
+
     [output]
     rrd = true
     video_decimation = 1              # log every n-th frame to Rerun
@@ -143,6 +148,8 @@ class ExperimentConfig:
     video_decimation: int = 1
     figures: bool = True
     columns: tuple = ()            # for column experiments: object ids bottom to top
+    column_cut_m: float = 0.0
+    column_impacts: int = 1
     truth: Path | None = None      # synthetic sessions: truth.csv for the report
 
     def block(self):
@@ -360,6 +367,12 @@ def load_experiment(path) -> ExperimentConfig:
     if "given" in laws and eta_given is None:
         r.fail("simulate.laws", "contains 'given' but [simulate] eta is not set")
     columns = tuple(r.get("column.objects", []))
+    if columns and cfg_video_missing(data):
+        r.fail("column.objects", "needs a [sources.video] section (the blocks are tracked on video)")
+    cut = r.get("column.cut_m", 0.0, kind=float)
+    if cut < 0 or cut >= (b or 1) / 2:
+        r.fail("column.cut_m", f"= {cut} m must be in [0, b/2)")
+    n_imp = r.get("column.impacts", 1, kind=int, positive=True)
     truth = r.file("truth", required=False)
     return ExperimentConfig(
         path=path, name=r.get("name", path.parent.name, kind=str), b_m=b, h_m=h, mass_kg=m,
@@ -374,8 +387,12 @@ def load_experiment(path) -> ExperimentConfig:
         rrd=r.get("output.rrd", True, kind=bool),
         video_decimation=r.get("output.video_decimation", 1, kind=int, positive=True),
         figures=r.get("output.figures", True, kind=bool),
-        columns=columns, truth=truth,
+        columns=columns, column_cut_m=cut, column_impacts=n_imp, truth=truth,
     )
+
+
+def cfg_video_missing(data: dict) -> bool:
+    return "video" not in data.get("sources", {})
 
 
 def _catalogue() -> dict:

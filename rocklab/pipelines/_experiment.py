@@ -77,6 +77,7 @@ class ExperimentResult:
     messages: list = field(default_factory=list)
     timings_s: dict = field(default_factory=dict)
     frames: object = None  # optional per-frame overlay data from the tracker
+    column: dict | None = None  # column experiments: see rocklab.pipelines._column_run
 
     def to_dict(self) -> dict:
         """The numbers of ``report.json`` (units in keys)."""
@@ -105,6 +106,9 @@ class ExperimentResult:
             },
             "truth": None if self.truth is None else {"eta": self.truth.get("eta"),
                                                       "theta_rms_error_rad": self.truth.get("theta_rms_error_rad")},
+            "column": None if self.column is None else {
+                k: self.column[k] for k in ("objects", "status", "comparison", "cut_m", "impacts_per_closing",
+                                            "sequence_vs_truth", "theta_rms_error_rad") if k in self.column},
             "timings_s": self.timings_s,
             "units": {"t": "s", "theta": "rad", "omega": "rad/s", "length": "m", "energy": "J",
                       "acceleration": "m/s^2"},
@@ -245,6 +249,17 @@ def analyse_experiment(cfg: ExperimentConfig, progress: bool = False) -> Experim
     per_imp = np.empty(0)
     sims: dict = {}
     status = "ok"
+    column = None
+    if cfg.columns:
+        from ._column_run import analyse_column
+
+        t3 = time.perf_counter()
+        column = analyse_column(cfg, tr, table, cfg.truth)
+        timings["column_s"] = time.perf_counter() - t3
+        return ExperimentResult(name=cfg.name, config=cfg, block=block, measured=measured, primary=cfg.primary,
+                                sync=sync, video_imu_residual=residual, fit=None, per_impact_eta=per_imp,
+                                simulations={}, table=table, truth=None, status=status, messages=msgs,
+                                timings_s=timings, frames=tr, column=column)
     if cfg.fit_restitution:
         from ..fitting import fit_restitution
 
@@ -308,25 +323,12 @@ def _simulate_laws(cfg, block, prim, fit_d, table, msgs) -> dict:
     dur = cfg.duration_s or float(np.nanmax(t_meas) - t_rel)
     base = None
     if table is not None and "acc_m_s2" in table:
-        from scipy.interpolate import CubicSpline
+        from ._column_run import base_from_table
 
-        tt = np.asarray(table["t_s"], float)
-        aa = np.asarray(table["acc_m_s2"], float)
-        fin = np.isfinite(tt) & np.isfinite(aa)
-        if fin.sum() < 4:
-            raise InputError(f"{cfg.path}: the table motion has {int(fin.sum())} valid samples; "
-                             "cannot drive the simulation (check the table object's tracking)")
-        # A near-critical rocking response is sensitive to how the frame-rate samples are
-        # interpolated: linear interpolation of a 50 fps, 0.6 s pulse moved the peak by 10 %,
-        # a cubic spline onto 1 ms by 1 % (measured on a synthetic session).
-        dt = 1e-3
-        tf = np.arange(tt[fin][0], tt[fin][-1], dt)
-        aa = CubicSpline(tt[fin], aa[fin])(tf)
-        tt = tf
         # Measured θ is counter-clockwise as the camera sees it, table x to the camera's right;
         # the simulator's θ is clockwise (Čeh Eq. 1-2). φ = -θ obeys the same equation with base
-        # -ü, so simulating with the negated table acceleration gives θ in the measurement's sense.
-        base = BaseMotion.from_samples(-aa, dt, t0_s=float(tt[0]) - t_rel, units="m/s2", name="table")
+        # -ü, so simulating with the mirrored table acceleration gives θ in the measurement's sense.
+        base = base_from_table(table, t_rel, str(cfg.path), sign=-1.0)
     sims = {}
     for law in cfg.laws:
         eta = _eta_for_law(law, cfg, block, fit_d, msgs)
@@ -391,6 +393,16 @@ def series_frame(res: ExperimentResult):
         for k in ("disp_m", "vel_m_s", "acc_m_s2"):
             if k in res.table:
                 cols[f"table_{k}"] = np.interp(t, res.table["t_s"], res.table[k], left=np.nan, right=np.nan)
+    if res.column is not None:
+        c = res.column
+        for i, o in enumerate(c["objects"]):
+            cols[f"theta_{o}_video_rad"] = np.interp(t, c["t_s"], c["theta_measured_rad"][:, i], left=np.nan,
+                                                     right=np.nan)
+            cols[f"theta_{o}_sim_column_rad"] = np.interp(t, c["sim_t_s"], c["theta_sim_rad"][:, i],
+                                                          left=np.nan, right=np.nan)
+            if "theta_truth_rad" in c:
+                tt, th = c["theta_truth_rad"]
+                cols[f"theta_{o}_truth_rad"] = np.interp(t, tt, th[:, i], left=np.nan, right=np.nan)
     return pd.DataFrame(cols)
 
 
@@ -416,6 +428,25 @@ def _summary_md(res: ExperimentResult, figs: dict, rrd: bool) -> str:
     if res.truth is not None:
         lines += [f"Synthetic truth: η = {res.truth.get('eta')}, measured θ RMS error "
                   f"{res.truth.get('theta_rms_error_rad')} rad", ""]
+    if res.column is not None:
+        c = res.column
+        cmp_ = c["comparison"]
+        lines += [f"Column of {len(c['objects'])} blocks (cut {1000 * c['cut_m']:.1f} mm, "
+                  f"{c['impacts_per_closing']} impact(s) per closing): simulation status {c['status']}", "",
+                  "| block | RMS measured − simulated (rad) | peak measured (rad) | peak simulated (rad) |",
+                  "|---|---|---|---|"]
+        for o, r, pm, ps in zip(c["objects"], cmp_["rms_theta_rad"], cmp_["peak_measured_rad"],
+                                cmp_["peak_simulated_rad"]):
+            lines.append(f"| {o} | {r:.4f} | {pm:.4f} | {ps:.4f} |")
+        sq = cmp_["sequence"]
+        lines += ["", f"Opening/closing sequence, measured vs simulated: {sq['n_matched']} of "
+                      f"{sq['n_measured']} measured / {sq['n_simulated']} simulated events matched "
+                      f"(median timing error {sq['timing_error_s']:.3f} s)"]
+        if "sequence_vs_truth" in c:
+            st = c["sequence_vs_truth"]
+            lines += [f"Measured sequence vs truth: same sequence = {st['same_sequence']} "
+                      f"({st['n_matched']}/{st['n_measured']} events)"]
+        lines.append("")
     for m in res.messages:
         lines.append(f"- note: {m}")
     lines += ["", "## Figures", ""] + [f"![{k}](figures/{p.name})" for k, p in figs.items()]

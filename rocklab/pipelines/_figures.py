@@ -89,6 +89,23 @@ def experiment_figures(res, out_dir) -> dict[str, Path]:
         ax.grid(alpha=0.3)
         figs["video_vs_imu"] = _save(fig, out / "video_vs_imu.png")
 
+    if res.column is not None:
+        c = res.column
+        n = len(c["objects"])
+        fig, axs = plt.subplots(n, 1, figsize=(10, 2.2 * n + 1), sharex=True, squeeze=False)
+        for i, (ax, o) in enumerate(zip(axs[:, 0], c["objects"])):
+            ax.plot(c["t_s"], c["theta_measured_rad"][:, i], lw=1.2, label="measured (video)")
+            ax.plot(c["sim_t_s"], c["theta_sim_rad"][:, i], lw=0.9, ls="--", label="column model")
+            if "theta_truth_rad" in c:
+                tt, th = c["theta_truth_rad"]
+                ax.plot(tt, th[:, i], lw=0.6, color="k", alpha=0.5, label="truth")
+            ax.set_ylabel(f"θ {o} (rad)")
+            ax.grid(alpha=0.3)
+        axs[0, 0].legend(fontsize=8)
+        axs[0, 0].set_title(f"{res.name}: column, measured vs simulated (status {c['status']})")
+        axs[-1, 0].set_xlabel("t (s)")
+        figs["column"] = _save(fig, out / "column.png")
+
     if res.table is not None:
         fig, axs = plt.subplots(3, 1, figsize=(10, 6), sharex=True)
         tt = res.table["t_s"]

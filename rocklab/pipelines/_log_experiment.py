@@ -92,6 +92,26 @@ def log_experiment(res, rrd_path=None, *, spawn: bool = False, connect: str | No
                for i, (a, c, e) in enumerate(zip(imp["omega_before_rad_s"], imp["omega_after_rad_s"], imp["eta"]))]
         log_events(rec, f"{blk}/impacts", imp["t_s"].to_numpy(float), txt, values=np.zeros(len(imp)))
         rows[f"{blk}/impacts"] = len(imp)
+    block_paths = [blk]
+    if res.column is not None:
+        c = res.column
+        block_paths = [f"{ROOT}/{o}" for o in c["objects"]]
+        for i, bp in enumerate(block_paths):
+            rows[f"{bp}/theta/measured_video"] = log_series(rec, f"{bp}/theta/measured_video", c["t_s"],
+                                                            c["theta_measured_rad"][:, i], name="measured (video)")
+            rows[f"{bp}/theta/sim_column"] = log_series(rec, f"{bp}/theta/sim_column", c["sim_t_s"],
+                                                        c["theta_sim_rad"][:, i], name="column model")
+            sim_on = np.interp(c["t_s"], c["sim_t_s"], c["theta_sim_rad"][:, i], left=np.nan, right=np.nan)
+            rows[f"{bp}/residual/measured_minus_sim"] = log_series(
+                rec, f"{bp}/residual/measured_minus_sim", c["t_s"], c["theta_measured_rad"][:, i] - sim_on)
+            if "theta_truth_rad" in c:
+                tt, th = c["theta_truth_rad"]
+                rows[f"{bp}/theta/truth"] = log_series(rec, f"{bp}/theta/truth", tt, th[:, i], name="truth")
+        conf = c["configurations"]
+        if len(conf):
+            log_events(rec, f"{ROOT}/column/configurations", conf["t_s"].to_numpy(float),
+                       [f"joint {j}: {st} ({ev})" for j, st, ev in zip(conf["joint"], conf["state"], conf["event"])])
+            rows[f"{ROOT}/column/configurations"] = len(conf)
     if res.table is not None:
         for k in ("disp_m", "vel_m_s", "acc_m_s2"):
             if k in res.table:
@@ -109,7 +129,7 @@ def log_experiment(res, rrd_path=None, *, spawn: bool = False, connect: str | No
             decimation=res.config.video_decimation, overlays=_overlay_fn(res), progress=bar)
         if bar is not None:
             bar.close()
-    rec.send_blueprint(experiment_blueprint([blk], has_video=has_video))
+    rec.send_blueprint(experiment_blueprint(block_paths, has_video=has_video))
     rec.flush()
     rec.disconnect()
     return rows

@@ -19,6 +19,11 @@ Newton), the pre-impact omega and theta'' follow from Eq. 10–11, the
 restitution law gives omega+ and the rest of the step continues with the other
 equation (several impacts per step are allowed).
 
+Free rocking (no base record, full equation) runs its steps between impacts in
+the lean loop :func:`~rocklab.models._newmark_free.free_steps` (same trapezoidal
+step, solved by a jerk-corrected predictor and a checked fixed-point update);
+impacts, rest and overturning are always handled here.
+
 Notes on the paper: Eq. 8 as printed reads ``A dt'^2 - 4 w dt' - theta = 0``; the
 Newmark relation and Eq. 9 both need ``- 4 theta``, which is used here.
 """
@@ -31,6 +36,30 @@ import numpy as np
 from numba import njit, prange
 
 from ..blocks import G
+from ._newmark_free import free_steps, sdcd
+
+
+
+def _drop_stale_cache():
+    """Delete this module's on-disk numba cache if ``_newmark_free.py`` is newer.
+
+    numba checks only the timestamp of the file that holds a cached function;
+    :func:`run_block` compiles in the loop of ``_newmark_free``, so an edit
+    there would otherwise run stale machine code.
+    """
+    from pathlib import Path
+
+    here = Path(__file__).resolve().parent
+    try:
+        newest = max((here / f).stat().st_mtime for f in ("_newmark_free.py", "_newmark.py"))
+        for idx in (here / "__pycache__").glob("_newmark.*.nbi"):
+            if idx.stat().st_mtime < newest:
+                idx.unlink()
+    except OSError:  # read-only install or a concurrent clean-up: numba decides on its own
+        pass
+
+
+_drop_stale_cache()
 
 #: Status codes returned by the kernel.
 ROCKING, REST, OVERTURNED, NO_UPLIFT = 0, 1, 2, 3
@@ -66,23 +95,10 @@ def _f(th, s, ug, p2, alpha, lin):
 def _shift(sc0, cc0, d):
     """sin and cos of (c0 - d) from sin c0, cos c0 for an increment |d| < 0.2.
 
-    Taylor series of sin d and cos d, as short as the size of d allows
-    (truncation error < 1e-20 relative): a few multiplications instead of two
-    libm calls per Newton iteration.
+    Taylor series of sin d and cos d (:func:`sdcd`): a few multiplications
+    instead of two libm calls per Newton iteration.
     """
-    d2 = d * d
-    ad = abs(d)
-    if ad < 1e-5:
-        sd = d * (1.0 - d2 * (1.0 / 6.0))
-        cd = 1.0 - 0.5 * d2
-    elif ad < 3e-3:
-        sd = d * (1.0 - d2 * (1.0 / 6.0) * (1.0 - d2 * (1.0 / 20.0) * (1.0 - d2 * (1.0 / 42.0))))
-        cd = 1.0 - d2 * 0.5 * (1.0 - d2 * (1.0 / 12.0) * (1.0 - d2 * (1.0 / 30.0) * (1.0 - d2 * (1.0 / 56.0))))
-    else:
-        sd = d * (1.0 - d2 * (1.0 / 6.0) * (1.0 - d2 * (1.0 / 20.0) * (1.0 - d2 * (1.0 / 42.0) * (
-            1.0 - d2 * (1.0 / 72.0) * (1.0 - d2 * (1.0 / 110.0))))))
-        cd = 1.0 - d2 * 0.5 * (1.0 - d2 * (1.0 / 12.0) * (1.0 - d2 * (1.0 / 30.0) * (
-            1.0 - d2 * (1.0 / 56.0) * (1.0 - d2 * (1.0 / 90.0) * (1.0 - d2 * (1.0 / 132.0))))))
+    sd, cd = sdcd(d)
     return sc0 * cd - cc0 * sd, cc0 * cd + sc0 * sd
 
 
@@ -240,10 +256,10 @@ def _contact_tau(th0, w0, a0, s, h, u0, u1, p2, alpha, lin):
     return t
 
 
-@njit(cache=True)
+@njit(cache=True, fastmath={"contract"})
 def run_block(p, alpha, theta0, omega0, h, n_steps, acc, acc_t0, acc_dt, scale,
               eta_mode, eta_x, eta_y, lin, rest_w2, t_last_uplift, stop_at_rest,
-              out_every, imp_cap, fall_rad=_HALF_PI, stop_on_fall=True):
+              out_every, imp_cap, fall_rad=_HALF_PI, stop_on_fall=True, e_scale=1.0):
     """Integrate one block for n_steps steps of h (s).
 
     Returns
@@ -251,7 +267,7 @@ def run_block(p, alpha, theta0, omega0, h, n_steps, acc, acc_t0, acc_dt, scale,
     tuple
         ``out_theta, out_omega, out_energy`` (n_out,): samples at every
         ``out_every``-th step (t = i h out_every), energy above rest per unit I_O
-        (rad^2/s^2, J = I_O * this); ``n_out``; ``imp`` (4, k): rows t_s,
+        times ``e_scale`` (rad^2/s^2 with the default 1; pass I_O for J); ``n_out``; ``imp`` (4, k): rows t_s,
         omega_before, omega_after, eta of the first ``imp_cap`` impacts; ``n_imp``
         (all impacts); ``status`` code; ``t_over`` (first |theta| >= alpha outward,
         NaN); ``t_fall`` (|theta| reached fall_rad, NaN); ``max_abs_theta``;
@@ -302,12 +318,23 @@ def run_block(p, alpha, theta0, omega0, h, n_steps, acc, acc_t0, acc_dt, scale,
     if out_every > 0:
         out_th[0] = th
         out_w[0] = w
-        out_e[0] = _energy(th, w, cc, cos_a, p2, alpha, lin)
+        out_e[0] = _energy(th, w, cc, cos_a, p2, alpha, lin) * e_scale
         n_out = 1
     step = 0
     countdown = out_every  # output every out_every steps (no integer modulo in the hot loop)
     t_end = 0.0
+    # free rocking (no base record, full equation): the lean loop of whole steps in
+    # _newmark_free; anything else (impact in the step, |theta| >= alpha, rest) is
+    # left to the general step below, which takes that step from the same state
+    fast = acc.shape[0] == 0 and not lin
     while step < n_steps:
+        if fast and not resting:
+            th, w, a, sc, cc, step, max_abs, n_out, countdown = free_steps(
+                th, w, a, sc, cc, s, step, n_steps, h, p2, alpha, cos_a, max_abs, out_th, out_w, out_e,
+                n_out, countdown, out_every, e_scale)
+            t_end = step * h
+            if step >= n_steps:
+                break
         t0 = step * h
         t1 = (step + 1) * h
         u1 = _ug_at(t1, acc, acc_t0, inv_dta, fac)
@@ -414,7 +441,7 @@ def run_block(p, alpha, theta0, omega0, h, n_steps, acc, acc_t0, acc_dt, scale,
             countdown = out_every
             out_th[n_out] = th
             out_w[n_out] = w
-            out_e[n_out] = 0.0 if resting else _energy(th, w, cc, cos_a, p2, alpha, lin)
+            out_e[n_out] = 0.0 if resting else _energy(th, w, cc, cos_a, p2, alpha, lin) * e_scale
             n_out += 1
         if ath >= alpha and th * w > 0.0 and t_over != t_over:
             t_over = t1 - h + h * _cross(th_beg * s, w_beg * s, th * s, w * s, h, alpha)
@@ -439,6 +466,25 @@ def run_block(p, alpha, theta0, omega0, h, n_steps, acc, acc_t0, acc_dt, scale,
             status = ROCKING
     return (out_th[:n_out], out_w[:n_out], out_e[:n_out], n_out, imp[:, :min(n_imp, imp_cap)], n_imp, status,
             t_over, t_fall, max_abs, t_end)
+
+
+@njit(cache=True)
+def run_single(p, alpha, theta0, omega0, h, n_steps, acc, acc_t0, acc_dt, eta_mode, eta_x, eta_y, lin,
+               rest_w2, t_last_uplift, stop_at_rest, out_every, imp_cap, fall_rad, e_scale):
+    """:func:`run_block` for ``simulate``: output times and a contiguous impact table in the same call.
+
+    Returns ``t, theta, omega, energy`` (n_out,; energy times ``e_scale``),
+    ``imp`` (4, k) C-contiguous, ``n_imp``, ``status``, ``t_over``, ``t_fall``,
+    ``max_abs`` (one dispatch from Python instead of several numpy calls).
+    """
+    th, w, e, n_out, imp, n_imp, st, t_over, t_fall, max_abs, t_end = run_block(
+        p, alpha, theta0, omega0, h, n_steps, acc, acc_t0, acc_dt, 1.0, eta_mode, eta_x, eta_y, lin, rest_w2,
+        t_last_uplift, stop_at_rest, out_every, imp_cap, fall_rad, True, e_scale)
+    t = np.empty(n_out)
+    dto = h * out_every
+    for i in range(n_out):
+        t[i] = i * dto
+    return t, th, w, e, np.ascontiguousarray(imp), n_imp, st, t_over, t_fall, max_abs
 
 
 @njit(cache=True)

@@ -57,5 +57,8 @@ def test_model_follows_the_tracked_blocks(column_run):
         assert rows[f"/experiment/{o}/theta/measured_video"] > 100
         assert f"/experiment/{o}/theta/sim_column" in rows
     assert rows["/experiment/column/configurations"] >= 4
+    # every 10th frame of the video, encoded while it was decoded for tracking
+    n_frames = json.loads((out.parent / "s" / "session.json").read_text())["n_frames"]
+    assert rows["/experiment/video"] == -(-n_frames // 10)
     assert (out / "figures" / "column.png").is_file()
     assert json.loads((out / "report.json").read_text())["column"]["status"] in ("rest", "rocking")

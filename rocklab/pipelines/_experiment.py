@@ -78,6 +78,7 @@ class ExperimentResult:
     timings_s: dict = field(default_factory=dict)
     frames: object = None  # optional per-frame overlay data from the tracker
     column: dict | None = None  # column experiments: see rocklab.pipelines._column_run
+    video_jpeg: list | None = None  # (frame index, JPEG bytes) of the frames to show in Rerun
 
     def to_dict(self) -> dict:
         """The numbers of ``report.json`` (units in keys)."""
@@ -160,11 +161,22 @@ def _read_track_csv(path: Path, obj: str | None):
     return df["t_s"].to_numpy(float), df["theta_rad"].to_numpy(float)
 
 
-def _measure_video(cfg: ExperimentConfig, progress: bool):
+def _measure_video(cfg: ExperimentConfig, progress: bool, keep_jpeg: bool):
     from ..tracking import load_track_config, track_video
 
     tcfg = load_track_config(cfg.video.track_config) if cfg.video.track_config else None
-    tr = track_video(cfg.video.path, tcfg, fps=cfg.video.fps, progress=progress)
+    jpeg: list = []
+
+    def keep(i, gray):  # encode the frames Rerun will show while they are decoded for tracking
+        if i % cfg.video_decimation == 0:
+            import cv2
+
+            ok, buf = cv2.imencode(".jpg", gray, [cv2.IMWRITE_JPEG_QUALITY, 80])
+            if ok:
+                jpeg.append((i, buf.tobytes()))
+
+    tr = track_video(cfg.video.path, tcfg, fps=cfg.video.fps, progress=progress,
+                     on_frame=keep if keep_jpeg else None)
     df = tr.to_frame()
     sel = df[df["object"] == cfg.video.object]
     if sel.empty:
@@ -175,7 +187,7 @@ def _measure_video(cfg: ExperimentConfig, progress: bool):
         tm = tr.table_motion(cfg.table.object)
         table = {"t_s": np.asarray(tm.t_s), "disp_m": np.asarray(tm.x_m),
                  "vel_m_s": np.asarray(tm.vx_m_s), "acc_m_s2": np.asarray(tm.ax_m_s2)}
-    return (sel["t_s"].to_numpy(float), sel["theta_rad"].to_numpy(float)), table, tr
+    return (sel["t_s"].to_numpy(float), sel["theta_rad"].to_numpy(float)), table, tr, jpeg
 
 
 def _measure_imu(cfg: ExperimentConfig):
@@ -209,9 +221,10 @@ def analyse_experiment(cfg: ExperimentConfig, progress: bool = False) -> Experim
     measured: dict = {}
     table = None
     tr = None
+    jpeg = None
     t0 = time.perf_counter()
     if cfg.video is not None:
-        measured["video"], table, tr = _measure_video(cfg, progress)
+        measured["video"], table, tr, jpeg = _measure_video(cfg, progress, keep_jpeg=cfg.rrd)
         timings["track_s"] = time.perf_counter() - t0
     if cfg.track is not None:
         measured["track"] = _read_track_csv(cfg.track.path, cfg.track.object)
@@ -259,7 +272,7 @@ def analyse_experiment(cfg: ExperimentConfig, progress: bool = False) -> Experim
         return ExperimentResult(name=cfg.name, config=cfg, block=block, measured=measured, primary=cfg.primary,
                                 sync=sync, video_imu_residual=residual, fit=None, per_impact_eta=per_imp,
                                 simulations={}, table=table, truth=None, status=status, messages=msgs,
-                                timings_s=timings, frames=tr, column=column)
+                                timings_s=timings, frames=tr, column=column, video_jpeg=jpeg)
     if cfg.fit_restitution:
         from ..fitting import fit_restitution
 
@@ -281,7 +294,7 @@ def analyse_experiment(cfg: ExperimentConfig, progress: bool = False) -> Experim
     return ExperimentResult(name=cfg.name, config=cfg, block=block, measured=measured,
                             primary=cfg.primary, sync=sync, video_imu_residual=residual, fit=fit_d,
                             per_impact_eta=per_imp, simulations=sims, table=table, truth=truth,
-                            status=status, messages=msgs, timings_s=timings, frames=tr)
+                            status=status, messages=msgs, timings_s=timings, frames=tr, video_jpeg=jpeg)
 
 
 def _eta_for_law(law, cfg, block, fit_d, msgs):

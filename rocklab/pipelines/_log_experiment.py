@@ -124,8 +124,13 @@ def log_experiment(res, rrd_path=None, *, spawn: bool = False, connect: str | No
             from tqdm import tqdm
 
             bar = tqdm(desc="rerun: video frames", unit="frame", leave=False)
+        if res.video_jpeg is not None and res.frames is not None:  # encoded during tracking
+            fps = res.frames.fps
+            frames = ((i, i / fps, data) for i, data in res.video_jpeg)
+        else:
+            frames = _video_frames(res.config.video.path, res.config.video.fps)
         rows[f"{ROOT}/video"] = log_video_frames(
-            rec, f"{ROOT}/video", _video_frames(res.config.video.path, res.config.video.fps),
+            rec, f"{ROOT}/video", frames,
             decimation=res.config.video_decimation, overlays=_overlay_fn(res), progress=bar)
         if bar is not None:
             bar.close()

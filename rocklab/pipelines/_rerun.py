@@ -100,7 +100,8 @@ def log_video_frames(rec, path: str, frames, *, decimation: int = 1, quality: in
 
     Parameters
     ----------
-    frames : iterable of (frame_index, t_s, image BGR uint8 (H, W, 3))
+    frames : iterable of (frame_index, t_s, image)
+        ``image`` is a uint8 array (H, W) or (H, W, 3) BGR, or JPEG bytes already encoded.
     decimation : int
         Log every n-th frame.
     overlays : callable(frame_index) -> dict, optional
@@ -114,12 +115,16 @@ def log_video_frames(rec, path: str, frames, *, decimation: int = 1, quality: in
     for idx, t, img in frames:
         if idx % decimation:
             continue
-        ok, buf = cv2.imencode(".jpg", img, [cv2.IMWRITE_JPEG_QUALITY, quality])
-        if not ok:  # pragma: no cover - OpenCV cannot fail on a valid uint8 image
-            continue
+        if isinstance(img, bytes):
+            data = img
+        else:
+            ok, buf = cv2.imencode(".jpg", img, [cv2.IMWRITE_JPEG_QUALITY, quality])
+            if not ok:  # pragma: no cover - OpenCV cannot fail on a valid uint8 image
+                continue
+            data = buf.tobytes()
         rec.set_time(TIMELINE, duration=float(t))
         rec.set_time("frame", sequence=int(idx))
-        rec.log(path, rr.EncodedImage(contents=buf.tobytes(), media_type="image/jpeg"))
+        rec.log(path, rr.EncodedImage(contents=data, media_type="image/jpeg"))
         if overlays is not None:
             ov = overlays(idx) or {}
             if ov.get("points") is not None and len(ov["points"]):

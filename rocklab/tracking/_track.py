@@ -405,8 +405,8 @@ def assemble_tracks(observations, config: TrackConfig, fps: float, width_px: int
                        None if source is None else str(source), config, plane)
 
 
-def track_video(path, config: TrackConfig, fps: float | None = None, progress: bool = False
-                ) -> TrackResult:
+def track_video(path, config: TrackConfig, fps: float | None = None, progress: bool = False,
+                on_frame=None) -> TrackResult:
     """Track a video file.
 
     Parameters
@@ -418,6 +418,9 @@ def track_video(path, config: TrackConfig, fps: float | None = None, progress: b
         Overrides ``config.video.fps`` and the container's rate.
     progress : bool
         tqdm progress bar on stderr.
+    on_frame : callable(index, gray), optional
+        Called with every decoded frame (uint8, (H, W)) before it is tracked, so a
+        caller can use the frames (e.g. log them) without decoding the video twice.
 
     Raises
     ------
@@ -442,6 +445,8 @@ def track_video(path, config: TrackConfig, fps: float | None = None, progress: b
                          f"({info.n_frames} frames); check start_frame / reference.board.frame")
     pm = make_plane_map(config, info.width_px, info.height_px, first)
     frames = iter_video_frames(path, start, stop)
+    if on_frame is not None:
+        frames = _tee(frames, on_frame)
     if progress:
         from tqdm import tqdm
 
@@ -450,3 +455,9 @@ def track_video(path, config: TrackConfig, fps: float | None = None, progress: b
                       leave=False)
     obs = track_frames(frames, config, pm)
     return assemble_tracks(obs, config, rate, info.width_px, info.height_px, pm, path)
+
+
+def _tee(frames, fn):
+    for i, g in frames:
+        fn(i, g)
+        yield i, g

@@ -109,7 +109,7 @@ def write_track_toml(path: Path, *, style, fps, camera, objects, marker_size_m, 
         d["targets"].update(dot_diameter_m=float(dot_diameter_m), dot_color="dark")
     for o in objects:
         e = {"id": o["id"], "kind": o["kind"]}
-        for k in ("markers", "marker_positions_m", "dots", "roi", "size_m", "theta0_rad"):
+        for k in ("markers", "marker_positions_m", "marker_size_m", "dots", "roi", "size_m", "theta0_rad"):
             if o.get(k) is not None:
                 v = o[k]
                 e[k] = v.tolist() if isinstance(v, np.ndarray) else v

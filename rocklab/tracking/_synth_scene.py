@@ -133,6 +133,8 @@ class Scene:
             if self.targets == "aruco":
                 e["markers"] = [int(k) for k in f["markers"]]
                 e["marker_positions_m"] = [np.mean(c, axis=0).round(12).tolist() for c in f["markers"].values()]
+                # each object's own printed marker size (the table's differ from the blocks')
+                e["marker_size_m"] = float(f["marker_size_m"])
             elif self.targets == "dots":
                 e["dots"] = np.asarray(f["dots"]).round(12).tolist()
             else:

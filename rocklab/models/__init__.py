@@ -11,7 +11,8 @@ from ._oas import (OASResult, OverturningCurve, critical_impulse, fit_inclined_l
                    normalised_critical_impulse, overturning_curve, overturning_spectrum, simplified_oas)
 from ._design import DesignCheck, design_check, required_width, required_width_slender
 from ._equivalent import (FundamentalParameters, Mechanism, arch_mechanism, asymmetric_frame,
-                          block_parameters, four_bar_mechanism, frame_parameters, free_rocking_period_eq24,
+                          block_parameters, equivalence_errors, four_bar_mechanism, frame_parameters,
+                          free_rocking_period_eq24,
                           linear_sine_pulse_response, overturning_time_eq25, sine_pulse_max_response,
                           strut_parameters, wall_mechanism, wall_parameters)
 from ._column_sim import STATE_NAMES, Column, ColumnResult, simulate_column, uplift_acc_m_s2
@@ -33,6 +34,7 @@ __all__ = ["BaseMotion", "load_base_motion", "UNITS_TO_M_S2", "bundled_record", 
            "frame_parameters", "wall_parameters", "wall_mechanism", "four_bar_mechanism",
            "asymmetric_frame", "free_rocking_period_eq24", "overturning_time_eq25",
            "sine_pulse_max_response", "linear_sine_pulse_response", "arch_mechanism",
+           "equivalence_errors",
            # columns (helper "column")
            "Column", "ColumnResult", "simulate_column", "uplift_acc_m_s2", "STATE_NAMES",
            "ImpactOutcome", "app_c_reduction", "column_impact", "full_mass_matrix", "mass_points",

@@ -30,7 +30,8 @@ from ..blocks import G
 __all__ = ["FundamentalParameters", "Mechanism", "block_parameters", "strut_parameters",
            "frame_parameters", "wall_parameters", "wall_mechanism", "four_bar_mechanism",
            "asymmetric_frame", "free_rocking_period_eq24", "overturning_time_eq25",
-           "sine_pulse_max_response", "linear_sine_pulse_response", "arch_mechanism"]
+           "sine_pulse_max_response", "linear_sine_pulse_response", "arch_mechanism",
+           "equivalence_errors"]
 
 
 def _pos(name, v):
@@ -176,6 +177,12 @@ class Mechanism:
     phi_max: float = math.pi / 2
     name: str = ""
     eta: float = float("nan")
+    eom: object = None  # optional fast callable phi -> (M, dM/dphi, dV/dphi, B)
+
+    def _eom(self, phi):
+        if self.eom is not None:
+            return self.eom(phi)
+        return self.M(phi), self.dM(phi), self.dV(phi), self.B(phi)
 
     def dV(self, phi, h=1e-6):
         return (self.V(phi + h) - self.V(phi - h)) / (2 * h)
@@ -234,12 +241,13 @@ class Mechanism:
 
         def f(t, y):
             phi, om = y
-            return [om, (-self.B(phi) * a - self.dV(phi) - 0.5 * self.dM(phi) * om * om) / self.M(phi)]
+            M, dM, dV, B = self._eom(phi)
+            return [om, (-B * a - dV - 0.5 * dM * om * om) / M]
 
         def hit(t, y):
             return y[0] - pc
         hit.terminal = True
-        sol = solve_ivp(f, (0, 1e4), [0.0, 0.0], events=hit, rtol=1e-10, atol=1e-13)
+        sol = solve_ivp(f, (0, 1e4), [0.0, 0.0], events=hit, rtol=1e-9, atol=1e-12)
         return float(sol.t_events[0][0]) if sol.t_events[0].size else float("inf")
 
 
@@ -343,7 +351,15 @@ def four_bar_mechanism(A, B, C, D, bodies, name: str = "four-bar") -> Mechanism:
         dr, _ = _derivs(phi)
         return float(ms @ dr[:, 0])
 
-    return Mechanism(M=M, V=V, B=Bf, phi_max=phi_max, name=name)
+    def eom(phi, h=1e-4):
+        (rm, tm), (r0, t0), (rp, tp) = config(phi - h), config(phi), config(phi + h)
+        dr, dt = (rp - rm) / (2 * h), (tp - tm) / (2 * h)
+        ddr, ddt = (rp - 2 * r0 + rm) / h ** 2, (tp - 2 * t0 + tm) / h ** 2
+        M_ = float(ms @ (dr ** 2).sum(axis=1) + Ic @ dt ** 2)
+        dM_ = float(2 * ms @ (dr * ddr).sum(axis=1) + 2 * Ic @ (dt * ddt))
+        return M_, dM_, G * float(ms @ dr[:, 1]), float(ms @ dr[:, 0])
+
+    return Mechanism(M=M, V=V, B=Bf, phi_max=phi_max, name=name, eom=eom)
 
 
 def asymmetric_frame(b_m: float, H_m: float, H1_m: float, L_m: float, h_m: float,
@@ -603,3 +619,22 @@ def arch_mechanism(inclusion_angle_rad: float, thickness_m: float, radius_m: flo
                               [(b[0], tuple(b[1]), b[2]) for b in bodies], name="arch")
     return mech, {"hinges": u, "faces": ["extrados" if f else "intrados" for f in faces],
                   "mirrored": mirror, "lambda": _lambda_at_rest(pts, bodies)}
+
+
+def equivalence_errors(mech: Mechanism, ratios=(0.1, 0.3, 0.5, 0.7, 0.9), accs=(1.2, 1.5, 2.0, 3.0)):
+    """Errors of the equivalent-block approximation of one mechanism (paper Fig. 3, 6–8).
+
+    Returns dict with ``period_ratio`` (T_eq24 / T_nonlinear at phi/phi_cr = ``ratios``) and
+    ``t_ratio_kappa1``, ``t_ratio_kappa2`` (t_eq25 / t_nonlinear under a constant base
+    acceleration u/(g lambda) = ``accs``), plus the parameters used.
+    """
+    fp = mech.parameters()
+    ratios = np.asarray(ratios, float)
+    accs = np.asarray(accs, float)
+    T = np.array([free_rocking_period_eq24(fp.p_rad_s, x) / mech.free_rocking_period(x * fp.phi_cr_rad)
+                  for x in ratios])
+    tn = np.array([mech.overturning_time(r * fp.lambda_) for r in accs])
+    t1 = overturning_time_eq25(fp.p_rad_s, accs, fp.lambda_, fp.lambda_lin, "kappa1") / tn
+    t2 = overturning_time_eq25(fp.p_rad_s, accs, fp.lambda_, fp.lambda_lin, "kappa2") / tn
+    return dict(parameters=fp, ratios=ratios, accs=accs, period_ratio=T, t_ratio_kappa1=t1,
+                t_ratio_kappa2=t2)

@@ -4,15 +4,15 @@
   transformed OAS with the vertical (Eq. 20) and inclined (Eq. 28) lines, and the
   OAS over 1/p with the simplified curves Eq. 21, 29, 30 (thesis Fig. 36–37, 47, 55).
 - :func:`plot_overturning_curve`: overturning curve and impulse curve of a pulse (Fig. 33–34).
-- :func:`plot_wall_error_maps`: rocking wall free-period and overturning-time error maps
-  (DeJong & Dimitrakopoulos Fig. 3 style).
+- :func:`plot_wall_error_maps`, :func:`plot_frame_error_maps`: free-period and
+  overturning-time error maps of the equivalent block (DeJong & Dimitrakopoulos Fig. 3, 6–8).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["plot_oas", "plot_overturning_curve", "plot_wall_error_maps"]
+__all__ = ["plot_oas", "plot_overturning_curve", "plot_wall_error_maps", "plot_frame_error_maps"]
 
 
 def _fig(ncols, w=4.2, h=3.6):
@@ -82,35 +82,48 @@ def plot_overturning_curve(c, path):
     return _save(plt, fig, path)
 
 
+def _error_maps(mechs, ys, ylabel, path, ratios, accs, title):
+    from ..models import equivalence_errors
+
+    errs = [equivalence_errors(m, ratios, accs) for m in mechs]
+    T = np.array([e["period_ratio"] for e in errs])
+    t1 = np.array([e["t_ratio_kappa1"] for e in errs])
+    t2 = np.array([e["t_ratio_kappa2"] for e in errs])
+    plt, fig, ax = _fig(3)
+    for k, (Z, x, lab) in enumerate(((T, ratios, "phi/phi_cr"), (t1, accs, "u_g/(g lambda)  [kappa1]"),
+                                      (t2, accs, "u_g/(g lambda)  [kappa2]"))):
+        cs = ax[k].contourf(x, ys, Z, levels=15, cmap="viridis")
+        fig.colorbar(cs, ax=ax[k])
+        ax[k].set(xlabel=lab, ylabel=ylabel)
+    ax[0].set_title(f"{title}: T_r,blockeq / T_r")
+    ax[1].set_title("t_over,blockeq / t_over")
+    ax[2].set_title("t_over,blockeq / t_over")
+    _save(plt, fig, path)
+    return dict(y=np.asarray(ys), ratios=np.asarray(ratios), accs=np.asarray(accs), period_ratio=T,
+                t_ratio_kappa1=t1, t_ratio_kappa2=t2)
+
+
 def plot_wall_error_maps(path, alphas=None, ratios=None, accs=None, R_m=1.0):
     """Rocking wall: T_eq24/T_wall over (phi/phi_cr, alpha) and t_eq25/t_wall over (u/(g lambda),
-    alpha) for kappa1 and kappa2 (DeJong & Dimitrakopoulos Fig. 3)."""
-    from ..models import free_rocking_period_eq24, overturning_time_eq25, wall_mechanism
+    alpha) for kappa1 and kappa2 (DeJong & Dimitrakopoulos Fig. 3). Returns the arrays."""
+    from ..models import wall_mechanism
 
     alphas = np.linspace(0.05, 0.4, 8) if alphas is None else np.asarray(alphas)
     ratios = np.linspace(0.05, 0.95, 10) if ratios is None else np.asarray(ratios)
     accs = np.linspace(1.1, 4.0, 8) if accs is None else np.asarray(accs)
-    T = np.zeros((alphas.size, ratios.size))
-    t1 = np.zeros((alphas.size, accs.size))
-    t2 = np.zeros_like(t1)
-    for i, a in enumerate(alphas):
-        m = wall_mechanism(R_m, a)
-        fp = m.parameters()
-        for j, x in enumerate(ratios):
-            T[i, j] = free_rocking_period_eq24(fp.p_rad_s, x) / m.free_rocking_period(x * fp.phi_cr_rad)
-        for j, r in enumerate(accs):
-            tn = m.overturning_time(r * fp.lambda_)
-            t1[i, j] = overturning_time_eq25(fp.p_rad_s, r, fp.lambda_, fp.lambda_lin, "kappa1") / tn
-            t2[i, j] = overturning_time_eq25(fp.p_rad_s, r, fp.lambda_, fp.lambda_lin, "kappa2") / tn
-    plt, fig, ax = _fig(3)
-    for k, (Z, x, lab) in enumerate(((T, ratios, "phi/phi_cr"), (t1, accs, "u_g/(g lambda)  [kappa1]"),
-                                      (t2, accs, "u_g/(g lambda)  [kappa2]"))):
-        cs = ax[k].contourf(x, alphas, Z, levels=15, cmap="viridis")
-        fig.colorbar(cs, ax=ax[k])
-        ax[k].set(xlabel=lab, ylabel="alpha [rad]")
-    ax[0].set_title("T_r,blockeq / T_r,wall")
-    ax[1].set_title("t_over,blockeq / t_over,wall")
-    ax[2].set_title("t_over,blockeq / t_over,wall")
-    _save(plt, fig, path)
-    return dict(alphas=alphas, ratios=ratios, accs=accs, period_ratio=T, t_ratio_kappa1=t1,
-                t_ratio_kappa2=t2)
+    return _error_maps([wall_mechanism(R_m, a) for a in alphas], alphas, "alpha [rad]", path, ratios, accs,
+                       "wall")
+
+
+def plot_frame_error_maps(path, H1_over_H=None, direction="+", b_m=0.3, H_m=2.0, L_m=3.0, h_m=0.2,
+                          masses=(1.0, 1.0, 1.0), ratios=None, accs=None):
+    """Asymmetric frame error maps over (phi/phi_cr or u/(g lambda), H1/H) for one rocking
+    direction (paper Fig. 6–8). Returns the arrays."""
+    from ..models import asymmetric_frame
+
+    hs = np.linspace(1.0, 1.5, 6) if H1_over_H is None else np.asarray(H1_over_H)
+    ratios = np.linspace(0.05, 0.95, 10) if ratios is None else np.asarray(ratios)
+    accs = np.linspace(1.1, 4.0, 8) if accs is None else np.asarray(accs)
+    k = 0 if direction == "+" else 1
+    mechs = [asymmetric_frame(b_m, H_m, r * H_m, L_m, h_m, *masses)[k] for r in hs]
+    return _error_maps(mechs, hs, "H1/H", path, ratios, accs, f"frame ({direction})")

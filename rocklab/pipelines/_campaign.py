@@ -96,9 +96,16 @@ class CampaignResult:
                 ci = (f"[{r['ci_lo']:.3f}, {r['ci_hi']:.3f}]" if np.isfinite(r.get("ci_lo", np.nan))
                       else "")
                 eta_e = f"{r['eta_e']:>8.3f}" if np.isfinite(r["eta_e"]) else f"{'(forced)':>8}"
-                lines.append(f"{str(r['experiment'])[:21]:<22}{str(r['block']):<7}{r['contact']:<8}"
+                lines.append(f"{str(r['experiment'])[:21]:<22}{str(r['block'])[:6]:<7}{r['contact']:<8}"
                              f"{r['eta_H']:>8.3f}{eta_e}{ci:>18}"
                              f"{r.get('eta_M', np.nan):>8.3f}{r.get('eta_true', np.nan):>8.3f}")
+            for _, r in t[t.get("column", "") != ""].iterrows() if "column" in t else []:
+                c = json.loads(r["column"])
+                lines.append(f"{r['experiment']}: column of {len(c['rms_theta_rad'])} blocks, model status "
+                             f"{c['status']}, θ RMS measured−model "
+                             f"{', '.join(f'{x:.4f}' for x in c['rms_theta_rad'])} rad, opening sequence "
+                             f"matched by the model {c['sequence_model_matched']}, same as truth: "
+                             f"{c['sequence_same_as_truth']}")
         if self.eta_mat:
             lines.append(f"eta_mat (edge contact, Čeh Eq. 16) = {self.eta_mat.get('eta_mat'):.4f} "
                          f"± {self.eta_mat.get('std', float('nan')):.4f} ({self.eta_mat.get('n')} blocks)")
@@ -131,7 +138,16 @@ def _row(run: dict) -> dict | None:
             "eta_e_first": fit.get("eta_e_first", np.nan),
             "eta_M": (sims.get("modified") or {}).get("eta", np.nan),
             "eta_true": truth.get("eta") if truth.get("eta") is not None else np.nan,
-            "fit_status": fit.get("status"), "out": run["out"]}
+            "fit_status": fit.get("status"), "out": run["out"],
+            "column": json.dumps(_column_summary(rep["column"])) if rep.get("column") else ""}
+
+
+def _column_summary(col: dict) -> dict:
+    seq = col["comparison"]["sequence"]
+    st = col.get("sequence_vs_truth") or {}
+    return {"status": col["status"], "rms_theta_rad": col["comparison"]["rms_theta_rad"],
+            "sequence_model_matched": f"{seq['n_matched']}/{seq['n_measured']}",
+            "sequence_same_as_truth": st.get("same_sequence")}
 
 
 def _campaign_fits(table, msgs):

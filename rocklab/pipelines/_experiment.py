@@ -277,7 +277,10 @@ def analyse_experiment(cfg: ExperimentConfig, progress: bool = False) -> Experim
         from ..fitting import fit_restitution
 
         t2 = time.perf_counter()
-        fit = fit_restitution(prim[0], prim[1], block, window=cfg.fit_window)
+        n_lost = int((~np.isfinite(prim[1])).sum())
+        if n_lost:  # frames the tracker flagged as lost stay NaN: skip them, never invent them
+            msgs.append(f"{n_lost} samples of the {cfg.primary} θ are NaN (lost target) and were skipped by the fit")
+        fit = fit_restitution(prim[0], prim[1], block, window=cfg.fit_window, nan="skip")
         timings["fit_s"] = time.perf_counter() - t2
         fit_d = fit.to_dict()
         per_imp = np.asarray(fit_d.get("per_impact_eta") or [], float)

@@ -136,7 +136,8 @@ def campaign_figures(table, out_dir, regression=None) -> dict[str, Path]:
         return figs
     fig, ax = plt.subplots(figsize=(7, 5))
     hb_grid = np.linspace(0.8, 10, 200)
-    for i, (b_m, grp) in enumerate(table.groupby("b_m")):
+    fitted = table[np.isfinite(table["eta_e"])]  # forced and column runs have no free-rocking η_e
+    for i, (b_m, grp) in enumerate(fitted.groupby("b_m")):
         eta_h = [Block(b_m, hb * b_m).eta_H for hb in hb_grid]
         ax.plot(hb_grid, eta_h, color=f"C{i}", ls=":", lw=1)
         for contact, mk in (("full", "o"), ("edge", "s")):

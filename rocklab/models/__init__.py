@@ -10,11 +10,11 @@ from ._pulses import (F_SINE, PULSE_KINDS, PulseParameters, lobe_impulses, pulse
 from ._oas import (OASResult, OverturningCurve, critical_impulse, fit_inclined_line,
                    normalised_critical_impulse, overturning_curve, overturning_spectrum, simplified_oas)
 from ._design import DesignCheck, design_check, required_width, required_width_slender
-from ._equivalent import (FundamentalParameters, Mechanism, arch_mechanism, asymmetric_frame,
-                          block_parameters, equivalence_errors, four_bar_mechanism, frame_parameters,
-                          free_rocking_period_eq24,
-                          linear_sine_pulse_response, overturning_time_eq25, sine_pulse_max_response,
-                          strut_parameters, wall_mechanism, wall_parameters)
+from ._equivalent import (FundamentalParameters, Mechanism, block_parameters, equivalence_errors,
+                          frame_parameters, free_rocking_period_eq24, linear_sine_pulse_response,
+                          overturning_time_eq25, sine_pulse_max_response, strut_parameters,
+                          wall_mechanism, wall_parameters)
+from ._mechanisms import arch_mechanism, asymmetric_frame, four_bar_mechanism
 from ._column_sim import STATE_NAMES, Column, ColumnResult, simulate_column, uplift_acc_m_s2
 from ._column_geometry import ImpactOutcome, app_c_reduction, column_impact, full_mass_matrix, mass_points
 from ._column_maps import ColumnMaps, column_overturning_maps, sine_pulse

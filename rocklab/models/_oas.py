@@ -46,13 +46,14 @@ from ..blocks import G
 from ._oas_kernel import run_batch, run_grid
 from ._records import BaseMotion
 
-__all__ = ["OASResult", "overturning_spectrum", "OverturningCurve", "overturning_curve", "normalised_critical_impulse", "critical_impulse",
+__all__ = ["OASResult", "overturning_spectrum", "OverturningCurve", "overturning_curve",
+           "normalised_critical_impulse", "critical_impulse",
            "fit_inclined_line", "simplified_oas", "OAS_DEFAULTS"]
 
 #: Defaults of :func:`overturning_spectrum` (thesis §5.3: 80 levels 1..10, 120 sizes 1000..0.1 m).
 OAS_DEFAULTS = dict(levels=80, level_max=10.0, sizes=120, R_max_m=1000.0, R_min_m=0.1, refine=10,
                     criterion="angle", free="energy", search="scan", alpha_I=4.0 / 3.0, eta=None,
-                    h_ph=0.1)
+                    h_ph=0.1, engine="rk4")
 
 _CRIT = {"angle": 0, "fall": 1}
 
@@ -221,7 +222,8 @@ def overturning_spectrum(base: BaseMotion, slenderness: float = 12.0, *, levels:
     if engine not in ("rk4", "batch"):
         raise InputError(f"engine={engine!r}: use 'rk4' or 'batch'")
     args = (alpha, eta_v, _CRIT[criterion], free_code, free_s, h_ph, engine, base)
-    over = _runs(acc, dt, np.repeat(scales, p.size), np.tile(p, scales.size), args).reshape(scales.size, p.size)
+    over = _runs(acc, dt, np.repeat(scales, p.size), np.tile(p, scales.size), args)
+    over = over.reshape(scales.size, p.size)
 
     # largest unsafe grid size per level
     k = np.full(lv.size, -1)
@@ -263,7 +265,8 @@ def _runs(acc, dt, scale, p, args):
 
     after = {0: 0.0, 1: 10.0, 2: free_s}[free_code]
     # scale multiplies the record in g (rk4) or in m/s^2 (simulate_batch): the same factor
-    b = simulate_batch(p, alpha, base=base, scale=scale, eta=eta, dt_s=dt, free_after_s=after, fall_rad=alpha if crit == 0 else None)
+    b = simulate_batch(p, alpha, base=base, scale=scale, eta=eta, dt_s=dt, free_after_s=after,
+                       fall_rad=alpha if crit == 0 else None)
     return np.asarray(b.overturned, bool)
 
 

@@ -10,10 +10,15 @@ its implicit equation is solved differs:
 - one evaluation ``a1 = f(theta0 + x)``, then ``x1 = h w0 + h^2/4 (a0 + a1)``:
   a fixed-point step of the Newmark equation, whose contraction is
   ``L = p^2 h^2 / 4``, so ``|theta0 + x1 - root| <= L/(1-L) |x1 - x|``; the step
-  is accepted when that bound is below the tolerance (almost always at once),
-  otherwise the iteration goes on;
-- sin and cos of ``c = alpha s - theta`` are carried along with a short Taylor
-  shift (:func:`sdcd`) instead of libm calls.
+  is accepted when that bound is below ``1e-15 (|theta0| + |x|)`` (almost always
+  at once), otherwise the iteration goes on;
+- ``-p^2 sin c`` and ``-p^2 cos c`` (``c = alpha s - theta``) are carried at an
+  anchor, the last evaluation point, and shifted to the next one by their
+  Taylor series (no libm call; exact sin/cos every 1024 steps against drift).
+  For one step of a rocking block (|shift| < 2e-4) the series is multiplied out
+  and evaluated by Estrin's scheme, which keeps the loop's dependency chain at
+  about 16 cycles; the next shift is formed with a single multiply-add after
+  ``a1``.
 
 theta1, omega1 and a1 satisfy the Newmark relations exactly; ``a1 - f(theta1)``
 is ``p^2 |x1 - x|`` (~1e-13 rad/s^2). The loop returns (without taking the
@@ -36,9 +41,8 @@ from numba import njit
 def sdcd(d):
     """sin d and cos d for |d| < 0.2 by the shortest Taylor form the size of d allows.
 
-    Truncation error < 2e-17 relative. The short form (|d| < 2e-4, one step of a
-    rocking block) is written as fused multiply-adds: it sits on the dependency
-    chain of the time loop.
+    Truncation error < 2e-17 relative (used by the general Newton step and by
+    :func:`free_steps` for increments beyond its multiplied-out short form).
     """
     d2 = d * d
     ad = abs(d)
@@ -77,72 +81,101 @@ def free_steps(th, w, a, sc, cc, s, step, n_steps, h, p2, alpha, cos_a, max_abs,
     hh2 = 0.5 * h * h
     hh4 = 0.25 * h * h
     h2 = 0.5 * h
-    h3p4 = hh4 * h * p2
+    hh4h = hh4 * h
     mp2 = -p2
+    p2cos_a = p2 * cos_a
     lip = hh4 * p2 / (1.0 - hh4 * p2)  # contraction L/(1-L) of the fixed-point step
     if lip >= 0.01:
         return th, w, a, sc, cc, step, max_abs, n_out, countdown
-    x = (h + h3p4 * cc) * w + hh2 * a
-    while step < n_steps:
-        if not abs(x) < 0.2:
-            break
-        sd, cd = sdcd(x)
-        psc = mp2 * sc
-        pcc = mp2 * cc
-        a1 = psc * cd - pcc * sd  # f(theta0 + x) = -p^2 sin(c0 - x)
-        base = h * w + hh4 * a
-        x1 = base + hh4 * a1
-        dl = x1 - x
-        tol = 1e-15 * (abs(th) + h * abs(w) + h * h * abs(a)) + 1e-300
-        if lip * abs(dl) > tol:
-            ok = False
-            for _ in range(60):
-                x = x1
-                if not abs(x) < 0.2:
-                    break
-                sd, cd = sdcd(x)
+    # psc, pcc = -p^2 (sin, cos) of c at the anchor theta_a = th - off
+    psc = mp2 * sc
+    pcc = mp2 * cc
+    off = 0.0
+    x = (h - hh4h * pcc) * w + hh2 * a
+    xr = x
+    broke = False
+    while step < n_steps and not broke:
+        # blocks of up to 1024 steps between re-anchorings: no calls inside the inner
+        # loop (a call makes the register allocator spill the loop state)
+        lim = min(n_steps, (step | 1023) + 1)
+        broke = True
+        while step < lim:
+            if abs(xr) < 2e-4:
+                # f and -p^2 cos at the anchor + xr: the Taylor shift (errors xr^5/120,
+                # xr^6/720) multiplied out and evaluated by Estrin's scheme
+                x2 = xr * xr
+                a1 = (psc - pcc * xr) + x2 * ((-0.5 * psc + (pcc * (1.0 / 6.0)) * xr) + x2 * (psc * (1.0 / 24.0)))
+                pccn = (pcc + psc * xr) + x2 * ((-0.5 * pcc - (psc * (1.0 / 6.0)) * xr) + x2 * (pcc * (1.0 / 24.0)))
+            elif abs(xr) < 0.2:
+                sd, cd = sdcd(xr)
                 a1 = psc * cd - pcc * sd
-                x1 = base + hh4 * a1
-                dl = x1 - x
-                if lip * abs(dl) <= tol:
-                    ok = True
-                    break
-            if not ok:
+                pccn = pcc * cd + psc * sd
+            else:
                 break
-        th1 = th + x1
-        if th1 * s <= 0.0 or abs(th1) >= alpha:
-            break
-        # next predictor, written so that only one multiply-add follows a1
-        kw = h + h3p4 * cc
-        wa = w + h2 * a
-        q = kw * h2 + hh2
-        x = kw * wa + q * a1
-        w = wa + h2 * a1
-        a = a1
-        th = th1
-        scp = sc * cd - cc * sd
-        ccp = cc * cd + sc * sd
-        # theta1 = theta0 + x_eval + dl with dl ~ 1e-15: the first-order shift is exact
-        if abs(dl) < 1e-8:
-            sc = scp - ccp * dl
-            cc = ccp + scp * dl
-        else:
-            sd, cd = sdcd(dl)
-            sc = scp * cd - ccp * sd
-            cc = ccp * cd + scp * sd
-        step += 1
-        ath = abs(th)
-        if ath > max_abs:
-            max_abs = ath
-        if (step & 1023) == 0:
-            # re-anchor the incremental sin/cos against rounding drift
-            sc = math.sin(alpha * s - th)
-            cc = math.cos(alpha * s - th)
-        countdown -= 1
-        if countdown == 0:
-            countdown = out_every
-            out_th[n_out] = th
-            out_w[n_out] = w
-            out_e[n_out] = (0.5 * w * w + p2 * (cc - cos_a)) * e_scale
-            n_out += 1
+            base = h * w + hh4 * a
+            x1 = base + hh4 * a1
+            dl = x1 - x
+            tol = 1e-15 * (abs(th) + abs(x))
+            if lip * abs(dl) > tol:
+                ok = False
+                for _ in range(60):
+                    x = x1
+                    xr = x + off
+                    if not abs(xr) < 0.2:
+                        break
+                    sd, cd = sdcd(xr)
+                    a1 = psc * cd - pcc * sd
+                    pccn = pcc * cd + psc * sd
+                    x1 = base + hh4 * a1
+                    dl = x1 - x
+                    if lip * abs(dl) <= tol:
+                        ok = True
+                        break
+                if not ok:
+                    break
+            th1 = th + x1
+            if th1 * s <= 0.0 or abs(th1) >= alpha:
+                break
+            # next predictor (jerk term with the old anchor's cos: it only has to be close)
+            kw = h - hh4h * pcc
+            wa = w + h2 * a
+            q = kw * h2 + hh2
+            kwa = kw * wa
+            # next evaluation point from the new anchor, x_next + dl, as one multiply-add after a1
+            xr = (kwa + (base - x)) + (q + hh4) * a1
+            x = kwa + q * a1
+            w = wa + h2 * a1
+            a = a1
+            th = th1
+            # the anchor moves to the evaluation point; theta1 lies dl beyond it
+            psc = a1
+            pcc = pccn
+            off = dl
+            step += 1
+            ath = abs(th)
+            if ath > max_abs:
+                max_abs = ath
+            countdown -= 1
+            if countdown == 0:
+                countdown = out_every
+                out_th[n_out] = th
+                out_w[n_out] = w
+                # -p^2 cos c at theta1 = anchor + off
+                if abs(off) < 1e-8:
+                    pc1 = pcc + psc * off
+                else:
+                    sd, cd = sdcd(off)
+                    pc1 = pcc * cd + psc * sd
+                out_e[n_out] = (0.5 * w * w - pc1 - p2cos_a) * e_scale
+                n_out += 1
+            if step == lim:
+                broke = False
+        if not broke:
+            # re-anchor at theta1 against rounding drift of the carried sin/cos
+            psc = mp2 * math.sin(alpha * s - th)
+            pcc = mp2 * math.cos(alpha * s - th)
+            off = 0.0
+            xr = x
+    sc = math.sin(alpha * s - th)
+    cc = math.cos(alpha * s - th)
     return th, w, a, sc, cc, step, max_abs, n_out, countdown

@@ -16,6 +16,9 @@ __all__ = []
 STILL_GYRO_RAD_S = np.deg2rad(2.0)
 STILL_ACC_M_S2 = 0.03 * G
 SMOOTH_S = 0.05
+#: Floor of the fine (noise-scaled) accelerometer-vector thresholds, m/s^2 (2 mg):
+#: a noise-free log must still have rest windows.
+_FINE_ACC = 0.002 * G
 
 
 def rownorm(v: np.ndarray) -> np.ndarray:
@@ -54,6 +57,18 @@ def motion_mask(t_s, gyro, acc, rate_hz, gyro_thr=STILL_GYRO_RAD_S, acc_thr=STIL
     g_level = np.median(an[: max(3, int(0.5 * rate_hz))]) if n else G
     am = moving_average(np.abs(an - g_level), w)
     return (gm > gyro_thr) | (am > acc_thr)
+
+
+def acc_departure(acc, f_ref, rate_hz, smooth_s=SMOOTH_S):
+    """``smooth_s`` running mean of ``|acc - f_ref|`` (m/s^2), shape (n,).
+
+    A horizontal table acceleration ``a`` changes the accelerometer *norm*
+    only by ~``a^2 / 2g`` (0.03 g of norm needs ~0.25 g of table) but turns
+    the vector by ``a``: this sees a block carried by a moving table while it
+    does not rotate yet.
+    """
+    w = max(1, int(round(smooth_s * rate_hz)))
+    return moving_average(rownorm(acc - np.asarray(f_ref, float)), w)
 
 
 def runs(mask: np.ndarray) -> list[tuple[int, int]]:
@@ -144,3 +159,60 @@ def cumtrapz(t: np.ndarray, y: np.ndarray) -> np.ndarray:
     out[0] = 0.0
     np.cumsum(0.5 * (y[1:] + y[:-1]) * np.diff(t), out=out[1:])
     return out
+
+
+def forced_run(t, gyro, acc, fs, gyro_thr, acc_thr, min_run):
+    """Is the block carried by a moving table before it rotates?  (``block_rotation`` doc, step 7)
+
+    Returns ``(forced, i_carry, i_carry_end)``: the decision, the first sample
+    whose accelerometer vector leaves its initial level (>= ``min_run``
+    samples above ``acc_thr``) and the end of the last stretch where it
+    differs from its final level (None when not found).  Both are then
+    pushed outwards to where the 0.1 s mean vector is within 5 noise standard
+    deviations of that level: the weak start of a table record (below
+    ``acc_thr``) would otherwise enter the rest window and, averaged there,
+    tilt the upright reference by ~(table velocity / window length) / g.
+    """
+    n = len(t)
+    n0 = max(3, min(n, int(0.5 * fs)))
+    f0, f1 = np.median(acc[:n0], axis=0), np.median(acc[-n0:], axis=0)
+    dep0 = acc_departure(acc, f0, fs) > acc_thr
+    dep1 = acc_departure(acc, f1, fs) > acc_thr
+    i_carry = first_motion(dep0, min_run)
+    i_carry_end = last_motion_end(dep1, min_run)
+    if i_carry is None:
+        return False, None, i_carry_end
+    w = max(1, int(round(0.05 * fs)))
+    g0 = np.median(gyro[:n0], axis=0)
+    rot = moving_average(rownorm(gyro - g0), w) > gyro_thr
+    i_rot = first_motion(rot, min_run)
+    forced = i_rot is None or t[i_rot] - t[i_carry] > 0.1
+    ws = max(2, int(round(0.1 * fs)))
+    sm = moving_average(acc, ws)
+    thr = max(5.0 * float(np.linalg.norm(np.std(acc[:n0], axis=0))) / np.sqrt(ws), _FINE_ACC)
+    quiet = np.flatnonzero(rownorm(sm[:i_carry] - f0) <= thr)
+    i_carry = max(0, int(quiet[-1]) + 1 - ws // 2) if quiet.size else 0
+    if i_carry_end is not None:
+        thr = max(5.0 * float(np.linalg.norm(np.std(acc[-n0:], axis=0))) / np.sqrt(ws), _FINE_ACC)
+        quiet = np.flatnonzero(rownorm(sm[i_carry_end:] - f1) <= thr)
+        i_carry_end = min(n, i_carry_end + (int(quiet[0]) if quiet.size else n) + ws // 2)
+    return bool(forced), i_carry, i_carry_end
+
+
+def still_acc_start(acc, e0, e1, sigma, fs, min_rest) -> int:
+    """Start of the final rest of a forced run by the accelerometer vector.
+
+    A block resting on a table that still moves is not at rest for the tilt
+    reference: its 0.1 s mean accelerometer vector must stay within
+    ``5 sigma / sqrt(window)`` (``sigma``: vector noise in the first rest
+    window; at least 2 mg) of the mean of the last ``min_rest`` samples.  Returns ``e1`` when
+    the end window never settles (no end rest).
+    """
+    ws = max(2, int(round(0.1 * fs)))
+    if e1 - e0 < min_rest:
+        return e0
+    f1 = acc[e1 - min_rest:e1].mean(axis=0)
+    sm = moving_average(acc[e0:e1], ws)
+    busy = np.flatnonzero(rownorm(sm - f1) > max(5.0 * sigma / np.sqrt(ws), _FINE_ACC))
+    busy = busy[busy < (e1 - e0) - ws // 2]  # the shrinking edge windows at the end are noisier
+    return e0 if busy.size == 0 else min(e1, e0 + int(busy[-1]) + 1 + ws // 2)

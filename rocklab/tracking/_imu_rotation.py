@@ -26,7 +26,21 @@ Method (``block_rotation``)
    changes sign.  The impact instant inside a sample comes from the fraction
    of the sample's mean rate between the extrapolated pre- and post-impact
    rates.
-7. Optional second estimate: imufusion's AHRS (1.3 API, no magnetometer),
+7. Kind of run (``release=``): a thread-burn release (``"thread"``: block
+   held tilted, released, rests upright at the end) or a forced run on a
+   shake table (``"none"``: block upright at rest, the table moves, the block
+   may rock and ends wherever it ends).  ``"auto"`` calls a run forced when
+   the accelerometer *vector* leaves its initial level (by 0.03 g, 50 ms
+   means, >= 0.1 s) more than 0.1 s before the gyro shows rotation: the table
+   carries the block before it uplifts, whereas a released block rotates at
+   once.  In a forced run the upright reference is the *initial* rest
+   (theta = 0 there), the rest windows end where the table starts / begin
+   where it has stopped (accelerometer vector, not only its norm), the end
+   rest's tilt is measured by the accelerometer, and ``release_t_s`` is NaN.
+   (Anchoring a forced run on the end rest as upright offsets the whole
+   history by the end tilt whenever the block stops -- or the log ends --
+   away from upright.)
+8. Optional second estimate: imufusion's AHRS (1.3 API, no magnetometer),
    its twist about the axis, and the RMS difference to the gyro estimate.
 """
 
@@ -38,8 +52,9 @@ import numpy as np
 
 from .._errors import InputError
 from ..blocks import G
-from ._imu_motion import (axis_vector, cumtrapz, first_motion, last_motion_end, motion_mask,
-                          moving_average, quat_mul, rownorm, tilt_about, twist_angle)
+from ._imu_motion import (axis_vector, cumtrapz, first_motion, forced_run, last_motion_end,
+                          motion_mask, moving_average, quat_mul, rownorm, still_acc_start,
+                          tilt_about, twist_angle)
 from ._imu_read import ImuLog
 
 __all__ = ["ImuRotation", "block_rotation", "ahrs_rotation", "ahrs_quaternions"]
@@ -54,7 +69,8 @@ class ImuRotation:
     t_s : ndarray (n,)
         Sample times, s (the log's clock).
     theta_rad : ndarray (n,)
-        Rotation about the rocking axis, rad; 0 = upright (rest at the end).
+        Rotation about the rocking axis, rad; 0 = upright (the rest at the end
+        for a thread release, the rest at the start for a forced run).
     omega_rad_s : ndarray (n,)
         Bias-corrected angular rate about the axis, rad/s.
     acc_m_s2 : ndarray (n, 3)
@@ -64,12 +80,14 @@ class ImuRotation:
     gyro_bias_rad_s : ndarray (3,)
         Gyro bias, rad/s: mean rate in the rest window before release.
     theta0_rad : float
-        Accelerometer tilt in the rest window before release, rad.
+        Accelerometer tilt in the rest window before release, rad (0 for a
+        forced run: that window defines upright).
     drift_rad_s : float
         Residual bias along the axis removed by the two-window anchoring, rad/s
         (the total bias along the axis is ``gyro_bias_rad_s @ axis + drift_rad_s``).
     release_t_s : float
-        Release instant, s (NaN if the log shows no rest then motion).
+        Release instant, s (NaN if the log shows no rest then motion, and for
+        a forced run, which has no release).
     impact_t_s : ndarray (k,)
         Impact instants, s.
     rest_t_s : float
@@ -85,6 +103,9 @@ class ImuRotation:
         (drift not anchored at the end) or ``"no_motion"``.
     message : str
         Human-readable note on the status.
+    run_kind : str
+        ``"thread"`` (released from a tilt; upright = end rest) or ``"forced"``
+        (shake table; upright = initial rest, ``theta0_rad`` = 0, no release).
     """
 
     t_s: np.ndarray
@@ -106,6 +127,7 @@ class ImuRotation:
     ahrs_rms_diff_rad: float = float("nan")
     status: str = "ok"
     message: str = ""
+    run_kind: str = "thread"
 
     def to_frame(self):
         """``t_s, theta_rad, omega_rad_s, acc_{x,y,z}_m_s2`` (+ ``theta_ahrs_rad``)."""
@@ -129,7 +151,8 @@ class ImuRotation:
                 "impact_t_s": [float(v) for v in self.impact_t_s],
                 "rest_t_s": float(self.rest_t_s),
                 "ahrs_rms_diff_rad": float(self.ahrs_rms_diff_rad),
-                "status": self.status, "message": self.message, "source": self.source}
+                "status": self.status, "message": self.message, "run_kind": self.run_kind,
+                "source": self.source}
 
 
 def _vertical_axis(f: np.ndarray) -> np.ndarray:
@@ -139,7 +162,8 @@ def _vertical_axis(f: np.ndarray) -> np.ndarray:
     return v
 
 
-def block_rotation(log: ImuLog, axis: str | None = None, *, ahrs: bool = False,
+def block_rotation(log: ImuLog, axis: str | None = None, *, release: str = "auto",
+                   ahrs: bool = False,
                    still_gyro_deg_s: float = 2.0, still_acc_g: float = 0.03,
                    min_rest_s: float = 0.1) -> ImuRotation:
     """Rotation of a rocking block about its rocking axis from its IMU log.
@@ -152,6 +176,10 @@ def block_rotation(log: ImuLog, axis: str | None = None, *, ahrs: bool = False,
     axis : {"x", "y", "z", "-x", "-y", "-z"} or None
         Rocking axis in the sensor frame; None finds it (principal axis of the
         rate during motion, signed so the initial tilt is positive).
+    release : {"auto", "thread", "none"}
+        Kind of run (module doc, step 7): ``"thread"`` -- released from a
+        held tilt, upright at the end; ``"none"`` -- forced (shake table),
+        upright at the start; ``"auto"`` -- decided from the log.
     ahrs : bool
         Also run imufusion's AHRS (slower: a Python loop over samples).
     still_gyro_deg_s, still_acc_g : float
@@ -166,17 +194,28 @@ def block_rotation(log: ImuLog, axis: str | None = None, *, ahrs: bool = False,
     n = log.n
     if n < 8:
         raise InputError(f"{log.source}: {n} samples; need at least 8 to estimate a rotation")
+    if release not in ("auto", "thread", "none"):
+        raise InputError(f"release={release!r}: use 'auto', 'thread' (thread-burn release) "
+                         "or 'none' (forced run on a shake table)")
     t, gyro, acc, fs = log.t_s, log.gyro_rad_s, log.acc_m_s2, float(log.rate_hz)
     moving = motion_mask(t, gyro, acc, fs, np.deg2rad(still_gyro_deg_s), still_acc_g * G)
     min_run = max(2, int(round(0.1 * fs)))
+    forced, i_carry, i_carry_end = forced_run(t, gyro, acc, fs, np.deg2rad(still_gyro_deg_s),
+                                               still_acc_g * G, min_run)
+    if release != "auto":
+        forced = release == "none"
     i_move = first_motion(moving, min_run)
+    if forced and i_carry is not None:
+        i_move = i_carry if i_move is None else min(i_move, i_carry)
     status, msg = "ok", ""
     if i_move is None:
         i_move, i_end = n, n
         status, msg = "no_motion", "no motion found above the stillness thresholds"
     else:
         # Decaying rocking fragments the motion mask; the last moving sample ends it.
-        i_end = last_motion_end(moving, 1)
+        i_end = last_motion_end(moving, 1) or i_move
+        if forced and i_carry_end is not None:
+            i_end = max(i_end, i_carry_end)
     # Rest windows (trim 50 ms next to motion: the smoothing widens motion edges).
     guard = max(1, int(round(0.05 * fs)))
     min_rest = max(3, int(round(min_rest_s * fs)))
@@ -199,10 +238,20 @@ def block_rotation(log: ImuLog, axis: str | None = None, *, ahrs: bool = False,
     omega = w @ u
     if has_end:
         e0 = _strict_rest_start(omega, e0, e1, float(np.std(omega[s0:s1])), fs, min_rest)
+        if forced:
+            e0 = still_acc_start(acc, e0, e1, float(np.linalg.norm(np.std(acc[s0:s1], axis=0))),
+                                  fs, min_rest)
+            if e1 - e0 < min_rest:
+                has_end = False
+                if status == "ok":
+                    status, msg = "no_rest_after", "table still moving at the end: drift not anchored"
     f_start = acc[s0:s1].mean(axis=0)
     f_end = acc[e0:e1].mean(axis=0) if has_end else None
     f_ref = f_end if has_end else _vertical_axis(f_start)
-    if has_end and abs(float(tilt_about(u, _vertical_axis(f_start), f_end))) > np.deg2rad(20.0):
+    if forced:
+        # Shake table: the block starts upright; the end rest is measured, not assumed.
+        f_ref = f_start
+    elif has_end and abs(float(tilt_about(u, _vertical_axis(f_start), f_end))) > np.deg2rad(20.0):
         # Ended far from upright (overturned, or stopped leaning on something):
         # upright is then the sensor axis nearest to gravity at the start
         # (square mounting); both windows still anchor the drift.
@@ -222,7 +271,8 @@ def block_rotation(log: ImuLog, axis: str | None = None, *, ahrs: bool = False,
         ref = th_start if abs(th_start) > np.deg2rad(1.0) else theta[np.argmax(np.abs(theta))]
         if ref < 0:
             u, theta, omega, th_start, drift = -u, -theta, -omega, -th_start, -drift
-    release = _release_time(t, omega, i_move, s0, s1) if status != "no_motion" else np.nan
+    release_t = (_release_time(t, omega, i_move, s0, s1)
+                 if status != "no_motion" and not forced else np.nan)
     impacts = (_impacts(t, theta, omega, acc, moving, i_move, i_end, fs)
                if status != "no_motion" else np.empty(0))
     rest_t = float(t[e0]) if has_end else np.nan
@@ -233,9 +283,9 @@ def block_rotation(log: ImuLog, axis: str | None = None, *, ahrs: bool = False,
         a, b = (i_move, i_end) if status != "no_motion" else (0, n)
         diff = (ahrs_theta[a:b] - theta[a:b] + np.pi) % (2 * np.pi) - np.pi
         ahrs_rms = float(np.sqrt(np.mean(diff ** 2)))
-    return ImuRotation(t, theta, omega, acc, u, bias, th_start, float(drift), release,
+    return ImuRotation(t, theta, omega, acc, u, bias, th_start, float(drift), release_t,
                        impacts, rest_t, fs, log.dropped_samples, log.format, log.source,
-                       ahrs_theta, ahrs_rms, status, msg)
+                       ahrs_theta, ahrs_rms, status, msg, "forced" if forced else "thread")
 
 
 def _strict_rest_start(omega, e0, e1, sigma, fs, min_rest) -> int:

@@ -12,7 +12,8 @@ import os
 import tempfile
 from pathlib import Path
 
-__all__ = ["atomic_path", "write_text_atomic", "write_json_atomic", "write_frame_atomic"]
+__all__ = ["atomic_path", "write_text_atomic", "write_json_atomic", "write_frame_atomic", "json_safe",
+           "dumps_json"]
 
 
 @contextlib.contextmanager
@@ -44,7 +45,13 @@ def write_text_atomic(path, text: str) -> Path:
 
 def write_json_atomic(path, obj, indent: int = 2) -> Path:
     """Write ``obj`` as JSON to ``path`` atomically (NaN written as null)."""
-    return write_text_atomic(path, json.dumps(_nan_to_none(obj), indent=indent) + "\n")
+    return write_text_atomic(path, dumps_json(obj, indent=indent) + "\n")
+
+
+def dumps_json(obj, indent: int | None = None) -> str:
+    """Strict JSON text of ``obj``: NaN/inf as null, numpy scalars and arrays as numbers and lists,
+    paths and other objects as strings."""
+    return json.dumps(json_safe(obj), indent=indent, allow_nan=False, default=str)
 
 
 def write_frame_atomic(path, frame, **kwargs) -> Path:
@@ -55,22 +62,23 @@ def write_frame_atomic(path, frame, **kwargs) -> Path:
     return Path(path)
 
 
-def _nan_to_none(obj):
+def json_safe(obj):
+    """``obj`` with NaN/inf replaced by None and numpy values by Python ones (recursively)."""
     import math
 
     if isinstance(obj, float) and not math.isfinite(obj):
         return None
     if isinstance(obj, dict):
-        return {k: _nan_to_none(v) for k, v in obj.items()}
+        return {k: json_safe(v) for k, v in obj.items()}
     if isinstance(obj, (list, tuple)):
-        return [_nan_to_none(v) for v in obj]
+        return [json_safe(v) for v in obj]
     try:
         import numpy as np
 
         if isinstance(obj, np.generic):
-            return _nan_to_none(obj.item())
+            return json_safe(obj.item())
         if isinstance(obj, np.ndarray):
-            return _nan_to_none(obj.tolist())
+            return json_safe(obj.tolist())
     except ImportError:  # pragma: no cover
         pass
     return obj

@@ -46,7 +46,10 @@ def test_campaign_recovers_eta_mat_and_reports_failure(tmp_path, run_cli):
     out = tmp_path / "out"
     rc, stdout, err = run_cli("campaign", root, "--out", out, "--workers", "2", "--no-progress", "--json")
     assert rc == 0, err
-    res = json.loads(stdout)
+    def strict(c):  # NaN/Infinity are not JSON; the CLI must write null
+        raise ValueError(f"non-JSON constant {c} in the --json output")
+
+    res = json.loads(stdout, parse_constant=strict)
     assert res["n_experiments"] == 4 and res["n_ok"] == 3
     assert len(res["failures"]) == 1 and "missing.csv" in res["failures"][0]["error"]
     assert not (out / "experiments" / "broken").exists()  # a failed run leaves no partial output

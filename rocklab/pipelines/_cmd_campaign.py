@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 
 
 def register(sub):
@@ -23,7 +22,9 @@ def run(args) -> int:
     res = run_campaign(args.dir, args.out, workers=args.workers, scheduler=args.scheduler,
                        force=args.force, progress=not args.no_progress)
     if args.json:
-        print(json.dumps(res.to_dict(), default=str))
+        from .._io import dumps_json
+
+        print(dumps_json(res.to_dict()))
     else:
         print(res.summary_text())
     return 0 if res.n_ok > 0 else 1

@@ -14,7 +14,6 @@ energy_J``) atomically.
 
 from __future__ import annotations
 
-import json
 import math
 import sys
 
@@ -80,14 +79,6 @@ def _blocks(text, density):
     return tuple(out)
 
 
-def _nan_to_none(obj):
-    if isinstance(obj, float) and not math.isfinite(obj):
-        return None
-    if isinstance(obj, dict):
-        return {k: _nan_to_none(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [_nan_to_none(v) for v in obj]
-    return obj
 
 
 def run(args) -> int:
@@ -121,7 +112,9 @@ def run(args) -> int:
     if args.maps_png is not None:
         out["maps"] = _maps(args)
     if args.json:
-        sys.stdout.write(json.dumps(_nan_to_none(out)) + "\n")
+        from .._io import dumps_json
+
+        sys.stdout.write(dumps_json(out) + "\n")
         return 0
     if args.blocks is not None:
         _print_summary(res, out)

@@ -12,25 +12,13 @@
 
 from __future__ import annotations
 
-import json
 import math
 import sys
 
 from .._errors import InputError
 
 
-def _dumps(obj) -> str:
-    def clean(v):
-        if isinstance(v, float) and not math.isfinite(v):
-            return None
-        if isinstance(v, dict):
-            return {k: clean(x) for k, x in v.items()}
-        if isinstance(v, (list, tuple)):
-            return [clean(x) for x in v]
-        if hasattr(v, "item"):
-            return clean(v.item())
-        return v
-    return json.dumps(clean(obj))
+from .._io import dumps_json as _dumps
 
 
 def register(sub):

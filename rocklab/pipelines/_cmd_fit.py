@@ -69,24 +69,13 @@ def _common(p):
     p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
 
 
-def _clean(obj):
-    if isinstance(obj, float) and not math.isfinite(obj):
-        return None
-    if isinstance(obj, dict):
-        return {str(k): _clean(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [_clean(v) for v in obj]
-    if hasattr(obj, "item") and not isinstance(obj, (str, bytes)):
-        try:
-            return _clean(obj.item())
-        except (TypeError, ValueError):
-            return obj
-    return obj
 
 
 def _emit(args, payload: dict, text: str) -> None:
     if args.json:
-        sys.stdout.write(json.dumps(_clean(payload)) + "\n")
+        from .._io import dumps_json
+
+        sys.stdout.write(dumps_json(payload) + "\n")
     else:
         sys.stdout.write(text + "\n")
 

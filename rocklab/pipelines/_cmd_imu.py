@@ -11,7 +11,6 @@ dropped_samples, gyro_bias_rad_s, release_t_s, impact_t_s`` and more.
 
 from __future__ import annotations
 
-import json
 import sys
 
 
@@ -52,14 +51,9 @@ def run(args) -> int:
         write_frame_atomic(args.out, res.to_frame())
         summary["output"] = str(args.out)
     if args.json:
-        def clean(v):
-            if isinstance(v, float) and not math.isfinite(v):
-                return None
-            if isinstance(v, list):
-                return [clean(x) for x in v]
-            return v
+        from .._io import dumps_json
 
-        print(json.dumps({k: clean(v) for k, v in summary.items()}))
+        print(dumps_json(summary))
         return 0
     out = sys.stdout
     out.write(f"{summary['source']}: {summary['format']}, {summary['n_samples']} samples at "

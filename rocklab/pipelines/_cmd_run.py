@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 import sys
 
 
@@ -19,6 +18,7 @@ def register(sub):
 
 
 def run(args) -> int:
+    from .._io import dumps_json
     from ._experiment import run_experiment
 
     report, ran = run_experiment(args.config, args.out, force=args.force, spawn=args.spawn,
@@ -27,7 +27,7 @@ def run(args) -> int:
         keys = ("name", "status", "fit", "simulations", "sync", "video_vs_imu_rms_rad", "truth")
         out = {k: report.get(k) for k in keys}
         out["ran"] = ran
-        print(json.dumps(out, default=str))
+        print(dumps_json(out))
     elif not ran:
         print(f"{args.out}: inputs and config unchanged; nothing to do (use --force to re-run)")
     else:

@@ -11,7 +11,6 @@ history (``t_s, theta_rad, omega_rad_s, energy_J``) atomically.
 
 from __future__ import annotations
 
-import json
 import sys
 
 
@@ -79,7 +78,9 @@ def run(args) -> int:
         write_frame_atomic(args.output, res.to_frame())
     d = res.to_dict()
     if args.json:
-        sys.stdout.write(json.dumps(d) + "\n")
+        from .._io import dumps_json
+
+        sys.stdout.write(dumps_json(d) + "\n")
     else:
         over = "" if d["overturn_t_s"] is None else f", passed alpha at t = {d['overturn_t_s']:.4f} s"
         sys.stdout.write(

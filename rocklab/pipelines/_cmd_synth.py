@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 import sys
 
 from .._errors import InputError
@@ -71,7 +70,9 @@ def run(args) -> int:
                       progress=args.progress)
     d = s.to_dict()
     if args.json:
-        sys.stdout.write(json.dumps(d, allow_nan=False, default=str) + "\n")
+        from .._io import dumps_json
+
+        sys.stdout.write(dumps_json(d) + "\n")
     else:
         sys.stdout.write(f"wrote {d['n_frames']} frames ({d['size'][0]}x{d['size'][1]}, {d['fps']:g} fps) "
                          f"and truth for {', '.join(d['objects'])} to {d['out_dir']} "

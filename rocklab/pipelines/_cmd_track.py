@@ -7,7 +7,6 @@ sigma_theta_rad, quality, status``) and, when the config has a table, a
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 from .._errors import InputError
@@ -55,9 +54,9 @@ def run(args) -> int:
             write_frame_atomic(tpath, tm.to_frame(), float_format="%.9g")
             summary["table_motion"] = {**tm.to_dict(), "csv": str(tpath)}
     if args.json:
-        from .._io import _nan_to_none
+        from .._io import dumps_json
 
-        print(json.dumps(_nan_to_none(summary)))
+        print(dumps_json(summary))
     else:
         for oid, d in summary["objects"].items():
             print(f"{oid}: {d['n_ok']}/{res.n_frames} frames ok, "

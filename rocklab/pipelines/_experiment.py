@@ -326,7 +326,7 @@ def _eta_for_law(law, cfg, block, fit_d, msgs):
 
 
 def _simulate_laws(cfg, block, prim, fit_d, table, msgs) -> dict:
-    from ..models import BaseMotion, simulate
+    from ..models import simulate
 
     t_meas, th_meas = prim
     ok = np.isfinite(th_meas)

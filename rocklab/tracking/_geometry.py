@@ -216,7 +216,6 @@ def board_homography(gray, board, plane_map: PlaneMap | None = None):
     InputError
         The board is not found in the image.
     """
-    import cv2
 
     found = _find_board(gray, board)
     if found is None:

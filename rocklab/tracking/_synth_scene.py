@@ -228,7 +228,6 @@ def build_scene(*, seed, blocks, table, fps, size, targets, duration_s, occlusio
     from ._render import Occluder, RenderObject
     from ._render_targets import block_texture, table_texture
     from ._synth_camera import make_camera
-    from ._synth_motion import BlockMotion
 
     ss = np.random.SeedSequence(seed)
     s_cam, s_motion, s_tex, s_noise, s_imu, s_bg = ss.spawn(6)

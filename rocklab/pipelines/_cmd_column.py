@@ -17,6 +17,8 @@ from __future__ import annotations
 import math
 import sys
 
+from ._cli_base import add_base_motion_args, base_motion_from_args
+
 _MAX_LINES = 40
 
 
@@ -35,9 +37,7 @@ def register(sub):
     p.add_argument("--dt", type=float, default=1e-4, help="time step, s (default 1e-4)")
     p.add_argument("--impacts", type=int, default=1,
                    help="consecutive impacts per closing: 1 Housner, 2 one mid-joint bump (thesis)")
-    p.add_argument("--base-motion", default=None, help="base acceleration record (.AT2, CSV t_s,acc_m_s2, 2-column text)")
-    p.add_argument("--units", default=None, help="record units: g, m/s2, cm/s2 (2-column text needs it)")
-    p.add_argument("--scale-pga", type=float, default=None, help="scale the record to this PGA (in --units, default g)")
+    add_base_motion_args(p)
     p.add_argument("--thesis-form", action="store_true",
                    help="drop the velocity terms of the App. C reduction (the thesis's M(phi) phi'' = p(phi))")
     p.add_argument("-o", "--output", default=None, help="write the time history CSV here")
@@ -84,7 +84,7 @@ def _blocks(text, density):
 def run(args) -> int:
     from .._errors import InputError
     from .._io import write_frame_atomic
-    from ..models import Column, load_base_motion, simulate_column
+    from ..models import Column, simulate_column
 
     if args.blocks is None and args.maps_png is None:
         raise InputError("give --blocks WIDTHxHEIGHT,... (and/or --maps-png FILE)")
@@ -93,13 +93,7 @@ def run(args) -> int:
         blocks = _blocks(args.blocks, args.density)
         n = len(blocks)
         col = Column(blocks, cut_m=_floats(args.cut, "cut", n), mu=args.mu)
-        base = None
-        if args.base_motion is not None:
-            base = load_base_motion(args.base_motion, units=args.units)
-            if args.scale_pga is not None:
-                base = base.scaled_to_pga(args.scale_pga, args.units or "g")
-        elif args.scale_pga is not None or args.units is not None:
-            raise InputError("--scale-pga/--units need --base-motion FILE")
+        base = base_motion_from_args(args)
         th0 = _floats(args.theta0, "theta0", n) if args.theta0 else None
         om0 = _floats(args.omega0, "omega0", n) if args.omega0 else None
         if base is None and not (th0 and any(th0)) and not (om0 and any(om0)):

@@ -29,6 +29,9 @@ def register(sub):
     p.add_argument("--json", action="store_true", help="print one JSON summary on stdout")
     p.add_argument("--table", action="store_true",
                    help="table IMU: base acceleration along the shaking axis, gravity removed")
+    p.add_argument("--release", default="auto", choices=("auto", "thread", "none"),
+                   help="thread: thread-burn release (rest tilted, then rocking); none: a block on a "
+                        "shake table that starts upright; auto (default): decide from the data")
     p.add_argument("--ahrs", action="store_true",
                    help="also run imufusion's AHRS and report its difference (slower)")
     p.set_defaults(func=run)
@@ -45,7 +48,7 @@ def run(args) -> int:
         res = table_acceleration(log, args.axis)
         summary = {**log.to_dict(), **res.to_dict()}
     else:
-        res = block_rotation(log, args.axis, ahrs=args.ahrs)
+        res = block_rotation(log, args.axis, ahrs=args.ahrs, release=args.release)
         summary = {**log.to_dict(), **res.to_dict()}
     if args.out:
         write_frame_atomic(args.out, res.to_frame())

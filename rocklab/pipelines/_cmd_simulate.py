@@ -13,6 +13,8 @@ from __future__ import annotations
 
 import sys
 
+from ._cli_base import add_base_motion_args, base_motion_from_args
+
 
 def register(sub):
     p = sub.add_parser("simulate", help="simulate a rocking block (free rocking or base motion)",
@@ -33,9 +35,7 @@ def register(sub):
     p.add_argument("--eta", type=float, default=None, help="constant law: omega+/omega-")
     p.add_argument("--bumps", type=int, default=None, help="bumps law: number of bumps (n+1 impacts)")
     p.add_argument("--b2", type=float, default=None, help="cut_corner/bumps: half-distance of contact lines, m")
-    p.add_argument("--base-motion", default=None, help="base acceleration record (.AT2, CSV t_s,acc_m_s2, 2-column text)")
-    p.add_argument("--units", default=None, help="record units: g, m/s2, cm/s2 (2-column text needs it)")
-    p.add_argument("--scale-pga", type=float, default=None, help="scale the record to this PGA (in --units, default g)")
+    add_base_motion_args(p)
     p.add_argument("--method", default="newmark", choices=["newmark", "event"],
                    help="newmark (numba, fast) or event (scipy solve_ivp reference)")
     p.add_argument("--no-stop-at-rest", dest="stop_at_rest", action="store_false",
@@ -49,7 +49,7 @@ def run(args) -> int:
     from .._errors import InputError
     from .._io import write_frame_atomic
     from ..blocks import Block
-    from ..models import load_base_motion, simulate
+    from ..models import simulate
 
     block = Block(args.width, args.height, alpha_I=args.alpha_I)
     law = {}
@@ -64,13 +64,7 @@ def run(args) -> int:
             law["n"] = 1 if args.bumps is None else args.bumps
         if args.b2 is not None:
             law["b2_m"] = args.b2
-    base = None
-    if args.base_motion is not None:
-        base = load_base_motion(args.base_motion, units=args.units)
-        if args.scale_pga is not None:
-            base = base.scaled_to_pga(args.scale_pga, args.units or "g")
-    elif args.scale_pga is not None or args.units is not None:
-        raise InputError("--scale-pga/--units need --base-motion FILE")
+    base = base_motion_from_args(args)
     res = simulate(block, theta0_rad=args.theta0, omega0_rad_s=args.omega0, duration_s=args.duration,
                    dt_s=args.dt, restitution=args.restitution, base=base, method=args.method,
                    stop_at_rest=args.stop_at_rest, output_dt_s=args.output_dt, **law)

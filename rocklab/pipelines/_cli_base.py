@@ -1,0 +1,28 @@
+"""Command-line options shared by ``rocklab simulate`` and ``rocklab column``: a base-motion record."""
+
+from __future__ import annotations
+
+from .._errors import InputError
+
+__all__ = ["add_base_motion_args", "base_motion_from_args"]
+
+
+def add_base_motion_args(p) -> None:
+    """``--base-motion FILE [--units U] [--scale-pga X]``."""
+    p.add_argument("--base-motion", default=None, help="base acceleration record (.AT2, CSV t_s,acc_m_s2, 2-column text)")
+    p.add_argument("--units", default=None, help="record units: g, m/s2, cm/s2 (2-column text needs it)")
+    p.add_argument("--scale-pga", type=float, default=None, help="scale the record to this PGA (in --units, default g)")
+
+
+def base_motion_from_args(args):
+    """The :class:`BaseMotion` the options name (SI units), or None for free rocking."""
+    from ..models import load_base_motion
+
+    if args.base_motion is None:
+        if args.scale_pga is not None or args.units is not None:
+            raise InputError("--scale-pga/--units need --base-motion FILE")
+        return None
+    base = load_base_motion(args.base_motion, units=args.units)
+    if args.scale_pga is not None:
+        base = base.scaled_to_pga(args.scale_pga, args.units or "g")
+    return base

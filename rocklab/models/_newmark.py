@@ -36,22 +36,24 @@ import numpy as np
 from numba import njit, prange
 
 from ..blocks import G
+from ._newmark_contact import contact_tau, cross_fraction
 from ._newmark_free import free_steps, sdcd
 
 
 
 def _drop_stale_cache():
-    """Delete this module's on-disk numba cache if ``_newmark_free.py`` is newer.
+    """Delete this module's on-disk numba cache if a kernel module it uses is newer.
 
     numba checks only the timestamp of the file that holds a cached function;
-    :func:`run_block` compiles in the loop of ``_newmark_free``, so an edit
-    there would otherwise run stale machine code.
+    :func:`run_block` compiles in the kernels of ``_newmark_free`` and
+    ``_newmark_contact``, so an edit there would otherwise run stale machine code.
     """
     from pathlib import Path
 
     here = Path(__file__).resolve().parent
     try:
-        newest = max((here / f).stat().st_mtime for f in ("_newmark_free.py", "_newmark.py"))
+        newest = max((here / f).stat().st_mtime
+                     for f in ("_newmark_free.py", "_newmark_contact.py", "_newmark.py"))
         for idx in (here / "__pycache__").glob("_newmark.*.nbi"):
             if idx.stat().st_mtime < newest:
                 idx.unlink()
@@ -153,35 +155,6 @@ def _newmark(th0, w0, a0, s, h, c1, c4h, ug1, p2, alpha, lin, sc0, cc0):
     return th, w0 + 0.5 * h * (a0 + a1), a1, sc, cc
 
 
-@njit(cache=True)
-def _cross(x0, v0, x1, v1, h, level):
-    """Fraction u in [0, 1] of a step where the cubic Hermite of (x, v) reaches ``level``.
-
-    x0, v0 / x1, v1: position and velocity at the step ends (on one side, x > 0
-    outward). Falls back to linear interpolation when the step started on the other
-    side (an impact inside the step).
-    """
-    if x1 == x0:
-        return 1.0
-    u = min(max((level - x0) / (x1 - x0), 0.0), 1.0)
-    if x0 < 0.0:
-        return u
-    for _ in range(20):
-        u2 = u * u
-        u3 = u2 * u
-        x = (2 * u3 - 3 * u2 + 1) * x0 + (u3 - 2 * u2 + u) * h * v0 + (-2 * u3 + 3 * u2) * x1 \
-            + (u3 - u2) * h * v1
-        dx = (6 * u2 - 6 * u) * x0 + (3 * u2 - 4 * u + 1) * h * v0 + (6 * u - 6 * u2) * x1 \
-            + (3 * u2 - 2 * u) * h * v1
-        if dx <= 0.0:
-            break
-        du = (x - level) / dx
-        u = min(max(u - du, 0.0), 1.0)
-        if abs(du) < 1e-15:
-            break
-    return u
-
-
 @njit(cache=True, inline="always")
 def _energy(th, w, cc, cos_a, p2, alpha, lin):
     """Energy above rest per unit I_O (rad^2/s^2); cc = cos(alpha - |theta|)."""
@@ -189,71 +162,6 @@ def _energy(th, w, cc, cos_a, p2, alpha, lin):
         ath = abs(th)
         return 0.5 * w * w + p2 * (alpha * ath - 0.5 * ath * ath)
     return 0.5 * w * w + p2 * (cc - cos_a)
-
-
-@njit(cache=True)
-def _contact_tau(th0, w0, a0, s, h, u0, u1, p2, alpha, lin):
-    """Length tau in (0, h] of the Newmark step that ends exactly at theta = 0.
-
-    G(tau) = -4 th0 - 4 w0 tau + A tau^2 + C3 tau^3 = 0 with the base acceleration
-    linear over the step. C3 = 0 (free rocking, or constant ug) is the closed
-    form Čeh Eq. 9, written in the cancellation-free form.
-    """
-    if lin:
-        F0 = -p2 * alpha * s
-        F1 = -p2
-    else:
-        F0 = -p2 * s * math.sin(alpha)
-        F1 = -p2 * math.cos(alpha)
-    du = (u1 - u0) / h
-    A = -(a0 + F0 + F1 * u0)
-    C3 = -F1 * du
-    # quadratic roots (C3 ignored) as the first guess / the exact answer when C3 == 0
-    if th0 == 0.0:
-        # right after an impact: tau = 0 is a trivial root; G/tau = -4 w0 + A tau (+ C3 tau^2)
-        tq = 4.0 * w0 / A if A != 0.0 else h
-    else:
-        B = -4.0 * w0
-        C = -4.0 * th0
-        D = B * B - 4.0 * A * C
-        if D < 0.0:
-            D = 0.0
-        sq = math.sqrt(D)
-        q = -0.5 * (B + sq) if B >= 0.0 else -0.5 * (B - sq)
-        r1 = q / A if A != 0.0 else -1.0
-        r2 = C / q if q != 0.0 else -1.0
-        tq = h
-        if 0.0 < r1 <= h * (1.0 + 1e-12):
-            tq = r1
-        if 0.0 < r2 <= h * (1.0 + 1e-12) and (r2 < tq or not (0.0 < r1 <= h * (1.0 + 1e-12))):
-            tq = r2
-    if not (0.0 < tq <= h):
-        tq = min(max(tq, 0.0), h)
-    if C3 == 0.0:
-        return tq if tq > 0.0 else h
-    # safeguarded Newton on g(tau) = G(tau)/tau^k (k = 1 when th0 == 0): bracket [lo, hi]
-    lo, hi = 0.0, h
-    t = tq if tq > 0.0 else 0.5 * h
-    # sign of g near 0 is -s (theta starts on side s and must come back)
-    for _ in range(100):
-        if th0 == 0.0:
-            g = -4.0 * w0 + A * t + C3 * t * t
-            dg = A + 2.0 * C3 * t
-        else:
-            g = -4.0 * th0 - 4.0 * w0 * t + A * t * t + C3 * t * t * t
-            dg = -4.0 * w0 + 2.0 * A * t + 3.0 * C3 * t * t
-        if g * s < 0.0:
-            lo = t
-        else:
-            hi = t
-        tn = t - g / dg if dg != 0.0 else 0.5 * (lo + hi)
-        if not (lo < tn < hi):
-            tn = 0.5 * (lo + hi)
-        if abs(tn - t) <= 1e-15 * h:
-            t = tn
-            break
-        t = tn
-    return t
 
 
 @njit(cache=True, fastmath={"contract"})
@@ -323,12 +231,13 @@ def run_block(p, alpha, theta0, omega0, h, n_steps, acc, acc_t0, acc_dt, scale,
     step = 0
     countdown = out_every  # output every out_every steps (no integer modulo in the hot loop)
     t_end = 0.0
-    # free rocking (no base record, full equation): the lean loop of whole steps in
-    # _newmark_free; anything else (impact in the step, |theta| >= alpha, rest) is
-    # left to the general step below, which takes that step from the same state
-    fast = acc.shape[0] == 0 and not lin
+    # free rocking (full equation, no base record or past its end: ug = 0 exactly) runs
+    # in the lean loop of _newmark_free; anything else (impact in the step,
+    # |theta| >= alpha, rest) is left to the general step below, which takes that
+    # step from the same state. One sample of margin keeps _ug_at's rounding out.
+    t_free = acc_t0 + acc.shape[0] * acc_dt if acc.shape[0] > 0 else -np.inf
     while step < n_steps:
-        if fast and not resting:
+        if not lin and not resting and step * h > t_free and abs(th) < alpha:
             th, w, a, sc, cc, step, max_abs, n_out, countdown = free_steps(
                 th, w, a, sc, cc, s, step, n_steps, h, p2, alpha, cos_a, max_abs, out_th, out_w, out_e,
                 n_out, countdown, out_every, e_scale)
@@ -377,7 +286,7 @@ def run_block(p, alpha, theta0, omega0, h, n_steps, acc, acc_t0, acc_dt, scale,
                 tc = t1
             else:
                 # contact within the (rest of the) step
-                tau = _contact_tau(th, w, a, s, rem, u_c, u1, p2, alpha, lin)
+                tau = contact_tau(th, w, a, s, rem, u_c, u1, p2, alpha, lin)
                 if tau > rem:
                     tau = rem
                 if th == 0.0 or tau <= 0.0:
@@ -444,9 +353,9 @@ def run_block(p, alpha, theta0, omega0, h, n_steps, acc, acc_t0, acc_dt, scale,
             out_e[n_out] = 0.0 if resting else _energy(th, w, cc, cos_a, p2, alpha, lin) * e_scale
             n_out += 1
         if ath >= alpha and th * w > 0.0 and t_over != t_over:
-            t_over = t1 - h + h * _cross(th_beg * s, w_beg * s, th * s, w * s, h, alpha)
+            t_over = t1 - h + h * cross_fraction(th_beg * s, w_beg * s, th * s, w * s, h, alpha)
         if ath >= fall_rad and t_fall != t_fall:
-            t_fall = t1 - h + h * _cross(th_beg * s, w_beg * s, th * s, w * s, h, fall_rad)
+            t_fall = t1 - h + h * cross_fraction(th_beg * s, w_beg * s, th * s, w * s, h, fall_rad)
             status = OVERTURNED
             if stop_on_fall:
                 break

@@ -19,10 +19,12 @@ Newton), the pre-impact omega and theta'' follow from Eq. 10–11, the
 restitution law gives omega+ and the rest of the step continues with the other
 equation (several impacts per step are allowed).
 
-Free rocking (no base record, full equation) runs its steps between impacts in
-the lean loop :func:`~rocklab.models._newmark_free.free_steps` (same trapezoidal
-step, solved by a jerk-corrected predictor and a checked fixed-point update);
-impacts, rest and overturning are always handled here.
+Free rocking (full equation, no base record or past its end) runs its steps
+between impacts in the lean loop :func:`~rocklab.models._newmark_free.free_steps`
+(same trapezoidal step, solved by a jerk-corrected predictor and a checked
+fixed-point update); impacts, rest and overturning are always handled here.
+The kernels compile with ``fastmath={"contract"}``: multiply-adds are fused
+(rounding only; no reassociation or other fast-math liberties).
 
 Notes on the paper: Eq. 8 as printed reads ``A dt'^2 - 4 w dt' - theta = 0``; the
 Newmark relation and Eq. 9 both need ``- 4 theta``, which is used here.
@@ -38,7 +40,6 @@ from numba import njit, prange
 from ..blocks import G
 from ._newmark_contact import contact_tau, cross_fraction
 from ._newmark_free import free_steps, sdcd
-
 
 
 def _drop_stale_cache():

@@ -95,8 +95,8 @@ def free_steps(th, w, a, sc, cc, s, step, n_steps, h, p2, alpha, cos_a, max_abs,
     xr = x
     broke = False
     while step < n_steps and not broke:
-        # blocks of up to 1024 steps between re-anchorings: no calls inside the inner
-        # loop (a call makes the register allocator spill the loop state)
+        # blocks of up to 1024 steps, each followed by a re-anchoring with libm sin/cos
+        # against the rounding drift of the carried values
         lim = min(n_steps, (step | 1023) + 1)
         broke = True
         while step < lim:

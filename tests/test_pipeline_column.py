@@ -62,3 +62,12 @@ def test_model_follows_the_tracked_blocks(column_run):
     assert rows["/experiment/video"] == -(-n_frames // 10)
     assert (out / "figures" / "column.png").is_file()
     assert json.loads((out / "report.json").read_text())["column"]["status"] in ("rest", "rocking")
+
+
+def test_video_overlays_in_rrd(column_run):
+    """Target points and block outlines are logged on the decimated video frames."""
+    _, out = column_run
+    rows = read_rrd_summary(out / "session.rrd")
+    n_video = rows["/experiment/video"]
+    assert rows["/experiment/video/outline"] == n_video   # three outlines per frame, one entity row
+    assert rows["/experiment/video/targets"] == n_video

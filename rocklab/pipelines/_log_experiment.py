@@ -33,18 +33,34 @@ def _video_frames(path: Path, fps: float | None):
 
 
 def _overlay_fn(res):
-    """Per-frame overlays from the tracker (target points, block outline) plus a θ label."""
+    """Per-frame overlays: target centres and block outlines mapped back to pixels from the
+    tracked poses, and a θ label."""
     tr = res.frames
     t, th = res.measured.get("video", (None, None))
-    get = getattr(tr, "overlay", None) if tr is not None else None
+    shapes = []
+    if tr is not None and getattr(tr, "plane_map", None) is not None:
+        b = res.block
+        rect = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1], [-1, -1]]) * [b.b_m / 2, b.h_m / 2]
+        blocks = res.column["objects"] if res.column is not None else [res.config.video.object]
+        for o in tr.config.objects:
+            targets = o.dots if o.dots else o.marker_positions_m
+            # the outline assumes the object frame is centred on the block's front face (as
+            # `rocklab synth` writes it); drawn only where the config defines that frame
+            framed = bool(o.dots) or o.marker_positions_m is not None or o.size_m is not None
+            outline = rect if (o.id in blocks and framed) else None
+            shapes.append((o.id, None if targets is None else np.asarray(targets, float), outline))
 
     def fn(idx):
-        ov = {}
-        if get is not None:
-            try:
-                ov = dict(get(idx) or {})
-            except (IndexError, KeyError):
-                ov = {}
+        pts, lines = [], []
+        for oid, targets, outline in shapes:
+            if targets is not None and len(targets):
+                p = tr.to_pixels(oid, idx, targets)
+                pts.extend(p[np.isfinite(p).all(axis=1)])
+            if outline is not None:
+                q = tr.to_pixels(oid, idx, outline)
+                if np.isfinite(q).all():
+                    lines.append(q)
+        ov = {"points": np.asarray(pts) if pts else None, "outlines": lines}
         if th is not None and idx < len(th) and np.isfinite(th[idx]):
             ov["label"] = f"θ = {np.degrees(th[idx]):+.2f}°"
         return ov

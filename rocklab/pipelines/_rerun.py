@@ -105,7 +105,7 @@ def log_video_frames(rec, path: str, frames, *, decimation: int = 1, quality: in
     decimation : int
         Log every n-th frame.
     overlays : callable(frame_index) -> dict, optional
-        Returns {"points": (k, 2) px, "outline": (m, 2) px, "label": str} to draw.
+        Returns {"points": (k, 2) px, "outlines": list of (m, 2) px polylines, "label": str}.
     Returns the number of frames logged.
     """
     import cv2
@@ -129,8 +129,8 @@ def log_video_frames(rec, path: str, frames, *, decimation: int = 1, quality: in
             ov = overlays(idx) or {}
             if ov.get("points") is not None and len(ov["points"]):
                 rec.log(f"{path}/targets", rr.Points2D(ov["points"], radii=3.0, colors=[0, 255, 0]))
-            if ov.get("outline") is not None and len(ov["outline"]):
-                rec.log(f"{path}/outline", rr.LineStrips2D([ov["outline"]], colors=[255, 128, 0]))
+            if ov.get("outlines"):
+                rec.log(f"{path}/outline", rr.LineStrips2D(ov["outlines"], colors=[255, 128, 0]))
             if ov.get("label"):
                 rec.log(f"{path}/label", rr.TextLog(ov["label"]))
         n += 1

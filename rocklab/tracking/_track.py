@@ -256,6 +256,7 @@ class TrackResult:
     source: str | None
     config: TrackConfig = field(repr=False)
     plane: str = "image"
+    plane_map: PlaneMap | None = field(default=None, repr=False, compare=False)
 
     def __getitem__(self, oid: str) -> ObjectTrack:
         for t in self.tracks:
@@ -290,6 +291,52 @@ class TrackResult:
         m = self.config.motion
         return table_motion(tr.t_s, tr.x_m, window_s if window_s is not None else m.sg_window_s,
                             polyorder if polyorder is not None else m.sg_polyorder, object)
+
+    def to_pixels(self, object: str, frame: int, points_m) -> np.ndarray:
+        """Image pixels of points fixed to a tracked object, at one frame.
+
+        Inverts what :func:`assemble_tracks` did (levelling, scale, homography or
+        centring, lens distortion), so overlays land on the image.
+
+        Parameters
+        ----------
+        object : str
+        frame : int
+            Frame index.
+        points_m : array_like (k, 2)
+            Points in the object's frame, m (x right, y up when upright).
+
+        Returns
+        -------
+        ndarray (k, 2)
+            Pixel coordinates (u right, v down); NaN when the object is not tracked there.
+        """
+        tr = self[object]
+        pts = np.asarray(points_m, float).reshape(-1, 2)
+        hit = np.flatnonzero(tr.frame == int(frame))
+        if not hit.size or self.plane_map is None or not np.isfinite(tr.theta_rad[hit[0]]):
+            return np.full(pts.shape, np.nan)
+        i = hit[0]
+        c, s = math.cos(tr.theta_rad[i]), math.sin(tr.theta_rad[i])
+        x = tr.x_m[i] + c * pts[:, 0] - s * pts[:, 1]
+        y = tr.y_m[i] + s * pts[:, 0] + c * pts[:, 1]
+        cl, sl = math.cos(self.level_rad), math.sin(self.level_rad)
+        X = (cl * x - sl * y) / tr.m_per_unit
+        Y = (sl * x + cl * y) / tr.m_per_unit
+        pm = self.plane_map
+        if pm.H is not None:
+            h = np.column_stack((X, Y, np.ones_like(X))) @ np.linalg.inv(pm.H).T
+            uv = h[:, :2] / h[:, 2:3]
+        else:
+            uv = np.column_stack((X + pm.cx, pm.cy - Y))
+        if pm.K is not None and pm.dist is not None and np.any(pm.dist):
+            import cv2
+
+            xn = (uv - pm.K[:2, 2]) / np.array([pm.K[0, 0], pm.K[1, 1]])
+            obj = np.column_stack((xn, np.ones(len(xn))))
+            uv, _ = cv2.projectPoints(obj, np.zeros(3), np.zeros(3), pm.K, pm.dist)
+            uv = uv.reshape(-1, 2)
+        return uv
 
     def to_dict(self) -> dict:
         per = {}
@@ -402,7 +449,7 @@ def assemble_tracks(observations, config: TrackConfig, fps: float, width_px: int
         tracks.append(ObjectTrack(o.id, o.kind, frames.copy(), frames / float(fps), x, y, th, sig,
                                   q, st.astype(str), m_per[o.id]))
     return TrackResult(tuple(tracks), float(fps), level, n, int(width_px), int(height_px),
-                       None if source is None else str(source), config, plane)
+                       None if source is None else str(source), config, plane, plane_map)
 
 
 def track_video(path, config: TrackConfig, fps: float | None = None, progress: bool = False,

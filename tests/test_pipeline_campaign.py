@@ -69,3 +69,20 @@ def test_campaign_recovers_eta_mat_and_reports_failure(tmp_path, run_cli):
     rows = read_rrd_summary(out / "campaign.rrd")
     assert rows["/campaign/experiments"] == 3
     assert (out / "figures" / "eta_vs_hb.png").is_file()
+
+
+def test_campaign_on_a_dask_cluster_matches_local(tmp_path):
+    """``--scheduler ADDR`` runs the same tasks on a Dask distributed cluster, same answers."""
+    distributed = pytest.importorskip("distributed")
+    from rocklab.pipelines import _campaign as C
+
+    root = tmp_path / "c"
+    _exp(root, "B4M_full", "B4M", "full", 0.882, 3)
+    _exp(root, "B6M_full", "B6M", "full", 0.941, 4)
+    local = C.run_campaign(root, tmp_path / "local", workers=1, progress=False)
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
+                                  dashboard_address=None) as cluster:
+        remote = C.run_campaign(root, tmp_path / "remote", scheduler=cluster.scheduler_address, progress=False)
+    assert remote.n_ok == local.n_ok == 2
+    assert remote.table["eta_e"].tolist() == pytest.approx(local.table["eta_e"].tolist(), abs=1e-12)
+    assert remote.table["eta_e"].tolist() == pytest.approx([0.882, 0.941], abs=0.002)

@@ -75,7 +75,13 @@ def _edit_experiment(path: Path, name: str, block_id: str, contact: str, table: 
     extra = "\n[output]\nvideo_decimation = 5\n"
     if table != "none":
         # forced rocking: no free-rocking restitution fit; simulate the table-driven response
-        extra += '\n[fit]\nrestitution = false\n\n[simulate]\nlaws = ["housner", "modified"]\n'
+        # a record's table acceleration has content a 50 fps camera cannot sample: drive the
+        # simulation from the table IMU (256 Hz), synced to the video by its acceleration
+        sub('[sources.table]\nfrom = "video"\nobject = "table"\n',
+            '[sources.table]\nfrom = "imu"\nobject = "table"\nimu = "imu/table"\n')
+        # (the η a lab would have calibrated on free rocking of the same block: here the truth)
+        extra += ('\n[fit]\nrestitution = false\n\n[simulate]\nlaws = ["housner", "modified"]\n'
+                  f'eta = {_true_eta(block_id, contact):.6f}\n')
     path.write_text(text + extra, encoding="utf-8")
 
 

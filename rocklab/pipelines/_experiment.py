@@ -183,7 +183,7 @@ def _measure_video(cfg: ExperimentConfig, progress: bool, keep_jpeg: bool):
         raise InputError(f"{cfg.path}: [sources.video] object {cfg.video.object!r} was never tracked in "
                          f"{cfg.video.path.name}; objects seen: {sorted(set(df['object']))}")
     table = None
-    if cfg.table.source == "video":
+    if cfg.table.source in ("video", "imu") and tcfg is not None and tcfg.table is not None:
         tm = tr.table_motion(cfg.table.object)
         table = {"t_s": np.asarray(tm.t_s), "disp_m": np.asarray(tm.x_m),
                  "vel_m_s": np.asarray(tm.vx_m_s), "acc_m_s2": np.asarray(tm.ax_m_s2)}
@@ -199,12 +199,31 @@ def _measure_imu(cfg: ExperimentConfig):
     return (np.asarray(rot.t_s, float), np.asarray(rot.theta_rad, float)), rot
 
 
-def _table_from_imu(cfg: ExperimentConfig):
-    from ..tracking import read_imu, table_acceleration
+def _table_from_imu(cfg: ExperimentConfig, video_table: dict | None, msgs: list):
+    """Table acceleration from the table IMU, on the video clock when the video tracked the table.
+
+    A 50 fps camera cannot measure a record's table acceleration (content above 25 Hz is lost;
+    on a synthetic El Centro run the 50 Hz samples turned a surviving block into an overturning
+    one), so the IMU (~256 Hz) drives the simulation; its clock is found by cross-correlating its
+    acceleration with the video's (t_imu = t_video + offset + drift t_video).
+    """
+    from ..tracking import read_imu, sync_offset, table_acceleration
 
     log = read_imu(cfg.table.imu)
     ta = table_acceleration(log, axis=None)
-    return {"t_s": np.asarray(ta.t_s, float), "acc_m_s2": np.asarray(ta.acc_m_s2, float)}
+    t, a = np.asarray(ta.t_s, float), np.asarray(ta.acc_m_s2, float)
+    out = {"t_s": t, "acc_m_s2": a}
+    sync = None
+    if video_table is not None:
+        s = sync_offset(t, a, video_table["t_s"], video_table["acc_m_s2"], max_offset_s=cfg.max_offset_s)
+        sync = s.to_dict()
+        # the video's sense of x is the reference: a_video = sign * a_imu
+        out = {"t_s": (t - s.offset_s) / (1.0 + s.drift), "acc_m_s2": s.sign * a}
+        for k in ("disp_m", "vel_m_s"):  # displacement and velocity stay the video's
+            out[k] = np.interp(out["t_s"], video_table["t_s"], video_table[k], left=np.nan, right=np.nan)
+    else:
+        msgs.append("table IMU used on its own clock: no tracked table on video to sync it with")
+    return out, sync
 
 
 def _sync(ref, rot, max_offset_s):
@@ -233,8 +252,9 @@ def analyse_experiment(cfg: ExperimentConfig, progress: bool = False) -> Experim
         t1 = time.perf_counter()
         measured["imu"], rot = _measure_imu(cfg)
         timings["imu_s"] = time.perf_counter() - t1
+    table_sync = None
     if cfg.table.source == "imu":
-        table = _table_from_imu(cfg)
+        table, table_sync = _table_from_imu(cfg, table, msgs)
     elif cfg.table.source == "record":
         from ..models import load_base_motion
 
@@ -256,6 +276,8 @@ def analyse_experiment(cfg: ExperimentConfig, progress: bool = False) -> Experim
         thi_on_v = np.interp(tv, measured["imu"][0], thi, left=np.nan, right=np.nan)
         residual = (tv, thv - thi_on_v)
 
+    if table_sync is not None:
+        sync = dict(sync or {}, table_imu=table_sync)
     block = cfg.block()
     prim = measured[cfg.primary]
     fit_d = None

@@ -13,21 +13,12 @@ import math
 from dataclasses import asdict, dataclass
 
 from ._errors import InputError
+from ._errors import positive as _positive
 
 __all__ = ["Block", "G"]
 
 #: Standard gravity, m/s^2.
 G = 9.80665
-
-
-def _positive(name: str, value) -> float:
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise InputError(f"{name}={value!r}: must be a number; give a positive value in SI units") from None
-    if not math.isfinite(v) or v <= 0.0:
-        raise InputError(f"{name}={value!r}: must be a finite positive number (SI units); fix the value")
-    return v
 
 
 @dataclass(frozen=True)

@@ -23,6 +23,7 @@ from numba.extending import register_jitable
 from ._column_events import impact_model, opening_model
 from ._column_kernels import active_dofs, base_acc, geometry, kinetic_energy, make_work, pivots
 from ._column_step import evaluate, locate_closing, nm_step, state_checks
+from ._numba_cache import drop_stale_cache
 
 __all__: list[str] = []
 
@@ -342,25 +343,7 @@ def run_core(phi0, v0, s0, blk, par, accb, n_steps, dt, max_enum, n_imp, v_tol, 
     return nr, ne, ni, status, t_status
 
 
-def _drop_stale_cache():
-    """Delete the on-disk numba cache of :func:`run_core` if a kernel module is newer.
-
-    numba checks only the timestamp of the file that holds the cached function;
-    the kernels it inlines live in sibling modules, so an edit there would
-    otherwise run stale machine code.
-    """
-    from pathlib import Path
-
-    here = Path(__file__).resolve().parent
-    try:
-        newest = max((here / f).stat().st_mtime for f in
-                     ("_column_kernels.py", "_column_step.py", "_column_events.py", "_column_core.py"))
-        for idx in (here / "__pycache__").glob("_column_core.run_core-*.nbi"):
-            if idx.stat().st_mtime < newest:
-                idx.unlink()
-    except OSError:  # read-only install or a concurrent clean-up: numba decides on its own
-        pass
-
-
-_drop_stale_cache()
+# run_core inlines the kernels of these modules (see _numba_cache)
+drop_stale_cache("_column_core.run_core-*.nbi",
+                 ("_column_kernels.py", "_column_step.py", "_column_events.py", "_column_core.py"))
 run_core_jit = njit(cache=True)(run_core)

@@ -19,19 +19,10 @@ import math
 from dataclasses import asdict, dataclass
 
 from .._errors import InputError
+from .._errors import positive as _pos
 from ..blocks import G, Block
 
 __all__ = ["DesignCheck", "design_check", "required_width", "required_width_slender"]
-
-
-def _pos(name, v):
-    try:
-        x = float(v)
-    except (TypeError, ValueError):
-        raise InputError(f"{name}={v!r}: must be a positive number") from None
-    if not (math.isfinite(x) and x > 0):
-        raise InputError(f"{name}={v!r}: must be a finite positive number")
-    return x
 
 
 @dataclass(frozen=True)

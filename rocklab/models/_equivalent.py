@@ -25,22 +25,13 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from .._errors import InputError
+from .._errors import positive as _pos
 from ..blocks import G
 
 __all__ = ["FundamentalParameters", "Mechanism", "block_parameters", "strut_parameters",
            "frame_parameters", "wall_parameters", "wall_mechanism", "free_rocking_period_eq24",
            "overturning_time_eq25", "sine_pulse_max_response", "linear_sine_pulse_response",
            "equivalence_errors"]
-
-
-def _pos(name, v):
-    try:
-        x = float(v)
-    except (TypeError, ValueError):
-        raise InputError(f"{name}={v!r}: must be a positive number") from None
-    if not (math.isfinite(x) and x > 0):
-        raise InputError(f"{name}={v!r}: must be a finite positive number")
-    return x
 
 
 def _slender(name, a):

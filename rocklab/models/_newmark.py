@@ -40,29 +40,11 @@ from numba import njit, prange
 from ..blocks import G
 from ._newmark_contact import contact_tau, cross_fraction
 from ._newmark_free import free_steps, sdcd
+from ._numba_cache import drop_stale_cache
 
 
-def _drop_stale_cache():
-    """Delete this module's on-disk numba cache if a kernel module it uses is newer.
-
-    numba checks only the timestamp of the file that holds a cached function;
-    :func:`run_block` compiles in the kernels of ``_newmark_free`` and
-    ``_newmark_contact``, so an edit there would otherwise run stale machine code.
-    """
-    from pathlib import Path
-
-    here = Path(__file__).resolve().parent
-    try:
-        newest = max((here / f).stat().st_mtime
-                     for f in ("_newmark_free.py", "_newmark_contact.py", "_newmark.py"))
-        for idx in (here / "__pycache__").glob("_newmark.*.nbi"):
-            if idx.stat().st_mtime < newest:
-                idx.unlink()
-    except OSError:  # read-only install or a concurrent clean-up: numba decides on its own
-        pass
-
-
-_drop_stale_cache()
+# run_block compiles in the kernels of _newmark_free and _newmark_contact (see _numba_cache)
+drop_stale_cache("_newmark.*.nbi", ("_newmark_free.py", "_newmark_contact.py", "_newmark.py"))
 
 #: Status codes returned by the kernel.
 ROCKING, REST, OVERTURNED, NO_UPLIFT = 0, 1, 2, 3

@@ -112,6 +112,13 @@ class CampaignResult:
         if self.k_table:
             ks = ", ".join(f"{r['block']}: {r['k']:.3f}" for r in self.k_table.get("per_block", []))
             lines.append(f"k per full-contact block (Čeh Eq. 18, eta_mat = {self.k_table.get('eta_mat'):.4f}): {ks}")
+            co = self.k_table.get("coefficients")
+            if co:
+                terms = " ".join(f"{v:+.4f}·{k}" if k != "const" else f"{v:+.4f}" for k, v in co.items())
+                lines.append(f"k(h/b, b) regression (Čeh Eq. 19 form, b in cm): k = {terms}; "
+                             f"R² = {self.k_table.get('r2', float('nan')):.3f}, "
+                             f"RMSE = {self.k_table.get('rmse', float('nan')):.4f} "
+                             f"(Čeh: +0.0047·hb2 -0.0258·hb +1.0635 -0.0565·b_cm)")
         for r in self.runs:
             if not r["ok"]:
                 lines.append(f"FAILED {r['config']}: {r['error']}")

@@ -4,8 +4,9 @@ The campaign (all rendered by :func:`rocklab.tracking.synth_session` with ArUco
 targets and x-IMU logs, 960×540 at 50 fps; at this size η_e of a 4.5 cm wide
 block comes back within 1e-4 of the truth):
 
-- full-contact free rocking of Čeh Table 2 blocks, whose true restitution is
-  Čeh Table 3's η_e,full;
+- full-contact free rocking of Čeh Table 2 blocks (B3M, B5M, B7M, B9M, B4L), whose
+  true restitution is Čeh Table 3's η_e,full, so the campaign fits k per block and
+  the k(h/b, b) regression of Čeh Eq. 19;
 - edge-contact free rocking (base strips l_c = 1.5 mm) whose true restitution is
   η_M(k = 1 − 2 l_c/b) · η_mat with η_mat = 0.989 (Čeh Eq. 14, 16), so the
   campaign's η_mat fit has a known answer;
@@ -41,6 +42,9 @@ DEMO_RUNS = (
     ("B5M_edge", "B5M", "edge", "none"),
     ("B5L_elcentro", "B5L", "full", "record"),
     ("column_sine", "column", "full", "sine"),
+    # two more full-contact blocks (two widths) so the campaign can fit the Eq. 19 regression
+    ("B9M_full", "B9M", "full", "none"),
+    ("B4L_full", "B4L", "full", "none"),
 )
 
 

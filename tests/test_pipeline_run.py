@@ -90,11 +90,12 @@ def test_failing_stage_leaves_previous_output_intact(tmp_path, run_cli, monkeypa
     assert run_cli("run", cfg, "--out", out)[0] == 0
     before = (out / "report.json").read_text()
     import rocklab.pipelines._experiment as E
+    import rocklab.pipelines._report as R
 
     def boom(*a, **k):
         raise RuntimeError("figure backend exploded")
 
-    monkeypatch.setattr(E, "series_frame", boom)
+    monkeypatch.setattr(R, "series_frame", boom)
     with pytest.raises(RuntimeError):
         E.run_experiment(cfg, out, force=True)
     assert (out / "report.json").read_text() == before

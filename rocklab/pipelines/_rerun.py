@@ -27,7 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["open_recording", "log_series", "log_events", "log_video_frames",
+__all__ = ["open_recording", "log_series", "log_events", "log_video_frames", "read_rrd_scalars",
            "experiment_blueprint", "campaign_blueprint", "read_rrd_summary"]
 
 TIMELINE = "time"

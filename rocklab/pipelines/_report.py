@@ -1,0 +1,115 @@
+"""Outputs of ``rocklab run``: ``series.csv``, ``summary.md``, figures, ``session.rrd`` and
+``report.json``, written into a (staging) folder."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from .._io import write_frame_atomic, write_json_atomic, write_text_atomic
+
+__all__ = ["series_frame", "write_outputs"]
+
+
+def series_frame(res):
+    """All time series on one table: measured sources and simulations on the primary time base."""
+    import pandas as pd
+
+    t, th = res.measured[res.primary]
+    cols = {"t_s": t, f"theta_{res.primary}_rad": th}
+    for name, (tn, thn) in res.measured.items():
+        if name != res.primary:
+            cols[f"theta_{name}_rad"] = np.interp(t, tn, thn, left=np.nan, right=np.nan)
+    for law, s in res.simulations.items():
+        cols[f"theta_sim_{law}_rad"] = np.interp(t, s["t_s"], s["theta_rad"], left=np.nan, right=np.nan)
+    if res.truth is not None:
+        cols["theta_truth_rad"] = np.interp(t, res.truth["t_s"], res.truth["theta_rad"], left=np.nan, right=np.nan)
+    if res.table is not None:
+        for k in ("disp_m", "vel_m_s", "acc_m_s2"):
+            if k in res.table:
+                cols[f"table_{k}"] = np.interp(t, res.table["t_s"], res.table[k], left=np.nan, right=np.nan)
+    if res.column is not None:
+        c = res.column
+        for i, o in enumerate(c["objects"]):
+            cols[f"theta_{o}_video_rad"] = np.interp(t, c["t_s"], c["theta_measured_rad"][:, i], left=np.nan,
+                                                     right=np.nan)
+            cols[f"theta_{o}_sim_column_rad"] = np.interp(t, c["sim_t_s"], c["theta_sim_rad"][:, i],
+                                                          left=np.nan, right=np.nan)
+            if "theta_truth_rad" in c:
+                tt, th = c["theta_truth_rad"]
+                cols[f"theta_{o}_truth_rad"] = np.interp(t, tt, th[:, i], left=np.nan, right=np.nan)
+    return pd.DataFrame(cols)
+
+
+def _summary_md(res, figs: dict, rrd: bool) -> str:
+    f = res.fit or {}
+    lines = [f"# {res.name}", "", f"Status: **{res.status}**", "",
+             f"Block: b = {res.block.b_m:.4f} m, h = {res.block.h_m:.4f} m, α = {res.block.alpha_rad:.4f} rad, "
+             f"p = {res.block.p_rad_s:.3f} rad/s, η_H = {res.block.eta_H:.4f}; contact: {res.config.contact}", ""]
+    if f:
+        ci = f.get("ci95_eta_e") or [None, None]
+        lines += [f"η_e = {f.get('eta_e', float('nan')):.4f} (95 % CI {ci[0]} – {ci[1]}), "
+                  f"η'_e = {f.get('eta_e_first')}, θ0 = {f.get('theta0_rad')} rad, "
+                  f"release at {f.get('release_t_s')} s, residual RMS {f.get('rms_residual_rad')} rad", ""]
+    if res.sync:
+        lines += [f"IMU sync: offset {1000 * res.sync.get('offset_s', float('nan')):.2f} ms, "
+                  f"drift {res.sync.get('drift')}, residual {res.sync.get('residual_ms')} ms", ""]
+    lines += ["| simulation | η | RMS vs measured (rad) | impacts |", "|---|---|---|---|"]
+    for law, s in res.simulations.items():
+        rms = s.get("rms_vs_measured_rad")
+        lines.append(f"| {law} | {s['eta']:.4f} | {rms:.5f} | {len(s['impacts'])} |" if rms is not None
+                     else f"| {law} | {s['eta']:.4f} | – | {len(s['impacts'])} |")
+    lines.append("")
+    if res.truth is not None:
+        lines += [f"Synthetic truth: η = {res.truth.get('eta')}, measured θ RMS error "
+                  f"{res.truth.get('theta_rms_error_rad')} rad", ""]
+    if res.column is not None:
+        c = res.column
+        cmp_ = c["comparison"]
+        lines += [f"Column of {len(c['objects'])} blocks (cut {1000 * c['cut_m']:.1f} mm, "
+                  f"{c['impacts_per_closing']} impact(s) per closing): simulation status {c['status']}", "",
+                  "| block | RMS measured − simulated (rad) | peak measured (rad) | peak simulated (rad) |",
+                  "|---|---|---|---|"]
+        for o, r, pm, ps in zip(c["objects"], cmp_["rms_theta_rad"], cmp_["peak_measured_rad"],
+                                cmp_["peak_simulated_rad"]):
+            lines.append(f"| {o} | {r:.4f} | {pm:.4f} | {ps:.4f} |")
+        sq = cmp_["sequence"]
+        lines += ["", f"Opening/closing sequence, measured vs simulated: {sq['n_matched']} of "
+                      f"{sq['n_measured']} measured / {sq['n_simulated']} simulated events matched "
+                      f"(median timing error {sq['timing_error_s']:.3f} s)"]
+        if "sequence_vs_truth" in c:
+            st = c["sequence_vs_truth"]
+            lines += [f"Measured sequence vs truth: same sequence = {st['same_sequence']} "
+                      f"({st['n_matched']}/{st['n_measured']} events)"]
+        lines.append("")
+    for m in res.messages:
+        lines.append(f"- note: {m}")
+    lines += ["", "## Figures", ""] + [f"![{k}](figures/{p.name})" for k, p in figs.items()]
+    lines += ["", "Data: [report.json](report.json), [series.csv](series.csv)"]
+    if rrd:
+        lines += ["", "Visual review: `rerun session.rrd`"]
+    return "\n".join(lines) + "\n"
+
+
+def write_outputs(res, out_dir: Path, fp: str, *, spawn=False, connect=None,
+                  progress=False) -> dict:
+    """Write report.json, series.csv, figures, summary.md and session.rrd into ``out_dir``."""
+    from ._figures import experiment_figures
+    from ._log_experiment import log_experiment
+
+    out_dir.mkdir(parents=True, exist_ok=True)
+    figs = experiment_figures(res, out_dir / "figures") if res.config.figures else {}
+    write_frame_atomic(out_dir / "series.csv", series_frame(res))
+    rrd_rows = None
+    if res.config.rrd or spawn or connect:
+        rrd_path = out_dir / "session.rrd" if res.config.rrd else None
+        rrd_rows = log_experiment(res, rrd_path, spawn=spawn, connect=connect, progress=progress)
+    report = res.to_dict()
+    report["fingerprint"] = fp
+    report["outputs"] = {"figures": {k: f"figures/{p.name}" for k, p in figs.items()},
+                         "series": "series.csv", "rrd": "session.rrd" if res.config.rrd else None,
+                         "rrd_rows": rrd_rows}
+    write_text_atomic(out_dir / "summary.md", _summary_md(res, figs, bool(res.config.rrd)))
+    write_json_atomic(out_dir / "report.json", report)
+    return report

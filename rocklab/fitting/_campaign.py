@@ -108,6 +108,7 @@ class EtaMatResult:
     message: str = ""
 
     def to_dict(self) -> dict:
+        """Plain dict of the fields, JSON-ready (SI units in the keys)."""
         return dict(eta_mat=self.eta_mat, std=self.std, n=self.n, rule=self.rule, contact=self.contact,
                     l_c_m=self.l_c_m, min_hb=self.min_hb, status=self.status, message=self.message,
                     per_block=self.per_block.to_dict(orient="records"))
@@ -188,6 +189,7 @@ class KTableResult:
     message: str = ""
 
     def to_dict(self) -> dict:
+        """Plain dict of the fields, JSON-ready (SI units in the keys)."""
         reg = self.regression
         pb = self.per_block[["block", "b_m", "h_m", "h_over_b", "eta_e", "eta_RB", "k", "b_bar_m", "feasible"]]
         d = dict(eta_mat=self.eta_mat, per_block=pb.to_dict(orient="records"), n_infeasible=self.n_infeasible,

@@ -424,6 +424,7 @@ class EnergyLoss:
     exact: bool
 
     def to_dict(self) -> dict:
+        """Plain dict of the fields, JSON-ready (SI units in the keys)."""
         return dict(mean4=self.mean4, start=self.start, eta_equivalent=self.eta_equivalent, exact=self.exact,
                     loss=[float(x) for x in self.loss], peaks=self.peaks.to_dict(orient="records"))
 

@@ -58,6 +58,7 @@ class KPrediction:
     message: str = ""
 
     def to_dict(self) -> dict:
+        """Plain dict of the fields, JSON-ready (SI units in the keys)."""
         return dict(hb=self.hb, b_m=self.b_m, b_cm=100 * self.b_m, k=self.k, eta_M=self.eta_M,
                     b_bar_m=self.b_bar_m, extrapolated=self.extrapolated, feasible=self.feasible,
                     message=self.message)
@@ -164,6 +165,7 @@ class KRegression:
                            extrapolated=extrap, feasible=feasible, message="; ".join(msgs))
 
     def to_dict(self) -> dict:
+        """Plain dict of the fields, JSON-ready (SI units in the keys)."""
         return dict(form=self.form, coefficients=dict(self.coefficients), r2=self.r2, rmse=self.rmse, n=self.n,
                     residuals=[float(x) for x in self.residuals], hb_range=list(self.hb_range),
                     b_cm_range=list(self.b_cm_range), loso=self.loso.to_dict(orient="records"))

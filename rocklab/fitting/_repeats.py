@@ -49,6 +49,7 @@ class RepeatSummary:
     message: str = ""
 
     def to_dict(self) -> dict:
+        """Plain dict of the fields, JSON-ready (SI units in the keys)."""
         return dict(mean=self.mean, std=self.std, median=self.median, n=self.n, n_used=self.n_used,
                     values=[float(v) for v in self.values], outliers=list(self.outliers), failed=list(self.failed),
                     suspicious=list(self.suspicious), z_max=self.z_max, status=self.status, message=self.message)

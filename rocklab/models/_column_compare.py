@@ -110,6 +110,7 @@ class SequenceComparison:
     tol_s: float
 
     def to_dict(self) -> dict:
+        """Plain dict of the fields, JSON-ready (SI units in the keys)."""
         return {"n_measured": self.n_measured, "n_simulated": self.n_simulated, "n_matched": self.n_matched,
                 "timing_error_s": self.timing_error_s, "same_sequence": self.same_sequence, "tol_s": self.tol_s,
                 "pairs": [list(p) for p in self.pairs]}
@@ -176,6 +177,7 @@ class ColumnComparison:
     peak_simulated_rad: np.ndarray
 
     def to_dict(self) -> dict:
+        """Plain dict of the fields, JSON-ready (SI units in the keys)."""
         return {"sequence": self.sequence.to_dict(),
                 "measured_sequence": [list(e) for e in self.measured_sequence],
                 "simulated_sequence": [list(e) for e in self.simulated_sequence],

@@ -73,6 +73,7 @@ class ColumnMaps:
                              "max_theta_over_alpha": self.max_theta_over_alpha.ravel()})
 
     def to_dict(self) -> dict:
+        """Plain dict of the fields, JSON-ready (SI units in the keys)."""
         return {"H_m": self.H_m, "B_m": self.B_m, "n_blocks": self.n_blocks.tolist(),
                 "ap_m_s2": self.ap_m_s2.tolist(), "tp_s": self.tp_s.tolist(),
                 "overturned": self.overturned.tolist(),

@@ -118,6 +118,7 @@ class Column:
         return out
 
     def to_dict(self) -> dict:
+        """Plain dict of the fields, JSON-ready (SI units in the keys)."""
         return {"blocks": [b.to_dict() for b in self.blocks], "cut_m": list(self.cut_m), "mu": self.mu}
 
 

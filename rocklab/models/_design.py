@@ -53,6 +53,7 @@ class DesignCheck:
     utilisation: float
 
     def to_dict(self) -> dict:
+        """Plain dict of the fields, JSON-ready (SI units in the keys)."""
         return asdict(self)
 
 

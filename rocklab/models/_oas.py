@@ -393,6 +393,7 @@ class OverturningCurve:
     i_cr: float
 
     def to_frame(self):
+        """The result as a pandas DataFrame (SI units in the column names)."""
         import pandas as pd
 
         return pd.DataFrame({"ptp": self.ptp, "a_min_ratio": self.a_min_ratio,

@@ -89,6 +89,7 @@ class Restitution:
         return self.eta
 
     def to_dict(self) -> dict:
+        """Plain dict of the fields, JSON-ready (SI units in the keys)."""
         d = {"law": self.name, "eta": self.eta, "mode": self.mode}
         d.update({k: v for k, v in self.params.items() if not callable(v)})
         return d

@@ -78,15 +78,18 @@ class CampaignResult:
 
     @property
     def n_ok(self) -> int:
+        """Number of experiments that ran without failing."""
         return sum(1 for r in self.runs if r["ok"])
 
     def to_dict(self) -> dict:
+        """Plain dict of the fields, JSON-ready (SI units in the keys)."""
         return {"out_dir": str(self.out_dir), "n_experiments": len(self.runs), "n_ok": self.n_ok,
                 "failures": [{"config": r["config"], "error": r["error"]} for r in self.runs if not r["ok"]],
                 "experiments": self.table.to_dict(orient="records") if self.table is not None else [],
                 "eta_mat": self.eta_mat, "k_table": self.k_table, "messages": list(self.messages)}
 
     def summary_text(self) -> str:
+        """The table the CLI prints: per experiment η_H, η_e ± CI, η_M, truth; then the campaign fits."""
         lines = [f"campaign: {self.n_ok}/{len(self.runs)} experiments ok; outputs in {self.out_dir}"]
         t = self.table
         if t is not None and len(t):

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 
 def register(sub):
+    """Add this module's subcommand(s) to the ``rocklab`` parser ``sub``."""
     p = sub.add_parser("campaign", help="run every experiment.toml under DIR in parallel, then campaign fits")
     p.add_argument("dir", help="folder searched recursively for experiment*.toml")
     p.add_argument("--out", required=True, help="output folder")
@@ -17,6 +18,7 @@ def register(sub):
 
 
 def run(args) -> int:
+    """Run ``rocklab campaign`` with parsed ``args``; returns the exit status (0 ok)."""
     from ._campaign import run_campaign
 
     res = run_campaign(args.dir, args.out, workers=args.workers, scheduler=args.scheduler,

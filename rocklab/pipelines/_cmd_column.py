@@ -23,6 +23,7 @@ _MAX_LINES = 40
 
 
 def register(sub):
+    """Add this module's subcommand(s) to the ``rocklab`` parser ``sub``."""
     p = sub.add_parser("column", help="simulate a multi-block column (opening and impact models)",
                        description="Simulate a planar column of rigid blocks on a rigid base (SI units).")
     p.add_argument("--blocks", default=None,
@@ -82,6 +83,7 @@ def _blocks(text, density):
 
 
 def run(args) -> int:
+    """Run ``rocklab column`` with parsed ``args``; returns the exit status (0 ok)."""
     from .._errors import InputError
     from .._io import write_frame_atomic
     from ..models import Column, simulate_column

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 
 def register(sub):
+    """Add this module's subcommand(s) to the ``rocklab`` parser ``sub``."""
     p = sub.add_parser("demo", help="render a small synthetic campaign (Čeh blocks, ArUco video, x-IMU logs, "
                                     "an El Centro shake-table run) and run it end to end")
     p.add_argument("--out", default="demo_out", help="output folder (default: demo_out)")
@@ -13,6 +14,7 @@ def register(sub):
 
 
 def run(args) -> int:
+    """Run ``rocklab demo`` with parsed ``args``; returns the exit status (0 ok)."""
     from ._demo import run_demo
 
     res, t = run_demo(args.out, workers=args.workers, progress=not args.no_progress)

@@ -22,6 +22,7 @@ from .._io import dumps_json as _dumps
 
 
 def register(sub):
+    """Add this module's subcommand(s) to the ``rocklab`` parser ``sub``."""
     p = sub.add_parser("pulse", help="pulse parameters of a record (a_max, I_max, t_p)")
     p.add_argument("record")
     p.add_argument("--units", default=None, help="units of a headerless record (g, m/s2, cm/s2)")
@@ -81,6 +82,7 @@ def register(sub):
 # -- handlers -------------------------------------------------------------------------
 
 def run(args) -> int:
+    """Run ``rocklab design`` with parsed ``args``; returns the exit status (0 ok)."""
     return {"pulse": run_pulse, "oas": run_oas, "design": run_design,
             "equivalent": run_equivalent}[args.command](args)
 

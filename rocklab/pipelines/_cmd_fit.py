@@ -22,6 +22,7 @@ from .._errors import InputError, where
 
 
 def register(sub):
+    """Add this module's subcommand(s) to the ``rocklab`` parser ``sub``."""
     p = sub.add_parser("fit", help="restitution calibration: eta_e, eta_mat, inverse k, k regression",
                        description=__doc__.split("\n\n")[0])
     fs = p.add_subparsers(dest="fit_command", metavar="WHAT")
@@ -81,6 +82,7 @@ def _emit(args, payload: dict, text: str) -> None:
 
 
 def run(args) -> int:
+    """Run ``rocklab fit`` with parsed ``args``; returns the exit status (0 ok)."""
     cmd = getattr(args, "fit_command", None)
     if cmd is None:
         args._fit_parser.print_help()

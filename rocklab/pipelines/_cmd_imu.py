@@ -15,6 +15,7 @@ import sys
 
 
 def register(sub):
+    """Add this module's subcommand(s) to the ``rocklab`` parser ``sub``."""
     p = sub.add_parser("imu", help="IMU log -> block rotation / table acceleration",
                        description="Read an IMU log (x-IMU GUI export, x-IMU3 folder, Fusion CSV) "
                                    "and estimate the block rotation about the rocking axis "
@@ -38,6 +39,7 @@ def register(sub):
 
 
 def run(args) -> int:
+    """Run ``rocklab imu`` with parsed ``args``; returns the exit status (0 ok)."""
     import math
 
     from .._io import write_frame_atomic

@@ -6,6 +6,7 @@ import sys
 
 
 def register(sub):
+    """Add this module's subcommand(s) to the ``rocklab`` parser ``sub``."""
     p = sub.add_parser("run", help="run one experiment: track, IMU, sync, fit, simulate, report, Rerun")
     p.add_argument("config", help="experiment.toml")
     p.add_argument("--out", required=True, help="output folder (replaced atomically)")
@@ -18,6 +19,7 @@ def register(sub):
 
 
 def run(args) -> int:
+    """Run ``rocklab run`` with parsed ``args``; returns the exit status (0 ok)."""
     from .._io import dumps_json
     from ._experiment import run_experiment
 

@@ -17,6 +17,7 @@ from ._cli_base import add_base_motion_args, base_motion_from_args
 
 
 def register(sub):
+    """Add this module's subcommand(s) to the ``rocklab`` parser ``sub``."""
     p = sub.add_parser("simulate", help="simulate a rocking block (free rocking or base motion)",
                        description="Simulate one rigid block rocking on a rigid base (SI units).")
     p.add_argument("--width", type=float, required=True, help="block width b, m")
@@ -46,6 +47,7 @@ def register(sub):
 
 
 def run(args) -> int:
+    """Run ``rocklab simulate`` with parsed ``args``; returns the exit status (0 ok)."""
     from .._errors import InputError
     from .._io import write_frame_atomic
     from ..blocks import Block

@@ -8,6 +8,7 @@ from .._errors import InputError
 
 
 def register(sub):
+    """Add this module's subcommand(s) to the ``rocklab`` parser ``sub``."""
     p = sub.add_parser(
         "synth", help="render a synthetic lab session (video, truth, IMU logs, configs)",
         description="Simulate rocking blocks and render a lab session: video.mkv (FFV1 lossless), "
@@ -47,6 +48,7 @@ def register(sub):
 
 
 def run(args) -> int:
+    """Run ``rocklab synth`` with parsed ``args``; returns the exit status (0 ok)."""
     from ..tracking import synth_session
     from ..tracking._synth import parse_size
 

@@ -13,6 +13,7 @@ from .._errors import InputError
 
 
 def register(sub):
+    """Add this module's subcommand(s) to the ``rocklab`` parser ``sub``."""
     p = sub.add_parser("track", help="track blocks and table in a video (ArUco, dots, edges, region)",
                        description=__doc__)
     p.add_argument("video", help="video file (.mkv/.mp4/...) or image sequence 'dir/%%05d.png'")
@@ -27,6 +28,7 @@ def register(sub):
 
 
 def run(args) -> int:
+    """Run ``rocklab track`` with parsed ``args``; returns the exit status (0 ok)."""
     import math
 
     from .._io import write_frame_atomic

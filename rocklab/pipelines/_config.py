@@ -177,6 +177,7 @@ class ExperimentConfig:
         return files
 
     def to_dict(self) -> dict:
+        """Plain dict of the fields, JSON-ready (SI units in the keys)."""
         d = asdict(self)
         return _paths_to_str(d)
 
@@ -367,7 +368,7 @@ def load_experiment(path) -> ExperimentConfig:
     if "given" in laws and eta_given is None:
         r.fail("simulate.laws", "contains 'given' but [simulate] eta is not set")
     columns = tuple(r.get("column.objects", []))
-    if columns and cfg_video_missing(data):
+    if columns and _video_missing(data):
         r.fail("column.objects", "needs a [sources.video] section (the blocks are tracked on video)")
     cut = r.get("column.cut_m", 0.0, kind=float)
     if cut < 0 or cut >= (b or 1) / 2:
@@ -391,7 +392,8 @@ def load_experiment(path) -> ExperimentConfig:
     )
 
 
-def cfg_video_missing(data: dict) -> bool:
+def _video_missing(data: dict) -> bool:
+    """True when the config has no [sources.video] section."""
     return "video" not in data.get("sources", {})
 
 

@@ -302,6 +302,7 @@ class TrackConfig:
                          f"{', '.join(o.id for o in self.objects)}")
 
     def to_dict(self) -> dict:
+        """Plain dict of the fields, JSON-ready (SI units in the keys)."""
         d = {"video": _prune(asdict(self.video)), "targets": _prune(asdict(self.targets)),
              "reference": _prune(asdict(self.reference)), "motion": _prune(asdict(self.motion)),
              "objects": [_prune(asdict(o)) for o in self.objects]}

@@ -47,6 +47,7 @@ class TableMotion:
         return self.window * float(np.median(np.diff(self.t_s))) if len(self.t_s) > 1 else np.nan
 
     def to_frame(self):
+        """The result as a pandas DataFrame (SI units in the column names)."""
         import pandas as pd
 
         return pd.DataFrame({"t_s": self.t_s, "x_m": self.x_m, "vx_m_s": self.vx_m_s,
@@ -61,6 +62,7 @@ class TableMotion:
                                       name=name or f"{self.object} (video)")
 
     def to_dict(self) -> dict:
+        """Plain dict of the fields, JSON-ready (SI units in the keys)."""
         return {"object": self.object, "window": self.window, "window_s": self.window_s,
                 "polyorder": self.polyorder, "noise_m": self.noise_m,
                 "max_abs_ax_m_s2": float(np.nanmax(np.abs(self.ax_m_s2))) if np.any(

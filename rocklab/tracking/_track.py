@@ -339,6 +339,7 @@ class TrackResult:
         return uv
 
     def to_dict(self) -> dict:
+        """Plain dict of the fields, JSON-ready (SI units in the keys)."""
         per = {}
         for t in self.tracks:
             st, cnt = np.unique(t.status, return_counts=True)

@@ -40,6 +40,7 @@ class VideoInfo:
     height_px: int
 
     def to_dict(self) -> dict:
+        """Plain dict of the fields, JSON-ready (SI units in the keys)."""
         return dict(path=self.path, n_frames=self.n_frames, fps=self.fps,
                     width_px=self.width_px, height_px=self.height_px)
 

@@ -21,7 +21,7 @@ from numba import njit
 from numba.extending import register_jitable
 
 from ._column_events import impact_model, opening_model
-from ._column_kernels import base_acc, configure, kinetic_energy, make_work
+from ._column_kernels import active_dofs, base_acc, geometry, kinetic_energy, make_work, pivots
 from ._column_step import evaluate, locate_closing, nm_step, state_checks
 from ._numba_cache import drop_stale_cache
 
@@ -37,7 +37,11 @@ EV_START, EV_OPEN, EV_IMPACT = 0, 1, 2
 def _energy(phi, v, s, blk, g, y0, w):
     """Kinetic and potential energy (J); leaves the geometry in ``w``."""
     n = phi.shape[0]
-    k = configure(phi, v, s, blk, w)
+    geometry(phi, s, blk, w.theta, w.thlow, w.C, w.G)
+    k = active_dofs(s, blk, w.dj, w.dpx)
+    pivots(w.dj, w.dpx, k, w.C, w.thlow, w.PP)
+    for q in range(k):
+        w.vk[q] = v[w.dj[q]]
     ke = kinetic_energy(w.dj, k, w.PP, w.vk, w.G, blk)
     pe = 0.0
     for i in range(n):

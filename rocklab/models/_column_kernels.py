@@ -267,15 +267,3 @@ def kinetic_energy(dj, k, PP, v, G, blk):
                 w += v[q]
         e += 0.5 * blk[i, 0] * (vx * vx + vy * vy) + 0.5 * blk[i, 1] * w * w
     return e
-
-
-@register_jitable
-def configure(phi, v, s, blk, w):
-    """Load the current state into the scratch ``w``: block geometry, active joints, their
-    pivots and velocities (``w.vk``). Returns the number of active degrees of freedom."""
-    geometry(phi, s, blk, w.theta, w.thlow, w.C, w.G)
-    k = active_dofs(s, blk, w.dj, w.dpx)
-    pivots(w.dj, w.dpx, k, w.C, w.thlow, w.PP)
-    for q in range(k):
-        w.vk[q] = v[w.dj[q]]
-    return k

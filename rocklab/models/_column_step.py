@@ -19,7 +19,8 @@ from __future__ import annotations
 import numpy as np
 from numba.extending import register_jitable
 
-from ._column_kernels import base_acc, configure, quad_acc, reactions, solve_small, system
+from ._column_kernels import (active_dofs, base_acc, geometry, pivots, quad_acc, reactions, solve_small,
+                              system)
 
 __all__: list[str] = []
 
@@ -36,7 +37,11 @@ def evaluate(phi, v, s, t, blk, par, accb, acc_out, N, V, Mc, w):
     when the mass matrix is singular.
     """
     n = phi.shape[0]
-    k = configure(phi, v, s, blk, w)
+    geometry(phi, s, blk, w.theta, w.thlow, w.C, w.G)
+    k = active_dofs(s, blk, w.dj, w.dpx)
+    pivots(w.dj, w.dpx, k, w.C, w.thlow, w.PP)
+    for q in range(k):
+        w.vk[q] = v[w.dj[q]]
     aq = w.aq
     for i in range(n):
         aq[i, 0] = 0.0

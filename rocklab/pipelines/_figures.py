@@ -8,10 +8,11 @@ import numpy as np
 
 from .._io import atomic_path
 
-__all__ = ["experiment_figures", "campaign_figures"]
+__all__ = ["experiment_figures", "campaign_figures", "pyplot", "save_png"]
 
 
-def _plt():
+def pyplot():
+    """``matplotlib.pyplot`` on the non-interactive Agg backend (rocklab only writes files)."""
     import matplotlib
 
     matplotlib.use("Agg", force=True)
@@ -20,10 +21,11 @@ def _plt():
     return plt
 
 
-def _save(fig, path: Path) -> Path:
+def save_png(fig, path, dpi: int = 110, tight: bool = True):
+    """Write ``fig`` to ``path`` as a PNG atomically, close it, and return ``path``."""
     with atomic_path(path, suffix=".png") as tmp:
-        fig.savefig(tmp, dpi=110, bbox_inches="tight", format="png")
-    _plt().close(fig)
+        fig.savefig(tmp, dpi=dpi, format="png", **({"bbox_inches": "tight"} if tight else {}))
+    pyplot().close(fig)
     return path
 
 
@@ -32,7 +34,7 @@ def experiment_figures(res, out_dir) -> dict[str, Path]:
 
     ``res`` is an :class:`~rocklab.pipelines.ExperimentResult`.
     """
-    plt = _plt()
+    plt = pyplot()
     out = Path(out_dir)
     figs: dict[str, Path] = {}
     alpha = res.block.alpha_rad
@@ -51,7 +53,7 @@ def experiment_figures(res, out_dir) -> dict[str, Path]:
     ax.set_title(f"{res.name}: rotation, measured vs simulated")
     ax.legend(fontsize=8, ncol=2)
     ax.grid(alpha=0.3)
-    figs["theta"] = _save(fig, out / "theta.png")
+    figs["theta"] = save_png(fig, out / "theta.png")
 
     if res.fit is not None and len(res.per_impact_eta):
         fig, ax = plt.subplots(figsize=(6, 4))
@@ -64,7 +66,7 @@ def experiment_figures(res, out_dir) -> dict[str, Path]:
         ax.set_ylabel("η = ω⁺/ω⁻")
         ax.legend(fontsize=8)
         ax.grid(alpha=0.3)
-        figs["per_impact_eta"] = _save(fig, out / "per_impact_eta.png")
+        figs["per_impact_eta"] = save_png(fig, out / "per_impact_eta.png")
 
     if res.simulations:
         fig, ax = plt.subplots(figsize=(8, 4))
@@ -77,7 +79,7 @@ def experiment_figures(res, out_dir) -> dict[str, Path]:
         ax.set_ylabel("kinetic-energy loss per impact (-)")
         ax.legend(fontsize=8)
         ax.grid(alpha=0.3)
-        figs["energy_per_impact"] = _save(fig, out / "energy_per_impact.png")
+        figs["energy_per_impact"] = save_png(fig, out / "energy_per_impact.png")
 
     if res.video_imu_residual is not None:
         t, r = res.video_imu_residual
@@ -87,7 +89,7 @@ def experiment_figures(res, out_dir) -> dict[str, Path]:
         ax.set_ylabel("θ video − θ IMU (°)")
         ax.set_title(f"video vs IMU, RMS {np.degrees(np.sqrt(np.nanmean(np.asarray(r) ** 2))):.3f}°")
         ax.grid(alpha=0.3)
-        figs["video_vs_imu"] = _save(fig, out / "video_vs_imu.png")
+        figs["video_vs_imu"] = save_png(fig, out / "video_vs_imu.png")
 
     if res.column is not None:
         c = res.column
@@ -104,7 +106,7 @@ def experiment_figures(res, out_dir) -> dict[str, Path]:
         axs[0, 0].legend(fontsize=8)
         axs[0, 0].set_title(f"{res.name}: column, measured vs simulated (status {c['status']})")
         axs[-1, 0].set_xlabel("t (s)")
-        figs["column"] = _save(fig, out / "column.png")
+        figs["column"] = save_png(fig, out / "column.png")
 
     if res.table is not None:
         fig, axs = plt.subplots(3, 1, figsize=(10, 6), sharex=True)
@@ -117,7 +119,7 @@ def experiment_figures(res, out_dir) -> dict[str, Path]:
             ax.grid(alpha=0.3)
         axs[-1].set_xlabel("t (s)")
         axs[0].set_title("table motion")
-        figs["table"] = _save(fig, out / "table.png")
+        figs["table"] = save_png(fig, out / "table.png")
     return figs
 
 
@@ -129,7 +131,7 @@ def campaign_figures(table, out_dir, regression=None) -> dict[str, Path]:
     """
     from ..blocks import Block
 
-    plt = _plt()
+    plt = pyplot()
     out = Path(out_dir)
     figs: dict[str, Path] = {}
     if table is None or not len(table):
@@ -161,7 +163,7 @@ def campaign_figures(table, out_dir, regression=None) -> dict[str, Path]:
     ax.set_title("restitution vs slenderness (dotted: η_H)")
     ax.legend(fontsize=7)
     ax.grid(alpha=0.3)
-    figs["eta_vs_hb"] = _save(fig, out / "eta_vs_hb.png")
+    figs["eta_vs_hb"] = save_png(fig, out / "eta_vs_hb.png")
 
     if regression is not None and hasattr(regression, "predict"):
         try:
@@ -175,7 +177,7 @@ def campaign_figures(table, out_dir, regression=None) -> dict[str, Path]:
             ax.set_xlabel("h/b (-)")
             ax.set_ylabel("b (cm)")
             ax.set_title("k(h/b, b) regression (Čeh Eq. 19 form)")
-            figs["k_surface"] = _save(fig, out / "k_surface.png")
+            figs["k_surface"] = save_png(fig, out / "k_surface.png")
         except Exception:  # noqa: BLE001 - the surface is optional decoration
             pass
     return figs

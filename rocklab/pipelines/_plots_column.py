@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from ._figures import pyplot, save_png
+
 __all__ = ["plot_column_maps", "plot_column_response"]
 
 
@@ -14,13 +16,9 @@ def plot_column_maps(maps, path=None, title: str | None = None):
     path : str or Path, optional
         Write a PNG here (atomically); the figure is returned either way.
     """
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
     import numpy as np
 
-    from .._io import atomic_path
+    plt = pyplot()
 
     k = len(maps.n_blocks)
     fig, axes = plt.subplots(1, k, figsize=(3.6 * k, 3.4), sharey=True, squeeze=False)
@@ -37,20 +35,15 @@ def plot_column_maps(maps, path=None, title: str | None = None):
                  f"({maps.params.get('n_impacts', 1)} impact(s) per closing)", fontsize=10)
     fig.tight_layout()
     if path is not None:
-        with atomic_path(path, suffix=".png") as tmp:
-            fig.savefig(tmp, dpi=120, format="png")
-    plt.close(fig)
+        save_png(fig, path, dpi=120, tight=False)
+    else:
+        plt.close(fig)
     return fig
 
 
 def plot_column_response(result, path=None):
     """Block angles and joint states of a :class:`rocklab.models.ColumnResult` against time."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    from .._io import atomic_path
+    plt = pyplot()
 
     fig, (a1, a2) = plt.subplots(2, 1, figsize=(8, 5), sharex=True, gridspec_kw={"height_ratios": [3, 1]})
     for i in range(result.column.n):
@@ -66,7 +59,7 @@ def plot_column_response(result, path=None):
     a2.set_xlabel("t [s]")
     fig.tight_layout()
     if path is not None:
-        with atomic_path(path, suffix=".png") as tmp:
-            fig.savefig(tmp, dpi=120, format="png")
-    plt.close(fig)
+        save_png(fig, path, dpi=120, tight=False)
+    else:
+        plt.close(fig)
     return fig

@@ -12,25 +12,14 @@ from __future__ import annotations
 
 import numpy as np
 
+from ._figures import pyplot, save_png
+
 __all__ = ["plot_oas", "plot_overturning_curve", "plot_wall_error_maps", "plot_frame_error_maps"]
 
 
 def _fig(ncols, w=4.2, h=3.6):
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+    plt = pyplot()
     return plt, *plt.subplots(1, ncols, figsize=(w * ncols, h), constrained_layout=True)
-
-
-def _save(plt, fig, path):
-    from .._io import atomic_path
-
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, dpi=120, format="png")
-    plt.close(fig)
-    return path
 
 
 def plot_oas(o, path):
@@ -65,7 +54,7 @@ def plot_oas(o, path):
               title="over 1/p")
     ax[2].legend(fontsize=7)
     ax[0].legend(fontsize=7)
-    return _save(plt, fig, path)
+    return save_png(fig, path, dpi=120, tight=False)
 
 
 def plot_overturning_curve(c, path):
@@ -79,7 +68,7 @@ def plot_overturning_curve(c, path):
     ax[1].axhline(c.i_cr, ls="--", color="C3", label=f"i_cr = {c.i_cr:.4f}")
     ax[1].set(xlabel="p t_p", ylabel="p I / a_p,min", title="overturning impulse curve")
     ax[1].legend(fontsize=7)
-    return _save(plt, fig, path)
+    return save_png(fig, path, dpi=120, tight=False)
 
 
 def _error_maps(mechs, ys, ylabel, path, ratios, accs, title):
@@ -98,7 +87,7 @@ def _error_maps(mechs, ys, ylabel, path, ratios, accs, title):
     ax[0].set_title(f"{title}: T_r,blockeq / T_r")
     ax[1].set_title("t_over,blockeq / t_over")
     ax[2].set_title("t_over,blockeq / t_over")
-    _save(plt, fig, path)
+    save_png(fig, path, dpi=120, tight=False)
     return dict(y=np.asarray(ys), ratios=np.asarray(ratios), accs=np.asarray(accs), period_ratio=T,
                 t_ratio_kappa1=t1, t_ratio_kappa2=t2)
 

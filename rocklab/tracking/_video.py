@@ -119,20 +119,7 @@ def iter_video_frames(path, start: int = 0, stop: int | None = None, prefetch: i
     if start:
         cap.set(cv2.CAP_PROP_POS_FRAMES, start)
 
-    def produce(put):
-        i = start
-        try:
-            while stop is None or i < stop:
-                ok, img = cap.read()
-                if not ok or img is None:
-                    break
-                if not put((i, _to_gray(img))):
-                    return
-                i += 1
-        finally:
-            cap.release()
-
-    if prefetch <= 0:
+    def read():
         i = start
         try:
             while stop is None or i < stop:
@@ -143,7 +130,19 @@ def iter_video_frames(path, start: int = 0, stop: int | None = None, prefetch: i
                 i += 1
         finally:
             cap.release()
+
+    if prefetch <= 0:
+        yield from read()
         return
+
+    def produce(put):
+        frames = read()
+        try:
+            for item in frames:
+                if not put(item):
+                    return
+        finally:
+            frames.close()  # releases the capture when the consumer stopped early
 
     q: queue.Queue = queue.Queue(maxsize=prefetch)
     stop_flag = threading.Event()

@@ -70,3 +70,24 @@ def test_table_from_imu_is_synced_to_the_video(tmp_path):
     m = np.isfinite(a)
     # same sense as the video's x; the 5 mg sensor noise gives 5.4 % RMS (measured)
     assert np.sqrt(np.mean((a[m] - a_true[m]) ** 2)) < 0.08 * np.sqrt(np.mean(a_true[m] ** 2))
+
+
+def test_streaming_without_rrd_file_still_logs_the_video(sine_session, tmp_path):
+    """``rrd = false`` with --spawn/--connect: the frames are kept while tracking and logged."""
+    from rocklab.pipelines._config import load_experiment
+    from rocklab.pipelines._experiment import analyse_experiment
+    from rocklab.pipelines._log_experiment import log_experiment
+    from rocklab.pipelines._rerun import read_rrd_summary
+
+    text = (sine_session / "experiment.toml").read_text()
+    assert text.count("video_decimation = 10\n") == 1
+    cfg_path = sine_session / "experiment_stream.toml"
+    cfg_path.write_text(text.replace("video_decimation = 10\n", "video_decimation = 10\nrrd = false\n"))
+    cfg = load_experiment(cfg_path)
+    assert cfg.rrd is False
+    n_frames = json.loads((sine_session / "session.json").read_text())["n_frames"]
+    res = analyse_experiment(cfg, keep_video=True)  # what run_experiment passes for --spawn/--connect
+    rows = log_experiment(res, tmp_path / "stream.rrd")
+    assert rows["experiment/video"] == -(-n_frames // 10)
+    assert read_rrd_summary(tmp_path / "stream.rrd")["/experiment/video"] == -(-n_frames // 10)
+    assert analyse_experiment(cfg).video_jpeg is None  # no Rerun output: nothing kept

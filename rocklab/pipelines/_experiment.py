@@ -187,7 +187,7 @@ def _measure_video(cfg: ExperimentConfig, progress: bool, keep_jpeg: bool):
         tm = tr.table_motion(cfg.table.object)
         table = {"t_s": np.asarray(tm.t_s), "disp_m": np.asarray(tm.x_m),
                  "vel_m_s": np.asarray(tm.vx_m_s), "acc_m_s2": np.asarray(tm.ax_m_s2)}
-    return (sel["t_s"].to_numpy(float), sel["theta_rad"].to_numpy(float)), table, tr, jpeg
+    return (sel["t_s"].to_numpy(float), sel["theta_rad"].to_numpy(float)), table, tr, (jpeg if keep_jpeg else None)
 
 
 def _measure_imu(cfg: ExperimentConfig):
@@ -233,8 +233,13 @@ def _sync(ref, rot, max_offset_s):
     return sync_imu_to_track(rot, ref[0], ref[1], max_offset_s=max_offset_s)
 
 
-def analyse_experiment(cfg: ExperimentConfig, progress: bool = False) -> ExperimentResult:
-    """Run every stage of one experiment in memory (no files written)."""
+def analyse_experiment(cfg: ExperimentConfig, progress: bool = False,
+                       keep_video: bool | None = None) -> ExperimentResult:
+    """Run every stage of one experiment in memory (no files written).
+
+    ``keep_video``: JPEG-encode the frames Rerun will show while they are decoded for
+    tracking (default: when the config writes ``session.rrd``).
+    """
     msgs: list[str] = []
     timings: dict[str, float] = {}
     measured: dict = {}
@@ -243,7 +248,8 @@ def analyse_experiment(cfg: ExperimentConfig, progress: bool = False) -> Experim
     jpeg = None
     t0 = time.perf_counter()
     if cfg.video is not None:
-        measured["video"], table, tr, jpeg = _measure_video(cfg, progress, keep_jpeg=cfg.rrd)
+        keep = cfg.rrd if keep_video is None else keep_video
+        measured["video"], table, tr, jpeg = _measure_video(cfg, progress, keep_jpeg=keep)
         timings["track_s"] = time.perf_counter() - t0
     if cfg.track is not None:
         measured["track"] = _read_track_csv(cfg.track.path, cfg.track.object)
@@ -433,7 +439,7 @@ def run_experiment(config_path, out_dir, *, force: bool = False, spawn: bool = F
             old = {}
         if old.get("fingerprint") == fp:
             return old, False
-    res = analyse_experiment(cfg, progress=progress)
+    res = analyse_experiment(cfg, progress=progress, keep_video=cfg.rrd or spawn or bool(connect))
     out_dir.parent.mkdir(parents=True, exist_ok=True)
     stage = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.tmp-", dir=out_dir.parent))
     try:

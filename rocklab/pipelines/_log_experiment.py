@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-from pathlib import Path
 
 import numpy as np
 
@@ -11,25 +10,6 @@ from ._rerun import experiment_blueprint, log_events, log_series, log_video_fram
 __all__ = ["log_experiment"]
 
 ROOT = "experiment"
-
-
-def _video_frames(path: Path, fps: float | None):
-    import cv2
-
-    cap = cv2.VideoCapture(str(path))
-    if not cap.isOpened():
-        return
-    f = fps or cap.get(cv2.CAP_PROP_FPS) or 0.0
-    i = 0
-    try:
-        while True:
-            ok, img = cap.read()
-            if not ok:
-                break
-            yield i, (i / f if f else float(i)), img
-            i += 1
-    finally:
-        cap.release()
 
 
 def _overlay_fn(res):
@@ -140,11 +120,9 @@ def log_experiment(res, rrd_path=None, *, spawn: bool = False, connect: str | No
             from tqdm import tqdm
 
             bar = tqdm(desc="rerun: video frames", unit="frame", leave=False)
-        if res.video_jpeg is not None and res.frames is not None:  # encoded during tracking
-            fps = res.frames.fps
-            frames = ((i, i / fps, data) for i, data in res.video_jpeg)
-        else:
-            frames = _video_frames(res.config.video.path, res.config.video.fps)
+        # frames were JPEG-encoded while the tracker decoded them (analyse_experiment(keep_video=...))
+        fps = res.frames.fps
+        frames = ((i, i / fps, data) for i, data in (res.video_jpeg or ()))
         rows[f"{ROOT}/video"] = log_video_frames(
             rec, f"{ROOT}/video", frames,
             decimation=res.config.video_decimation, overlays=_overlay_fn(res), progress=bar)

@@ -124,8 +124,7 @@ def log_experiment(res, rrd_path=None, *, spawn: bool = False, connect: str | No
         fps = res.frames.fps
         frames = ((i, i / fps, data) for i, data in (res.video_jpeg or ()))
         rows[f"{ROOT}/video"] = log_video_frames(
-            rec, f"{ROOT}/video", frames,
-            decimation=res.config.video_decimation, overlays=_overlay_fn(res), progress=bar)
+            rec, f"{ROOT}/video", frames, overlays=_overlay_fn(res), progress=bar)
         if bar is not None:
             bar.close()
     rec.send_blueprint(experiment_blueprint(block_paths, has_video=has_video))

@@ -94,34 +94,21 @@ def log_events(rec, path: str, t_s, texts, values=None) -> None:
     rec.reset_time()
 
 
-def log_video_frames(rec, path: str, frames, *, decimation: int = 1, quality: int = 80,
-                     overlays=None, progress=None) -> int:
-    """Log video frames as encoded JPEG images on the ``time`` timeline.
+def log_video_frames(rec, path: str, frames, *, overlays=None, progress=None) -> int:
+    """Log video frames (JPEG-encoded) on the ``time`` and ``frame`` timelines.
 
     Parameters
     ----------
-    frames : iterable of (frame_index, t_s, image)
-        ``image`` is a uint8 array (H, W) or (H, W, 3) BGR, or JPEG bytes already encoded.
-    decimation : int
-        Log every n-th frame.
+    frames : iterable of (frame_index, t_s, jpeg_bytes)
+        The frames to show (already decimated: see ``output.video_decimation``).
     overlays : callable(frame_index) -> dict, optional
         Returns {"points": (k, 2) px, "outlines": list of (m, 2) px polylines, "label": str}.
     Returns the number of frames logged.
     """
-    import cv2
     import rerun as rr
 
     n = 0
-    for idx, t, img in frames:
-        if idx % decimation:
-            continue
-        if isinstance(img, bytes):
-            data = img
-        else:
-            ok, buf = cv2.imencode(".jpg", img, [cv2.IMWRITE_JPEG_QUALITY, quality])
-            if not ok:  # pragma: no cover - OpenCV cannot fail on a valid uint8 image
-                continue
-            data = buf.tobytes()
+    for idx, t, data in frames:
         rec.set_time(TIMELINE, duration=float(t))
         rec.set_time("frame", sequence=int(idx))
         rec.log(path, rr.EncodedImage(contents=data, media_type="image/jpeg"))

@@ -466,9 +466,11 @@ def track_video(path, config: TrackConfig, fps: float | None = None, progress: b
         Overrides ``config.video.fps`` and the container's rate.
     progress : bool
         tqdm progress bar on stderr.
-    on_frame : callable(index, gray), optional
-        Called with every decoded frame (uint8, (H, W)) before it is tracked, so a
-        caller can use the frames (e.g. log them) without decoding the video twice.
+    on_frame : callable(index, gray, image), optional
+        Called with every decoded frame before it is tracked, so a caller can use the
+        frames (e.g. log them) without decoding the video twice: ``gray`` uint8 (H, W)
+        as tracked, ``image`` the decoded picture, uint8 (H, W, 3) BGR (see
+        :func:`~rocklab.tracking.iter_video_frames` with ``color=True``).
 
     Raises
     ------
@@ -492,7 +494,7 @@ def track_video(path, config: TrackConfig, fps: float | None = None, progress: b
         raise InputError(f"{path}: frame {ref_frame} is past the end of the video "
                          f"({info.n_frames} frames); check start_frame / reference.board.frame")
     pm = make_plane_map(config, info.width_px, info.height_px, first)
-    frames = iter_video_frames(path, start, stop)
+    frames = iter_video_frames(path, start, stop, color=on_frame is not None)
     if on_frame is not None:
         frames = _tee(frames, on_frame)
     if progress:
@@ -506,6 +508,6 @@ def track_video(path, config: TrackConfig, fps: float | None = None, progress: b
 
 
 def _tee(frames, fn):
-    for i, g in frames:
-        fn(i, g)
+    for i, g, img in frames:
+        fn(i, g, img)
         yield i, g

@@ -1,4 +1,5 @@
-"""Video input: probe a file and stream grey frames (OpenCV ``VideoCapture``).
+"""Video input: probe a file and stream grey frames (OpenCV ``VideoCapture``), optionally
+with the decoded colour picture alongside.
 
 Decoding runs in a background thread (OpenCV releases the GIL) so it overlaps
 with detection on a second core.
@@ -96,8 +97,10 @@ def _to_gray(img):
     return cv2.cvtColor(img, cv2.COLOR_BGR2GRAY)
 
 
-def iter_video_frames(path, start: int = 0, stop: int | None = None, prefetch: int = 8):
-    """Yield ``(index, gray)`` for frames ``start <= index < stop``.
+def iter_video_frames(path, start: int = 0, stop: int | None = None, prefetch: int = 8,
+                      color: bool = False):
+    """Yield ``(index, gray)`` (``(index, gray, image)`` with ``color``) for frames
+    ``start <= index < stop``.
 
     Parameters
     ----------
@@ -107,11 +110,17 @@ def iter_video_frames(path, start: int = 0, stop: int | None = None, prefetch: i
         Half-open frame range.
     prefetch : int
         Frames decoded ahead in a background thread (0: decode inline).
+    color : bool
+        Also yield the decoded picture, so a caller can show the frames in colour
+        without decoding the video a second time.
 
     Yields
     ------
     index : int
     gray : ndarray, shape (height, width), uint8
+    image : ndarray, shape (height, width, 3), uint8, BGR
+        Only with ``color``: the frame as decoded (a grey source decodes to three equal
+        channels; ``gray`` itself when the reader returns one channel).
     """
     import cv2
 
@@ -126,7 +135,7 @@ def iter_video_frames(path, start: int = 0, stop: int | None = None, prefetch: i
                 ok, img = cap.read()
                 if not ok or img is None:
                     return
-                yield i, _to_gray(img)
+                yield (i, _to_gray(img), img) if color else (i, _to_gray(img))
                 i += 1
         finally:
             cap.release()

@@ -1,0 +1,116 @@
+"""Rerun video in colour: the frames kept while tracking (``track_video(on_frame=...)``) are
+JPEG-encoded from the decoded colour picture, with the right channel order, and stay one
+channel for a grey source; the overlays (tracked pixels) still land on the picture."""
+
+import cv2
+import numpy as np
+import pytest
+
+W, H, N = 320, 200, 6                     # non-square, so a transposed frame would show
+BLUE, RED = (200, 60, 30), (30, 40, 220)  # BGR
+MARKER = (180, 60, 64)                    # ArUco id 1: left, top, side (px)
+
+
+def _frame(i):
+    img = np.empty((H, W, 3), np.uint8)
+    img[:] = BLUE
+    x0 = 20 + 4 * i  # the square moves: a frame kept under the wrong index would show
+    img[20:80, x0:x0 + 60] = RED
+    u, v, s = MARKER
+    q = s // 8
+    img[v - q:v + s + q, u - q:u + s + q] = 255
+    m = cv2.aruco.generateImageMarker(cv2.aruco.getPredefinedDictionary(cv2.aruco.DICT_4X4_50), 1, s)
+    img[v:v + s, u:u + s] = m[..., None]
+    return img
+
+
+@pytest.fixture(scope="module")
+def videos(tmp_path_factory):
+    d = tmp_path_factory.mktemp("colour")
+    out = {}
+    for kind in ("colour", "grey"):
+        p = d / f"{kind}.mkv"
+        vw = cv2.VideoWriter(str(p), cv2.VideoWriter_fourcc(*"FFV1"), 50.0, (W, H), kind == "colour")
+        assert vw.isOpened()
+        for i in range(N):
+            f = _frame(i)
+            vw.write(f if kind == "colour" else cv2.cvtColor(f, cv2.COLOR_BGR2GRAY))
+        vw.release()
+        out[kind] = p
+    return out
+
+
+def _track(path, decimation=2):
+    from rocklab.pipelines._experiment import _frame_keeper
+    from rocklab.tracking import TrackConfig, track_video
+
+    cfg = TrackConfig.from_dict({"targets": {"style": "aruco", "marker_size_m": 0.05},
+                                 "objects": [{"id": "block_1", "markers": [1]}]})
+    jpeg, keep = _frame_keeper(decimation)
+    tr = track_video(path, cfg, fps=50.0, on_frame=keep)
+    return tr, jpeg
+
+
+def _decode(data):
+    return cv2.imdecode(np.frombuffer(data, np.uint8), cv2.IMREAD_UNCHANGED)
+
+
+def test_colour_source_gives_colour_jpeg_through_rrd(videos, tmp_path):
+    from rocklab.pipelines._rerun import log_video_frames, open_recording
+    import rerun.chunk as rc
+
+    tr, jpeg = _track(videos["colour"])
+    assert [i for i, _ in jpeg] == [0, 2, 4]
+    # end to end: the bytes Rerun stores are the JPEG we made (EncodedImage keeps the file as is;
+    # a JPEG is YCbCr, decoded to RGB by the viewer, so BGR vs RGB cannot get swapped there)
+    rrd = tmp_path / "v.rrd"
+    rec = open_recording("test_colour", rrd)
+    log_video_frames(rec, "experiment/video", ((i, i / 50.0, b) for i, b in jpeg))
+    rec.flush()
+    rec.disconnect()
+    stored = []
+    for ch in rc.RrdReader(str(rrd)).stream().collect().stream():
+        if str(ch.entity_path) == "/experiment/video":
+            rb = ch.to_record_batch()
+            stored += [bytes(x[0]) for x in rb.column(rb.schema.names.index("EncodedImage:blob")).to_pylist()]
+    assert stored == [b for _, b in jpeg]
+    for i, data in jpeg:
+        bgr = _decode(data)
+        assert bgr.shape == (H, W, 3)  # overlays are pixels of this frame size
+        x0 = 20 + 4 * i
+        b, g, r = bgr[25:75, x0 + 5:x0 + 55].reshape(-1, 3).mean(axis=0)
+        assert r > 150 and b < 80 and g < 80, (i, b, g, r)  # red square, truth (30, 40, 220) BGR
+        b, g, r = bgr[120:190, 20:150].reshape(-1, 3).mean(axis=0)
+        assert b > 150 and r < 80, (i, b, g, r)  # blue background, truth (200, 60, 30)
+        # the square is where frame i has it, not where another frame has it
+        assert bgr[50, x0 + 2, 2] > 150 and bgr[50, x0 - 3, 0] > 150
+    # overlays: the tracked marker centre maps back to where it was drawn, and there the
+    # colour picture shows the (black/white, achromatic) marker, not the blue background
+    u, v, s = MARKER
+    for i, data in jpeg:
+        px = tr.to_pixels("block_1", i, [[0.0, 0.0]])[0]
+        assert px == pytest.approx([u + s / 2 - 0.5, v + s / 2 - 0.5], abs=0.5)
+        patch = _decode(data)[v + 4:v + s - 4, u + 4:u + s - 4].astype(float)
+        assert np.abs(patch[..., 0] - patch[..., 2]).mean() < 25  # background: |B - R| = 170
+
+
+def test_grey_source_stays_one_channel(videos):
+    tr, jpeg = _track(videos["grey"], decimation=3)
+    assert [i for i, _ in jpeg] == [0, 3]
+    assert tr.n_frames == N and (tr["block_1"].status == "ok").all()  # tracked as before
+    for i, data in jpeg:
+        img = _decode(data)
+        assert img.shape == (H, W)  # one channel: a grey video is not blown up to three
+        truth = cv2.cvtColor(_frame(i), cv2.COLOR_BGR2GRAY)
+        x0 = 20 + 4 * i
+        assert abs(img[25:75, x0 + 5:x0 + 55].mean() - truth[25:75, x0 + 5:x0 + 55].mean()) < 3
+
+
+def test_is_grey_detects_colour_hidden_from_the_sample():
+    from rocklab.pipelines._experiment import _is_grey
+
+    g = np.random.default_rng(1).integers(0, 256, (H, W), dtype=np.uint8)
+    img = cv2.merge([g, g, g])
+    assert _is_grey(cv2.cvtColor(img, cv2.COLOR_BGR2GRAY), img) and _is_grey(g, g)
+    img[5, 7, 2] ^= 1  # one unit of red, off the 16-px sample grid
+    assert not _is_grey(cv2.cvtColor(img, cv2.COLOR_BGR2GRAY), img)

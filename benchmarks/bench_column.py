@@ -4,7 +4,13 @@ Prints, in one process:
 
 1. wall time of 3-block columns through the first 20 s of the bundled El Centro
    record (dt = 1e-4 s, compiled loop, after a warm-up call that loads/compiles it);
-2. the ratio against the baseline: the SAME stepper run as plain Python (the
+2. the same runs storing every 10th step (``output_dt_s=1e-3``) and no history
+   (``output_dt_s=inf``): time, stored bytes, and a check that the events and
+   peaks are those of the full run;
+3. the thesis Fig. 40 overturning maps (3 columns x 10 x 10 pulses, as
+   ``rocklab column --maps-png``), which store no history, against the same maps
+   storing every step;
+4. the ratio against the baseline: the SAME stepper run as plain Python (the
    kernels are ``register_jitable`` functions, ``jit=False`` calls them
    uncompiled) on an identical short workload, and a check that both give the
    same response.
@@ -14,12 +20,13 @@ Run: ``.venv/bin/python benchmarks/bench_column.py`` (part of ``make bench``).
 
 from __future__ import annotations
 
+import math
 import time
 
 import numpy as np
 
 from rocklab.blocks import Block
-from rocklab.models import BaseMotion, Column, bundled_record, simulate_column
+from rocklab.models import BaseMotion, Column, bundled_record, column_overturning_maps, simulate_column
 
 
 def _timed(fn, repeat=1):
@@ -30,6 +37,11 @@ def _timed(fn, repeat=1):
         out = fn()
         best = min(best, time.perf_counter() - t0)
     return best, out
+
+
+def _stored_mb(r):
+    return sum(getattr(r, a).nbytes for a in ("t_s", "phi_rad", "omega_rad_s", "theta_rad", "energy_J",
+                                               "kinetic_J")) / 1e6
 
 
 def main() -> int:
@@ -54,6 +66,23 @@ def main() -> int:
               f"{len(r.configurations)} configuration changes, status {r.status}; "
               f"target <= 2 s: {'OK' if t <= 2.0 else 'MISSED'}")
         ok &= t <= 2.0
+        for odt in (1e-3, math.inf):
+            t_d, r_d = _timed(lambda: simulate_column(col, base, duration_s=20.0, dt_s=1e-4, stop_at_rest=False,
+                                                      output_dt_s=odt), 3)
+            same = (r_d.configurations.equals(r.configurations) and r_d.impacts.equals(r.impacts)
+                    and np.array_equal(r_d.max_abs_theta_rad, r.max_abs_theta_rad))
+            print(f"  output_dt_s={odt:g}: {t_d:.3f} s ({t / t_d:.2f}x), {len(r_d.t_s)} rows, "
+                  f"{_stored_mb(r_d):.2f} MB stored vs {_stored_mb(r):.2f} MB; same events and peaks: {same}")
+            ok &= same
+
+    k = 10
+    grid = dict(ap_m_s2=np.linspace(1.0, 12.0, k), tp_s=np.linspace(0.3, 2.4, k))
+    t_lean, m_lean = _timed(lambda: column_overturning_maps(**grid))
+    t_full, m_full = _timed(lambda: column_overturning_maps(**grid, output_dt_s=None))
+    same = np.array_equal(m_lean.max_theta_over_alpha, m_full.max_theta_over_alpha)
+    print(f"overturning maps 3 x {k} x {k}: {t_lean:.2f} s without history vs {t_full:.2f} s storing every "
+          f"step ({t_full / t_lean:.2f}x); identical maps: {same}")
+    ok &= same
 
     # same stepper, plain Python vs compiled, identical workload (free rocking, many events)
     kw = dict(theta0_rad=[0.0, 0.0, 0.08], duration_s=0.3, dt_s=1e-4)
@@ -63,7 +92,7 @@ def main() -> int:
     print(f"baseline (same stepper, plain Python) {t_py:.2f} s vs numba {t_nb * 1e3:.2f} ms for "
           f"{len(r_nb.t_s) - 1} steps with {len(r_nb.impacts)} impacts: ratio {t_py / t_nb:.0f}x; "
           f"identical response: {same}")
-    return 0 if same else 1
+    return 0 if (same and ok) else 1
 
 
 if __name__ == "__main__":

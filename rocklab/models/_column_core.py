@@ -96,15 +96,19 @@ def _apply_opening(t, s, px, s_new, px_new, EVT, EVI, ne):
 
 @register_jitable
 def run_core(phi0, v0, s0, blk, par, accb, n_steps, dt, max_enum, n_imp, v_tol, stop_at_rest, ovt_angle,
-             PHI, VEL, EN, EVT, EVI, IMP):
+             stride, PHI, VEL, EN, EVT, EVI, IMP, PEAK):
     """Integrate ``n_steps`` steps of ``dt`` (s) from t = 0.
 
     The grid ``t_k = k dt`` is kept: an event inside a step is followed by the
-    rest of that step (as in the single-block kernel). Records the state at every
-    grid time in ``PHI, VEL, EN (ke, pe)``; configuration changes in
-    ``EVT (t) / EVI (joint, new state, kind)``; impacts in ``IMP`` rows
-    ``(t, joint, v_before, ke_before, ke_after, state after)``.
-    Returns ``(n_rec, n_ev, n_imp_rec, status, t_status)``.
+    rest of that step (as in the single-block kernel). Records the state at
+    t = 0, at every ``stride``-th step and at the last completed step (when off
+    that grid) in ``PHI, VEL, EN (ke, pe)`` (``n_steps // stride + 2`` rows
+    suffice); configuration changes in ``EVT (t) / EVI (joint, new state,
+    kind)``; impacts in ``IMP`` rows ``(t, joint, v_before, ke_before,
+    ke_after, state after)``; the peaks ``PEAK[0] = max |theta|`` per block and
+    ``PEAK[1] = max |phi|`` per joint (rad) over EVERY completed step.
+    Returns ``(n_rec, n_ev, n_imp_rec, status, t_status, k_last)`` with
+    ``k_last`` the step index of the last recorded row.
     """
     n = phi0.shape[0]
     g = par[0]
@@ -160,7 +164,7 @@ def run_core(phi0, v0, s0, blk, par, accb, n_steps, dt, max_enum, n_imp, v_tol, 
             EVI[ne, 2] = EV_START
             ne += 1
     if not evaluate(phi, v, s, 0.0, blk, par, accb, acc, N, V, Mc, w):
-        return nr, ne, ni, ST_NUMERIC, 0.0
+        return nr, ne, ni, ST_NUMERIC, 0.0, 0
     code = state_checks(s, phi, v, blk, par, N, V, Mc, viol0)
     for j in range(n):
         if viol0[j] > 0.0 and code == 0:
@@ -175,9 +179,18 @@ def run_core(phi0, v0, s0, blk, par, accb, n_steps, dt, max_enum, n_imp, v_tol, 
     EN[0, 0] = ke
     EN[0, 1] = pe
     nr = 1
+    for i in range(n):
+        PEAK[0, i] = abs(w.theta[i])
+        PEAK[1, i] = abs(phi[i])
     if code != 0:
-        return nr, ne, ni, ST_TENSION if code == 1 else ST_SLIDING, 0.0
+        return nr, ne, ni, ST_TENSION if code == 1 else ST_SLIDING, 0.0, 0
     step = 0
+    # the state of a step off the output grid waits in row nr (with its joint
+    # states in s_pend) until the next one: the last completed step is always kept
+    pending = False
+    k_pend = 0
+    s_pend = s.copy()
+    countdown = stride  # no integer modulo in the loop
     while step < n_steps:
         t1 = (step + 1) * dt
         tc = step * dt
@@ -321,13 +334,35 @@ def run_core(phi0, v0, s0, blk, par, accb, n_steps, dt, max_enum, n_imp, v_tol, 
         if status != ST_END:
             t_status = tc
             break
-        ke, pe = _energy(phi, v, s, blk, g, y0, w)
         PHI[nr, :] = phi
         VEL[nr, :] = v
-        EN[nr, 0] = ke
-        EN[nr, 1] = pe
-        nr += 1
-        if _overturned(v, s, blk, ovt_angle, w):
+        any_open = ovt_angle > 0.0
+        th = 0.0
+        for i in range(n):
+            # block angle summed as in geometry(): the peaks equal those of the full history
+            th += phi[i]
+            if abs(th) > PEAK[0, i]:
+                PEAK[0, i] = abs(th)
+            if abs(phi[i]) > PEAK[1, i]:
+                PEAK[1, i] = abs(phi[i])
+            if s[i] != 0:
+                any_open = True
+        countdown -= 1
+        if countdown == 0:
+            countdown = stride
+            ke, pe = _energy(phi, v, s, blk, g, y0, w)
+            EN[nr, 0] = ke
+            EN[nr, 1] = pe
+            nr += 1
+            pending = False
+        else:
+            # off the output grid: no energy, and the geometry only if the overturning check reads it
+            if any_open:
+                geometry(phi, s, blk, w.theta, w.thlow, w.C, w.G)
+            s_pend[:] = s
+            k_pend = step
+            pending = True
+        if any_open and _overturned(v, s, blk, ovt_angle, w):
             status = ST_OVERTURN
             t_status = t1
             break
@@ -340,7 +375,14 @@ def run_core(phi0, v0, s0, blk, par, accb, n_steps, dt, max_enum, n_imp, v_tol, 
                 status = ST_REST
                 t_status = t1
                 break
-    return nr, ne, ni, status, t_status
+    k_last = (nr - 1) * stride
+    if pending:
+        ke, pe = _energy(PHI[nr], VEL[nr], s_pend, blk, g, y0, w)
+        EN[nr, 0] = ke
+        EN[nr, 1] = pe
+        nr += 1
+        k_last = k_pend
+    return nr, ne, ni, status, t_status, k_last
 
 
 # run_core inlines the kernels of these modules (see _numba_cache)

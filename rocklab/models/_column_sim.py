@@ -130,7 +130,9 @@ class ColumnResult:
     ----------
     column : Column
     t_s : ndarray (m,)
-        Uniform output times ``k * dt_s``, s (events fall between them).
+        Output times, s: ``k * output_dt_s`` (``output_dt_s = dt_s`` by
+        default: every step) and, when the run ends off that grid, the last
+        completed step ``k_end * dt_s``. Events fall between them.
     phi_rad, omega_rad_s : ndarray (m, n)
         Joint rotations (block j relative to block j-1, clockwise positive), rad,
         and their rates, rad/s.
@@ -156,6 +158,11 @@ class ColumnResult:
     message : str
     params : dict
         Solver settings used.
+    max_abs_theta_rad : ndarray (n,)
+        Peak |θ| per block over EVERY completed integration step (not only the
+        stored samples), rad.
+    max_abs_phi_rad : ndarray (n,)
+        Peak |φ| per joint over every completed step, rad.
     """
 
     column: Column
@@ -171,6 +178,16 @@ class ColumnResult:
     t_status_s: float
     message: str = ""
     params: dict = field(default_factory=dict)
+    max_abs_theta_rad: np.ndarray = None
+    max_abs_phi_rad: np.ndarray = None
+
+    def __post_init__(self):
+        # results built by hand (no kernel peaks): the peaks of the stored samples
+        for name, x in (("max_abs_theta_rad", self.theta_rad), ("max_abs_phi_rad", self.phi_rad)):
+            if getattr(self, name) is None:
+                x = np.asarray(x)
+                peak = np.max(np.abs(x), axis=0) if len(x) else np.full(x.shape[1:], np.nan)
+                object.__setattr__(self, name, peak)
 
     @property
     def overturned(self) -> bool:
@@ -181,15 +198,11 @@ class ColumnResult:
         """Absolute block angular velocities (clockwise positive), rad/s, shape (m, n)."""
         return np.cumsum(self.omega_rad_s, axis=1)
 
-    @property
-    def max_abs_theta_rad(self) -> np.ndarray:
-        """Peak |θ| per block, rad, shape (n,)."""
-        return np.max(np.abs(self.theta_rad), axis=0)
-
     def joint_sequence(self, threshold_rad: float = 0.005, min_duration_s: float = 0.0) -> list:
         """Opening/closing sequence read from the block angles, as for measured data.
 
-        See :func:`rocklab.models.joint_sequence`; the exact model events are in
+        See :func:`rocklab.models.joint_sequence`; read from the stored samples
+        (so at the ``output_dt_s`` resolution); the exact model events are in
         :attr:`configurations`.
         """
         from ._column_compare import joint_sequence
@@ -267,11 +280,27 @@ def _quiet_time(column, base, g_m_s2):
     return float(base.t_s[np.flatnonzero(over)[-1]]) if over.any() else -math.inf
 
 
+def _stride(output_dt_s, dt_s, n_steps) -> int:
+    """Steps per stored sample for ``output_dt_s`` (s); ``n_steps + 1`` stores none in between."""
+    if output_dt_s is None:
+        return 1
+    odt = float(output_dt_s)
+    if odt == math.inf:
+        return n_steps + 1
+    if not (math.isfinite(odt) and odt > 0):
+        raise InputError(f"output_dt_s={output_dt_s!r}: must be positive (s), inf, or None for every step")
+    k = int(round(odt / dt_s))
+    if k < 1 or abs(k * dt_s - odt) > 1e-9 * odt:
+        raise InputError(f"output_dt_s={odt:g}: must be a whole multiple of dt_s={dt_s:g} s "
+                         f"(e.g. {max(k, 1) * dt_s:g}), the events stay exact at any spacing")
+    return min(k, n_steps + 1)
+
+
 def simulate_column(column: Column, base: BaseMotion | None = None, *, theta0_rad=None, omega0_rad_s=None,
                     duration_s: float | None = None, dt_s: float = 1e-4, n_impacts: int = 1,
                     velocity_terms: bool = True, max_enum_closed: int = 9, stop_at_rest: bool = True,
                     overturn_angle_rad: float | None = None, rest_omega_rad_s: float = 1e-6,
-                    g_m_s2: float = G_STD, jit: bool = True) -> ColumnResult:
+                    g_m_s2: float = G_STD, output_dt_s: float | None = None, jit: bool = True) -> ColumnResult:
     """Simulate a multi-block column under gravity and a horizontal base acceleration.
 
     Parameters
@@ -305,6 +334,15 @@ def simulate_column(column: Column, base: BaseMotion | None = None, *, theta0_ra
     rest_omega_rad_s : float
         Post-impact joint rates below this close the joint (ends the accumulation
         of ever smaller impacts), rad/s.
+    output_dt_s : float, optional
+        Spacing of the stored time history, s: a whole multiple of ``dt_s``
+        keeps every k-th step (plus the last completed step when the run ends
+        between two samples). Default None: every step, as ``dt_s`` (20 s at
+        1e-4 s = 200 001 rows). ``math.inf``: only the initial and the final
+        state. The integration, the events (``configurations``, ``impacts``),
+        ``status``, ``t_status_s`` and the peaks ``max_abs_theta_rad`` /
+        ``max_abs_phi_rad`` do not depend on it (taken from every step); the
+        stored samples equal the full history's at the shared times.
     jit : bool
         Use the compiled loop (False: pure Python, slow; the benchmark baseline).
 
@@ -337,21 +375,24 @@ def simulate_column(column: Column, base: BaseMotion | None = None, *, theta0_ra
         accb, t0b, dtb = np.zeros(0), 0.0, 1.0
     n = column.n
     n_steps = int(math.ceil(duration_s / dt_s - 1e-9))
+    stride = _stride(output_dt_s, dt_s, n_steps)
+    n_rows = n_steps // stride + 2
     par = np.array([g_m_s2, column.mu, t0b, dtb, 1.0 if velocity_terms else 0.0, 1e-14,
                     _quiet_time(column, base, g_m_s2), 0.0])
     ecap = 20000
     fn = run_core_jit if jit else run_core
     ovt = float(overturn_angle_rad) if overturn_angle_rad else -1.0
-    PHI = np.empty((n_steps + 1, n))
-    VEL = np.empty((n_steps + 1, n))
-    EN = np.empty((n_steps + 1, 2))
+    PHI = np.empty((n_rows, n))
+    VEL = np.empty((n_rows, n))
+    EN = np.empty((n_rows, 2))
+    PEAK = np.full((2, n), np.nan)  # stays nan when the run fails before its first sample
     while True:
         EVT = np.empty(ecap)
         EVI = np.empty((ecap, 3), np.int64)
         IMP = np.empty((ecap, 6))
-        nr, ne, ni, st, t_st = fn(phi0, v0, s0, blk, par, accb, n_steps, float(dt_s),
-                                  int(max_enum_closed), int(n_impacts), float(rest_omega_rad_s),
-                                  bool(stop_at_rest), ovt, PHI, VEL, EN, EVT, EVI, IMP)
+        nr, ne, ni, st, t_st, k_last = fn(phi0, v0, s0, blk, par, accb, n_steps, float(dt_s),
+                                          int(max_enum_closed), int(n_impacts), float(rest_omega_rad_s),
+                                          bool(stop_at_rest), ovt, stride, PHI, VEL, EN, EVT, EVI, IMP, PEAK)
         if st != 5 or ecap >= 5_000_000:
             break
         ecap *= 10
@@ -377,12 +418,14 @@ def simulate_column(column: Column, base: BaseMotion | None = None, *, theta0_ra
         msg = f"terminated at t={t_st:.6g} s: {status} at a joint (the column may disintegrate)"
     elif status in ("capacity", "numerical"):
         msg = f"integration failed at t={t_st:.6g} s ({status}); reduce dt_s or check the input"
-    params = dict(dt_s=dt_s, duration_s=float(duration_s), n_impacts=int(n_impacts),
+    params = dict(dt_s=dt_s, output_dt_s=float(dt_s if output_dt_s is None else output_dt_s),
+                  duration_s=float(duration_s), n_impacts=int(n_impacts),
                   velocity_terms=bool(velocity_terms), max_enum_closed=int(max_enum_closed),
                   overturn_angle_rad=overturn_angle_rad, g_m_s2=g_m_s2, rest_omega_rad_s=rest_omega_rad_s,
                   base=None if base is None else base.name)
-    t = np.arange(nr) * dt_s
+    t = (np.arange(nr) * stride) * dt_s  # the full history's k * dt_s, bit for bit
+    t[nr - 1:] = k_last * dt_s
     return ColumnResult(column=column, t_s=t, phi_rad=phi, omega_rad_s=om,
                         theta_rad=np.cumsum(phi, axis=1), energy_J=EN[:nr].sum(axis=1), kinetic_J=EN[:nr, 0].copy(),
                         configurations=conf, impacts=imp, status=status, t_status_s=float(t_st), message=msg,
-                        params=params)
+                        params=params, max_abs_theta_rad=PEAK[0].copy(), max_abs_phi_rad=PEAK[1].copy())

@@ -208,7 +208,10 @@ def synth_session(out_dir, seed: int = 0, blocks: int = 1, table: str = "none", 
     noise_dn : float
         Sensor noise, grey levels (sigma).
     imu : bool
-        Write IMU logs (one per block and one on the table), x-IMU GUI format.
+        Write IMU logs (one per block and one on the table), x-IMU GUI format. They
+        start 0.5..1.5 s before the video and run on 0.5 s after its last frame (the
+        camera is stopped first); the blocks and the table are simulated to the end
+        of the logs, while ``truth.csv`` covers the video frames.
 
     Returns
     -------

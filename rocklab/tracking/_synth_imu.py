@@ -27,7 +27,10 @@ def write_object_imu(folder: Path, oid: str, *, block_motion=None, block=None, t
     ``block_motion`` (a ``BlockMotion``) and ``block`` for a sensor on a block;
     only ``table`` (a ``TableMotion``) for the sensor on the table. Errors: a
     gyro bias of 0.2..1 deg/s per axis, white noise (0.1 deg/s, 0.005 g), one
-    or two bursts of lost packets; the log starts 0.5..1.5 s before the video.
+    or two bursts of lost packets; the log starts 0.5..1.5 s before the video and
+    ends at ``t_end_s`` (video time), which the motions must cover: before their
+    first time the pose is held (a block held by its thread), after their last
+    one too, which is right only for a block at rest (or fallen).
 
     Returns the truth for ``session.json``.
     """

@@ -14,6 +14,10 @@ __all__ = ["build_scene", "Scene"]
 
 TABLE_THICK_M = 0.06
 _MOUNT_FRAC = 0.85          # IMU height on the block, fraction of h
+#: The IMUs keep logging this long after the last video frame, s (as in the lab: the
+#: camera is stopped first). The blocks and the table are simulated to the end of the
+#: logs, so a block still rocking when the video ends keeps rocking in its IMU log.
+IMU_TAIL_S = 0.5
 
 
 def _blocks(block, n):
@@ -175,7 +179,7 @@ class Scene:
 
         out = {}
         seqs = self.imu_seed.spawn(len(self.block_motions) + 1)
-        t_end = self.n_frames / self.fps + 0.5
+        t_end = self.n_frames / self.fps + IMU_TAIL_S
         blocks = {s["id"]: s["block"] for s in self.sims}
         for k, bm in enumerate(self.block_motions):
             bd = blocks[bm.id]
@@ -218,6 +222,9 @@ class Scene:
                 "t_s": "frame i is centred on t_s = i / fps (with rolling shutter: the middle row)",
                 "x_m, y_m": "blocks: centre of the front face; table: top centre of its front face",
                 "object_frame": "origin as x_m, y_m; x right, y up when upright",
+                "simulated_span": f"truth.csv covers the video frames; the motions (and blocks' "
+                                  f"impact_t_s, n_impacts, sim_status, max_abs_theta_rad) run on to "
+                                  f"the end of the IMU logs, {IMU_TAIL_S} s after the last frame",
             },
         }
 
@@ -243,9 +250,14 @@ def build_scene(*, seed, blocks, table, fps, size, targets, duration_s, occlusio
         table_amplitude_m = 0.02 if layout == "column" else 0.045
     rest_s = 0.6
     horizon = float(duration_s) if duration_s is not None else 12.0
+    # The motions run past the video to the end of the IMU logs (IMU_TAIL_S after the last
+    # frame, which rounding of n_frames puts up to half a frame past `horizon`) plus 0.1 s
+    # for the IMU's interval means. Fixed-step integration: the part under the video is the
+    # same as a run stopped at the video's end.
+    sim_end = horizon + IMU_TAIL_S + 0.5 / fps + 0.1
     tbl = _table_motion(table, rng_m, record=record, amplitude=table_amplitude_m, period=table_period_s,
                         stroke=table_stroke_m, blocks=blks, start_s=rest_s, horizon_s=max(horizon, 3.0))
-    base = tbl.base_motion(horizon + 0.1)
+    base = tbl.base_motion(sim_end)
     spacing = 0.35
     xs = [0.0] if n == 1 else [-spacing, 0.0, spacing]
     if theta0_rad is None:
@@ -256,14 +268,19 @@ def build_scene(*, seed, blocks, table, fps, size, targets, duration_s, occlusio
             if not abs(p) < b.alpha_rad:
                 raise InputError(f"theta0_rad={p!r}: must be within ±alpha = ±{b.alpha_rad:.4f} rad")
     if layout == "column":
-        motions, sims, ends = _column_motions(blks, tbl, base, table, rest_s, horizon, rng_m,
+        motions, sims, ends = _column_motions(blks, tbl, base, table, rest_s, sim_end, rng_m,
                                               None if theta0_rad is None else float(np.ravel(theta0_rad)[0]))
     else:
-        motions, sims, ends = _single_motions(blks, xs, phi0, tbl, base, table, rest_s, horizon, rng_m,
+        motions, sims, ends = _single_motions(blks, xs, phi0, tbl, base, table, rest_s, sim_end, rng_m,
                                               restitution, eta)
     if duration_s is None:
         duration_s = float(np.clip(max(ends) + 0.6, 2.0, 12.0))
     n_frames = max(2, int(round(duration_s * fps)))
+    for m, sim in zip(motions, sims):
+        # a run cut short while still moving would freeze the block in the IMU log's tail
+        if sim["sim_status"] == "rocking" and float(m.t_s[-1]) < n_frames / fps + IMU_TAIL_S:
+            raise AssertionError(f"{m.id}: simulated to {float(m.t_s[-1]):.3f} s only, before the "
+                                 f"IMU logs end at {n_frames / fps + IMU_TAIL_S:.3f} s")
     W, H = size
     h_max = max(b.h_m for b in blks)
     stack = sum(b.h_m for b in blks) if layout == "column" else h_max
@@ -327,8 +344,8 @@ def _block_info(blk) -> dict:
                             "eta_H": blk.eta_H}
 
 
-def _single_motions(blks, xs, phi0, tbl, base, table, rest_s, horizon, rng_m, restitution, eta):
-    """Independent blocks side by side: one ``simulate`` run each."""
+def _single_motions(blks, xs, phi0, tbl, base, table, rest_s, sim_end_s, rng_m, restitution, eta):
+    """Independent blocks side by side: one ``simulate`` run each, to ``sim_end_s`` (video time)."""
     from ._synth_motion import BlockMotion
 
     motions, sims, ends = [], [], [tbl.end_s]
@@ -336,13 +353,13 @@ def _single_motions(blks, xs, phi0, tbl, base, table, rest_s, horizon, rng_m, re
         oid = f"block_{k + 1}"
         if table == "none":
             release = round(rest_s + 0.3 * k + float(rng_m.uniform(0.0, 0.1)), 4)
-            res = _simulate(blk, theta0_sim=-phi0[k], base=None, horizon_s=max(horizon - release, 0.5),
+            res = _simulate(blk, theta0_sim=-phi0[k], base=None, horizon_s=max(sim_end_s - release, 0.5),
                             restitution=restitution, eta=eta)
             t = np.concatenate(([0.0], release + res.t_s))
             ph = np.concatenate(([phi0[k]], -res.theta_rad))
         else:
             release = None
-            res = _simulate(blk, theta0_sim=0.0, base=base, horizon_s=horizon + 0.1,
+            res = _simulate(blk, theta0_sim=0.0, base=base, horizon_s=sim_end_s,
                             restitution=restitution, eta=eta)
             t, ph = res.t_s, -res.theta_rad
         ends.append(float(t[-1]))
@@ -361,10 +378,10 @@ def _single_motions(blks, xs, phi0, tbl, base, table, rest_s, horizon, rng_m, re
     return motions, sims, ends
 
 
-def _column_motions(blks, tbl, base, table, rest_s, horizon, rng_m, phi0=None):
+def _column_motions(blks, tbl, base, table, rest_s, sim_end_s, rng_m, phi0=None):
     """A stacked column (``rocklab.models.simulate_column``): free rocking after a
     thread-burn release of the whole column tilted by half its slenderness angle,
-    or standing on the moving table."""
+    or standing on the moving table; simulated to ``sim_end_s`` (video time)."""
     from ._synth_column import ColumnBlockView, ColumnMotion, column_api
 
     Column, simulate_column = column_api()
@@ -379,14 +396,14 @@ def _column_motions(blks, tbl, base, table, rest_s, horizon, rng_m, phi0=None):
             raise InputError(f"theta0_rad={phi0!r}: the column tips as one body; give |theta0| < "
                              f"{alpha_col:.4f} rad (its slenderness angle)")
         release = round(rest_s + float(rng_m.uniform(0.0, 0.1)), 4)
-        res = simulate_column(col, None, theta0_rad=[-phi0] * n, duration_s=max(horizon - release, 0.5))
+        res = simulate_column(col, None, theta0_rad=[-phi0] * n, duration_s=max(sim_end_s - release, 0.5))
         psi0 = np.zeros((1, n))
         psi0[0, 0] = phi0
         t = np.concatenate(([0.0], release + res.t_s))
         psi = np.vstack([psi0, -res.phi_rad])
     else:
         phi0, release = 0.0, None
-        res = simulate_column(col, base, duration_s=horizon + 0.1)
+        res = simulate_column(col, base, duration_s=sim_end_s)
         t, psi = res.t_s, -res.phi_rad
     cm = ColumnMotion(np.array([b.b_m for b in blks]), np.array([b.h_m for b in blks]),
                       np.asarray(col.half_width_m, float), 0.0, t, psi, tbl, release)

@@ -1,7 +1,6 @@
 """Rerun output is read back with rerun's own reader (rerun.chunk.RrdReader), no mocks."""
 
 import numpy as np
-import pytest
 
 from rocklab.pipelines._rerun import (experiment_blueprint, log_events, log_series, open_recording,
                                       read_rrd_scalars, read_rrd_summary)

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from rocklab import Block, G, InputError
+from rocklab import Block, InputError
 from rocklab.models import BaseMotion, simulate, simulate_batch
 
 

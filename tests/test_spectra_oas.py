@@ -7,10 +7,9 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from rocklab import G, InputError
-from rocklab.models import (F_SINE, BaseMotion, fit_inclined_line, load_base_motion,
-                            normalised_critical_impulse, overturning_curve, overturning_spectrum,
-                            pulse_motion, simplified_oas)
-from rocklab.models._oas_kernel import run_one
+from rocklab.models import (F_SINE, BaseMotion, fit_inclined_line, free_rocking_overturns,
+                            load_base_motion, normalised_critical_impulse, overturning_curve,
+                            overturning_spectrum, pulse_motion, simplified_oas, simulate_batch)
 
 FF = "records/fema-p695-far-field/SortedEQFile_{}.txt"
 
@@ -52,18 +51,47 @@ def _reference(acc, dt, scale, p, alpha, eta):
     return False
 
 
-def test_kernel_matches_event_driven_reference(shared_data):
+def test_oas_runs_match_event_driven_reference(shared_data):
     r = load_base_motion(shared_data / FF.format("120111"), units="g")
     acc = r.acc_m_s2[:1500] / G  # first 15 s hold the strong motion
     alpha = math.atan(1 / 12)
     eta = 1 - 1.5 * math.sin(alpha) ** 2
     scale = 1.342 * math.tan(alpha) / np.abs(r.acc_m_s2 / G).max()
-    # p around the FF-1 boundary at a_p/a_p,min = 1.34 (overturns, safe, overturns ...)
-    got, want = [], []
-    for p in (2.21, 2.30, 2.58):
-        got.append(bool(run_one(acc, r.dt_s, scale, p, alpha, eta, 0, 0, 0.0, 0.1)[0]))
-        want.append(_reference(acc, r.dt_s, scale, p, alpha, eta))
-    assert got == want and any(got) and not all(got)
+    # p around the FF-1 boundary at a_p/a_p,min = 1.34 (reference: safe, safe, overturns)
+    ps = np.array([2.21, 2.30, 2.58])
+    base = BaseMotion.from_samples(r.acc_m_s2[:1500], r.dt_s)
+    # the verdicts here are chaotic: p h <= 0.02 flips the middle one, 0.005 the first;
+    # from 0.001 down they are converged and equal the reference
+    got = simulate_batch(ps, alpha, base=base, scale=scale, eta=eta, dt_s=r.dt_s, fall_rad=alpha,
+                         max_p_dt=0.001)
+    want = [_reference(acc, r.dt_s, scale, p, alpha, eta) for p in ps]
+    assert list(got.overturned) == want and any(want) and not all(want)
+
+
+def test_free_rocking_verdict_equals_integration():
+    # random states (both pivots, inward and outward, some beyond the top): the closed-form
+    # verdict must equal integrating free rocking to the end (Housner eta)
+    rng = np.random.default_rng(7)
+    m = 400
+    alpha = np.full(m, 0.25)
+    p = rng.uniform(1.0, 4.0, m)
+    th = rng.uniform(-1.1, 1.1, m) * alpha
+    w = rng.normal(0.0, 0.3, m) * p
+    eta = 1 - 1.5 * np.sin(alpha) ** 2
+    verdict = free_rocking_overturns(th, w, p, alpha, eta)
+    ok = np.abs(th) < alpha  # simulate_batch starts below the top
+    run = simulate_batch(p[ok], alpha[ok], theta0_rad=th[ok], omega0_rad_s=w[ok], eta=eta[ok],
+                         duration_s=60.0, fall_rad=alpha[ok])
+    assert np.array_equal(verdict[ok], run.overturned)
+    assert 0.2 < verdict.mean() < 0.8  # both outcomes are exercised
+    # beyond the top: outward always falls; inward falls only when too slow to climb back
+    past = ~ok
+    e = 0.5 * w[past] ** 2 + p[past] ** 2 * np.cos(alpha[past] - np.abs(th[past]))
+    inward = th[past] * w[past] < 0
+    assert np.array_equal(verdict[past][~inward], np.ones((~inward).sum(), bool))
+    assert np.array_equal(verdict[past][inward] | (e[inward] >= p[past][inward] ** 2),
+                          np.ones(inward.sum(), bool))
+    assert not free_rocking_overturns(0.0, 0.0, 2.0, 0.2, 1.0)  # at rest
 
 
 def test_short_pulse_impulse_tends_to_critical_impulse():
@@ -105,15 +133,17 @@ def ff_oas(shared_data):
 def test_tI_of_fema_pair_vs_table4(ff_oas):
     scan1, cont1, scan2 = ff_oas["120111"], ff_oas["cont"], ff_oas["120112"]
     # Table 4 (H/B = 12): FF-1 t_I = 0.266 s, FF-2 t_I = 0.360 s.
-    # FF-2 with the defaults: 0.348 s (-3 %).
+    # FF-2 with the defaults: 0.333 s (-7 %).
     assert scan2.t_I_s == pytest.approx(0.360, rel=0.10)
-    # FF-1 with the defaults gives 0.336 s (+26 %): at a_p/a_p,min = 1.34 blocks of
-    # R = 1.6-2.0 m overturn (an unsafe island reaching to large sizes, confirmed by the
-    # solve_ivp reference above) that the thesis's OAS does not show. A search that only
-    # follows the unsafe region connected to the smallest blocks ignores it and gives
-    # 0.271 s (+2 %), which is what Table 4 lists.
+    # FF-1 with the defaults gives 0.336 s (+26 %): at a_p/a_p,min = 1.34 the unsafe band
+    # reaches R = 1.49 m (p = 2.22 rad/s; the event-driven reference overturns there too),
+    # broken by single safe grid sizes (chaotic bays) from R = 0.47 m up. A search that
+    # stops at the first safe size above the smallest blocks gives 0.275 s (+3 %), close
+    # to Table 4; the thesis's text ("always searching for the largest unsafe block size")
+    # describes the scan, so the scan stays the default and the gap is recorded here.
+    assert scan1.t_I_s == pytest.approx(0.266, rel=0.30)
     assert cont1.t_I_s == pytest.approx(0.266, rel=0.05)
-    assert scan1.t_I_s > 1.2 * cont1.t_I_s
+    assert scan1.t_I_s > 1.1 * cont1.t_I_s
     # invariant: islands only add unsafe sizes, so the scan's f_min is never larger
     assert scan1.f_min_rad_s <= cont1.f_min_rad_s + 1e-12
     for s in (scan1, scan2):

@@ -78,7 +78,6 @@ def _one_line_error(run_cli, *argv, match):
 
 
 def test_bad_video_inputs(tmp_path, run_cli, session):
-    d = session[0]
     (tmp_path / "track.toml").write_text(TOML)
     garbage = tmp_path / "garbage.mkv"
     garbage.write_bytes(b"not a video at all" * 10)

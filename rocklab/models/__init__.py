@@ -2,7 +2,7 @@
 
 from ._records import BUNDLED_RECORDS, UNITS_TO_M_S2, BaseMotion, bundled_record, load_base_motion
 from ._restitution import RESTITUTION_LAWS, Restitution, make_restitution
-from ._batch import simulate_batch
+from ._batch import free_rocking_overturns, simulate_batch
 from ._result import BatchResult, RockingResult, block_energy
 from ._single import simulate
 from ._pulses import (F_SINE, PULSE_KINDS, PulseParameters, lobe_impulses, pulse_fullness, pulse_motion,
@@ -22,7 +22,7 @@ from ._column_compare import (ColumnComparison, SequenceComparison, compare_sequ
                               joint_sequence)
 
 __all__ = ["BaseMotion", "load_base_motion", "UNITS_TO_M_S2", "bundled_record", "BUNDLED_RECORDS",
-           "simulate", "RockingResult", "block_energy", "simulate_batch", "BatchResult",
+           "simulate", "RockingResult", "block_energy", "simulate_batch", "free_rocking_overturns", "BatchResult",
            "RESTITUTION_LAWS", "Restitution", "make_restitution",
            # spectra (helper "spectra")
            "PulseParameters", "pulse_parameters", "lobe_impulses", "pulse_shape", "pulse_motion",

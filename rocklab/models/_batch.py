@@ -17,7 +17,7 @@ from ._newmark import run_batch
 from ._records import BaseMotion
 from ._result import BatchResult
 
-__all__ = ["simulate_batch"]
+__all__ = ["simulate_batch", "free_rocking_overturns"]
 
 _HALF_PI = 0.5 * math.pi
 
@@ -69,7 +69,10 @@ def simulate_batch(p_rad_s, alpha_rad, *, base: BaseMotion | None = None, scale=
     -------
     BatchResult
         ``overturned`` (m,) bool, ``overturn_t_s`` (m,) first |theta| >= alpha
-        outward (NaN if never), ``max_abs_theta_over_alpha`` (m,), ``n_impacts`` (m,).
+        outward (NaN if never), ``max_abs_theta_over_alpha`` (m,), ``n_impacts`` (m,),
+        and the state where each run ended (``theta_end_rad``, ``omega_end_rad_s``,
+        ``t_end_s``) for verdicts beyond the simulated span (see
+        :func:`free_rocking_overturns`).
     """
     try:
         arrs = np.broadcast_arrays(*(np.asarray(x, float) for x in (
@@ -111,8 +114,46 @@ def simulate_batch(p_rad_s, alpha_rad, *, base: BaseMotion | None = None, scale=
         acc.setflags(write=False)  # same numba type as a BaseMotion array: one compile
     else:
         acc, t0, dta = np.ascontiguousarray(base.acc_m_s2, float), float(base.t_s[0]), base.dt_s
-    over, t_over, mx, nimp, status, steps = run_batch(p, al, th0, w0, et, h, n_steps, acc, t0, dta, sc,
-                                                   float(rest_tol), fr, bool(stop_on_overturn))
+    over, t_over, mx, nimp, status, steps, th_end, w_end = run_batch(
+        p, al, th0, w0, et, h, n_steps, acc, t0, dta, sc, float(rest_tol), fr, bool(stop_on_overturn))
     return BatchResult(overturned=over, overturn_t_s=t_over, max_abs_theta_over_alpha=mx,
                        n_impacts=nimp, status=status, p_rad_s=p, alpha_rad=al, scale=sc, eta=et,
-                       dt_s=h, n_steps=int(steps.sum()))
+                       dt_s=h, n_steps=int(steps.sum()), theta_end_rad=th_end, omega_end_rad_s=w_end,
+                       t_end_s=steps * h)
+
+
+def free_rocking_overturns(theta_rad, omega_rad_s, p_rad_s, alpha_rad, eta) -> np.ndarray:
+    """Exact fate of a block left to rock freely from a state: does it overturn?
+
+    With no base motion the energy E = omega^2/2 + p^2 cos(alpha - |theta|)
+    (per unit I_O, rad^2/s^2) is constant between impacts and the top of the
+    corner (|theta| = alpha) needs E > p^2. An impact multiplies the kinetic
+    energy at theta = 0, E - p^2 cos(alpha), by eta^2, so only the next impact
+    matters: a block that does not get over the top after it never will.
+
+    Parameters
+    ----------
+    theta_rad, omega_rad_s : array_like
+        State (rad, rad/s; the sign of theta names the pivot, as in ``simulate``).
+    p_rad_s, alpha_rad : array_like
+        Frequency parameter (rad/s) and slenderness angle (rad).
+    eta : array_like
+        Restitution (omega after / before an impact).
+
+    Returns
+    -------
+    ndarray of bool
+        Broadcast shape of the inputs. |theta| >= alpha moving outward, or
+        beyond the top too slow to come back over it, counts as overturning;
+        a block at rest (theta = omega = 0) never does.
+    """
+    th, w, p, a, e = np.broadcast_arrays(*(np.asarray(x, float) for x in
+                                           (theta_rad, omega_rad_s, p_rad_s, alpha_rad, eta)))
+    p2 = p * p
+    ath = np.abs(th)
+    energy = 0.5 * w * w + p2 * np.cos(a - ath)
+    past = ath >= a
+    outward = (th * w > 0) | ((th == 0) & (w != 0))
+    after_impact = p2 * np.cos(a) + e * e * (energy - p2 * np.cos(a))
+    inward = np.where(past & (energy < p2), True, after_impact > p2)
+    return np.where(outward, past | (energy > p2), inward) & ((th != 0) | (w != 0))

@@ -162,7 +162,8 @@ def run_block(p, alpha, theta0, omega0, h, n_steps, acc, acc_t0, acc_dt, scale,
         omega_before, omega_after, eta of the first ``imp_cap`` impacts; ``n_imp``
         (all impacts); ``status`` code; ``t_over`` (first |theta| >= alpha outward,
         NaN); ``t_fall`` (|theta| reached fall_rad, NaN); ``max_abs_theta``;
-        ``t_end`` (s, last time integrated). The run always ends when |theta|
+        ``t_end`` (s, last time integrated); ``theta_end``, ``omega_end`` (state at
+        ``t_end``, rad and rad/s; 0, 0 at rest). The run always ends when |theta|
         reaches pi/2 (the side hits the ground), and at fall_rad when stop_on_fall.
     """
     p2 = p * p
@@ -357,7 +358,7 @@ def run_block(p, alpha, theta0, omega0, h, n_steps, acc, acc_t0, acc_dt, scale,
         else:
             status = ROCKING
     return (out_th[:n_out], out_w[:n_out], out_e[:n_out], n_out, imp[:, :min(n_imp, imp_cap)], n_imp, status,
-            t_over, t_fall, max_abs, t_end)
+            t_over, t_fall, max_abs, t_end, th, w)
 
 
 @njit(cache=True)
@@ -369,7 +370,7 @@ def run_single(p, alpha, theta0, omega0, h, n_steps, acc, acc_t0, acc_dt, eta_mo
     ``imp`` (4, k) C-contiguous, ``n_imp``, ``status``, ``t_over``, ``t_fall``,
     ``max_abs`` (one dispatch from Python instead of several numpy calls).
     """
-    th, w, e, n_out, imp, n_imp, st, t_over, t_fall, max_abs, t_end = run_block(
+    th, w, e, n_out, imp, n_imp, st, t_over, t_fall, max_abs, t_end, _, _ = run_block(
         p, alpha, theta0, omega0, h, n_steps, acc, acc_t0, acc_dt, 1.0, eta_mode, eta_x, eta_y, lin, rest_w2,
         t_last_uplift, stop_at_rest, out_every, imp_cap, fall_rad, True, e_scale)
     t = np.empty(n_out)
@@ -404,6 +405,8 @@ def run_batch(p, alpha, th0, w0, eta, h, n_steps, acc, acc_t0, acc_dt, scale, re
     nimp = np.zeros(m, np.int64)
     status = np.zeros(m, np.int8)
     steps = np.zeros(m, np.int64)
+    th_end = np.zeros(m)
+    w_end = np.zeros(m)
     ex = np.zeros(1)
     for i in prange(m):
         a = alpha[i]
@@ -422,4 +425,6 @@ def run_batch(p, alpha, th0, w0, eta, h, n_steps, acc, acc_t0, acc_dt, scale, re
         over[i] = r[6] == 2
         mx[i] = r[9] / a
         steps[i] = int(r[10] / h[i] + 0.5)
-    return over, t_over, mx, nimp, status, steps
+        th_end[i] = r[11]
+        w_end[i] = r[12]
+    return over, t_over, mx, nimp, status, steps, th_end, w_end

@@ -22,16 +22,31 @@ Definition choices the thesis leaves open are options (defaults first):
   search from small blocks upward would find it).
 - ``levels``, ``sizes``, ``refine``: grid density and bisection steps.
 - ``eta``: restitution; ``None`` = Housner's 1 - 2 sin^2(alpha)/alpha_I.
-- ``engine``: ``"rk4"`` (this module's kernel) or ``"batch"`` (``simulate_batch``).
+- ``max_p_dt``: integration step times p of the runs (``simulate_batch``).
 
-How much each choice moves t_I (measured, H/B = 12, FEMA FF-1 / FF-2; thesis Table 4
-0.266 / 0.360 s): defaults 0.336 / 0.348 s; ``criterion="fall"``, ``free="none"`` or
-10 s, RK4 step p h = 0.03: no change; ``engine="batch"`` 0.320 / 0.327; ``search=
-"contiguous"`` 0.271 / 0.324; ``refine=0`` 0.324 / 0.348; 160 levels 0.299 / 0.365;
-240 sizes 0.346 / 0.381; ``eta=0.95`` 0.289 / 0.304. t_I is the minimum over a
-fractal-like boundary (bays, islands, chaotic verdicts at the boundary), so grid
-density and integrator alone move it by ~10 %; the overturning criterion and the
-free-rocking rule do not matter for slender blocks.
+How much each choice moves t_I (H/B = 12; output of ``benchmarks/oas_sensitivity.py``;
+thesis Table 4: FF-1 0.266 s, FF-2 0.360 s, FF-41 0.503 s)::
+
+    variant              FF-1            FF-2            FF-41 (NGA-West2 file)
+    defaults             0.336 (+26 %)   0.333 ( -7 %)   0.470 ( -7 %)
+    search=contiguous    0.275 ( +3 %)   0.324 (-10 %)   0.376 (-25 %)
+    criterion=fall, free=none or 10 s: no change
+    refine=0             0.324 (+22 %)   0.323 (-10 %)   0.467 ( -7 %)
+    levels=160           0.294 (+11 %)   0.372 ( +3 %)   0.464 ( -8 %)
+    sizes=240            0.346 (+30 %)   0.333 ( -7 %)   0.415 (-17 %)
+    max_p_dt=0.02        0.320 (+20 %)   0.327 ( -9 %)   0.512 ( +2 %)
+    max_p_dt=0.005       0.329 (+24 %)   0.332 ( -8 %)   0.396 (-21 %)
+    eta=0.95             0.289 ( +9 %)   0.317 (-12 %)   0.394 (-22 %)
+
+Why not closer: t_I is the minimum of f over a boundary that is chaotic near
+its edge (bays, islands; single verdicts flip with the integration step even
+at p h = 0.001), so grid density and step alone move it by 10-20 %. For FF-1
+the minimum comes from a_p/a_p,min = 1.34, where blocks up to R = 1.49 m
+overturn (confirmed by an event-driven solve_ivp run), with single safe sizes
+from R = 0.47 m up; the thesis's boundary there lies below R = 0.93 m. The
+FF-41 file is the NGA-West2 processing, not the thesis's (its t_p is 0.293 s
+against Table 4's 0.224 s). The overturning criterion and the free-rocking rule
+do not matter for slender blocks.
 """
 
 from __future__ import annotations
@@ -43,7 +58,7 @@ import numpy as np
 
 from .._errors import InputError
 from ..blocks import G
-from ._oas_kernel import run_batch, run_grid
+from ._batch import free_rocking_overturns, simulate_batch
 from ._records import BaseMotion
 
 __all__ = ["OASResult", "overturning_spectrum", "OverturningCurve", "overturning_curve",
@@ -53,7 +68,7 @@ __all__ = ["OASResult", "overturning_spectrum", "OverturningCurve", "overturning
 #: Defaults of :func:`overturning_spectrum` (thesis §5.3: 80 levels 1..10, 120 sizes 1000..0.1 m).
 OAS_DEFAULTS = dict(levels=80, level_max=10.0, sizes=120, R_max_m=1000.0, R_min_m=0.1, refine=10,
                     criterion="angle", free="energy", search="scan", alpha_I=4.0 / 3.0, eta=None,
-                    h_ph=0.1, engine="rk4")
+                    max_p_dt=0.001)
 
 _CRIT = {"angle": 0, "fall": 1}
 
@@ -169,7 +184,7 @@ def overturning_spectrum(base: BaseMotion, slenderness: float = 12.0, *, levels:
                          level_max: float = 10.0, sizes: int = 120, R_max_m: float = 1000.0,
                          R_min_m: float = 0.1, refine: int = 10, criterion: str = "angle",
                          free="energy", search: str = "scan", alpha_I: float = 4.0 / 3.0,
-                         eta: float | None = None, h_ph: float = 0.1, engine: str = "rk4") -> OASResult:
+                         eta: float | None = None, max_p_dt: float = 0.001) -> OASResult:
     """OAS, transformed OAS, t_I, t'_I and beta of a record for one block slenderness.
 
     Parameters
@@ -188,14 +203,12 @@ def overturning_spectrum(base: BaseMotion, slenderness: float = 12.0, *, levels:
     criterion, free, search, eta : see the module docstring.
     alpha_I : float
         Inertia coefficient I_O/(m R^2) (thesis Eq. 22).
-    h_ph : float
-        Largest RK4 step times p (engine ``rk4``).
-    engine : {"rk4", "batch"}
-        ``rk4``: the OAS kernel of ``_oas_kernel`` (RK4, exact impacts, early exit and the
-        exact free-rocking verdict at the record end). ``batch``: the general
-        :func:`rocklab.models.simulate_batch` (Newmark, p h <= 0.02); it returns no end
-        state, so ``free="energy"`` becomes 10 s of free rocking there. Both agree on
-        ~99 % of the grid (the rest sits on the chaotic boundary), see benchmarks/bench_oas.py.
+    max_p_dt : float
+        Largest integration step times p (the runs are :func:`simulate_batch`'s
+        Newmark steps with exact impacts). Verdicts near the boundary are chaotic:
+        on FEMA FF-1, 0.02 / 0.005 / 0.002 / 0.001 disagree with 0.0005 on
+        1.1 / 0.55 / 0.35 / 0.18 % of the 9600 grid runs; 0.001 is the default
+        (about 8 CPU-s for a 30 s record, 4 s on 2 cores).
 
     Returns
     -------
@@ -213,16 +226,14 @@ def overturning_spectrum(base: BaseMotion, slenderness: float = 12.0, *, levels:
     free_code, free_s = _free_code(free)
     alpha = math.atan(1.0 / sl)
     eta_v = 1.0 - 2.0 * math.sin(alpha) ** 2 / alpha_I if eta is None else float(eta)
-    acc = np.ascontiguousarray(base.acc_m_s2 / G)
-    dt = base.dt_s
     lv = np.linspace(1.0, float(level_max), int(levels))
     R = np.geomspace(R_max_m, R_min_m, int(sizes))
     p = np.sqrt(G / (alpha_I * R))
-    scales = lv * math.tan(alpha) / float(np.max(np.abs(acc)))
-    if engine not in ("rk4", "batch"):
-        raise InputError(f"engine={engine!r}: use 'rk4' or 'batch'")
-    args = (alpha, eta_v, _CRIT[criterion], free_code, free_s, h_ph, engine, base)
-    over = _runs(acc, dt, np.repeat(scales, p.size), np.tile(p, scales.size), args)
+    scales = lv * math.tan(alpha) * G / base.pga_m_s2  # record scaled to a_p = level g tan(alpha)
+    if not (math.isfinite(max_p_dt) and 0 < max_p_dt <= 0.5):
+        raise InputError(f"max_p_dt={max_p_dt!r}: step times p must be in (0, 0.5]")
+    args = (alpha, eta_v, _CRIT[criterion], free_code, free_s, float(max_p_dt))
+    over = _runs(base, np.repeat(scales, p.size), np.tile(p, scales.size), args)
     over = over.reshape(scales.size, p.size)
 
     # largest unsafe grid size per level
@@ -237,7 +248,7 @@ def overturning_spectrum(base: BaseMotion, slenderness: float = 12.0, *, levels:
             k[i] = safe[-1] + 1 if safe.size else 0
     p_hi = np.where(k >= 0, p[np.clip(k, 0, None)], np.nan)  # unsafe
     p_lo = np.where(k > 0, p[np.clip(k - 1, 0, None)], np.nan)  # safe neighbour (larger block)
-    p_hi, p_lo = _bisect(acc, dt, scales, p_hi, p_lo, refine, args)
+    p_hi, p_lo = _bisect(base, scales, p_hi, p_lo, refine, args)
 
     f = lv * p_hi
     icr = normalised_critical_impulse(alpha)
@@ -246,31 +257,27 @@ def overturning_spectrum(base: BaseMotion, slenderness: float = 12.0, *, levels:
     tIp, beta = fit_inclined_line(f, lv)
     opts = dict(levels=int(levels), level_max=float(level_max), sizes=int(sizes), R_max_m=float(R_max_m),
                 R_min_m=float(R_min_m), refine=int(refine), criterion=criterion, free=free,
-                search=search, h_ph=h_ph, engine=engine)
+                search=search, max_p_dt=float(max_p_dt))
     return OASResult(levels=lv, R_m=R, p_rad_s=p, overturned=over, p_min_rad_s=p_hi,
                      R_unsafe_max_m=G / (alpha_I * p_hi ** 2), f_rad_s=f, f_min_rad_s=f_min,
                      t_I_s=t_I, t_I_prime_s=tIp, beta=beta, i_cr=icr, alpha_rad=alpha,
                      alpha_I=float(alpha_I), eta=eta_v, name=base.name, options=opts)
 
 
-def _runs(acc, dt, scale, p, args):
-    """Overturned flags of independent runs (record ``acc`` in g times ``scale``, blocks ``p``)."""
-    alpha, eta, crit, free_code, free_s, h_ph, engine, base = args
-    if engine == "rk4":
-        m = scale.size
-        o, _, _, _ = run_batch(acc, dt, scale, p, np.full(m, alpha), np.full(m, eta), crit, free_code,
-                               free_s, h_ph)
-        return o
-    from ._batch import simulate_batch
-
-    after = {0: 0.0, 1: 10.0, 2: free_s}[free_code]
-    # scale multiplies the record in g (rk4) or in m/s^2 (simulate_batch): the same factor
-    b = simulate_batch(p, alpha, base=base, scale=scale, eta=eta, dt_s=dt, free_after_s=after,
-                       fall_rad=alpha if crit == 0 else None)
-    return np.asarray(b.overturned, bool)
+def _runs(base, scale, p, args):
+    """Overturned flags of independent runs (``base`` times ``scale``, blocks ``p``) by ``simulate_batch``."""
+    alpha, eta, crit, free_code, free_s, max_p_dt = args
+    b = simulate_batch(p, alpha, base=base, scale=scale, eta=eta, dt_s=base.dt_s,
+                       free_after_s=free_s if free_code == 2 else 0.0,
+                       fall_rad=alpha if crit == 0 else None, max_p_dt=max_p_dt)
+    over = np.asarray(b.overturned, bool)
+    if free_code == 1:
+        rocking = b.status == 0
+        over = over | (rocking & free_rocking_overturns(b.theta_end_rad, b.omega_end_rad_s, p, alpha, eta))
+    return over
 
 
-def _bisect(acc, dt, scales, p_hi, p_lo, n, args):
+def _bisect(base, scales, p_hi, p_lo, n, args):
     """Geometric bisection of every level's bracket [p_lo safe, p_hi unsafe] at once."""
     p_hi = p_hi.copy()
     p_lo = p_lo.copy()
@@ -280,7 +287,7 @@ def _bisect(acc, dt, scales, p_hi, p_lo, n, args):
     idx = np.flatnonzero(m)
     for _ in range(int(n)):
         pm = np.sqrt(p_hi[idx] * p_lo[idx])
-        o = _runs(acc, dt, scales[idx], pm, args)
+        o = _runs(base, scales[idx], pm, args)
         p_hi[idx] = np.where(o, pm, p_hi[idx])
         p_lo[idx] = np.where(o, p_lo[idx], pm)
     return p_hi, p_lo
@@ -422,15 +429,15 @@ def overturning_curve(kind: str, slenderness: float, ptp, levels, *, n: int = 1,
         raise InputError("ptp and levels must be positive")
     over = np.zeros((lv.size, x.size), bool)
     amin = np.full(x.size, np.nan)
-    one = np.ones(1)
+    args = (alpha, eta_v, _CRIT[criterion], fc, fs, OAS_DEFAULTS["max_p_dt"])
     for j, tp in enumerate(x):
+        # dimensionless: p = 1 rad/s, the pulse in g (record in m/s^2 times level tan(alpha))
         dt = tp / samples_per_lobe
         t = np.arange(int(round(pulse_duration(kind, tp, n) / dt)) + 2) * dt
-        acc = np.ascontiguousarray(pulse_shape(kind, t, tp, n))
-        sc = lv * math.tan(alpha)
-        o, _ = run_grid(acc, dt, sc, one, alpha, eta_v, _CRIT[criterion], fc, fs, 0.05)
-        over[:, j] = o[:, 0]
-        hit = np.flatnonzero(o[:, 0])
+        base = BaseMotion.from_samples(G * pulse_shape(kind, t, tp, n), dt, name=kind)
+        o = _runs(base, lv * math.tan(alpha), np.ones(lv.size), args)
+        over[:, j] = o
+        hit = np.flatnonzero(o)
         if hit.size == 0:
             continue
         k = hit[0]
@@ -438,9 +445,7 @@ def overturning_curve(kind: str, slenderness: float, ptp, levels, *, n: int = 1,
         lo = lv[k - 1] if k > 0 else 1.0
         for _ in range(refine if lo < hi else 0):
             mid = 0.5 * (lo + hi)
-            om, _, _, _ = run_batch(acc, dt, np.array([mid * math.tan(alpha)]), one, np.array([alpha]),
-                                    np.array([eta_v]), _CRIT[criterion], fc, fs, 0.05)
-            if om[0]:
+            if _runs(base, np.array([mid * math.tan(alpha)]), np.ones(1), args)[0]:
                 hi = mid
             else:
                 lo = mid

@@ -183,7 +183,7 @@ class BatchResult:
     Attributes
     ----------
     overturned : ndarray of bool, shape (m,)
-        The block fell (|theta| reached pi/2).
+        The block fell (|theta| reached ``fall_rad``, default pi/2).
     overturn_t_s : ndarray, shape (m,)
         First time |theta| >= alpha with outward velocity, s (NaN if never).
     max_abs_theta_over_alpha : ndarray, shape (m,)
@@ -197,6 +197,12 @@ class BatchResult:
         Integration step actually used (after sub-stepping), s.
     n_steps : int
         Total block-steps integrated (for throughput figures).
+    theta_end_rad, omega_end_rad_s : ndarray, shape (m,)
+        State where each run ended (rad, rad/s; the sign of theta names the
+        pivot; 0, 0 at rest). Feed to :func:`free_rocking_overturns` for the
+        fate of blocks still rocking at the end.
+    t_end_s : ndarray, shape (m,)
+        Time each run ended (early at rest or overturning), s.
     """
 
     overturned: np.ndarray
@@ -210,6 +216,9 @@ class BatchResult:
     eta: np.ndarray
     dt_s: np.ndarray
     n_steps: int
+    theta_end_rad: np.ndarray
+    omega_end_rad_s: np.ndarray
+    t_end_s: np.ndarray
 
     def to_frame(self):
         """DataFrame, one row per run."""
@@ -219,4 +228,6 @@ class BatchResult:
                              "eta": self.eta, "dt_s": self.dt_s, "overturned": self.overturned,
                              "overturn_t_s": self.overturn_t_s,
                              "max_abs_theta_over_alpha": self.max_abs_theta_over_alpha,
-                             "n_impacts": self.n_impacts, "status": self.status})
+                             "n_impacts": self.n_impacts, "status": self.status,
+                             "theta_end_rad": self.theta_end_rad, "omega_end_rad_s": self.omega_end_rad_s,
+                             "t_end_s": self.t_end_s})

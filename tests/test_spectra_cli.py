@@ -50,7 +50,8 @@ def test_oas_json_csv_plot_and_many(run_cli, shared_data, tmp_path):
                          "--sizes", 30, "--workers", 1, "--no-progress", "--json", "-o", tmp_path / "t.csv")
     rows = json.loads(out)["records"]
     assert rc == 0 and rows[0]["t_I_s"] == pytest.approx(d["t_I_s"]) and rows[0]["error"] == ""
-    assert (tmp_path / "t.csv").read_text().startswith("record,t_p_s,t_I_s,t_I_prime_s,beta,f_min,error")
+    assert (tmp_path / "t.csv").read_text().startswith(
+        "record,t_p_s,t_I_s,t_I_prime_s,beta,f_min,f_min_level,f_min_R_m,error")
 
 
 def test_oas_bad_input(run_cli, shared_data, tmp_path):

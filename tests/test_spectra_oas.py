@@ -149,6 +149,8 @@ def test_tI_of_fema_pair_vs_table4(ff_oas):
     for s in (scan1, scan2):
         assert s.t_I_s == pytest.approx(s.i_cr / s.f_min_rad_s)
         assert np.nanmin(s.f_rad_s) == s.f_min_rad_s
+        lv, R = s.f_min_at  # the boundary point behind t_I: f = level p(R) (Eq. 13, 19)
+        assert lv * math.sqrt(G / (s.alpha_I * R)) == pytest.approx(s.f_min_rad_s, rel=1e-12)
     # the record's OAS has safe islands/bays inside the unsafe region (thesis Fig. 36a)
     rows = ["".join("X" if o else "." for o in r) for r in scan1.overturned]
     assert any("X.X" in r.strip(".") for r in rows)

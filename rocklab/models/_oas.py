@@ -154,10 +154,23 @@ class OASResult:
         return pd.DataFrame({"level": self.levels, "p_min_rad_s": self.p_min_rad_s,
                              "R_unsafe_max_m": self.R_unsafe_max_m, "f_rad_s": self.f_rad_s})
 
+    @property
+    def f_min_at(self) -> tuple[float, float]:
+        """Where t_I comes from: (a_p/a_p,min, R m) of the leftmost transformed-OAS point.
+
+        t_I rests on this one boundary point, so it is worth a look in the OAS plot
+        (a single chaotic verdict there moves t_I); NaN, NaN without any unsafe level.
+        """
+        if not np.isfinite(self.f_rad_s).any():
+            return float("nan"), float("nan")
+        i = int(np.nanargmin(self.f_rad_s))
+        return float(self.levels[i]), float(self.R_unsafe_max_m[i])
+
     def to_dict(self) -> dict:
         """Scalars and options (JSON-ready; arrays are in :meth:`to_frame`)."""
+        lv, R = self.f_min_at
         return dict(name=self.name, t_I_s=self.t_I_s, t_I_prime_s=self.t_I_prime_s, beta=self.beta,
-                    f_min=self.f_min_rad_s, i_cr=self.i_cr, alpha_rad=self.alpha_rad,
+                    f_min=self.f_min_rad_s, f_min_level=lv, f_min_R_m=R, i_cr=self.i_cr, alpha_rad=self.alpha_rad,
                     slenderness=1.0 / math.tan(self.alpha_rad), alpha_I=self.alpha_I, eta=self.eta,
                     options=dict(self.options))
 

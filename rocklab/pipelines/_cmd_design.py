@@ -145,8 +145,10 @@ def run_oas(args) -> int:
     if args.json:
         print(_dumps(d))
     else:
+        lv, R = o.f_min_at
         print(f"{rec.name}: t_I = {o.t_I_s:.4f} s, t'_I = {o.t_I_prime_s:.4f} s, beta = {o.beta:.3f}, "
-              f"f_min = {o.f_min_rad_s:.4f} 1/s (H/B = {args.slenderness:g})")
+              f"f_min = {o.f_min_rad_s:.4f} 1/s at a_p/a_p,min = {lv:.3f}, R = {R:.3f} m "
+              f"(H/B = {args.slenderness:g})")
     return 0
 
 

@@ -32,6 +32,14 @@ def plot_oas(o, path):
     ax[0].plot(P[ov], L[ov], ".", ms=1.5, color="0.6", label="overturns (grid)")
     ax[0].plot(o.p_min_rad_s, o.levels, "k-", lw=1.2, label="largest unsafe size")
     ax[0].set(xlabel="p [1/s]", ylabel="a_p / a_p,min", title=f"OAS {o.name}", xscale="log")
+    from matplotlib.ticker import LogLocator, NullFormatter, ScalarFormatter
+
+    ax[0].xaxis.set_major_locator(LogLocator(subs=(1.0, 2.0, 5.0)))  # 1, 2, 5, 10 ...: no crowding
+    ax[0].xaxis.set_major_formatter(ScalarFormatter())
+    ax[0].xaxis.set_minor_formatter(NullFormatter())
+    i = int(np.nanargmin(o.f_rad_s)) if np.isfinite(o.f_rad_s).any() else None
+    if i is not None:  # where t_I comes from
+        ax[0].plot(o.p_min_rad_s[i], o.levels[i], "o", mfc="none", color="C3", label="sets f_min")
     f = o.f_rad_s
     ax[1].plot(f, o.levels, "k.-", ms=3, label="transformed OAS")
     ax[1].axvline(o.f_min_rad_s, ls="--", color="C3", label=f"f_min: t_I = {o.t_I_s:.3f} s")

@@ -1,7 +1,7 @@
 """OAS and t_I of many records in parallel (local processes or a Dask cluster).
 
 Each record is one task: read it, compute its pulse parameters and OAS, return
-one summary row ``record, t_p_s, t_I_s, t_I_prime_s, beta, f_min``. Local runs
+one summary row ``record, t_p_s, t_I_s, t_I_prime_s, beta, f_min, f_min_level, f_min_R_m``. Local runs
 use :class:`concurrent.futures.ProcessPoolExecutor`; ``scheduler="tcp://host:port"``
 submits the same function to a ``dask.distributed`` cluster. A tqdm progress bar
 goes to stderr.
@@ -23,12 +23,14 @@ def oas_summary_row(path: str, units: str | None = None, slenderness: float = 12
     from ..models import load_base_motion, overturning_spectrum, pulse_parameters
 
     row = dict(record=str(path), t_p_s=math.nan, t_I_s=math.nan, t_I_prime_s=math.nan, beta=math.nan,
-               f_min=math.nan, error="")
+               f_min=math.nan, f_min_level=math.nan, f_min_R_m=math.nan, error="")
     try:
         rec = load_base_motion(path, units=units)
         row["t_p_s"] = pulse_parameters(rec).t_p_s
         o = overturning_spectrum(rec, slenderness, **(oas_kwargs or {}))
-        row.update(t_I_s=o.t_I_s, t_I_prime_s=o.t_I_prime_s, beta=o.beta, f_min=o.f_min_rad_s)
+        lv, R = o.f_min_at
+        row.update(t_I_s=o.t_I_s, t_I_prime_s=o.t_I_prime_s, beta=o.beta, f_min=o.f_min_rad_s,
+                   f_min_level=lv, f_min_R_m=R)
     except InputError as e:
         row["error"] = str(e)
     return row
@@ -92,4 +94,5 @@ def oas_many(paths, units: str | None = None, slenderness: float = 12.0, oas_kwa
                     bar.update()
     finally:
         bar.close()
-    return pd.DataFrame(rows, columns=["record", "t_p_s", "t_I_s", "t_I_prime_s", "beta", "f_min", "error"])
+    return pd.DataFrame(rows, columns=["record", "t_p_s", "t_I_s", "t_I_prime_s", "beta", "f_min", "f_min_level",
+                                       "f_min_R_m", "error"])

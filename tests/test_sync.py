@@ -105,3 +105,15 @@ def test_sync_events_from_impacts_of_two_imus(rocking):
     assert s.residual_ms < 3.0
     with pytest.raises(InputError, match=">= 2 events"):
         sync_events([1.0], [1.0, 2.0])
+
+
+def test_correlation_is_normalised_over_the_overlap():
+    # a camera that films only part of a longer IMU log: b is an exact, noise-free piece of a,
+    # so the normalised correlation at the true lag is 1 whatever a does outside b's span
+    # (normalised over the whole of a it was 0.50 here)
+    t = np.arange(0.0, 20.0, 1e-3)
+    rate = np.sin(2 * np.pi * (0.5 + 0.05 * t) * t)  # a chirp: one best lag
+    piece = (t > 4.0) & (t < 9.0)
+    s = sync_offset(t, rate, t[piece] - 4.0, rate[piece], drift=False)
+    assert s.offset_s == pytest.approx(4.0, abs=1e-3)
+    assert s.correlation == pytest.approx(1.0, abs=1e-3)

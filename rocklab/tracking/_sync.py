@@ -47,7 +47,8 @@ class SyncResult:
         RMS scatter of the window offsets about the clock model, ms (NaN with
         fewer than 3 usable windows).
     correlation : float
-        Peak normalised cross-correlation of the rates (0..1).
+        Peak normalised cross-correlation of the rates (0..1), normalised over
+        the overlap of the two spans at that lag.
     n_windows : int
         Windows with enough motion used for the drift / residual.
     window_t_s, window_offset_s : ndarray
@@ -132,7 +133,12 @@ def _coarse(span_a, fa, tb, yb, fs, max_offset_s, center=0.0):
     if max_offset_s is not None:
         c = np.where(np.abs(off - center) <= max_offset_s, c, np.nan)
     k = int(np.argmax(np.where(np.isfinite(c), np.abs(c), -np.inf)))
-    den = np.sqrt(np.sum(a * a) * np.sum(b * b)) or 1.0
+    # normalise over the overlap at this lag: signal outside the other's span (an IMU that
+    # logs on after the camera stops) says nothing about how well the two agree
+    lag = int(lags[k])
+    n0, n1 = max(0, lag), min(a.size, b.size + lag)
+    ao, bo = a[n0:n1], b[n0 - lag:n1 - lag]
+    den = np.sqrt(np.sum(ao * ao) * np.sum(bo * bo)) or 1.0
     corr = float(c[k] / den)
     if corr < 0:
         c = -c

@@ -5,8 +5,8 @@ Prints, in one process:
 
 1. wall time of the full default OAS of FEMA far-field FF-1 (Northridge, Beverly Hills MUL009,
    30 s at dt = 0.01 s) after a warm-up call that loads/compiles the kernel;
-2. the baseline: the same single-block runs by scipy ``solve_ivp`` (DOP853, events for impact
-   and overturning) on a random sample of the grid's rocking runs, the time per run of both,
+2. the baseline: the same single-block runs by ``simulate(method="event")`` (scipy
+   ``solve_ivp`` DOP853, events for impact and overturning) on a random sample of the grid's rocking runs, the time per run of both,
    the ratio, and how many sampled verdicts agree (the rest sit on the chaotic boundary).
 
 Falls back to the bundled El Centro record if ../shared is absent.
@@ -20,48 +20,18 @@ import time
 from pathlib import Path
 
 import numpy as np
-from scipy.integrate import solve_ivp
 
-from rocklab import G
-from rocklab.models import bundled_record, load_base_motion, overturning_spectrum
+from rocklab import Block, G
+from rocklab.models import bundled_record, load_base_motion, overturning_spectrum, simulate
 
 FF1 = Path(__file__).resolve().parents[2] / "shared/data/records/fema-p695-far-field/SortedEQFile_120111.txt"
 
 
-def ivp_run(t_rec, u, p, alpha, eta):
-    """Event-driven DOP853 run of the rocking equation under ``u`` (g); True if |theta| reaches alpha."""
-    thr = math.tan(alpha)
-    up = np.flatnonzero(np.abs(u) > thr)
-    if up.size == 0:
-        return False
-    t, s, y, T = t_rec[up[0]], -np.sign(u[up[0]]), [0.0, 0.0], t_rec[-1]
-    while t < T:
-        def rhs(t, y, s=s):
-            a = alpha * s - y[0]
-            return [y[1], -p * p * (math.sin(a) + np.interp(t, t_rec, u) * math.cos(a))]
-
-        def cross(t, y):
-            return y[0]
-        cross.terminal, cross.direction = True, -s
-
-        def over(t, y):
-            return abs(y[0]) - alpha
-        over.terminal = True
-        sol = solve_ivp(rhs, (t, T), y, method="DOP853", events=[cross, over], rtol=1e-9, atol=1e-11,
-                        max_step=t_rec[1] - t_rec[0])
-        if sol.t_events[1].size:
-            return True
-        if sol.status == 0:
-            return False
-        t, om = sol.t[-1], eta * sol.y[1, -1]
-        if abs(om) < 1e-7 * p:  # settled: wait for the next uplift
-            nxt = np.flatnonzero((np.abs(u) > thr) & (t_rec > t))
-            if nxt.size == 0:
-                return False
-            t, s, y = t_rec[nxt[0]], -np.sign(u[nxt[0]]), [0.0, 0.0]
-            continue
-        s, y, t = np.sign(om), [0.0, om], t + 1e-12
-    return False
+def ivp_run(block, base, eta):
+    """The package's event-driven reference (scipy solve_ivp DOP853 with impact events)."""
+    r = simulate(block, base=base, duration_s=float(base.t_s[-1]), method="event", restitution=eta,
+                 fall_rad=block.alpha_rad, rtol=1e-9)
+    return bool(r.overturned)
 
 
 def main() -> int:
@@ -81,15 +51,15 @@ def main() -> int:
 
     # baseline in the same process: solve_ivp on a sample of grid runs that uplift
     alpha = o.alpha_rad
-    u = rec.acc_m_s2 / G
     rng = np.random.default_rng(1)
     rows = np.flatnonzero(o.levels > 1.5)
     sample = [(int(rng.choice(rows)), int(rng.integers(o.p_rad_s.size))) for _ in range(12)]
     t0 = time.perf_counter()
     agree = 0
     for i, j in sample:
-        scale = o.levels[i] * math.tan(alpha) / np.abs(u).max()
-        agree += ivp_run(rec.t_s, scale * u, o.p_rad_s[j], alpha, o.eta) == bool(o.overturned[i, j])
+        block = Block.general(G / (o.alpha_I * o.p_rad_s[j] ** 2), alpha, o.alpha_I)
+        base = rec.scaled(o.levels[i] * math.tan(alpha) * G / rec.pga_m_s2)
+        agree += ivp_run(block, base, o.eta) == bool(o.overturned[i, j])
     t_ivp = (time.perf_counter() - t0) / len(sample)
     print(f"baseline solve_ivp DOP853 + events: {1e3 * t_ivp:.1f} ms/run on {len(sample)} sampled grid "
           f"runs (levels > 1.5); OAS is {t_ivp / (t_oas / n_runs):.0f}x faster per run (2 cores); "

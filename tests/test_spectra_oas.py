@@ -92,6 +92,10 @@ def test_free_rocking_verdict_equals_integration():
     assert np.array_equal(verdict[past][inward] | (e[inward] >= p[past][inward] ** 2),
                           np.ones(inward.sum(), bool))
     assert not free_rocking_overturns(0.0, 0.0, 2.0, 0.2, 1.0)  # at rest
+    for bad in (dict(p_rad_s=0.0), dict(alpha_rad=2.0), dict(eta=1.5), dict(theta_rad=np.nan)):
+        kw = dict(theta_rad=0.1, omega_rad_s=0.0, p_rad_s=2.0, alpha_rad=0.2, eta=0.9) | bad
+        with pytest.raises(InputError, match="free_rocking_overturns"):
+            free_rocking_overturns(**kw)
 
 
 def test_short_pulse_impulse_tends_to_critical_impulse():

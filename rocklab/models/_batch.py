@@ -147,8 +147,18 @@ def free_rocking_overturns(theta_rad, omega_rad_s, p_rad_s, alpha_rad, eta) -> n
         beyond the top too slow to come back over it, counts as overturning;
         a block at rest (theta = omega = 0) never does.
     """
-    th, w, p, a, e = np.broadcast_arrays(*(np.asarray(x, float) for x in
-                                           (theta_rad, omega_rad_s, p_rad_s, alpha_rad, eta)))
+    try:
+        th, w, p, a, e = np.broadcast_arrays(*(np.asarray(x, float) for x in
+                                               (theta_rad, omega_rad_s, p_rad_s, alpha_rad, eta)))
+    except (ValueError, TypeError) as err:
+        raise InputError(f"free_rocking_overturns: arguments do not broadcast ({err}); give equal "
+                         "lengths or scalars") from None
+    if not (np.all(np.isfinite(th)) and np.all(np.isfinite(w))):
+        raise InputError("free_rocking_overturns: theta_rad and omega_rad_s must be finite")
+    if not np.all((p > 0) & np.isfinite(p)) or not np.all((a > 0) & (a < _HALF_PI)):
+        raise InputError("free_rocking_overturns: need p_rad_s > 0 and 0 < alpha_rad < pi/2")
+    if not np.all(np.abs(e) <= 1):
+        raise InputError("free_rocking_overturns: |eta| must be <= 1")
     p2 = p * p
     ath = np.abs(th)
     energy = 0.5 * w * w + p2 * np.cos(a - ath)

@@ -22,7 +22,11 @@ equation (several impacts per step are allowed).
 Free rocking (full equation, no base record or past its end) runs its steps
 between impacts in the lean loop :func:`~rocklab.models._newmark_free.free_steps`
 (same trapezoidal step, solved by a jerk-corrected predictor and a checked
-fixed-point update); impacts, rest and overturning are always handled here.
+fixed-point update), rocking under the record in its twin
+:func:`~rocklab.models._newmark_forced.forced_steps`, and steps at rest in which
+the base stays below the uplift level in a short scan; impacts, uplift,
+overturning and anything else the lean loops decline are handled by the
+general step here (``lean=False``: every step, the reference in the tests).
 The kernels compile with ``fastmath={"contract"}``: multiply-adds are fused
 (rounding only; no reassociation or other fast-math liberties).
 
@@ -39,12 +43,14 @@ from numba import njit, prange
 
 from ..blocks import G
 from ._newmark_contact import contact_tau, cross_fraction
+from ._newmark_forced import forced_steps
 from ._newmark_free import free_steps, sdcd
 from ._numba_cache import drop_stale_cache
 
 
-# run_block compiles in the kernels of _newmark_free and _newmark_contact (see _numba_cache)
-drop_stale_cache("_newmark.*.nbi", ("_newmark_free.py", "_newmark_contact.py", "_newmark.py"))
+# run_block compiles in the kernels of _newmark_free, _newmark_forced and _newmark_contact (see _numba_cache)
+drop_stale_cache("_newmark.*.nbi", ("_newmark_free.py", "_newmark_forced.py", "_newmark_contact.py",
+                                    "_newmark.py"))
 
 #: Status codes returned by the kernel.
 ROCKING, REST, OVERTURNED, NO_UPLIFT = 0, 1, 2, 3
@@ -150,7 +156,7 @@ def _energy(th, w, cc, cos_a, p2, alpha, lin):
 @njit(cache=True, fastmath={"contract"})
 def run_block(p, alpha, theta0, omega0, h, n_steps, acc, acc_t0, acc_dt, scale,
               eta_mode, eta_x, eta_y, lin, rest_w2, t_last_uplift, stop_at_rest,
-              out_every, imp_cap, fall_rad=_HALF_PI, stop_on_fall=True, e_scale=1.0):
+              out_every, imp_cap, fall_rad=_HALF_PI, stop_on_fall=True, e_scale=1.0, lean=True):
     """Integrate one block for n_steps steps of h (s).
 
     Returns
@@ -165,6 +171,7 @@ def run_block(p, alpha, theta0, omega0, h, n_steps, acc, acc_t0, acc_dt, scale,
         ``t_end`` (s, last time integrated); ``theta_end``, ``omega_end`` (state at
         ``t_end``, rad and rad/s; 0, 0 at rest). The run always ends when |theta|
         reaches pi/2 (the side hits the ground), and at fall_rad when stop_on_fall.
+        ``lean=False`` takes every step in the general loop (reference for tests).
     """
     p2 = p * p
     tan_a = math.tan(alpha)
@@ -219,12 +226,46 @@ def run_block(p, alpha, theta0, omega0, h, n_steps, acc, acc_t0, acc_dt, scale,
     # in the lean loop of _newmark_free; anything else (impact in the step,
     # |theta| >= alpha, rest) is left to the general step below, which takes that
     # step from the same state. One sample of margin keeps _ug_at's rounding out.
+    # Under the record the same holds for _newmark_forced (steps ending inside the record;
+    # its fixed-point update needs the contraction L = p^2 (1 + max|ug|) h^2 / 4 small).
     t_free = acc_t0 + acc.shape[0] * acc_dt if acc.shape[0] > 0 else -np.inf
+    lip = 1.0
+    if acc.shape[0] > 1:
+        L = 0.25 * h * h * p2 * (1.0 + np.max(np.abs(acc)) * abs(fac))
+        lip = L / (1.0 - L) if L < 0.5 else 1.0
     while step < n_steps:
-        if not lin and not resting and step * h > t_free and abs(th) < alpha:
-            th, w, a, sc, cc, step, max_abs, n_out, countdown = free_steps(
-                th, w, a, sc, cc, s, step, n_steps, h, p2, alpha, cos_a, max_abs, out_th, out_w, out_e,
-                n_out, countdown, out_every, e_scale)
+        if lean and not lin and not resting and abs(th) < alpha:
+            if step * h > t_free:
+                th, w, a, sc, cc, step, max_abs, n_out, countdown = free_steps(
+                    th, w, a, sc, cc, s, step, n_steps, h, p2, alpha, cos_a, max_abs, out_th, out_w, out_e,
+                    n_out, countdown, out_every, e_scale)
+            elif lip < 0.01:
+                th, w, a, sc, cc, step, max_abs, n_out, countdown = forced_steps(
+                    th, w, a, sc, cc, s, step, n_steps, h, p2, alpha, cos_a, max_abs, out_th, out_w, out_e,
+                    n_out, countdown, out_every, e_scale, acc, acc_t0, inv_dta, fac, lip)
+                u_prev = _ug_at(step * h, acc, acc_t0, inv_dta, fac)
+            t_end = step * h
+            if step >= n_steps:
+                break
+        elif lean and resting:
+            # at rest: skip the steps that end with the base below the uplift level (and
+            # before the last uplift when runs stop at rest); the general step takes the next one
+            while step < n_steps:
+                t1 = (step + 1) * h
+                if stop_at_rest and t1 >= t_last_uplift:
+                    break
+                u1 = _ug_at(t1, acc, acc_t0, inv_dta, fac)
+                if abs(u1) > tan_a:
+                    break
+                step += 1
+                u_prev = u1
+                countdown -= 1
+                if countdown == 0:
+                    countdown = out_every
+                    out_th[n_out] = th
+                    out_w[n_out] = w
+                    out_e[n_out] = 0.0
+                    n_out += 1
             t_end = step * h
             if step >= n_steps:
                 break
@@ -363,16 +404,19 @@ def run_block(p, alpha, theta0, omega0, h, n_steps, acc, acc_t0, acc_dt, scale,
 
 @njit(cache=True)
 def run_single(p, alpha, theta0, omega0, h, n_steps, acc, acc_t0, acc_dt, eta_mode, eta_x, eta_y, lin,
-               rest_w2, t_last_uplift, stop_at_rest, out_every, imp_cap, fall_rad, e_scale):
+               rest_w2, t_last_uplift, stop_at_rest, out_every, imp_cap, fall_rad, e_scale, lean=True):
     """:func:`run_block` for ``simulate``: output times and a contiguous impact table in the same call.
 
     Returns ``t, theta, omega, energy`` (n_out,; energy times ``e_scale``),
     ``imp`` (4, k) C-contiguous, ``n_imp``, ``status``, ``t_over``, ``t_fall``,
-    ``max_abs`` (one dispatch from Python instead of several numpy calls).
+    ``max_abs`` (one dispatch from Python instead of several numpy calls). ``lean=False``:
+    general loop only (see :func:`run_block`).
     """
+    # writeable law tables and typed (non-literal) flags: the same run_block signature as
+    # run_batch's, so the kernel compiles once for both (a second specialisation: ~15 CPU-s cold)
     th, w, e, n_out, imp, n_imp, st, t_over, t_fall, max_abs, t_end, _, _ = run_block(
-        p, alpha, theta0, omega0, h, n_steps, acc, acc_t0, acc_dt, 1.0, eta_mode, eta_x, eta_y, lin, rest_w2,
-        t_last_uplift, stop_at_rest, out_every, imp_cap, fall_rad, True, e_scale)
+        p, alpha, theta0, omega0, h, n_steps, acc, acc_t0, acc_dt, 1.0, eta_mode, eta_x.copy(), eta_y.copy(), lin,
+        rest_w2, t_last_uplift, stop_at_rest, out_every, imp_cap, fall_rad, np.bool_(True), e_scale, np.bool_(lean))
     t = np.empty(n_out)
     dto = h * out_every
     for i in range(n_out):
@@ -408,6 +452,10 @@ def run_batch(p, alpha, th0, w0, eta, h, n_steps, acc, acc_t0, acc_dt, scale, re
     th_end = np.zeros(m)
     w_end = np.zeros(m)
     ex = np.zeros(1)
+    # typed (non-literal) constants: literal 0/True/False would make numba compile a second
+    # specialisation of run_block next to run_single's (compile time only)
+    zero = np.int64(0)
+    no, yes = np.bool_(False), np.bool_(True)
     for i in prange(m):
         a = alpha[i]
         p2 = p[i] * p[i]
@@ -418,7 +466,7 @@ def run_batch(p, alpha, th0, w0, eta, h, n_steps, acc, acc_t0, acc_dt, scale, re
         ey[0] = eta[i]
         fr = fall_rad[i]
         r = run_block(p[i], a, th0[i], w0[i], h[i], n_steps[i], acc, acc_t0, acc_dt, scale[i],
-                      0, ex, ey, False, rest_w2, t_last, True, 0, 0, fr, stop_on_fall)
+                      zero, ex, ey, no, rest_w2, t_last, yes, zero, zero, fr, stop_on_fall, 1.0, yes)
         nimp[i] = r[5]
         status[i] = r[6]
         t_over[i] = r[7]

@@ -1,0 +1,210 @@
+"""Numba: the lean time loop of :func:`~rocklab.models._newmark.run_block` under a base record.
+
+The same idea as the free-rocking loop (:mod:`._newmark_free`) with the base
+acceleration ``u = ug/g`` in the equation,
+``theta'' = f(theta, u) = -p^2 (sin c + u cos c)``, ``c = alpha s - theta``:
+
+- ``u`` at the end of each step is the record's linear interpolation at
+  ``t = (step + 1) h`` (the general loop's ``ug(t)``): the general loop's formula
+  at the first step end in each record interval, then ``+ k du`` for the k-th
+  step after it on the same straight segment (rounding-level differences);
+- ``-p^2 sin c`` and ``-p^2 cos c`` are both carried at an anchor and shifted by
+  their Taylor series (multiplied out, Estrin's scheme, for one step of a
+  rocking block), ``f = -p^2 sin c + u (-p^2 cos c)``; exact sin/cos every
+  1024 steps against drift;
+- the predictor ``h w0 + h^2/4 (a0 + a_pred)`` takes
+  ``a_pred = a0 + h (f_theta w0 + f_u u')``, then one fixed-point step of the
+  trapezoidal equation, accepted when its contraction bound
+  ``L/(1-L) |x1 - x|`` (``L = p^2 (1 + max|u|) h^2 / 4``) is below
+  ``1e-15 (|theta0| + |x|)``, as in the free loop.
+
+The result is the trapezoidal (Newmark beta = 1/4) step of the general loop to
+rounding. The loop returns (without taking the step) whenever anything else could
+happen: theta reaching 0 (impact: exact contact time in the general loop),
+|theta| >= alpha, an increment too large for the Taylor shift, slow convergence,
+or a step end outside the record (before its first sample or at/after its last).
+
+Kept in its own module to keep ``_newmark.py`` short; ``_newmark`` drops its
+on-disk numba cache when this file is newer (numba only tracks the caller's file).
+"""
+
+from __future__ import annotations
+
+import math
+
+from numba import njit
+
+from ._newmark_free import sdcd
+
+
+@njit(cache=True, inline="always", fastmath={"contract"})
+def ug_inside(t, acc, t0, inv_dta, fac):
+    """Base acceleration * fac at t (the general loop's interpolation) and whether t is inside the record.
+
+    Inside means ``t0 <= t < t_last``; there the value is the same expression as
+    ``_newmark._ug_at``. Outside: ``(0.0, False)``.
+    """
+    x = (t - t0) * inv_dta
+    if not (x >= 0.0 and x < acc.shape[0] - 1):
+        return 0.0, False
+    i = int(x)
+    f = x - i
+    return (acc[i] * (1.0 - f) + acc[i + 1] * f) * fac, True
+
+
+@njit(cache=True, inline="always", fastmath={"contract"})
+def ug_ramp(j, h, acc, t0, inv_dta, fac):
+    """u at the end of step j, ``t = (j + 1) h`` (:func:`ug_inside`), and the ramp it lies on.
+
+    Returns ``u, ok, du, k_max``: u at the end of step ``j + k`` is ``u + k du``
+    for ``k <= k_max`` (same record interval; one step of margin against rounding).
+    """
+    t = (j + 1) * h
+    x = (t - t0) * inv_dta
+    if not (x >= 0.0 and x < acc.shape[0] - 1):
+        return 0.0, False, 0.0, -1.0
+    i = int(x)
+    f = x - i
+    r = h * inv_dta
+    k_max = math.floor((i + 1 - x) / r) - 1.0
+    return (acc[i] * (1.0 - f) + acc[i + 1] * f) * fac, True, (acc[i + 1] - acc[i]) * fac * r, k_max
+
+
+@njit(cache=True, fastmath={"contract"})
+def forced_steps(th, w, a, sc, cc, s, step, n_steps, h, p2, alpha, cos_a, max_abs, out_th, out_w, out_e,
+                 n_out, countdown, out_every, e_scale, acc, acc_t0, inv_dta, fac, lip):
+    """Whole steps under the record from ``step`` on, as long as none needs the general loop.
+
+    State in and out as :func:`~rocklab.models._newmark_free.free_steps` (theta
+    ``th`` rad on side ``s``, omega ``w`` rad/s, theta'' ``a`` rad/s^2, ``sc, cc``
+    = sin, cos of ``alpha s - th``, step counter, running max |theta|, output
+    buffers with fill count and countdown). The record: ``acc`` (n,) m/s^2 from
+    ``acc_t0`` s every ``1/inv_dta`` s, times ``fac`` = scale/g. ``lip`` is the
+    fixed-point contraction bound L/(1-L) (< 0.01; the caller checks).
+
+    Returns
+    -------
+    tuple
+        ``th, w, a, sc, cc, step, max_abs, n_out, countdown`` after the last step
+        taken (the next step, if any, is left to the general loop).
+    """
+    u1, ok1 = ug_inside((step + 1) * h, acc, acc_t0, inv_dta, fac)
+    if not ok1:
+        return th, w, a, sc, cc, step, max_abs, n_out, countdown
+    # u at the end of the next step: ua + k du on the current record interval
+    ua, ok2, du, k_max = ug_ramp(step + 1, h, acc, acc_t0, inv_dta, fac)
+    k = -1.0  # the loop's first increment gives k = 0: u at the end of step + 1
+    u0, ok0 = ug_inside(step * h, acc, acc_t0, inv_dta, fac)
+    if not ok0:
+        u0 = u1
+    hh2 = 0.5 * h * h
+    hh4 = 0.25 * h * h
+    h2 = 0.5 * h
+    hh4h = hh4 * h
+    mp2 = -p2
+    p2cos_a = p2 * cos_a
+    # psn, pcc = -p^2 (sin, cos) of c at the anchor theta_a = th - off
+    psn = mp2 * sc
+    pcc = mp2 * cc
+    off = 0.0
+    x = (h - hh4h * (pcc - u1 * psn)) * w + hh2 * a + hh4 * pcc * (u1 - u0)
+    xr = x
+    broke = False
+    while step < n_steps and not broke:
+        # blocks of up to 1024 steps, each followed by a re-anchoring with libm sin/cos
+        lim = min(n_steps, (step | 1023) + 1)
+        broke = True
+        while step < lim:
+            if not ok1:
+                break
+            # u at the end of the next step (off the dependency chain; exact at each record interval)
+            if k < k_max:
+                k += 1.0
+            else:
+                ua, ok2, du, k_max = ug_ramp(step + 1, h, acc, acc_t0, inv_dta, fac)
+                k = 0.0
+            u2 = ua + k * du if ok2 else u1
+            if abs(xr) < 2e-4:
+                # -p^2 sin c and -p^2 cos c at the anchor + xr: Taylor shift (errors xr^5/120,
+                # xr^6/720) multiplied out and evaluated by Estrin's scheme
+                x2 = xr * xr
+                sn = (psn - pcc * xr) + x2 * ((-0.5 * psn + (pcc * (1.0 / 6.0)) * xr) + x2 * (psn * (1.0 / 24.0)))
+                cn = (pcc + psn * xr) + x2 * ((-0.5 * pcc - (psn * (1.0 / 6.0)) * xr) + x2 * (pcc * (1.0 / 24.0)))
+            elif abs(xr) < 0.2:
+                sd, cd = sdcd(xr)
+                sn = psn * cd - pcc * sd
+                cn = pcc * cd + psn * sd
+            else:
+                break
+            a1 = sn + u1 * cn
+            base = h * w + hh4 * a
+            x1 = base + hh4 * a1
+            dl = x1 - x
+            tol = 1e-15 * (abs(th) + abs(x))
+            if lip * abs(dl) > tol:
+                ok = False
+                for _ in range(60):
+                    x = x1
+                    xr = x + off
+                    if not abs(xr) < 0.2:
+                        break
+                    sd, cd = sdcd(xr)
+                    sn = psn * cd - pcc * sd
+                    cn = pcc * cd + psn * sd
+                    a1 = sn + u1 * cn
+                    x1 = base + hh4 * a1
+                    dl = x1 - x
+                    if lip * abs(dl) <= tol:
+                        ok = True
+                        break
+                if not ok:
+                    break
+            th1 = th + x1
+            if th1 * s <= 0.0 or abs(th1) >= alpha:
+                break
+            # next predictor: a_pred = a1 + h (f_theta w1 + f_u u'), f_theta = u psn - pcc,
+            # f_u = pcc (old anchor: it only has to be close)
+            kw = h + hh4h * (u1 * psn - pcc)
+            wa = w + h2 * a
+            q = kw * h2 + hh2
+            kwa = kw * wa + hh4 * pcc * (u2 - u1)
+            # next evaluation point from the new anchor, x_next + dl, as one multiply-add after a1
+            xr = (kwa + (base - x)) + (q + hh4) * a1
+            x = kwa + q * a1
+            w = wa + h2 * a1
+            a = a1
+            th = th1
+            # the anchor moves to the evaluation point; theta1 lies dl beyond it
+            psn = sn
+            pcc = cn
+            off = dl
+            u1 = u2
+            ok1 = ok2
+            step += 1
+            ath = abs(th)
+            if ath > max_abs:
+                max_abs = ath
+            countdown -= 1
+            if countdown == 0:
+                countdown = out_every
+                out_th[n_out] = th
+                out_w[n_out] = w
+                # -p^2 cos c at theta1 = anchor + off
+                if abs(off) < 1e-8:
+                    pc1 = pcc + psn * off
+                else:
+                    sd, cd = sdcd(off)
+                    pc1 = pcc * cd + psn * sd
+                out_e[n_out] = (0.5 * w * w - pc1 - p2cos_a) * e_scale
+                n_out += 1
+            if step == lim:
+                broke = False
+        if not broke:
+            # re-anchor at theta1 against rounding drift of the carried sin/cos
+            psn = mp2 * math.sin(alpha * s - th)
+            pcc = mp2 * math.cos(alpha * s - th)
+            off = 0.0
+            xr = x
+    sc = math.sin(alpha * s - th)
+    cc = math.cos(alpha * s - th)
+    return th, w, a, sc, cc, step, max_abs, n_out, countdown

@@ -13,20 +13,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-import rocklab.models._single as single_mod
 from rocklab import Block
-from rocklab.models import BaseMotion, bundled_record, simulate
-from rocklab.models._newmark import run_single
-
-
-def _run(lean, blk, **kw):
-    """simulate() with the kernel's lean loops on or off (same compiled kernel both ways)."""
-    orig = single_mod.run_single
-    single_mod.run_single = lambda *args: run_single(*args, lean)
-    try:
-        return simulate(blk, **kw)
-    finally:
-        single_mod.run_single = orig
+from rocklab.models import BaseMotion, bundled_record
 
 
 def _compare(fast, gen, th_tol=1e-10):
@@ -58,11 +46,11 @@ def elcentro():
     (Block(0.3, 1.5), 1.2, 12.0, {"fall_rad": "alpha"}),               # overturns (|theta| >= alpha) at 9.1 s
     (Block(0.045, 0.2025), 1.0, 5.0, {}),                              # B6M: falls over (pi/2) at 2.8 s
 ])
-def test_forced_loop_equals_general_loop_elcentro(elcentro, blk, scale, T, extra):
+def test_forced_loop_equals_general_loop_elcentro(simulate_loop, elcentro, blk, scale, T, extra):
     if extra.get("fall_rad") == "alpha":
         extra = dict(extra, fall_rad=blk.alpha_rad)
     kw = dict(theta0_rad=0.0, base=elcentro.scaled(scale), duration_s=T, dt_s=1e-4, **extra)
-    fast, gen = _run(True, blk, **kw), _run(False, blk, **kw)
+    fast, gen = simulate_loop(True, blk, **kw), simulate_loop(False, blk, **kw)
     assert fast.n_impacts >= 3
     _compare(fast, gen)
     if "fall_rad" in extra:
@@ -70,20 +58,20 @@ def test_forced_loop_equals_general_loop_elcentro(elcentro, blk, scale, T, extra
         assert abs(fast.overturn_t_s - gen.overturn_t_s) <= 1e-9
 
 
-def test_difference_is_rounding_amplified_by_the_dynamics(elcentro):
+def test_difference_is_rounding_amplified_by_the_dynamics(simulate_loop, elcentro):
     # under a record a rocking response amplifies any rounding-level change: the lean loop may
     # differ from the general loop by no more than a 1e-15 relative change of the record does
     blk, kw = Block(0.5, 3.0), dict(theta0_rad=0.0, duration_s=20.0, dt_s=5e-4, stop_at_rest=False)
-    fast = _run(True, blk, base=elcentro.scaled(1.5), **kw)
-    gen = _run(False, blk, base=elcentro.scaled(1.5), **kw)
-    pert = _run(False, blk, base=elcentro.scaled(1.5 * (1 + 1e-15)), **kw)
+    fast = simulate_loop(True, blk, base=elcentro.scaled(1.5), **kw)
+    gen = simulate_loop(False, blk, base=elcentro.scaled(1.5), **kw)
+    pert = simulate_loop(False, blk, base=elcentro.scaled(1.5 * (1 + 1e-15)), **kw)
     assert fast.n_impacts == gen.n_impacts == pert.n_impacts >= 20
     d_fast = np.max(np.abs(fast.theta_rad - gen.theta_rad))
     d_pert = np.max(np.abs(pert.theta_rad - gen.theta_rad))
     assert 0.0 < d_fast <= 10.0 * d_pert + 1e-13
 
 
-def test_coarse_record_late_start_and_free_tail():
+def test_coarse_record_late_start_and_free_tail(simulate_loop):
     # record samples every 0.02 s (200 steps per interval, u(t) stepped along each straight
     # segment), starting at 0.3 s: free rocking before it, then the record, then free rocking
     dt_rec = 0.02
@@ -93,6 +81,6 @@ def test_coarse_record_late_start_and_free_tail():
     rec = BaseMotion.from_samples(a, dt_rec, "m/s2", t0_s=0.3, name="coarse")
     blk = Block(0.15, 0.9)
     kw = dict(theta0_rad=0.3 * blk.alpha_rad, base=rec, duration_s=4.0, dt_s=1e-4, stop_at_rest=False)
-    fast, gen = _run(True, blk, **kw), _run(False, blk, **kw)
+    fast, gen = simulate_loop(True, blk, **kw), simulate_loop(False, blk, **kw)
     assert fast.n_impacts >= 5
     _compare(fast, gen)

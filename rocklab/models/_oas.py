@@ -221,7 +221,7 @@ def overturning_spectrum(base: BaseMotion, slenderness: float = 12.0, *, levels:
         Newmark steps with exact impacts). Verdicts near the boundary are chaotic:
         on FEMA FF-1, 0.02 / 0.005 / 0.002 / 0.001 disagree with 0.0005 on
         1.1 / 0.55 / 0.35 / 0.18 % of the 9600 grid runs; 0.001 is the default
-        (about 8 CPU-s for a 30 s record, 4 s on 2 cores).
+        (about 2 CPU-s for a 30 s record, 1.5 s on 2 cores).
 
     Returns
     -------

@@ -34,7 +34,7 @@ import math
 
 from numba import njit
 
-from ._newmark_free import sdcd
+from ._newmark_free import sdcd, store_sample
 
 
 @njit(cache=True, inline="always", fastmath={"contract"})
@@ -187,16 +187,7 @@ def forced_steps(th, w, a, sc, cc, s, step, n_steps, h, p2, alpha, cos_a, max_ab
             countdown -= 1
             if countdown == 0:
                 countdown = out_every
-                out_th[n_out] = th
-                out_w[n_out] = w
-                # -p^2 cos c at theta1 = anchor + off
-                if abs(off) < 1e-8:
-                    pc1 = pcc + psn * off
-                else:
-                    sd, cd = sdcd(off)
-                    pc1 = pcc * cd + psn * sd
-                out_e[n_out] = (0.5 * w * w - pc1 - p2cos_a) * e_scale
-                n_out += 1
+                n_out = store_sample(out_th, out_w, out_e, n_out, th, w, off, psn, pcc, p2cos_a, e_scale)
             if step == lim:
                 broke = False
         if not broke:

@@ -61,6 +61,25 @@ def sdcd(d):
     return sd, cd
 
 
+@njit(cache=True, inline="always", fastmath={"contract"})
+def store_sample(out_th, out_w, out_e, n_out, th, w, off, psn, pcc, p2cos_a, e_scale):
+    """Write one output sample of a lean loop; returns the new fill count.
+
+    ``psn, pcc`` are -p^2 (sin, cos) of c at the loop's anchor and ``off`` the
+    distance of theta from it, so the energy needs no libm call.
+    """
+    out_th[n_out] = th
+    out_w[n_out] = w
+    # -p^2 cos c at theta = anchor + off
+    if abs(off) < 1e-8:
+        pc1 = pcc + psn * off
+    else:
+        sd, cd = sdcd(off)
+        pc1 = pcc * cd + psn * sd
+    out_e[n_out] = (0.5 * w * w - pc1 - p2cos_a) * e_scale
+    return n_out + 1
+
+
 @njit(cache=True, fastmath={"contract"})
 def free_steps(th, w, a, sc, cc, s, step, n_steps, h, p2, alpha, cos_a, max_abs, out_th, out_w, out_e,
                n_out, countdown, out_every, e_scale):
@@ -158,16 +177,7 @@ def free_steps(th, w, a, sc, cc, s, step, n_steps, h, p2, alpha, cos_a, max_abs,
             countdown -= 1
             if countdown == 0:
                 countdown = out_every
-                out_th[n_out] = th
-                out_w[n_out] = w
-                # -p^2 cos c at theta1 = anchor + off
-                if abs(off) < 1e-8:
-                    pc1 = pcc + psc * off
-                else:
-                    sd, cd = sdcd(off)
-                    pc1 = pcc * cd + psc * sd
-                out_e[n_out] = (0.5 * w * w - pc1 - p2cos_a) * e_scale
-                n_out += 1
+                n_out = store_sample(out_th, out_w, out_e, n_out, th, w, off, psc, pcc, p2cos_a, e_scale)
             if step == lim:
                 broke = False
         if not broke:

@@ -22,9 +22,15 @@ def atomic_path(path, suffix: str | None = None):
 
     On an exception the temporary file is removed and ``path`` is untouched.
     """
+    from ._errors import InputError
+    from ._outdir import clean_stale, stale_prefix
+
     path = Path(path)
+    if path.is_dir():
+        raise InputError(f"{path}: is a folder; give a file name for this output")
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=suffix or path.suffix or ".tmp",
+    clean_stale(path.parent, path.name)  # leftovers of a killed writer of this same file
+    fd, tmp = tempfile.mkstemp(prefix=stale_prefix(path.name, "tmp"), suffix=suffix or path.suffix or ".tmp",
                                dir=path.parent)
     os.close(fd)
     try:

@@ -45,7 +45,8 @@ def test_campaign_recovers_eta_mat_and_reports_failure(tmp_path, run_cli):
 
     out = tmp_path / "out"
     rc, stdout, err = run_cli("campaign", root, "--out", out, "--workers", "2", "--no-progress", "--json")
-    assert rc == 0, err
+    assert rc == 1, err  # one experiment failed: the campaign finishes the rest but says so
+    assert "1 of 4 experiments FAILED" not in err  # the summary goes to stdout, not stderr
     def strict(c):  # NaN/Infinity are not JSON; the CLI must write null
         raise ValueError(f"non-JSON constant {c} in the --json output")
 
@@ -63,6 +64,9 @@ def test_campaign_recovers_eta_mat_and_reports_failure(tmp_path, run_cli):
     (row,) = [r for r in res["k_table"]["per_block"] if r["block"] == "B4M"]
     assert row["k"] == pytest.approx(k_expect, abs=0.01)
     tab = pd.read_csv(out / "campaign.csv")
+    (failed,) = tab[tab["status"] == "failed"].itertuples()  # the failure is listed, with its error
+    assert failed.experiment == "broken" and "missing.csv" in failed.error
+    assert res["status"] == "partial" and res["n_failed"] == 1
     for _, r in tab.iterrows():
         if r["experiment"] in truth:
             assert r["eta_e"] == pytest.approx(truth[r["experiment"]], abs=0.002)

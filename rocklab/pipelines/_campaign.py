@@ -9,6 +9,8 @@ spans enough blocks, ``campaign.csv``, figures and ``campaign.rrd``.
 
 from __future__ import annotations
 
+import os
+
 import json
 import traceback
 from concurrent.futures import ProcessPoolExecutor, as_completed
@@ -18,9 +20,14 @@ from pathlib import Path
 import numpy as np
 
 from .._errors import InputError
+from .._procs import dask_client, pool_initializer
 from .._io import write_frame_atomic, write_json_atomic
 
 __all__ = ["CampaignResult", "run_campaign", "find_experiments"]
+
+
+#: What a campaign writes in its output folder.
+CAMPAIGN_ENTRIES = ("experiments", "campaign.csv", "campaign.json", "campaign.rrd", "figures")
 
 
 def find_experiments(root) -> list[Path]:
@@ -81,9 +88,23 @@ class CampaignResult:
         """Number of experiments that ran without failing."""
         return sum(1 for r in self.runs if r["ok"])
 
+    @property
+    def ok_table(self):
+        """Rows of :attr:`table` for the experiments that did not fail."""
+        t = self.table
+        if t is None or not len(t):
+            return t
+        return t[t["status"] != "failed"].reset_index(drop=True)
+
+    @property
+    def n_failed(self) -> int:
+        """Number of experiments that failed (they are listed in ``campaign.csv`` with their error)."""
+        return len(self.runs) - self.n_ok
+
     def to_dict(self) -> dict:
         """Plain dict of the fields, JSON-ready (SI units in the keys)."""
         return {"out_dir": str(self.out_dir), "n_experiments": len(self.runs), "n_ok": self.n_ok,
+                "n_failed": self.n_failed, "status": "ok" if self.n_failed == 0 else "partial",
                 "failures": [{"config": r["config"], "error": r["error"]} for r in self.runs if not r["ok"]],
                 "experiments": self.table.to_dict(orient="records") if self.table is not None else [],
                 "eta_mat": self.eta_mat, "k_table": self.k_table, "messages": list(self.messages)}
@@ -91,7 +112,7 @@ class CampaignResult:
     def summary_text(self) -> str:
         """The table the CLI prints: per experiment η_H, η_e ± CI, η_M, truth; then the campaign fits."""
         lines = [f"campaign: {self.n_ok}/{len(self.runs)} experiments ok; outputs in {self.out_dir}"]
-        t = self.table
+        t = self.ok_table
         if t is not None and len(t):
             lines.append(f"{'experiment':<22}{'block':<7}{'contact':<8}{'eta_H':>8}{'eta_e':>8}"
                          f"{'95% CI':>18}{'eta_M':>8}{'truth':>8}")
@@ -127,21 +148,28 @@ class CampaignResult:
                 lines.append(f"FAILED {r['config']}: {r['error']}")
         for m in self.messages:
             lines.append(f"note: {m}")
+        if self.n_failed:
+            lines.append(f"{self.n_failed} of {len(self.runs)} experiments FAILED (listed in campaign.csv "
+                         "with status 'failed'); exit status 1")
         lines.append(f"look: {self.out_dir / 'campaign.csv'}, {self.out_dir / 'figures'}, "
                      f"rerun {self.out_dir / 'campaign.rrd'}")
         return "\n".join(lines)
 
 
-def _row(run: dict) -> dict | None:
+def _row(run: dict) -> dict:
     rep = run.get("report")
-    if not rep:
-        return None
+    if not rep:  # a failed experiment is a row too, so campaign.csv shows it with its error
+        return {"experiment": Path(run["config"]).parent.name, "status": "failed",
+                "error": str(run.get("error") or "")[:300], "config": run["config"], "out": run["out"]}
     b = rep["block"]
     fit = rep.get("fit") or {}
     ci = fit.get("ci95_eta_e") or [np.nan, np.nan]
     sims = rep.get("simulations") or {}
     truth = rep.get("truth") or {}
-    return {"experiment": rep["name"], "block": b.get("name") or rep["name"], "b_m": b["b_m"], "h_m": b["h_m"],
+    warn_codes = sorted({w["code"] for w in rep.get("warnings") or []})
+    return {"experiment": rep["name"], "status": rep.get("status"),
+            "error": "; ".join(warn_codes), "config": run["config"],
+            "block": b.get("name") or rep["name"], "b_m": b["b_m"], "h_m": b["h_m"],
             "hb": b["h_m"] / b["b_m"], "contact": rep["contact"]["type"], "l_c_m": rep["contact"]["l_c_m"],
             "eta_H": b["eta_H"], "eta_e": fit.get("eta_e", np.nan),
             "ci_lo": ci[0] if ci[0] is not None else np.nan, "ci_hi": ci[1] if ci[1] is not None else np.nan,
@@ -189,9 +217,12 @@ def run_campaign(root, out_dir, *, workers: int = 2, scheduler: str | None = Non
     import pandas as pd
     from tqdm import tqdm
 
+    from .._outdir import check_output_dir, claim_dir
+
     root = Path(root).resolve()
     configs = find_experiments(root)
-    out_dir = Path(out_dir).resolve()
+    out_dir = check_output_dir(out_dir, force=force, need_bytes=len(configs) * 30 * 1024 * 1024)
+    claim_dir(out_dir, CAMPAIGN_ENTRIES, command="campaign")
     jobs = []
     for c in configs:
         rel = c.parent.relative_to(root) if c.parent != root else Path(c.stem)
@@ -199,11 +230,10 @@ def run_campaign(root, out_dir, *, workers: int = 2, scheduler: str | None = Non
     runs = []
     bar = tqdm(total=len(jobs), desc="campaign", unit="exp", disable=not progress)
     if scheduler:
-        try:
-            from dask.distributed import Client, as_completed as das_completed
-        except ImportError:
-            raise InputError("--scheduler needs dask[distributed]: pip install 'rocklab[dask]'") from None
-        with Client(scheduler) as client:
+        client = dask_client(scheduler)
+        from dask.distributed import as_completed as das_completed
+
+        with client:
             futs = [client.submit(_one, *j, pure=False) for j in jobs]
             for f in das_completed(futs):
                 runs.append(f.result())
@@ -215,20 +245,21 @@ def run_campaign(root, out_dir, *, workers: int = 2, scheduler: str | None = Non
     else:
         import multiprocessing as mp
 
-        with ProcessPoolExecutor(max_workers=workers, mp_context=mp.get_context("spawn")) as ex:
+        with ProcessPoolExecutor(max_workers=workers, mp_context=mp.get_context("spawn"),
+                                 initializer=pool_initializer, initargs=(os.getpid(),)) as ex:
             futs = [ex.submit(_one, *j) for j in jobs]
             for f in as_completed(futs):
                 runs.append(f.result())
                 bar.update(1)
     bar.close()
     runs.sort(key=lambda r: r["config"])
-    rows = [r for r in (_row(x) for x in runs) if r is not None]
-    table = pd.DataFrame(rows)
+    table = pd.DataFrame([_row(x) for x in runs])
     msgs: list[str] = []
     eta_mat = k_tab = None
-    if len(table):
+    good = table[table["status"] != "failed"] if len(table) else table
+    if len(good):
         try:
-            eta_mat, k_tab = _campaign_fits(table, msgs)
+            eta_mat, k_tab = _campaign_fits(good.reset_index(drop=True), msgs)
         except InputError as e:
             msgs.append(f"campaign fits not done: {e}")
     res = CampaignResult(out_dir=out_dir, runs=runs, table=table, eta_mat=eta_mat, k_table=k_tab, messages=msgs)
@@ -249,7 +280,8 @@ def _write_campaign(res: CampaignResult) -> None:
         reg = KRegression.ceh2018()
         if res.k_table and res.k_table.get("coefficients"):
             reg = KRegression.from_coefficients(res.k_table["coefficients"])
-        campaign_figures(res.table, out / "figures", regression=reg)
+        if len(res.ok_table):
+            campaign_figures(res.ok_table, out / "figures", regression=reg)
         _campaign_rrd(res, out / "campaign.rrd")
     write_json_atomic(out / "campaign.json", json.loads(json.dumps(res.to_dict(), default=str)))
 
@@ -258,11 +290,11 @@ def _campaign_rrd(res: CampaignResult, path: Path) -> None:
     import rerun as rr
 
     from .._io import atomic_path
-    from ._rerun import campaign_blueprint, open_recording
+    from ._rerun import campaign_blueprint, close_recording, open_recording
 
     with atomic_path(path, suffix=".rrd") as tmp:
         rec = open_recording("rocklab", tmp, recording_id="campaign")
-        t = res.table
+        t = res.ok_table
         for _, r in t.iterrows():
             # h/b on a sequence timeline so the viewer plots η against slenderness
             rec.set_time("h_over_b_x1000", sequence=int(round(1000 * r["hb"])))
@@ -276,5 +308,4 @@ def _campaign_rrd(res: CampaignResult, path: Path) -> None:
                 f"η_H = {r['eta_H']:.4f}"))
         rec.reset_time()
         rec.send_blueprint(campaign_blueprint())
-        rec.flush()
-        rec.disconnect()
+        close_recording(rec, tmp)

@@ -4,15 +4,27 @@ Each subcommand group lives in its own ``_cmd_<name>.py`` module exposing
 ``register(subparsers)``; the module imports heavy dependencies (OpenCV, Rerun,
 numba kernels) inside its handler so ``rocklab --help`` stays fast.
 
-Bad input (:class:`rocklab.InputError`, a missing file) prints one line on
-stderr and exits with status 2, never a traceback.
+Exit status (the policy scripts rely on):
+
+- 0: the command ran; its result is ``ok`` or ``suspect`` (every plausibility
+  warning is one line on stderr, ``rocklab CMD: warning W-CODE: ...``, and in the
+  JSON output's ``warnings`` list); with ``--strict`` a suspect result exits 4;
+- 1: the command ran but (part of) its result failed: a failed fit, a campaign
+  with a failed experiment (the others are still reported);
+- 2: bad input, or an output that cannot be written: one line on stderr naming
+  the file/line or parameter, the rule and the fix; nothing is written;
+- 3: an internal error (a bug): one line, ``--debug`` shows the traceback;
+- 4: ``--strict`` and a warning of severity ``suspect``;
+- 130/143: interrupted (Ctrl-C / SIGTERM); staged outputs are removed.
 """
 
 from __future__ import annotations
 
 import argparse
+import errno
 import importlib
 import sys
+import threading
 
 from .._errors import InputError
 
@@ -35,31 +47,108 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = _Parser(prog="rocklab", description="Rocking-block experiments to calibrated physics.")
     p.add_argument("--version", action="version", version=f"rocklab {__version__}")
+    p.add_argument("--debug", action="store_true", help="show Python tracebacks and numerical warnings")
+    p.add_argument("--strict", action="store_true", help="exit 4 when a result is suspect (any W- warning "
+                                                         "of severity suspect)")
     sub = p.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     for mod in COMMAND_MODULES:
         importlib.import_module(f"{__package__}.{mod}").register(sub)
     return p
 
 
+def _check_file_outputs(args) -> None:
+    """Output files named on the command line are checked before any work starts."""
+    from .._outdir import check_output_file
+
+    for attr, opt in (("output", "-o"), ("plot", "--plot"), ("maps_png", "--maps-png")):
+        v = getattr(args, attr, None)
+        if v:
+            check_output_file(v, opt)
+    if args.command not in FOLDER_COMMANDS and getattr(args, "out", None):
+        check_output_file(args.out, "-o/--out")
+
+
+#: Commands whose ``--out`` is a folder (checked by :func:`rocklab._outdir.check_output_dir`).
+FOLDER_COMMANDS = ("run", "campaign", "synth", "demo")
+
+_ERRNO_FIX = {
+    errno.ENOSPC: "no space left on the device; free space or choose another output location",
+    errno.EACCES: "permission denied; choose a location you can write to (or read)",
+    errno.EROFS: "read-only file system; choose another output location",
+    errno.EISDIR: "is a folder; give a file name",
+    errno.ENOTDIR: "a part of the path is a file, not a folder; check the path",
+    errno.ENOENT: "file not found; check the path",
+    errno.EDQUOT: "disk quota exceeded; free space or choose another output location",
+}
+
+
+def _os_error_line(e: OSError) -> str:
+    name = e.filename or ""
+    fix = _ERRNO_FIX.get(e.errno, f"{e.strerror or e}; check the path")
+    return f"{name}: {fix}" if name else fix
+
+
+def _on_sigterm(signum, frame):  # a killed run removes its staged outputs on the way out
+    raise SystemExit(143)
+
+
 def main(argv=None) -> int:
-    """Run the CLI on ``argv`` (default ``sys.argv[1:]``); returns the exit status (2: bad input)."""
+    """Run the CLI on ``argv`` (default ``sys.argv[1:]``); returns the exit status (see the module doc)."""
+    import signal
+    import warnings
+
+    from .._diagnostics import collecting
+
     parser = build_parser()
     args = parser.parse_args(argv)
     if not getattr(args, "func", None):
         parser.print_help()
         return 2
+    cmd = args.command
+    if threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGTERM, _on_sigterm)
+
+    def echo(d):
+        sys.stderr.write(d.line(cmd) + "\n")
+        sys.stderr.flush()
+
     try:
-        rc = args.func(args)
+        with warnings.catch_warnings(), collecting(echo=echo) as diags:
+            if not args.debug:  # numpy's RuntimeWarnings name source paths; results carry W- codes instead
+                warnings.simplefilter("ignore", RuntimeWarning)
+            _check_file_outputs(args)
+            rc = int(args.func(args) or 0)
     except InputError as e:
-        sys.stderr.write(f"rocklab {args.command}: error: {e}\n")
-        return 2
-    except FileNotFoundError as e:
-        sys.stderr.write(f"rocklab {args.command}: error: {e.filename or e}: file not found; check the path\n")
+        sys.stderr.write(f"rocklab {cmd}: error: {e}\n")
         return 2
     except KeyboardInterrupt:
-        sys.stderr.write("rocklab: interrupted\n")
+        sys.stderr.write(f"rocklab {cmd}: interrupted; staged outputs removed\n")
         return 130
-    return int(rc or 0)
+    except SystemExit:
+        raise
+    except MemoryError:
+        sys.stderr.write(f"rocklab {cmd}: error: not enough memory for this request; reduce its size "
+                         "(duration, grid, frames)\n")
+        return 2
+    except UnicodeDecodeError as e:
+        sys.stderr.write(f"rocklab {cmd}: error: an input is not a text file ({e.reason} at byte {e.start}); "
+                         "give the CSV/text file the option expects\n")
+        return 2
+    except OSError as e:
+        if args.debug:
+            raise
+        sys.stderr.write(f"rocklab {cmd}: error: {_os_error_line(e)}\n")
+        return 2
+    except Exception as e:  # noqa: BLE001 - a bug: one line, not a traceback
+        if args.debug:
+            raise
+        msg = str(e).splitlines()[0][:200] if str(e) else ""
+        sys.stderr.write(f"rocklab {cmd}: internal error: {type(e).__name__}: {msg} "
+                         "(run with --debug for the traceback, and please report it)\n")
+        return 3
+    if rc == 0 and args.strict and any(d.severity == "suspect" for d in diags):
+        return 4
+    return rc
 
 
 if __name__ == "__main__":  # pragma: no cover

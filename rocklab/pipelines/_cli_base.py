@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from .._errors import InputError
 
-__all__ = ["add_base_motion_args", "base_motion_from_args"]
+__all__ = ["add_base_motion_args", "base_motion_from_args", "emit_json"]
 
 
 def add_base_motion_args(p) -> None:
@@ -26,3 +26,23 @@ def base_motion_from_args(args):
     if args.scale_pga is not None:
         base = base.scaled_to_pga(args.scale_pga, args.units or "g")
     return base
+
+
+def emit_json(obj: dict) -> None:
+    """Print ``obj`` as one JSON line on stdout, with the warnings raised so far.
+
+    Adds ``warnings`` (the :class:`rocklab._diagnostics.Diagnostic` dicts collected by the
+    CLI) and turns a ``status`` of ``"ok"`` into ``"suspect"`` when one of them is.
+    """
+    import sys
+
+    from .._diagnostics import _active, worst_status
+    from .._io import dumps_json
+
+    sink = _active.get()
+    diags = list(sink[0]) if sink is not None else []
+    out = dict(obj)
+    out["warnings"] = [d.to_dict() for d in diags]
+    if isinstance(out.get("status"), str):
+        out["status"] = worst_status(out["status"], diags)
+    sys.stdout.write(dumps_json(out) + "\n")

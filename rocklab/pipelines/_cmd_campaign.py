@@ -24,9 +24,9 @@ def run(args) -> int:
     res = run_campaign(args.dir, args.out, workers=args.workers, scheduler=args.scheduler,
                        force=args.force, progress=not args.no_progress)
     if args.json:
-        from .._io import dumps_json
+        from ._cli_base import emit_json
 
-        print(dumps_json(res.to_dict()))
+        emit_json(res.to_dict())
     else:
         print(res.summary_text())
-    return 0 if res.n_ok > 0 else 1
+    return 0 if res.n_failed == 0 else 1

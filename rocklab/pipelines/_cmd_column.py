@@ -114,9 +114,9 @@ def run(args) -> int:
     if args.maps_png is not None:
         out["maps"] = _maps(args)
     if args.json:
-        from .._io import dumps_json
+        from ._cli_base import emit_json
 
-        sys.stdout.write(dumps_json(out) + "\n")
+        emit_json(out)
         return 0
     if args.blocks is not None:
         _print_summary(res, out)

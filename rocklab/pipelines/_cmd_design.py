@@ -18,7 +18,7 @@ import sys
 from .._errors import InputError
 
 
-from .._io import dumps_json as _dumps
+from ._cli_base import emit_json as _emit
 
 
 def register(sub):
@@ -93,7 +93,7 @@ def run_pulse(args) -> int:
     pp = pulse_parameters(load_base_motion(args.record, units=args.units))
     d = pp.to_dict()
     if args.json:
-        print(_dumps(d))
+        _emit(d)
     else:
         print(f"{pp.name}: a_max = {pp.a_max_m_s2:.4f} m/s2, I_max = {pp.I_max_m_s:.4f} m/s, "
               f"t_p = {pp.t_p_s:.4f} s (lobe {pp.lobe_start_s:.2f}-{pp.lobe_end_s:.2f} s)")
@@ -126,7 +126,7 @@ def run_oas(args) -> int:
         if args.out:
             write_frame_atomic(args.out, tab)
         if args.json:
-            print(_dumps({"records": tab.to_dict(orient="records")}))
+            _emit({"records": tab.to_dict(orient="records")})
         else:
             print(tab.to_string(index=False))
         return 0 if (tab["error"] == "").all() else 1
@@ -143,7 +143,7 @@ def run_oas(args) -> int:
     d = o.to_dict()
     d["t_p_s"] = pulse_parameters(rec).t_p_s
     if args.json:
-        print(_dumps(d))
+        _emit(d)
     else:
         lv, R = o.f_min_at
         print(f"{rec.name}: t_I = {o.t_I_s:.4f} s, t'_I = {o.t_I_prime_s:.4f} s, beta = {o.beta:.3f}, "
@@ -166,7 +166,7 @@ def run_design(args) -> int:
              width_slender_m=required_width_slender(args.height, ag, args.tI, **kw),
              width_no_uplift_m=2 * c * args.height * args.ag, cm_height_ratio=c, alpha_I=aI, g_m_s2=g)
     if args.json:
-        print(_dumps(d))
+        _emit(d)
     else:
         print(f"required width {d['width_m']:.4f} m (Eq. 21 exact; i_cr = 1: {d['width_eq31_m']:.4f} m, "
               f"slender: {d['width_slender_m']:.4f} m, no uplift: {d['width_no_uplift_m']:.4f} m)")
@@ -212,7 +212,7 @@ def run_equivalent(args) -> int:
         extra = {"hinges": list(info["hinges"]), "faces": info["faces"]}
     out.update(extra)
     if args.json:
-        print(_dumps(out))
+        _emit(out)
     else:
         keys = ("p_rad_s", "theta_cr_rad", "lambda", "lambda_lin", "eta", "kappa1", "kappa2", "phi_cr_rad")
         print(f"{mech}: " + ", ".join(f"{k} = {out[k]:.5g}" for k in keys))

@@ -74,9 +74,9 @@ def _common(p):
 
 def _emit(args, payload: dict, text: str) -> None:
     if args.json:
-        from .._io import dumps_json
+        from ._cli_base import emit_json
 
-        sys.stdout.write(dumps_json(payload) + "\n")
+        emit_json(payload)
     else:
         sys.stdout.write(text + "\n")
 

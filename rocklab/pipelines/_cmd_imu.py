@@ -56,9 +56,9 @@ def run(args) -> int:
         write_frame_atomic(args.out, res.to_frame())
         summary["output"] = str(args.out)
     if args.json:
-        from .._io import dumps_json
+        from ._cli_base import emit_json
 
-        print(dumps_json(summary))
+        emit_json(summary)
         return 0
     out = sys.stdout
     out.write(f"{summary['source']}: {summary['format']}, {summary['n_samples']} samples at "

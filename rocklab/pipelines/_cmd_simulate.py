@@ -74,9 +74,9 @@ def run(args) -> int:
         write_frame_atomic(args.output, res.to_frame())
     d = res.to_dict()
     if args.json:
-        from .._io import dumps_json
+        from ._cli_base import emit_json
 
-        sys.stdout.write(dumps_json(d) + "\n")
+        emit_json(d)
     else:
         over = "" if d["overturn_t_s"] is None else f", passed alpha at t = {d['overturn_t_s']:.4f} s"
         sys.stdout.write(

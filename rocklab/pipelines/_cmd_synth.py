@@ -72,9 +72,9 @@ def run(args) -> int:
                       progress=args.progress)
     d = s.to_dict()
     if args.json:
-        from .._io import dumps_json
+        from ._cli_base import emit_json
 
-        sys.stdout.write(dumps_json(d) + "\n")
+        emit_json(d)
     else:
         sys.stdout.write(f"wrote {d['n_frames']} frames ({d['size'][0]}x{d['size'][1]}, {d['fps']:g} fps) "
                          f"and truth for {', '.join(d['objects'])} to {d['out_dir']} "

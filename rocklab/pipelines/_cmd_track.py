@@ -56,9 +56,9 @@ def run(args) -> int:
             write_frame_atomic(tpath, tm.to_frame(), float_format="%.9g")
             summary["table_motion"] = {**tm.to_dict(), "csv": str(tpath)}
     if args.json:
-        from .._io import dumps_json
+        from ._cli_base import emit_json
 
-        print(dumps_json(summary))
+        emit_json(summary)
     else:
         for oid, d in summary["objects"].items():
             print(f"{oid}: {d['n_ok']}/{res.n_frames} frames ok, "

@@ -23,10 +23,12 @@ block, η_H, η_e ± CI, η_M and the truth.
 
 from __future__ import annotations
 
+import os
+
 import time
 from pathlib import Path
 
-from .._errors import InputError
+from .._procs import pool_initializer
 
 __all__ = ["DEMO_RUNS", "make_demo_campaign", "run_demo"]
 
@@ -125,7 +127,8 @@ def make_demo_campaign(root, *, size=(960, 540), fps: float = 50.0, progress: bo
             if not (root / name / "experiment.toml").is_file()]
     bar = tqdm(total=len(todo), desc="demo: render sessions", unit="session", disable=not progress)
     if workers > 1 and len(todo) > 1:
-        with ProcessPoolExecutor(max_workers=workers, mp_context=mp.get_context("spawn")) as ex:
+        with ProcessPoolExecutor(max_workers=workers, mp_context=mp.get_context("spawn"),
+                                 initializer=pool_initializer, initargs=(os.getpid(),)) as ex:
             for f in [ex.submit(_render_one, *job) for job in todo]:
                 f.result()
                 bar.update(1)
@@ -142,9 +145,10 @@ def run_demo(out_dir="demo_out", *, workers: int = 2, progress: bool = True, siz
     """Make the demo campaign under ``out_dir/sessions`` and run it into ``out_dir/results``."""
     from ._campaign import run_campaign
 
-    out_dir = Path(out_dir)
-    if out_dir.exists() and not out_dir.is_dir():
-        raise InputError(f"--out {out_dir}: exists and is not a folder; choose another path")
+    from .._outdir import check_output_dir, claim_dir
+
+    out_dir = check_output_dir(out_dir, need_bytes=300 * 1024 * 1024)
+    claim_dir(out_dir, ("sessions", "results"), command="demo")
     t0 = time.perf_counter()
     make_demo_campaign(out_dir / "sessions", size=size, progress=progress, runs=runs, workers=workers)
     t1 = time.perf_counter()

@@ -12,10 +12,10 @@ no-op unless ``force=True``.
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import json
 import shutil
-import tempfile
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -79,6 +79,7 @@ class ExperimentResult:
     frames: object = None  # optional per-frame overlay data from the tracker
     column: dict | None = None  # column experiments: see rocklab.pipelines._column_run
     video_jpeg: list | None = None  # (frame index, JPEG bytes) of the frames to show in Rerun
+    diagnostics: tuple = ()  # rocklab._diagnostics.Diagnostic raised while analysing
 
     def to_dict(self) -> dict:
         """The numbers of ``report.json`` (units in keys)."""
@@ -87,6 +88,7 @@ class ExperimentResult:
             "name": self.name,
             "status": self.status,
             "messages": list(self.messages),
+            "warnings": [d.to_dict() for d in self.diagnostics],
             "block": {k: v for k, v in b.to_dict().items()},
             "contact": {"type": self.config.contact, "l_c_m": self.config.l_c_m, "k": self.config.k},
             "primary_source": self.primary,
@@ -455,8 +457,10 @@ def run_experiment(config_path, out_dir, *, force: bool = False, spawn: bool = F
     ran : bool
         False when the inputs and config were unchanged and nothing was done.
     """
+    from .._outdir import check_output_dir, publish_dir, stage_dir
+
     cfg = load_experiment(config_path)
-    out_dir = Path(out_dir).resolve()
+    out_dir = check_output_dir(out_dir, force=force, need_bytes=_space_needed(cfg))
     fp = fingerprint(cfg)
     rep_path = out_dir / "report.json"
     if not force and rep_path.is_file():
@@ -466,23 +470,38 @@ def run_experiment(config_path, out_dir, *, force: bool = False, spawn: bool = F
             old = {}
         if old.get("fingerprint") == fp:
             return old, False
-    res = analyse_experiment(cfg, progress=progress, keep_video=cfg.rrd or spawn or bool(connect))
-    out_dir.parent.mkdir(parents=True, exist_ok=True)
-    stage = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.tmp-", dir=out_dir.parent))
+    from .._diagnostics import collecting, worst_status
+
+    with collecting(echo=_echo_warning) as diags:
+        res = analyse_experiment(cfg, progress=progress, keep_video=cfg.rrd or spawn or bool(connect))
+    if diags:
+        res = dataclasses.replace(res, status=worst_status(res.status, diags),
+                                  diagnostics=tuple(diags))
+    stage = stage_dir(out_dir)
     try:
         report = write_outputs(res, stage, fp, spawn=spawn, connect=connect, progress=progress)
-        _swap_into_place(stage, out_dir)
+        publish_dir(stage, out_dir, command="run")
     except BaseException:
         shutil.rmtree(stage, ignore_errors=True)
         raise
     return report, True
 
 
-def _swap_into_place(stage: Path, out_dir: Path) -> None:
-    if out_dir.exists():
-        old = out_dir.with_name(f".{out_dir.name}.old-{int(time.time() * 1e6)}")
-        out_dir.rename(old)
-        stage.rename(out_dir)
-        shutil.rmtree(old, ignore_errors=True)
-    else:
-        stage.rename(out_dir)
+def _echo_warning(d) -> None:
+    """Diagnostics of a run reach stderr as they are found (the CLI's own echo is not active in workers)."""
+    import sys
+
+    sys.stderr.write(d.line("run") + "\n")
+    sys.stderr.flush()
+
+
+def _space_needed(cfg: ExperimentConfig) -> int:
+    """Bytes an experiment's outputs may take: 20 MB of tables and figures plus, for the Rerun
+    recording, half the size of the video (JPEG frames at the tracker's decimation)."""
+    need = 20 * 1024 * 1024
+    if cfg.rrd and cfg.video is not None:
+        try:
+            need += Path(cfg.video.path).stat().st_size // 2
+        except OSError:
+            pass
+    return need

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._rerun import experiment_blueprint, log_events, log_series, log_video_frames, open_recording
+from ._rerun import close_recording, experiment_blueprint, log_events, log_series, log_video_frames, open_recording
 
 __all__ = ["log_experiment"]
 
@@ -128,6 +128,5 @@ def log_experiment(res, rrd_path=None, *, spawn: bool = False, connect: str | No
         if bar is not None:
             bar.close()
     rec.send_blueprint(experiment_blueprint(block_paths, has_video=has_video))
-    rec.flush()
-    rec.disconnect()
+    close_recording(rec, rrd_path)
     return rows

@@ -83,6 +83,8 @@ def _summary_md(res, figs: dict, rrd: bool) -> str:
             lines += [f"Measured sequence vs truth: same sequence = {st['same_sequence']} "
                       f"({st['n_matched']}/{st['n_measured']} events)"]
         lines.append("")
+    for d in res.diagnostics:
+        lines.append(f"- **warning {d.code}**: {d.message}")
     for m in res.messages:
         lines.append(f"- note: {m}")
     lines += ["", "## Figures", ""] + [f"![{k}](figures/{p.name})" for k, p in figs.items()]

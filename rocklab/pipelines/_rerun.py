@@ -27,7 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["open_recording", "log_series", "log_events", "log_video_frames", "read_rrd_scalars",
+__all__ = ["open_recording", "close_recording", "log_series", "log_events", "log_video_frames", "read_rrd_scalars",
            "experiment_blueprint", "campaign_blueprint", "read_rrd_summary"]
 
 TIMELINE = "time"
@@ -61,6 +61,30 @@ def open_recording(app_id: str, rrd_path=None, spawn: bool = False, connect: str
     if sinks:
         rec.set_sinks(*sinks)
     return rec
+
+
+#: Longest wait for a Rerun sink to take the logged data, s. A full disk or a gone
+#: viewer must fail the run, not hang it.
+FLUSH_TIMEOUT_S = 60.0
+
+
+def close_recording(rec, rrd_path=None) -> None:
+    """Flush ``rec`` (bounded by :data:`FLUSH_TIMEOUT_S`) and disconnect it.
+
+    Raises
+    ------
+    OSError
+        The ``.rrd`` file was not written (full disk, folder gone).
+    """
+    import errno
+
+    rec.flush(timeout_sec=FLUSH_TIMEOUT_S)
+    rec.disconnect()
+    if rrd_path is not None:
+        p = Path(rrd_path)
+        if not p.is_file() or p.stat().st_size == 0:
+            raise OSError(errno.EIO, "the Rerun recording was not written (disk full or folder removed?)",
+                          str(p))
 
 
 def log_series(rec, path: str, t_s, values, *, color=None, name: str | None = None) -> int:

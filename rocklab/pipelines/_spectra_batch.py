@@ -13,6 +13,8 @@ import math
 import os
 import sys
 
+from .._procs import dask_client, pool_initializer
+
 __all__ = ["oas_summary_row", "oas_many"]
 
 
@@ -73,9 +75,9 @@ def oas_many(paths, units: str | None = None, slenderness: float = 12.0, oas_kwa
     args = (units, slenderness, oas_kwargs)
     try:
         if scheduler:
-            from dask.distributed import Client, as_completed
+            from dask.distributed import as_completed
 
-            with Client(scheduler) as client:
+            with dask_client(scheduler) as client:
                 futs = {client.submit(oas_summary_row, p, *args, pure=False): i for i, p in enumerate(paths)}
                 for f in as_completed(futs):
                     rows[futs[f]] = f.result()
@@ -87,7 +89,8 @@ def oas_many(paths, units: str | None = None, slenderness: float = 12.0, oas_kwa
         else:
             from concurrent.futures import ProcessPoolExecutor, as_completed
 
-            with ProcessPoolExecutor(max_workers=workers, initializer=_one_numba_thread) as ex:
+            with ProcessPoolExecutor(max_workers=workers, initializer=pool_initializer,
+                                     initargs=(os.getpid(), _one_numba_thread)) as ex:
                 futs = {ex.submit(oas_summary_row, p, *args): i for i, p in enumerate(paths)}
                 for f in as_completed(futs):
                     rows[futs[f]] = f.result()

@@ -25,10 +25,8 @@ from __future__ import annotations
 import contextlib
 import json
 import math
-import os
 import shutil
 import sys
-import tempfile
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -141,12 +139,13 @@ def _check(seed, blocks, table, fps, targets, duration_s, exposure_s, noise_dn):
 
 
 def _prepare_out(out_dir: Path, force: bool) -> Path:
-    if out_dir.exists() and not out_dir.is_dir():
-        raise InputError(f"{out_dir}: exists and is not a folder; choose another --out")
+    from .._outdir import check_output_dir, stage_dir
+
+    out_dir = check_output_dir(out_dir, force=force, need_bytes=200 * 1024 * 1024)
     if out_dir.is_dir() and any(out_dir.iterdir()) and not force:
-        raise InputError(f"{out_dir}: folder is not empty; choose a new --out or pass --force to replace it")
-    out_dir.parent.mkdir(parents=True, exist_ok=True)
-    return Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.", suffix=".tmp", dir=out_dir.parent))
+        raise InputError(f"--out {out_dir}: folder is not empty; choose a new --out or pass --force to "
+                         "replace rocklab's files in it (nothing else is deleted)")
+    return stage_dir(out_dir)
 
 
 def synth_session(out_dir, seed: int = 0, blocks: int = 1, table: str = "none", fps: float = 50.0,
@@ -245,12 +244,9 @@ def synth_session(out_dir, seed: int = 0, blocks: int = 1, table: str = "none", 
         from .._io import write_json_atomic
 
         write_json_atomic(tmp / "session.json", meta)
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o777 & ~umask)          # mkdtemp made it private
-        if out_dir.exists():
-            shutil.rmtree(out_dir)
-        os.replace(tmp, out_dir)
+        from .._outdir import publish_dir
+
+        publish_dir(tmp, out_dir, command="synth")
     except BaseException:
         shutil.rmtree(tmp, ignore_errors=True)
         raise

@@ -1,0 +1,169 @@
+"""Plausibility warnings: named, documented, never silent.
+
+Anything that degrades a result without making it impossible (a record of
+implausible amplitude, a step too coarse for the block, a gap in a measured
+track, an IMU whose axes disagree) is reported as a :class:`Diagnostic` with a
+code from :data:`WARNING_CODES`. Severity ``"suspect"`` means the number may
+be wrong and the result's status becomes ``"suspect"``; ``"note"`` means the
+result stands but the user should know.
+
+Where the diagnostic goes depends on the caller:
+
+- inside :func:`collecting` (the CLI, the experiment pipeline) it is appended to
+  the active list and echoed (the CLI prints ``rocklab CMD: warning W-CODE: ...``
+  on stderr as one line);
+- otherwise it is raised through Python's :mod:`warnings` as a
+  :class:`RocklabWarning`, so a library user sees it too.
+
+Results that carry a status also carry the diagnostics they raised
+(``warnings`` in their ``to_dict()``).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import contextvars
+import warnings
+from dataclasses import dataclass
+
+__all__ = ["Diagnostic", "RocklabWarning", "WARNING_CODES", "warn", "collecting", "worst_status",
+           "codes_markdown"]
+
+#: Every warning code: (severity, what it means and what to check). Documented in
+#: ``docs/warnings.md`` (generated from this table by :func:`codes_markdown`).
+WARNING_CODES: dict[str, tuple[str, str]] = {
+    # records
+    "W-RECORD-PGA": ("suspect", "peak acceleration above 5 g: usually a unit error (g read as m/s^2, "
+                                "cm/s^2 read as g); check the units field or --units"),
+    "W-RECORD-DT": ("suspect", "sample step above 0.05 s: too coarse for an earthquake record and "
+                               "often a wrong DT; check the header"),
+    "W-RECORD-SHORT": ("suspect", "record shorter than one cycle of its own main pulse or of 1 s; "
+                                  "check that the whole file was read"),
+    "W-RECORD-PULSE": ("suspect", "the main pulse lasts less than 2 samples: t_p cannot be resolved; "
+                                  "check the record's sampling and zero padding"),
+    "W-RECORD-STEP": ("suspect", "the record's own step is coarser than the simulation step allows "
+                                 "to follow (p dt_record > 0.2): the block's response depends on the "
+                                 "interpolation between samples"),
+    # simulation
+    "W-SIM-DT": ("suspect", "time step dt is large against the block's 1/p (p dt > 0.01): "
+                            "impact times and rocking amplitudes are not converged; use a smaller --dt"),
+    # fitting
+    "W-FIT-GAP": ("suspect", "the measured theta(t) has a gap (lost frames) over which impacts may be "
+                             "missing; the fit skipped it, but counting half-cycles across it is unsafe"),
+    "W-FIT-DUPLICATE": ("suspect", "repeated time stamps in the input were dropped; check the file "
+                                   "was not concatenated twice"),
+    "W-FIT-THETA0": ("suspect", "the measured release angle is large for the block's geometry "
+                                "(|theta0| above 0.9 alpha or beyond alpha): check b and h (swapped, "
+                                "or in cm instead of m)"),
+    "W-FIT-RESIDUAL": ("suspect", "the fitted simulation misses the measurement by far more than the "
+                                  "noise: the model or the block's dimensions do not describe this test"),
+    "W-FIT-BOUND": ("suspect", "the fitted parameter sits at a bound of its search range"),
+    "W-FIT-UNITS": ("suspect", "block dimensions outside 1 mm - 20 m: probably not in metres"),
+    # IMU
+    "W-IMU-AXES": ("suspect", "the gyro's integral and the accelerometer's tilt disagree in sign or "
+                              "scale: axes swapped, rotation axis wrong, or gyro units wrong "
+                              "(rad/s in a deg/s column); check the column names and --axis"),
+    "W-IMU-CLOCK": ("suspect", "the log's clock jumps or has a gap: samples are missing or the "
+                               "timestamps are corrupt; impacts in the gap are lost"),
+    "W-IMU-RATE": ("suspect", "sample rate disagrees between the option, the log's register and its "
+                              "timestamps; the timestamps were trusted"),
+    "W-IMU-TRUNCATED": ("note", "an incomplete final line (logger stopped mid-write) was dropped"),
+    # video tracking
+    "W-VIDEO-LOST": ("suspect", "more than 1 % of the frames were lost or never decoded"),
+    "W-TRACK-GEOMETRY": ("suspect", "the camera geometry maps pixels to nothing finite"),
+    # runs
+    "W-RUN-FAILED-PART": ("suspect", "part of a batch failed; the rest is reported"),
+}
+
+
+class RocklabWarning(UserWarning):
+    """A plausibility warning raised outside a :func:`collecting` block (see :data:`WARNING_CODES`)."""
+
+    def __init__(self, diagnostic: "Diagnostic"):
+        super().__init__(f"{diagnostic.code}: {diagnostic.message}")
+        self.diagnostic = diagnostic
+
+
+@dataclass(frozen=True)
+class Diagnostic:
+    """One plausibility warning.
+
+    Attributes
+    ----------
+    code : str
+        A key of :data:`WARNING_CODES` (``"W-..."``).
+    message : str
+        One line: what was found, with numbers and units, and what to check.
+    severity : str
+        ``"suspect"`` (the result may be wrong) or ``"note"``.
+    """
+
+    code: str
+    message: str
+    severity: str = "suspect"
+
+    def to_dict(self) -> dict:
+        """``{"code", "message", "severity"}``."""
+        return {"code": self.code, "message": self.message, "severity": self.severity}
+
+    def line(self, command: str = "") -> str:
+        """The stderr line: ``rocklab CMD: warning W-CODE: message``."""
+        pre = f"rocklab {command}: " if command else "rocklab: "
+        return f"{pre}warning {self.code}: {self.message}"
+
+
+_active: contextvars.ContextVar = contextvars.ContextVar("rocklab_diagnostics", default=None)
+
+
+def warn(code: str, message: str) -> Diagnostic:
+    """Report a plausibility warning ``code`` (a key of :data:`WARNING_CODES`) with a one-line message.
+
+    Returns the :class:`Diagnostic` so a result object can keep it.
+    """
+    if code not in WARNING_CODES:  # a programming error, not bad input
+        raise KeyError(f"unknown warning code {code!r}; add it to WARNING_CODES")
+    d = Diagnostic(code, " ".join(str(message).split()), WARNING_CODES[code][0])
+    sink = _active.get()
+    if sink is None:
+        warnings.warn(RocklabWarning(d), stacklevel=2)
+    elif d not in sink[0]:  # the same finding reported twice is one warning
+        while sink is not None:  # every enclosing collector sees it; the outermost echo prints it
+            sink[0].append(d)
+            if sink[1] is not None:
+                sink[1](d)
+            sink = sink[2]
+    return d
+
+
+@contextlib.contextmanager
+def collecting(echo=None):
+    """Collect the diagnostics raised inside the block into the yielded list.
+
+    Parameters
+    ----------
+    echo : callable(Diagnostic), optional
+        Called once per new diagnostic as it is raised (the CLI prints it). Ignored
+        inside another :func:`collecting` block: the enclosing one echoes, and
+        receives the diagnostics too.
+    """
+    found: list[Diagnostic] = []
+    parent = _active.get()
+    token = _active.set((found, echo if parent is None else None, parent))
+    try:
+        yield found
+    finally:
+        _active.reset(token)
+
+
+def worst_status(status: str, diagnostics) -> str:
+    """``status`` downgraded to ``"suspect"`` when it is ``"ok"`` and a diagnostic is suspect."""
+    if status == "ok" and any(d.severity == "suspect" for d in diagnostics):
+        return "suspect"
+    return status
+
+
+def codes_markdown() -> str:
+    """The table of warning codes as Markdown (for the docs)."""
+    rows = ["| code | severity | meaning and what to check |", "| --- | --- | --- |"]
+    rows += [f"| `{c}` | {s} | {m} |" for c, (s, m) in WARNING_CODES.items()]
+    return "\n".join(rows) + "\n"

@@ -1,0 +1,245 @@
+"""Output folders and files that never destroy what rocklab did not make.
+
+Every folder rocklab writes (``run``, ``campaign``, ``synth``, ``demo``) carries
+a marker file, :data:`MARKER`. Before any expensive work:
+
+- an ``--out`` that is an existing *file* is refused;
+- a non-empty folder without the marker (a user's folder) is refused unless
+  ``force``; with ``force`` rocklab writes its outputs beside the user's files
+  and deletes nothing of theirs;
+- the parent must be writable and hold the estimated free space;
+- rocklab's own stale staging folders (``.NAME.tmp-PID-*``, ``.NAME.old-PID-*``
+  left by a killed run whose process is gone) are removed.
+
+Outputs are staged in ``.NAME.tmp-PID-*`` next to the target and swapped into
+place by renames (:func:`publish_dir`), so a kill at any moment leaves either the
+previous output or the new one, never half of one.
+"""
+
+from __future__ import annotations
+
+import errno
+import json
+import os
+import re
+import shutil
+import tempfile
+import time
+from pathlib import Path
+
+from ._errors import InputError
+
+__all__ = ["MARKER", "check_output_dir", "check_output_file", "claim_dir", "stage_dir", "publish_dir", "clean_stale",
+           "is_rocklab_dir", "owned_entries", "foreign_entries", "pid_alive", "stale_prefix"]
+
+#: Name of the marker file in every folder rocklab writes.
+MARKER = ".rocklab-output"
+
+_MB = 1024 * 1024
+
+
+def pid_alive(pid: int) -> bool:
+    """Whether process ``pid`` exists on this machine."""
+    if pid <= 0:
+        return False
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # exists, owned by someone else
+        return True
+    return True
+
+
+def stale_prefix(name: str, kind: str = "tmp") -> str:
+    """The staging-name prefix for ``name`` owned by this process: ``.NAME.KIND-PID-``."""
+    return f".{name}.{kind}-{os.getpid()}-"
+
+
+def clean_stale(parent, name: str) -> list[Path]:
+    """Remove rocklab's staging leftovers of ``name`` in ``parent`` whose creating process is gone.
+
+    Returns the removed paths.
+    """
+    parent = Path(parent)
+    removed = []
+    if not parent.is_dir():
+        return removed
+    pat = re.compile(r"^\." + re.escape(name) + r"\.(?:tmp|old)-(\d+)-")
+    try:
+        entries = list(parent.iterdir())
+    except OSError:
+        return removed
+    for p in entries:
+        m = pat.match(p.name)
+        if not m or pid_alive(int(m.group(1))):
+            continue
+        try:
+            if p.is_dir() and not p.is_symlink():
+                shutil.rmtree(p)
+            else:
+                p.unlink()
+            removed.append(p)
+        except OSError:
+            pass
+    return removed
+
+
+def is_rocklab_dir(path) -> bool:
+    """True when ``path`` is a folder rocklab wrote (it holds :data:`MARKER`)."""
+    return (Path(path) / MARKER).is_file()
+
+
+def owned_entries(path) -> set[str]:
+    """Names of the entries in folder ``path`` that rocklab wrote (from its marker)."""
+    try:
+        d = json.loads((Path(path) / MARKER).read_text(encoding="utf-8"))
+        return set(d.get("entries", []))
+    except (OSError, ValueError, AttributeError):
+        return set()
+
+
+def foreign_entries(path) -> list[str]:
+    """Entries of folder ``path`` that rocklab did not write (sorted names)."""
+    owned = owned_entries(path) | {MARKER}
+    return sorted(p.name for p in Path(path).iterdir() if p.name not in owned)
+
+
+def _check_parent(path: Path, option: str, need_bytes: int) -> None:
+    parent = path.parent
+    probe = parent
+    while not probe.exists():  # the folder will be created: its first existing ancestor decides
+        probe = probe.parent
+    if not probe.is_dir():
+        raise InputError(f"{option} {path}: {probe} is a file, not a folder; choose another path")
+    try:  # probe the folder (or the ancestor it will be created in) without creating anything
+        fd, tmp = tempfile.mkstemp(prefix=stale_prefix(path.name, "tmp") + "probe", dir=probe)
+        os.close(fd)
+        os.unlink(tmp)
+    except PermissionError:
+        raise InputError(f"{option} {path}: folder {probe} is not writable; choose a writable location") from None
+    except OSError as e:
+        if e.errno == errno.ENOSPC:
+            raise InputError(f"{option} {path}: no space left on {probe}; free space or choose "
+                             "another location") from None
+        raise InputError(f"{option} {path}: cannot write in {probe} ({e.strerror}); choose another "
+                         "location") from None
+    if need_bytes > 0:
+        free = shutil.disk_usage(probe).free
+        if free < need_bytes:
+            raise InputError(f"{option} {path}: {free / _MB:.4g} MB free on {probe} but this run needs "
+                             f"about {need_bytes / _MB:.4g} MB; free space or choose another location")
+
+
+def check_output_file(path, option: str = "-o", need_bytes: int = 0) -> Path:
+    """Check an output *file* path before the work: not a folder, its folder writable.
+
+    Raises
+    ------
+    InputError
+        ``path`` is a folder, or its folder cannot be written.
+    """
+    path = Path(path)
+    if path.is_dir():
+        raise InputError(f"{option} {path}: is a folder; give a file name (e.g. {path / 'out.csv'})")
+    _check_parent(path, option, need_bytes)
+    clean_stale(path.parent, path.name)
+    return path
+
+
+def check_output_dir(path, *, force: bool = False, option: str = "--out", need_bytes: int = 0) -> Path:
+    """Check an output *folder* before the work (see the module docstring for the rules).
+
+    Returns the resolved path.
+    """
+    path = Path(path).resolve()
+    if path.exists() and not path.is_dir():
+        raise InputError(f"{option} {path}: is an existing file; rocklab writes a folder there and never "
+                         "replaces a file; choose another path")
+    if path.is_dir() and not force:
+        try:
+            names = foreign_entries(path)
+        except OSError as e:
+            raise InputError(f"{option} {path}: cannot list the folder ({e.strerror})") from None
+        if names:
+            shown = ", ".join(names[:3]) + (", ..." if len(names) > 3 else "")
+            raise InputError(f"{option} {path}: folder holds files rocklab did not write ({shown}); choose a "
+                             "new or empty folder, or pass --force to write beside them (nothing of "
+                             "yours is deleted)")
+    _check_parent(path, option, need_bytes)
+    clean_stale(path.parent, path.name)
+    return path
+
+
+def stage_dir(out_dir) -> Path:
+    """A new private staging folder next to ``out_dir`` (``.NAME.tmp-PID-*``)."""
+    out_dir = Path(out_dir)
+    out_dir.parent.mkdir(parents=True, exist_ok=True)
+    return Path(tempfile.mkdtemp(prefix=stale_prefix(out_dir.name, "tmp"), dir=out_dir.parent))
+
+
+def _write_marker(folder: Path, command: str, entries) -> None:
+    from . import __version__
+
+    text = json.dumps({"written_by": f"rocklab {__version__}", "command": command,
+                       "time_unix_s": time.time(), "entries": sorted(entries)}) + "\n"
+    tmp = folder / f"{MARKER}.tmp-{os.getpid()}"
+    tmp.write_text(text, encoding="utf-8")
+    os.replace(tmp, folder / MARKER)
+
+
+def claim_dir(path, entries, command: str = "") -> Path:
+    """Create folder ``path`` (if needed) for outputs written in place and record ``entries``
+    (names rocklab will write there) in its marker, next to any recorded before."""
+    path = Path(path)
+    path.mkdir(parents=True, exist_ok=True)
+    _write_marker(path, command, owned_entries(path) | set(entries))
+    return path
+
+
+def _swap(src: Path, dest: Path) -> None:
+    """Put ``src`` at ``dest`` (a folder rocklab owns there is replaced whole, by renames)."""
+    if dest.is_dir() and not dest.is_symlink():
+        old = Path(tempfile.mkdtemp(prefix=stale_prefix(dest.name, "old"), dir=dest.parent))
+        os.rmdir(old)
+        os.rename(dest, old)
+        os.rename(src, dest)
+        shutil.rmtree(old, ignore_errors=True)
+    else:
+        os.replace(src, dest)
+
+
+def publish_dir(stage, out_dir, command: str = "") -> Path:
+    """Move the finished ``stage`` folder onto ``out_dir`` by renames.
+
+    A folder holding only what rocklab wrote (or nothing) is replaced whole. A
+    folder that also holds the user's files (``--force``) receives rocklab's
+    entries one by one: rocklab's own earlier entries are replaced, a user's entry
+    of the same name is kept under ``NAME.user-<time>``; nothing of the user's is
+    deleted.
+    """
+    stage, out_dir = Path(stage), Path(out_dir)
+    umask = os.umask(0)
+    os.umask(umask)
+    os.chmod(stage, 0o777 & ~umask)  # mkdtemp made it private
+    new = [p.name for p in stage.iterdir() if p.name != MARKER]
+    if not out_dir.exists():
+        _write_marker(stage, command, new)
+        os.rename(stage, out_dir)
+        return out_dir
+    foreign = foreign_entries(out_dir)
+    if not foreign:
+        _write_marker(stage, command, new)
+        _swap(stage, out_dir)
+        return out_dir
+    owned = owned_entries(out_dir)
+    stamp = time.strftime("%Y%m%dT%H%M%S")
+    for name in sorted(new):
+        dest = out_dir / name
+        if (dest.exists() or dest.is_symlink()) and name not in owned:
+            os.rename(dest, out_dir / f"{name}.user-{stamp}")
+        _swap(stage / name, dest)
+    _write_marker(stage, command, owned | set(new))
+    os.replace(stage / MARKER, out_dir / MARKER)
+    shutil.rmtree(stage, ignore_errors=True)
+    return out_dir

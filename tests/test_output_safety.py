@@ -1,0 +1,134 @@
+"""Outputs never destroy what rocklab did not make; checks happen before the work; errors are one line."""
+
+import json
+import os
+import shutil
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from rocklab import Block
+from rocklab._outdir import MARKER, check_output_dir, clean_stale
+from rocklab.models import simulate
+
+
+def _experiment(tmp_path, rrd="false"):
+    blk = Block(0.045, 0.2025)
+    sim = simulate(blk, theta0_rad=0.8 * blk.alpha_rad, duration_s=4.0, restitution="constant", eta=0.9)
+    t = np.arange(0, 4.0, 1 / 100)
+    th = np.where(t < 0.3, sim.theta_rad[0], np.interp(t - 0.3, sim.t_s, sim.theta_rad))
+    th = th + np.random.default_rng(0).normal(0, 3e-4, t.size)
+    d = tmp_path / "exp"
+    d.mkdir()
+    pd.DataFrame({"t_s": t, "theta_rad": th}).to_csv(d / "tracks.csv", index=False)
+    (d / "experiment.toml").write_text(
+        'name = "safe"\n[block]\nb_m = 0.045\nh_m = 0.2025\n[sources.track]\npath = "tracks.csv"\n'
+        f'[output]\nrrd = {rrd}\nfigures = false\n')
+    return d / "experiment.toml"
+
+
+def test_run_refuses_a_users_folder_and_never_deletes_its_files(tmp_path, run_cli):
+    cfg = _experiment(tmp_path)
+    precious = tmp_path / "precious"
+    precious.mkdir()
+    (precious / "thesis.txt").write_text("three years of work")
+    rc, out, err = run_cli("run", cfg, "--out", precious)
+    assert rc == 2 and err.count("\n") == 1 and "thesis.txt" in err and "--force" in err
+    assert sorted(p.name for p in precious.iterdir()) == ["thesis.txt"]
+    # --force writes beside the user's file; a second forced run replaces only rocklab's own outputs
+    for _ in range(2):
+        rc, out, err = run_cli("run", cfg, "--out", precious, "--force")
+        assert rc == 0, err
+        assert (precious / "thesis.txt").read_text() == "three years of work"
+        assert json.loads((precious / "report.json").read_text())["status"] == "ok"
+    # a user's file that collides with an output name is kept under another name, not overwritten
+    (precious / "summary.md").unlink()
+    (precious / "summary.md").write_text("my notes")
+    marker = json.loads((precious / MARKER).read_text())
+    marker["entries"].remove("summary.md")
+    (precious / MARKER).write_text(json.dumps(marker))
+    rc, out, err = run_cli("run", cfg, "--out", precious, "--force")
+    assert rc == 0, err
+    kept = [p for p in precious.iterdir() if p.name.startswith("summary.md.user-")]
+    assert len(kept) == 1 and kept[0].read_text() == "my notes"
+
+
+def test_run_replaces_its_own_folder_and_refuses_a_file(tmp_path, run_cli):
+    cfg = _experiment(tmp_path)
+    out = tmp_path / "res"
+    assert run_cli("run", cfg, "--out", out)[0] == 0
+    assert run_cli("run", cfg, "--out", out, "--force")[0] == 0  # rocklab's own folder: replaced whole
+    assert (out / MARKER).is_file() and (out / "report.json").is_file()
+    f = tmp_path / "afile.txt"
+    f.write_text("keep me")
+    rc, _, err = run_cli("run", cfg, "--out", f)
+    assert rc == 2 and "existing file" in err and err.count("\n") == 1
+    assert f.read_text() == "keep me"
+
+
+def test_stale_staging_of_dead_processes_is_cleaned(tmp_path):
+    parent = tmp_path
+    dead = parent / ".res.tmp-999999999-abc"  # no such pid
+    dead.mkdir()
+    (dead / "half.csv").write_text("1,2")
+    live = parent / f".res.tmp-{os.getpid()}-xyz"  # a run in progress (this process) is left alone
+    live.mkdir()
+    other = parent / ".unrelated.tmp-999999999-abc"
+    other.mkdir()
+    removed = clean_stale(parent, "res")
+    assert removed == [dead] and live.is_dir() and other.is_dir()
+
+
+def test_free_space_and_writability_checked_before_work(tmp_path, monkeypatch):
+    from collections import namedtuple
+
+    import rocklab._outdir as O
+
+    usage = namedtuple("usage", "total used free")
+    monkeypatch.setattr(shutil, "disk_usage", lambda p: usage(10**9, 10**9 - 1000, 1000))
+    with pytest.raises(O.InputError, match="MB free"):
+        check_output_dir(tmp_path / "new", need_bytes=10**6)
+    monkeypatch.undo()
+
+    def denied(*a, **k):
+        raise PermissionError(13, "Permission denied")
+
+    monkeypatch.setattr(O.tempfile, "mkstemp", denied)
+    with pytest.raises(O.InputError, match="not writable"):
+        check_output_dir(tmp_path / "new2")
+
+
+def test_file_outputs_checked_before_work(tmp_path, run_cli):
+    d = tmp_path / "adir"
+    d.mkdir()
+    rc, out, err = run_cli("simulate", "--width", 0.045, "--height", 0.2, "--theta0", 0.05, "-o", d)
+    assert rc == 2 and "is a folder" in err and err.count("\n") == 1 and "Traceback" not in err
+    (tmp_path / "f.txt").write_text("x")
+    rc, out, err = run_cli("simulate", "--width", 0.045, "--height", 0.2, "--theta0", 0.05,
+                           "-o", tmp_path / "f.txt" / "x.csv")
+    assert rc == 2 and "is a file, not a folder" in err
+    rc, out, err = run_cli("simulate", "--width", 0.045, "--height", 0.2, "--theta0", 0.05,
+                           "-o", tmp_path / "new" / "deep" / "x.csv")
+    assert rc == 0 and (tmp_path / "new" / "deep" / "x.csv").is_file()
+
+
+def test_internal_error_is_one_line_exit_3(monkeypatch, run_cli):
+    import rocklab.pipelines._cmd_simulate as S
+
+    def boom(args):
+        raise ZeroDivisionError("float division by zero")
+
+    monkeypatch.setattr(S, "run", boom)
+    rc, out, err = run_cli("simulate", "--width", 0.045, "--height", 0.2)
+    assert rc == 3 and err.count("\n") == 1 and "--debug" in err and "ZeroDivisionError" in err
+    with pytest.raises(ZeroDivisionError):
+        run_cli("--debug", "simulate", "--width", 0.045, "--height", 0.2)
+
+
+def test_unreachable_scheduler_is_one_line(tmp_path, run_cli):
+    pytest.importorskip("distributed")
+    cfg = _experiment(tmp_path)
+    rc, out, err = run_cli("campaign", cfg.parent, "--out", tmp_path / "c", "--scheduler",
+                           "tcp://127.0.0.1:9", "--no-progress")
+    assert rc == 2 and err.count("\n") == 1 and "no Dask scheduler answered" in err

@@ -41,9 +41,6 @@ WARNING_CODES: dict[str, tuple[str, str]] = {
                                   "check that the whole file was read"),
     "W-RECORD-PULSE": ("suspect", "the main pulse lasts less than 2 samples: t_p cannot be resolved; "
                                   "check the record's sampling and zero padding"),
-    "W-RECORD-STEP": ("suspect", "the record's own step is coarser than the simulation step allows "
-                                 "to follow (p dt_record > 0.2): the block's response depends on the "
-                                 "interpolation between samples"),
     # simulation
     "W-SIM-DT": ("suspect", "time step dt is large against the block's 1/p (p dt > 0.01): "
                             "impact times and rocking amplitudes are not converged; use a smaller --dt"),

@@ -7,7 +7,7 @@ The CLI turns it into one line on stderr and exit status 2.
 
 from __future__ import annotations
 
-__all__ = ["InputError", "where", "positive"]
+__all__ = ["InputError", "where", "positive", "check_memory", "available_memory_bytes"]
 
 
 class InputError(ValueError):
@@ -40,3 +40,24 @@ def positive(name: str, value) -> float:
     if not math.isfinite(v) or v <= 0.0:
         raise InputError(f"{name}={value!r}: must be a finite positive number (SI units); fix the value")
     return v
+
+
+def available_memory_bytes() -> int:
+    """Memory this machine can still give, bytes (physical pages available; 8 GiB if unknown)."""
+    import os
+
+    try:
+        return int(os.sysconf("SC_AVPHYS_PAGES")) * int(os.sysconf("SC_PAGE_SIZE"))
+    except (ValueError, OSError, AttributeError):
+        return 8 * 1024 ** 3
+
+
+def check_memory(nbytes: float, what: str, fix: str) -> None:
+    """:class:`InputError` when ``what`` would need more than half of the available memory.
+
+    ``nbytes`` is an estimate made before allocating; ``fix`` says which option to reduce.
+    """
+    avail = available_memory_bytes()
+    if nbytes > 0.5 * avail:
+        raise InputError(f"{what} would need about {nbytes / 1024 ** 3:.4g} GiB of memory "
+                         f"({avail / 1024 ** 3:.4g} GiB available); {fix}")

@@ -22,6 +22,8 @@ def _zeros(T_s, dt_s=1e-3):
     return BaseMotion.from_samples(np.zeros(int(T_s / dt_s) + 2), dt_s, "m/s2", name="zeros")
 
 
+# coarse steps (p dt up to 0.017, W-SIM-DT) on purpose: the two loops must agree even there
+@pytest.mark.filterwarnings("ignore::rocklab._diagnostics.RocklabWarning")
 @pytest.mark.parametrize("dt_s, f, law", [
     (1e-4, 0.8, {}),                                      # the benchmark case: one step shifts < 2e-4 rad
     (2e-3, 0.95, {}),                                     # larger increments: the longer Taylor forms

@@ -67,7 +67,7 @@ def test_bad_records_one_line_errors(tmp_path):
     with pytest.raises(InputError, match="at least 2"):
         BaseMotion(np.array([]), np.array([]))
     with pytest.raises(InputError, match="all zeros"):
-        pulse_parameters(BaseMotion.from_samples(np.zeros(10), 0.01))
+        pulse_parameters(BaseMotion.from_samples(np.zeros(40), 0.01))
     gap = tmp_path / "gap.txt"
     gap.write_text("0 0\n0.01 0.1\n0.02 -0.1\n0.05 0.2\n")
     with pytest.raises(InputError) as e:

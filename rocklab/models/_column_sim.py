@@ -366,7 +366,15 @@ def simulate_column(column: Column, base: BaseMotion | None = None, *, theta0_ra
         duration_s = (float(base.t_s[-1]) + 5.0) if base is not None else 10.0
     if not (math.isfinite(duration_s) and duration_s > 0):
         raise InputError(f"duration_s={duration_s!r}: must be positive (s)")
+    from ._single import check_step
+
+    check_step(max(b.p_rad_s for b in column.blocks), dt_s, "dt_s")
     phi0, v0, s0 = _initial_state(column, theta0_rad, omega0_rad_s)
+    for j, b in enumerate(column.blocks):  # each joint opens by less than its block's slenderness
+        if abs(phi0[j]) >= b.alpha_rad:
+            raise InputError(f"theta0_rad: block {j + 1} starts {abs(phi0[j]):.4g} rad open against the one "
+                             f"below, not < its alpha = {b.alpha_rad:.4g} rad (it would fall at release); "
+                             "give smaller initial angles")
     blk = column.block_array()
     if base is not None:
         accb = np.array(base.acc_m_s2, dtype=float)  # writable: numba types read-only arrays apart

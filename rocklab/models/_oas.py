@@ -230,8 +230,14 @@ def overturning_spectrum(base: BaseMotion, slenderness: float = 12.0, *, levels:
     sl = _check_opts(slenderness, levels, sizes, R_max_m, R_min_m, level_max, alpha_I)
     if not isinstance(base, BaseMotion):
         raise InputError(f"base={type(base).__name__}: expected a BaseMotion (load_base_motion)")
-    if base.pga_m_s2 == 0:
-        raise InputError(f"{base.source}: record is all zeros; nothing can overturn")
+    from .._errors import check_memory
+    from ._pulses import _check_record
+
+    base = _check_record(base)  # enough samples, not all zeros
+    if int(levels) < 1 or int(sizes) < 2:
+        raise InputError(f"levels={levels!r}, sizes={sizes!r}: need at least 1 level and 2 sizes")
+    check_memory(80.0 * int(levels) * int(sizes), f"an OAS grid of {int(levels)} x {int(sizes)} runs",
+                 "reduce --levels/--sizes (the defaults 80 x 120 resolve t_I)")
     if criterion not in _CRIT:
         raise InputError(f"criterion={criterion!r}: use 'angle' (|theta|>=alpha) or 'fall' (|theta|>=pi/2)")
     if search not in ("scan", "contiguous"):

@@ -38,10 +38,17 @@ def _check_record(base: BaseMotion) -> BaseMotion:
         raise InputError(f"base={type(base).__name__}: expected a BaseMotion; read the record with "
                          "rocklab.models.load_base_motion")
     # BaseMotion already rejects gaps, non-uniform dt and < 2 samples; an all-zero record has no pulse.
+    src = f"{base.source}: " if base.source != "array" else ""
+    if base.t_s.size < MIN_SAMPLES:
+        raise InputError(f"{src}record has {base.t_s.size} samples; pulse and spectrum analysis needs at "
+                         f"least {MIN_SAMPLES}; check the file was read whole")
     if base.pga_m_s2 == 0.0:
-        src = f"{base.source}: " if base.source != "array" else ""
         raise InputError(f"{src}record is all zeros; it has no pulse (check the file or its units)")
     return base
+
+
+#: Fewest samples a record needs for its pulse parameters and spectra.
+MIN_SAMPLES = 16
 
 
 def lobe_impulses(acc, dt_s: float):
@@ -69,23 +76,27 @@ def lobe_impulses(acc, dt_s: float):
     a = np.asarray(acc, float)
     n = a.size
     a0, a1 = a[:-1], a[1:]
+    # Lobe boundaries: a sign change inside an interval (located by linear interpolation) or a
+    # sample that is exactly zero (a sampled sine has them at its crossings; a plateau of zeros
+    # is a run of them). Testing a0*a1 < 0 alone would merge the lobes on both sides of a zero.
     cross = (a0 * a1) < 0
-    # crossing fraction within the interval
+    zero = a == 0.0
     frac = np.where(cross, a0 / np.where(cross, a0 - a1, 1.0), 0.0)
-    # area of each interval; split at crossings into the part before and after
     full = 0.5 * (a0 + a1) * dt_s
     before = np.where(cross, 0.5 * a0 * frac * dt_s, full)
     after = np.where(cross, 0.5 * a1 * (1 - frac) * dt_s, 0.0)
-    # lobe id increments after each crossing interval
-    lobe_of_before = np.concatenate(([0], np.cumsum(cross)[:-1]))
-    lobe_of_after = lobe_of_before + 1
-    k = int(cross.sum()) + 1
+    # boundaries in order of position: a zero sample i sits at i, a crossing in interval i at i+frac
+    zpos = np.flatnonzero(zero).astype(float)
+    cpos = np.flatnonzero(cross) + frac[cross]
+    bpos = np.sort(np.concatenate((zpos, cpos)))
+    # lobe of an interval's first part: boundaries at or before its start (zero samples at i count)
+    n_before = np.searchsorted(bpos, np.arange(n - 1), side="right")
+    k = bpos.size + 1
     imp = np.zeros(k)
-    np.add.at(imp, lobe_of_before, before)
-    np.add.at(imp, lobe_of_after[cross], after[cross])
-    tc = (np.flatnonzero(cross) + frac[cross]) * dt_s
-    t_start = np.concatenate(([0.0], tc))
-    t_end = np.concatenate((tc, [(n - 1) * dt_s]))
+    np.add.at(imp, n_before, before)
+    np.add.at(imp, n_before[cross] + 1, after[cross])
+    t_start = np.concatenate(([0.0], bpos * dt_s))
+    t_end = np.concatenate((bpos * dt_s, [(n - 1) * dt_s]))
     return imp, t_start, t_end
 
 
@@ -164,6 +175,11 @@ def pulse_parameters(base: BaseMotion, F: float = F_SINE) -> PulseParameters:
     t_hi = min(te[j], (i0 + nz[-1] + 1) * base.dt_s)
     ts[j], te[j] = t_lo, t_hi
     dur = t_hi - t_lo
+    if i_max / (F * a_max) < 2.0 * base.dt_s:
+        from .._diagnostics import warn
+
+        warn("W-RECORD-PULSE", f"{base.name}: main pulse t_p = {i_max / (F * a_max):.4g} s is shorter than 2 "
+                               f"samples (dt = {base.dt_s:.4g} s); t_I and spectra from it are unreliable")
     return PulseParameters(
         a_max_m_s2=a_max, I_max_m_s=i_max, t_p_s=i_max / (F * a_max),
         fullness=i_max / (lobe_peak * dur) if dur > 0 else float("nan"),

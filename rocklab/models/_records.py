@@ -25,7 +25,7 @@ import numpy as np
 from .._errors import InputError
 from ..blocks import G
 
-__all__ = ["BaseMotion", "load_base_motion", "UNITS_TO_M_S2", "bundled_record", "BUNDLED_RECORDS"]
+__all__ = ["BaseMotion", "load_base_motion", "check_plausible", "UNITS_TO_M_S2", "bundled_record", "BUNDLED_RECORDS"]
 
 #: Factors from accepted acceleration units to m/s^2.
 UNITS_TO_M_S2 = {"g": G, "m/s2": 1.0, "m/s^2": 1.0, "m_s2": 1.0, "cm/s2": 0.01,
@@ -189,11 +189,15 @@ def load_base_motion(path, units: str | None = None, dt_s: float | None = None,
     if not text.strip():
         raise InputError(f"{path}: file is empty; give a record with samples")
     nm = name or path.stem
+    if "\x00" in text[:4096]:
+        raise InputError(f"{path}: binary file, not a record; give an .AT2, CSV or two-column text file")
     if re.search(r"NPTS\s*=", text[:4000], re.I):
-        return _read_at2(path, text, units, nm)
-    if path.suffix.lower() == ".csv" or re.match(r"\s*[A-Za-z_]", text):
-        return _read_csv(path, units, nm)
-    return _read_columns(path, text, units, dt_s, nm)
+        bm = _read_at2(path, text, units, nm)
+    elif path.suffix.lower() == ".csv" or re.match(r"\s*[A-Za-z_]", text):
+        bm = _read_csv(path, units, nm)
+    else:
+        bm = _read_columns(path, text, units, dt_s, nm)
+    return check_plausible(bm)
 
 
 def _read_at2(path: Path, text: str, units: str | None, name: str) -> BaseMotion:
@@ -208,14 +212,10 @@ def _read_at2(path: Path, text: str, units: str | None, name: str) -> BaseMotion
     npts, dt = int(m_n.group(1)), float(m_dt.group(1))
     if dt <= 0:
         raise InputError(f"{path}, line {hdr_i + 1}: DT={dt} must be positive")
-    head = "\n".join(lines[:hdr_i]).upper()
+    file_units = _at2_units(path, lines[:hdr_i])
+    units_from = "option" if units is not None else ("header" if file_units else "PEER convention (g)")
     if units is None:
-        if "CM/S" in head or "CM/SEC" in head or "GAL" in head:
-            units = "cm/s2"
-        elif "M/S" in head:
-            units = "m/s2"
-        else:
-            units = "g"  # PEER's convention; both headers here say "units ... g"
+        units = file_units or "g"  # PEER's documented convention when the file names no units
     f = _unit_factor(units, f"{path}: ")
     vals = []
     for j, ln in enumerate(lines[hdr_i + 1:], start=hdr_i + 2):
@@ -230,11 +230,95 @@ def _read_at2(path: Path, text: str, units: str | None, name: str) -> BaseMotion
             else:
                 vals.append(float(tok.replace("D", "E").replace("d", "e")))
     a = np.asarray(vals, float)
+    _check_last_token(path, lines[hdr_i + 1:], hdr_i + 2)
     if a.size != npts:
         raise InputError(f"{path}: header says NPTS={npts} but the file holds {a.size} values; "
                          "the file is truncated or the header is wrong")
     bm = BaseMotion(dt * np.arange(npts), a * f, name=name, source=str(path),
-                    meta={"format": "AT2", "units_in_file": units, "header": lines[:hdr_i + 1]})
+                    meta={"format": "AT2", "units_in_file": units, "header": lines[:hdr_i + 1],
+                          "units_from": units_from})
+    return bm
+
+
+# units named in an AT2 header ("IN UNITS OF G", "The units are (g)", "UNITS: CM/S/S")
+_UNITS_FIELD = re.compile(r"\bUNITS?\b\s*(?:OF|ARE|IN|:|=)?\s*[(\[]?\s*([A-Z][A-Z0-9/*^.\-]*(?:\s*/\s*[A-Z0-9*^]+)*)",
+                          re.I)
+_ACC_UNITS = {"G": "g", "GS": "g", "CM/S/S": "cm/s2", "CM/S2": "cm/s2", "CM/S**2": "cm/s2", "CM/S^2": "cm/s2",
+              "CM/SEC/SEC": "cm/s2", "CM/SEC2": "cm/s2", "CM/SEC**2": "cm/s2", "CM/SEC^2": "cm/s2",
+              "GAL": "cm/s2", "M/S/S": "m/s2", "M/S2": "m/s2", "M/S**2": "m/s2", "M/S^2": "m/s2",
+              "M/SEC/SEC": "m/s2", "M/SEC2": "m/s2", "M/SEC**2": "m/s2", "MM/S/S": "mm/s2", "MM/S2": "mm/s2"}
+_OTHER_QUANTITY = {"CM/S": "velocity", "CM/SEC": "velocity", "M/S": "velocity", "M/SEC": "velocity",
+                   "IN/S": "velocity", "IN/SEC": "velocity", "CM": "displacement", "M": "displacement",
+                   "MM": "displacement", "IN": "displacement"}
+
+
+def _at2_units(path: Path, header: list[str]) -> str | None:
+    """The acceleration units an AT2 header names in a units field, or None when it names none.
+
+    Free text (a station called "Galway" or "Portugal") is never read as a unit; a
+    velocity or displacement series, or two different units, is an error.
+    """
+    found = {}
+    for i, ln in enumerate(header, start=1):
+        if re.search(r"\b(VELOCITY|DISPLACEMENT)\s+TIME\s+SERIES\b", ln, re.I):
+            kind = re.search(r"VELOCITY|DISPLACEMENT", ln, re.I).group(0).lower()
+            raise InputError(f"{path}, line {i}: this is a {kind} time series, not acceleration; give the "
+                             "matching .AT2 acceleration file")
+        for m in _UNITS_FIELD.finditer(ln):
+            tok = re.sub(r"\s+", "", m.group(1)).upper().rstrip(".,;)]")
+            if tok in _ACC_UNITS:
+                found[_ACC_UNITS[tok]] = i
+            elif tok in _OTHER_QUANTITY:
+                raise InputError(f"{path}, line {i}: units {m.group(1)!r} are {_OTHER_QUANTITY[tok]}, not "
+                                 "acceleration; give the acceleration record")
+            else:
+                raise InputError(f"{path}, line {i}: unknown units {m.group(1)!r} in the header; give --units "
+                                 "g|m/s2|cm/s2 to say what the file holds")
+    if len(found) > 1:
+        raise InputError(f"{path}: header names two units ({', '.join(sorted(found))}); give --units to say "
+                         "which is right")
+    return next(iter(found), None)
+
+
+def _token_shape(tok: str) -> tuple:
+    """(exponent?, digits after the point) of a number as written."""
+    t = tok.upper().replace("D", "E")
+    mant, _, exp = t.partition("E")
+    dec = mant.split(".", 1)[1] if "." in mant else ""
+    return (bool(exp), len(dec))
+
+
+def _check_last_token(path: Path, data_lines: list[str], first_lineno: int) -> None:
+    """A value cut mid-token at the end of the file ("-.17901" for "-.1790158E-03") is an error:
+    every value of a PEER file is written in one format, so the last one must share it."""
+    toks = []
+    for ln in data_lines[-50:]:
+        toks.extend(ln.split())
+    if len(toks) < 5:
+        return
+    shapes = [_token_shape(t) for t in toks[:-1]]
+    common = max(set(shapes), key=shapes.count)
+    if shapes.count(common) >= 0.9 * len(shapes) and _token_shape(toks[-1]) != common:
+        last_line = first_lineno + max(i for i, ln in enumerate(data_lines) if ln.strip())
+        raise InputError(f"{path}, line {last_line}: the last value {toks[-1]!r} is not written like the "
+                         "others (cut off mid-number?); restore the file's end from its source")
+
+
+def check_plausible(bm: BaseMotion) -> BaseMotion:
+    """Warn (``W-RECORD-*``) when a record's amplitude, step or length is implausible for an
+    earthquake or shake-table record. Returns ``bm``."""
+    from .._diagnostics import warn
+
+    src = f"{bm.source}: " if bm.source != "array" else f"{bm.name}: "
+    pga_g = bm.pga_m_s2 / G
+    if pga_g > 5.0:
+        warn("W-RECORD-PGA", f"{src}peak acceleration {pga_g:.4g} g is above 5 g; check the units "
+                             f"(read as {bm.meta.get('units_in_file', 'given')}) or --units")
+    if bm.dt_s > 0.05:
+        warn("W-RECORD-DT", f"{src}sample step {bm.dt_s:.4g} s is above 0.05 s; check DT in the header")
+    if bm.t_s.size < 16 or bm.duration_s < 0.2:
+        warn("W-RECORD-SHORT", f"{src}only {bm.t_s.size} samples ({bm.duration_s:.4g} s); check the whole "
+                               "file was read")
     return bm
 
 

@@ -30,7 +30,7 @@ import math
 
 import numpy as np
 
-from .._errors import InputError
+from .._errors import InputError, check_memory
 from ..blocks import G
 from ._newmark import STATUS_NAMES, run_single
 from ._records import BaseMotion
@@ -96,6 +96,26 @@ def _last_uplift_t(base, alpha, scale=1.0):
         return -np.inf
     over = np.abs(base.acc_m_s2 * scale) > G * math.tan(alpha)
     return float(base.t_s[np.flatnonzero(over)[-1]]) if over.any() else -np.inf
+
+
+#: Largest p*dt the Newmark step may take: beyond it the step cannot follow a rocking half-cycle
+#: (about 1/p long) and the result is meaningless; between P_DT_WARN and it, amplitudes and impact
+#: times are not converged (W-SIM-DT).
+P_DT_MAX = 0.1
+P_DT_WARN = 0.01
+
+
+def check_step(p_rad_s: float, dt_s: float, option: str = "dt_s") -> None:
+    """:class:`InputError` when ``p dt`` > :data:`P_DT_MAX`; warning ``W-SIM-DT`` above :data:`P_DT_WARN`."""
+    pdt = p_rad_s * dt_s
+    if pdt > P_DT_MAX:
+        raise InputError(f"{option}={dt_s:g} s: too coarse for this block (p = {p_rad_s:.4g} rad/s, p dt = "
+                         f"{pdt:.4g} > {P_DT_MAX}); use dt <= {P_DT_WARN / p_rad_s:.4g} s")
+    if pdt > P_DT_WARN:
+        from .._diagnostics import warn
+
+        warn("W-SIM-DT", f"{option}={dt_s:g} s gives p dt = {pdt:.4g} (> {P_DT_WARN}) for p = {p_rad_s:.4g} "
+                         f"rad/s; use dt <= {P_DT_WARN / p_rad_s:.4g} s for converged impacts")
 
 
 def simulate(block, theta0_rad: float = 0.0, omega0_rad_s: float = 0.0, duration_s: float = 10.0,
@@ -193,6 +213,10 @@ def simulate(block, theta0_rad: float = 0.0, omega0_rad_s: float = 0.0, duration
     p = block.p_rad_s
     rest_w2 = 2.0 * p * p * (math.cos(alpha - rest_tol * alpha) - math.cos(alpha))
     n_steps = int(math.ceil(T / dt - 1e-9))
+    if str(method).lower() == "newmark":
+        check_step(p, dt, "dt_s")
+    check_memory(40.0 * n_steps / every, f"{T:g} s at dt = {dt:g} s ({n_steps} steps stored every {every})",
+                 "shorten duration_s or give a coarser output_dt_s")
     t_last = _last_uplift_t(base, alpha)
     meth = str(method).lower()
     if meth == "newmark":

@@ -13,6 +13,8 @@ import math
 import numpy as np
 import pytest
 
+from rocklab._diagnostics import RocklabWarning
+
 from rocklab import InputError
 from rocklab.fitting import (catalogue_block, energy_loss_from_peaks, fit_many, fit_restitution, per_impact_eta,
                              summarize_repeats)
@@ -186,8 +188,10 @@ def test_bad_input_errors():
 
 def test_parameter_at_bound_is_flagged():
     t, y, _ = synthetic(8)
-    f = fit_restitution(t, y, B6M, eta_bounds=(0.5, 0.9295))
+    with pytest.warns(RocklabWarning, match="W-FIT-BOUND"):
+        f = fit_restitution(t, y, B6M, eta_bounds=(0.5, 0.9295))
     assert "eta_e" in f.at_bound and f.eta_e == pytest.approx(0.9295, abs=1e-4)
+    assert f.status == "suspect" and "W-FIT-BOUND" in f.warnings and f.ok
     assert "(at bound!)" in f.report()
 
 

@@ -71,6 +71,15 @@ def read_block_table(src, nan: str = "raise") -> pd.DataFrame:
         raise InputError(f"{where(path, i + 2 if path else None, 'eta_e')}restitution must be in (0, 1); "
                          f"got {df.loc[i, 'eta_e']}")
     df["block"] = df["block"].astype(str)
+    _check_block_rows(df, path)
+    dup = df.duplicated(subset=["block", "b_m", "h_m", "eta_e"])
+    if dup.any():
+        from .._diagnostics import warn
+
+        i = int(df.index[dup][0])
+        warn("W-FIT-DUPLICATE", f"{where(path, i + 2 if path else None)}{int(dup.sum())} repeated row(s) dropped "
+                                "(each block counted once)")
+        df = df[~dup].copy()
     df["h_over_b"] = df["h_m"] / df["b_m"]
     df["alpha_rad"] = np.arctan2(df["b_m"], df["h_m"])
     return df.reset_index(drop=True)
@@ -123,6 +132,19 @@ class EtaMatResult:
         return "\n".join(lines)
 
 
+def _check_block_rows(df: pd.DataFrame, path) -> None:
+    """W-FIT-UNITS when a row's size is not a lab block in metres (1 mm - 20 m, h/b 0.5 - 50)."""
+    from .._diagnostics import warn
+
+    b, h = df["b_m"].to_numpy(float), df["h_m"].to_numpy(float)
+    odd = (b < 1e-3) | (b > 20) | (h < 1e-3) | (h > 20) | (h / b < 0.5) | (h / b > 50)
+    if odd.any():
+        i = int(df.index[odd][0])
+        warn("W-FIT-UNITS", f"{where(path, i + 2 if path else None)}block {df.loc[i, 'block']}: b = "
+                            f"{b[odd][0]:.4g} m, h = {h[odd][0]:.4g} m (h/b = {h[odd][0] / b[odd][0]:.4g}) is not a "
+                            f"rocking block in metres ({int(odd.sum())} such row(s)); check units and column order")
+
+
 def fit_eta_mat(edge_table, l_c_m: float = 0.0015, contact: str = "inner", rule: str = "mean",
                 min_hb: float = 0.0) -> EtaMatResult:
     """η_mat = η_e/η_M averaged over edge-contact experiments (Čeh Eq. 16).
@@ -163,8 +185,13 @@ def fit_eta_mat(edge_table, l_c_m: float = 0.0015, contact: str = "inner", rule:
     if u["above_one"].any():
         msg = (f"{int(u['above_one'].sum())} block(s) have eta_e/eta_M > 1 (contact further inside than "
                "assumed); consider contact='inner'")
+    status = "ok"
+    if not (0.0 < eta <= 1.05):  # a material restitution outside (0, 1] is not a result
+        status = "failed"
+        msg = (f"eta_mat = {eta:.4g} is outside (0, 1]: the table's sizes or eta_e values are not what the "
+               "edge-contact model expects (units? full-contact runs?)")
     return EtaMatResult(eta_mat=eta, std=std, n=int(len(r)), rule=rule, contact=contact, l_c_m=float(l_c_m),
-                        min_hb=float(min_hb), per_block=df, status="ok", message=msg)
+                        min_hb=float(min_hb), per_block=df, status=status, message=msg)
 
 
 @dataclass(frozen=True)

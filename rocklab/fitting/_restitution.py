@@ -84,7 +84,9 @@ class RestitutionFit:
         Simulations run by the fit.
     per_impact : DataFrame
         Full :func:`~rocklab.fitting.per_impact_eta` table (not in ``to_dict``).
-    status : "ok" | "failed";  message : reason when failed, notes otherwise
+    status : "ok" | "suspect" | "failed";  message : reason when failed, notes otherwise
+    warnings : tuple of str
+        Codes of the plausibility warnings the fit raised (W-FIT-GAP, W-FIT-THETA0, W-FIT-BOUND).
     """
 
     eta_e: float
@@ -111,10 +113,12 @@ class RestitutionFit:
     status: str = "ok"
     message: str = ""
     per_impact: pd.DataFrame | None = field(default=None, repr=False)
+    warnings: tuple = ()
 
     @property
     def ok(self) -> bool:
-        return self.status == "ok"
+        """True when the fit produced a value (status ``"ok"``, or ``"suspect"`` with warnings)."""
+        return self.status in ("ok", "suspect")
 
     def to_dict(self) -> dict:
         """Plain-JSON dict (NaN kept as float NaN; the CLI writes null)."""
@@ -123,6 +127,7 @@ class RestitutionFit:
             "theta_offset_rad",
             "n_impacts", "window", "objective", "n_points", "block_name", "suspicious", "n_skipped",
             "n_evaluations", "status", "message")}
+        d["warnings"] = list(self.warnings)
         d["ci95_eta_e"] = [float(x) for x in self.ci95_eta_e]
         d["window_t_s"] = [float(x) for x in self.window_t_s]
         d["eta_bounds"] = [float(x) for x in self.eta_bounds]
@@ -237,13 +242,24 @@ def fit_restitution(t_s, theta_rad, block, window: str = "middle50", objective: 
     fail = dict(window=window, objective=objective, bounds=(lo_b, hi_b), n_skip=n_skip, name=name)
     if not rel.found:
         return _failed(f"no release found: {rel.message}", theta0=rel.theta0_rad, sigma=rel.sigma_rad, **fail)
+    diags = []
+    t, y, gap_diag = _cut_at_gap(t, y, rel.t_s, rel.sigma_rad)
+    if gap_diag is not None:
+        diags.append(gap_diag)
     s0 = 1.0 if rel.theta0_rad > 0 else -1.0
     y = s0 * y  # symmetric block: fit with θ0 > 0
     theta0 = abs(rel.theta0_rad) if theta0_rad is None else abs(float(theta0_rad))
     alpha = block.alpha_rad
     if theta0 >= alpha:
         return _failed(f"theta0 = {theta0:.4g} rad >= alpha = {alpha:.4g} rad: the block would overturn, "
-                       "not rock", theta0=rel.theta0_rad, sigma=rel.sigma_rad, **fail)
+                       "not rock (check b and h: swapped, or not in metres?)", theta0=rel.theta0_rad,
+                       sigma=rel.sigma_rad, **fail)
+    if theta0 > 0.9 * alpha:
+        from .._diagnostics import warn
+
+        diags.append(warn("W-FIT-THETA0", f"{name or 'block'}: measured theta0 = {theta0:.4g} rad is "
+                                          f"{theta0 / alpha:.3f} alpha (alpha = {alpha:.4g} rad from b = "
+                                          f"{block.b_m:.4g} m, h = {block.h_m:.4g} m); check b and h"))
     tc = _crossings(t, y, rel)
     n_imp = int(tc.size)
     if n_imp < 3:
@@ -389,7 +405,13 @@ def fit_restitution(t_s, theta_rad, block, window: str = "middle50", objective: 
         at_bound.append("release_t_s")
     flags = _suspicion(t, y - offset, win_res if objective_used == "theta" else np.array([]), rms, sigma, pie,
                        tc, alpha)
-    msg = f"{n_skip} NaN sample(s) skipped" if n_skip else ""
+    msg = "; ".join(([f"{n_skip} NaN sample(s) skipped"] if n_skip else []) + [d.message for d in diags])
+    eta_at_bound = [b for b in at_bound if b.startswith("eta")]  # the release time's bound is a sample
+    if eta_at_bound:
+        from .._diagnostics import warn
+
+        diags.append(warn("W-FIT-BOUND", f"{name or 'block'}: {', '.join(eta_at_bound)} at the bound of the search "
+                                         f"(eta in [{lo_b:g}, {hi_b:g}])"))
     return RestitutionFit(
         eta_e=float(eta_hat), eta_e_first=float(eta_first), ci95_eta_e=ci, theta0_rad=float(s0 * theta0_hat),
         release_t_s=float(tr_hat), rms_residual_rad=rms, sigma_theta_rad=float(rel.sigma_rad),
@@ -397,7 +419,41 @@ def fit_restitution(t_s, theta_rad, block, window: str = "middle50", objective: 
         objective=objective_used, window_t_s=(float(w0), float(w1)), n_points=n_pts, eta_bounds=(lo_b, hi_b),
         theta_offset_rad=float(s0 * offset),
         block_name=name, suspicious=bool(flags), flags=tuple(flags), at_bound=tuple(at_bound), n_skipped=n_skip,
-        n_evaluations=sum(q.n_sim for q in probs.values()), status="ok", message=msg, per_impact=pie)
+        n_evaluations=sum(q.n_sim for q in probs.values()),
+        status="suspect" if any(d.severity == "suspect" for d in diags) else "ok", message=msg, per_impact=pie,
+        warnings=tuple(d.code for d in diags))
+
+
+def _cut_at_gap(t, y, t_release_s, sigma_rad):
+    """Keep the record up to the first gap after the release that could hide an impact.
+
+    Impacts inside a gap cannot be seen, so counting half-cycles across it makes every
+    later impact one off (a 0.4 s occlusion turned eta_e 0.75 into 0.53). A gap is
+    dangerous when it lasts more than half of the shortest half-cycle seen before it;
+    the fit then uses the data before the gap and says so (``W-FIT-GAP``).
+    """
+    d = np.diff(t)
+    med = float(np.median(d))
+    cand = np.flatnonzero((d > 1.5 * med) & (t[:-1] >= t_release_s))
+    if not cand.size:
+        return t, y, None
+    # sign changes of theta away from the noise band: the impacts seen so far
+    big = np.abs(y) > 5.0 * max(sigma_rad, 1e-9)
+    idx = np.flatnonzero(big & (t >= t_release_s))
+    sgn = np.sign(y[idx])
+    t_cross = t[idx[1:][sgn[1:] != sgn[:-1]]]
+    for i in cand:
+        before = t_cross[t_cross <= t[i]]
+        half = float(np.min(np.diff(before))) if before.size >= 2 else float(t[i] - t_release_s)
+        if d[i] > 0.5 * half:
+            from .._diagnostics import warn
+
+            n_lost = int(round(d[i] / med)) - 1
+            diag = warn("W-FIT-GAP", f"theta(t) has a {d[i]:.4g} s gap ({n_lost} samples) at t = {t[i]:.4g} s, "
+                                     f"longer than half the shortest half-cycle before it ({half:.4g} s); the "
+                                     f"fit uses the {i + 1} samples before the gap")
+            return t[:i + 1], y[:i + 1], diag
+    return t, y, None
 
 
 def _suspicion(t, y, res, rms, sigma, pie, tc, alpha):

@@ -158,7 +158,7 @@ def _run_eta_mat(args) -> int:
     payload = dict(eta_mat=res.eta_mat, std=res.std, n=res.n, rule=res.rule, contact=res.contact,
                    l_c_m=res.l_c_m, per_block=pb.to_dict(orient="records"), message=res.message, status=res.status)
     _emit(args, payload, res.report())
-    return 0
+    return 0 if res.status != "failed" else 1
 
 
 def _run_k_table(args) -> int:

@@ -42,13 +42,14 @@ def _read_csv(path: Path):
 
     from ._imu_fastcsv import parse_numeric_csv
 
-    fast = parse_numeric_csv(path) if path.is_file() else None
+    nrows = _complete_rows(path)
+    fast = parse_numeric_csv(path) if path.is_file() and nrows is None else None
     if fast is not None:
         names, values = fast
         keep = [i for i, c in enumerate(names) if _skip_mag(c)]
         return pd.DataFrame(values[:, keep], columns=[names[i] for i in keep], copy=False)
     try:
-        df = pd.read_csv(path, engine="c", usecols=_skip_mag)
+        df = pd.read_csv(path, engine="c", usecols=_skip_mag, nrows=nrows)
     except pd.errors.EmptyDataError:
         raise InputError(f"{where(path)}empty file; an IMU CSV needs a header and data rows") from None
     if len(df) == 0:
@@ -56,6 +57,30 @@ def _read_csv(path: Path):
                          "log some samples or pick another file")
     df.columns = [str(c).strip() for c in df.columns]
     return df
+
+
+def _complete_rows(path: Path) -> int | None:
+    """Data rows to read when the file's last line is incomplete (a logger stopped mid-write:
+    no final newline), else None. The cut line is dropped with ``W-IMU-TRUNCATED``."""
+    try:
+        with open(path, "rb") as fh:
+            fh.seek(0, 2)
+            size = fh.tell()
+            if size == 0:
+                return None
+            fh.seek(size - 1)
+            if fh.read(1) in (b"\n", b"\r"):
+                return None
+            fh.seek(0)
+            n_lines = fh.read().count(b"\n")  # complete lines, header included
+    except OSError:
+        return None
+    if n_lines < 2:
+        return None
+    from .._diagnostics import warn
+
+    warn("W-IMU-TRUNCATED", f"{path}, line {n_lines + 1}: incomplete last line (no newline) dropped")
+    return n_lines - 1
 
 
 def _numeric(df, col, path: Path) -> np.ndarray:

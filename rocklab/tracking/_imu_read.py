@@ -35,6 +35,8 @@ Formats
 
 from __future__ import annotations
 
+import dataclasses
+
 from pathlib import Path
 
 import numpy as np
@@ -195,6 +197,52 @@ def read_imu(path, rate_hz: float | None = None, mapping: dict | None = None,
     p = _resolve(Path(path))
     if rate_hz is not None and not (np.isfinite(rate_hz) and rate_hz > 0):
         raise InputError(f"rate_hz={rate_hz!r}: the sample rate must be a positive number of Hz")
+    return check_imu_log(_read_any(p, rate_hz, mapping, full_scale_g), rate_hz)
+
+
+#: Sample rates an inertial logger can have, Hz; outside them the timestamps' or the rate
+#: register's units are wrong.
+RATE_RANGE_HZ = (1.0, 20000.0)
+
+
+def check_imu_log(log: ImuLog, rate_option_hz: float | None = None) -> ImuLog:
+    """Plausibility of a log's clock: rate range, option vs timestamps, clock jumps and gaps.
+
+    Returns the log, with the timestamps' rate when ``rate_option_hz`` disagrees with them
+    (``W-IMU-RATE``). Gaps longer than 10 samples and 0.05 s give ``W-IMU-CLOCK``.
+    """
+    from .._diagnostics import warn
+
+    lo, hi = RATE_RANGE_HZ
+    if log.n > 1:
+        d = np.diff(log.t_s)
+        period = float(np.median(d))
+        ts_rate = 1.0 / period
+        if not lo <= ts_rate <= hi:
+            raise InputError(f"{log.source}: timestamps give {ts_rate:.4g} Hz, not an IMU sample rate "
+                             f"({lo:g}-{hi:g} Hz); check the time column's units (s/ms/us) or the rate register")
+        timed = log.format != "ximu-gui"  # x-IMU GUI times come from packet numbers and the rate
+        if timed and rate_option_hz is not None and abs(rate_option_hz / ts_rate - 1) > 0.02:
+            warn("W-IMU-RATE", f"{log.source}: --rate {rate_option_hz:g} Hz but the timestamps say "
+                               f"{ts_rate:.4g} Hz; the timestamps are used")
+            from ._imu_csv import _gap_drops
+
+            log = dataclasses.replace(log, rate_hz=ts_rate, dropped_samples=_gap_drops(log.t_s, period))
+        gap = d > max(10 * period, 0.05)
+        if gap.any():
+            i = int(np.argmax(d))
+            warn("W-IMU-CLOCK", f"{log.source}: {int(gap.sum())} gap(s) in the clock, the longest "
+                                f"{d[i]:.4g} s at t = {log.t_s[i]:.4g} s ({int(round(d[i] / period)) - 1} "
+                                "samples missing or a clock jump)")
+    elif not lo <= log.rate_hz <= hi:
+        raise InputError(f"{log.source}: sample rate {log.rate_hz:.4g} Hz is not an IMU rate; check --rate")
+    if not lo <= log.rate_hz <= hi:
+        raise InputError(f"{log.source}: sample rate {log.rate_hz:.4g} Hz (rate register or --rate) is not "
+                         f"an IMU rate ({lo:g}-{hi:g} Hz); check the register or give --rate")
+    return log
+
+
+def _read_any(p: Path, rate_hz, mapping, full_scale_g) -> ImuLog:
     if mapping:
         return _read_timed(p, rate_hz, full_scale_g, mapping)
     if p.name.endswith(("_CalInertialAndMag.csv", "_CalInertialMagnetic.csv")):

@@ -155,6 +155,38 @@ class ImuRotation:
                 "source": self.source}
 
 
+def _check_gyro_vs_tilt(source, gyro_change_rad, tilt_change_rad, status, msg):
+    """The gyro's integral between the two rests must equal the accelerometer's tilt change.
+
+    Swapped gyro axes, the wrong rocking axis, a gyro in rad/s under a deg/s header or a
+    clock jump break this (``W-IMU-AXES``; status ``suspect``). Tolerance: 20 % + 1 deg.
+    """
+    mismatch = gyro_change_rad - tilt_change_rad
+    tol = 0.2 * max(abs(tilt_change_rad), abs(gyro_change_rad)) + np.deg2rad(1.0)
+    if abs(mismatch) <= tol:
+        return status, msg
+    from .._diagnostics import warn
+
+    d = warn("W-IMU-AXES", f"{source}: the gyro integrates to {np.rad2deg(gyro_change_rad):.4g} deg between the "
+                           f"rests but the accelerometer tilts by {np.rad2deg(tilt_change_rad):.4g} deg; check "
+                           "the gyro columns (axes, deg/s vs rad/s), --axis and the clock")
+    return ("suspect" if status == "ok" else status), (msg + "; " if msg else "") + d.message
+
+
+def _check_still_tilt(log: ImuLog, fs: float) -> None:
+    """No gyro motion but the accelerometer tilted between start and end: the gyro is not
+    measuring the rocking (units or axes; ``W-IMU-AXES``)."""
+    k = max(3, min(log.n // 4, int(round(0.5 * fs))))
+    a0, a1 = log.acc_m_s2[:k].mean(axis=0), log.acc_m_s2[-k:].mean(axis=0)
+    c = float(np.dot(a0, a1) / (np.linalg.norm(a0) * np.linalg.norm(a1) + 1e-300))
+    ang = float(np.arccos(np.clip(c, -1.0, 1.0)))
+    if ang > np.deg2rad(2.0):
+        from .._diagnostics import warn
+
+        warn("W-IMU-AXES", f"{log.source}: the gyro shows no motion but gravity turned by {np.rad2deg(ang):.4g} "
+                           "deg between the start and the end; check the gyro columns' units (deg/s vs rad/s)")
+
+
 def _vertical_axis(f: np.ndarray) -> np.ndarray:
     k = int(np.argmax(np.abs(f)))
     v = np.zeros(3)
@@ -211,6 +243,7 @@ def block_rotation(log: ImuLog, axis: str | None = None, *, release: str = "auto
     if i_move is None:
         i_move, i_end = n, n
         status, msg = "no_motion", "no motion found above the stillness thresholds"
+        _check_still_tilt(log, fs)
     else:
         # Decaying rocking fragments the motion mask; the last moving sample ends it.
         i_end = last_motion_end(moving, 1) or i_move
@@ -267,6 +300,11 @@ def block_rotation(log: ImuLog, axis: str | None = None, *, release: str = "auto
         drift = ((ie_mean - is_mean) - (th_end - th_start)) / (te_mid - ts_mid)
     theta = th_start + (integ - is_mean) - drift * (t - ts_mid)
     omega = omega - drift
+    # rocking: one axis carries the rate and the block turns by less than 90 deg; other motion
+    # (a hand-held sensor) has no single tilt to compare the gyro with
+    planar = float(np.sum(omega[moving] ** 2)) >= 0.9 * float(np.sum(w[moving] ** 2)) if moving.any() else False
+    if has_end and planar and float(np.max(np.abs(theta))) < 0.5 * np.pi:
+        status, msg = _check_gyro_vs_tilt(log.source, ie_mean - is_mean, th_end - th_start, status, msg)
     if axis is None:
         ref = th_start if abs(th_start) > np.deg2rad(1.0) else theta[np.argmax(np.abs(theta))]
         if ref < 0:

@@ -71,6 +71,7 @@ Schema (all lengths in m, times in s, angles in rad)::
 
 from __future__ import annotations
 
+import math
 import re
 import textwrap
 import tomllib
@@ -196,6 +197,30 @@ class _Reader:
     def __init__(self, path: Path, text: str, data: dict):
         self.path, self.text, self.data = path, text, data
         self.used: set[str] = set()
+        self.asked: set[str] = set()
+
+    def check_unknown(self) -> None:
+        """Every key in the file must be one the reader asked for: a typo (``fsp = 50``) is an
+        error naming its line and the nearest known key, never silently ignored."""
+        import difflib
+
+        def leaves(node, pre):
+            for k, v in node.items():
+                d = f"{pre}.{k}" if pre else k
+                if isinstance(v, dict):
+                    yield from leaves(v, d)
+                else:
+                    yield d
+
+        for d in leaves(self.data, ""):
+            if d in self.asked:
+                continue
+            section = d.rpartition(".")[0]
+            known = sorted(a.rpartition(".")[2] for a in self.asked if a.rpartition(".")[0] == section)
+            near = difflib.get_close_matches(d.rpartition(".")[2], known, n=1)
+            hint = f"did you mean '{near[0]}'? " if near else ""
+            self.fail(d, f"is not a known key{' of [' + section + ']' if section else ''}; {hint}"
+                         f"known: {', '.join(known) or '(none)'}")
 
     def line_of(self, dotted: str) -> int | None:
         parts = dotted.split(".")
@@ -226,6 +251,7 @@ class _Reader:
         raise InputError(f"{loc}: '{dotted}' {msg}")
 
     def get(self, dotted: str, default=None, kind=None, choices=None, positive=False):
+        self.asked.add(dotted)
         node = self.data
         for p in dotted.split("."):
             if not isinstance(node, dict) or p not in node:
@@ -375,7 +401,10 @@ def load_experiment(path) -> ExperimentConfig:
         r.fail("column.cut_m", f"= {cut} m must be in [0, b/2)")
     n_imp = r.get("column.impacts", 1, kind=int, positive=True)
     truth = r.file("truth", required=False)
-    return ExperimentConfig(
+    duration = r.get("simulate.duration_s", 0.0, kind=float)
+    if not (math.isfinite(duration) and duration >= 0):
+        r.fail("simulate.duration_s", f"= {duration} must be >= 0 s (0: as long as the measurement)")
+    cfg = ExperimentConfig(
         path=path, name=r.get("name", path.parent.name, kind=str), b_m=b, h_m=h, mass_kg=m,
         block_id=bid, contact=contact, l_c_m=l_c, k=k, primary=primary, video=video,
         track=track, imu=imu, table=table,
@@ -384,12 +413,14 @@ def load_experiment(path) -> ExperimentConfig:
         fit_restitution=r.get("fit.restitution", True, kind=bool),
         fit_window=r.get("fit.window", "middle50", kind=str, choices=_WINDOWS),
         laws=laws,
-        duration_s=r.get("simulate.duration_s", 0.0, kind=float), eta_given=eta_given,
+        duration_s=duration, eta_given=eta_given,
         rrd=r.get("output.rrd", True, kind=bool),
         video_decimation=r.get("output.video_decimation", 1, kind=int, positive=True),
         figures=r.get("output.figures", True, kind=bool),
         columns=columns, column_cut_m=cut, column_impacts=n_imp, truth=truth,
     )
+    r.check_unknown()
+    return cfg
 
 
 def _video_missing(data: dict) -> bool:

@@ -10,6 +10,8 @@ import math
 import re
 from dataclasses import fields
 
+import numpy as np
+
 from .._errors import InputError, where
 from ._config import (CORNER_REFINEMENTS, LEVEL_MODES, OBJECT_KINDS, TARGET_STYLES, BoardConfig,
                       MotionConfig, ObjectConfig, ReferenceConfig, TargetsConfig, TrackConfig,
@@ -95,6 +97,15 @@ class ConfigParser:
             self.err(section, key, f"must be a {shape[0]}x{shape[1]} array of numbers", index)
         return rows
 
+    def _homography(self, v, section):
+        H = self.matrix(v, (3, 3), section, "homography")
+        if H is not None:
+            c = float(np.linalg.cond(np.asarray(H, float)))
+            if not math.isfinite(c) or c > 1e12:
+                self.err(section, "homography", f"is singular (condition number {c:.3g}): it maps the image "
+                                                "to a line or a point; fix it or drop it")
+        return H
+
     def vector(self, v, section, key, index=None, n=None, integer=False):
         if v is None:
             return None
@@ -150,6 +161,11 @@ class ConfigParser:
             self.err(s, "stop_frame" if stop is not None and stop <= start else "start_frame",
                      "need 0 <= start_frame < stop_frame")
         K = self.matrix(d.get("camera_matrix"), (3, 3), s, "camera_matrix")
+        if K is not None:
+            fx, fy, k22 = K[0][0], K[1][1], K[2][2]
+            if not (fx > 0 and fy > 0 and abs(K[1][0]) + abs(K[2][0]) + abs(K[2][1]) == 0 and k22 == 1):
+                self.err(s, "camera_matrix", "must be [[fx, 0, cx], [0, fy, cy], [0, 0, 1]] with fx, fy > 0 "
+                                             "(pixels); fix it or drop it")
         dist = self.vector(d.get("dist_coeffs"), s, "dist_coeffs")
         if dist is not None and len(dist) not in (4, 5, 8, 12, 14):
             self.err(s, "dist_coeffs", "must have 4, 5, 8, 12 or 14 coefficients")
@@ -206,7 +222,7 @@ class ConfigParser:
             level=level,
             level_rad=self.num(d.get("level_rad", 0.0), s, "level_rad", allow_none=False),
             m_per_px=self.num(d.get("m_per_px"), s, "m_per_px", positive=True),
-            homography=self.matrix(d.get("homography"), (3, 3), s, "homography"),
+            homography=self._homography(d.get("homography"), s),
             board=board,
             plane=self.choice(d.get("plane", "auto"), ("auto", "table", "image"), s, "plane"))
 

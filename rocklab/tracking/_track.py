@@ -504,7 +504,25 @@ def track_video(path, config: TrackConfig, fps: float | None = None, progress: b
         frames = tqdm(frames, total=total if total > 0 else None, unit="frame", desc="track",
                       leave=False)
     obs = track_frames(frames, config, pm)
-    return assemble_tracks(obs, config, rate, info.width_px, info.height_px, pm, path)
+    res = assemble_tracks(obs, config, rate, info.width_px, info.height_px, pm, path)
+    expected = (min(stop, info.n_frames) if stop else info.n_frames) - start
+    _check_frames(res, expected, path)
+    return res
+
+
+def _check_frames(res, expected: int, path) -> None:
+    """W-VIDEO-LOST when fewer frames decode than the container promises, or an object is lost
+    on more than 1 % of the frames."""
+    from .._diagnostics import warn
+
+    if expected > 0 and res.n_frames < 0.99 * expected:
+        warn("W-VIDEO-LOST", f"{path}: the container promises {expected} frames but {res.n_frames} decoded "
+                             "(file cut or damaged?)")
+    for t in res.tracks:
+        lost = int(np.sum(~np.isin(t.status, ("ok", "interpolated"))))
+        if lost > 0.01 * len(t.status):
+            warn("W-VIDEO-LOST", f"{path}: object {t.object!r} lost on {lost} of {len(t.status)} frames "
+                                 f"({100 * lost / len(t.status):.3g} %); see the status column")
 
 
 def _tee(frames, fn):

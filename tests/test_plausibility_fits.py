@@ -7,7 +7,7 @@ import pandas as pd
 import pytest
 
 from rocklab import Block
-from rocklab._diagnostics import RocklabWarning, collecting
+from rocklab._diagnostics import collecting
 from rocklab.fitting import fit_eta_mat, fit_restitution, read_block_table
 from rocklab.models import simulate
 
@@ -56,8 +56,9 @@ def test_swapped_or_wrong_dimensions_are_not_silent():
     th0 = 0.8 * BLK.alpha_rad
     blk = Block(0.1, 0.1 / math.tan(th0 / 0.95))
     assert 0.9 * blk.alpha_rad < th0 < blk.alpha_rad
-    with pytest.warns(RocklabWarning, match="W-FIT-THETA0"):
+    with collecting() as found:
         fit_restitution(t, th, blk)
+    assert [d.code for d in found][:1] == ["W-FIT-THETA0"]  # (and the misfit: W-FIT-RESIDUAL)
 
 
 def test_block_tables_in_cm_and_duplicates(tmp_path):
@@ -75,3 +76,12 @@ def test_block_tables_in_cm_and_duplicates(tmp_path):
     with collecting() as found:
         tab = read_block_table(q)
     assert [d.code for d in found] == ["W-FIT-DUPLICATE"] and len(tab) == 2 and "line 3" in found[0].message
+
+
+def test_wrong_block_size_shows_in_the_residual():
+    t, th = _track()
+    # b 50 % too wide: the fit converges but misses the measurement by ~50x the noise
+    with collecting() as found:
+        f = fit_restitution(t, th, Block(0.15, 0.2))
+    assert [d.code for d in found] == ["W-FIT-RESIDUAL"] and f.status == "suspect"
+    assert f.rms_residual_rad > 20 * f.sigma_theta_rad

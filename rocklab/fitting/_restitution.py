@@ -406,6 +406,13 @@ def fit_restitution(t_s, theta_rad, block, window: str = "middle50", objective: 
     flags = _suspicion(t, y - offset, win_res if objective_used == "theta" else np.array([]), rms, sigma, pie,
                        tc, alpha)
     msg = "; ".join(([f"{n_skip} NaN sample(s) skipped"] if n_skip else []) + [d.message for d in diags])
+    if np.isfinite(rms) and rms > RESIDUAL_FACTOR * max(rel.sigma_rad, 1e-12) and rms > 1e-4:
+        from .._diagnostics import warn
+
+        diags.append(warn("W-FIT-RESIDUAL", f"{name or 'block'}: the fitted simulation misses the measurement by "
+                                            f"{rms:.4g} rad RMS, {rms / max(rel.sigma_rad, 1e-12):.4g}x the noise "
+                                            f"({rel.sigma_rad:.4g} rad); check b = {block.b_m:.4g} m, h = "
+                                            f"{block.h_m:.4g} m and the contact type"))
     eta_at_bound = [b for b in at_bound if b.startswith("eta")]  # the release time's bound is a sample
     if eta_at_bound:
         from .._diagnostics import warn
@@ -422,6 +429,11 @@ def fit_restitution(t_s, theta_rad, block, window: str = "middle50", objective: 
         n_evaluations=sum(q.n_sim for q in probs.values()),
         status="suspect" if any(d.severity == "suspect" for d in diags) else "ok", message=msg, per_impact=pie,
         warnings=tuple(d.code for d in diags))
+
+
+#: A fit whose residual RMS exceeds this multiple of the measurement noise is flagged
+#: W-FIT-RESIDUAL: the model (or the block's dimensions) does not describe the test.
+RESIDUAL_FACTOR = 20.0
 
 
 def _cut_at_gap(t, y, t_release_s, sigma_rad):

@@ -97,9 +97,7 @@ def test_first_half_period_sees_the_first_impact_only():
     # half-period) must find 0.95. No constant eta matches the middle 50 % (amplitudes there need
     # 0.90 per impact after a 0.95 one): eta_e is a compromise close to 0.90, and the misfit shows.
     t, y, _ = synthetic(5, law=dict(restitution="per_impact", eta=[0.95] + [0.90] * 200))
-    with pytest.warns(RocklabWarning, match="W-FIT-RESIDUAL"):  # 21x the noise: the misfit is reported
-        f = fit_restitution(t, y, B6M)
-    assert f.status == "suspect"
+    f = fit_restitution(t, y, B6M)  # 6.8e-3 rad RMS: flagged by the runs test, below W-FIT-RESIDUAL's 0.02
     assert abs(f.eta_e_first - 0.95) < 0.003
     assert 0.90 < f.eta_e < 0.92 and f.suspicious
     assert any("structured residuals" in s for s in f.flags)

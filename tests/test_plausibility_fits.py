@@ -80,8 +80,10 @@ def test_block_tables_in_cm_and_duplicates(tmp_path):
 
 def test_wrong_block_size_shows_in_the_residual():
     t, th = _track()
-    # b 50 % too wide: the fit converges but misses the measurement by ~50x the noise
-    with collecting() as found:
-        f = fit_restitution(t, th, Block(0.15, 0.2))
-    assert [d.code for d in found] == ["W-FIT-RESIDUAL"] and f.status == "suspect"
-    assert f.rms_residual_rad > 20 * f.sigma_theta_rad
+    # width and height swapped (was eta_e 0.67 for a true 0.75, status ok), or b twice the truth:
+    # the fit converges but misses the measurement by 20x the noise floor (1e-3 rad)
+    for blk in (Block(0.2, 0.1), Block(0.2, 0.2)):
+        with collecting() as found:
+            f = fit_restitution(t, th, blk)
+        assert [d.code for d in found][0] == "W-FIT-RESIDUAL" and f.status == "suspect"
+        assert f.rms_residual_rad > 20 * 1e-3

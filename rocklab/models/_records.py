@@ -241,7 +241,7 @@ def _read_at2(path: Path, text: str, units: str | None, name: str) -> BaseMotion
 
 
 # units named in an AT2 header ("IN UNITS OF G", "The units are (g)", "UNITS: CM/S/S")
-_UNITS_FIELD = re.compile(r"\bUNITS?\b\s*(?:OF|ARE|IN|:|=)?\s*[(\[]?\s*([A-Z][A-Z0-9/*^.\-]*(?:\s*/\s*[A-Z0-9*^]+)*)",
+_UNITS_FIELD = re.compile(r"\bUNITS?\b\s*(?:(?:OF|ARE|IN)\b\s*[(\[]?|[:=(\[])\s*[(\[]?\s*([A-Z][A-Z0-9/*^.\-]*(?:\s*/\s*[A-Z0-9*^]+)*)",
                           re.I)
 _ACC_UNITS = {"G": "g", "GS": "g", "CM/S/S": "cm/s2", "CM/S2": "cm/s2", "CM/S**2": "cm/s2", "CM/S^2": "cm/s2",
               "CM/SEC/SEC": "cm/s2", "CM/SEC2": "cm/s2", "CM/SEC**2": "cm/s2", "CM/SEC^2": "cm/s2",

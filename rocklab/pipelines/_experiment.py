@@ -341,9 +341,9 @@ def analyse_experiment(cfg: ExperimentConfig, progress: bool = False,
         timings["fit_s"] = time.perf_counter() - t2
         fit_d = fit.to_dict()
         per_imp = np.asarray(fit_d.get("per_impact_eta") or [], float)
-        if fit_d.get("status") != "ok":
+        if fit_d.get("status") == "failed":
             status = "partial"
-            msgs.append(f"restitution fit {fit_d.get('status')}: {fit_d.get('message')}")
+            msgs.append(f"restitution fit failed: {fit_d.get('message')}")
     t3 = time.perf_counter()
     sims = _simulate_laws(cfg, block, prim, fit_d, table, msgs)
     timings["simulate_s"] = time.perf_counter() - t3

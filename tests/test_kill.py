@@ -1,0 +1,144 @@
+"""``kill -9`` at random moments of ``run``, ``campaign`` and ``oas``: never a half-written result,
+no orphaned worker, and the next run finishes (a campaign resumes, skipping finished experiments)."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from rocklab import Block
+from rocklab._outdir import MARKER
+from rocklab.models import simulate
+
+psutil = pytest.importorskip("psutil")
+pytestmark = pytest.mark.slow
+
+CLI = [sys.executable, "-c", "import sys; from rocklab.pipelines import main; sys.exit(main())"]
+EXP_FILES = ("report.json", "summary.md", "series.csv", "session.rrd", MARKER)
+
+
+def _experiment(root, name, seed):
+    blk = Block(0.045, 0.2025)
+    sim = simulate(blk, theta0_rad=0.8 * blk.alpha_rad, duration_s=5.0, restitution="constant", eta=0.9)
+    t = np.arange(0, 5.0, 1 / 100)
+    th = np.where(t < 0.5, sim.theta_rad[0], np.interp(t - 0.5, sim.t_s, sim.theta_rad))
+    th = th + np.random.default_rng(seed).normal(0, 3e-4, t.size)
+    d = root / name
+    d.mkdir(parents=True)
+    pd.DataFrame({"t_s": t, "theta_rad": th}).to_csv(d / "tracks.csv", index=False)
+    (d / "experiment.toml").write_text(
+        f'name = "{name}"\n[block]\nb_m = 0.045\nh_m = 0.2025\n[sources.track]\npath = "tracks.csv"\n'
+        '[output]\nrrd = true\nfigures = true\n')
+    return d / "experiment.toml"
+
+
+def _start(args):
+    return subprocess.Popen(CLI + [str(a) for a in args], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+
+
+def _finish(args):
+    p = subprocess.run(CLI + [str(a) for a in args], capture_output=True, text=True, timeout=600)
+    return p.returncode, p.stdout, p.stderr
+
+
+def _complete_experiment(out) -> bool:
+    """A finished output holds every file and a readable report; anything else is half-written."""
+    if not out.exists():
+        return False
+    names = {p.name for p in out.iterdir()}
+    assert set(EXP_FILES) <= names, f"partial output in {out}: {sorted(names)}"
+    json.loads((out / "report.json").read_text())
+    return True
+
+
+def _kill_at(args, delay_s):
+    proc = _start(args)
+    time.sleep(delay_s)
+    kids = []
+    try:
+        kids = psutil.Process(proc.pid).children(recursive=True)
+    except psutil.NoSuchProcess:
+        pass
+    os.kill(proc.pid, signal.SIGKILL)
+    proc.wait()
+    return kids
+
+
+def _gone(kids, within_s=10.0):
+    t_end = time.time() + within_s
+    alive = list(kids)
+    while alive and time.time() < t_end:
+        alive = [k for k in alive if k.is_running() and k.status() != psutil.STATUS_ZOMBIE]
+        time.sleep(0.1)
+    return [k.pid for k in alive]
+
+
+def test_kill_run_at_random_moments(tmp_path):
+    cfg = _experiment(tmp_path, "e", 0)
+    out = tmp_path / "out"
+    t0 = time.perf_counter()
+    rc, _, err = _finish(["run", cfg, "--out", out])
+    full_s = time.perf_counter() - t0
+    assert rc == 0, err and _complete_experiment(out)
+    first = json.loads((out / "report.json").read_text())["fit"]["eta_e"]
+    rng = np.random.default_rng(7)
+    for delay in rng.uniform(0.1, full_s, 5):
+        _kill_at(["run", cfg, "--out", out, "--force"], delay)
+        assert _complete_experiment(out)  # the previous result, whole, or the new one, whole
+        assert json.loads((out / "report.json").read_text())["fit"]["eta_e"] == pytest.approx(first, abs=1e-9)
+    rc, _, err = _finish(["run", cfg, "--out", out, "--force"])
+    assert rc == 0, err and _complete_experiment(out)
+    assert not list(tmp_path.glob(".out.*")), "staging folders of killed runs were not cleaned up"
+
+
+def test_kill_campaign_no_orphans_and_resume(tmp_path):
+    root = tmp_path / "c"
+    for i in range(4):
+        _experiment(root, f"e{i}", i)
+    out = tmp_path / "out"
+    rng = np.random.default_rng(11)
+    for delay in rng.uniform(2.0, 6.0, 3):
+        kids = _kill_at(["campaign", root, "--out", out, "--workers", 2, "--no-progress"], delay)
+        assert _gone(kids) == [], "worker processes outlived the killed campaign"
+        for d in (out / "experiments").glob("*") if (out / "experiments").exists() else []:
+            if not d.name.startswith("."):
+                assert _complete_experiment(d)
+    exp_dir = out / "experiments"
+    done_before = {d.name: (d / "report.json").stat().st_mtime_ns
+                   for d in (exp_dir.glob("e*") if exp_dir.exists() else [])}
+    rc, stdout, err = _finish(["campaign", root, "--out", out, "--workers", 2, "--no-progress", "--json"])
+    assert rc == 0, err
+    res = json.loads(stdout)
+    assert res["n_ok"] == 4 and res["n_failed"] == 0
+    for d in (out / "experiments").iterdir():
+        if not d.name.startswith("."):
+            assert _complete_experiment(d)
+    assert (out / "campaign.csv").is_file()
+    # resumed: experiments that finished before a kill were not run again (fingerprint unchanged)
+    assert done_before, "no experiment finished before the kills; lengthen the delays"
+    for name, mtime in done_before.items():
+        assert (exp_dir / name / "report.json").stat().st_mtime_ns == mtime, name
+
+
+def test_kill_oas_leaves_no_partial_csv(tmp_path):
+    t = np.arange(0, 10, 0.01)
+    rec = tmp_path / "r.csv"
+    pd.DataFrame({"t_s": t, "acc_g": 0.3 * np.sin(2 * np.pi * t) * np.exp(-0.3 * t)}).to_csv(rec, index=False)
+    out = tmp_path / "oas.csv"
+    rng = np.random.default_rng(3)
+    for delay in rng.uniform(0.5, 3.0, 3):
+        _kill_at(["oas", rec, "--levels", 20, "--sizes", 30, "-o", out], delay)
+        if out.exists():
+            pd.read_csv(out)  # whole CSV or none
+    rc, _, err = _finish(["oas", rec, "--levels", 20, "--sizes", 30, "-o", out])
+    assert rc == 0, err
+    assert len(pd.read_csv(out)) > 0
+    assert not list(tmp_path.glob(".oas.csv.*")), "temp files of killed writers were not cleaned up"

@@ -37,25 +37,25 @@ WARNING_CODES: dict[str, tuple[str, str]] = {
                                 "cm/s^2 read as g); check the units field or --units"),
     "W-RECORD-DT": ("suspect", "sample step above 0.05 s: too coarse for an earthquake record and "
                                "often a wrong DT; check the header"),
-    "W-RECORD-SHORT": ("suspect", "record shorter than one cycle of its own main pulse or of 1 s; "
-                                  "check that the whole file was read"),
+    "W-RECORD-SHORT": ("suspect", "record of fewer than 16 samples or under 0.2 s: check that the whole file was read"),
     "W-RECORD-PULSE": ("suspect", "the main pulse lasts less than 2 samples: t_p cannot be resolved; "
                                   "check the record's sampling and zero padding"),
     # simulation
     "W-SIM-DT": ("suspect", "time step dt is large against the block's 1/p (p dt > 0.01): "
                             "impact times and rocking amplitudes are not converged; use a smaller --dt"),
     # fitting
-    "W-FIT-GAP": ("suspect", "the measured theta(t) has a gap (lost frames) over which impacts may be "
-                             "missing; the fit skipped it, but counting half-cycles across it is unsafe"),
-    "W-FIT-DUPLICATE": ("suspect", "repeated time stamps in the input were dropped; check the file "
-                                   "was not concatenated twice"),
+    "W-FIT-GAP": ("suspect", "the measured theta(t) has a gap (lost frames) long enough to hide an impact; the "
+                             "fit uses the data before the gap"),
+    "W-FIT-DUPLICATE": ("suspect", "repeated rows in a block table were dropped (each block counted once); check the "
+                                   "file was not concatenated twice"),
     "W-FIT-THETA0": ("suspect", "the measured release angle is large for the block's geometry "
-                                "(|theta0| above 0.9 alpha or beyond alpha): check b and h (swapped, "
+                                "(theta0 above 0.9 alpha): check b and h (swapped, "
                                 "or in cm instead of m)"),
-    "W-FIT-RESIDUAL": ("suspect", "the fitted simulation misses the measurement by far more than the "
-                                  "noise: the model or the block's dimensions do not describe this test"),
+    "W-FIT-RESIDUAL": ("suspect", "the fitted simulation misses the measurement by more than 20x the noise (at least "
+                                  "1e-3 rad): the model or the block's dimensions do not describe this test"),
     "W-FIT-BOUND": ("suspect", "the fitted parameter sits at a bound of its search range"),
-    "W-FIT-UNITS": ("suspect", "block dimensions outside 1 mm - 20 m: probably not in metres"),
+    "W-FIT-UNITS": ("suspect", "block dimensions outside 1 mm - 20 m or h/b outside 0.5 - 50: probably not in "
+                               "metres, or b and h swapped"),
     # IMU
     "W-IMU-AXES": ("suspect", "the gyro's integral and the accelerometer's tilt disagree in sign or "
                               "scale: axes swapped, rotation axis wrong, or gyro units wrong "
@@ -67,9 +67,6 @@ WARNING_CODES: dict[str, tuple[str, str]] = {
     "W-IMU-TRUNCATED": ("note", "an incomplete final line (logger stopped mid-write) was dropped"),
     # video tracking
     "W-VIDEO-LOST": ("suspect", "more than 1 % of the frames were lost or never decoded"),
-    "W-TRACK-GEOMETRY": ("suspect", "the camera geometry maps pixels to nothing finite"),
-    # runs
-    "W-RUN-FAILED-PART": ("suspect", "part of a batch failed; the rest is reported"),
 }
 
 

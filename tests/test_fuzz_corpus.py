@@ -98,7 +98,7 @@ many("record", [
     ("cols-ragged", _rec("0 0.1\n0.01 0.2 5\n", "r.txt"), "error", "columns"),
     ("cols-text", _rec("0 0.1\n0.01 abc\n", "r.txt"), "error", "not numeric"),
     ("missing-file", lambda tmp: ["pulse", tmp / "nope.AT2"], "error", "not found"),
-    ("folder", lambda tmp: ["pulse", tmp], "error", "not found"),
+    ("folder", lambda tmp: ["pulse", tmp], "error", "is a folder"),
 ], None)
 
 
@@ -173,6 +173,8 @@ many("column", [
     ("theta-count", _col("--blocks", "0.1x0.2,0.1x0.2", "--theta0", "0.05,0.05,0.05"), "error", "theta0"),
     ("cut-big", _col("--blocks", "0.1x0.2", "--theta0", 0.05, "--cut", 0.06), "error", "cut"),
     ("nothing-moves", _col("--blocks", "0.1x0.2"), "error", "--theta0"),
+    ("duration-huge", lambda tmp: ["column", "--blocks", "0.1x0.2,0.1x0.2", "--theta0", "0.02,0.02",
+                                   "--duration", 1e9, "-o", tmp / "c.csv"], "error", "GiB of memory"),
     ("ok", _col("--blocks", "0.1x0.2,0.1x0.2", "--theta0", "0.02,0.02", "--duration", 1, "--json"), "ok",
      None),
 ], None)

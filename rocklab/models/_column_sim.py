@@ -385,6 +385,10 @@ def simulate_column(column: Column, base: BaseMotion | None = None, *, theta0_ra
     n_steps = int(math.ceil(duration_s / dt_s - 1e-9))
     stride = _stride(output_dt_s, dt_s, n_steps)
     n_rows = n_steps // stride + 2
+    from .._errors import check_memory
+
+    check_memory(8.0 * n_rows * (4 * column.n + 4), f"{duration_s:g} s of a {column.n}-block column at "
+                 f"{dt_s:g} s ({n_rows} stored rows)", "shorten duration_s or give a coarser output_dt_s")
     par = np.array([g_m_s2, column.mu, t0b, dtb, 1.0 if velocity_terms else 0.0, 1e-14,
                     _quiet_time(column, base, g_m_s2), 0.0])
     ecap = 20000

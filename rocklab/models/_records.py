@@ -180,6 +180,8 @@ def load_base_motion(path, units: str | None = None, dt_s: float | None = None,
     path = Path(path)
     if units is not None:
         _unit_factor(units, f"{path}: ")  # fail on a bad option before reading anything
+    if path.is_dir():
+        raise InputError(f"{path}: is a folder; give the record file (.AT2, .csv or two-column text)")
     if not path.is_file():
         raise InputError(f"{path}: base-motion file not found; check the path")
     try:

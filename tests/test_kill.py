@@ -142,3 +142,21 @@ def test_kill_oas_leaves_no_partial_csv(tmp_path):
     assert rc == 0, err
     assert len(pd.read_csv(out)) > 0
     assert not list(tmp_path.glob(".oas.csv.*")), "temp files of killed writers were not cleaned up"
+
+
+def test_sigterm_stops_cleanly(tmp_path):
+    """SIGTERM (what a scheduler or `timeout` sends) exits 143 and removes the staged output."""
+    cfg = _experiment(tmp_path, "e", 1)
+    out = tmp_path / "out"
+    proc = subprocess.Popen(CLI + ["run", str(cfg), "--out", str(out)], stdout=subprocess.DEVNULL,
+                            stderr=subprocess.DEVNULL)
+    t_end = time.time() + 60
+    while time.time() < t_end and not list(tmp_path.glob(".out.tmp-*")) and proc.poll() is None:
+        time.sleep(0.02)  # wait until the run is staging its outputs
+    proc.send_signal(signal.SIGTERM)
+    rc = proc.wait(timeout=60)
+    if rc == 0:  # finished before the signal landed: the output is whole
+        assert _complete_experiment(out)
+    else:
+        assert rc == 143 and not out.exists()
+    assert not list(tmp_path.glob(".out.tmp-*"))

@@ -66,7 +66,9 @@ WARNING_CODES: dict[str, tuple[str, str]] = {
                               "timestamps; the timestamps were trusted"),
     "W-IMU-TRUNCATED": ("note", "an incomplete final line (logger stopped mid-write) was dropped"),
     # video tracking
-    "W-VIDEO-LOST": ("suspect", "more than 1 % of the frames were lost or never decoded"),
+    "W-VIDEO-SHORT": ("note", "fewer frames decoded than the container's header counts: the file was cut or "
+                              "damaged, or its header over-counts; the frames there are measured"),
+    "W-VIDEO-LOST": ("suspect", "an object was lost on more than 1 % of the frames (see the status column)"),
 }
 
 

@@ -59,8 +59,13 @@ def _complete_experiment(out) -> bool:
     return True
 
 
-def _kill_at(args, delay_s):
+def _kill_at(args, delay_s, after=None):
+    """Start the command, wait ``delay_s`` (after ``after()`` turns true, if given), kill -9 it."""
     proc = _start(args)
+    if after is not None:
+        t_end = time.time() + 600  # a cold numba cache makes the first experiments slow
+        while not after() and proc.poll() is None and time.time() < t_end:
+            time.sleep(0.05)
     time.sleep(delay_s)
     kids = []
     try:
@@ -105,8 +110,14 @@ def test_kill_campaign_no_orphans_and_resume(tmp_path):
         _experiment(root, f"e{i}", i)
     out = tmp_path / "out"
     rng = np.random.default_rng(11)
-    for delay in rng.uniform(2.0, 6.0, 3):
-        kids = _kill_at(["campaign", root, "--out", out, "--workers", 2, "--no-progress"], delay)
+
+    def one_done():
+        return any((out / "experiments").glob("e*/report.json"))
+
+    for k, delay in enumerate(rng.uniform(0.0, 3.0, 3)):
+        # the first kill lands once an experiment has finished (so the re-run can show it resumes)
+        kids = _kill_at(["campaign", root, "--out", out, "--workers", 2, "--no-progress"], delay,
+                        after=one_done if k == 0 else None)
         assert _gone(kids) == [], "worker processes outlived the killed campaign"
         for d in (out / "experiments").glob("*") if (out / "experiments").exists() else []:
             if not d.name.startswith("."):

@@ -57,4 +57,5 @@ def test_video_cut_in_half_warns(tmp_path):
     with collecting() as found:
         res = track_video(cut, load_track_config(out / "track.toml"))
     assert res.n_frames < 0.8 * full.n_frames
-    assert [d.code for d in found] == ["W-VIDEO-LOST"] and f"{full.n_frames} frames" in found[0].message
+    assert [d.code for d in found] == ["W-VIDEO-SHORT"] and f"{full.n_frames} frames" in found[0].message
+    assert found[0].severity == "note"

@@ -63,7 +63,7 @@ __all__ = [
     "MotionConfig", "ObjectConfig", "load_track_config", "TARGET_STYLES", "OBJECT_KINDS",
 ]
 
-TARGET_STYLES = ("aruco", "apriltag", "dots", "edges", "region")
+TARGET_STYLES = ("aruco", "apriltag", "dots", "edges", "region", "markerless")
 OBJECT_KINDS = ("block", "table")
 LEVEL_MODES = ("table", "none", "value")
 CORNER_REFINEMENTS = ("edges", "subpix", "contour", "apriltag", "none")

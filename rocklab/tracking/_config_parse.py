@@ -266,7 +266,7 @@ class ConfigParser:
                      "e.g. markers = [1]", i)
         if style == "dots" and len(dots) < 2:
             self.err(s, "dots", "style 'dots' needs at least two dot centres [[x_m, y_m], ...]", i)
-        if style in ("edges", "region") and roi is None:
+        if style in ("edges", "region", "markerless") and roi is None:
             self.err(s, "roi", f"style {style!r} needs roi = [u, v, width, height] (px, first frame)", i)
         return ObjectConfig(id=oid, kind=kind, markers=markers, marker_positions_m=mpos, dots=dots,
                             roi=roi, size_m=size,

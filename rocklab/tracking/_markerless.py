@@ -1,0 +1,250 @@
+"""Markerless rigid tracker: an object's pose (x, y, θ) from its own texture and outline.
+
+The object is a region of the first frame (``roi``). Every frame is registered
+against a *keyframe* template by intensity (ECC, Euclidean motion, coarse to fine),
+never chained frame to frame, so the pose does not drift:
+
+1. predict the pose from the last two (constant velocity);
+2. ECC on a 3-level pyramid from the prediction, against the first frame's template;
+   if its correlation is low (appearance changed: a spinning ball, lighting), against
+   the latest keyframe — a keyframe is the current frame warped back into the first
+   template's coordinates, so both templates share one coordinate frame;
+3. if ECC fails (occlusion, a jump at an impact), re-acquire: normalised cross-
+   correlation of the template over a search window around the prediction, then ECC;
+4. still nothing: the frame is lost (NaN, status ``lost``) and the next frame searches.
+
+The per-frame orientation uncertainty is the Gauss-Newton covariance of the ECC fit,
+``σ² (JᵀJ)⁻¹`` with σ the intensity residual, inflated by :data:`CORRELATION_INFLATION`
+because neighbouring pixels are not independent (optics, codec, the ECC smoothing).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .._errors import InputError
+from ._aruco import Detection
+
+__all__ = ["MarkerlessTracker", "MarkerlessDetector", "MIN_CC", "REKEY_CC"]
+
+#: ECC correlation below which a registration is rejected.
+MIN_CC = 0.6
+#: Correlation with the first template below which the latest keyframe is used (and renewed).
+REKEY_CC = 0.9
+#: Pixels are correlated over about a 3 x 3 neighbourhood: the covariance's σ is scaled by 3.
+CORRELATION_INFLATION = 3.0
+#: Smallest grey-level standard deviation of a region worth tracking.
+MIN_TEXTURE_STD = 3.0
+
+
+def _euclid(theta, tx, ty):
+    c, s = math.cos(theta), math.sin(theta)
+    return np.array([[c, -s, tx], [s, c, ty]], np.float32)
+
+
+def _params(W):
+    return math.atan2(float(W[1, 0]), float(W[0, 0])), float(W[0, 2]), float(W[1, 2])
+
+
+class MarkerlessTracker:
+    """One object's markerless tracker.
+
+    Parameters
+    ----------
+    obj : ObjectConfig
+        Needs ``roi = (u, v, w, h)``, px, first frame.
+    plane_map : PlaneMap
+    first_gray : ndarray (H, W) uint8
+
+    Raises
+    ------
+    InputError
+        The region leaves the frame or holds no texture to register.
+    """
+
+    def __init__(self, obj, plane_map, first_gray):
+        import cv2
+
+        self.obj, self.pm = obj, plane_map
+        H, W = first_gray.shape[:2]
+        u, v, w, h = (int(round(x)) for x in obj.roi)
+        u0, v0, u1, v1 = max(u, 0), max(v, 0), min(u + w, W), min(v + h, H)
+        if u1 - u0 < 8 or v1 - v0 < 8:
+            raise InputError(f"object {obj.id!r}: roi {list(obj.roi)} lies outside the {W}x{H} frame or is "
+                             "smaller than 8x8 px; give the object's region in the first frame")
+        tmpl = first_gray[v0:v1, u0:u1].astype(np.float32)
+        if float(tmpl.std()) < MIN_TEXTURE_STD:
+            raise InputError(f"object {obj.id!r}: roi {list(obj.roi)} holds no texture (grey std "
+                             f"{float(tmpl.std()):.3g}); draw it round the object's edges or surface detail")
+        self.origin = np.array([u0, v0], float)  # template pixel (0, 0) in the first frame
+        self.tmpl0 = tmpl
+        self.key = tmpl
+        self.size = (u1 - u0, v1 - v0)
+        self.poses: list = []  # last two accepted (theta, tx, ty): template px -> image px
+        # reference points: a 3x3 grid over the template, as plane points of the first frame
+        gx, gy = np.meshgrid(np.linspace(0, self.size[0] - 1, 3), np.linspace(0, self.size[1] - 1, 3))
+        self.grid = np.column_stack((gx.ravel(), gy.ravel()))
+        q = plane_map.to_plane(self.grid + self.origin)
+        centre = plane_map.to_plane(np.array([[u + w / 2, v + h / 2]]))[0]
+        th0 = obj.theta0_rad or 0.0
+        c, s = math.cos(-th0), math.sin(-th0)
+        self.obj_pts = (q - centre) @ np.array([[c, -s], [s, c]]).T
+        self._cv2 = cv2
+
+    # -- registration -------------------------------------------------------------
+    def _window(self, gray, W, margin):
+        """The part of ``gray`` round the template's footprint under W (float32) and its offset (px)."""
+        w, h = self.size
+        corners = (np.array([[0, 0], [w, 0], [0, h], [w, h]], float) + self.origin) @ W[:, :2].T.astype(float) \
+            + W[:, 2].astype(float)
+        H, Wd = gray.shape[:2]
+        x0 = int(max(np.floor(corners[:, 0].min() - margin), 0))
+        y0 = int(max(np.floor(corners[:, 1].min() - margin), 0))
+        x1 = int(min(np.ceil(corners[:, 0].max() + margin), Wd))
+        y1 = int(min(np.ceil(corners[:, 1].max() + margin), H))
+        if x1 - x0 < 8 or y1 - y0 < 8:
+            return None, None
+        return gray[y0:y1, x0:x1].astype(np.float32), np.array([x0, y0], np.float32)
+
+    def _ecc(self, tmpl, gray, W0, levels=3):
+        """ECC of ``tmpl`` in ``gray`` from the warp W0 (first-frame px -> image px); (W, cc) or None."""
+        crop, off = self._window(gray, W0, 0.5 * max(self.size) + 16)
+        if crop is None:
+            return None
+        W0 = W0.copy()
+        W0[:, 2] -= off
+        r = self._ecc_full(tmpl, crop, W0, levels)
+        if r is None:
+            return None
+        W, cc = r
+        W[:, 2] += off
+        return W, cc
+
+    def _ecc_full(self, tmpl, gray_f, W0, levels=3):
+        cv2 = self._cv2
+        crit = (cv2.TERM_CRITERIA_EPS | cv2.TERM_CRITERIA_COUNT, 60, 1e-5)
+        W = W0.copy()
+        W[:, 2] += (W[:, :2] @ self.origin).astype(np.float32)  # template px -> image px incl. origin
+        for lvl in range(levels - 1, -1, -1):
+            f = 0.5 ** lvl
+            t = cv2.resize(tmpl, None, fx=f, fy=f, interpolation=cv2.INTER_AREA) if lvl else tmpl
+            if min(t.shape) < 8:
+                continue
+            img = cv2.resize(gray_f, None, fx=f, fy=f, interpolation=cv2.INTER_AREA) if lvl else gray_f
+            Wl = W.copy()
+            Wl[:, 2] *= f
+            try:
+                cc, Wl = cv2.findTransformECC(t, img, Wl, cv2.MOTION_EUCLIDEAN, crit, None, 3 if lvl else 5)
+            except cv2.error:
+                return None
+            Wl[:, 2] /= f
+            W = Wl
+        W[:, 2] -= (W[:, :2] @ self.origin).astype(np.float32)
+        return W, float(cc)
+
+    def _search(self, tmpl, gray_f, W_pred):
+        """Re-acquire by normalised cross-correlation of the (rotated) template round the prediction."""
+        cv2 = self._cv2
+        th, tx, ty = _params(W_pred)
+        w, h = self.size
+        rot = cv2.warpAffine(tmpl, cv2.getRotationMatrix2D((w / 2, h / 2), -math.degrees(th), 1.0), (w, h),
+                             borderMode=cv2.BORDER_REPLICATE)
+        ctr = self.origin + (w / 2, h / 2)
+        cx, cy = W_pred[:, :2] @ ctr + W_pred[:, 2]
+        H, Wd = gray_f.shape
+        m = max(w, h)
+        x0, y0 = int(max(cx - w / 2 - m, 0)), int(max(cy - h / 2 - m, 0))
+        x1, y1 = int(min(cx + w / 2 + m, Wd)), int(min(cy + h / 2 + m, H))
+        if x1 - x0 <= w or y1 - y0 <= h:
+            return None
+        res = cv2.matchTemplate(gray_f[y0:y1, x0:x1].astype(np.float32), rot, cv2.TM_CCOEFF_NORMED)
+        _, best, _, loc = cv2.minMaxLoc(res)
+        if best < MIN_CC:
+            return None
+        new_ctr = np.array([x0 + loc[0] + w / 2, y0 + loc[1] + h / 2])
+        R = np.array([[math.cos(th), -math.sin(th)], [math.sin(th), math.cos(th)]])
+        t = new_ctr - R @ ctr
+        return _euclid(th, t[0], t[1])
+
+    def _sigma_theta(self, tmpl, gray, W):
+        """Gauss-Newton σ of θ (rad) from the residual of the registered template."""
+        cv2 = self._cv2
+        h, w = tmpl.shape
+        warped = self._warp_back(gray, W)
+        if warped is None:
+            return math.inf
+        # ECC matches up to gain and offset: compare zero-mean, unit-variance patches
+        a = (tmpl - tmpl.mean()) / (tmpl.std() + 1e-9)
+        b = (warped - warped.mean()) / (warped.std() + 1e-9)
+        r = a - b
+        gx = cv2.Sobel(b, cv2.CV_32F, 1, 0, ksize=3) / 8.0
+        gy = cv2.Sobel(b, cv2.CV_32F, 0, 1, ksize=3) / 8.0
+        yy, xx = np.mgrid[0:h, 0:w].astype(np.float32)
+        xc, yc = xx - w / 2, yy - h / 2
+        J = np.column_stack(((-yc * gx + xc * gy).ravel(), gx.ravel(), gy.ravel())).astype(float)
+        JTJ = J.T @ J
+        s2 = float(np.sum(r.astype(float) ** 2)) / max(r.size - 3, 1)
+        try:
+            cov = s2 * np.linalg.inv(JTJ)
+        except np.linalg.LinAlgError:
+            return math.inf
+        return CORRELATION_INFLATION * math.sqrt(max(cov[0, 0], 0.0))
+
+    def _warp_back(self, gray, W):
+        """The current image resampled onto the template grid by the pose W (float32), or None."""
+        cv2 = self._cv2
+        crop, off = self._window(gray, W, 4)
+        if crop is None:
+            return None
+        Wfull = W.copy()
+        Wfull[:, 2] += (W[:, :2] @ self.origin).astype(np.float32) - off
+        h, w = self.tmpl0.shape
+        return cv2.warpAffine(crop, Wfull, (w, h), flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP,
+                              borderMode=cv2.BORDER_REPLICATE)
+
+    def detect(self, gray, frame):
+        """The object's reference points in ``gray``: a :class:`Detection`, or None (lost)."""
+        gray_f = gray
+        if len(self.poses) >= 2:
+            (a0, x0, y0), (a1, x1, y1) = self.poses[-2], self.poses[-1]
+            W_pred = _euclid(2 * a1 - a0, 2 * x1 - x0, 2 * y1 - y0)
+        elif self.poses:
+            W_pred = _euclid(*self.poses[-1])
+        else:
+            W_pred = _euclid(0.0, 0.0, 0.0)
+        fit = self._ecc(self.tmpl0, gray_f, W_pred)
+        tmpl = self.tmpl0
+        if (fit is None or fit[1] < REKEY_CC) and self.key is not self.tmpl0:
+            alt = self._ecc(self.key, gray_f, W_pred if fit is None else fit[0])
+            if alt is not None and (fit is None or alt[1] > fit[1]):
+                fit, tmpl = alt, self.key
+        if fit is None or fit[1] < MIN_CC:
+            W_s = self._search(self.key, gray_f, W_pred)
+            if W_s is not None:
+                alt = self._ecc(self.key, gray_f, W_s)
+                if alt is not None and alt[1] >= MIN_CC:
+                    fit, tmpl = alt, self.key
+        if fit is None or fit[1] < MIN_CC:
+            self.poses = []  # the next frame searches from the last known place
+            return None
+        W, cc = fit
+        if cc < REKEY_CC:  # appearance drifted from the first frame: renew the keyframe here
+            key = self._warp_back(gray_f, W)
+            if key is not None:
+                self.key = key
+        self.poses = (self.poses + [_params(W)])[-2:]
+        sig = self._sigma_theta(tmpl, gray_f, W)
+        pts = self.grid @ W[:, :2].T.astype(float) + W[:, 2] + self.origin @ W[:, :2].T.astype(float)
+        return Detection(pts, self.obj_pts, False, len(self.grid), sigma_rad=sig, n_groups=1)
+
+
+class MarkerlessDetector:
+    """Detector for the ``markerless`` style: one :class:`MarkerlessTracker` per object."""
+
+    def __init__(self, config, plane_map, first_gray):
+        self.trackers = {o.id: MarkerlessTracker(o, plane_map, first_gray) for o in config.objects}
+
+    def detect(self, gray, frame):
+        return {oid: t.detect(gray, frame) for oid, t in self.trackers.items()}

@@ -66,6 +66,10 @@ WARNING_CODES: dict[str, tuple[str, str]] = {
                               "timestamps; the timestamps were trusted"),
     "W-IMU-TRUNCATED": ("note", "an incomplete final line (logger stopped mid-write) was dropped"),
     # video tracking
+    "W-TRACK-NOSCALE": ("note", "no metric scale (marker size, object size, m_per_px, homography): x_m and y_m "
+                                "are left empty; x_px, y_px and theta_rad are measured"),
+    "W-LEVEL-NONE": ("suspect", "levelling asked for a table that is missing or never seen: the camera's roll "
+                                "stays in every angle; add a level reference or say the camera is level"),
     "W-VIDEO-SHORT": ("note", "fewer frames decoded than the container's header counts: the file was cut or "
                               "damaged, or its header over-counts; the frames there are measured"),
     "W-VIDEO-LOST": ("suspect", "an object was lost on more than 1 % of the frames (see the status column)"),

@@ -137,7 +137,7 @@ def test_track_video_file_matches_in_memory(tmp_path):
     mem = assemble_tracks(track_frames(frames, cfg), cfg, FPS, W, H)
     np.testing.assert_allclose(res["block_1"].theta_rad, mem["block_1"].theta_rad, atol=1e-12)
     df = res.to_frame()
-    assert list(df.columns) == ["frame", "t_s", "object", "x_m", "y_m", "theta_rad",
+    assert list(df.columns) == ["frame", "t_s", "object", "x_px", "y_px", "x_m", "y_m", "theta_rad",
                                 "sigma_theta_rad", "quality", "status"]
     assert len(df) == 2 * n
     np.testing.assert_allclose(df.loc[df.object == "block_1", "t_s"], np.arange(n) / FPS)

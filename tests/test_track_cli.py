@@ -58,7 +58,7 @@ def test_cli_writes_tracks_and_table_motion(session, run_cli, tmp_path):
     summary = json.loads(stdout)
     assert summary["fps"] == FPS and summary["objects"]["block_1"]["n_ok"] == len(frames)
     df = pd.read_csv(out)
-    assert list(df.columns) == ["frame", "t_s", "object", "x_m", "y_m", "theta_rad",
+    assert list(df.columns) == ["frame", "t_s", "object", "x_px", "y_px", "x_m", "y_m", "theta_rad",
                                 "sigma_theta_rad", "quality", "status"]
     blk = df[df.object == "block_1"]
     assert np.sqrt(np.mean(np.degrees(blk.theta_rad.to_numpy() - th) ** 2)) < 0.15

@@ -8,6 +8,7 @@ import pytest
 
 from _render import TEX, Scene, dots_texture, plain_texture
 from rocklab import InputError
+from rocklab._diagnostics import RocklabWarning
 from rocklab.tracking import TrackConfig, assemble_tracks, track_frames
 from rocklab.tracking._dots import dot_centroid
 
@@ -117,14 +118,21 @@ def test_region_tracker_rotation_and_scale_from_m_per_px():
     assert np.sqrt(np.mean((b.x_m - xt) ** 2)) < 2e-4
 
 
-def test_region_without_any_scale_is_an_input_error():
+def test_region_without_any_scale_keeps_pixels_and_leaves_metres_empty():
     sc = Scene(200, 150, px_per_m=500.0, seed=8)
     sc.add(*_textured_table(0.2, 0.1))
-    frames = [sc.render([(0.0, 0.0, 0.0)]) for _ in range(3)]
-    cfg = TrackConfig.from_dict({"targets": {"style": "region"},
+    frames = [sc.render([(0.01 * i, 0.0, 0.0)]) for i in range(3)]
+    cfg = TrackConfig.from_dict({"targets": {"style": "region"}, "reference": {"level": "none"},
                                  "objects": [{"id": "t", "kind": "table", "roi": [60, 40, 80, 60]}]})
-    with pytest.raises(InputError, match="no scale"):
-        assemble_tracks(track_frames(frames, cfg), cfg, FPS, 200, 150)
+    with pytest.warns(RocklabWarning, match="W-TRACK-NOSCALE"):  # never a made-up scale
+        res = assemble_tracks(track_frames(frames, cfg), cfg, FPS, 200, 150)
+    t = res["t"]
+    assert np.all(np.isnan(t.x_m)) and np.isnan(t.m_per_unit)
+    # the roi centre in pixels, moving 5 px per frame (0.01 m at 500 px/m)
+    np.testing.assert_allclose(t.x_px, 100.0 + 5.0 * np.arange(3), atol=0.05)
+    np.testing.assert_allclose(t.y_px, 70.0, atol=0.05)
+    df = res.to_frame()
+    assert list(df.columns[:7]) == ["frame", "t_s", "object", "x_px", "y_px", "x_m", "y_m"]
 
 
 def test_apriltag_style():

@@ -127,6 +127,29 @@ class PlaneMap:
             return h[:, :2] / h[:, 2:3]
         return np.column_stack((uv[:, 0] - self.cx, self.cy - uv[:, 1]))
 
+    def to_image(self, XY):
+        """Image pixels (distorted, as in the video) of plane points ``XY``, shape (n, 2): the
+        inverse of :meth:`to_plane`."""
+        XY = np.asarray(XY, float).reshape(-1, 2)
+        X, Y = XY[:, 0], XY[:, 1]
+        if self.H is not None:
+            h = np.column_stack((X, Y, np.ones_like(X))) @ np.linalg.inv(self.H).T
+            uv = h[:, :2] / h[:, 2:3]
+        else:
+            uv = np.column_stack((X + self.cx, self.cy - Y))
+        if self.K is not None and self.dist is not None and np.any(self.dist):
+            import cv2
+
+            ok = np.all(np.isfinite(uv), axis=1)
+            out = np.full(uv.shape, np.nan)
+            if ok.any():
+                xn = (uv[ok] - self.K[:2, 2]) / np.array([self.K[0, 0], self.K[1, 1]])
+                obj = np.column_stack((xn, np.ones(len(xn))))
+                pr, _ = cv2.projectPoints(obj, np.zeros(3), np.zeros(3), self.K, self.dist)
+                out[ok] = pr.reshape(-1, 2)
+            uv = out
+        return uv
+
 
 def plane_homography_from_points(img_px, obj_m, plane_map: PlaneMap):
     """Homography undistorted px -> plane (m) from points of known plane position.

@@ -25,7 +25,7 @@ from ._motion import TableMotion, table_motion
 __all__ = ["Observation", "ObjectTrack", "TrackResult", "track_frames", "assemble_tracks",
            "track_video", "make_plane_map", "TRACK_COLUMNS"]
 
-TRACK_COLUMNS = ("frame", "t_s", "object", "x_m", "y_m", "theta_rad", "sigma_theta_rad",
+TRACK_COLUMNS = ("frame", "t_s", "object", "x_px", "y_px", "x_m", "y_m", "theta_rad", "sigma_theta_rad",
                  "quality", "status")
 #: Largest believable rotation between consecutive frames (rad); bigger steps are outliers.
 MAX_STEP_RAD = 0.35
@@ -211,7 +211,10 @@ class ObjectTrack:
     quality : ndarray (n,)
     status : ndarray (n,) of str
     m_per_unit : float
-        Metres per plane unit used for this object.
+        Metres per plane unit used for this object; NaN when no metric scale is known
+        (then ``x_m, y_m`` are NaN: never a made-up scale).
+    x_px, y_px : ndarray (n,)
+        The object's reference point in the image (px, as in the video: u right, v down).
     """
 
     object: str
@@ -225,6 +228,8 @@ class ObjectTrack:
     quality: np.ndarray
     status: np.ndarray
     m_per_unit: float
+    x_px: np.ndarray | None = None
+    y_px: np.ndarray | None = None
 
     @property
     def ok(self) -> np.ndarray:
@@ -276,7 +281,10 @@ class TrackResult:
         """Long table with :data:`TRACK_COLUMNS` (the ``tracks.csv`` layout)."""
         import pandas as pd
 
-        parts = [pd.DataFrame({"frame": t.frame, "t_s": t.t_s, "object": t.object, "x_m": t.x_m,
+        parts = [pd.DataFrame({"frame": t.frame, "t_s": t.t_s, "object": t.object,
+                               "x_px": t.x_px if t.x_px is not None else np.full(t.frame.size, np.nan),
+                               "y_px": t.y_px if t.y_px is not None else np.full(t.frame.size, np.nan),
+                               "x_m": t.x_m,
                                "y_m": t.y_m, "theta_rad": t.theta_rad,
                                "sigma_theta_rad": t.sigma_theta_rad, "quality": t.quality,
                                "status": t.status}) for t in self.tracks]
@@ -327,20 +335,7 @@ class TrackResult:
         cl, sl = math.cos(self.level_rad), math.sin(self.level_rad)
         X = (cl * x - sl * y) / tr.m_per_unit
         Y = (sl * x + cl * y) / tr.m_per_unit
-        pm = self.plane_map
-        if pm.H is not None:
-            h = np.column_stack((X, Y, np.ones_like(X))) @ np.linalg.inv(pm.H).T
-            uv = h[:, :2] / h[:, 2:3]
-        else:
-            uv = np.column_stack((X + pm.cx, pm.cy - Y))
-        if pm.K is not None and pm.dist is not None and np.any(pm.dist):
-            import cv2
-
-            xn = (uv - pm.K[:2, 2]) / np.array([pm.K[0, 0], pm.K[1, 1]])
-            obj = np.column_stack((xn, np.ones(len(xn))))
-            uv, _ = cv2.projectPoints(obj, np.zeros(3), np.zeros(3), pm.K, pm.dist)
-            uv = uv.reshape(-1, 2)
-        return uv
+        return self.plane_map.to_image(np.column_stack((X, Y)))
 
     def to_dict(self) -> dict:
         """Plain dict of the fields, JSON-ready (SI units in the keys)."""
@@ -429,18 +424,32 @@ def assemble_tracks(observations, config: TrackConfig, fps: float, width_px: int
             m_per[o.id] = 1.0 / float(np.nanmedian(a["scale"][st == "ok"]))
         elif fallback is not None:
             m_per[o.id] = float(fallback)
-        else:
-            raise InputError(f"{config.source or 'config'}: no scale for object {o.id!r}; give "
-                             "targets.marker_size_m, objects.size_m or reference.m_per_px")
+        else:  # no metric scale anywhere: positions stay in pixels, never a made-up metre
+            from .._diagnostics import warn
+
+            m_per[o.id] = math.nan
+            warn("W-TRACK-NOSCALE", f"{config.source or 'config'}: no metric scale for object {o.id!r}: x_m, y_m "
+                                    "left empty (x_px, y_px and theta_rad are measured); give "
+                                    "targets.marker_size_m, objects.size_m or reference.m_per_px")
     ref = config.reference
     level = 0.0
     if ref.level == "value":
         level = ref.level_rad
-    elif ref.level == "table" and config.table is not None:
-        ta, tst, _ = raw[config.table.id]
+    elif ref.level == "table":
+        ta, tst = (raw[config.table.id][:2] if config.table is not None else (None, np.zeros(0, bool)))
         if np.any(tst == "ok"):
             level = float(np.nanmedian(ta["th"][tst == "ok"]))
+        elif not metric_plane:
+            from .._diagnostics import warn
+
+            why = "no object of kind 'table'" if config.table is None else "the table was never seen"
+            warn("W-LEVEL-NONE", f"{config.source or 'config'}: level = 'table' but {why}: angles are not "
+                                 "levelled (camera roll stays in theta); add a table object, set "
+                                 "reference.level = 'value' with level_rad, or 'none' if the camera is level")
     c, s = math.cos(-level), math.sin(-level)
+    pm_px = plane_map
+    if pm_px is None and plane == "image":  # observations in centred pixels: invert that
+        pm_px = PlaneMap(width_px, height_px, config.video.camera_matrix, config.video.dist_coeffs)
     tracks = []
     for o in config.objects:
         a, st, _ = raw[o.id]
@@ -449,10 +458,15 @@ def assemble_tracks(observations, config: TrackConfig, fps: float, width_px: int
         th = a["th"] - level
         sig = a["sig"].copy()
         q = np.where(st == "ok", a["q"], np.nan)
+        if pm_px is not None:
+            uv = pm_px.to_image(np.column_stack((a["X"], a["Y"])))
+            u, v = uv[:, 0].copy(), uv[:, 1].copy()
+        else:
+            u = v = np.full(n, np.nan)
         if config.motion.interpolate_max_gap_frames:
-            _interpolate([x, y, th], st, config.motion.interpolate_max_gap_frames)
+            _interpolate([x, y, th, u, v], st, config.motion.interpolate_max_gap_frames)
         tracks.append(ObjectTrack(o.id, o.kind, frames.copy(), frames / float(fps), x, y, th, sig,
-                                  q, st.astype(str), m_per[o.id]))
+                                  q, st.astype(str), m_per[o.id], u, v))
     return TrackResult(tuple(tracks), float(fps), level, n, int(width_px), int(height_px),
                        None if source is None else str(source), config, plane, plane_map)
 

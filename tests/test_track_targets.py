@@ -7,7 +7,6 @@ import numpy as np
 import pytest
 
 from _render import TEX, Scene, dots_texture, plain_texture
-from rocklab import InputError
 from rocklab._diagnostics import RocklabWarning
 from rocklab.tracking import TrackConfig, assemble_tracks, track_frames
 from rocklab.tracking._dots import dot_centroid

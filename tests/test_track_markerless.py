@@ -122,3 +122,34 @@ def test_real_pendulum_footage(shared_data):
 
     T_track, T_blob = period(x), period(blob_x)
     assert abs(T_track / T_blob - 1) <= 5e-4, (T_track, T_blob)
+
+
+def test_mixed_styles_aruco_block_on_markerless_table(tmp_path):
+    """A block with ArUco markers on a table followed markerless (issue: mixed styles per object)."""
+    import pandas as pd
+
+    from rocklab.tracking import load_track_config, synth_session, track_video
+
+    out = tmp_path / "s"
+    synth_session(out, seed=3, table="sine", size=(960, 540), duration_s=1.8, imu=False, mp4=False)
+    text = (out / "track.toml").read_text()
+    # the table object becomes markerless: a roi round the left part of its top edge (texture, a
+    # marker, and the top edge that levels the angles)
+    text = text.replace('id = "table"\nkind = "table"\n', 'id = "table"\nkind = "table"\nstyle = "markerless"\n'
+                        'roi = [125.0, 322.0, 290.0, 44.0]\n', 1)
+    (out / "track.toml").write_text(text)
+    cfg = load_track_config(out / "track.toml")
+    assert cfg.object("table").style == "markerless" and cfg.targets.style == "aruco"
+    res = track_video(out / "video.mkv", cfg)
+    truth = pd.read_csv(out / "truth.csv")
+    tt = truth[truth.object == "table"].sort_values("frame")
+    tab = res["table"]
+    assert np.all(tab.status == "ok")
+    disp = tab.x_m - tab.x_m[0]
+    disp_true = tt.x_m.to_numpy() - tt.x_m.to_numpy()[0]
+    assert np.sqrt(np.mean((disp - disp_true) ** 2)) <= 1e-4  # <= 0.1 mm
+    tb = truth[truth.object == "block_1"].sort_values("frame")
+    b = res["block_1"]
+    ok = b.status == "ok"
+    assert ok.mean() > 0.99
+    assert np.sqrt(np.mean(np.degrees(b.theta_rad[ok] - tb.theta_rad.to_numpy()[ok]) ** 2)) <= 0.05

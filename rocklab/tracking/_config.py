@@ -256,6 +256,9 @@ class ObjectConfig:
         ``edges``: a hint (default 0) to tell the outline's top from its side.
     marker_size_m : float or None
         This object's marker side (m) when it differs from ``targets.marker_size_m``.
+    style : str or None
+        This object's target style when it differs from ``targets.style`` (mixed styles:
+        e.g. a block with ArUco markers on a markerless table).
     """
 
     id: str
@@ -267,6 +270,7 @@ class ObjectConfig:
     size_m: tuple | None = None
     theta0_rad: float | None = None
     marker_size_m: float | None = None
+    style: str | None = None
 
 
 @dataclass(frozen=True)

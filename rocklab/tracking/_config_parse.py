@@ -260,7 +260,10 @@ class ConfigParser:
         size = self.vector(d.get("size_m"), s, "size_m", i, n=2)
         if size is not None and min(size) <= 0:
             self.err(s, "size_m", "must be [b_m, h_m] > 0", i)
-        style = targets.style
+        own = d.get("style")
+        if own is not None:
+            own = self.choice(own, TARGET_STYLES, s, "style", i)
+        style = own or targets.style
         if style in ("aruco", "apriltag") and not markers:
             self.err(s, "markers", f"style {style!r} needs the marker ids on this object, "
                      "e.g. markers = [1]", i)
@@ -272,4 +275,5 @@ class ConfigParser:
                             roi=roi, size_m=size,
                             theta0_rad=self.num(d.get("theta0_rad"), s, "theta0_rad", i),
                             marker_size_m=self.num(d.get("marker_size_m"), s, "marker_size_m", i,
-                                                   positive=True))
+                                                   positive=True),
+                            style=own)

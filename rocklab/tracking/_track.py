@@ -78,7 +78,39 @@ class Observation:
     plane: str = "image"
 
 
+class _MixedDetector:
+    """Objects of different target styles: one detector per style, results merged."""
+
+    def __init__(self, parts):
+        self.parts = parts
+
+    def detect(self, gray, frame):
+        out = {}
+        for d in self.parts:
+            out.update(d.detect(gray, frame))
+        return out
+
+
 def _make_detector(config, pm, first_gray):
+    styles = {o.style or config.targets.style for o in config.objects}
+    if len(styles) > 1:
+        import dataclasses
+
+        parts = []
+        for st in sorted(styles):
+            objs = tuple(o for o in config.objects if (o.style or config.targets.style) == st)
+            sub = dataclasses.replace(config, objects=objs,
+                                      targets=dataclasses.replace(config.targets, style=st))
+            parts.append(_make_single(sub, pm, first_gray))
+        return _MixedDetector(parts)
+    if styles and styles != {config.targets.style}:
+        import dataclasses
+
+        config = dataclasses.replace(config, targets=dataclasses.replace(config.targets, style=styles.pop()))
+    return _make_single(config, pm, first_gray)
+
+
+def _make_single(config, pm, first_gray):
     style = config.targets.style
     if style in ("aruco", "apriltag"):
         from ._aruco import ArucoDetector

@@ -59,3 +59,23 @@ def test_video_cut_in_half_warns(tmp_path):
     assert res.n_frames < 0.8 * full.n_frames
     assert [d.code for d in found] == ["W-VIDEO-SHORT"] and f"{full.n_frames} frames" in found[0].message
     assert found[0].severity == "note"
+
+
+def test_no_level_reference_warns(tmp_path):
+    """level = 'table' (the default) without a table used to fall back to 0 silently."""
+    from rocklab.tracking import synth_session
+
+    out = tmp_path / "s"
+    synth_session(out, seed=2, size=(480, 270), duration_s=0.6, imu=False, mp4=False)
+    text = (out / "track.toml").read_text()
+    # drop the table object and the plane homography: nothing left to level from
+    head, _, objs = text.partition("[[objects]]")
+    blocks = "[[objects]]" + "[[objects]]".join(o for o in objs.split("[[objects]]") if 'kind = "table"' not in o)
+    head = "\n".join(ln for ln in head.splitlines() if not ln.startswith("homography"))
+    (out / "t.toml").write_text(head + "\n" + blocks)
+    cfg = load_track_config(out / "t.toml")
+    assert cfg.table is None and cfg.reference.level == "table"
+    with collecting() as found:
+        track_video(out / "video.mkv", cfg)
+    assert "W-LEVEL-NONE" in [d.code for d in found]
+    assert "no object of kind 'table'" in [d for d in found if d.code == "W-LEVEL-NONE"][0].message

@@ -111,7 +111,7 @@ def test_multi_marker_layout_learnt_and_partial_occlusion(tmp_path):
         if i >= 10:
             f[:160, :] = 100  # hide the upper marker (image rows 99..148)
         frames.append(f)
-    cfg = TrackConfig.from_dict({"targets": {"marker_size_m": 0.07},
+    cfg = TrackConfig.from_dict({"targets": {"marker_size_m": 0.07}, "reference": {"level": "none"},
                                  "objects": [{"id": "b", "markers": [3, 4]}]})
     res = assemble_tracks(track_frames(frames, cfg), cfg, FPS, W, H)
     b = res["b"]

@@ -68,4 +68,4 @@ def test_dots_need_two_and_edges_need_roi():
     cfg = TrackConfig.from_dict({"targets": {"style": "dots"},
                                  "objects": [{"id": "b", "dots": [[0, 0], [0.1, 0.05]]}]})
     assert cfg.objects[0].dots == ((0.0, 0.0), (0.1, 0.05))
-    assert cfg.reference.level == "none"  # no table to level from
+    assert cfg.reference.level == "table"  # kept as written: tracking warns W-LEVEL-NONE (no table)

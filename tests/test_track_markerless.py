@@ -43,7 +43,7 @@ def _scene(n=60, W=481, H=361, k=1000.0, seed=6, occlude=None):
 def test_markerless_block_rotation_position_and_sigma():
     sc, frames, theta, xt = _scene()
     roi = _roi(sc, (-0.045, 0.07), (0.045, -0.07))
-    cfg = TrackConfig.from_dict({"targets": {"style": "markerless"}, "reference": {"m_per_px": 1e-3},
+    cfg = TrackConfig.from_dict({"targets": {"style": "markerless"}, "reference": {"m_per_px": 1e-3, "level": "none"},
                                  "objects": [{"id": "b", "roi": roi, "theta0_rad": float(theta[0])}]})
     res = assemble_tracks(track_frames(frames, cfg), cfg, FPS, 481, 361)
     b = res["b"]
@@ -60,7 +60,7 @@ def test_markerless_block_rotation_position_and_sigma():
 def test_markerless_occlusion_lost_then_reacquired():
     sc, frames, theta, xt = _scene(occlude=(20, 26))
     roi = _roi(sc, (-0.045, 0.07), (0.045, -0.07))
-    cfg = TrackConfig.from_dict({"targets": {"style": "markerless"}, "reference": {"m_per_px": 1e-3},
+    cfg = TrackConfig.from_dict({"targets": {"style": "markerless"}, "reference": {"m_per_px": 1e-3, "level": "none"},
                                  "objects": [{"id": "b", "roi": roi, "theta0_rad": float(theta[0])}]})
     res = assemble_tracks(track_frames(frames, cfg), cfg, FPS, 481, 361)
     b = res["b"]
@@ -73,7 +73,7 @@ def test_markerless_occlusion_lost_then_reacquired():
 
 def test_markerless_region_without_texture_is_an_error():
     frame = np.full((120, 160), 128, np.uint8)
-    cfg = TrackConfig.from_dict({"targets": {"style": "markerless"}, "reference": {"m_per_px": 1e-3},
+    cfg = TrackConfig.from_dict({"targets": {"style": "markerless"}, "reference": {"m_per_px": 1e-3, "level": "none"},
                                  "objects": [{"id": "wall", "roi": [20, 20, 40, 40]}]})
     with pytest.raises(InputError, match="'wall'.*no texture") as e:
         list(track_frames([frame, frame], cfg))
@@ -100,7 +100,7 @@ def test_real_pendulum_footage(shared_data):
         ys, xs = np.nonzero(m)
         blob_x.append(xs.mean() if xs.size > 30 else np.nan)
     blob_x = np.array(blob_x)
-    cfg = TrackConfig.from_dict({"targets": {"style": "markerless"},
+    cfg = TrackConfig.from_dict({"targets": {"style": "markerless"}, "reference": {"level": "none"},
                                  "objects": [{"id": "ball", "roi": [310, 66, 70, 74]}]})
     obs = [o for fr in track_frames(((i, g) for i, g in iter_video_frames(path)), cfg) for o in fr]
     ok = np.array([o.status == "ok" for o in obs])

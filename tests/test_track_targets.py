@@ -108,7 +108,7 @@ def test_region_tracker_rotation_and_scale_from_m_per_px():
     frames = [sc.render([(xt[i], 0.0, theta[i])]) for i in range(n)]
     roi = _roi(sc, (-0.035, 0.05), (0.035, -0.05))
     cfg = TrackConfig.from_dict({"targets": {"style": "region"},
-                                 "reference": {"m_per_px": 1 / k},
+                                 "reference": {"m_per_px": 1 / k, "level": "none"},
                                  "objects": [{"id": "b", "roi": roi, "theta0_rad": float(theta[0])}]})
     res = assemble_tracks(track_frames(frames, cfg), cfg, FPS, W, H)
     b = res["b"]
@@ -145,6 +145,7 @@ def test_apriltag_style():
     theta = np.linspace(-0.1, 0.1, n)
     frames = [sc.render([(0.0, 0.0, theta[i])]) for i in range(n)]
     cfg = TrackConfig.from_dict({"targets": {"style": "apriltag", "marker_size_m": 0.08},
+                                 "reference": {"level": "none"},
                                  "objects": [{"id": "b", "markers": [5]}]})
     assert cfg.targets.dictionary == "DICT_APRILTAG_36h11"  # the style's default
     res = assemble_tracks(track_frames(frames, cfg), cfg, FPS, W, H)

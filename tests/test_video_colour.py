@@ -45,6 +45,7 @@ def _track(path, decimation=2):
     from rocklab.tracking import TrackConfig, track_video
 
     cfg = TrackConfig.from_dict({"targets": {"style": "aruco", "marker_size_m": 0.05},
+                                 "reference": {"level": "none"},  # rendered level
                                  "objects": [{"id": "block_1", "markers": [1]}]})
     jpeg, keep = _frame_keeper(decimation)
     tr = track_video(path, cfg, fps=50.0, on_frame=keep)

@@ -140,14 +140,8 @@ class ConfigParser:
                     self.err("objects", "markers", f"marker {m} already belongs to "
                              f"{seen_markers[m]!r}; each marker id belongs to one object", i)
                 seen_markers[m] = o.id
-        if reference.level == "table" and not any(o.kind == "table" for o in objects):
-            import dataclasses
-            # No table to level from: fall back to the image rows (documented).
-            reference = dataclasses.replace(reference, level="none")
-        if targets.style in ("aruco", "apriltag") and targets.marker_size_m is None and \
-                any(o.marker_size_m is None for o in objects) and reference.m_per_px is None and reference.homography is None and reference.board is None:
-            self.err("targets", "marker_size_m", "needed for the scale (or give reference.m_per_px, "
-                     "reference.homography or [reference.board])")
+        # level = "table" without a table object stays as written: tracking then warns W-LEVEL-NONE.
+        # Markers of unknown size are tracked in marker units: x_m, y_m stay empty (W-TRACK-NOSCALE).
         return TrackConfig(objects=objects, video=video, targets=targets, reference=reference,
                            motion=motion, source=None if self.source is None else str(self.source))
 

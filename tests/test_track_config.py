@@ -69,3 +69,18 @@ def test_dots_need_two_and_edges_need_roi():
                                  "objects": [{"id": "b", "dots": [[0, 0], [0.1, 0.05]]}]})
     assert cfg.objects[0].dots == ((0.0, 0.0), (0.1, 0.05))
     assert cfg.reference.level == "table"  # kept as written: tracking warns W-LEVEL-NONE (no table)
+
+
+def test_schema_page_and_examples():
+    """docs/track-toml.md carries the generated reference; every example in examples/ loads."""
+    from pathlib import Path
+
+    from rocklab.tracking import load_track_config
+    from rocklab.tracking._config import schema_markdown
+
+    root = Path(__file__).resolve().parents[1]
+    assert (root / "docs" / "track-toml.md").read_text(encoding="utf-8").endswith(schema_markdown())
+    loaded = {p.name: load_track_config(p) for p in sorted((root / "examples").glob("track_*.toml"))}
+    assert set(loaded) == {"track_aruco.toml", "track_markerless.toml", "track_mixed.toml"}
+    assert loaded["track_mixed.toml"].object("table").style == "markerless"
+    assert loaded["track_markerless.toml"].targets.style == "markerless"

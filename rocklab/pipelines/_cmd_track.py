@@ -1,8 +1,15 @@
-"""``rocklab track VIDEO``: per-object θ, x, y (and table motion) from a video.
+"""``rocklab track``: per-object θ, x, y (and table motion) from a video.
 
-Writes ``tracks.csv`` (columns ``frame, t_s, object, x_m, y_m, theta_rad,
-sigma_theta_rad, quality, status``) and, when the config has a table, a
-``<stem>_table.csv`` next to it (``t_s, x_m, vx_m_s, ax_m_s2``).
+- ``rocklab track VIDEO [--config track.toml] [-o tracks.csv]`` writes ``tracks.csv``
+  (columns ``frame, t_s, object, x_px, y_px, x_m, y_m, theta_rad, sigma_theta_rad,
+  quality, status``; ``x_m, y_m`` empty without a metric scale) and, when the config
+  has a table, ``<stem>_table.csv`` (``t_s, x_m, vx_m_s, ax_m_s2``).
+- ``rocklab track init VIDEO [--object NAME=x,y,w,h ...] [--table x,y,w,h]
+  [--marker-size M] -o track.toml``: a config from the first frame (markers found by
+  trying the common dictionaries, or the named regions followed markerless), commented,
+  plus ``track_init.png`` with every detection, region and the level line drawn.
+- ``rocklab track preview VIDEO --config track.toml [-o sheet.png] [--frames 6]``: a
+  contact sheet of frames spread over the video with each object's pose and θ drawn.
 """
 
 from __future__ import annotations
@@ -16,7 +23,16 @@ def register(sub):
     """Add this module's subcommand(s) to the ``rocklab`` parser ``sub``."""
     p = sub.add_parser("track", help="track blocks and table in a video (ArUco, dots, edges, region)",
                        description=__doc__)
-    p.add_argument("video", help="video file (.mkv/.mp4/...) or image sequence 'dir/%%05d.png'")
+    p.add_argument("video", help="video file (.mkv/.mp4/...) or image sequence 'dir/%%05d.png'; or 'init' / "
+                                 "'preview' followed by the video")
+    p.add_argument("video2", nargs="?", default=None, metavar="VIDEO", help=argparse_suppress())
+    p.add_argument("--object", action="append", default=[], metavar="NAME=x,y,w,h",
+                   help="init: an object's region in the first frame (px), followed markerless")
+    p.add_argument("--table", default=None, metavar="x,y,w,h",
+                   help="init: a markerless table's region (round its top edge: it levels the angles)")
+    p.add_argument("--marker-size", type=float, default=None, help="init: printed marker side, m")
+    p.add_argument("--preview", default=None, help="init: preview PNG (default: <config stem>_init.png)")
+    p.add_argument("--frames", type=int, default=6, help="preview: frames on the contact sheet (default 6)")
     p.add_argument("--config", default=None,
                    help="track.toml (default: track.toml next to the video)")
     p.add_argument("-o", "--out", default=None, help="output CSV (default: tracks.csv next to the video)")
@@ -27,9 +43,21 @@ def register(sub):
     p.set_defaults(func=run)
 
 
+def argparse_suppress():
+    import argparse
+
+    return argparse.SUPPRESS
+
+
 def run(args) -> int:
     """Run ``rocklab track`` with parsed ``args``; returns the exit status (0 ok)."""
     import math
+
+    if args.video in ("init", "preview"):
+        return _tools(args)
+    if args.video2 is not None:
+        raise InputError(f"unexpected second argument {args.video2!r}; use 'rocklab track VIDEO', "
+                         "'rocklab track init VIDEO' or 'rocklab track preview VIDEO'")
 
     from .._io import write_frame_atomic
     from ..tracking import load_track_config, track_video
@@ -64,4 +92,37 @@ def run(args) -> int:
             print(f"{oid}: {d['n_ok']}/{res.n_frames} frames ok, "
                   f"median sigma_theta {d['median_sigma_theta_rad']:.2e} rad")
         print(f"wrote {out}")
+    return 0
+
+
+def _tools(args) -> int:
+    from ._track_tools import track_init, track_preview
+
+    if args.video2 is None:
+        raise InputError(f"rocklab track {args.video}: give the video, e.g. 'rocklab track {args.video} film.mp4'")
+    video = Path(args.video2)
+    if args.video == "init":
+        out = Path(args.out) if args.out else video.parent / "track.toml"
+        if out.suffix.lower() != ".toml":
+            raise InputError(f"-o {out}: the config is a .toml file; give e.g. -o track.toml")
+        preview = Path(args.preview) if args.preview else out.with_name(out.stem + "_init.png")
+        cfg, notes = track_init(video, out, objects=args.object, table=args.table,
+                                marker_size_m=args.marker_size, preview=preview)
+        if args.json:
+            from ._cli_base import emit_json
+
+            emit_json({"config": str(out), "preview": str(preview), "objects": [o.id for o in cfg.objects],
+                       "style": cfg.targets.style, "notes": notes})
+        else:
+            for n in notes:
+                print(f"note: {n}")
+            print(f"wrote {out} ({', '.join(o.id for o in cfg.objects)}) and {preview}; check the preview, then "
+                  f"'rocklab track {video} --config {out}'")
+        return 0
+    cfg_path = Path(args.config) if args.config else video.parent / "track.toml"
+    if not cfg_path.exists():
+        raise InputError(f"{cfg_path}: tracking config not found; pass --config track.toml")
+    out = Path(args.out) if args.out else video.parent / "track_preview.png"
+    res, frames = track_preview(video, cfg_path, out, n_frames=args.frames, progress=args.progress)
+    print(f"wrote {out}: frames {', '.join(map(str, frames))}")
     return 0

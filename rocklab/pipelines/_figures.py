@@ -29,6 +29,18 @@ def save_png(fig, path, dpi: int = 110, tight: bool = True):
     return path
 
 
+def save_bgr_png(path, image):
+    """Write a BGR (or grey) uint8 image to ``path`` as a PNG atomically; returns ``path``."""
+    import cv2
+
+    ok, buf = cv2.imencode(".png", image)
+    if not ok:
+        raise OSError(f"{path}: PNG encoding failed")
+    with atomic_path(path, suffix=".png") as tmp:
+        Path(tmp).write_bytes(buf.tobytes())
+    return path
+
+
 def experiment_figures(res, out_dir) -> dict[str, Path]:
     """Write the experiment figures; returns {name: path}.
 

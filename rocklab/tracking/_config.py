@@ -7,7 +7,7 @@ dataclass below. Lengths are metres, angles radians, image coordinates pixels
     [video]
     fps = 50                     # optional when the container has it
     [targets]
-    style = "aruco"              # aruco | apriltag | dots | edges | region
+    style = "aruco"              # aruco | apriltag | dots | edges | region | markerless
     dictionary = "DICT_4X4_50"   # aruco/apriltag
     marker_size_m = 0.03         # side length of the printed marker (gives the scale)
     [reference]
@@ -104,7 +104,11 @@ class TargetsConfig:
 
     Attributes
     ----------
-    style : {"aruco", "apriltag", "dots", "edges", "region"}
+    style : {"aruco", "apriltag", "dots", "edges", "region", "markerless"}
+        How every object is followed unless it names its own ``style``: printed
+        markers, dot targets, the block's outline, optical flow in a region, or
+        ``markerless`` (the region's own texture and edges registered against a
+        keyframe; see :mod:`rocklab.tracking._markerless`).
     dictionary : str
         OpenCV predefined dictionary name (``DICT_4X4_50``, ``DICT_APRILTAG_36h11``...).
     marker_size_m : float or None
@@ -248,7 +252,7 @@ class ObjectConfig:
     dots : tuple of (x, y)
         Dot centres in the object frame (m), at least two (``dots`` style).
     roi : (u, v, w, h) or None
-        Region in the first tracked frame (px), for ``edges``/``region``.
+        Region in the first tracked frame (px), for ``edges``/``region``/``markerless``.
     size_m : (b, h) or None
         Block outline width and height (m), for ``edges`` (gives the scale).
     theta0_rad : float or None
@@ -374,3 +378,47 @@ def _toml_value(v) -> str:
     if isinstance(v, (list, tuple)):
         return "[" + ", ".join(_toml_value(x) for x in v) + "]"
     raise TypeError(f"cannot write {type(v).__name__} to TOML")
+
+
+def schema_markdown() -> str:
+    """The ``track.toml`` reference (every table, key, default and meaning) as Markdown, from
+    the dataclasses' fields and their numpydoc ``Attributes`` (``docs/track-toml.md``)."""
+    import dataclasses
+    import inspect
+    import re
+
+    def attr_docs(cls) -> dict:
+        doc = inspect.getdoc(cls) or ""
+        body = doc.split("Attributes\n----------\n", 1)[-1] if "Attributes" in doc else ""
+        out, key = {}, None
+        for ln in body.splitlines():
+            m = re.match(r"^(\w+(?:, \w+)*)\s*:\s*(.*)$", ln)
+            if m and not ln.startswith(" "):
+                names = [n.strip() for n in m.group(1).split(",")]
+                key = names
+                for n in names:
+                    out[n] = [f"*{m.group(2).strip()}*:"]
+            elif key and ln.strip():
+                for n in key:
+                    out[n].append(ln.strip())
+        return {k: " ".join(v) for k, v in out.items()}
+
+    sections = [("[video]", VideoConfig), ("[targets]", TargetsConfig), ("[reference]", ReferenceConfig),
+                ("[reference.board]", BoardConfig), ("[motion]", MotionConfig), ("[[objects]] (one per object)",
+                                                                              ObjectConfig)]
+    lines = []
+    for title, cls in sections:
+        first = (inspect.getdoc(cls) or "").splitlines()[0]
+        lines += [f"## `{title}`", "", first, "", "| key | default | type and meaning |", "| --- | --- | --- |"]
+        docs = attr_docs(cls)
+        for f in dataclasses.fields(cls):
+            if f.default is not dataclasses.MISSING:
+                dflt = f"`{f.default!r}`"
+            elif f.default_factory is not dataclasses.MISSING:  # type: ignore[misc]
+                dflt = f"`{f.default_factory()!r}`"  # type: ignore[misc]
+            else:
+                dflt = "required"
+            text = docs.get(f.name, "").replace("|", "/")
+            lines.append(f"| `{f.name}` | {dflt} | {text} |")
+        lines.append("")
+    return "\n".join(lines)

@@ -1,0 +1,91 @@
+"""Markerless tracking speed at 1920x1080 (issue 13 target: >= 100 frames/s on 2 cores).
+
+Baseline in the same process on the same frames: the plain OpenCV code a user writes for a
+textured region: ``goodFeaturesToTrack`` in the first frame's region, pyramidal Lucas-Kanade
+from the first frame to every frame, ``estimateAffinePartial2D`` with RANSAC for the pose.
+Frames are rendered in memory (a textured block rotating by up to 10 deg and translating on a
+textured wall, sensor noise), so decoding is not timed; both are timed with OpenCV on 1 thread
+(per core) and on all threads. Accuracy of both against the rendered angle is printed too.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+import cv2
+import numpy as np
+
+from rocklab.tracking import TrackConfig, track_frames
+
+W, H, N = 1920, 1080, 120
+
+
+def render(seed=0):
+    rng = np.random.default_rng(seed)
+    wall = cv2.GaussianBlur((rng.random((H, W)) * 255).astype(np.uint8), (0, 0), 9)
+    wall = cv2.normalize(wall, None, 90, 160, cv2.NORM_MINMAX)
+    tex = cv2.GaussianBlur((rng.random((420, 240)) * 255).astype(np.uint8), (0, 0), 4)
+    tex = cv2.normalize(tex, None, 30, 230, cv2.NORM_MINMAX)
+    t = np.arange(N) / 50.0
+    theta = np.radians(10) * np.sin(2 * np.pi * t / 1.2)
+    dx = 40 * np.sin(2 * np.pi * t / 0.9)
+    frames = []
+    cx, cy = W / 2, H / 2
+    for th, x in zip(theta, dx):
+        # rotation about the block's bottom-left corner (its pivot), then the shift
+        M = cv2.getRotationMatrix2D((0.0, 420.0), math.degrees(th), 1.0)
+        M[:, 2] += (cx - 120 + x, cy - 210)
+        f = wall.copy()
+        mask = cv2.warpAffine(np.full_like(tex, 255), M, (W, H))
+        blk = cv2.warpAffine(tex, M, (W, H))
+        f[mask > 128] = blk[mask > 128]
+        f = np.clip(f + rng.normal(0, 1.5, f.shape), 0, 255).astype(np.uint8)
+        frames.append(f)
+    roi = (cx - 120 + 10, cy - 210 + 10, 220, 400)
+    return frames, theta, roi
+
+
+def plain_opencv(frames, roi):
+    x, y, w, h = (int(v) for v in roi)
+    mask = np.zeros_like(frames[0])
+    mask[y:y + h, x:x + w] = 255
+    p0 = cv2.goodFeaturesToTrack(frames[0], 200, 0.01, 5, mask=mask)
+    out = []
+    for f in frames:
+        p1, st, _ = cv2.calcOpticalFlowPyrLK(frames[0], f, p0, None, winSize=(21, 21), maxLevel=3)
+        ok = st.ravel() == 1
+        M, _ = cv2.estimateAffinePartial2D(p0[ok], p1[ok], method=cv2.RANSAC)
+        out.append(-math.atan2(M[1, 0], M[0, 0]) if M is not None else np.nan)
+    return np.array(out)
+
+
+def ours(frames, roi):
+    cfg = TrackConfig.from_dict({"targets": {"style": "markerless"}, "reference": {"level": "none"},
+                                 "objects": [{"id": "b", "roi": list(roi)}]})
+    obs = [o for fr in track_frames(frames, cfg) for o in fr]
+    return np.array([o.theta_rad for o in obs])
+
+
+def main() -> None:
+    frames, theta, roi = render()
+    nt = cv2.getNumThreads()
+    print(f"baseline: plain OpenCV (goodFeaturesToTrack + LK to the first frame + estimateAffinePartial2D), "
+          f"same {N} frames {W}x{H}, same process")
+    for threads in sorted({1, nt}):
+        cv2.setNumThreads(threads)
+        res = {}
+        for name, fn in (("rocklab markerless", ours), ("plain OpenCV", plain_opencv)):
+            fn(frames[:3], roi)  # warm-up
+            t0 = time.perf_counter()
+            th = fn(frames, roi)
+            dt = time.perf_counter() - t0
+            err = np.degrees(th - theta)
+            res[name] = N / dt
+            print(f"  {threads} thread(s) {name:>20}: {N / dt:7.1f} frames/s, theta RMS error "
+                  f"{np.sqrt(np.nanmean(err ** 2)):.4f} deg, {np.isfinite(th).sum()}/{N} frames")
+    cv2.setNumThreads(nt)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,165 @@
+"""``rocklab track init`` and ``rocklab track preview``: a config from the first frame, and a
+contact sheet to check the set-up before a long run."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+
+from .._errors import InputError
+
+__all__ = ["track_init", "track_preview", "draw_init_preview", "contact_sheet"]
+
+_COLOURS = [(0, 200, 255), (255, 120, 0), (0, 220, 0), (220, 0, 220), (0, 0, 255), (255, 255, 0)]
+
+
+def _first_frame(video: Path):
+    from ..tracking._video import iter_video_frames, probe_video
+
+    if not video.exists():
+        raise InputError(f"{video}: video not found; check the path")
+    info = probe_video(video)
+    for _, gray, img in iter_video_frames(video, 0, 1, color=True):
+        return info, gray, img
+    raise InputError(f"{video}: no frame could be decoded; check the file")
+
+
+def track_init(video, out, *, objects=(), table=None, marker_size_m=None, preview=None):
+    """Write a commented ``track.toml`` for ``video`` (and a preview PNG); returns (config, notes).
+
+    Parameters
+    ----------
+    objects : sequence of str
+        ``NAME=x,y,w,h`` regions (px, first frame), followed markerless.
+    table : str or None
+        ``x,y,w,h`` of a markerless table (round its top edge: it levels the angles).
+    marker_size_m : float or None
+        Printed marker side, m, when markers are used.
+    preview : path or None
+        PNG with every detection, region and the level line drawn on the first frame.
+    """
+    from .._io import write_text_atomic
+    from ..tracking._init import parse_region, suggest_config
+
+    video, out = Path(video), Path(out)
+    info, gray, img = _first_frame(video)
+    regions = {}
+    for spec in objects:
+        name, sep, box = str(spec).partition("=")
+        if not sep or not name or "," in name:
+            raise InputError(f"--object {spec!r}: give NAME=x,y,w,h (px, first frame)")
+        if name in regions:
+            raise InputError(f"--object {name}: given twice; names must be unique")
+        regions[name] = parse_region(box, f"--object {name}")
+    troi = parse_region(table, "--table") if table is not None else None
+    if marker_size_m is not None and not (math.isfinite(marker_size_m) and marker_size_m > 0):
+        raise InputError(f"--marker-size {marker_size_m}: give the printed marker side in metres (> 0)")
+    cfg, notes, found = suggest_config(gray, regions=regions or None, table_roi=troi,
+                                       fps=None if info.fps else 50.0, marker_size_m=marker_size_m)
+    if not info.fps:
+        notes.append("the container has no frame rate: fps = 50 written; correct it")
+    head = [f"# track.toml written by 'rocklab track init' from {video.name} ({info.width_px}x{info.height_px}, "
+            f"{info.n_frames} frames, {info.fps or 'unknown'} fps)", "# Schema: docs/track-toml.md"]
+    head += [f"# {n}" for n in notes]
+    write_text_atomic(out, "\n".join(head) + "\n\n" + cfg.to_toml())
+    if preview is not None:
+        from ._figures import save_bgr_png
+
+        save_bgr_png(Path(preview), draw_init_preview(img, cfg, found))
+    return cfg, notes
+
+
+def draw_init_preview(img, cfg, found):
+    """The first frame (BGR) with markers (id, outline), regions and the level line drawn."""
+    import cv2
+
+    out = img.copy() if img.ndim == 3 else cv2.cvtColor(img, cv2.COLOR_GRAY2BGR)
+    owner = {m: (k, o) for k, o in enumerate(cfg.objects) for m in o.markers}
+    if found is not None:
+        for mid, c in zip(found.ids, found.corners_px):
+            k, o = owner.get(mid, (len(_COLOURS) - 1, None))
+            col = _COLOURS[k % len(_COLOURS)]
+            cv2.polylines(out, [np.round(c).astype(np.int32)], True, col, 2)
+            cv2.putText(out, f"{mid} {o.id if o else '?'}", tuple(int(x) for x in c[0] - (0, 6)),
+                        cv2.FONT_HERSHEY_SIMPLEX, 0.5, col, 1, cv2.LINE_AA)
+        tab = cfg.table
+        if tab is not None and len(tab.markers) >= 2:  # the level line through the table's markers
+            cs = found.centres_px[[found.ids.index(m) for m in tab.markers]]
+            a, b = cs[np.argmin(cs[:, 0])], cs[np.argmax(cs[:, 0])]
+            cv2.line(out, tuple(int(x) for x in a), tuple(int(x) for x in b), (0, 255, 255), 1, cv2.LINE_AA)
+    for k, o in enumerate(cfg.objects):
+        if o.roi is not None:
+            x, y, w, h = (int(round(v)) for v in o.roi)
+            col = _COLOURS[k % len(_COLOURS)]
+            cv2.rectangle(out, (x, y), (x + w, y + h), col, 2)
+            cv2.putText(out, o.id, (x, max(y - 6, 10)), cv2.FONT_HERSHEY_SIMPLEX, 0.5, col, 1, cv2.LINE_AA)
+            if o.kind == "table":
+                cv2.line(out, (x, y + 1), (x + w, y + 1), (0, 255, 255), 1, cv2.LINE_AA)
+    return out
+
+
+def track_preview(video, config, out, *, n_frames: int = 6, progress: bool = False):
+    """Track ``video`` and write a contact sheet of ``n_frames`` frames spread over it (PNG)."""
+    from ..tracking import load_track_config, track_video
+
+    video = Path(video)
+    if not 1 <= int(n_frames) <= 48:
+        raise InputError(f"--frames {n_frames}: give 1 to 48 frames for the sheet")
+    from ..tracking._video import iter_video_frames
+
+    cfg = load_track_config(config)
+    res = track_video(video, cfg, progress=progress)
+    frames = np.asarray(res.tracks[0].frame)
+    pick = frames[np.unique(np.round(np.linspace(0, frames.size - 1, int(n_frames))).astype(int))]
+    tiles = []
+    for f in pick:  # decode only the frames shown (a long film is not kept in memory)
+        for i, _, img in iter_video_frames(video, int(f), int(f) + 1, prefetch=0, color=True):
+            tiles.append(_draw_pose(img, res, i))
+    from ._figures import save_bgr_png
+
+    save_bgr_png(Path(out), contact_sheet(tiles))
+    return res, [int(f) for f in pick]
+
+
+def _draw_pose(img, res, frame):
+    import cv2
+
+    out = img.copy() if img.ndim == 3 else cv2.cvtColor(img, cv2.COLOR_GRAY2BGR)
+    cv2.putText(out, f"frame {frame}  t = {frame / res.fps:.3f} s", (8, 22), cv2.FONT_HERSHEY_SIMPLEX, 0.6,
+                (255, 255, 255), 2, cv2.LINE_AA)
+    for k, t in enumerate(res.tracks):
+        col = _COLOURS[k % len(_COLOURS)]
+        i = int(np.flatnonzero(t.frame == frame)[0])
+        if t.status[i] != "ok" or t.x_px is None or not np.isfinite(t.x_px[i]):
+            cv2.putText(out, f"{t.object}: {t.status[i]}", (8, 46 + 20 * k), cv2.FONT_HERSHEY_SIMPLEX, 0.55, col,
+                        2, cv2.LINE_AA)
+            continue
+        u, v, th = float(t.x_px[i]), float(t.y_px[i]), float(t.theta_rad[i] + res.level_rad)
+        L = 0.06 * max(out.shape[:2])
+        for ang, ln in ((th, L), (th + math.pi / 2, 0.6 * L)):  # object x and y axes (image v points down)
+            cv2.line(out, (int(u), int(v)), (int(u + ln * math.cos(ang)), int(v - ln * math.sin(ang))), col, 2,
+                     cv2.LINE_AA)
+        cv2.circle(out, (int(u), int(v)), 4, col, -1)
+        cv2.putText(out, f"{t.object}: theta {math.degrees(t.theta_rad[i]):.4g} deg", (8, 46 + 20 * k),
+                    cv2.FONT_HERSHEY_SIMPLEX, 0.55, col, 2, cv2.LINE_AA)
+    return out
+
+
+def contact_sheet(tiles, width_px: int = 1800):
+    """Tiles (BGR, same size) in a grid of up to 3 columns, scaled to ``width_px`` wide."""
+    import cv2
+
+    if not tiles:
+        raise InputError("no tracked frame to show; check the video and the config")
+    cols = min(3, len(tiles))
+    rows = -(-len(tiles) // cols)
+    h, w = tiles[0].shape[:2]
+    s = min(1.0, width_px / (cols * w))
+    th, tw = max(int(h * s), 1), max(int(w * s), 1)
+    sheet = np.zeros((rows * th, cols * tw, 3), np.uint8)
+    for k, t in enumerate(tiles):
+        r, c = divmod(k, cols)
+        sheet[r * th:(r + 1) * th, c * tw:(c + 1) * tw] = cv2.resize(t, (tw, th), interpolation=cv2.INTER_AREA)
+    return sheet

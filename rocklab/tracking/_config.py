@@ -65,7 +65,7 @@ __all__ = [
 
 TARGET_STYLES = ("aruco", "apriltag", "dots", "edges", "region", "markerless")
 OBJECT_KINDS = ("block", "table")
-LEVEL_MODES = ("table", "none", "value")
+LEVEL_MODES = ("table", "none", "value", "rest", "line")
 CORNER_REFINEMENTS = ("edges", "subpix", "contour", "apriltag", "none")
 
 
@@ -181,12 +181,20 @@ class ReferenceConfig:
 
     Attributes
     ----------
-    level : {"table", "none", "value"}
-        ``"table"``: the table object's median image angle is the horizontal
-        (so a slightly rotated camera does not bias θ); ``"value"``: use
-        ``level_rad``; ``"none"``: the image rows are horizontal.
+    level : {"table", "none", "value", "rest", "line"}
+        Where the horizontal comes from: ``"table"``: the table object's median
+        angle (markers, or a markerless table's top edge); ``"rest"``: the
+        block's final rest (free rocking ends upright; ``level_object``, default
+        the first block); ``"line"``: ``level_line_px``, a line the user marked
+        on a horizontal edge of the first frame; ``"value"``: ``level_rad``;
+        ``"none"``: the image rows are horizontal (say so only when the camera is
+        known to be level). The source and its uncertainty are in the result.
     level_rad : float
         Camera roll (rad, counter-clockwise) removed when ``level = "value"``.
+    level_line_px : ((u0, v0), (u1, v1)) or None
+        Two pixels of the first frame on a horizontal line, for ``level = "line"``.
+    level_object : str or None
+        The block whose final rest is upright, for ``level = "rest"``.
     m_per_px : float or None
         Explicit scale (m per px); otherwise from markers/dots/board.
     homography : 3x3 tuple or None
@@ -207,6 +215,8 @@ class ReferenceConfig:
 
     level: str = "table"
     level_rad: float = 0.0
+    level_line_px: tuple | None = None
+    level_object: str | None = None
     m_per_px: float | None = None
     homography: tuple | None = None
     board: BoardConfig | None = None

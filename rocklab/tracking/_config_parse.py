@@ -212,9 +212,17 @@ class ConfigParser:
                 marker_m=self.num(b.get("marker_m"), bs, "marker_m", positive=True),
                 dictionary=str(b.get("dictionary", "DICT_4X4_50")),
                 frame=self.num(b.get("frame", 0), bs, "frame", integer=True, allow_none=False))
+        line = self.matrix(d.get("level_line_px"), (2, 2), s, "level_line_px")
+        if level == "line" and (line is None or (line[0][0] - line[1][0]) ** 2 + (line[0][1] - line[1][1]) ** 2 < 400):
+            self.err(s, "level_line_px", "level = 'line' needs level_line_px = [[u0, v0], [u1, v1]] (px, first "
+                                         "frame), at least 20 px apart along a horizontal edge")
+        lobj = d.get("level_object")
+        if lobj is not None and not isinstance(lobj, str):
+            self.err(s, "level_object", "must be an object id (string)")
         return ReferenceConfig(
             level=level,
             level_rad=self.num(d.get("level_rad", 0.0), s, "level_rad", allow_none=False),
+            level_line_px=line, level_object=lobj,
             m_per_px=self.num(d.get("m_per_px"), s, "m_per_px", positive=True),
             homography=self._homography(d.get("homography"), s),
             board=board,

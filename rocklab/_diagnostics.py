@@ -70,6 +70,9 @@ WARNING_CODES: dict[str, tuple[str, str]] = {
                                 "are left empty; x_px, y_px and theta_rad are measured"),
     "W-LEVEL-NONE": ("suspect", "levelling asked for a table that is missing or never seen: the camera's roll "
                                 "stays in every angle; add a level reference or say the camera is level"),
+    "W-TABLE-MOTION": ("suspect", "the table's displacement could not be differentiated into velocity and "
+                                  "acceleration (too few consecutive samples, or no metric scale); no "
+                                  "<stem>_table.csv was written"),
     "W-VIDEO-SHORT": ("note", "fewer frames decoded than the container's header counts: the file was cut or "
                               "damaged, or its header over-counts; the frames there are measured"),
     "W-VIDEO-LOST": ("suspect", "an object was lost on more than 1 % of the frames (see the status column)"),

@@ -29,6 +29,9 @@ def test_init_finds_markers_and_tracks_unedited(session, tmp_path, run_cli):
     assert (tmp_path / "t_init.png").is_file()
     rc, out, err = run_cli("track", session / "video.mkv", "--config", cfg, "-o", tmp_path / "tr.csv")
     assert rc == 0, err
+    # no marker size: no metres, so no table acceleration either -- said, not skipped silently
+    assert "W-TRACK-NOSCALE" in err and "W-TABLE-MOTION" in err
+    assert not (tmp_path / "tr_table.csv").exists()
     tr = pd.read_csv(tmp_path / "tr.csv")
     truth = pd.read_csv(session / "truth.csv")
     b = tr[tr.object == "block_1"].sort_values("frame")

@@ -78,7 +78,10 @@ def run(args) -> int:
         try:
             tm = res.table_motion()
         except InputError as e:
+            from .._diagnostics import warn
+
             summary["table_motion"] = {"error": str(e)}
+            warn("W-TABLE-MOTION", f"{video}: no table motion for {cfg.table.id!r}: {e}")
         else:
             tpath = out.with_name(out.stem + "_table.csv")
             write_frame_atomic(tpath, tm.to_frame(), float_format="%.9g")

@@ -153,3 +153,34 @@ def test_mixed_styles_aruco_block_on_markerless_table(tmp_path):
     ok = b.status == "ok"
     assert ok.mean() > 0.99
     assert np.sqrt(np.mean(np.degrees(b.theta_rad[ok] - tb.theta_rad.to_numpy()[ok]) ** 2)) <= 0.05
+
+
+@pytest.mark.parametrize("table, size", [("none", (1280, 720)), ("sine", (1280, 720))])
+def test_markerless_synth_session_granite_block(tmp_path, table, size):
+    """`rocklab synth --targets markerless`: a granite-like block rocking through its impacts on a
+    textured steel table, no markers anywhere; the config synth writes tracks it."""
+    import pandas as pd
+
+    from rocklab.tracking import load_track_config, synth_session, track_video
+
+    out = tmp_path / "s"
+    synth_session(out, seed=1 if table == "none" else 3, table=table, size=size,
+                  duration_s=4.0 if table == "none" else 1.8, imu=False, mp4=False, targets="markerless")
+    res = track_video(out / "video.mkv", load_track_config(out / "track.toml"))
+    truth = pd.read_csv(out / "truth.csv")
+    tb = truth[truth.object == "block_1"].sort_values("frame")
+    b = res["block_1"]
+    assert (b.status == "ok").mean() >= 0.99
+    ok = b.status == "ok"
+    assert np.sqrt(np.mean(np.degrees(b.theta_rad[ok] - tb.theta_rad.to_numpy()[ok]) ** 2)) <= 0.05
+    assert res.level_source == "table table" and abs(res.level_rad) < np.radians(0.02)
+    if table == "sine":
+        tt = truth[truth.object == "table"].sort_values("frame")
+        tab = res["table"]
+        disp = tab.x_m - tab.x_m[0]
+        assert np.sqrt(np.mean((disp - (tt.x_m.to_numpy() - tt.x_m.to_numpy()[0])) ** 2)) <= 1e-4
+        tm = res.table_motion()
+        a = tt.ax_m_s2.to_numpy()
+        m = np.isfinite(tm.ax_m_s2)
+        assert m.mean() > 0.9
+        assert np.sqrt(np.mean((tm.ax_m_s2[m] - a[m]) ** 2)) / np.sqrt(np.mean(a[m] ** 2)) <= 0.05

@@ -27,7 +27,7 @@ def register(sub):
                    help="record for --table record (.AT2 or CSV; default: bundled El Centro 1940)")
     p.add_argument("--fps", type=float, default=50.0, help="frame rate, Hz (default 50)")
     p.add_argument("--size", default="1920x1080", help="frame size WxH, px (default 1920x1080)")
-    p.add_argument("--targets", choices=("aruco", "dots", "edges"), default="aruco", help="target style")
+    p.add_argument("--targets", choices=("aruco", "dots", "edges", "markerless"), default="aruco", help="target style")
     p.add_argument("--duration", type=float, default=None, metavar="S",
                    help="video length, s (default: until at rest + 0.6 s, at most 12 s)")
     p.add_argument("--occlusion", default=None, metavar="T0,T1",

@@ -157,6 +157,8 @@ def horizontal_edge_angle(gray, roi, plane_map, topmost: bool = False):
     crop = gray[max(v, 0):v + h, max(u, 0):u + w].astype(np.float32)
     gy = np.abs(cv2.Sobel(crop, cv2.CV_32F, 0, 1, ksize=3))
     if topmost:
+        # average along the (near-horizontal) edge: a textured face's grain averages out, the edge not
+        gy = cv2.blur(gy, (15, 1))
         inner = gy[1:-1]
         first = inner >= 0.5 * inner.max(axis=0, keepdims=True)
         rows = np.argmax(first, axis=0)

@@ -155,6 +155,11 @@ def block_texture(b_m, h_m, style, *, marker_ids=(), dictionary="DICT_4X4_50", m
         p.rect(-b_m / 2, b_m / 2, 0, h_m, face_value or 212.0, opaque=True)
         si, sj = p._slices(-b_m / 2, b_m / 2, 0, h_m)
         p.L[si, sj] += _speckle(p, si, sj, rng, 6.0, 0.004)
+    elif style == "markerless":
+        # granite-like stone: grains at two scales over a mid-grey face, no targets at all
+        p.rect(-b_m / 2, b_m / 2, 0, h_m, face_value or 150.0, opaque=True)
+        si, sj = p._slices(-b_m / 2, b_m / 2, 0, h_m)
+        p.L[si, sj] += _speckle(p, si, sj, rng, 22.0, 0.0025) + _speckle(p, si, sj, rng, 14.0, 0.01)
     elif style == "aruco":
         p.rect(-b_m / 2, b_m / 2, 0, h_m, face_value or 196.0, opaque=True)
         n = len(marker_ids)
@@ -196,7 +201,9 @@ def table_texture(width_m, thick_m, style, *, marker_ids=(), dictionary="DICT_4X
     feats: dict = {}
     p.rect(-width_m / 2, width_m / 2, -thick_m, 0, 96.0, opaque=True)
     si, sj = p._slices(-width_m / 2, width_m / 2, -thick_m, 0)
-    p.L[si, sj] += _speckle(p, si, sj, rng, 3.0, 0.006)
+    # a markerless steel slab needs visible grain to be followed; the others keep a faint one
+    p.L[si, sj] += (_speckle(p, si, sj, rng, 16.0, 0.004) if style == "markerless"
+                    else _speckle(p, si, sj, rng, 3.0, 0.006))
     xs = (-0.4 * width_m, 0.4 * width_m)
     yc = -thick_m / 2
     if style == "aruco":

@@ -37,7 +37,7 @@ from .._errors import InputError
 
 __all__ = ["SynthSession", "synth_session", "load_synth_session", "TARGETS", "TABLES", "parse_size"]
 
-TARGETS = ("aruco", "dots", "edges")
+TARGETS = ("aruco", "dots", "edges", "markerless")
 TABLES = ("none", "sine", "record")
 
 
@@ -186,7 +186,7 @@ def synth_session(out_dir, seed: int = 0, blocks: int = 1, table: str = "none", 
     size : (W, H) or "WxH"
         Frame size, px. The framing scales with it (a 0.2 m block fills a
         third of the frame height).
-    targets : {"aruco", "dots", "edges"}
+    targets : {"aruco", "dots", "edges", "markerless"}
         Two ArUco markers (DICT_4X4_50) per block and two on the table; four
         black dots per block and three on the table; or plain light blocks on
         a dark background.

@@ -141,6 +141,10 @@ class Scene:
                 e["marker_size_m"] = float(f["marker_size_m"])
             elif self.targets == "dots":
                 e["dots"] = np.asarray(f["dots"]).round(12).tolist()
+            elif self.targets == "markerless":
+                e["roi"] = self._inner_roi(o, f)
+                ox, oy, phi = (np.asarray(v, float) for v in o.pose(first))
+                e["theta0_rad"] = float(phi[0]) if e["kind"] == "block" else None
             else:
                 ox, oy, phi = (np.asarray(v, float) for v in o.pose(first))
                 from ._render import _to_world
@@ -154,6 +158,34 @@ class Scene:
                 e["theta0_rad"] = float(phi[0])
             objs.append(e)
         return objs
+
+    def _inner_roi(self, o, f):
+        """A region inside the object's face in the first frame (no background in the template).
+
+        Block: the largest box of the face's aspect inside the tilted face (90 %). Table: its
+        left part up to the first block, from 6 mm above its top edge (the edge levels the
+        angles) to its bottom.
+        """
+        from ._render import _to_world
+
+        t0 = np.array([0.0])
+        ox, oy, phi = (np.asarray(v, float).ravel()[:1] for v in o.pose(t0))
+        b, h = f["size_m"]
+        if o.id == "table":
+            xb = min(float(_to_world(ob.texture.outline_m, *(np.asarray(v, float).ravel()[:1] for v in ob.pose(t0)))
+                           [..., 0].min()) for ob in self.objects if ob.id != "table")
+            # table body frame: origin at the top centre of the face, y up; its pose is the shift
+            local = np.array([[-b / 2 + 0.01, 0.006], [min(xb - float(ox[0]) - 0.02, -b / 4), -h + 0.002]])
+            pts = _to_world(local, ox, oy, phi).reshape(-1, 2)
+        else:
+            a, c, ph = b / 2, h / 2, abs(float(phi[0]))
+            k = 0.9 * min(a / (a * np.cos(ph) + c * np.sin(ph)), c / (a * np.sin(ph) + c * np.cos(ph)))
+            centre = _to_world(np.array([[0.0, c]]), ox, oy, phi).reshape(-1, 2)[0]
+            pts = centre + np.array([[-k * a, -k * c], [k * a, k * c]])
+        px = self.camera.project(pts)
+        u0, v0 = px.min(axis=0)
+        u1, v1 = px.max(axis=0)
+        return [round(float(u0), 1), round(float(v0), 1), round(float(u1 - u0), 1), round(float(v1 - v0), 1)]
 
     def write_files(self, folder: Path, *, imu: bool, imu_rate_hz: float, calibrated: bool) -> dict:
         """Write truth.csv, track.toml, experiment.toml, imu/ and return session.json's content."""

@@ -4,7 +4,7 @@ VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 
-.PHONY: test demo bench venv clean
+.PHONY: test demo bench lint docs venv clean
 
 venv: $(STAMP)
 
@@ -21,8 +21,17 @@ test: $(STAMP)
 demo: $(STAMP)
 	$(VENV)/bin/rocklab demo
 
+lint: $(STAMP)
+	$(PY) -m pip install --quiet -e ".[lint]"
+	$(VENV)/bin/ruff check rocklab tests benchmarks examples
+
+# the documentation site (MkDocs Material), warnings are errors
+docs: $(STAMP)
+	$(PY) -m pip install --quiet -e ".[docs]"
+	$(VENV)/bin/mkdocs build --strict --site-dir site
+
 bench: $(STAMP)
 	@for f in benchmarks/bench_*.py; do echo "== $$f"; $(PY) $$f || exit 1; done
 
 clean:
-	rm -rf $(VENV) build *.egg-info
+	rm -rf $(VENV) build *.egg-info site

@@ -100,3 +100,19 @@ def test_failing_stage_leaves_previous_output_intact(tmp_path, run_cli, monkeypa
         E.run_experiment(cfg, out, force=True)
     assert (out / "report.json").read_text() == before
     assert not [p for p in tmp_path.iterdir() if p.name.startswith(".out")]
+
+
+def test_summary_numbers_for_people(tmp_path, run_cli):
+    """summary.md shows 4 significant digits (it printed '95 % CI 0.9139585433325578 – ...')."""
+    import re
+
+    cfg = _session(tmp_path)
+    out = tmp_path / "o"
+    assert run_cli("run", cfg, "--out", out)[0] == 0
+    text = (out / "summary.md").read_text()
+    assert "95 % CI" in text
+    def significant(num):
+        return len(num.replace(".", "").lstrip("0"))
+
+    long_numbers = [x for x in re.findall(r"\d+\.\d+", text) if significant(x) > 4]
+    assert long_numbers == [], long_numbers

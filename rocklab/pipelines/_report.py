@@ -42,28 +42,38 @@ def series_frame(res):
     return pd.DataFrame(cols)
 
 
+def _g(x, digits: int = 4) -> str:
+    """A number for people: ``digits`` significant digits, "–" when missing."""
+    try:
+        v = float(x)
+    except (TypeError, ValueError):
+        return "–"
+    return f"{v:.{digits}g}" if np.isfinite(v) else "–"
+
+
 def _summary_md(res, figs: dict, rrd: bool) -> str:
     f = res.fit or {}
     lines = [f"# {res.name}", "", f"Status: **{res.status}**", "",
-             f"Block: b = {res.block.b_m:.4f} m, h = {res.block.h_m:.4f} m, α = {res.block.alpha_rad:.4f} rad, "
-             f"p = {res.block.p_rad_s:.3f} rad/s, η_H = {res.block.eta_H:.4f}; contact: {res.config.contact}", ""]
+             f"Block: b = {_g(res.block.b_m)} m, h = {_g(res.block.h_m)} m, α = {_g(res.block.alpha_rad)} rad, "
+             f"p = {_g(res.block.p_rad_s)} rad/s, η_H = {_g(res.block.eta_H)}; contact: {res.config.contact}", ""]
     if f:
         ci = f.get("ci95_eta_e") or [None, None]
-        lines += [f"η_e = {f.get('eta_e', float('nan')):.4f} (95 % CI {ci[0]} – {ci[1]}), "
-                  f"η'_e = {f.get('eta_e_first')}, θ0 = {f.get('theta0_rad')} rad, "
-                  f"release at {f.get('release_t_s')} s, residual RMS {f.get('rms_residual_rad')} rad", ""]
+        lines += [f"η_e = {_g(f.get('eta_e'))} (95 % CI {_g(ci[0])} – {_g(ci[1])}), "
+                  f"η'_e = {_g(f.get('eta_e_first'))}, θ0 = {_g(f.get('theta0_rad'))} rad, "
+                  f"release at {_g(f.get('release_t_s'))} s, residual RMS {_g(f.get('rms_residual_rad'))} rad "
+                  f"(fit status {f.get('status')})", ""]
     if res.sync:
-        lines += [f"IMU sync: offset {1000 * res.sync.get('offset_s', float('nan')):.2f} ms, "
-                  f"drift {res.sync.get('drift')}, residual {res.sync.get('residual_ms')} ms", ""]
+        lines += [f"IMU sync: offset {_g(1000 * res.sync.get('offset_s', float('nan')))} ms, "
+                  f"drift {_g(res.sync.get('drift'))}, residual {_g(res.sync.get('residual_ms'))} ms", ""]
     lines += ["| simulation | η | RMS vs measured (rad) | impacts |", "|---|---|---|---|"]
     for law, s in res.simulations.items():
         rms = s.get("rms_vs_measured_rad")
-        lines.append(f"| {law} | {s['eta']:.4f} | {rms:.5f} | {len(s['impacts'])} |" if rms is not None
-                     else f"| {law} | {s['eta']:.4f} | – | {len(s['impacts'])} |")
+        lines.append(f"| {law} | {_g(s['eta'])} | {_g(rms)} | {len(s['impacts'])} |" if rms is not None
+                     else f"| {law} | {_g(s['eta'])} | – | {len(s['impacts'])} |")
     lines.append("")
     if res.truth is not None:
-        lines += [f"Synthetic truth: η = {res.truth.get('eta')}, measured θ RMS error "
-                  f"{res.truth.get('theta_rms_error_rad')} rad", ""]
+        lines += [f"Synthetic truth: η = {_g(res.truth.get('eta'))}, measured θ RMS error "
+                  f"{_g(res.truth.get('theta_rms_error_rad'))} rad", ""]
     if res.column is not None:
         c = res.column
         cmp_ = c["comparison"]

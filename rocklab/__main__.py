@@ -1,0 +1,8 @@
+"""``python -m rocklab ...``: the same as the ``rocklab`` command."""
+
+import sys
+
+from .pipelines._cli import main
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -111,7 +111,9 @@ class CampaignResult:
 
     def summary_text(self) -> str:
         """The table the CLI prints: per experiment η_H, η_e ± CI, η_M, truth; then the campaign fits."""
-        lines = [f"campaign: {self.n_ok}/{len(self.runs)} experiments ok; outputs in {self.out_dir}"]
+        n_sus = sum(1 for r in self.runs if r["ok"] and (r.get("report") or {}).get("status") == "suspect")
+        sus = f" ({n_sus} suspect: see their warnings)" if n_sus else ""
+        lines = [f"campaign: {self.n_ok}/{len(self.runs)} experiments ran{sus}; outputs in {self.out_dir}"]
         t = self.ok_table
         if t is not None and len(t):
             lines.append(f"{'experiment':<22}{'block':<7}{'contact':<8}{'eta_H':>8}{'eta_e':>8}"

@@ -19,6 +19,7 @@ import numpy as np
 from .._errors import InputError
 from ._config import TrackConfig
 from ._geometry import PlaneMap, fit_similarity
+from ._detectors import make_detector
 from ._plane import make_plane_map
 from ._motion import TableMotion, table_motion
 
@@ -78,61 +79,6 @@ class Observation:
     plane: str = "image"
 
 
-class _MixedDetector:
-    """Objects of different target styles: one detector per style, results merged."""
-
-    def __init__(self, parts):
-        self.parts = parts
-
-    def detect(self, gray, frame):
-        out = {}
-        for d in self.parts:
-            out.update(d.detect(gray, frame))
-        return out
-
-
-def _make_detector(config, pm, first_gray):
-    styles = {o.style or config.targets.style for o in config.objects}
-    if len(styles) > 1:
-        import dataclasses
-
-        parts = []
-        for st in sorted(styles):
-            objs = tuple(o for o in config.objects if (o.style or config.targets.style) == st)
-            sub = dataclasses.replace(config, objects=objs,
-                                      targets=dataclasses.replace(config.targets, style=st))
-            parts.append(_make_single(sub, pm, first_gray))
-        return _MixedDetector(parts)
-    if styles and styles != {config.targets.style}:
-        import dataclasses
-
-        config = dataclasses.replace(config, targets=dataclasses.replace(config.targets, style=styles.pop()))
-    return _make_single(config, pm, first_gray)
-
-
-def _make_single(config, pm, first_gray):
-    style = config.targets.style
-    if style in ("aruco", "apriltag"):
-        from ._aruco import ArucoDetector
-
-        return ArucoDetector(config, pm)
-    if style == "dots":
-        from ._dots import DotDetector
-
-        return DotDetector(config, pm, first_gray)
-    if style == "edges":
-        from ._edges import EdgeDetector
-
-        return EdgeDetector(config, pm, first_gray)
-    if style == "markerless":
-        from ._markerless import MarkerlessDetector
-
-        return MarkerlessDetector(config, pm, first_gray)
-    from ._region import RegionDetector
-
-    return RegionDetector(config, pm, first_gray)
-
-
 def _look(gray, box):
     """(Laplacian variance, grey std) of the window ``box`` = (u0, v0, u1, v1)."""
     import cv2
@@ -188,7 +134,7 @@ def track_frames(frames, config: TrackConfig, plane_map: PlaneMap | None = None)
         if det is None:
             if plane_map is None:
                 plane_map = make_plane_map(config, gray.shape[1], gray.shape[0], gray)
-            det = _make_detector(config, plane_map, gray)
+            det = make_detector(config, plane_map, gray)
         dets = det.detect(gray, idx)
         obs = []
         for o in config.objects:
@@ -471,7 +417,10 @@ def assemble_tracks(observations, config: TrackConfig, fps: float, width_px: int
             warn("W-TRACK-NOSCALE", f"{config.source or 'config'}: no metric scale for object {o.id!r}: x_m, y_m "
                                     "left empty (x_px, y_px and theta_rad are measured); give "
                                     "targets.marker_size_m, objects.size_m or reference.m_per_px")
-    level, level_src, level_sig = _level(config, raw, frames, fps, metric_plane, plane_map, width_px, height_px)
+    from ._level import level_from_reference
+
+    level, level_src, level_sig = level_from_reference(config, raw, fps, metric_plane, plane_map, width_px,
+                                                       height_px)
     c, s = math.cos(-level), math.sin(-level)
     pm_px = plane_map
     if pm_px is None and plane == "image":  # observations in centred pixels: invert that
@@ -495,85 +444,6 @@ def assemble_tracks(observations, config: TrackConfig, fps: float, width_px: int
                                   q, st.astype(str), m_per[o.id], u, v))
     return TrackResult(tuple(tracks), float(fps), level, n, int(width_px), int(height_px),
                        None if source is None else str(source), config, plane, plane_map, level_src, level_sig)
-
-
-def _robust_sem(x) -> float:
-    """Standard error of the median of ``x`` (1.4826 MAD, n effective samples), rad."""
-    x = np.asarray(x, float)
-    x = x[np.isfinite(x)]
-    if x.size < 2:
-        return math.nan
-    mad = 1.4826 * float(np.median(np.abs(x - np.median(x))))
-    return 1.2533 * mad / math.sqrt(x.size)
-
-
-def _level(config, raw, frames, fps, metric_plane, plane_map, width_px, height_px):
-    """(level angle rad, its source, its 1-σ rad) from ``config.reference.level``; warns
-    W-LEVEL-NONE when the asked-for reference is not there."""
-    from .._diagnostics import warn
-
-    ref = config.reference
-    src = config.source or "config"
-    if ref.level == "value":
-        return float(ref.level_rad), "value", 0.0
-    if ref.level == "none":
-        return 0.0, "none (camera level)", math.nan
-    if ref.level == "line":
-        pm = plane_map if plane_map is not None else PlaneMap(width_px, height_px, config.video.camera_matrix,
-                                                             config.video.dist_coeffs)
-        q = pm.to_plane(np.asarray(ref.level_line_px, float))
-        d = q[1] - q[0]
-        if d[0] < 0:
-            d = -d
-        length_px = float(np.hypot(*np.subtract(*np.asarray(ref.level_line_px, float))))
-        return float(math.atan2(d[1], d[0])), "line", 0.5 * math.sqrt(2) / length_px  # 0.5 px at each end
-    if ref.level == "rest":
-        oid = ref.level_object or next((o.id for o in config.objects if o.kind == "block"), None)
-        if oid is None or oid not in raw:
-            warn("W-LEVEL-NONE", f"{src}: level = 'rest' but there is no block {oid or ''} to take the final rest "
-                                 "of; name one with reference.level_object")
-            return 0.0, "none", math.nan
-        a, st, _ = raw[oid]
-        th = np.where(st == "ok", a["th"], np.nan)
-        rest = _final_rest(th, fps)
-        if rest is None:
-            warn("W-LEVEL-NONE", f"{src}: level = 'rest' but {oid!r} does not come to rest at the end of the video "
-                                 "(1 s still needed); angles are not levelled")
-            return 0.0, "none", math.nan
-        # the frames' scatter understates a bias shared by all frames: one frame's σ is the floor
-        sig = max(_robust_sem(th[rest]), float(np.nanmedian(a["sig"][rest])))
-        return float(np.nanmedian(th[rest])), f"rest of {oid}", sig
-    # "table"
-    if config.table is not None:
-        ta, tst, _ = raw[config.table.id]
-        if np.any(tst == "ok"):
-            th = ta["th"][tst == "ok"]
-            sig = max(_robust_sem(th), float(np.nanmedian(ta["sig"][tst == "ok"])))
-            return float(np.nanmedian(th)), f"table {config.table.id}", sig
-    if metric_plane:
-        return 0.0, f"plane ({plane_map.source if plane_map is not None else 'homography'})", math.nan
-    why = "no object of kind 'table'" if config.table is None else "the table was never seen"
-    warn("W-LEVEL-NONE", f"{src}: level = 'table' but {why}: angles are not levelled (camera roll stays in "
-                         "theta); add a table object, use level = 'rest' / 'line' / 'value', or 'none' if the "
-                         "camera is level")
-    return 0.0, "none", math.nan
-
-
-def _final_rest(th, fps, still_rad=None, min_s=1.0):
-    """Indices of the last still stretch of ``th`` (>= ``min_s`` long, ending at the last sample
-    seen), or None. Still: frame-to-frame steps within 5x the smallest steps' scale."""
-    ok = np.flatnonzero(np.isfinite(th))
-    if ok.size < 10:
-        return None
-    steps = np.abs(np.diff(th[ok]))
-    if still_rad is None:
-        q = np.quantile(steps, 0.2)
-        still_rad = max(5.0 * q, 1e-5)
-    k = ok.size - 1
-    while k > 0 and steps[k - 1] <= still_rad:
-        k -= 1
-    idx = ok[k:]
-    return idx if idx.size >= max(10, int(min_s * fps)) else None
 
 
 def track_video(path, config: TrackConfig, fps: float | None = None, progress: bool = False,

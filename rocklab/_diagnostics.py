@@ -73,6 +73,8 @@ WARNING_CODES: dict[str, tuple[str, str]] = {
     "W-TABLE-MOTION": ("suspect", "the table's displacement could not be differentiated into velocity and "
                                   "acceleration (too few consecutive samples, or no metric scale); no "
                                   "<stem>_table.csv was written"),
+    "W-TRACK-LATCH": ("suspect", "a tracker follows another object: a table that turns, or two objects on the "
+                                 "same pixels; redraw the region (or fix the marker ids) of the named object"),
     "W-VIDEO-SHORT": ("note", "fewer frames decoded than the container's header counts: the file was cut or "
                               "damaged, or its header over-counts; the frames there are measured"),
     "W-VIDEO-LOST": ("suspect", "an object was lost on more than 1 % of the frames (see the status column)"),

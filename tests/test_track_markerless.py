@@ -184,3 +184,25 @@ def test_markerless_synth_session_granite_block(tmp_path, table, size):
         m = np.isfinite(tm.ax_m_s2)
         assert m.mean() > 0.9
         assert np.sqrt(np.mean((tm.ax_m_s2[m] - a[m]) ** 2)) / np.sqrt(np.mean(a[m] ** 2)) <= 0.05
+
+
+def test_table_region_on_the_block_is_flagged(tmp_path):
+    """A table's region drawn on the rocking block: the 'table' turns with the block (W-TRACK-LATCH)."""
+    import re
+
+    from rocklab._diagnostics import collecting
+    from rocklab.tracking import load_track_config, synth_session, track_video
+
+    out = tmp_path / "s"
+    synth_session(out, seed=1, size=(960, 540), duration_s=1.5, imu=False, mp4=False, targets="markerless")
+    text = (out / "track.toml").read_text()
+    block_roi = re.search(r'id = "block_1"\nkind = "block"\nmarkers = \[\]\ndots = \[\]\nroi = (\[[^\]]*\])', text)
+    text = re.sub(r'(id = "table"\nkind = "table"\nmarkers = \[\]\ndots = \[\]\nroi = )\[[^\]]*\]',
+                  lambda m: m.group(1) + block_roi.group(1), text)
+    (out / "t.toml").write_text(text.replace('level = "table"', 'level = "none"'))
+    with collecting() as found:
+        track_video(out / "video.mkv", load_track_config(out / "t.toml"))
+    codes = [d.code for d in found]
+    assert "W-TRACK-LATCH" in codes
+    msgs = " ".join(d.message for d in found if d.code == "W-TRACK-LATCH")
+    assert "table 'table' turns" in msgs and "same pixels" in msgs

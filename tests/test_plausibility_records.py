@@ -131,3 +131,14 @@ def test_warning_codes_documented():
     src = "".join(p.read_text(encoding="utf-8") for p in (Path(__file__).resolve().parents[1] / "rocklab")
                   .rglob("*.py") if p.name != "_diagnostics.py")
     assert [c for c in WARNING_CODES if f'"{c}"' not in src] == []
+
+
+def test_given_units_decide_over_an_unknown_header(tmp_path):
+    """The error for unknown header units says 'give --units'; given, they decide (velocity stays an error)."""
+    p = _at2(tmp_path, units_line="TIME SERIES IN UNITS OF FURLONGS")
+    rec = load_base_motion(p, units="g")
+    assert rec.pga_m_s2 == pytest.approx(0.1 * G * np.max(np.abs(np.sin(np.linspace(0, 6, 40)))), rel=1e-6)
+    assert rec.meta["units_from"] == "option"
+    with pytest.raises(InputError, match="velocity"):
+        load_base_motion(_at2(tmp_path, units_line="VELOCITY TIME SERIES IN UNITS OF CM/S", name="v.AT2"),
+                         units="g")

@@ -20,7 +20,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from .._errors import InputError
-from ._records import BaseMotion
+from ._records import MIN_SAMPLES, BaseMotion
 
 __all__ = ["PulseParameters", "pulse_parameters", "lobe_impulses", "pulse_shape", "pulse_motion",
            "PULSE_KINDS", "F_SINE", "pulse_fullness"]
@@ -46,9 +46,6 @@ def _check_record(base: BaseMotion) -> BaseMotion:
         raise InputError(f"{src}record is all zeros; it has no pulse (check the file or its units)")
     return base
 
-
-#: Fewest samples a record needs for its pulse parameters and spectra.
-MIN_SAMPLES = 16
 
 
 def lobe_impulses(acc, dt_s: float):

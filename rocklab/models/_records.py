@@ -25,7 +25,7 @@ import numpy as np
 from .._errors import InputError
 from ..blocks import G
 
-__all__ = ["BaseMotion", "load_base_motion", "check_plausible", "UNITS_TO_M_S2", "bundled_record", "BUNDLED_RECORDS"]
+__all__ = ["BaseMotion", "load_base_motion", "check_plausible", "MIN_SAMPLES", "UNITS_TO_M_S2", "bundled_record", "BUNDLED_RECORDS"]
 
 #: Factors from accepted acceleration units to m/s^2.
 UNITS_TO_M_S2 = {"g": G, "m/s2": 1.0, "m/s^2": 1.0, "m_s2": 1.0, "cm/s2": 0.01,
@@ -214,7 +214,7 @@ def _read_at2(path: Path, text: str, units: str | None, name: str) -> BaseMotion
     npts, dt = int(m_n.group(1)), float(m_dt.group(1))
     if dt <= 0:
         raise InputError(f"{path}, line {hdr_i + 1}: DT={dt} must be positive")
-    file_units = _at2_units(path, lines[:hdr_i])
+    file_units = _at2_units(path, lines[:hdr_i], given=units)
     units_from = "option" if units is not None else ("header" if file_units else "PEER convention (g)")
     if units is None:
         units = file_units or "g"  # PEER's documented convention when the file names no units
@@ -254,11 +254,12 @@ _OTHER_QUANTITY = {"CM/S": "velocity", "CM/SEC": "velocity", "M/S": "velocity", 
                    "MM": "displacement", "IN": "displacement"}
 
 
-def _at2_units(path: Path, header: list[str]) -> str | None:
+def _at2_units(path: Path, header: list[str], given: str | None = None) -> str | None:
     """The acceleration units an AT2 header names in a units field, or None when it names none.
 
     Free text (a station called "Galway" or "Portugal") is never read as a unit; a
-    velocity or displacement series, or two different units, is an error.
+    velocity or displacement series is an error; so are unknown or two different units,
+    unless the user ``given`` the units (``--units``), which then decide.
     """
     found = {}
     for i, ln in enumerate(header, start=1):
@@ -273,10 +274,10 @@ def _at2_units(path: Path, header: list[str]) -> str | None:
             elif tok in _OTHER_QUANTITY:
                 raise InputError(f"{path}, line {i}: units {m.group(1)!r} are {_OTHER_QUANTITY[tok]}, not "
                                  "acceleration; give the acceleration record")
-            else:
+            elif given is None:
                 raise InputError(f"{path}, line {i}: unknown units {m.group(1)!r} in the header; give --units "
                                  "g|m/s2|cm/s2 to say what the file holds")
-    if len(found) > 1:
+    if len(found) > 1 and given is None:
         raise InputError(f"{path}: header names two units ({', '.join(sorted(found))}); give --units to say "
                          "which is right")
     return next(iter(found), None)
@@ -306,6 +307,11 @@ def _check_last_token(path: Path, data_lines: list[str], first_lineno: int) -> N
                          "others (cut off mid-number?); restore the file's end from its source")
 
 
+#: Fewest samples a record needs for its pulse parameters and spectra (fewer: W-RECORD-SHORT
+#: when read, an error in the pulse and spectrum analysis).
+MIN_SAMPLES = 16
+
+
 def check_plausible(bm: BaseMotion) -> BaseMotion:
     """Warn (``W-RECORD-*``) when a record's amplitude, step or length is implausible for an
     earthquake or shake-table record. Returns ``bm``."""
@@ -318,7 +324,7 @@ def check_plausible(bm: BaseMotion) -> BaseMotion:
                              f"(read as {bm.meta.get('units_in_file', 'given')}) or --units")
     if bm.dt_s > 0.05:
         warn("W-RECORD-DT", f"{src}sample step {bm.dt_s:.4g} s is above 0.05 s; check DT in the header")
-    if bm.t_s.size < 16 or bm.duration_s < 0.2:
+    if bm.t_s.size < MIN_SAMPLES or bm.duration_s < 0.2:
         warn("W-RECORD-SHORT", f"{src}only {bm.t_s.size} samples ({bm.duration_s:.4g} s); check the whole "
                                "file was read")
     return bm

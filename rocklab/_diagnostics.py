@@ -26,8 +26,8 @@ import contextvars
 import warnings
 from dataclasses import dataclass
 
-__all__ = ["Diagnostic", "RocklabWarning", "WARNING_CODES", "warn", "collecting", "worst_status",
-           "codes_markdown"]
+__all__ = ["Diagnostic", "RocklabWarning", "WARNING_CODES", "warn", "collecting", "collected", "stderr_echo",
+           "worst_status", "codes_markdown"]
 
 #: Every warning code: (severity, what it means and what to check). Documented in
 #: ``docs/warnings.md`` (generated from this table by :func:`codes_markdown`).
@@ -158,6 +158,24 @@ def collecting(echo=None):
         yield found
     finally:
         _active.reset(token)
+
+
+def collected() -> list[Diagnostic]:
+    """The diagnostics gathered so far by the innermost active :func:`collecting` block
+    (empty outside one)."""
+    sink = _active.get()
+    return list(sink[0]) if sink is not None else []
+
+
+def stderr_echo(command: str):
+    """An ``echo`` for :func:`collecting` that prints each diagnostic as its one stderr line."""
+    import sys
+
+    def echo(d: Diagnostic) -> None:
+        sys.stderr.write(d.line(command) + "\n")
+        sys.stderr.flush()
+
+    return echo
 
 
 def worst_status(status: str, diagnostics) -> str:

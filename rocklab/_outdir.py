@@ -30,7 +30,7 @@ from pathlib import Path
 from ._errors import InputError
 
 __all__ = ["MARKER", "check_output_dir", "check_output_file", "claim_dir", "stage_dir", "publish_dir", "clean_stale",
-           "is_rocklab_dir", "owned_entries", "foreign_entries", "pid_alive", "stale_prefix"]
+           "owned_entries", "foreign_entries", "pid_alive", "stale_prefix"]
 
 #: Name of the marker file in every folder rocklab writes.
 MARKER = ".rocklab-output"
@@ -83,11 +83,6 @@ def clean_stale(parent, name: str) -> list[Path]:
         except OSError:
             pass
     return removed
-
-
-def is_rocklab_dir(path) -> bool:
-    """True when ``path`` is a folder rocklab wrote (it holds :data:`MARKER`)."""
-    return (Path(path) / MARKER).is_file()
 
 
 def owned_entries(path) -> set[str]:
@@ -181,11 +176,10 @@ def stage_dir(out_dir) -> Path:
 def _write_marker(folder: Path, command: str, entries) -> None:
     from . import __version__
 
-    text = json.dumps({"written_by": f"rocklab {__version__}", "command": command,
-                       "time_unix_s": time.time(), "entries": sorted(entries)}) + "\n"
-    tmp = folder / f"{MARKER}.tmp-{os.getpid()}"
-    tmp.write_text(text, encoding="utf-8")
-    os.replace(tmp, folder / MARKER)
+    from ._io import write_json_atomic
+
+    write_json_atomic(folder / MARKER, {"written_by": f"rocklab {__version__}", "command": command,
+                                        "time_unix_s": time.time(), "entries": sorted(entries)})
 
 
 def claim_dir(path, entries, command: str = "") -> Path:
@@ -223,12 +217,7 @@ def publish_dir(stage, out_dir, command: str = "") -> Path:
     os.umask(umask)
     os.chmod(stage, 0o777 & ~umask)  # mkdtemp made it private
     new = [p.name for p in stage.iterdir() if p.name != MARKER]
-    if not out_dir.exists():
-        _write_marker(stage, command, new)
-        os.rename(stage, out_dir)
-        return out_dir
-    foreign = foreign_entries(out_dir)
-    if not foreign:
+    if not out_dir.exists() or not foreign_entries(out_dir):
         _write_marker(stage, command, new)
         _swap(stage, out_dir)
         return out_dir
@@ -239,7 +228,6 @@ def publish_dir(stage, out_dir, command: str = "") -> Path:
         if (dest.exists() or dest.is_symlink()) and name not in owned:
             os.rename(dest, out_dir / f"{name}.user-{stamp}")
         _swap(stage / name, dest)
-    _write_marker(stage, command, owned | set(new))
-    os.replace(stage / MARKER, out_dir / MARKER)
+    _write_marker(out_dir, command, owned | set(new))
     shutil.rmtree(stage, ignore_errors=True)
     return out_dir

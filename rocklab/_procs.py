@@ -13,7 +13,7 @@ import os
 import signal
 import sys
 
-__all__ = ["die_with_parent", "pool_initializer"]
+__all__ = ["die_with_parent", "pool_initializer", "dask_client"]
 
 _PR_SET_PDEATHSIG = 1
 

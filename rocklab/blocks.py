@@ -15,7 +15,7 @@ from dataclasses import asdict, dataclass
 from ._errors import InputError
 from ._errors import positive as _positive
 
-__all__ = ["Block", "G"]
+__all__ = ["Block", "G", "is_lab_size"]
 
 #: Standard gravity, m/s^2.
 G = 9.80665
@@ -147,3 +147,17 @@ class Block:
                  I_O_kg_m2=self.I_O_kg_m2, p_rad_s=self.p_rad_s, eta_H=self.eta_H,
                  uplift_acc_m_s2=self.uplift_acc_m_s2)
         return d
+
+
+def is_lab_size(b_m, h_m):
+    """Whether sizes (m) describe a rocking block in metres: b, h in 1 mm - 20 m and h/b in 0.5 - 50.
+
+    Array-valued (broadcast) for tables of blocks. Anything else is usually a unit slip (cm
+    in a ``b_m`` column) or b and h swapped (warning ``W-FIT-UNITS``).
+    """
+    import numpy as np
+
+    b, h = np.asarray(b_m, float), np.asarray(h_m, float)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        hb = h / b
+    return (b >= 1e-3) & (b <= 20) & (h >= 1e-3) & (h <= 20) & (hb >= 0.5) & (hb <= 50)

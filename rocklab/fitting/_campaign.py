@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from .._diagnostics import warn
 from .._errors import InputError, where
 from ._laws import edge_contact_k, eta_modified, k_from_eta
 from ._regression import KRegression, fit_k_regression
@@ -74,8 +75,6 @@ def read_block_table(src, nan: str = "raise") -> pd.DataFrame:
     _check_block_rows(df, path)
     dup = df.duplicated(subset=["block", "b_m", "h_m", "eta_e"])
     if dup.any():
-        from .._diagnostics import warn
-
         i = int(df.index[dup][0])
         warn("W-FIT-DUPLICATE", f"{where(path, i + 2 if path else None)}{int(dup.sum())} repeated row(s) dropped "
                                 "(each block counted once)")
@@ -134,10 +133,10 @@ class EtaMatResult:
 
 def _check_block_rows(df: pd.DataFrame, path) -> None:
     """W-FIT-UNITS when a row's size is not a lab block in metres (1 mm - 20 m, h/b 0.5 - 50)."""
-    from .._diagnostics import warn
+    from ..blocks import is_lab_size
 
     b, h = df["b_m"].to_numpy(float), df["h_m"].to_numpy(float)
-    odd = (b < 1e-3) | (b > 20) | (h < 1e-3) | (h > 20) | (h / b < 0.5) | (h / b > 50)
+    odd = ~is_lab_size(b, h)
     if odd.any():
         i = int(df.index[odd][0])
         warn("W-FIT-UNITS", f"{where(path, i + 2 if path else None)}block {df.loc[i, 'block']}: b = "

@@ -29,7 +29,9 @@ import numpy as np
 import pandas as pd
 from scipy.stats import chi2
 
+from .._diagnostics import warn
 from .._errors import InputError
+from ..blocks import is_lab_size
 from ._impacts import _crossings, arch_peaks, check_record, detect_release, per_impact_eta
 from ._simfit import _ac_factor, _grid_then_brent, _Problem, _profile_ci
 
@@ -243,12 +245,10 @@ def fit_restitution(t_s, theta_rad, block, window: str = "middle50", objective: 
     if not rel.found:
         return _failed(f"no release found: {rel.message}", theta0=rel.theta0_rad, sigma=rel.sigma_rad, **fail)
     diags = []
-    hb = block.h_m / block.b_m
-    if not (1e-3 <= block.b_m <= 20 and 1e-3 <= block.h_m <= 20 and 0.5 <= hb <= 50):
-        from .._diagnostics import warn
-
+    if not is_lab_size(block.b_m, block.h_m):
         diags.append(warn("W-FIT-UNITS", f"{name or 'block'}: b = {block.b_m:.4g} m, h = {block.h_m:.4g} m "
-                                         f"(h/b = {hb:.4g}) is not a rocking block in metres; check units and order"))
+                                         f"(h/b = {block.h_m / block.b_m:.4g}) is not a rocking block in metres; "
+                                         "check units and order"))
     t, y, gap_diag = _cut_at_gap(t, y, rel.t_s, rel.sigma_rad)
     if gap_diag is not None:
         diags.append(gap_diag)
@@ -261,8 +261,6 @@ def fit_restitution(t_s, theta_rad, block, window: str = "middle50", objective: 
                        "not rock (check b and h: swapped, or not in metres?)", theta0=rel.theta0_rad,
                        sigma=rel.sigma_rad, **fail)
     if theta0 > 0.9 * alpha:
-        from .._diagnostics import warn
-
         diags.append(warn("W-FIT-THETA0", f"{name or 'block'}: measured theta0 = {theta0:.4g} rad is "
                                           f"{theta0 / alpha:.3f} alpha (alpha = {alpha:.4g} rad from b = "
                                           f"{block.b_m:.4g} m, h = {block.h_m:.4g} m); check b and h"))
@@ -414,16 +412,12 @@ def fit_restitution(t_s, theta_rad, block, window: str = "middle50", objective: 
     msg = "; ".join(([f"{n_skip} NaN sample(s) skipped"] if n_skip else []) + [d.message for d in diags])
     noise = max(rel.sigma_rad, RESIDUAL_FLOOR_RAD)
     if np.isfinite(rms) and rms > RESIDUAL_FACTOR * noise:
-        from .._diagnostics import warn
-
         diags.append(warn("W-FIT-RESIDUAL", f"{name or 'block'}: the fitted simulation misses the measurement by "
                                             f"{rms:.4g} rad RMS, {rms / noise:.4g}x the noise "
                                             f"({noise:.4g} rad); check b = {block.b_m:.4g} m, h = "
                                             f"{block.h_m:.4g} m and the contact type"))
     eta_at_bound = [b for b in at_bound if b.startswith("eta")]  # the release time's bound is a sample
     if eta_at_bound:
-        from .._diagnostics import warn
-
         diags.append(warn("W-FIT-BOUND", f"{name or 'block'}: {', '.join(eta_at_bound)} at the bound of the search "
                                          f"(eta in [{lo_b:g}, {hi_b:g}])"))
     return RestitutionFit(
@@ -469,8 +463,6 @@ def _cut_at_gap(t, y, t_release_s, sigma_rad):
         before = t_cross[t_cross <= t[i]]
         half = float(np.min(np.diff(before))) if before.size >= 2 else float(t[i] - t_release_s)
         if d[i] > 0.5 * half:
-            from .._diagnostics import warn
-
             n_lost = int(round(d[i] / med)) - 1
             diag = warn("W-FIT-GAP", f"theta(t) has a {d[i]:.4g} s gap ({n_lost} samples) at t = {t[i]:.4g} s, "
                                      f"longer than half the shortest half-cycle before it ({half:.4g} s); the "

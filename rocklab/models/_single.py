@@ -213,12 +213,12 @@ def simulate(block, theta0_rad: float = 0.0, omega0_rad_s: float = 0.0, duration
     p = block.p_rad_s
     rest_w2 = 2.0 * p * p * (math.cos(alpha - rest_tol * alpha) - math.cos(alpha))
     n_steps = int(math.ceil(T / dt - 1e-9))
-    if str(method).lower() == "newmark":
+    meth = str(method).lower()
+    if meth == "newmark":
         check_step(p, dt, "dt_s")
     check_memory(40.0 * n_steps / every, f"{T:g} s at dt = {dt:g} s ({n_steps} steps stored every {every})",
                  "shorten duration_s or give a coarser output_dt_s")
     t_last = _last_uplift_t(base, alpha)
-    meth = str(method).lower()
     if meth == "newmark":
         t, th, w, E, imp_cols, n_imp, st, t_over, t_fall, max_abs = run_single(
             p, alpha, th0, w0, dt, n_steps, acc, acc_t0, acc_dt, law.mode, law.eta_x, law.eta_y,

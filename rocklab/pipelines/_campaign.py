@@ -68,8 +68,9 @@ class CampaignResult:
     runs : list[dict]
         Per experiment: config, out, ok, error.
     table : pandas.DataFrame
-        One row per successful experiment (block, b_m, h_m, contact, eta_e, ci_lo, ci_hi,
-        eta_H, eta_M, eta_true, ...).
+        One row per experiment (experiment, status ok/suspect/failed, error, warnings (the
+        W- codes), block, b_m, h_m, contact, eta_e, ci_lo, ci_hi, eta_H, eta_M, eta_true, ...);
+        a failed experiment's row carries only its name, status and error.
     eta_mat : dict or None
         Edge-contact η_mat fit (:meth:`to_dict` of the fitting result).
     k_table : dict or None
@@ -91,10 +92,7 @@ class CampaignResult:
     @property
     def ok_table(self):
         """Rows of :attr:`table` for the experiments that did not fail."""
-        t = self.table
-        if t is None or not len(t):
-            return t
-        return t[t["status"] != "failed"].reset_index(drop=True)
+        return _ok_rows(self.table)
 
     @property
     def n_failed(self) -> int:
@@ -158,6 +156,13 @@ class CampaignResult:
         return "\n".join(lines)
 
 
+def _ok_rows(table):
+    """The rows of a campaign table whose experiment did not fail (renumbered)."""
+    if table is None or not len(table):
+        return table
+    return table[table["status"] != "failed"].reset_index(drop=True)
+
+
 def _row(run: dict) -> dict:
     rep = run.get("report")
     if not rep:  # a failed experiment is a row too, so campaign.csv shows it with its error
@@ -169,8 +174,8 @@ def _row(run: dict) -> dict:
     sims = rep.get("simulations") or {}
     truth = rep.get("truth") or {}
     warn_codes = sorted({w["code"] for w in rep.get("warnings") or []})
-    return {"experiment": rep["name"], "status": rep.get("status"),
-            "error": "; ".join(warn_codes), "config": run["config"],
+    return {"experiment": rep["name"], "status": rep.get("status"), "error": "",
+            "warnings": "; ".join(warn_codes), "config": run["config"],
             "block": b.get("name") or rep["name"], "b_m": b["b_m"], "h_m": b["h_m"],
             "hb": b["h_m"] / b["b_m"], "contact": rep["contact"]["type"], "l_c_m": rep["contact"]["l_c_m"],
             "eta_H": b["eta_H"], "eta_e": fit.get("eta_e", np.nan),
@@ -258,10 +263,10 @@ def run_campaign(root, out_dir, *, workers: int = 2, scheduler: str | None = Non
     table = pd.DataFrame([_row(x) for x in runs])
     msgs: list[str] = []
     eta_mat = k_tab = None
-    good = table[table["status"] != "failed"] if len(table) else table
+    good = _ok_rows(table)
     if len(good):
         try:
-            eta_mat, k_tab = _campaign_fits(good.reset_index(drop=True), msgs)
+            eta_mat, k_tab = _campaign_fits(good, msgs)
         except InputError as e:
             msgs.append(f"campaign fits not done: {e}")
     res = CampaignResult(out_dir=out_dir, runs=runs, table=table, eta_mat=eta_mat, k_table=k_tab, messages=msgs)

@@ -97,7 +97,7 @@ def main(argv=None) -> int:
     import signal
     import warnings
 
-    from .._diagnostics import collecting
+    from .._diagnostics import collecting, stderr_echo
 
     parser = build_parser()
     args = parser.parse_args(argv)
@@ -108,12 +108,8 @@ def main(argv=None) -> int:
     if threading.current_thread() is threading.main_thread():
         signal.signal(signal.SIGTERM, _on_sigterm)
 
-    def echo(d):
-        sys.stderr.write(d.line(cmd) + "\n")
-        sys.stderr.flush()
-
     try:
-        with warnings.catch_warnings(), collecting(echo=echo) as diags:
+        with warnings.catch_warnings(), collecting(echo=stderr_echo(cmd)) as diags:
             if not args.debug:  # numpy's RuntimeWarnings name source paths; results carry W- codes instead
                 warnings.simplefilter("ignore", RuntimeWarning)
             _check_file_outputs(args)

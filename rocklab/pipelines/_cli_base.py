@@ -36,11 +36,10 @@ def emit_json(obj: dict) -> None:
     """
     import sys
 
-    from .._diagnostics import _active, worst_status
+    from .._diagnostics import collected, worst_status
     from .._io import dumps_json
 
-    sink = _active.get()
-    diags = list(sink[0]) if sink is not None else []
+    diags = collected()
     out = dict(obj)
     out["warnings"] = [d.to_dict() for d in diags]
     if isinstance(out.get("status"), str):

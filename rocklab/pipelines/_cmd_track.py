@@ -14,6 +14,7 @@
 
 from __future__ import annotations
 
+import argparse
 from pathlib import Path
 
 from .._errors import InputError
@@ -25,7 +26,7 @@ def register(sub):
                        description=__doc__)
     p.add_argument("video", help="video file (.mkv/.mp4/...) or image sequence 'dir/%%05d.png'; or 'init' / "
                                  "'preview' followed by the video")
-    p.add_argument("video2", nargs="?", default=None, metavar="VIDEO", help=argparse_suppress())
+    p.add_argument("video2", nargs="?", default=None, metavar="VIDEO", help=argparse.SUPPRESS)
     p.add_argument("--object", action="append", default=[], metavar="NAME=x,y,w,h",
                    help="init: an object's region in the first frame (px), followed markerless")
     p.add_argument("--table", default=None, metavar="x,y,w,h",
@@ -41,12 +42,6 @@ def register(sub):
     p.add_argument("--json", action="store_true", help="print a JSON summary on stdout")
     p.add_argument("--progress", action="store_true", help="progress bar on stderr")
     p.set_defaults(func=run)
-
-
-def argparse_suppress():
-    import argparse
-
-    return argparse.SUPPRESS
 
 
 def run(args) -> int:

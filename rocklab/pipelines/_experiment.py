@@ -470,9 +470,10 @@ def run_experiment(config_path, out_dir, *, force: bool = False, spawn: bool = F
             old = {}
         if old.get("fingerprint") == fp:
             return old, False
-    from .._diagnostics import collecting, worst_status
+    from .._diagnostics import collecting, stderr_echo, worst_status
 
-    with collecting(echo=_echo_warning) as diags:
+    # in a campaign worker no CLI collector is active: the run prints its own warnings
+    with collecting(echo=stderr_echo("run")) as diags:
         res = analyse_experiment(cfg, progress=progress, keep_video=cfg.rrd or spawn or bool(connect))
     if diags:
         res = dataclasses.replace(res, status=worst_status(res.status, diags),
@@ -485,14 +486,6 @@ def run_experiment(config_path, out_dir, *, force: bool = False, spawn: bool = F
         shutil.rmtree(stage, ignore_errors=True)
         raise
     return report, True
-
-
-def _echo_warning(d) -> None:
-    """Diagnostics of a run reach stderr as they are found (the CLI's own echo is not active in workers)."""
-    import sys
-
-    sys.stderr.write(d.line("run") + "\n")
-    sys.stderr.flush()
 
 
 def _space_needed(cfg: ExperimentConfig) -> int:

@@ -3,6 +3,8 @@ when objects of one video use different styles (a block with markers on a marker
 
 from __future__ import annotations
 
+import dataclasses
+
 __all__ = ["make_detector"]
 
 
@@ -21,22 +23,15 @@ class _MixedDetector:
 
 def make_detector(config, pm, first_gray):
     """The detector for ``config``'s objects: one per target style, merged when styles mix."""
-    styles = {o.style or config.targets.style for o in config.objects}
-    if len(styles) > 1:
-        import dataclasses
+    def style(o):
+        return o.style or config.targets.style
 
-        parts = []
-        for st in sorted(styles):
-            objs = tuple(o for o in config.objects if (o.style or config.targets.style) == st)
-            sub = dataclasses.replace(config, objects=objs,
-                                      targets=dataclasses.replace(config.targets, style=st))
-            parts.append(_make_single(sub, pm, first_gray))
-        return _MixedDetector(parts)
-    if styles and styles != {config.targets.style}:
-        import dataclasses
-
-        config = dataclasses.replace(config, targets=dataclasses.replace(config.targets, style=styles.pop()))
-    return _make_single(config, pm, first_gray)
+    parts = []
+    for st in sorted({style(o) for o in config.objects}):
+        sub = dataclasses.replace(config, objects=tuple(o for o in config.objects if style(o) == st),
+                                  targets=dataclasses.replace(config.targets, style=st))
+        parts.append(_make_single(sub, pm, first_gray))
+    return parts[0] if len(parts) == 1 else _MixedDetector(parts)
 
 
 def _make_single(config, pm, first_gray):

@@ -234,8 +234,6 @@ def check_imu_log(log: ImuLog, rate_option_hz: float | None = None) -> ImuLog:
             warn("W-IMU-CLOCK", f"{log.source}: {int(gap.sum())} gap(s) in the clock, the longest "
                                 f"{d[i]:.4g} s at t = {log.t_s[i]:.4g} s ({int(round(d[i] / period)) - 1} "
                                 "samples missing or a clock jump)")
-    elif not lo <= log.rate_hz <= hi:
-        raise InputError(f"{log.source}: sample rate {log.rate_hz:.4g} Hz is not an IMU rate; check --rate")
     if not lo <= log.rate_hz <= hi:
         raise InputError(f"{log.source}: sample rate {log.rate_hz:.4g} Hz (rate register or --rate) is not "
                          f"an IMU rate ({lo:g}-{hi:g} Hz); check the register or give --rate")

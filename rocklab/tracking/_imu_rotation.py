@@ -50,6 +50,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .._diagnostics import warn
 from .._errors import InputError
 from ..blocks import G
 from ._imu_motion import (axis_vector, cumtrapz, first_motion, forced_run, last_motion_end,
@@ -165,8 +166,6 @@ def _check_gyro_vs_tilt(source, gyro_change_rad, tilt_change_rad, status, msg):
     tol = 0.2 * max(abs(tilt_change_rad), abs(gyro_change_rad)) + np.deg2rad(1.0)
     if abs(mismatch) <= tol:
         return status, msg
-    from .._diagnostics import warn
-
     d = warn("W-IMU-AXES", f"{source}: the gyro integrates to {np.rad2deg(gyro_change_rad):.4g} deg between the "
                            f"rests but the accelerometer tilts by {np.rad2deg(tilt_change_rad):.4g} deg; check "
                            "the gyro columns (axes, deg/s vs rad/s), --axis and the clock")
@@ -181,8 +180,6 @@ def _check_still_tilt(log: ImuLog, fs: float) -> None:
     c = float(np.dot(a0, a1) / (np.linalg.norm(a0) * np.linalg.norm(a1) + 1e-300))
     ang = float(np.arccos(np.clip(c, -1.0, 1.0)))
     if ang > np.deg2rad(2.0):
-        from .._diagnostics import warn
-
         warn("W-IMU-AXES", f"{log.source}: the gyro shows no motion but gravity turned by {np.rad2deg(ang):.4g} "
                            "deg between the start and the end; check the gyro columns' units (deg/s vs rad/s)")
 

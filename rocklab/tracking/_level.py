@@ -12,7 +12,8 @@ import math
 
 import numpy as np
 
-from ._geometry import PlaneMap
+from .._diagnostics import warn
+from .._errors import InputError
 
 __all__ = ["level_from_reference"]
 
@@ -27,15 +28,14 @@ def _robust_sem(x) -> float:
     return 1.2533 * mad / math.sqrt(x.size)
 
 
-def level_from_reference(config, raw, fps, metric_plane, plane_map, width_px, height_px):
+def level_from_reference(config, raw, fps, metric_plane, plane_map):
     """(level angle rad, its source, its 1-σ rad) from ``config.reference.level``; warns
     W-LEVEL-NONE when the asked-for reference is not there.
 
     ``raw``: object id -> (per-frame arrays ``th``, ``sig`` in plane radians, status, metric), as
-    assembled by :func:`rocklab.tracking.assemble_tracks`.
+    assembled by :func:`rocklab.tracking.assemble_tracks`; ``plane_map``: the image -> plane
+    mapping the observations were made in (None only for a metric plane given without one).
     """
-    from .._diagnostics import warn
-
     ref = config.reference
     src = config.source or "config"
     if ref.level == "value":
@@ -43,9 +43,10 @@ def level_from_reference(config, raw, fps, metric_plane, plane_map, width_px, he
     if ref.level == "none":
         return 0.0, "none (camera level)", math.nan
     if ref.level == "line":
-        pm = plane_map if plane_map is not None else PlaneMap(width_px, height_px, config.video.camera_matrix,
-                                                             config.video.dist_coeffs)
-        q = pm.to_plane(np.asarray(ref.level_line_px, float))
+        if plane_map is None:
+            raise InputError(f"{src}: level = 'line' needs the image -> plane mapping the frames were tracked "
+                             "with; pass plane_map to assemble_tracks")
+        q = plane_map.to_plane(np.asarray(ref.level_line_px, float))
         d = q[1] - q[0]
         if d[0] < 0:
             d = -d
@@ -83,16 +84,14 @@ def level_from_reference(config, raw, fps, metric_plane, plane_map, width_px, he
     return 0.0, "none", math.nan
 
 
-def _final_rest(th, fps, still_rad=None, min_s=1.0):
+def _final_rest(th, fps, min_s=1.0):
     """Indices of the last still stretch of ``th`` (>= ``min_s`` long, ending at the last sample
     seen), or None. Still: frame-to-frame steps within 5x the smallest steps' scale."""
     ok = np.flatnonzero(np.isfinite(th))
     if ok.size < 10:
         return None
     steps = np.abs(np.diff(th[ok]))
-    if still_rad is None:
-        q = np.quantile(steps, 0.2)
-        still_rad = max(5.0 * q, 1e-5)
+    still_rad = max(5.0 * float(np.quantile(steps, 0.2)), 1e-5)
     k = ok.size - 1
     while k > 0 and steps[k - 1] <= still_rad:
         k -= 1

@@ -97,7 +97,7 @@ class MarkerlessTracker:
         self.tmpl0 = tmpl
         self.key = tmpl
         self.size = (u1 - u0, v1 - v0)
-        self.poses: list = []  # last two accepted (theta, tx, ty): template px -> image px
+        self.poses: list = []  # last two accepted (theta, tx, ty): first-frame px -> image px
         # reference points: a 3x3 grid over the template, as plane points of the first frame
         gx, gy = np.meshgrid(np.linspace(0, self.size[0] - 1, 3), np.linspace(0, self.size[1] - 1, 3))
         self.grid = np.column_stack((gx.ravel(), gy.ravel()))
@@ -168,7 +168,7 @@ class MarkerlessTracker:
         W[:, 2] -= (W[:, :2] @ self.origin).astype(np.float32)
         return W, float(cc)
 
-    def _search(self, tmpl, gray_f, W_pred):
+    def _search(self, tmpl, gray, W_pred):
         """Re-acquire by normalised cross-correlation of the (rotated) template round the prediction."""
         cv2 = self._cv2
         th, tx, ty = _params(W_pred)
@@ -177,13 +177,13 @@ class MarkerlessTracker:
                              borderMode=cv2.BORDER_REPLICATE)
         ctr = self.origin + (w / 2, h / 2)
         cx, cy = W_pred[:, :2] @ ctr + W_pred[:, 2]
-        H, Wd = gray_f.shape
+        H, Wd = gray.shape
         m = max(w, h)
         x0, y0 = int(max(cx - w / 2 - m, 0)), int(max(cy - h / 2 - m, 0))
         x1, y1 = int(min(cx + w / 2 + m, Wd)), int(min(cy + h / 2 + m, H))
         if x1 - x0 <= w or y1 - y0 <= h:
             return None
-        res = cv2.matchTemplate(gray_f[y0:y1, x0:x1].astype(np.float32), rot, cv2.TM_CCOEFF_NORMED)
+        res = cv2.matchTemplate(gray[y0:y1, x0:x1].astype(np.float32), rot, cv2.TM_CCOEFF_NORMED)
         _, best, _, loc = cv2.minMaxLoc(res)
         if best < MIN_CC:
             return None
@@ -230,7 +230,6 @@ class MarkerlessTracker:
 
     def detect(self, gray, frame):
         """The object's reference points in ``gray``: a :class:`Detection`, or None (lost)."""
-        gray_f = gray
         if len(self.poses) >= 2:
             (a0, x0, y0), (a1, x1, y1) = self.poses[-2], self.poses[-1]
             W_pred = _euclid(2 * a1 - a0, 2 * x1 - x0, 2 * y1 - y0)
@@ -238,16 +237,16 @@ class MarkerlessTracker:
             W_pred = _euclid(*self.poses[-1])
         else:
             W_pred = _euclid(0.0, 0.0, 0.0)
-        fit = self._ecc(self.tmpl0, gray_f, W_pred)
+        fit = self._ecc(self.tmpl0, gray, W_pred)
         tmpl = self.tmpl0
         if (fit is None or fit[1] < REKEY_CC) and self.key is not self.tmpl0:
-            alt = self._ecc(self.key, gray_f, W_pred if fit is None else fit[0])
+            alt = self._ecc(self.key, gray, W_pred if fit is None else fit[0])
             if alt is not None and (fit is None or alt[1] > fit[1]):
                 fit, tmpl = alt, self.key
         if fit is None or fit[1] < MIN_CC:
-            W_s = self._search(self.key, gray_f, W_pred)
+            W_s = self._search(self.key, gray, W_pred)
             if W_s is not None:
-                alt = self._ecc(self.key, gray_f, W_s)
+                alt = self._ecc(self.key, gray, W_s)
                 if alt is not None and alt[1] >= MIN_CC:
                     fit, tmpl = alt, self.key
         if fit is None or fit[1] < MIN_CC:
@@ -255,12 +254,12 @@ class MarkerlessTracker:
             return None
         W, cc = fit
         if cc < REKEY_CC:  # appearance drifted from the first frame: renew the keyframe here
-            key = self._warp_back(gray_f, W)
+            key = self._warp_back(gray, W)
             if key is not None:
                 self.key = key
         self.poses = (self.poses + [_params(W)])[-2:]
-        sig = self._sigma_theta(tmpl, gray_f, W)
-        pts = self.grid @ W[:, :2].T.astype(float) + W[:, 2] + self.origin @ W[:, :2].T.astype(float)
+        sig = self._sigma_theta(tmpl, gray, W)
+        pts = (self.grid + self.origin) @ W[:, :2].T.astype(float) + W[:, 2]
         return Detection(pts, self.obj_pts, False, len(self.grid), sigma_rad=sig, n_groups=1)
 
 

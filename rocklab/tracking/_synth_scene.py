@@ -129,11 +129,14 @@ class Scene:
         return df.sort_values(["frame", "object"], kind="stable").reset_index(drop=True)
 
     def _track_objects(self):
+        from ._render import _to_world
+
         objs = []
         first = np.array([0.0])
         for o in self.objects:
             f = self.features[o.id]
             e = {"id": o.id, "kind": "table" if o.id == "table" else "block"}
+            ox, oy, phi = (np.asarray(v, float) for v in o.pose(first))
             if self.targets == "aruco":
                 e["markers"] = [int(k) for k in f["markers"]]
                 e["marker_positions_m"] = [np.mean(c, axis=0).round(12).tolist() for c in f["markers"].values()]
@@ -142,25 +145,19 @@ class Scene:
             elif self.targets == "dots":
                 e["dots"] = np.asarray(f["dots"]).round(12).tolist()
             elif self.targets == "markerless":
-                e["roi"] = self._inner_roi(o, f)
-                ox, oy, phi = (np.asarray(v, float) for v in o.pose(first))
+                e["roi"] = _roi_box(self.camera.project(self._inner_points(o, f, ox, oy, phi)))
                 e["theta0_rad"] = float(phi[0]) if e["kind"] == "block" else None
             else:
-                ox, oy, phi = (np.asarray(v, float) for v in o.pose(first))
-                from ._render import _to_world
-
                 px = self.camera.project(_to_world(o.texture.outline_m, ox, oy, phi).reshape(-1, 2))
-                W, H = self.size
-                u0, v0 = max(0.0, px[:, 0].min() - 8), max(0.0, px[:, 1].min() - 8)
-                u1, v1 = min(W - 1.0, px[:, 0].max() + 8), min(H - 1.0, px[:, 1].max() + 8)
-                e["roi"] = [round(u0, 1), round(v0, 1), round(u1 - u0, 1), round(v1 - v0, 1)]
+                e["roi"] = _roi_box(px, margin_px=8.0, size=self.size)
                 e["size_m"] = list(f["size_m"])
                 e["theta0_rad"] = float(phi[0])
             objs.append(e)
         return objs
 
-    def _inner_roi(self, o, f):
-        """A region inside the object's face in the first frame (no background in the template).
+    def _inner_points(self, o, f, ox, oy, phi):
+        """Two world points (m) spanning a region inside the object's face in the first frame
+        (no background in a markerless template).
 
         Block: the largest box of the face's aspect inside the tilted face (90 %). Table: its
         left part up to the first block, from 6 mm above its top edge (the edge levels the
@@ -169,23 +166,17 @@ class Scene:
         from ._render import _to_world
 
         t0 = np.array([0.0])
-        ox, oy, phi = (np.asarray(v, float).ravel()[:1] for v in o.pose(t0))
         b, h = f["size_m"]
         if o.id == "table":
-            xb = min(float(_to_world(ob.texture.outline_m, *(np.asarray(v, float).ravel()[:1] for v in ob.pose(t0)))
+            xb = min(float(_to_world(ob.texture.outline_m, *(np.asarray(v, float) for v in ob.pose(t0)))
                            [..., 0].min()) for ob in self.objects if ob.id != "table")
             # table body frame: origin at the top centre of the face, y up; its pose is the shift
             local = np.array([[-b / 2 + 0.01, 0.006], [min(xb - float(ox[0]) - 0.02, -b / 4), -h + 0.002]])
-            pts = _to_world(local, ox, oy, phi).reshape(-1, 2)
-        else:
-            a, c, ph = b / 2, h / 2, abs(float(phi[0]))
-            k = 0.9 * min(a / (a * np.cos(ph) + c * np.sin(ph)), c / (a * np.sin(ph) + c * np.cos(ph)))
-            centre = _to_world(np.array([[0.0, c]]), ox, oy, phi).reshape(-1, 2)[0]
-            pts = centre + np.array([[-k * a, -k * c], [k * a, k * c]])
-        px = self.camera.project(pts)
-        u0, v0 = px.min(axis=0)
-        u1, v1 = px.max(axis=0)
-        return [round(float(u0), 1), round(float(v0), 1), round(float(u1 - u0), 1), round(float(v1 - v0), 1)]
+            return _to_world(local, ox, oy, phi).reshape(-1, 2)
+        a, c, ph = b / 2, h / 2, abs(float(phi[0]))
+        k = 0.9 * min(a / (a * np.cos(ph) + c * np.sin(ph)), c / (a * np.sin(ph) + c * np.cos(ph)))
+        centre = _to_world(np.array([[0.0, c]]), ox, oy, phi).reshape(-1, 2)[0]
+        return centre + np.array([[-k * a, -k * c], [k * a, k * c]])
 
     def write_files(self, folder: Path, *, imu: bool, imu_rate_hz: float, calibrated: bool) -> dict:
         """Write truth.csv, track.toml, experiment.toml, imu/ and return session.json's content."""
@@ -259,6 +250,17 @@ class Scene:
                                   f"the end of the IMU logs, {IMU_TAIL_S} s after the last frame",
             },
         }
+
+
+def _roi_box(px, margin_px: float = 0.0, size=None) -> list:
+    """``[u, v, w, h]`` (px, 0.1 px) of the box round the pixels ``px`` (n, 2), grown by
+    ``margin_px`` and, given the frame ``size`` (W, H), clipped to it."""
+    u0, v0 = px.min(axis=0) - margin_px
+    u1, v1 = px.max(axis=0) + margin_px
+    if size is not None:
+        u0, v0 = max(0.0, u0), max(0.0, v0)
+        u1, v1 = min(size[0] - 1.0, u1), min(size[1] - 1.0, v1)
+    return [round(float(u0), 1), round(float(v0), 1), round(float(u1 - u0), 1), round(float(v1 - v0), 1)]
 
 
 def build_scene(*, seed, blocks, table, fps, size, targets, duration_s, occlusion, rolling_shutter,

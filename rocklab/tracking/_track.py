@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .._diagnostics import warn
 from .._errors import InputError
 from ._config import TrackConfig
 from ._geometry import PlaneMap, fit_similarity
@@ -411,20 +412,17 @@ def assemble_tracks(observations, config: TrackConfig, fps: float, width_px: int
         elif fallback is not None:
             m_per[o.id] = float(fallback)
         else:  # no metric scale anywhere: positions stay in pixels, never a made-up metre
-            from .._diagnostics import warn
-
             m_per[o.id] = math.nan
             warn("W-TRACK-NOSCALE", f"{config.source or 'config'}: no metric scale for object {o.id!r}: x_m, y_m "
                                     "left empty (x_px, y_px and theta_rad are measured); give "
                                     "targets.marker_size_m, objects.size_m or reference.m_per_px")
     from ._level import level_from_reference
 
-    level, level_src, level_sig = level_from_reference(config, raw, fps, metric_plane, plane_map, width_px,
-                                                       height_px)
-    c, s = math.cos(-level), math.sin(-level)
     pm_px = plane_map
     if pm_px is None and plane == "image":  # observations in centred pixels: invert that
         pm_px = PlaneMap(width_px, height_px, config.video.camera_matrix, config.video.dist_coeffs)
+    level, level_src, level_sig = level_from_reference(config, raw, fps, metric_plane, pm_px)
+    c, s = math.cos(-level), math.sin(-level)
     tracks = []
     for o in config.objects:
         a, st, _ = raw[o.id]
@@ -506,8 +504,6 @@ def track_video(path, config: TrackConfig, fps: float | None = None, progress: b
 def _check_frames(res, expected: int, path) -> None:
     """W-VIDEO-SHORT (a note) when fewer frames decode than the container's header counts;
     W-VIDEO-LOST when an object is lost on more than 1 % of the frames."""
-    from .._diagnostics import warn
-
     if expected > 0 and res.n_frames < 0.99 * expected:
         # a note, not suspect: every decoded frame is measured; some headers count frames the
         # stream does not hold (the real pendulum film: 2057 in the header, 1844 decodable)
@@ -528,8 +524,6 @@ TABLE_TURN_MAX_RAD = math.radians(1.0)
 def _check_latch(res, path) -> None:
     """W-TRACK-LATCH when a tracker has latched onto another object: a table that turns (tables
     translate), or two objects whose reference points coincide on more than 10 % of the frames."""
-    from .._diagnostics import warn
-
     for t in res.tracks:
         th = t.theta_rad[t.ok]
         if t.kind == "table" and th.size >= 5:

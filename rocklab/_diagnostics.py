@@ -78,6 +78,14 @@ WARNING_CODES: dict[str, tuple[str, str]] = {
     "W-VIDEO-SHORT": ("note", "fewer frames decoded than the container's header counts: the file was cut or "
                               "damaged, or its header over-counts; the frames there are measured"),
     "W-VIDEO-LOST": ("suspect", "an object was lost on more than 1 % of the frames (see the status column)"),
+    # 3D points and the assumption audit
+    "W-3D-LOST": ("suspect", "a body had no pose (fewer than 3 of its points seen) in more than 1 % of the "
+                             "samples (see the status column)"),
+    "W-3D-REST": ("suspect", "no upright rest found at the end of the 3D record: theta is measured from another "
+                             "pose and may carry a constant tilt; give --rest T0,T1"),
+    "W-AUDIT": ("suspect", "the test broke the planar-rocking assumptions (sliding, jumping, twist, out-of-plane "
+                           "rotation or a double impact beyond tolerance): see audit.json for the impacts "
+                           "affected; fits through them are not trustworthy"),
 }
 
 

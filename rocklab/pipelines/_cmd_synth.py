@@ -25,7 +25,7 @@ def register(sub):
                         "record: an earthquake record scaled to the table stroke")
     p.add_argument("--record", metavar="FILE", default=None,
                    help="record for --table record (.AT2 or CSV; default: bundled El Centro 1940)")
-    p.add_argument("--fps", type=float, default=50.0, help="frame rate, Hz (default 50)")
+    p.add_argument("--fps", type=float, default=None, help="frame rate, Hz (default 50; 150 with --points3d)")
     p.add_argument("--size", default="1920x1080", help="frame size WxH, px (default 1920x1080)")
     p.add_argument("--targets", choices=("aruco", "dots", "edges", "markerless"), default="aruco", help="target style")
     p.add_argument("--duration", type=float, default=None, metavar="S",
@@ -44,13 +44,73 @@ def register(sub):
     p.add_argument("--force", action="store_true", help="replace a non-empty --out folder")
     p.add_argument("--json", action="store_true", help="print one JSON object with the paths")
     p.add_argument("--progress", action="store_true", help="progress bar on stderr")
+    g = p.add_argument_group("3D points (a motion-capture export instead of a video)")
+    g.add_argument("--points3d", action="store_true",
+                   help="write points.csv, points.c3d and truth.csv of a free-rocking block with dot targets")
+    g.add_argument("--up", default="z", help="the rig's vertical axis (default z)")
+    g.add_argument("--slide", default=None, metavar="K,MM", help="slide the block by MM mm at impact K")
+    g.add_argument("--jump", default=None, metavar="K,MM", help="a jump of MM mm at impact K")
+    g.add_argument("--twist", default=None, metavar="K,DEG", help="twist the block by DEG deg at impact K")
+    g.add_argument("--double-impact", type=int, default=None, metavar="K", help="a bounce at impact K")
     p.set_defaults(func=run)
+
+
+def _event(spec, option, scale):
+    if spec is None:
+        return None
+    try:
+        k, v = spec.split(",")
+        return int(k), float(v) * scale
+    except ValueError:
+        raise InputError(f"{option} {spec!r}: give K,VALUE (impact number, size), e.g. 3,1.0") from None
+
+
+def _run_points3d(args) -> int:
+    import math
+    import shutil
+
+    from .._outdir import check_output_dir, publish_dir, stage_dir
+    from ..synth import synth_points3d
+
+    out = check_output_dir(args.out, force=args.force)
+    if out.is_dir() and any(out.iterdir()) and not args.force:
+        raise InputError(f"--out {out}: folder is not empty; choose a new --out or pass --force")
+    try:
+        s = synth_points3d(rate_hz=args.fps or 150.0, seed=args.seed, up=args.up,
+                           slide=_event(args.slide, "--slide", 1e-3), jump=_event(args.jump, "--jump", 1e-3),
+                           twist=_event(args.twist, "--twist", math.pi / 180.0), double_impact=args.double_impact)
+    except ValueError as e:
+        raise InputError(f"rocklab synth --points3d: {e}; choose an earlier impact") from None
+    tmp = stage_dir(out)
+    try:
+        paths = s.write(tmp)
+        publish_dir(tmp, out, command="synth")
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    d = {"out_dir": str(out), "files": sorted(p.name for p in paths.values()),
+         "samples": int(s.series.t_s.size), "rate_hz": s.series.rate_hz, "impacts": int(s.impacts_t_s.size),
+         "bodies": {k: list(v) for k, v in s.bodies.items()}, "injected": s.injected}
+    if args.json:
+        from ._cli_base import emit_json
+
+        emit_json(d)
+    else:
+        body = " ".join(f"--body {k}={','.join(v)}" for k, v in s.bodies.items())
+        sys.stdout.write(f"wrote {d['samples']} samples at {d['rate_hz']:.4g} Hz ({d['impacts']} impacts) to "
+                         f"{out}; track with: rocklab track3d {out / 'points.csv'} {body} --up={args.up}\n")
+    return 0
 
 
 def run(args) -> int:
     """Run ``rocklab synth`` with parsed ``args``; returns the exit status (0 ok)."""
     from ..tracking import synth_session
     from ..tracking._synth import parse_size
+
+    if args.points3d:
+        return _run_points3d(args)
+    if args.fps is None:
+        args.fps = 50.0
 
     size = parse_size(args.size)
     occ = None

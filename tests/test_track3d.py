@@ -327,3 +327,45 @@ def test_cli_track3d_real_qualisys_pelvis_is_not_planar_rocking(tmp_path, run_cl
     audit = json.loads((tmp_path / "audit.json").read_text())
     assert audit["verdict"] == "invalid"
     assert {"twist"} <= {f["kind"] for f in audit["flags"]}
+
+
+# --- the audit in an experiment run, and on a plane track ----------------------------------------
+
+def test_run_with_a_track3d_source_reports_the_audit(tmp_path, run_cli):
+    s = synth_points3d(seed=12, slide=(5, 1.5e-3))
+    with collecting():
+        res = track_points3d(s.series, s.bodies)
+    res.to_frame().to_csv(tmp_path / "tracks.csv", index=False)
+    (tmp_path / "experiment.toml").write_text(
+        '[block]\nb_m = 0.1\nh_m = 0.4\n[sources.track]\npath = "tracks.csv"\nobject = "block"\n'
+        '[simulate]\nlaws = ["eta_e"]\n[output]\nrrd = false\nfigures = false\n')
+    rc, out, err = run_cli("run", tmp_path / "experiment.toml", "--out", tmp_path / "out")
+    assert rc == 0, err
+    assert "W-AUDIT" in err
+    rep = json.loads((tmp_path / "out" / "report.json").read_text())
+    assert rep["status"] == "suspect"
+    assert rep["audit"]["source"] == "3d" and rep["audit"]["verdict"] == "suspect"
+    assert [(f["kind"], f["impact"]) for f in rep["audit"]["flags"]] == [("slide", 5)]
+    assert "Assumption audit (3d): **suspect**" in (tmp_path / "out" / "summary.md").read_text()
+
+
+def test_audit_plane_track_finds_a_slide_in_a_plane_track():
+    # the block's centre in the plane (CCW theta, y up) from the simulated truth, with noise
+    s = synth_points3d(seed=13, slide=(4, 1e-3))
+    tr = s.truth
+    th = tr.theta_rad.to_numpy()
+    half, hc = s.block.b_m / 2, s.block.h_m / 2
+    px = np.where(th >= 0, half, -half)
+    x = px + np.cos(th) * (0 - px) + np.sin(th) * hc + tr.slide_m.to_numpy()
+    y = -np.sin(th) * (0 - px) + np.cos(th) * hc
+    rng = np.random.default_rng(0)
+    n = th.size
+    from rocklab.tracking.rigid import audit_plane_track, plane_pivot_motion
+
+    sl, up, arms, rms = plane_pivot_motion(tr.t_s, -th, x, y, base_width_m=s.block.b_m)
+    # exact data: the arms are the block's half-width and half-height, the slide a 1 mm step
+    np.testing.assert_allclose(np.abs(arms[0]), [half, hc], atol=1e-9)
+    assert np.nanmax(sl) - np.nanmin(sl) == pytest.approx(1e-3, abs=1e-6) and rms < 1e-9
+    a = audit_plane_track(tr.t_s, -th + rng.normal(0, 1.7e-4, n), x + rng.normal(0, 5e-5, n),
+                          y + rng.normal(0, 5e-5, n), 1.7e-4, base_width_m=s.block.b_m)
+    assert [(f.kind, f.impact) for f in a.flags] == [("slide", 4)] and a.source == "2d"

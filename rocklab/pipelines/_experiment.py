@@ -80,6 +80,7 @@ class ExperimentResult:
     column: dict | None = None  # column experiments: see rocklab.pipelines._column_run
     video_jpeg: list | None = None  # (frame index, JPEG bytes) of the frames to show in Rerun
     diagnostics: tuple = ()  # rocklab._diagnostics.Diagnostic raised while analysing
+    audit: dict | None = None  # rocklab.pipelines._audit_stage.audit_experiment
 
     def to_dict(self) -> dict:
         """The numbers of ``report.json`` (units in keys)."""
@@ -97,6 +98,7 @@ class ExperimentResult:
             "video_vs_imu_rms_rad": (float(np.sqrt(np.nanmean(np.square(self.video_imu_residual[1]))))
                                      if self.video_imu_residual is not None else None),
             "fit": self.fit,
+            "audit": self.audit,
             "per_impact_eta": [float(x) for x in self.per_impact_eta],
             "simulations": {
                 law: {"eta": float(s["eta"]), "status": s.get("status"),
@@ -330,6 +332,9 @@ def analyse_experiment(cfg: ExperimentConfig, progress: bool = False,
                                 sync=sync, video_imu_residual=residual, fit=None, per_impact_eta=per_imp,
                                 simulations={}, table=table, truth=None, status=status, messages=msgs,
                                 timings_s=timings, frames=tr, column=column, video_jpeg=jpeg)
+    from ._audit_stage import audit_experiment
+
+    audit = audit_experiment(cfg, measured, tr)
     if cfg.fit_restitution:
         from ..fitting import fit_restitution
 
@@ -354,7 +359,7 @@ def analyse_experiment(cfg: ExperimentConfig, progress: bool = False,
     return ExperimentResult(name=cfg.name, config=cfg, block=block, measured=measured,
                             primary=cfg.primary, sync=sync, video_imu_residual=residual, fit=fit_d,
                             per_impact_eta=per_imp, simulations=sims, table=table, truth=truth,
-                            status=status, messages=msgs, timings_s=timings, frames=tr, video_jpeg=jpeg)
+                            status=status, messages=msgs, timings_s=timings, frames=tr, video_jpeg=jpeg, audit=audit)
 
 
 def _eta_for_law(law, cfg, block, fit_d, msgs):

@@ -62,6 +62,14 @@ def _summary_md(res, figs: dict, rrd: bool) -> str:
                   f"η'_e = {_g(f.get('eta_e_first'))}, θ0 = {_g(f.get('theta0_rad'))} rad, "
                   f"release at {_g(f.get('release_t_s'))} s, residual RMS {_g(f.get('rms_residual_rad'))} rad "
                   f"(fit status {f.get('status')})", ""]
+    if res.audit:
+        a = res.audit
+        lines += [f"Assumption audit ({a['source']}): **{a['verdict']}**, checked {', '.join(a['checked']) or 'nothing'}"
+                  + (f"; impacts not to trust: {', '.join(map(str, a['excluded_impacts']))}"
+                     if a["excluded_impacts"] else ""), ""]
+        lines += [f"- {f['kind']} ({f['detail']}) at {_g(f['t_s'])} s, impact {f['impact']}: {_g(f['value'])} "
+                  f"(tolerance {_g(f['tolerance'])}, SI units)" for f in a["flags"]]
+        lines += [""] if a["flags"] else []
     if res.sync:
         lines += [f"IMU sync: offset {_g(1000 * res.sync.get('offset_s', float('nan')))} ms, "
                   f"drift {_g(res.sync.get('drift'))}, residual {_g(res.sync.get('residual_ms'))} ms", ""]

@@ -141,7 +141,13 @@ class AuditResult:
         Largest departure over the run per checked kind (SI units).
     tolerances : AuditTolerances
     source : str
-        ``"3d"`` or ``"2d"``.
+        ``"3d"``, ``"2d"`` or ``"imu"``.
+    notes : tuple of str
+        What could not be checked, or only above a noise floor.
+    noise : dict
+        Per-sample 1-sigma noise of each checked measure (from its first
+        differences), SI units. A flag needs its departure to exceed the
+        tolerance by 4 sigma (of the sample, or of the half-cycle median for a step).
     """
 
     verdict: str
@@ -153,13 +159,15 @@ class AuditResult:
     tolerances: AuditTolerances
     source: str = "3d"
     notes: tuple = field(default=())
+    noise: dict = field(default_factory=dict)
 
     def to_dict(self) -> dict:
         """The ``audit.json`` object: ``verdict``, ``flags`` and the context to read them."""
         return {"verdict": self.verdict, "flags": [f.to_dict() for f in self.flags],
                 "excluded_impacts": list(self.excluded_impacts), "checked": list(self.checked),
                 "impacts_t_s": [float(x) for x in self.impacts_t_s], "maxima": dict(self.maxima),
-                "tolerances": self.tolerances.to_dict(), "source": self.source, "notes": list(self.notes)}
+                "tolerances": self.tolerances.to_dict(), "source": self.source, "notes": list(self.notes),
+                "noise": dict(self.noise)}
 
     def to_frame(self):
         """One row per flag: ``kind, detail, impact, t_s, value, tolerance``."""
@@ -178,11 +186,25 @@ class AuditResult:
         return "\n".join(lines)
 
 
+def _noise(values) -> float:
+    """Per-sample 1-sigma noise of a series that is constant under the model, from its first differences (MAD)."""
+    v = np.asarray(values, float).reshape(len(values), -1)
+    tot = 0.0
+    for col in v.T:
+        d = np.diff(col[np.isfinite(col)])
+        if d.size < 3:
+            return float("nan")
+        tot += (1.4826 * np.median(np.abs(d - np.median(d))) / math.sqrt(2.0)) ** 2
+    return math.sqrt(tot)
+
+
 def _segment_stats(values, seg, n_seg):
-    """Per half-cycle (median, 5th and 95th percentile, index of the worst sample) of ``values``."""
+    """Per half-cycle (median, spread = twice the 90th percentile deviation, index of the worst sample,
+    samples used) of ``values``."""
     med = np.full((n_seg,) + values.shape[1:], np.nan)
     spread = np.full(n_seg, np.nan)
     worst = np.full(n_seg, -1)
+    count = np.zeros(n_seg, int)
     for j in range(n_seg):
         idx = np.flatnonzero((seg == j) & np.isfinite(values).reshape(len(values), -1).all(axis=1))
         idx = idx[EDGE_SAMPLES:-EDGE_SAMPLES] if idx.size > 2 * EDGE_SAMPLES + 2 else idx[:0]
@@ -194,7 +216,8 @@ def _segment_stats(values, seg, n_seg):
         dev = np.linalg.norm((v - m).reshape(len(v), -1), axis=1)
         spread[j] = 2.0 * float(np.percentile(dev, 90))
         worst[j] = int(idx[np.argmax(dev)])
-    return med, spread, worst
+        count[j] = idx.size
+    return med, spread, worst, count
 
 
 def _touches(t, th, seg, hyst):
@@ -222,7 +245,7 @@ def _touches(t, th, seg, hyst):
 
 def audit_rocking(t_s, theta_rad, *, slide_m=None, uplift_m=None, twist_rad=None, out_of_plane_rad=None,
                   sigma_theta_rad: float | None = None, tolerances: AuditTolerances | None = None,
-                  source: str = "3d") -> AuditResult:
+                  source: str = "3d", noise_floor: dict | None = None) -> AuditResult:
     """Check one block's run against the planar-rocking assumptions.
 
     Parameters
@@ -241,7 +264,11 @@ def audit_rocking(t_s, theta_rad, *, slide_m=None, uplift_m=None, twist_rad=None
         ``max(5 sigma, 0.05 deg)``.
     tolerances : AuditTolerances, optional
     source : str
-        ``"3d"`` or ``"2d"`` (reported).
+        ``"3d"``, ``"2d"`` or ``"imu"`` (reported).
+    noise_floor : dict, optional
+        Smallest noise to assume per kind (``{"slide": m, "jump": m, ...}``), e.g. the
+        misfit of a plane track to rigid rocking; the larger of it and the
+        series' own noise is used.
 
     Returns
     -------
@@ -258,6 +285,17 @@ def audit_rocking(t_s, theta_rad, *, slide_m=None, uplift_m=None, twist_rad=None
     flags: list[AuditFlag] = []
     checked = []
     maxima: dict = {}
+    noise: dict = {}
+    notes: list[str] = []
+    k_sigma = 4.0                   # a flag needs the departure beyond the tolerance by 4 sigma of its noise
+
+    floor = noise_floor or {}
+
+    def resolvable(kind, sigma, limit, margin):
+        noise[kind] = sigma
+        if np.isfinite(sigma) and margin > limit:
+            notes.append(f"{kind}: measurement noise {sigma:.3g} (SI) per sample; departures below "
+                         f"{limit + margin:.3g} cannot be told from noise")
 
     def impact_of(j):
         return int(j) if j >= 1 else None
@@ -269,8 +307,11 @@ def audit_rocking(t_s, theta_rad, *, slide_m=None, uplift_m=None, twist_rad=None
         if not np.isfinite(values).any():
             return
         checked.append(kind)
-        med, spread, worst = _segment_stats(values, seg, n_seg)
+        med, spread, worst, count = _segment_stats(values, seg, n_seg)
         ok = np.isfinite(med).all(axis=1)
+        sigma = np.nanmax([_noise(values), floor.get(kind, np.nan), 0.0])
+        sg = sigma if np.isfinite(sigma) else 0.0
+        resolvable(kind, sigma, limit, k_sigma * sg)
         dev = np.linalg.norm(values - np.nanmedian(values, axis=0), axis=1)
         maxima[kind] = float(np.nanmax(dev)) if np.isfinite(dev).any() else float("nan")
         prev = None
@@ -279,9 +320,10 @@ def audit_rocking(t_s, theta_rad, *, slide_m=None, uplift_m=None, twist_rad=None
                 continue
             if prev is not None:
                 step = float(np.linalg.norm(med[j] - med[prev]))
-                if step > limit:
+                s_step = 1.25 * sg * math.sqrt(1.0 / count[j] + 1.0 / count[prev])
+                if step > limit + k_sigma * s_step:
                     flags.append(AuditFlag(kind, float(impacts[j - 1]), step, limit, impact_of(j), "step"))
-            if spread[j] > limit:
+            if spread[j] > limit + k_sigma * sg:
                 flags.append(AuditFlag(kind, float(t[worst[j]]), float(spread[j]), limit, impact_of(j), "within"))
             prev = j
 
@@ -292,7 +334,9 @@ def audit_rocking(t_s, theta_rad, *, slide_m=None, uplift_m=None, twist_rad=None
         if np.isfinite(up).any():
             checked.append("jump")
             maxima["jump"] = float(np.nanmax(up))
-            above = np.isfinite(up) & (up > tol.jump_m)
+            s_up = float(np.nanmax([_noise(up), floor.get("jump", np.nan), 0.0]))
+            resolvable("jump", s_up, tol.jump_m, k_sigma * (s_up if np.isfinite(s_up) else 0.0))
+            above = np.isfinite(up) & (up > tol.jump_m + k_sigma * (s_up if np.isfinite(s_up) else 0.0))
             # one flag per flight phase (a run of samples above the tolerance), at its highest sample
             edges = np.flatnonzero(np.diff(np.r_[0, above.astype(int), 0]))
             for a, b in zip(edges[::2], edges[1::2]):
@@ -321,4 +365,5 @@ def audit_rocking(t_s, theta_rad, *, slide_m=None, uplift_m=None, twist_rad=None
     else:
         verdict = "suspect"
     excluded = tuple(sorted({f.impact for f in flags if f.impact is not None}))
-    return AuditResult(verdict, tuple(flags), impacts, excluded, tuple(checked), maxima, tol, source)
+    return AuditResult(verdict, tuple(flags), impacts, excluded, tuple(checked), maxima, tol, source,
+                       tuple(notes), noise)

@@ -30,7 +30,7 @@ from .._errors import InputError
 
 #: Subcommand modules, in help order.
 COMMAND_MODULES = (
-    "_cmd_simulate", "_cmd_imu", "_cmd_track", "_cmd_track3d", "_cmd_synth", "_cmd_fit", "_cmd_run",
+    "_cmd_simulate", "_cmd_imu", "_cmd_track", "_cmd_track3d", "_cmd_stereo", "_cmd_synth", "_cmd_fit", "_cmd_run",
     "_cmd_campaign", "_cmd_demo", "_cmd_column", "_cmd_design",
 )
 

@@ -52,6 +52,10 @@ def register(sub):
     g.add_argument("--jump", default=None, metavar="K,MM", help="a jump of MM mm at impact K")
     g.add_argument("--twist", default=None, metavar="K,DEG", help="twist the block by DEG deg at impact K")
     g.add_argument("--double-impact", type=int, default=None, metavar="K", help="a bounce at impact K")
+    g.add_argument("--stereo", action="store_true",
+                   help="two camera films of dot targets (and the ChArUco calibration films) instead of points; "
+                        "--size (default 2400x1728), --fps (default 150), and the events above apply")
+    g.add_argument("--offset-ms", type=float, default=2.7, help="--stereo: camera 2's clock lag, ms (default 2.7)")
     p.set_defaults(func=run)
 
 
@@ -65,6 +69,39 @@ def _event(spec, option, scale):
         raise InputError(f"{option} {spec!r}: give K,VALUE (impact number, size), e.g. 3,1.0") from None
 
 
+def _run_stereo(args, out, events) -> int:
+    import shutil
+
+    from .._outdir import publish_dir, stage_dir
+    from ..synth import synth_stereo
+    from ..tracking._synth import parse_size
+
+    size = parse_size(args.size if args.size != "1920x1080" else "2400x1728")
+    tmp = stage_dir(out)
+    try:
+        r = synth_stereo(tmp, size=size, fps=args.fps or 150.0, f_px=1.25 * size[0], offset_s=args.offset_ms * 1e-3,
+                         seed=args.seed, noise_dn=args.noise, duration_s=args.duration, **events)
+        publish_dir(tmp, out, command="synth")
+    except ValueError as e:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise InputError(f"rocklab synth --stereo: {e}; choose an earlier impact") from None
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    d = {"out_dir": str(out), "files": sorted(p.name for p in r["paths"].values()), "frames": int(r["t_s"].size),
+         "size": list(size), "offset_s": r["offset_s"], "injected": r["session"].injected}
+    if args.json:
+        from ._cli_base import emit_json
+
+        emit_json(d)
+    else:
+        sys.stdout.write(f"wrote two {size[0]}x{size[1]} films of {d['frames']} frames, the calibration films and "
+                         f"truth to {out}; next: rocklab stereo calibrate {out / 'calib_cam1.mkv'} "
+                         f"{out / 'calib_cam2.mkv'}, then rocklab stereo track {out / 'cam1.mkv'} "
+                         f"{out / 'cam2.mkv'} --calib {out / 'stereo.json'}\n")
+    return 0
+
+
 def _run_points3d(args) -> int:
     import math
     import shutil
@@ -75,10 +112,12 @@ def _run_points3d(args) -> int:
     out = check_output_dir(args.out, force=args.force)
     if out.is_dir() and any(out.iterdir()) and not args.force:
         raise InputError(f"--out {out}: folder is not empty; choose a new --out or pass --force")
+    events = dict(slide=_event(args.slide, "--slide", 1e-3), jump=_event(args.jump, "--jump", 1e-3),
+                  twist=_event(args.twist, "--twist", math.pi / 180.0), double_impact=args.double_impact)
+    if args.stereo:
+        return _run_stereo(args, out, events)
     try:
-        s = synth_points3d(rate_hz=args.fps or 150.0, seed=args.seed, up=args.up,
-                           slide=_event(args.slide, "--slide", 1e-3), jump=_event(args.jump, "--jump", 1e-3),
-                           twist=_event(args.twist, "--twist", math.pi / 180.0), double_impact=args.double_impact)
+        s = synth_points3d(rate_hz=args.fps or 150.0, seed=args.seed, up=args.up, **events)
     except ValueError as e:
         raise InputError(f"rocklab synth --points3d: {e}; choose an earlier impact") from None
     tmp = stage_dir(out)
@@ -107,7 +146,7 @@ def run(args) -> int:
     from ..tracking import synth_session
     from ..tracking._synth import parse_size
 
-    if args.points3d:
+    if args.points3d or args.stereo:
         return _run_points3d(args)
     if args.fps is None:
         args.fps = 50.0

@@ -74,14 +74,15 @@ class Points3DSession:
         return paths
 
 
-def _targets(block: Block, depth_m: float):
+def _targets(block: Block, depth_m: float, side: bool = True):
     """Block targets in block axes (x along the width, y along the depth, z up; origin at the base centre)."""
     b, h, d = block.b_m, block.h_m, depth_m
     pts = []
     for zf in (0.2, 0.45, 0.7, 0.92):
         for xf in (-0.3, 0.3):
             pts.append((xf * b, -d / 2, zf * h))          # front face, two columns of dots
-    pts += [(b / 2, 0.15 * d, 0.35 * h), (b / 2, -0.2 * d, 0.8 * h)]     # one side face
+    if side:
+        pts += [(b / 2, 0.15 * d, 0.35 * h), (b / 2, -0.2 * d, 0.8 * h)]     # one side face
     labels = [f"B{i + 1}" for i in range(len(pts))]
     return np.asarray(pts), labels
 
@@ -114,7 +115,7 @@ def synth_points3d(block: Block | None = None, theta0_rad: float | None = None, 
                    seed: int = 0, up: str = "z", yaw_deg: float = 27.0, offset_m=(0.42, -0.31, 0.05),
                    slide: tuple | None = None, jump: tuple | None = None, twist: tuple | None = None,
                    double_impact: int | None = None, depth_m: float | None = None,
-                   table: bool = True) -> Points3DSession:
+                   table: bool = True, side_targets: bool = True) -> Points3DSession:
     """Simulate a motion-capture record of a free-rocking block (thread-burn release).
 
     Parameters
@@ -148,6 +149,9 @@ def synth_points3d(block: Block | None = None, theta0_rad: float | None = None, 
         Out-of-plane depth of the block, m (default 0.6 b).
     table : bool
         Also four targets on the (still) table, body ``table``.
+    side_targets : bool
+        Two of the block's targets on its side face (off: all on the front face,
+        as two cameras in front see them).
 
     Returns
     -------
@@ -201,7 +205,7 @@ def synth_points3d(block: Block | None = None, theta0_rad: float | None = None, 
         psi[t >= t_k] = float(twist[1])
         injected["twist"] = (int(twist[0]), float(twist[1]))
 
-    body, labels = _targets(block, depth)
+    body, labels = _targets(block, depth, side_targets)
     n = t.size
     half = block.b_m / 2.0
     c, s = np.cos(theta), np.sin(theta)

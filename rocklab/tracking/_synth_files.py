@@ -16,7 +16,7 @@ __all__ = ["VideoPair", "write_track_toml", "write_experiment_toml"]
 
 
 class VideoPair:
-    """Write the same grey frames to ``video.mkv`` (FFV1, lossless) and ``video.mp4`` (mp4v).
+    """Write the same grey frames to ``STEM.mkv`` (FFV1, lossless) and ``STEM.mp4`` (mp4v); STEM = ``video``.
 
     Encoding runs in a background thread (OpenCV releases the GIL while
     encoding), overlapping with the rendering of the next frame. If this
@@ -24,7 +24,7 @@ class VideoPair:
     Matroska (``codec`` says which was used).
     """
 
-    def __init__(self, folder: Path, fps: float, size, mp4: bool = True):
+    def __init__(self, folder: Path, fps: float, size, mp4: bool = True, stem: str = "video"):
         import cv2
 
         W, H = size
@@ -32,23 +32,23 @@ class VideoPair:
         self.paths = {}
         self.writers = []
         for fourcc in ("FFV1", "png "):
-            w = cv2.VideoWriter(str(folder / "video.mkv"), cv2.VideoWriter_fourcc(*fourcc), float(fps),
+            w = cv2.VideoWriter(str(folder / f"{stem}.mkv"), cv2.VideoWriter_fourcc(*fourcc), float(fps),
                                 (W, H), isColor=False)
             if w.isOpened():
                 self.codec = fourcc.strip()
                 self.writers.append(w)
-                self.paths["mkv"] = folder / "video.mkv"
+                self.paths["mkv"] = folder / f"{stem}.mkv"
                 break
             w.release()
         if self.codec is None:
             raise RuntimeError("this OpenCV build writes neither FFV1 nor PNG into .mkv; "
                                "install an opencv build with FFmpeg")
         if mp4:
-            w = cv2.VideoWriter(str(folder / "video.mp4"), cv2.VideoWriter_fourcc(*"mp4v"), float(fps),
+            w = cv2.VideoWriter(str(folder / f"{stem}.mp4"), cv2.VideoWriter_fourcc(*"mp4v"), float(fps),
                                 (W, H), isColor=False)
             if w.isOpened():
                 self.writers.append(w)
-                self.paths["mp4"] = folder / "video.mp4"
+                self.paths["mp4"] = folder / f"{stem}.mp4"
         self._q: queue.Queue = queue.Queue(maxsize=4)
         self._err: list = []
         self._t = threading.Thread(target=self._run, daemon=True)

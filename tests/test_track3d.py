@@ -293,8 +293,18 @@ def test_cli_track3d_c3d_then_fit_restitution(tmp_path, run_cli):
     assert rc == 0, err
     body = ["--body", "block=" + ",".join(f"B{i}" for i in range(1, 11)), "--body", "table=T1,T2,T3,T4"]
     rc, out, err = run_cli("track3d", tmp_path / "s" / "points.c3d", "-o", tmp_path / "t" / "tracks.csv",
-                           *body, "--up=-y")
+                           *body, "--up=-y", "--rrd", tmp_path / "t" / "review.rrd")
     assert rc == 0, err
+    # the Rerun review: every sample's targets, the pivot, the plots, one text row per impact and flag
+    from rocklab.pipelines._rerun import read_rrd_summary
+
+    rows = read_rrd_summary(tmp_path / "t" / "review.rrd")
+    n = len(pd.read_csv(tmp_path / "s" / "truth.csv"))
+    # one row per sample plus the static row of colours and sizes
+    assert rows["/3d/block/targets"] == rows["/3d/table/targets"] == n + 1
+    assert rows["/plots/block/theta_deg"] == n + 1 and "/3d/block/pivot_path" in rows
+    n_impacts = len(json.loads((tmp_path / "t" / "audit.json").read_text())["blocks"]["block"]["impacts_t_s"])
+    assert rows["/audit/block"] == n_impacts + 1
     assert "warning W-AUDIT" in err and "impacts 4" in err
     audit = json.loads((tmp_path / "t" / "audit.json").read_text())
     assert audit["verdict"] == "suspect"
@@ -369,3 +379,21 @@ def test_audit_plane_track_finds_a_slide_in_a_plane_track():
     a = audit_plane_track(tr.t_s, -th + rng.normal(0, 1.7e-4, n), x + rng.normal(0, 5e-5, n),
                           y + rng.normal(0, 5e-5, n), 1.7e-4, base_width_m=s.block.b_m)
     assert [(f.kind, f.impact) for f in a.flags] == [("slide", 4)] and a.source == "2d"
+
+
+def test_run_names_the_fit_impacts_the_audit_flagged(tmp_path, run_cli):
+    s = synth_points3d(seed=14, jump=(4, 3e-3))
+    with collecting():
+        res = track_points3d(s.series, s.bodies)
+    res.to_frame().to_csv(tmp_path / "tracks.csv", index=False)
+    (tmp_path / "experiment.toml").write_text(
+        '[block]\nb_m = 0.1\nh_m = 0.4\n[sources.track]\npath = "tracks.csv"\nobject = "block"\n'
+        '[simulate]\nlaws = ["eta_e"]\n[output]\nrrd = false\nfigures = false\n')
+    rc, out, err = run_cli("run", tmp_path / "experiment.toml", "--out", tmp_path / "out")
+    assert rc == 0, err
+    rep = json.loads((tmp_path / "out" / "report.json").read_text())
+    ex = rep["fit"]["excluded_impacts"]
+    # the fit's impact at the simulated 4th impact's time, with the jump as the reason
+    assert len(ex) == 1 and ex[0]["t_s"] == pytest.approx(s.impacts_t_s[3], abs=0.01)
+    assert ex[0]["reasons"][0].startswith("jump (flight)")
+    assert "is not to be trusted: jump" in (tmp_path / "out" / "summary.md").read_text()

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["audit_experiment"]
+__all__ = ["audit_experiment", "fit_exclusions"]
 
 _3D_COLUMNS = ("pivot_slide_m", "pivot_uplift_m", "twist_rad", "out_of_plane_rad")
 
@@ -77,3 +77,39 @@ def audit_experiment(cfg, measured: dict, tr) -> dict:
                         f"{', '.join(map(str, res.excluded_impacts)) or 'none'}); their per-impact eta "
                         "are not trustworthy")
     return res.to_dict()
+
+
+def fit_exclusions(audit: dict | None, per_impact, max_dt_s: float = 0.02) -> list:
+    """The fit's impacts that the audit flagged, with the reasons.
+
+    Parameters
+    ----------
+    audit : dict
+        :func:`audit_experiment`'s result.
+    per_impact : pandas.DataFrame or None
+        The fit's per-impact table (``impact, t_s, ...``).
+    max_dt_s : float
+        An audit impact and a fit impact closer than this are the same impact, s.
+
+    Returns
+    -------
+    list of dict
+        ``{"impact": fit impact number, "t_s", "eta": its per-impact eta, "reasons": [...]}``.
+    """
+    if not audit or not audit.get("flags") or per_impact is None or len(per_impact) == 0:
+        return []
+    times = np.asarray(audit["impacts_t_s"], float)
+    fit_t = per_impact["t_s"].to_numpy(float)
+    out: dict = {}
+    for f in audit["flags"]:
+        k = f.get("impact")
+        if k is None or not 1 <= k <= times.size:
+            continue
+        j = int(np.argmin(np.abs(fit_t - times[k - 1])))
+        if abs(fit_t[j] - times[k - 1]) > max_dt_s:
+            continue
+        row = per_impact.iloc[j]
+        e = out.setdefault(int(row["impact"]), {"impact": int(row["impact"]), "t_s": float(row["t_s"]),
+                                                "eta": float(row.get("eta_peaks", np.nan)), "reasons": []})
+        e["reasons"].append(f"{f['kind']} ({f['detail']}): {f['value']:.4g} against {f['tolerance']:.4g} (SI)")
+    return [out[k] for k in sorted(out)]

@@ -60,7 +60,7 @@ def _check_file_outputs(args) -> None:
     """Output files named on the command line are checked before any work starts."""
     from .._outdir import check_output_file
 
-    for attr, opt in (("output", "-o"), ("plot", "--plot"), ("maps_png", "--maps-png")):
+    for attr, opt in (("output", "-o"), ("plot", "--plot"), ("maps_png", "--maps-png"), ("rrd", "--rrd")):
         v = getattr(args, attr, None)
         if v:
             check_output_file(v, opt)

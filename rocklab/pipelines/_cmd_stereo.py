@@ -36,6 +36,7 @@ def register(sub):
     p.add_argument("--body", action="append", default=[], metavar="NAME=P1,P2,...",
                    help="track: bodies by point label (default: still targets = table, moving = block)")
     p.add_argument("--rest", default="auto", metavar="auto|first|last|T0,T1", help="track: the upright rest")
+    p.add_argument("--rrd", default=None, metavar="FILE", help="track: also write a Rerun review (see track3d)")
     p.add_argument("--json", action="store_true", help="print a JSON summary on stdout")
     p.add_argument("--progress", action="store_true", help="progress bar on stderr")
     p.set_defaults(func=run)
@@ -119,6 +120,10 @@ def _track(args) -> int:
     audit = res.audit_dict()
     audit_path = out.with_name("audit.json")
     write_json_atomic(audit_path, audit)
+    if args.rrd:
+        from ._rerun3d import write_track3d_rrd
+
+        write_track3d_rrd(args.rrd, series, res)
     d = res.to_dict()
     d.update(tracks_csv=str(out), audit_json=str(audit_path), points_csv=str(pts_path), verdict=audit["verdict"],
              sync=None if sp.sync is None else sp.sync.to_dict(), bodies={k: list(v) for k, v in bodies.items()},

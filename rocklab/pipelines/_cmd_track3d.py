@@ -41,6 +41,8 @@ def register(sub):
     p.add_argument("--jump-tol", type=float, default=1.0, metavar="MM", help="pivot uplift tolerance, mm (1.0)")
     p.add_argument("--twist-tol", type=float, default=0.5, metavar="DEG",
                    help="twist and out-of-plane rotation tolerance, deg (0.5)")
+    p.add_argument("--rrd", default=None, metavar="FILE",
+                   help="also write a Rerun review: the targets in 3D, the pivot path, the plots, the audit's flags")
     p.add_argument("--json", action="store_true", help="print a JSON summary on stdout")
     p.set_defaults(func=run)
 
@@ -82,6 +84,11 @@ def run(args) -> int:
     write_json_atomic(audit_path, audit)
     summary = res.to_dict()
     summary.update(tracks_csv=str(out), audit_json=str(audit_path), verdict=audit["verdict"])
+    if args.rrd:
+        from ._rerun3d import write_track3d_rrd
+
+        write_track3d_rrd(args.rrd, series, res)
+        summary["rrd"] = str(args.rrd)
     if args.json:
         from ._cli_base import emit_json
 

@@ -345,6 +345,9 @@ def analyse_experiment(cfg: ExperimentConfig, progress: bool = False,
         fit = fit_restitution(prim[0], prim[1], block, window=cfg.fit_window, nan="skip")
         timings["fit_s"] = time.perf_counter() - t2
         fit_d = fit.to_dict()
+        from ._audit_stage import fit_exclusions
+
+        fit_d["excluded_impacts"] = fit_exclusions(audit, fit.per_impact)  # flagged by the audit: not to trust
         per_imp = np.asarray(fit_d.get("per_impact_eta") or [], float)
         if fit_d.get("status") == "failed":
             status = "partial"

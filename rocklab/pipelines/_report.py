@@ -70,6 +70,10 @@ def _summary_md(res, figs: dict, rrd: bool) -> str:
         lines += [f"- {f['kind']} ({f['detail']}) at {_g(f['t_s'])} s, impact {f['impact']}: {_g(f['value'])} "
                   f"(tolerance {_g(f['tolerance'])}, SI units)" for f in a["flags"]]
         lines += [""] if a["flags"] else []
+        for e in (res.fit or {}).get("excluded_impacts") or []:
+            lines.append(f"- per-impact η of fit impact {e['impact']} at {_g(e['t_s'])} s ({_g(e['eta'])}) is not "
+                         f"to be trusted: {'; '.join(e['reasons'])}")
+        lines += [""] if (res.fit or {}).get("excluded_impacts") else []
     if res.sync:
         lines += [f"IMU sync: offset {_g(1000 * res.sync.get('offset_s', float('nan')))} ms, "
                   f"drift {_g(res.sync.get('drift'))}, residual {_g(res.sync.get('residual_ms'))} ms", ""]

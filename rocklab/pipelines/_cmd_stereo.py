@@ -1,11 +1,12 @@
-"""``rocklab stereo``: two-camera 3D tracking of dot targets (a GOM Pontos-style rig).
+"""``rocklab stereo``: two-camera 3D tracking of dots or ArUco markers (a GOM Pontos-style rig).
 
 - ``rocklab stereo calibrate CALIB1 CALIB2 -o stereo.json [--board 9x6,0.03,0.022,DICT_5X5_100]``:
   intrinsics, distortion and relative pose from films of a ChArUco board seen by both
   cameras; prints the reprojection RMS (px) and the baseline (m).
-- ``rocklab stereo track FILM1 FILM2 --calib stereo.json -o tracks.csv [--fps F] [--no-sync]
-  [--body NAME=P1,...] [--rest ...]``: dots detected, followed, clock offset estimated (no
-  shared trigger needed), matched along epipolar lines and triangulated; the targets are
+- ``rocklab stereo track FILM1 FILM2 --calib stereo.json -o tracks.csv [--targets dots|aruco]
+  [--fps F] [--no-sync] [--body NAME=P1,...] [--rest ...]``: dots detected and followed (or
+  ArUco corners found by id), clock offset estimated (no shared trigger needed), matched
+  along epipolar lines (dots) or by name (corners) and triangulated; the targets are
   split into the table (still) and the blocks (moving) and put in a table frame (z up);
   writes ``points.csv`` (``t_s, point, x_m, y_m, z_m``), ``tracks.csv`` and ``audit.json``
   exactly as ``rocklab track3d`` does.
@@ -32,6 +33,9 @@ def register(sub):
                    help="calibrate: ChArUco board (default 9x6,0.03,0.022,DICT_5X5_100)")
     p.add_argument("--calib", default=None, help="track: stereo.json from 'rocklab stereo calibrate'")
     p.add_argument("--fps", type=float, default=None, help="track: frame rate, Hz (default: the containers')")
+    p.add_argument("--targets", choices=("dots", "aruco"), default="dots",
+                   help="track: bright dots (default) or ArUco markers (each corner a target named M<id>c<k>)")
+    p.add_argument("--dictionary", default="DICT_4X4_50", help="track --targets aruco: ArUco dictionary")
     p.add_argument("--no-sync", action="store_true", help="track: the cameras share a trigger (no offset estimated)")
     p.add_argument("--body", action="append", default=[], metavar="NAME=P1,P2,...",
                    help="track: bodies by point label (default: still targets = table, moving = block)")
@@ -106,8 +110,14 @@ def _track(args) -> int:
     rig = load_rig(args.calib)
     rest = _rest(args.rest)
     out = Path(args.out) if args.out else Path(args.film1).parent / "tracks.csv"
-    sp = track_dots_stereo(args.film1, args.film2, rig, fps=args.fps, sync=not args.no_sync,
-                           progress=args.progress)
+    if args.targets == "aruco":
+        from ..tracking.stereo import track_markers_stereo
+
+        sp = track_markers_stereo(args.film1, args.film2, rig, dictionary=args.dictionary, fps=args.fps,
+                                  sync=not args.no_sync)
+    else:
+        sp = track_dots_stereo(args.film1, args.film2, rig, fps=args.fps, sync=not args.no_sync,
+                               progress=args.progress)
     series, bodies, notes = stereo_point_series(sp, str(args.film1))
     if args.body:
         bodies = parse_bodies(args.body, series.labels, series.source)

@@ -27,7 +27,8 @@ def register(sub):
                    help="record for --table record (.AT2 or CSV; default: bundled El Centro 1940)")
     p.add_argument("--fps", type=float, default=None, help="frame rate, Hz (default 50; 150 with --points3d)")
     p.add_argument("--size", default="1920x1080", help="frame size WxH, px (default 1920x1080)")
-    p.add_argument("--targets", choices=("aruco", "dots", "edges", "markerless"), default="aruco", help="target style")
+    p.add_argument("--targets", choices=("aruco", "dots", "edges", "markerless"), default=None,
+                   help="target style (default aruco; with --stereo: dots, or aruco)")
     p.add_argument("--duration", type=float, default=None, metavar="S",
                    help="video length, s (default: until at rest + 0.6 s, at most 12 s)")
     p.add_argument("--occlusion", default=None, metavar="T0,T1",
@@ -79,12 +80,15 @@ def _run_stereo(args, out, events) -> int:
     size = parse_size(args.size if args.size != "1920x1080" else "2400x1728")
     tmp = stage_dir(out)
     try:
+        if args.targets not in (None, "dots", "aruco"):
+            raise ValueError(f"--targets {args.targets}: a stereo session has dots or aruco targets")
         r = synth_stereo(tmp, size=size, fps=args.fps or 150.0, f_px=1.25 * size[0], offset_s=args.offset_ms * 1e-3,
-                         seed=args.seed, noise_dn=args.noise, duration_s=args.duration, **events)
+                         seed=args.seed, noise_dn=args.noise, duration_s=args.duration,
+                         targets=args.targets or "dots", **events)
         publish_dir(tmp, out, command="synth")
     except ValueError as e:
         shutil.rmtree(tmp, ignore_errors=True)
-        raise InputError(f"rocklab synth --stereo: {e}; choose an earlier impact") from None
+        raise InputError(f"rocklab synth --stereo: {e}") from None
     except BaseException:
         shutil.rmtree(tmp, ignore_errors=True)
         raise
@@ -150,6 +154,8 @@ def run(args) -> int:
         return _run_points3d(args)
     if args.fps is None:
         args.fps = 50.0
+    if args.targets is None:
+        args.targets = "aruco"
 
     size = parse_size(args.size)
     occ = None

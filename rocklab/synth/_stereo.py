@@ -111,29 +111,48 @@ def _board():
     return cv2.aruco.CharucoBoard(CHARUCO["squares"], CHARUCO["square_m"], CHARUCO["marker_m"], d)
 
 
+_RAYS: dict = {}
+
+
+def _rays(cam: StereoCamera) -> np.ndarray:
+    """Undistorted normalised ray of every pixel of ``cam``, shape (H*W, 2) (cached per camera)."""
+    import cv2
+
+    key = (id(cam), cam.size)
+    if key not in _RAYS:
+        W, H = cam.size
+        u, v = np.meshgrid(np.arange(W, dtype=np.float32), np.arange(H, dtype=np.float32))
+        pts = np.stack([u.ravel(), v.ravel()], axis=1).reshape(-1, 1, 2)
+        _RAYS.clear()
+        _RAYS[key] = cv2.undistortPoints(pts, cam.K, cam.dist).reshape(-1, 2)
+    return _RAYS[key]
+
+
+def _plane_maps(cam: StereoCamera, R_b, t_b, ppm):
+    """Texture coordinates (px at ``ppm`` px/m) of the plane z=0 of the frame (R_b, t_b) under every pixel."""
+    W, H = cam.size
+    n = _rays(cam)
+    Rcb = cam.R @ R_b
+    tcb = cam.R @ t_b + cam.t
+    # the ray through each pixel in the plane's frame: C + s d, and its crossing of z = 0
+    C = -Rcb.T @ tcb
+    d = np.column_stack([n, np.ones(len(n))]) @ Rcb            # rows: Rcb^T ray
+    with np.errstate(divide="ignore", invalid="ignore"):
+        s = -C[2] / d[:, 2]
+    X = C[0] + s * d[:, 0]
+    Y = C[1] + s * d[:, 1]
+    bad = ~(s > 0)
+    X[bad] = -1e6
+    Y[bad] = -1e6
+    return (X * ppm).reshape(H, W).astype(np.float32), (Y * ppm).reshape(H, W).astype(np.float32)
+
+
 def _render_board(cam: StereoCamera, R_b, t_b, texture, ppm, noise, rng):
     """The board (plane z=0 of its own frame, texture at ``ppm`` px/m) seen by ``cam``; grey uint8."""
     import cv2
 
-    W, H = cam.size
-    # every output pixel -> undistorted normalised ray -> board plane -> texture pixel
-    u, v = np.meshgrid(np.arange(W, dtype=np.float32), np.arange(H, dtype=np.float32))
-    pts = np.stack([u.ravel(), v.ravel()], axis=1).reshape(-1, 1, 2)
-    n = cv2.undistortPoints(pts, cam.K, cam.dist).reshape(-1, 2)
-    # camera frame of the board: x_cam = Rc (R_b X + t_b) + tc
-    Rcb = cam.R @ R_b
-    tcb = cam.R @ t_b + cam.t
-    rays = np.column_stack([n, np.ones(len(n))])
-    # solve for X (board plane, z=0): Rcb[:, :2] @ [X, Y] + tcb = s * ray
-    A = np.zeros((len(n), 3, 3))
-    A[:, :, 0] = Rcb[:, 0]
-    A[:, :, 1] = Rcb[:, 1]
-    A[:, :, 2] = -rays
-    sol = np.linalg.solve(A, -np.broadcast_to(tcb, (len(n), 3))[..., None])[..., 0]
-    mx = (sol[:, 0] * ppm).reshape(H, W).astype(np.float32)
-    my = (sol[:, 1] * ppm).reshape(H, W).astype(np.float32)
-    img = cv2.remap(texture, mx, my, cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT,
-                    borderValue=60)
+    mx, my = _plane_maps(cam, R_b, t_b, ppm)
+    img = cv2.remap(texture, mx, my, cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT, borderValue=60)
     img = cv2.GaussianBlur(img, (0, 0), 0.7).astype(np.float32)
     img += rng.normal(0.0, noise, img.shape)
     return np.clip(img, 0, 255).astype(np.uint8)
@@ -188,9 +207,81 @@ def _render_dots(cam: StereoCamera, X, radius_m, noise, rng, background=18.0, pe
     return np.clip(img, 0, 255).astype(np.uint8), uv
 
 
+def _render_aruco_films(out, cams, sess, X1, X2, fps, size, noise, rng, paths):
+    """Films of ArUco markers on the block's face and the table's plate; returns the corners' truth."""
+    import cv2
+
+    from ..tracking._synth_files import VideoPair
+    from ..tracking.rigid import kabsch
+    from ._points3d import _targets
+
+    ppm = 4000.0
+    b, h = sess.block.b_m, sess.block.h_m
+    depth = 0.6 * b
+    body_pts, _ = _targets(sess.block, depth, side=False)
+    nb = body_pts.shape[0]
+    # the block's front face: x along the width, y down, origin at its top-left corner
+    side = 0.6 * b
+    face = np.full((int(round(h * ppm)), int(round(b * ppm))), 235, np.uint8)
+    d = cv2.aruco.getPredefinedDictionary(cv2.aruco.DICT_4X4_50)
+    face_corners = {}
+    for mid, top in ((0, 0.2 * h), (1, 0.6 * h)):
+        x0, y0, n = int(round(0.2 * b * ppm)), int(round(top * ppm)), int(round(side * ppm))
+        face[y0:y0 + n, x0:x0 + n] = cv2.aruco.generateImageMarker(d, mid, n)
+        face_corners[mid] = np.array([[x0, y0], [x0 + n, y0], [x0 + n, y0 + n], [x0, y0 + n]], float) / ppm
+    # band-limit the textures to the pixel footprint (about ppm * 1 m / f texels per pixel): remap samples
+    # them point-wise, and an unfiltered edge would land on the sample grid, biasing corners by ~0.5 px
+    sig = 0.5 * ppm * 1.0 / float(cams[0].K[0, 0])
+    face = cv2.GaussianBlur(face, (0, 0), sig)
+    R_fb = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]])       # face x, y, z -> body x, -z, y
+    o_face = np.array([-b / 2, -depth / 2, h])
+    # the table's plate: 6 cm tall, standing on the table in front of the block, facing the cameras
+    plate = np.full((int(round(0.06 * ppm)), int(round(0.4 * ppm))), 235, np.uint8)
+    plate_corners = {}
+    for mid, x in ((2, 0.01), (3, 0.35)):
+        x0, y0, n = int(round(x * ppm)), int(round(0.01 * ppm)), int(round(0.04 * ppm))
+        plate[y0:y0 + n, x0:x0 + n] = cv2.aruco.generateImageMarker(d, mid, n)
+        plate_corners[mid] = np.array([[x0, y0], [x0 + n, y0], [x0 + n, y0 + n], [x0, y0 + n]], float) / ppm
+    plate = cv2.GaussianBlur(plate, (0, 0), sig)
+    R_p = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]])
+    o_p = np.array([-0.2, -0.12, 0.06])
+    labels, corners_face = [], []
+    for mid in (0, 1):
+        for k in range(4):
+            labels.append(f"M{mid}c{k}")
+            corners_face.append(o_face + R_fb @ np.r_[face_corners[mid][k], 0.0])
+    plate_world = [o_p + R_p @ np.r_[plate_corners[mid][k], 0.0] for mid in (2, 3) for k in range(4)]
+    labels += [f"M{mid}c{k}" for mid in (2, 3) for k in range(4)]
+    corners_face = np.asarray(corners_face)
+    outs = []
+    for k_cam, (cam, X) in enumerate(zip(cams, (X1, X2)), start=1):
+        R, t, _ = kabsch(body_pts, X[:, :nb])
+        mxp, myp = _plane_maps(cam, R_p, o_p, ppm)
+        pimg = cv2.remap(plate, mxp, myp, cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT, borderValue=0)
+        pmask = cv2.remap(np.full_like(plate, 255), mxp, myp, cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT,
+                          borderValue=0).astype(np.float32) / 255.0
+        vp = VideoPair(out, fps, size, mp4=False, stem=f"cam{k_cam}")
+        for i in range(X.shape[0]):
+            mx, my = _plane_maps(cam, R[i] @ R_fb, R[i] @ o_face + t[i], ppm)
+            img = cv2.remap(face, mx, my, cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT, borderValue=0)
+            m = cv2.remap(np.full_like(face, 255), mx, my, cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT,
+                          borderValue=0).astype(np.float32) / 255.0
+            frame = 30.0 * (1 - m) + img.astype(np.float32) * m
+            frame = frame * (1 - pmask) + pimg.astype(np.float32) * pmask       # the plate is in front
+            frame = cv2.GaussianBlur(frame, (0, 0), 0.6)
+            lit = (m > 0) | (pmask > 0)
+            frame[lit] += rng.normal(0.0, noise, int(lit.sum()))
+            vp.write(np.clip(frame, 0, 255).astype(np.uint8))
+        vp.close()
+        paths[f"cam{k_cam}"] = vp.paths["mkv"]
+        block_c = np.einsum("nij,pj->npi", R, corners_face) + t[:, None]
+        outs.append(np.concatenate([block_c, np.broadcast_to(np.asarray(plate_world), (X.shape[0], 8, 3))], axis=1))
+    return outs[0], outs[1], labels
+
+
 def synth_stereo(out_dir, *, size=(2400, 1728), fps: float = 150.0, f_px: float = 3000.0, offset_s: float = 0.0027,
                  n_board: int = 24, noise_dn: float = 2.0, dot_radius_m: float = 0.003, seed: int = 0,
-                 duration_s: float | None = None, **motion) -> dict:
+                 duration_s: float | None = None, targets: str = "dots", **motion) -> dict:
     """Render a stereo session (see the module doc) into ``out_dir``; returns the paths and the truth.
 
     Parameters
@@ -211,6 +302,10 @@ def synth_stereo(out_dir, *, size=(2400, 1728), fps: float = 150.0, f_px: float 
         Image noise (1-sigma, grey levels) and target radius (m).
     duration_s : float, optional
         Cut the rocking film after this long, s.
+    targets : {"dots", "aruco"}
+        Dots (retro-reflective targets), or two ArUco markers (``DICT_4X4_50`` ids 0, 1) on the
+        block's front face and two (ids 2, 3) on a plate on the table's front edge; the truth
+        then holds the markers' corners, labelled ``M<id>c<k>`` as the tracker labels them.
     **motion
         Passed to :func:`~rocklab.synth.synth_points3d` (``slide=``, ``jump=``, ``twist=``,
         ``double_impact=``, ``block=``, ``theta0_rad=``, ``restitution=``).
@@ -221,6 +316,7 @@ def synth_stereo(out_dir, *, size=(2400, 1728), fps: float = 150.0, f_px: float 
         ``paths`` (name -> Path), ``cameras`` (two StereoCamera), ``session`` (the
         :class:`~rocklab.synth.Points3DSession` at camera 1's frame times), ``offset_s``.
     """
+    import cv2
     import pandas as pd
 
     from ..tracking._synth_files import VideoPair
@@ -237,6 +333,7 @@ def synth_stereo(out_dir, *, size=(2400, 1728), fps: float = 150.0, f_px: float 
     bh = int(round(CHARUCO["squares"][1] * CHARUCO["square_m"] * ppm))
     texture = board.generateImage((bw, bh), marginSize=0)
     texture = (40 + texture.astype(np.float32) * (200 / 255)).astype(np.uint8)
+    texture = cv2.GaussianBlur(texture, (0, 0), 0.5 * ppm * 0.9 / f_px)        # band-limited (see the markers)
     poses = _board_poses(n_board, rng)
     paths = {}
     for k, cam in enumerate(cams, start=1):
@@ -262,19 +359,24 @@ def synth_stereo(out_dir, *, size=(2400, 1728), fps: float = 150.0, f_px: float 
         return X
 
     X1, X2 = at(t1), at(t1 + offset_s)
-    for k, (cam, X) in enumerate(zip(cams, (X1, X2)), start=1):
-        vp = VideoPair(out, fps, size, mp4=False, stem=f"cam{k}")
-        for i in range(t1.size):
-            img, _ = _render_dots(cam, X[i], dot_radius_m, noise_dn, rng)
-            vp.write(img)
-        vp.close()
-        paths[f"cam{k}"] = vp.paths["mkv"]
+    if targets == "aruco":
+        X1, X2, labels = _render_aruco_films(out, cams, sess, X1, X2, fps, size, noise_dn, rng, paths)
+    elif targets == "dots":
+        for k, (cam, X) in enumerate(zip(cams, (X1, X2)), start=1):
+            vp = VideoPair(out, fps, size, mp4=False, stem=f"cam{k}")
+            for i in range(t1.size):
+                img, _ = _render_dots(cam, X[i], dot_radius_m, noise_dn, rng)
+                vp.write(img)
+            vp.close()
+            paths[f"cam{k}"] = vp.paths["mkv"]
+    else:
+        raise ValueError(f"targets={targets!r}: must be 'dots' or 'aruco'")
     truth = sess.truth
     tr = pd.DataFrame({c: np.interp(t1, truth["t_s"], truth[c]) for c in truth.columns})
     tr["t_s"] = t1
     truth_path = out / "truth.csv"
     tr.to_csv(truth_path, index=False, float_format="%.9g")
-    pts = pd.DataFrame({"t_s": np.repeat(t1, len(labels)), "point": np.tile(labels, t1.size),
+    pts = pd.DataFrame({"t_s": np.repeat(t1, len(labels)), "point": np.tile(np.asarray(labels, dtype=object), t1.size),
                         "x_m": X1[:, :, 0].ravel(), "y_m": X1[:, :, 1].ravel(), "z_m": X1[:, :, 2].ravel()})
     pts.to_csv(out / "points_truth.csv", index=False, float_format="%.9g")
     rig = {"cam1": cams[0].to_dict(), "cam2": cams[1].to_dict(), "offset_s": offset_s, "fps": fps,

@@ -30,7 +30,7 @@ from ..._errors import InputError, where
 from ._calib import StereoRig
 
 __all__ = ["detect_dots", "track_dots_2d", "DotTracks2D", "sync_offset_stereo", "SyncOffset", "match_tracks",
-           "triangulate_tracks", "StereoPoints", "track_dots_stereo"]
+           "triangulate_tracks", "StereoPoints", "track_dots_stereo", "check_films"]
 
 
 def detect_dots(gray, min_area_px: int = 6, max_area_px: int = 20000, threshold: float | None = None,
@@ -348,6 +348,8 @@ class StereoPoints:
     pairs : ndarray, shape (k, 2)
     sync : SyncOffset or None
     notes : tuple of str
+    labels : tuple of str or None
+        Target names when the targets carry them (ArUco corners ``M<id>c<k>``); None for dots.
     """
 
     t_s: np.ndarray
@@ -356,6 +358,7 @@ class StereoPoints:
     pairs: np.ndarray
     sync: SyncOffset | None = None
     notes: tuple = field(default=())
+    labels: tuple | None = None
 
 
 def triangulate_tracks(rig: StereoRig, tracks1: DotTracks2D, tracks2: DotTracks2D, pairs, lag: float, fps: float,
@@ -388,6 +391,28 @@ def triangulate_tracks(rig: StereoRig, tracks1: DotTracks2D, tracks2: DotTracks2
     return StereoPoints(np.arange(n) / fps, X.reshape(n, k, 3), err.reshape(n, k), np.asarray(pairs, int))
 
 
+def check_films(film1, film2, rig: StereoRig, fps: float | None = None) -> float:
+    """The common frame rate of two films, or :class:`InputError` when they cannot be one test of ``rig``."""
+    from .._video import probe_video
+
+    i1, i2 = probe_video(film1), probe_video(film2)
+    for info, film in ((i1, film1), (i2, film2)):
+        if (info.width_px, info.height_px) != tuple(rig.size):
+            raise InputError(f"{where(film)}frame size {info.width_px}x{info.height_px} differs from the "
+                             f"calibration's {rig.size[0]}x{rig.size[1]}; calibrate with films of this camera mode")
+    rate1 = fps or i1.fps
+    rate2 = fps or i2.fps
+    if not rate1:
+        raise InputError(f"{where(film1)}the container has no frame rate; give --fps")
+    if fps is None and rate2 and abs(rate1 - rate2) > 1e-3 * rate1:
+        raise InputError(f"{where(film2)}{rate2:.6g} frames/s but {film1} has {rate1:.6g}; the two cameras must run "
+                         "at one rate (give --fps if a container is wrong)")
+    if abs(i1.n_frames - i2.n_frames) > max(5, 0.05 * max(i1.n_frames, i2.n_frames)):
+        raise InputError(f"{where(film2)}{i2.n_frames} frames but {film1} has {i1.n_frames}: the films must cover "
+                         "the same test (trim them to the same start and length)")
+    return float(rate1)
+
+
 def track_dots_stereo(film1, film2, rig: StereoRig, fps: float | None = None, sync: bool = True,
                       progress: bool = False) -> StereoPoints:
     """Dots of two films to 3D points in camera 1's axes (the steps of the module doc).
@@ -411,20 +436,7 @@ def track_dots_stereo(film1, film2, rig: StereoRig, fps: float | None = None, sy
     from .._video import iter_video_frames, probe_video
 
     i1, i2 = probe_video(film1), probe_video(film2)
-    for info, film in ((i1, film1), (i2, film2)):
-        if (info.width_px, info.height_px) != tuple(rig.size):
-            raise InputError(f"{where(film)}frame size {info.width_px}x{info.height_px} differs from the "
-                             f"calibration's {rig.size[0]}x{rig.size[1]}; calibrate with films of this camera mode")
-    rate1 = fps or i1.fps
-    rate2 = fps or i2.fps
-    if not rate1:
-        raise InputError(f"{where(film1)}the container has no frame rate; give --fps")
-    if fps is None and rate2 and abs(rate1 - rate2) > 1e-3 * rate1:
-        raise InputError(f"{where(film2)}{rate2:.6g} frames/s but {film1} has {rate1:.6g}; the two cameras must run "
-                         "at one rate (give --fps if a container is wrong)")
-    if abs(i1.n_frames - i2.n_frames) > max(5, 0.05 * max(i1.n_frames, i2.n_frames)):
-        raise InputError(f"{where(film2)}{i2.n_frames} frames but {film1} has {i1.n_frames}: the films must cover "
-                         "the same test (trim them to the same start and length)")
+    rate1 = check_films(film1, film2, rig, fps)
     bar = None
     if progress:
         from tqdm import tqdm
@@ -450,4 +462,4 @@ def track_dots_stereo(film1, film2, rig: StereoRig, fps: float | None = None, sy
         lag = so.offset_frames
         pairs, _ = match_tracks(rig, t1, t2, lag)
     pts = triangulate_tracks(rig, t1, t2, pairs, lag, rate1)
-    return StereoPoints(pts.t_s, pts.xyz_m, pts.reproj_px, pts.pairs, so, pts.notes)
+    return StereoPoints(pts.t_s, pts.xyz_m, pts.reproj_px, pts.pairs, so, pts.notes, None)

@@ -388,9 +388,10 @@ def test_run_names_the_fit_impacts_the_audit_flagged(tmp_path, run_cli):
     res.to_frame().to_csv(tmp_path / "tracks.csv", index=False)
     (tmp_path / "experiment.toml").write_text(
         '[block]\nb_m = 0.1\nh_m = 0.4\n[sources.track]\npath = "tracks.csv"\nobject = "block"\n'
-        '[simulate]\nlaws = ["eta_e"]\n[output]\nrrd = false\nfigures = false\n')
+        '[simulate]\nlaws = ["eta_e"]\n[output]\nrrd = false\nfigures = true\n')
     rc, out, err = run_cli("run", tmp_path / "experiment.toml", "--out", tmp_path / "out")
     assert rc == 0, err
+    assert (tmp_path / "out" / "figures" / "theta.png").stat().st_size > 10_000
     rep = json.loads((tmp_path / "out" / "report.json").read_text())
     ex = rep["fit"]["excluded_impacts"]
     # the fit's impact at the simulated 4th impact's time, with the jump as the reason

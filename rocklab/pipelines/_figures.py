@@ -60,9 +60,16 @@ def experiment_figures(res, out_dir) -> dict[str, Path]:
     if res.truth is not None:
         ax.plot(res.truth["t_s"], np.asarray(res.truth["theta_rad"]) / alpha, lw=0.6, color="k",
                 alpha=0.5, label="truth")
+    # the assumption audit's flags, where they happened (the impacts a fit should not trust)
+    flags = (res.audit or {}).get("flags") or []
+    for i, f in enumerate(flags):
+        ax.axvline(f["t_s"], color="crimson", lw=0.8, alpha=0.7, label="audit flag" if i == 0 else None)
+        ax.annotate(f"{f['kind']}", (f["t_s"], 1.0), xycoords=("data", "axes fraction"), rotation=90,
+                    va="top", ha="right", fontsize=7, color="crimson")
     ax.set_xlabel("t (s)")
     ax.set_ylabel("θ/α (-)")
-    ax.set_title(f"{res.name}: rotation, measured vs simulated")
+    verdict = (res.audit or {}).get("verdict")
+    ax.set_title(f"{res.name}: rotation, measured vs simulated" + (f" (audit: {verdict})" if verdict else ""))
     ax.legend(fontsize=8, ncol=2)
     ax.grid(alpha=0.3)
     figs["theta"] = save_png(fig, out / "theta.png")
@@ -71,6 +78,10 @@ def experiment_figures(res, out_dir) -> dict[str, Path]:
         fig, ax = plt.subplots(figsize=(6, 4))
         k = np.arange(1, len(res.per_impact_eta) + 1)
         ax.plot(k, res.per_impact_eta, "o-", label="per impact (local fits)")
+        ex = [e["impact"] for e in res.fit.get("excluded_impacts") or [] if 1 <= e["impact"] <= len(k)]
+        if ex:
+            ax.plot(ex, np.asarray(res.per_impact_eta)[np.asarray(ex) - 1], "x", color="crimson", ms=10, mew=2,
+                    label="flagged by the audit (not to trust)")
         if np.isfinite(res.fit.get("eta_e", np.nan)):
             ax.axhline(res.fit["eta_e"], color="C1", label=f"η_e = {res.fit['eta_e']:.4f}")
         ax.axhline(res.block.eta_H, color="k", ls=":", label=f"η_H = {res.block.eta_H:.4f}")

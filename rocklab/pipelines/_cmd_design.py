@@ -30,7 +30,9 @@ def register(sub):
     p.set_defaults(func=run)
 
     p = sub.add_parser("oas", help="Overturning Acceleration Spectrum and t_I of record(s)")
-    p.add_argument("record", nargs="+")
+    p.add_argument("record", nargs="*", help="record files or folders of records (every visible file in them)")
+    p.add_argument("--list", default=None, metavar="FILE",
+                   help="a text file naming one record per line (relative to its folder; # comments)")
     p.add_argument("--units", default=None)
     p.add_argument("--slenderness", type=float, default=12.0, help="block h/b (default 12)")
     p.add_argument("--levels", type=int, default=80, help="a_p/a_p,min levels 1..level-max (80)")
@@ -41,8 +43,10 @@ def register(sub):
     p.add_argument("--free", default="energy", help="after the record: energy | none | SECONDS")
     p.add_argument("--search", choices=("scan", "contiguous"), default="scan")
     p.add_argument("--eta", type=float, default=None, help="restitution (default Housner)")
-    p.add_argument("-o", "--out", default=None, help="CSV: OAS boundary (one record) or summary table")
-    p.add_argument("--plot", default=None, help="PNG with OAS, transformed OAS, 1/p view (one record)")
+    p.add_argument("-o", "--out", default=None,
+                   help="CSV: OAS boundary (one record) or the record table (several; also written as .parquet)")
+    p.add_argument("--plot", default=None,
+                   help="PNG: OAS, transformed OAS, 1/p view (one record), or t_I vs t_p with the thesis's values")
     p.add_argument("--workers", type=int, default=None, help="local processes for several records")
     p.add_argument("--scheduler", default=None, help="Dask distributed scheduler address")
     p.add_argument("--no-progress", action="store_true")
@@ -116,20 +120,12 @@ def run_oas(args) -> int:
               criterion=args.criterion, free=_free(args.free), search=args.search, eta=args.eta)
     if args.slenderness is None or not (args.slenderness > 0):
         raise InputError(f"--slenderness {args.slenderness}: h/b must be > 0 (e.g. 12)")
-    if len(args.record) > 1:
-        from ._spectra_batch import oas_many
+    from pathlib import Path
 
-        if args.plot:
-            raise InputError("--plot needs a single record")
-        tab = oas_many(args.record, units=args.units, slenderness=args.slenderness, oas_kwargs=kw,
-                       workers=args.workers, scheduler=args.scheduler, progress=not args.no_progress)
-        if args.out:
-            write_frame_atomic(args.out, tab)
-        if args.json:
-            _emit({"records": tab.to_dict(orient="records")})
-        else:
-            print(tab.to_string(index=False))
-        return 0 if (tab["error"] == "").all() else 1
+    if not args.record and not args.list:
+        raise InputError("rocklab oas: give record files, folders of records, or --list FILE")
+    if args.list or len(args.record) > 1 or any(Path(r).is_dir() for r in args.record):
+        return _run_oas_batch(args, kw)
     from ..models import load_base_motion, overturning_spectrum, pulse_parameters
 
     rec = load_base_motion(args.record[0], units=args.units)
@@ -150,6 +146,45 @@ def run_oas(args) -> int:
               f"f_min = {o.f_min_rad_s:.4f} 1/s at a_p/a_p,min = {lv:.3f}, R = {R:.3f} m "
               f"(H/B = {args.slenderness:g})")
     return 0
+
+
+def _run_oas_batch(args, kw) -> int:
+    import sys
+    from pathlib import Path
+
+    from .._io import write_frame_atomic
+    from ._spectra_batch import expand_records, oas_table
+
+    items = expand_records(args.record, args.list)
+    if not items:
+        raise InputError(f"rocklab oas: no records in {', '.join(args.record) or args.list}; give record files")
+    for _, _, err in items:
+        if err:
+            sys.stderr.write(f"rocklab oas: error: {err}\n")
+    tab = oas_table(items, units=args.units, slenderness=args.slenderness, oas_kwargs=kw, workers=args.workers,
+                    scheduler=args.scheduler, progress=not args.no_progress)
+    for _, r in tab.iterrows():
+        if r["error"] and r["record"] not in [p for _, p, e in items if e]:
+            sys.stderr.write(f"rocklab oas: error: {r['error']}\n")
+    if args.out:
+        out = Path(args.out)
+        write_frame_atomic(out, tab, float_format="%.6g")
+        from .._io import atomic_path
+
+        with atomic_path(out.with_suffix(".parquet")) as tmp:
+            tab.to_parquet(tmp, index=False)
+    if args.plot:
+        from ._plots_spectra import plot_tI_vs_tp
+
+        plot_tI_vs_tp(tab, args.plot, args.slenderness)
+    n_bad = int((tab["error"] != "").sum())
+    if args.json:
+        _emit({"records": tab.to_dict(orient="records"), "failed": n_bad})
+    else:
+        show = tab[["name", "t_p_s", "t_I_s", "t_I_prime_s", "beta", "thesis_id", "thesis_t_I_s"]]
+        print(show.to_string(index=False, float_format=lambda v: f"{v:.4g}"))
+        print(f"{len(tab) - n_bad}/{len(tab)} records done" + (f", {n_bad} failed (see above)" if n_bad else ""))
+    return 0 if n_bad == 0 else 1
 
 
 def run_design(args) -> int:

@@ -124,3 +124,33 @@ def plot_frame_error_maps(path, H1_over_H=None, direction="+", b_m=0.3, H_m=2.0,
     k = 0 if direction == "+" else 1
     mechs = [asymmetric_frame(b_m, H_m, r * H_m, L_m, h_m, *masses)[k] for r in hs]
     return _error_maps(mechs, hs, "H1/H", path, ratios, accs, f"frame ({direction})")
+
+
+def plot_tI_vs_tp(table, path, slenderness: float = 12.0):
+    """t_I against t_p across records (the thesis's Fig. 56 kind), the thesis's Table 4 values overlaid.
+
+    ``table`` is the record table of ``rocklab oas`` (``t_p_s, t_I_s, thesis_t_p_s, thesis_t_I_s, name``).
+    """
+    plt = pyplot()
+    fig, ax = plt.subplots(figsize=(6.4, 5.2))
+    ok = table[np.isfinite(table["t_I_s"].astype(float)) & np.isfinite(table["t_p_s"].astype(float))]
+    ax.plot(ok["t_p_s"], ok["t_I_s"], "o", color="C0", label=f"rocklab (H/B = {slenderness:g})")
+    th = ok[np.isfinite(ok["thesis_t_I_s"].astype(float))]
+    if len(th):
+        ax.plot(th["thesis_t_p_s"], th["thesis_t_I_s"], "s", mfc="none", color="C3", label="thesis Table 4")
+        for _, r in th.iterrows():
+            ax.plot([r["t_p_s"], r["thesis_t_p_s"]], [r["t_I_s"], r["thesis_t_I_s"]], color="0.6", lw=0.6)
+    for _, r in ok.iterrows():
+        ax.annotate(str(r["thesis_id"] or r["name"]), (r["t_p_s"], r["t_I_s"]), fontsize=6, xytext=(3, 2),
+                    textcoords="offset points")
+    lim = float(np.nanmax(np.r_[ok["t_p_s"], ok["t_I_s"], th["thesis_t_I_s"] if len(th) else []])) * 1.1 \
+        if len(ok) else 1.0
+    ax.plot([0, lim], [0, lim], "k:", lw=0.8, label="t_I = t_p")
+    ax.set_xlim(0, lim)
+    ax.set_ylim(0, lim)
+    ax.set_xlabel("pulse duration t_p (s)")
+    ax.set_ylabel("replacement impulse duration t_I (s)")
+    ax.set_title(f"t_I vs t_p over {len(ok)} records")
+    ax.legend(fontsize=8)
+    ax.grid(alpha=0.3)
+    return save_png(fig, path)

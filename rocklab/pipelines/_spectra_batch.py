@@ -15,7 +15,77 @@ import sys
 
 from .._procs import dask_client, pool_initializer
 
-__all__ = ["oas_summary_row", "oas_many"]
+__all__ = ["oas_summary_row", "oas_many", "expand_records", "thesis_table4", "table4_row"]
+
+#: Columns of the record table (``rocklab oas`` with several records), in order: the first nine as
+#: scripts have always read them, then the record's name and the thesis's Table 4 values.
+TABLE_COLUMNS = ["record", "t_p_s", "t_I_s", "t_I_prime_s", "beta", "f_min", "f_min_level", "f_min_R_m", "error",
+                 "name", "thesis_id", "thesis_t_p_s", "thesis_t_I_s", "thesis_t_I_prime_s", "thesis_beta"]
+
+
+def thesis_table4():
+    """The thesis's Table 4 (44 far-field records, H/B = 12) as a DataFrame (see its PROVENANCE.md)."""
+    from importlib.resources import files
+
+    import pandas as pd
+
+    with (files("rocklab") / "data" / "thesis" / "table4_ff.csv").open("r", encoding="utf-8") as f:
+        return pd.read_csv(f, dtype={"fema_id": str})
+
+
+def table4_row(name: str, table=None):
+    """The Table 4 row of a record named by its FEMA P695 number (``...120111...``), or None."""
+    import re
+
+    table = thesis_table4() if table is None else table
+    for m in re.finditer(r"(?<!\d)(12\d{4})(?!\d)", str(name)):
+        hit = table[table["fema_id"] == m.group(1)]
+        if len(hit):
+            return hit.iloc[0]
+    return None
+
+
+def expand_records(paths, list_file=None) -> list:
+    """``[(name, path, error)]`` of the records named on the command line.
+
+    A folder stands for every visible file in it (sorted); ``list_file`` holds one
+    path per line (relative to the list's folder; ``#`` starts a comment). A missing
+    file and a second record of the same name get an ``error`` (one line), so the
+    rest of the batch still runs and the table says what happened to each.
+    """
+    from pathlib import Path
+
+    items = []
+    for p in paths:
+        p = Path(p)
+        if p.is_dir():
+            items += [(f, "") for f in sorted(p.iterdir()) if f.is_file() and not f.name.startswith(".")]
+        else:
+            items.append((p, "" if p.is_file() else f"{p}: not found; check the path"))
+    if list_file is not None:
+        lf = Path(list_file)
+        try:
+            lines = lf.read_text(encoding="utf-8").splitlines()
+        except (OSError, UnicodeDecodeError) as e:
+            from .._errors import InputError
+
+            raise InputError(f"--list {lf}: cannot read the list ({type(e).__name__}); give a text file with one "
+                             "record path per line") from None
+        for i, line in enumerate(lines, start=1):
+            entry = line.split("#", 1)[0].strip()
+            if not entry:
+                continue
+            f = Path(entry) if Path(entry).is_absolute() else lf.parent / entry
+            items.append((f, "" if f.is_file() else f"{lf}, line {i}: {entry} not found; fix the list"))
+    out, seen = [], {}
+    for f, err in items:
+        name = f.stem
+        if not err and name in seen:
+            err = (f"{f}: same record name as {seen[name]}; rename one (names key the table and the figure)")
+        elif not err:
+            seen[name] = f
+        out.append((name, str(f), err))
+    return out
 
 
 def oas_summary_row(path: str, units: str | None = None, slenderness: float = 12.0,
@@ -71,6 +141,8 @@ def oas_many(paths, units: str | None = None, slenderness: float = 12.0, oas_kwa
 
     paths = [str(p) for p in paths]
     rows = [None] * len(paths)
+    if not paths:
+        return pd.DataFrame(columns=TABLE_COLUMNS[:9])
     bar = tqdm(total=len(paths), desc="OAS", unit="record", file=sys.stderr, disable=not progress)
     args = (units, slenderness, oas_kwargs)
     try:
@@ -99,3 +171,34 @@ def oas_many(paths, units: str | None = None, slenderness: float = 12.0, oas_kwa
         bar.close()
     return pd.DataFrame(rows, columns=["record", "t_p_s", "t_I_s", "t_I_prime_s", "beta", "f_min", "f_min_level",
                                        "f_min_R_m", "error"])
+
+
+def oas_table(items, units: str | None = None, slenderness: float = 12.0, oas_kwargs: dict | None = None,
+              workers: int | None = None, scheduler: str | None = None, progress: bool = True):
+    """The record table (:data:`TABLE_COLUMNS`) of :func:`expand_records` items.
+
+    Records with an error from the expansion are not run; each row carries the
+    thesis's Table 4 values when the record is named by its FEMA P695 number
+    (compared only for H/B = 12, the table's slenderness).
+    """
+    import math
+
+    import pandas as pd
+
+    ok = [(n, p) for n, p, e in items if not e]
+    res = oas_many([p for _, p in ok], units=units, slenderness=slenderness, oas_kwargs=oas_kwargs,
+                   workers=workers, scheduler=scheduler, progress=progress)
+    by_path = {r["record"]: r for r in res.to_dict(orient="records")}
+    t4 = thesis_table4()
+    rows = []
+    for name, path, err in items:
+        row = {c: math.nan for c in TABLE_COLUMNS}
+        row.update(name=name, record=path, thesis_id="", error=err)
+        if not err:
+            row.update({k: v for k, v in by_path[path].items() if k in row})
+        hit = table4_row(name, t4) if abs(slenderness - 12.0) < 1e-9 else None
+        if hit is not None:
+            row.update(thesis_id=hit["ff_id"], thesis_t_p_s=float(hit["t_p_s"]), thesis_t_I_s=float(hit["t_I_s"]),
+                       thesis_t_I_prime_s=float(hit["t_I_prime_s"]), thesis_beta=float(hit["beta"]))
+        rows.append(row)
+    return pd.DataFrame(rows, columns=TABLE_COLUMNS)

@@ -1,0 +1,86 @@
+"""rocklab oas over record sets: folders, list files, bad entries, CSV + Parquet, t_I vs t_p figure."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from rocklab.pipelines._spectra_batch import expand_records, table4_row, thesis_table4
+
+
+def test_thesis_table4_transcription():
+    t = thesis_table4()
+    assert len(t) == 44 and list(t.ff_id) == [f"FF-{i}" for i in range(1, 45)]
+    ff1 = t.iloc[0]
+    assert (ff1.t_p_s, ff1.t_I_s, ff1.t_I_prime_s, ff1.beta) == (0.405, 0.266, 0.387, 1.744)
+    # "~∞" rows
+    assert set(t.ff_id[np.isinf(t.t_I_prime_s)]) == {"FF-19", "FF-20"}
+    # printed: t'_I > t_I in every finite row (the thesis's own invariant of the inclined line)
+    fin = np.isfinite(t.t_I_prime_s)
+    assert (t.t_I_prime_s[fin] > t.t_I_s[fin]).all()
+    # FEMA P695 numbers ascend with FF-n; two components per station
+    ids = t.fema_id.astype(int).to_numpy()
+    assert (np.diff(ids) > 0).all() and set(t.fema_id.str[-1]) == {"1", "2"}
+    assert table4_row("SortedEQFile_(120821).txt", t).ff_id == "FF-19"
+    assert table4_row("elcentro.AT2", t) is None
+
+
+def _sine_record(path, period_s, amp_g=0.4, dt=0.005):
+    t = np.arange(0, 6.0, dt)
+    a = np.where((t >= 1.0) & (t < 1.0 + period_s), amp_g * np.sin(2 * np.pi * (t - 1.0) / period_s), 0.0)
+    pd.DataFrame({"t_s": t, "acc_g": a}).to_csv(path, index=False)
+
+
+def test_batch_folder_list_duplicates_and_outputs(tmp_path, run_cli):
+    recs = tmp_path / "recs"
+    recs.mkdir()
+    _sine_record(recs / "pulse_a.csv", 0.6)
+    _sine_record(recs / "pulse_b.csv", 1.0)
+    (recs / "README.md").write_text("not a record\n")
+    other = tmp_path / "other"
+    other.mkdir()
+    _sine_record(other / "pulse_a.csv", 0.8)                     # same name as recs/pulse_a.csv
+    lst = tmp_path / "set.txt"
+    lst.write_text("other/pulse_a.csv\nnope.csv   # a missing one\n\n")
+    rc, out, err = run_cli("oas", recs, "--list", lst, "--sizes", 30, "--levels", 20, "--workers", 1,
+                           "-o", tmp_path / "t" / "table.csv", "--plot", tmp_path / "t" / "tI.png",
+                           "--no-progress", "--json")
+    assert rc == 1                                               # some failed: say so
+    tab = pd.DataFrame(json.loads(out)["records"])
+    assert list(tab.name) == ["README", "pulse_a", "pulse_b", "pulse_a", "nope"]
+    errs = [e for e in err.strip().splitlines()]
+    assert len(errs) == 3 and all(e.startswith("rocklab oas: error: ") for e in errs)
+    assert any("set.txt, line 2: nope.csv not found" in e for e in errs)
+    assert any("same record name as" in e and "other/pulse_a.csv" in e for e in errs)
+    assert any("README.md, line 1" in e for e in errs)
+    ok = tab[tab.error == ""]
+    assert list(ok.name) == ["pulse_a", "pulse_b"]
+    # one full sine: its largest lobe is half a period
+    assert ok.t_p_s.tolist() == pytest.approx([0.3, 0.5], rel=0.03)
+    assert (ok.t_I_s > 0).all() and ok.t_I_s.iloc[1] > ok.t_I_s.iloc[0]
+    csv = pd.read_csv(tmp_path / "t" / "table.csv")
+    pq = pd.read_parquet(tmp_path / "t" / "table.parquet")
+    assert len(csv) == len(pq) == 5
+    np.testing.assert_allclose(pq.t_I_s.to_numpy(float), csv.t_I_s.to_numpy(float), rtol=1e-5)
+    assert (tmp_path / "t" / "tI.png").stat().st_size > 10_000
+
+
+def test_batch_fema_records_get_the_thesis_values(shared_data, tmp_path, run_cli):
+    folder = shared_data / "records" / "fema-p695-far-field"
+    rc, out, err = run_cli("oas", folder, "--units", "g", "--workers", 1, "--no-progress", "--json",
+                           "-o", tmp_path / "t.csv")
+    assert rc == 0, err
+    tab = pd.DataFrame(json.loads(out)["records"])
+    assert list(tab.thesis_id) == ["FF-1", "FF-2"]
+    # t_p as printed within 0.35 % (Table 4: 0.405 s and 0.367 s)
+    assert tab.t_p_s.tolist() == pytest.approx(tab.thesis_t_p_s.tolist(), rel=0.0035)
+    assert math.isclose(tab.thesis_t_I_s[0], 0.266) and math.isclose(tab.thesis_t_I_s[1], 0.360)
+
+
+def test_expand_records_missing_file_is_a_row_not_a_crash(tmp_path):
+    items = expand_records([tmp_path / "absent.AT2"])
+    assert items == [("absent", str(tmp_path / "absent.AT2"), f"{tmp_path / 'absent.AT2'}: not found; check the path")]

@@ -84,3 +84,32 @@ def test_batch_fema_records_get_the_thesis_values(shared_data, tmp_path, run_cli
 def test_expand_records_missing_file_is_a_row_not_a_crash(tmp_path):
     items = expand_records([tmp_path / "absent.AT2"])
     assert items == [("absent", str(tmp_path / "absent.AT2"), f"{tmp_path / 'absent.AT2'}: not found; check the path")]
+
+
+def test_t_I_band_members_and_consistency(tmp_path):
+    from rocklab.models import BAND_ENSEMBLE, load_base_motion, overturning_spectrum, t_I_band
+
+    _sine_record(tmp_path / "p.csv", 0.5)
+    rec = load_base_motion(tmp_path / "p.csv")
+    kw = dict(levels=16, sizes=24, refine=6)
+    b = t_I_band(rec, 8.0, **kw)
+    assert [m["name"] for m in b.members] == list(BAND_ENSEMBLE)
+    assert b.t_I_p05_s <= b.t_I_s <= b.t_I_p95_s
+    # the default member is the plain OAS
+    assert b.members[0]["t_I_s"] == pytest.approx(overturning_spectrum(rec, 8.0, **kw).t_I_s, rel=1e-12)
+    # a half-step offset places the levels half a step higher
+    o = overturning_spectrum(rec, 8.0, level_offset=0.5, **kw)
+    step = (10.0 - 1.0) / 15
+    assert o.levels[0] == pytest.approx(1.0 + 0.5 * step) and np.diff(o.levels) == pytest.approx(step)
+    # percentiles of the members
+    ti = np.array([m["t_I_s"] for m in b.members])
+    assert b.t_I_p05_s == pytest.approx(np.percentile(ti, 5)) and b.t_I_s == pytest.approx(np.median(ti))
+
+
+def test_cli_band_columns(tmp_path, run_cli):
+    _sine_record(tmp_path / "p.csv", 0.5)
+    rc, out, err = run_cli("oas", tmp_path / "p.csv", "--band", "--levels", 12, "--sizes", 20, "--refine", 4,
+                           "--slenderness", 8, "--workers", 1, "--no-progress", "--json")
+    assert rc == 0, err
+    r = json.loads(out)["records"][0]
+    assert r["t_I_p05_s"] <= r["t_I_s"] <= r["t_I_p95_s"] and r["t_I_default_s"] > 0

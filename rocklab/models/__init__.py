@@ -9,6 +9,7 @@ from ._pulses import (F_SINE, PULSE_KINDS, PulseParameters, lobe_impulses, pulse
                       pulse_parameters, pulse_shape)
 from ._oas import (OASResult, OverturningCurve, critical_impulse, fit_inclined_line,
                    normalised_critical_impulse, overturning_curve, overturning_spectrum, simplified_oas)
+from ._oas_band import BAND_ENSEMBLE, TIBand, t_I_band
 from ._design import DesignCheck, design_check, required_width, required_width_slender
 from ._equivalent import (FundamentalParameters, Mechanism, block_parameters, equivalence_errors,
                           frame_parameters, free_rocking_period_eq24, linear_sine_pulse_response,
@@ -29,6 +30,7 @@ __all__ = ["BaseMotion", "load_base_motion", "UNITS_TO_M_S2", "bundled_record", 
            "pulse_fullness", "PULSE_KINDS", "F_SINE",
            "OASResult", "overturning_spectrum", "OverturningCurve", "overturning_curve",
            "critical_impulse", "normalised_critical_impulse", "fit_inclined_line", "simplified_oas",
+           "t_I_band", "TIBand", "BAND_ENSEMBLE",
            "DesignCheck", "design_check", "required_width", "required_width_slender",
            "FundamentalParameters", "Mechanism", "block_parameters", "strut_parameters",
            "frame_parameters", "wall_parameters", "wall_mechanism", "four_bar_mechanism",

@@ -47,6 +47,9 @@ def register(sub):
                    help="CSV: OAS boundary (one record) or the record table (several; also written as .parquet)")
     p.add_argument("--plot", default=None,
                    help="PNG: OAS, transformed OAS, 1/p view (one record), or t_I vs t_p with the thesis's values")
+    p.add_argument("--band", action="store_true",
+                   help="t_I, t'_I and beta over an ensemble of grid placements, densities, step, eta and search "
+                        "(median and 5-95 %% band; 8 OAS per record)")
     p.add_argument("--workers", type=int, default=None, help="local processes for several records")
     p.add_argument("--scheduler", default=None, help="Dask distributed scheduler address")
     p.add_argument("--no-progress", action="store_true")
@@ -124,7 +127,7 @@ def run_oas(args) -> int:
 
     if not args.record and not args.list:
         raise InputError("rocklab oas: give record files, folders of records, or --list FILE")
-    if args.list or len(args.record) > 1 or any(Path(r).is_dir() for r in args.record):
+    if args.list or args.band or len(args.record) > 1 or any(Path(r).is_dir() for r in args.record):
         return _run_oas_batch(args, kw)
     from ..models import load_base_motion, overturning_spectrum, pulse_parameters
 
@@ -162,7 +165,7 @@ def _run_oas_batch(args, kw) -> int:
         if err:
             sys.stderr.write(f"rocklab oas: error: {err}\n")
     tab = oas_table(items, units=args.units, slenderness=args.slenderness, oas_kwargs=kw, workers=args.workers,
-                    scheduler=args.scheduler, progress=not args.no_progress)
+                    scheduler=args.scheduler, progress=not args.no_progress, band=args.band)
     for _, r in tab.iterrows():
         if r["error"] and r["record"] not in [p for _, p, e in items if e]:
             sys.stderr.write(f"rocklab oas: error: {r['error']}\n")
@@ -181,7 +184,9 @@ def _run_oas_batch(args, kw) -> int:
     if args.json:
         _emit({"records": tab.to_dict(orient="records"), "failed": n_bad})
     else:
-        show = tab[["name", "t_p_s", "t_I_s", "t_I_prime_s", "beta", "thesis_id", "thesis_t_I_s"]]
+        cols = ["name", "t_p_s", "t_I_s"] + (["t_I_p05_s", "t_I_p95_s"] if args.band else []) + \
+            ["t_I_prime_s", "beta", "thesis_id", "thesis_t_I_s"]
+        show = tab[cols]
         print(show.to_string(index=False, float_format=lambda v: f"{v:.4g}"))
         print(f"{len(tab) - n_bad}/{len(tab)} records done" + (f", {n_bad} failed (see above)" if n_bad else ""))
     return 0 if n_bad == 0 else 1

@@ -134,7 +134,13 @@ def plot_tI_vs_tp(table, path, slenderness: float = 12.0):
     plt = pyplot()
     fig, ax = plt.subplots(figsize=(6.4, 5.2))
     ok = table[np.isfinite(table["t_I_s"].astype(float)) & np.isfinite(table["t_p_s"].astype(float))]
-    ax.plot(ok["t_p_s"], ok["t_I_s"], "o", color="C0", label=f"rocklab (H/B = {slenderness:g})")
+    if "t_I_p05_s" in ok.columns:
+        lo = (ok["t_I_s"] - ok["t_I_p05_s"]).clip(lower=0)
+        hi = (ok["t_I_p95_s"] - ok["t_I_s"]).clip(lower=0)
+        ax.errorbar(ok["t_p_s"], ok["t_I_s"], yerr=[lo, hi], fmt="o", color="C0", ms=4, elinewidth=0.8,
+                    label=f"rocklab, median and 90 % band (H/B = {slenderness:g})")
+    else:
+        ax.plot(ok["t_p_s"], ok["t_I_s"], "o", color="C0", label=f"rocklab (H/B = {slenderness:g})")
     th = ok[np.isfinite(ok["thesis_t_I_s"].astype(float))]
     if len(th):
         ax.plot(th["thesis_t_p_s"], th["thesis_t_I_s"], "s", mfc="none", color="C3", label="thesis Table 4")

@@ -17,6 +17,9 @@ from .._procs import dask_client, pool_initializer
 
 __all__ = ["oas_summary_row", "oas_many", "expand_records", "thesis_table4", "table4_row"]
 
+#: Extra columns with ``--band``: the 90 % band of each quantity and the default member's t_I.
+BAND_COLUMNS = ["t_I_p05_s", "t_I_p95_s", "t_I_prime_p05_s", "t_I_prime_p95_s", "beta_p05", "beta_p95",
+                "t_I_default_s"]
 #: Columns of the record table (``rocklab oas`` with several records), in order: the first nine as
 #: scripts have always read them, then the record's name and the thesis's Table 4 values.
 TABLE_COLUMNS = ["record", "t_p_s", "t_I_s", "t_I_prime_s", "beta", "f_min", "f_min_level", "f_min_R_m", "error",
@@ -89,20 +92,33 @@ def expand_records(paths, list_file=None) -> list:
 
 
 def oas_summary_row(path: str, units: str | None = None, slenderness: float = 12.0,
-                    oas_kwargs: dict | None = None) -> dict:
-    """One record's summary row (runs in a worker process). Bad input becomes an ``error`` field."""
+                    oas_kwargs: dict | None = None, band: bool = False) -> dict:
+    """One record's summary row (runs in a worker process). Bad input becomes an ``error`` field.
+
+    With ``band`` the row also holds the 5th/95th percentiles over
+    :data:`rocklab.models.BAND_ENSEMBLE` (``t_I_p05_s, t_I_p95_s`` and the same for
+    t'_I and beta), and ``t_I_s`` etc. are the ensemble's medians.
+    """
     from .._errors import InputError
-    from ..models import load_base_motion, overturning_spectrum, pulse_parameters
+    from ..models import load_base_motion, overturning_spectrum, pulse_parameters, t_I_band
 
     row = dict(record=str(path), t_p_s=math.nan, t_I_s=math.nan, t_I_prime_s=math.nan, beta=math.nan,
                f_min=math.nan, f_min_level=math.nan, f_min_R_m=math.nan, error="")
     try:
         rec = load_base_motion(path, units=units)
         row["t_p_s"] = pulse_parameters(rec).t_p_s
-        o = overturning_spectrum(rec, slenderness, **(oas_kwargs or {}))
-        lv, R = o.f_min_at
-        row.update(t_I_s=o.t_I_s, t_I_prime_s=o.t_I_prime_s, beta=o.beta, f_min=o.f_min_rad_s,
-                   f_min_level=lv, f_min_R_m=R)
+        if band:
+            b = t_I_band(rec, slenderness, **(oas_kwargs or {}))
+            d = b.members[0]
+            row.update(t_I_s=b.t_I_s, t_I_prime_s=b.t_I_prime_s, beta=b.beta, f_min=math.nan,
+                       f_min_level=d["f_min_level"], f_min_R_m=d["f_min_R_m"], t_I_p05_s=b.t_I_p05_s,
+                       t_I_p95_s=b.t_I_p95_s, t_I_prime_p05_s=b.t_I_prime_p05_s, t_I_prime_p95_s=b.t_I_prime_p95_s,
+                       beta_p05=b.beta_p05, beta_p95=b.beta_p95, t_I_default_s=d["t_I_s"])
+        else:
+            o = overturning_spectrum(rec, slenderness, **(oas_kwargs or {}))
+            lv, R = o.f_min_at
+            row.update(t_I_s=o.t_I_s, t_I_prime_s=o.t_I_prime_s, beta=o.beta, f_min=o.f_min_rad_s,
+                       f_min_level=lv, f_min_R_m=R)
     except InputError as e:
         row["error"] = str(e)
     return row
@@ -116,7 +132,7 @@ def _one_numba_thread():
 
 
 def oas_many(paths, units: str | None = None, slenderness: float = 12.0, oas_kwargs: dict | None = None,
-             workers: int | None = None, scheduler: str | None = None, progress: bool = True):
+             workers: int | None = None, scheduler: str | None = None, progress: bool = True, band: bool = False):
     """Summary table (pandas DataFrame, input order) of many records' OAS.
 
     Parameters
@@ -144,7 +160,7 @@ def oas_many(paths, units: str | None = None, slenderness: float = 12.0, oas_kwa
     if not paths:
         return pd.DataFrame(columns=TABLE_COLUMNS[:9])
     bar = tqdm(total=len(paths), desc="OAS", unit="record", file=sys.stderr, disable=not progress)
-    args = (units, slenderness, oas_kwargs)
+    args = (units, slenderness, oas_kwargs, band)
     try:
         if scheduler:
             from dask.distributed import as_completed
@@ -169,12 +185,12 @@ def oas_many(paths, units: str | None = None, slenderness: float = 12.0, oas_kwa
                     bar.update()
     finally:
         bar.close()
-    return pd.DataFrame(rows, columns=["record", "t_p_s", "t_I_s", "t_I_prime_s", "beta", "f_min", "f_min_level",
-                                       "f_min_R_m", "error"])
+    cols = ["record", "t_p_s", "t_I_s", "t_I_prime_s", "beta", "f_min", "f_min_level", "f_min_R_m", "error"]
+    return pd.DataFrame(rows, columns=cols + (BAND_COLUMNS if band else []))
 
 
 def oas_table(items, units: str | None = None, slenderness: float = 12.0, oas_kwargs: dict | None = None,
-              workers: int | None = None, scheduler: str | None = None, progress: bool = True):
+              workers: int | None = None, scheduler: str | None = None, progress: bool = True, band: bool = False):
     """The record table (:data:`TABLE_COLUMNS`) of :func:`expand_records` items.
 
     Records with an error from the expansion are not run; each row carries the
@@ -187,12 +203,13 @@ def oas_table(items, units: str | None = None, slenderness: float = 12.0, oas_kw
 
     ok = [(n, p) for n, p, e in items if not e]
     res = oas_many([p for _, p in ok], units=units, slenderness=slenderness, oas_kwargs=oas_kwargs,
-                   workers=workers, scheduler=scheduler, progress=progress)
+                   workers=workers, scheduler=scheduler, progress=progress, band=band)
     by_path = {r["record"]: r for r in res.to_dict(orient="records")}
     t4 = thesis_table4()
     rows = []
+    columns = TABLE_COLUMNS + (BAND_COLUMNS if band else [])
     for name, path, err in items:
-        row = {c: math.nan for c in TABLE_COLUMNS}
+        row = {c: math.nan for c in columns}
         row.update(name=name, record=path, thesis_id="", error=err)
         if not err:
             row.update({k: v for k, v in by_path[path].items() if k in row})
@@ -201,4 +218,4 @@ def oas_table(items, units: str | None = None, slenderness: float = 12.0, oas_kw
             row.update(thesis_id=hit["ff_id"], thesis_t_p_s=float(hit["t_p_s"]), thesis_t_I_s=float(hit["t_I_s"]),
                        thesis_t_I_prime_s=float(hit["t_I_prime_s"]), thesis_beta=float(hit["beta"]))
         rows.append(row)
-    return pd.DataFrame(rows, columns=TABLE_COLUMNS)
+    return pd.DataFrame(rows, columns=columns)

@@ -1,0 +1,127 @@
+"""t_I as a distribution over the open choices of its computation (thesis Eq. 20, §5).
+
+One t_I is a minimum over a chaotic boundary: where the grids fall, the step
+and the restitution move it by 10-20 % on some records. :func:`t_I_band`
+computes the OAS for a documented ensemble of those choices and reports the
+median, the 5th-95th percentile band and the grid point behind each member.
+
+The ensemble (:data:`BAND_ENSEMBLE`), each member changing one choice of the default:
+
+- ``default``: 80 levels x 120 sizes, step p*dt <= 0.001, Housner eta, scan;
+- ``level+1/2``, ``size+1/2``, ``both+1/2``: the level grid, the size grid, or
+  both shifted by half a step (same resolution, different placement);
+- ``coarse``: 60 levels x 90 sizes (three quarters of the resolution);
+- ``step x2``: p*dt <= 0.002;
+- ``eta -1%``: restitution 1 % below Housner's (Čeh's eta_mat = 0.989 says
+  real impacts lose slightly more than Housner's model);
+- ``contiguous``: the unsafe band counted from the smallest blocks up to the
+  first safe size (islands of overturning above it ignored).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ._oas import overturning_spectrum
+
+__all__ = ["BAND_ENSEMBLE", "TIBand", "t_I_band"]
+
+#: Ensemble members: name -> options of :func:`overturning_spectrum` changed from the default.
+BAND_ENSEMBLE: dict[str, dict] = {
+    "default": {},
+    "level+1/2": {"level_offset": 0.5},
+    "size+1/2": {"size_offset": 0.5},
+    "both+1/2": {"level_offset": 0.5, "size_offset": 0.5},
+    "coarse": {"levels": 60, "sizes": 90},
+    "step x2": {"max_p_dt": 0.002},
+    "eta -1%": {"eta_factor": 0.99},
+    "contiguous": {"search": "contiguous"},
+}
+
+
+@dataclass(frozen=True)
+class TIBand:
+    """t_I, t'_I and beta over an ensemble of OAS computations.
+
+    Attributes
+    ----------
+    t_I_s, t_I_p05_s, t_I_p95_s : float
+        Median and 5th / 95th percentiles of t_I over the members, s.
+    t_I_prime_s, t_I_prime_p05_s, t_I_prime_p95_s : float
+        The same for t'_I, s (``inf`` members count as the largest).
+    beta, beta_p05, beta_p95 : float
+    members : tuple of dict
+        Per member: ``name, t_I_s, t_I_prime_s, beta, f_min_level, f_min_R_m`` (the grid
+        point behind its t_I).
+    """
+
+    t_I_s: float
+    t_I_p05_s: float
+    t_I_p95_s: float
+    t_I_prime_s: float
+    t_I_prime_p05_s: float
+    t_I_prime_p95_s: float
+    beta: float
+    beta_p05: float
+    beta_p95: float
+    members: tuple
+
+    @property
+    def half_width_rel(self) -> float:
+        """Half the 90 % band over the median t_I (-)."""
+        return 0.5 * (self.t_I_p95_s - self.t_I_p05_s) / self.t_I_s if self.t_I_s > 0 else float("nan")
+
+    def to_dict(self) -> dict:
+        """Numbers and members (SI units)."""
+        d = {k: getattr(self, k) for k in ("t_I_s", "t_I_p05_s", "t_I_p95_s", "t_I_prime_s", "t_I_prime_p05_s",
+                                          "t_I_prime_p95_s", "beta", "beta_p05", "beta_p95")}
+        d["members"] = list(self.members)
+        return d
+
+
+def _stats(v):
+    v = np.asarray(v, float)
+    v = v[~np.isnan(v)]
+    if not v.size:
+        return (float("nan"),) * 3
+    return tuple(float(x) for x in np.percentile(v, [50, 5, 95]))
+
+
+def t_I_band(base, slenderness: float = 12.0, ensemble: dict | None = None, **options) -> TIBand:
+    """t_I over the :data:`BAND_ENSEMBLE` (or ``ensemble``) of OAS choices.
+
+    Parameters
+    ----------
+    base : BaseMotion
+    slenderness : float
+        Block h/b.
+    ensemble : dict, optional
+        Name -> options changed from ``options`` (``eta_factor`` scales the
+        restitution the base options use, Housner's by default).
+    **options
+        Options of :func:`overturning_spectrum` shared by every member.
+
+    Returns
+    -------
+    TIBand
+    """
+    members = []
+    for name, change in (ensemble or BAND_ENSEMBLE).items():
+        kw = dict(options)
+        kw.update({k: v for k, v in change.items() if k != "eta_factor"})
+        if "eta_factor" in change:
+            alpha_I = kw.get("alpha_I", 4.0 / 3.0)
+            alpha = math.atan(1.0 / slenderness)
+            eta0 = kw.get("eta") if kw.get("eta") is not None else 1.0 - 2.0 * math.sin(alpha) ** 2 / alpha_I
+            kw["eta"] = eta0 * change["eta_factor"]
+        o = overturning_spectrum(base, slenderness, **kw)
+        lv, R = o.f_min_at
+        members.append({"name": name, "t_I_s": o.t_I_s, "t_I_prime_s": o.t_I_prime_s, "beta": o.beta,
+                        "f_min_level": float(lv), "f_min_R_m": float(R)})
+    ti = _stats([m["t_I_s"] for m in members])
+    tp = _stats([m["t_I_prime_s"] for m in members])
+    be = _stats([m["beta"] for m in members])
+    return TIBand(*ti, *tp, *be, tuple(members))

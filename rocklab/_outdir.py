@@ -176,10 +176,19 @@ def stage_dir(out_dir) -> Path:
 def _write_marker(folder: Path, command: str, entries) -> None:
     from . import __version__
 
-    from ._io import write_json_atomic
-
-    write_json_atomic(folder / MARKER, {"written_by": f"rocklab {__version__}", "command": command,
-                                        "time_unix_s": time.time(), "entries": sorted(entries)})
+    # written here, not through rocklab._io (which uses this module's stale-file helpers): a temporary
+    # file renamed over the marker, so a killed writer leaves the old marker or the new one
+    text = json.dumps({"written_by": f"rocklab {__version__}", "command": command, "time_unix_s": time.time(),
+                       "entries": sorted(entries)}, indent=2) + "\n"
+    fd, tmp = tempfile.mkstemp(prefix=stale_prefix(MARKER, "tmp"), dir=folder)
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as f:
+            f.write(text)
+        os.replace(tmp, folder / MARKER)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
 
 
 def claim_dir(path, entries, command: str = "") -> Path:

@@ -10,6 +10,8 @@ from __future__ import annotations
 import numpy as np
 
 from .._errors import InputError
+from ._detection import Detection
+from ._edges import refine_rectangle
 from ._geometry import fit_similarity
 
 __all__ = ["ArucoDetector", "Detection"]
@@ -19,46 +21,6 @@ _REFINE = {"none": "CORNER_REFINE_NONE", "subpix": "CORNER_REFINE_SUBPIX",
            "edges": "CORNER_REFINE_NONE"}
 # Object-frame corner offsets (y up) in OpenCV's order TL, TR, BR, BL, unit side.
 _UNIT_CORNERS = np.array([[-0.5, 0.5], [0.5, 0.5], [0.5, -0.5], [-0.5, -0.5]])
-
-
-class Detection:
-    """One object's points in one frame.
-
-    Attributes
-    ----------
-    img_pts : ndarray (n, 2)
-        Measured image positions (px, distorted as in the video).
-    obj_pts : ndarray (n, 2)
-        Matching object-frame positions (m if ``metric`` else object units).
-    metric : bool
-    n_expected : int
-        Points a complete detection would have (quality = n / n_expected ...).
-    sigma_rad : float
-        Orientation uncertainty from the shapes' own edges (the corners of one
-        marker come from fitted lines and always form a near-perfect square, so
-        the corner residual cannot show it).
-    n_groups : int
-        Independent rigid shapes (markers) behind the points. With one, the
-        reported σ is ``hypot(σ_fit, sigma_rad)``; with several, the corner fit
-        also carries their relative positions and the two are combined as
-        independent estimates, ``(σ_fit⁻² + sigma_rad⁻²)^-1/2``.
-    """
-
-    __slots__ = ("img_pts", "obj_pts", "metric", "n_expected", "sigma_rad", "n_groups")
-
-    def __init__(self, img_pts, obj_pts, metric, n_expected, sigma_rad=0.0, n_groups=1):
-        self.img_pts = np.asarray(img_pts, float).reshape(-1, 2)
-        self.obj_pts = np.asarray(obj_pts, float).reshape(-1, 2)
-        self.metric = bool(metric)
-        self.n_expected = int(n_expected)
-        self.sigma_rad = float(sigma_rad) if np.isfinite(sigma_rad) else 0.0
-        self.n_groups = int(n_groups)
-
-    def combined_sigma(self, sigma_fit):
-        """The reported 1-σ of θ given the rigid fit's own σ (rad)."""
-        if self.n_groups >= 2 and self.sigma_rad > 0 and sigma_fit > 0:
-            return float((sigma_fit ** -2 + self.sigma_rad ** -2) ** -0.5)
-        return float(np.hypot(sigma_fit, self.sigma_rad))
 
 
 def make_cv_detector(targets, win: int | None = None):
@@ -94,7 +56,7 @@ def refine_marker_corners(gray, corners, cells=6):
     sigma_theta_rad : float
         The marker's orientation uncertainty from the edge-line scatter.
     """
-    from ._edges import refine_rectangle
+
 
     side = float(np.mean(np.hypot(*(np.roll(corners, -1, axis=0) - corners).T)))
     half = float(np.clip(0.5 * side / cells, 1.5, 4.0))

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._aruco import Detection
+from ._detection import Detection
 
 __all__ = ["DotDetector", "dot_centroid"]
 

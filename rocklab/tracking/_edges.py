@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._aruco import Detection
+from ._detection import Detection
 from ._region import RegionTracker
 
 __all__ = ["EdgeDetector", "refine_rectangle"]

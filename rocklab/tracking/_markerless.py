@@ -25,7 +25,7 @@ import math
 import numpy as np
 
 from .._errors import InputError
-from ._aruco import Detection
+from ._detection import Detection
 
 __all__ = ["MarkerlessTracker", "MarkerlessDetector", "MIN_CC", "REKEY_CC"]
 

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._aruco import Detection
+from ._detection import Detection
 
 __all__ = ["RegionTracker", "RegionDetector"]
 

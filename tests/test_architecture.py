@@ -1,0 +1,134 @@
+"""The package's shape: no import circles, dependencies flow one way, only pipelines draw or log."""
+
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+import pytest
+
+PKG = Path(__file__).resolve().parents[1] / "rocklab"
+
+# Known and documented exceptions, each to disappear with the restructure of issue 16:
+#: TrackConfig.from_dict imports its parser lazily, and the parser builds TrackConfig.
+KNOWN_CYCLES = [{"rocklab.tracking._config", "rocklab.tracking._config_parse"}]
+#: Measurement modules that call the physics (table motion filters, the IMU table model) and the synthetic
+#: lab sessions that still live in tracking.
+TRACKING_TO_MODELS = {"_motion", "_imu_table", "_synth_column", "_synth_motion", "_synth_scene"}
+
+
+def _module_name(path: Path) -> str:
+    rel = path.relative_to(PKG.parent).with_suffix("")
+    parts = list(rel.parts)
+    if parts[-1] == "__init__":
+        parts = parts[:-1]
+    return ".".join(parts)
+
+
+def _imports():
+    """{module: set of imported rocklab modules and top-level third-party names}, every import (lazy ones too)."""
+    graph = {}
+    for path in PKG.rglob("*.py"):
+        mod = _module_name(path)
+        pkg = mod if path.name == "__init__.py" else mod.rsplit(".", 1)[0]
+        deps = set()
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.ImportFrom):
+                if node.level:
+                    base = pkg.split(".")
+                    base = base[:len(base) - (node.level - 1)]
+                    target = ".".join(base + ([node.module] if node.module else []))
+                else:
+                    target = node.module or ""
+                if target.startswith("rocklab"):
+                    # "from . import x" / "from .pkg import mod": the imported names may be modules
+                    for a in node.names:
+                        cand = f"{target}.{a.name}"
+                        deps.add(cand if (PKG.parent / (cand.replace(".", "/") + ".py")).exists() else target)
+                else:
+                    deps.add(target.split(".")[0])
+            elif isinstance(node, ast.Import):
+                for a in node.names:
+                    deps.add(a.name if a.name.startswith("rocklab") else a.name.split(".")[0])
+        graph[mod] = deps
+    return graph
+
+
+def _cycles(graph):
+    """Strongly connected components with more than one module (Tarjan)."""
+    index, low, stack, on, out = {}, {}, [], set(), []
+    counter = [0]
+
+    def visit(v):
+        index[v] = low[v] = counter[0]
+        counter[0] += 1
+        stack.append(v)
+        on.add(v)
+        for w in graph.get(v, ()):
+            if w not in graph:
+                continue
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in on:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            comp = set()
+            while True:
+                w = stack.pop()
+                on.discard(w)
+                comp.add(w)
+                if w == v:
+                    break
+            if len(comp) > 1:
+                out.append(comp)
+
+    for v in graph:
+        if v not in index:
+            visit(v)
+    return out
+
+
+def _internal(graph):
+    """The graph restricted to modules, without package __init__ re-exports (they import downwards)."""
+    mods = {m for m in graph if (PKG.parent / (m.replace(".", "/") + ".py")).exists()}
+    return {m: {d for d in graph[m] if d in mods} for m in mods}
+
+
+def test_no_import_circles_but_the_known_one():
+    cycles = _cycles(_internal(_imports()))
+    assert sorted(map(sorted, cycles)) == sorted(map(sorted, KNOWN_CYCLES))
+
+
+def _subpackage(mod):
+    parts = mod.split(".")
+    return parts[1] if len(parts) > 2 else ""
+
+
+@pytest.mark.parametrize("layer, forbidden", [
+    ("models", {"fitting", "pipelines", "tracking", "synth"}),
+    ("fitting", {"pipelines", "tracking", "synth"}),
+    ("tracking", {"pipelines", "fitting", "synth"}),
+    ("synth", {"pipelines", "fitting"}),
+])
+def test_dependencies_flow_one_way(layer, forbidden):
+    bad = []
+    for mod, deps in _imports().items():
+        if _subpackage(mod) != layer:
+            continue
+        for d in deps:
+            if d.startswith("rocklab.") and _subpackage(d) in forbidden:
+                bad.append(f"{mod} -> {d}")
+    assert not bad
+
+
+def test_tracking_uses_the_physics_only_where_known():
+    users = {mod.rsplit(".", 1)[-1] for mod, deps in _imports().items()
+             if _subpackage(mod) == "tracking" and any(_subpackage(d) == "models" for d in deps)}
+    assert users <= TRACKING_TO_MODELS, users - TRACKING_TO_MODELS
+
+
+def test_only_pipelines_draw_or_log_to_rerun():
+    bad = [mod for mod, deps in _imports().items()
+           if deps & {"matplotlib", "rerun"} and _subpackage(mod) != "pipelines"]
+    assert not bad

@@ -22,7 +22,8 @@ import numpy as np
 
 from rocklab import Block
 from rocklab.models import simulate
-from rocklab.tracking import block_rotation, read_imu, simulate_imu_log, write_ximu_csv
+from rocklab.tracking import block_rotation, read_imu
+from rocklab.synth import simulate_imu_log, write_ximu_csv
 
 
 def _best(fn, repeat=3):

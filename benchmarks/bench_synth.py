@@ -18,8 +18,8 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from rocklab.tracking import synth_session
-from rocklab.tracking._synth_scene import build_scene
+from rocklab.synth import synth_session
+from rocklab.synth._scene import build_scene
 
 SIZE = (1920, 1080)
 FPS = 50.0

@@ -12,9 +12,8 @@ PKG = Path(__file__).resolve().parents[1] / "rocklab"
 # Known and documented exceptions, each to disappear with the restructure of issue 16:
 #: TrackConfig.from_dict imports its parser lazily, and the parser builds TrackConfig.
 KNOWN_CYCLES = [{"rocklab.tracking._config", "rocklab.tracking._config_parse"}]
-#: Measurement modules that call the physics (table motion filters, the IMU table model) and the synthetic
-#: lab sessions that still live in tracking.
-TRACKING_TO_MODELS = {"_motion", "_imu_table", "_synth_column", "_synth_motion", "_synth_scene"}
+#: Measurement modules that call the physics (the table-motion filters, the IMU table model).
+TRACKING_TO_MODELS = {"_motion", "_imu_table"}
 
 
 def _module_name(path: Path) -> str:
@@ -132,3 +131,21 @@ def test_only_pipelines_draw_or_log_to_rerun():
     bad = [mod for mod, deps in _imports().items()
            if deps & {"matplotlib", "rerun"} and _subpackage(mod) != "pipelines"]
     assert not bad
+
+
+def test_moved_names_keep_a_deprecated_alias_for_one_release():
+    import rocklab.synth
+    import rocklab.tracking
+
+    with pytest.warns(DeprecationWarning, match="rocklab.tracking.synth_session moved to rocklab.synth"):
+        f = rocklab.tracking.synth_session
+    assert f is rocklab.synth.synth_session
+    with pytest.raises(AttributeError):
+        rocklab.tracking.no_such_name  # noqa: B018
+
+
+def test_packages_hold_at_most_12_modules_where_split():
+    # the split packages (issue 16 moves the rest): synth, tracking.rigid, tracking.stereo
+    for pkg in ("synth", "tracking/rigid", "tracking/stereo"):
+        mods = [p for p in (PKG / pkg).glob("*.py") if p.name != "__init__.py"]
+        assert len(mods) <= 12, (pkg, len(mods))

@@ -25,7 +25,8 @@ import pytest
 
 from rocklab import Block
 from rocklab.models import BaseMotion, simulate
-from rocklab.tracking import block_rotation, simulate_imu_log
+from rocklab.tracking import block_rotation
+from rocklab.synth import simulate_imu_log
 
 FS = 256.0
 

@@ -9,8 +9,8 @@ import pandas as pd
 import pytest
 
 from rocklab import G, InputError
-from rocklab.tracking import (ImuLog, ahrs_quaternions, read_imu, simulate_imu_log,
-                              write_ximu3_csv, write_ximu_csv, ximu_rate_from_registers)
+from rocklab.tracking import ImuLog, ahrs_quaternions, read_imu, ximu_rate_from_registers
+from rocklab.synth import simulate_imu_log, write_ximu3_csv, write_ximu_csv
 
 XIMU = "imu/x-imu-matlab-library-example"
 

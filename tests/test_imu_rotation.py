@@ -13,8 +13,8 @@ import pytest
 
 from rocklab import G, Block
 from rocklab.models import simulate
-from rocklab.tracking import (block_rotation, read_imu, simulate_imu_log, table_acceleration,
-                              write_ximu_csv)
+from rocklab.tracking import block_rotation, read_imu, table_acceleration
+from rocklab.synth import simulate_imu_log, write_ximu_csv
 
 FS = 256.0
 BIAS_DEG_S = np.array([0.5, -0.5, 0.5])

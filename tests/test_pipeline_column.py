@@ -13,7 +13,7 @@ from rocklab.pipelines._rerun import read_rrd_summary
 @pytest.fixture(scope="module")
 def column_run(tmp_path_factory):
     from rocklab.pipelines._experiment import run_experiment
-    from rocklab.tracking import synth_session
+    from rocklab.synth import synth_session
 
     d = tmp_path_factory.mktemp("column")
     synth_session(d / "s", seed=4, blocks=3, table="sine", size=(960, 540), duration_s=3.0, imu=False, mp4=False)

@@ -11,7 +11,7 @@ import pytest
 
 @pytest.fixture(scope="module")
 def sine_session(tmp_path_factory):
-    from rocklab.tracking import synth_session
+    from rocklab.synth import synth_session
 
     d = tmp_path_factory.mktemp("forced") / "session"
     synth_session(d, seed=2, table="sine", size=(960, 540), duration_s=3.0, imu=False, mp4=False)

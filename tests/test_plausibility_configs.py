@@ -46,7 +46,7 @@ def test_impossible_geometry_is_an_error(tmp_path, section, key, value, words):
 
 
 def test_video_cut_in_half_warns(tmp_path):
-    from rocklab.tracking import synth_session
+    from rocklab.synth import synth_session
 
     out = tmp_path / "s"
     synth_session(out, seed=1, size=(480, 270), duration_s=2.0, imu=False, mp4=False)
@@ -63,7 +63,7 @@ def test_video_cut_in_half_warns(tmp_path):
 
 def test_no_level_reference_warns(tmp_path):
     """level = 'table' (the default) without a table used to fall back to 0 silently."""
-    from rocklab.tracking import synth_session
+    from rocklab.synth import synth_session
 
     out = tmp_path / "s"
     synth_session(out, seed=2, size=(480, 270), duration_s=0.6, imu=False, mp4=False)

@@ -7,7 +7,8 @@ import pytest
 from rocklab import Block, InputError
 from rocklab._diagnostics import collecting
 from rocklab.models import simulate
-from rocklab.tracking import block_rotation, read_imu, simulate_imu_log, write_ximu3_csv
+from rocklab.tracking import block_rotation, read_imu
+from rocklab.synth import simulate_imu_log, write_ximu3_csv
 
 FS = 256.0
 

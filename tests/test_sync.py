@@ -7,8 +7,8 @@ import pytest
 
 from rocklab import Block, InputError
 from rocklab.models import simulate
-from rocklab.tracking import (block_rotation, simulate_imu_log, sync_events, sync_imu_to_track,
-                              sync_offset, track_rate)
+from rocklab.tracking import block_rotation, sync_events, sync_imu_to_track, sync_offset, track_rate
+from rocklab.synth import simulate_imu_log
 
 
 @pytest.fixture(scope="module")

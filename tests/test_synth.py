@@ -10,7 +10,7 @@ import pandas as pd
 import pytest
 
 from rocklab import Block, InputError
-from rocklab.tracking import load_synth_session, synth_session
+from rocklab.synth import load_synth_session, synth_session
 
 SMALL = (320, 180)
 
@@ -265,7 +265,7 @@ def test_full_hd_markers_give_theta_to_a_few_hundredths_of_a_degree():
     """Issue 4 needs 0.05 deg from a 0.2 m block at 1920x1080: plain cv2.aruco corners mapped
     to the plane with the session camera, rigid fit per frame, over held and rocking frames.
     (Frames rendered in memory: the same renderer as synth_session, without the encoders.)"""
-    from rocklab.tracking._synth_scene import build_scene
+    from rocklab.synth._scene import build_scene
 
     sc = build_scene(seed=0, blocks=1, table="none", fps=50.0, size=(1920, 1080), targets="aruco",
                      duration_s=1.2, occlusion=None, rolling_shutter=False, block=None,

@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 
 from rocklab import G, Block
-from rocklab.tracking import read_imu, synth_session
+from rocklab.tracking import read_imu
+from rocklab.synth import synth_session
 
 GYRO_NOISE = np.deg2rad(0.1)      # rad/s per sample, the synth's error model (session.json)
 ACC_NOISE = 0.005 * G             # m/s^2 per sample

@@ -11,7 +11,7 @@ import pytest
 
 @pytest.fixture(scope="module")
 def session(tmp_path_factory):
-    from rocklab.tracking import synth_session
+    from rocklab.synth import synth_session
 
     out = tmp_path_factory.mktemp("init") / "s"
     synth_session(out, seed=3, table="sine", size=(960, 540), duration_s=1.2, imu=False, mp4=False)

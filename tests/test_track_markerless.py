@@ -128,7 +128,8 @@ def test_mixed_styles_aruco_block_on_markerless_table(tmp_path):
     """A block with ArUco markers on a table followed markerless (issue: mixed styles per object)."""
     import pandas as pd
 
-    from rocklab.tracking import load_track_config, synth_session, track_video
+    from rocklab.tracking import load_track_config, track_video
+    from rocklab.synth import synth_session
 
     out = tmp_path / "s"
     synth_session(out, seed=3, table="sine", size=(960, 540), duration_s=1.8, imu=False, mp4=False)
@@ -161,7 +162,8 @@ def test_markerless_synth_session_granite_block(tmp_path, table, size):
     textured steel table, no markers anywhere; the config synth writes tracks it."""
     import pandas as pd
 
-    from rocklab.tracking import load_track_config, synth_session, track_video
+    from rocklab.tracking import load_track_config, track_video
+    from rocklab.synth import synth_session
 
     out = tmp_path / "s"
     synth_session(out, seed=1 if table == "none" else 3, table=table, size=size,
@@ -191,7 +193,8 @@ def test_table_region_on_the_block_is_flagged(tmp_path):
     import re
 
     from rocklab._diagnostics import collecting
-    from rocklab.tracking import load_track_config, synth_session, track_video
+    from rocklab.tracking import load_track_config, track_video
+    from rocklab.synth import synth_session
 
     out = tmp_path / "s"
     synth_session(out, seed=1, size=(960, 540), duration_s=1.5, imu=False, mp4=False, targets="markerless")

@@ -13,7 +13,7 @@ from rocklab.tracking import load_track_config, track_video
 
 @pytest.fixture(scope="module", params=["aruco", "dots", "edges"])
 def sine_session(tmp_path_factory, request):
-    from rocklab.tracking import synth_session
+    from rocklab.synth import synth_session
 
     out = tmp_path_factory.mktemp("synth") / request.param
     # 640x360 keeps the test short; the 45 mm / 0.6 s sine pulse of thesis Fig. 31 at 50 fps,

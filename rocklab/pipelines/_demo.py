@@ -1,6 +1,6 @@
 """``rocklab demo``: a small synthetic campaign, made deterministically, run end to end.
 
-The campaign (all rendered by :func:`rocklab.tracking.synth_session` with ArUco
+The campaign (all rendered by :func:`rocklab.synth.synth_session` with ArUco
 targets and x-IMU logs, 960×540 at 50 fps; at this size η_e of a 4.5 cm wide
 block comes back within 1e-4 of the truth):
 
@@ -93,7 +93,7 @@ def _edit_experiment(path: Path, name: str, block_id: str, contact: str, table: 
 
 def _render_one(d: Path, seed: int, name: str, bid: str, contact: str, table: str, size, fps) -> Path:
     from ..fitting import catalogue_block
-    from ..tracking import synth_session
+    from ..synth import synth_session
 
     cfg = d / "experiment.toml"
     if bid == "column":

@@ -211,7 +211,7 @@ def _render_aruco_films(out, cams, sess, X1, X2, fps, size, noise, rng, paths):
     """Films of ArUco markers on the block's face and the table's plate; returns the corners' truth."""
     import cv2
 
-    from ..tracking._synth_files import VideoPair
+    from ._files import VideoPair
     from ..tracking.rigid import kabsch
     from ._points3d import _targets
 
@@ -319,7 +319,7 @@ def synth_stereo(out_dir, *, size=(2400, 1728), fps: float = 150.0, f_px: float 
     import cv2
     import pandas as pd
 
-    from ..tracking._synth_files import VideoPair
+    from ._files import VideoPair
     from ._points3d import synth_points3d
 
     out = Path(out_dir)

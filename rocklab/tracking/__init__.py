@@ -4,7 +4,6 @@ from ._config import (BoardConfig, MotionConfig, ObjectConfig, ReferenceConfig, 
                       TrackConfig, VideoConfig, load_track_config)
 from ._imu_read import ImuLog, read_imu, read_ximu_registers, ximu_rate_from_registers
 from ._imu_rotation import ImuRotation, ahrs_quaternions, block_rotation
-from ._imu_sim import simulate_imu_log, write_ximu3_csv, write_ximu_csv
 from ._imu_table import TableAcceleration, table_acceleration
 from ._sync import SyncResult, sync_events, sync_imu_to_track, sync_offset, track_rate
 from ._geometry import PlaneMap, SimilarityFit, calibrate_camera, fit_similarity
@@ -12,7 +11,6 @@ from ._motion import TableMotion, choose_sg_window, estimate_noise, table_motion
 from ._track import (TRACK_COLUMNS, ObjectTrack, Observation, TrackResult, assemble_tracks,
                      track_frames, track_video)
 from ._video import VideoInfo, iter_video_frames, probe_video
-from ._synth import SynthSession, load_synth_session, synth_session
 
 __all__: list[str] = [
     # video tracking (helper "track")
@@ -26,7 +24,21 @@ __all__: list[str] = [
     "ImuLog", "read_imu", "read_ximu_registers", "ximu_rate_from_registers",
     "ImuRotation", "block_rotation", "ahrs_quaternions", "TableAcceleration", "table_acceleration",
     "SyncResult", "sync_offset", "sync_events", "sync_imu_to_track", "track_rate",
-    "simulate_imu_log", "write_ximu_csv", "write_ximu3_csv",
-    # synthetic lab sessions (helper "synth")
-    "synth_session", "SynthSession", "load_synth_session",
 ]
+
+#: Names that moved to :mod:`rocklab.synth` (simulated lab sessions are a simulator of the lab, not a
+#: measurement); reachable here for one release with a DeprecationWarning.
+_MOVED_TO_SYNTH = ("synth_session", "SynthSession", "load_synth_session", "simulate_imu_log", "write_ximu_csv",
+                   "write_ximu3_csv")
+
+
+def __getattr__(name):
+    if name in _MOVED_TO_SYNTH:
+        import warnings
+
+        import rocklab.synth as synth
+
+        warnings.warn(f"rocklab.tracking.{name} moved to rocklab.synth.{name}; import it from there",
+                      DeprecationWarning, stacklevel=2)
+        return getattr(synth, name)
+    raise AttributeError(f"module 'rocklab.tracking' has no attribute {name!r}")

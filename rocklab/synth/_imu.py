@@ -63,7 +63,7 @@ def write_object_imu(folder: Path, oid: str, *, block_motion=None, block=None, t
             "clock": "sample k (reader index) at video time t0_video_s + k / rate_hz",
             "axes": "x along the width (+x world when upright), z up, y away from the camera "
                     "(rocking axis); gyro_y = -d(theta_rad)/dt",
-            "writer": "rocklab.tracking._imu_sim.simulate_imu_log + write_ximu_csv"}
+            "writer": "rocklab.synth._imu_sim.simulate_imu_log + write_ximu_csv"}
 
 
 def _rigid_body_log(view, mount_m, t0, t_end_s, rate_hz, bias_deg_s, seed, bursts):
@@ -71,7 +71,7 @@ def _rigid_body_log(view, mount_m, t0, t_end_s, rate_hz, bias_deg_s, seed, burst
     (column blocks, which do not pivot on their own corners); same error model
     and axes as ``simulate_imu_log``: interval-mean rate and specific force."""
     from ..blocks import G
-    from ._imu_read import ImuLog
+    from ..tracking._imu_read import ImuLog
 
     rng = np.random.default_rng(seed)
     dt = 1.0 / rate_hz

@@ -83,7 +83,7 @@ class SynthSession:
 
     @property
     def camera(self):
-        from ._synth_camera import SynthCamera
+        from ._camera import SynthCamera
 
         return SynthCamera.from_dict(self.meta["camera"])
 
@@ -221,7 +221,7 @@ def synth_session(out_dir, seed: int = 0, blocks: int = 1, table: str = "none", 
     InputError
         Bad parameter values, non-empty ``out_dir`` without ``force``, an unreadable record.
     """
-    from ._synth_scene import build_scene
+    from ._scene import build_scene
 
     size = parse_size(size)
     fps = float(fps) if isinstance(fps, (int, float, np.number)) and not isinstance(fps, bool) else fps
@@ -254,7 +254,7 @@ def synth_session(out_dir, seed: int = 0, blocks: int = 1, table: str = "none", 
 
 
 def _render_video(scene, folder: Path, mp4: bool, progress: bool):
-    from ._synth_files import VideoPair
+    from ._files import VideoPair
 
     try:
         from tqdm import tqdm

@@ -32,7 +32,7 @@ def _blocks(block, n):
 
 
 def _layout(layout, n):
-    from ._synth_column import column_api
+    from ._column import column_api
 
     if n == 1:
         return "single"
@@ -55,7 +55,7 @@ def _simulate(blk, *, theta0_sim, base, horizon_s, restitution, eta):
 
 
 def _table_motion(kind, seed_rng, *, record, amplitude, period, stroke, blocks, start_s, horizon_s):
-    from ._synth_motion import record_table, sine_pulse_table, still_table
+    from ._motion import record_table, sine_pulse_table, still_table
 
     if kind == "none":
         return still_table()
@@ -181,7 +181,7 @@ class Scene:
     def write_files(self, folder: Path, *, imu: bool, imu_rate_hz: float, calibrated: bool) -> dict:
         """Write truth.csv, track.toml, experiment.toml, imu/ and return session.json's content."""
         from .._io import write_frame_atomic
-        from ._synth_files import write_experiment_toml, write_track_toml
+        from ._files import write_experiment_toml, write_track_toml
 
         write_frame_atomic(folder / "truth.csv", self.truth_frame())
         f1 = self.features[self.block_motions[0].id]
@@ -198,7 +198,7 @@ class Scene:
         return self._meta(imu_info)
 
     def _write_imu(self, folder: Path, rate_hz: float) -> dict:
-        from ._synth_imu import write_object_imu
+        from ._imu import write_object_imu
 
         out = {}
         seqs = self.imu_seed.spawn(len(self.block_motions) + 1)
@@ -268,7 +268,7 @@ def build_scene(*, seed, blocks, table, fps, size, targets, duration_s, occlusio
                 table_stroke_m, exposure_s, noise_dn, distortion, layout=None) -> Scene:
     from ._render import Occluder, RenderObject
     from ._render_targets import block_texture, table_texture
-    from ._synth_camera import make_camera
+    from ._camera import make_camera
 
     ss = np.random.SeedSequence(seed)
     s_cam, s_motion, s_tex, s_noise, s_imu, s_bg = ss.spawn(6)
@@ -380,7 +380,7 @@ def _block_info(blk) -> dict:
 
 def _single_motions(blks, xs, phi0, tbl, base, table, rest_s, sim_end_s, rng_m, restitution, eta):
     """Independent blocks side by side: one ``simulate`` run each, to ``sim_end_s`` (video time)."""
-    from ._synth_motion import BlockMotion
+    from ._motion import BlockMotion
 
     motions, sims, ends = [], [], [tbl.end_s]
     for k, blk in enumerate(blks):
@@ -416,7 +416,7 @@ def _column_motions(blks, tbl, base, table, rest_s, sim_end_s, rng_m, phi0=None)
     """A stacked column (``rocklab.models.simulate_column``): free rocking after a
     thread-burn release of the whole column tilted by half its slenderness angle,
     or standing on the moving table; simulated to ``sim_end_s`` (video time)."""
-    from ._synth_column import ColumnBlockView, ColumnMotion, column_api
+    from ._column import ColumnBlockView, ColumnMotion, column_api
 
     Column, simulate_column = column_api()
     col = Column(tuple(blks))

@@ -90,7 +90,7 @@ def write_track_toml(path: Path, *, style, fps, camera, objects, marker_size_m, 
     Validated by parsing it back with :func:`load_track_config`.
     """
     from .._io import write_text_atomic
-    from ._config import TrackConfig, load_track_config
+    from ..tracking._config import TrackConfig, load_track_config
 
     d = {"video": {"fps": float(fps)},
          "targets": {"style": style},

@@ -22,7 +22,7 @@ from typing import Callable
 import numpy as np
 
 from ._render_targets import Texture
-from ._synth_camera import SynthCamera
+from ._camera import SynthCamera
 
 __all__ = ["RenderObject", "Renderer"]
 

@@ -19,7 +19,7 @@ import cv2
 import numpy as np
 
 from rocklab.synth import synth_stereo
-from rocklab.tracking._video import iter_video_frames
+from rocklab.tracking.video._video import iter_video_frames
 from rocklab.tracking.rigid import kabsch
 from rocklab.tracking.stereo import calibrate_stereo, track_dots_stereo
 

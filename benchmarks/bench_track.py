@@ -20,7 +20,7 @@ import cv2
 import numpy as np
 
 from rocklab.tracking import TrackConfig, track_frames, track_video
-from rocklab.tracking._aruco import make_cv_detector
+from rocklab.tracking.video.targets._aruco import make_cv_detector
 
 N_FRAMES = 60
 

@@ -11,9 +11,9 @@ PKG = Path(__file__).resolve().parents[1] / "rocklab"
 
 # Known and documented exceptions, each to disappear with the restructure of issue 16:
 #: TrackConfig.from_dict imports its parser lazily, and the parser builds TrackConfig.
-KNOWN_CYCLES = [{"rocklab.tracking._config", "rocklab.tracking._config_parse"}]
+KNOWN_CYCLES = [{"rocklab.tracking.video._config", "rocklab.tracking.video._config_parse"}]
 #: Measurement modules that call the physics (the table-motion filters, the IMU table model).
-TRACKING_TO_MODELS = {"_motion", "_imu_table"}
+TRACKING_TO_MODELS = {"rocklab.tracking.video._motion", "rocklab.tracking.imu._table"}
 
 
 def _module_name(path: Path) -> str:
@@ -101,7 +101,11 @@ def test_no_import_circles_but_the_known_one():
 
 def _subpackage(mod):
     parts = mod.split(".")
-    return parts[1] if len(parts) > 2 else ""
+    return parts[1] if len(parts) >= 2 else ""
+
+
+#: The one-release aliases of names that moved from tracking to synth (rocklab.tracking.__getattr__).
+ALIASES = {("rocklab.tracking", "rocklab.synth")}
 
 
 @pytest.mark.parametrize("layer, forbidden", [
@@ -116,13 +120,13 @@ def test_dependencies_flow_one_way(layer, forbidden):
         if _subpackage(mod) != layer:
             continue
         for d in deps:
-            if d.startswith("rocklab.") and _subpackage(d) in forbidden:
+            if d.startswith("rocklab.") and _subpackage(d) in forbidden and (mod, d) not in ALIASES:
                 bad.append(f"{mod} -> {d}")
     assert not bad
 
 
 def test_tracking_uses_the_physics_only_where_known():
-    users = {mod.rsplit(".", 1)[-1] for mod, deps in _imports().items()
+    users = {mod for mod, deps in _imports().items()
              if _subpackage(mod) == "tracking" and any(_subpackage(d) == "models" for d in deps)}
     assert users <= TRACKING_TO_MODELS, users - TRACKING_TO_MODELS
 
@@ -145,7 +149,8 @@ def test_moved_names_keep_a_deprecated_alias_for_one_release():
 
 
 def test_packages_hold_at_most_12_modules_where_split():
-    # the split packages (issue 16 moves the rest): synth, tracking.rigid, tracking.stereo
-    for pkg in ("synth", "tracking/rigid", "tracking/stereo"):
+    # the split packages (models and pipelines are still to be split, issue 16)
+    for pkg in ("synth", "tracking", "tracking/video", "tracking/video/targets", "tracking/imu", "tracking/rigid",
+                "tracking/stereo"):
         mods = [p for p in (PKG / pkg).glob("*.py") if p.name != "__init__.py"]
         assert len(mods) <= 12, (pkg, len(mods))

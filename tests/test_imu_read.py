@@ -254,7 +254,7 @@ def test_cli_bad_input_exit_2(run_cli, tmp_path):
 
 
 def test_fast_numeric_scanner_matches_pandas(shared_data):
-    from rocklab.tracking._imu_fastcsv import parse_numeric_csv
+    from rocklab.tracking.imu._fastcsv import parse_numeric_csv
 
     p = shared_data / XIMU / "00000_CalInertialAndMag.csv"
     names, vals = parse_numeric_csv(p)

@@ -16,7 +16,7 @@ _COLOURS = [(0, 200, 255), (255, 120, 0), (0, 220, 0), (220, 0, 220), (0, 0, 255
 
 
 def _first_frame(video: Path):
-    from ..tracking._video import iter_video_frames, probe_video
+    from ..tracking.video._video import iter_video_frames, probe_video
 
     if not video.exists():
         raise InputError(f"{video}: video not found; check the path")
@@ -41,7 +41,7 @@ def track_init(video, out, *, objects=(), table=None, marker_size_m=None, previe
         PNG with every detection, region and the level line drawn on the first frame.
     """
     from .._io import write_text_atomic
-    from ..tracking._init import parse_region, suggest_config
+    from ..tracking.video._init import parse_region, suggest_config
 
     video, out = Path(video), Path(out)
     info, gray, img = _first_frame(video)
@@ -107,7 +107,7 @@ def track_preview(video, config, out, *, n_frames: int = 6, progress: bool = Fal
     video = Path(video)
     if not 1 <= int(n_frames) <= 48:
         raise InputError(f"--frames {n_frames}: give 1 to 48 frames for the sheet")
-    from ..tracking._video import iter_video_frames
+    from ..tracking.video._video import iter_video_frames
 
     cfg = load_track_config(config)
     res = track_video(video, cfg, progress=progress)

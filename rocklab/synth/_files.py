@@ -90,7 +90,7 @@ def write_track_toml(path: Path, *, style, fps, camera, objects, marker_size_m, 
     Validated by parsing it back with :func:`load_track_config`.
     """
     from .._io import write_text_atomic
-    from ..tracking._config import TrackConfig, load_track_config
+    from ..tracking.video._config import TrackConfig, load_track_config
 
     d = {"video": {"fps": float(fps)},
          "targets": {"style": style},
@@ -115,7 +115,7 @@ def write_track_toml(path: Path, *, style, fps, camera, objects, marker_size_m, 
                 e[k] = v.tolist() if isinstance(v, np.ndarray) else v
         d["objects"].append(e)
     cfg = TrackConfig.from_dict(d)
-    text = ("# Tracking config written by 'rocklab synth' (schema: rocklab/tracking/_config.py).\n"
+    text = ("# Tracking config written by 'rocklab synth' (schema: rocklab/tracking/video/_config.py).\n"
             "# Object origins: block = centre of its front face, table = top centre of its front face.\n"
             + cfg.to_toml())
     write_text_atomic(path, text)

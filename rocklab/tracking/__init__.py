@@ -1,26 +1,32 @@
-"""rocklab.tracking (see the package docs)."""
+"""Measurement: from films, IMU logs and 3D point exports to rotations and table motion.
 
-from ._config import (BoardConfig, MotionConfig, ObjectConfig, ReferenceConfig, TargetsConfig,
-                      TrackConfig, VideoConfig, load_track_config)
-from ._imu_read import ImuLog, read_imu, read_ximu_registers, ximu_rate_from_registers
-from ._imu_rotation import ImuRotation, ahrs_quaternions, block_rotation
-from ._imu_table import TableAcceleration, table_acceleration
+Sub-packages:
+
+- :mod:`rocklab.tracking.video`: one camera, any target style, ``track.toml``;
+- :mod:`rocklab.tracking.imu`: x-IMU / x-IMU3 / Fusion logs, block rotation, table acceleration;
+- :mod:`rocklab.tracking.rigid`: 3D point imports (CSV, C3D), rigid poses, the rocking
+  decomposition and the assumption audit;
+- :mod:`rocklab.tracking.stereo`: two cameras (calibration, sync, 3D dots and markers).
+
+The clock synchronisation of an IMU to a video track is here (:func:`sync_offset`,
+:func:`sync_imu_to_track`). The most used names of the sub-packages are re-exported.
+"""
+
 from ._sync import SyncResult, sync_events, sync_imu_to_track, sync_offset, track_rate
-from ._geometry import PlaneMap, SimilarityFit, calibrate_camera, fit_similarity
-from ._motion import TableMotion, choose_sg_window, estimate_noise, table_motion
-from ._track import (TRACK_COLUMNS, ObjectTrack, Observation, TrackResult, assemble_tracks,
-                     track_frames, track_video)
-from ._video import VideoInfo, iter_video_frames, probe_video
+from .imu import (ImuLog, ImuRotation, TableAcceleration, ahrs_quaternions, block_rotation, read_imu,
+                  read_ximu_registers, table_acceleration, ximu_rate_from_registers)
+from .video import (TRACK_COLUMNS, BoardConfig, MotionConfig, ObjectConfig, ObjectTrack, Observation, PlaneMap,
+                    ReferenceConfig, SimilarityFit, TableMotion, TargetsConfig, TrackConfig, TrackResult, VideoConfig,
+                    VideoInfo, assemble_tracks, calibrate_camera, choose_sg_window, estimate_noise, fit_similarity,
+                    iter_video_frames, load_track_config, probe_video, table_motion, track_frames, track_video)
 
 __all__: list[str] = [
-    # video tracking (helper "track")
     "TrackConfig", "VideoConfig", "TargetsConfig", "ReferenceConfig", "BoardConfig",
     "MotionConfig", "ObjectConfig", "load_track_config",
     "track_video", "track_frames", "assemble_tracks", "TrackResult", "ObjectTrack", "Observation",
     "TRACK_COLUMNS", "TableMotion", "table_motion", "choose_sg_window", "estimate_noise",
     "VideoInfo", "probe_video", "iter_video_frames", "PlaneMap", "SimilarityFit",
     "fit_similarity", "calibrate_camera",
-    # IMU and clock sync (helper "imu")
     "ImuLog", "read_imu", "read_ximu_registers", "ximu_rate_from_registers",
     "ImuRotation", "block_rotation", "ahrs_quaternions", "TableAcceleration", "table_acceleration",
     "SyncResult", "sync_offset", "sync_events", "sync_imu_to_track", "track_rate",

@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .._errors import InputError
-from ._imu_motion import cumtrapz
+from .imu._motion import cumtrapz
 
 __all__ = ["SyncResult", "sync_offset", "sync_events", "track_rate", "sync_imu_to_track"]
 

@@ -111,7 +111,7 @@ def _detect(path, board):
     """Per frame ``{corner id: (u, v)}`` of the ChArUco corners in the film at ``path``."""
     import cv2
 
-    from .._video import iter_video_frames, probe_video
+    from ..video._video import iter_video_frames, probe_video
 
     info = probe_video(path)
     det = cv2.aruco.CharucoDetector(board)

@@ -393,7 +393,7 @@ def triangulate_tracks(rig: StereoRig, tracks1: DotTracks2D, tracks2: DotTracks2
 
 def check_films(film1, film2, rig: StereoRig, fps: float | None = None) -> float:
     """The common frame rate of two films, or :class:`InputError` when they cannot be one test of ``rig``."""
-    from .._video import probe_video
+    from ..video._video import probe_video
 
     i1, i2 = probe_video(film1), probe_video(film2)
     for info, film in ((i1, film1), (i2, film2)):
@@ -433,7 +433,7 @@ def track_dots_stereo(film1, film2, rig: StereoRig, fps: float | None = None, sy
     -------
     StereoPoints
     """
-    from .._video import iter_video_frames, probe_video
+    from ..video._video import iter_video_frames, probe_video
 
     i1, i2 = probe_video(film1), probe_video(film2)
     rate1 = check_films(film1, film2, rig, fps)

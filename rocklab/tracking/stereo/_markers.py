@@ -56,7 +56,7 @@ def _sort_key(label: str):
 def track_markers_stereo(film1, film2, rig: StereoRig, dictionary: str = "DICT_4X4_50", fps: float | None = None,
                          sync: bool = True) -> StereoPoints:
     """ArUco corners of two films to 3D points in camera 1's axes (labels in ``StereoPoints.labels``)."""
-    from .._video import iter_video_frames
+    from ..video._video import iter_video_frames
 
     rate = check_films(film1, film2, rig, fps)
     from concurrent.futures import ThreadPoolExecutor

@@ -16,9 +16,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .._errors import InputError, where
-from ._imu_csv import _check_increasing, _inertial_columns, _numeric, _read_csv, _saturation, _stack
-from ._imu_log import ImuLog
+from ..._errors import InputError, where
+from ._csv import _check_increasing, _inertial_columns, _numeric, _read_csv, _saturation, _stack
+from ._log import ImuLog
 
 __all__ = ["read_ximu_registers", "ximu_rate_from_registers"]
 

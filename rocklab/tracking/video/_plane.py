@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._errors import InputError
+from ..._errors import InputError
 from ._config import TrackConfig
 from ._geometry import PlaneMap, board_homography, load_calibration, plane_homography_from_points
 
@@ -64,7 +64,7 @@ def _table_plane(config, pm, gray):
     elif gray is None:
         why = "needs the first frame"
     if why is None:
-        from ._aruco import _UNIT_CORNERS, make_cv_detector, refine_marker_corners
+        from .targets._aruco import _UNIT_CORNERS, make_cv_detector, refine_marker_corners
 
         det, _ = make_cv_detector(config.targets)
         corners, ids, _ = det.detectMarkers(gray)

@@ -9,10 +9,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._errors import InputError
+from ...._errors import InputError
 from ._detection import Detection
 from ._edges import refine_rectangle
-from ._geometry import fit_similarity
+from .._geometry import fit_similarity
 
 __all__ = ["ArucoDetector", "Detection"]
 

@@ -15,10 +15,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._errors import InputError
-from ..blocks import G
-from ._imu_motion import axis_vector, first_motion, motion_mask, rotation_between
-from ._imu_read import ImuLog
+from ..._errors import InputError
+from ...blocks import G
+from ._motion import axis_vector, first_motion, motion_mask, rotation_between
+from ._read import ImuLog
 
 __all__ = ["TableAcceleration", "table_acceleration"]
 
@@ -72,7 +72,7 @@ class TableAcceleration:
 
         Dropped samples are filled by linear interpolation.
         """
-        from ..models import BaseMotion
+        from ...models import BaseMotion
 
         n = int(np.floor((self.t_s[-1] - self.t_s[0]) * self.rate_hz)) + 1
         t = self.t_s[0] + np.arange(n) / self.rate_hz

@@ -11,8 +11,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .._errors import InputError, where
-from ..blocks import G
+from ..._errors import InputError, where
+from ...blocks import G
 
 __all__ = []
 
@@ -40,7 +40,7 @@ def _read_csv(path: Path):
     """
     import pandas as pd
 
-    from ._imu_fastcsv import parse_numeric_csv
+    from ._fastcsv import parse_numeric_csv
 
     nrows = _complete_rows(path)
     fast = parse_numeric_csv(path) if path.is_file() and nrows is None else None
@@ -77,7 +77,7 @@ def _complete_rows(path: Path) -> int | None:
         return None
     if n_lines < 2:
         return None
-    from .._diagnostics import warn
+    from ..._diagnostics import warn
 
     warn("W-IMU-TRUNCATED", f"{path}, line {n_lines + 1}: incomplete last line (no newline) dropped")
     return n_lines - 1

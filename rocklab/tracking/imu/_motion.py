@@ -7,8 +7,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._errors import InputError
-from ..blocks import G
+from ..._errors import InputError
+from ...blocks import G
 
 __all__ = []
 

@@ -41,13 +41,13 @@ from pathlib import Path
 
 import numpy as np
 
-from .._errors import InputError, where
-from ..blocks import G
-from ._imu_csv import (_ACC_UNITS, _GYRO_UNITS, _ROLES, _TIME_UNITS, XIMU3_FULL_SCALE_G,
+from ..._errors import InputError, where
+from ...blocks import G
+from ._csv import (_ACC_UNITS, _GYRO_UNITS, _ROLES, _TIME_UNITS, XIMU3_FULL_SCALE_G,
                        _check_increasing, _gap_drops, _inertial_columns, _numeric, _read_csv,
                        _saturation, _stack)
-from ._imu_log import ImuLog
-from ._imu_ximu import _read_ximu_gui, read_ximu_registers, ximu_rate_from_registers
+from ._log import ImuLog
+from ._ximu import _read_ximu_gui, read_ximu_registers, ximu_rate_from_registers
 
 __all__ = ["ImuLog", "read_imu", "read_ximu_registers", "ximu_rate_from_registers"]
 
@@ -211,7 +211,7 @@ def check_imu_log(log: ImuLog, rate_option_hz: float | None = None) -> ImuLog:
     Returns the log, with the timestamps' rate when ``rate_option_hz`` disagrees with them
     (``W-IMU-RATE``). Gaps longer than 10 samples and 0.05 s give ``W-IMU-CLOCK``.
     """
-    from .._diagnostics import warn
+    from ..._diagnostics import warn
 
     lo, hi = RATE_RANGE_HZ
     if log.n > 1:
@@ -225,7 +225,7 @@ def check_imu_log(log: ImuLog, rate_option_hz: float | None = None) -> ImuLog:
         if timed and rate_option_hz is not None and abs(rate_option_hz / ts_rate - 1) > 0.02:
             warn("W-IMU-RATE", f"{log.source}: --rate {rate_option_hz:g} Hz but the timestamps say "
                                f"{ts_rate:.4g} Hz; the timestamps are used")
-            from ._imu_csv import _gap_drops
+            from ._csv import _gap_drops
 
             log = dataclasses.replace(log, rate_hz=ts_rate, dropped_samples=_gap_drops(log.t_s, period))
         gap = d > max(10 * period, 0.05)

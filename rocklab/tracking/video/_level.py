@@ -12,8 +12,8 @@ import math
 
 import numpy as np
 
-from .._diagnostics import warn
-from .._errors import InputError
+from ..._diagnostics import warn
+from ..._errors import InputError
 
 __all__ = ["level_from_reference"]
 

@@ -3,7 +3,7 @@ camera calibration from a board video.
 
 Plane coordinates are ``y`` up. Without a homography they are pixels about the
 image centre (``X = u - cx``, ``Y = cy - v``) and become metres only at the
-output boundary (:mod:`rocklab.tracking._track`), with the scale measured from
+output boundary (:mod:`rocklab.tracking.video._track`), with the scale measured from
 the targets.
 """
 
@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._errors import InputError
+from ..._errors import InputError
 
 __all__ = ["PlaneMap", "SimilarityFit", "fit_similarity", "calibrate_camera",
            "board_homography", "load_calibration", "plane_homography_from_points"]
@@ -285,7 +285,7 @@ def calibrate_camera(frames, board, every: int = 10, out=None):
     rms, K, dist, _, _ = cv2.calibrateCamera(obj_pts, img_pts, size, None, None)
     dist = dist.ravel()
     if out is not None:
-        from .._io import atomic_path
+        from ..._io import atomic_path
 
         with atomic_path(out, suffix=".npz") as tmp:
             with open(tmp, "wb") as fh:

@@ -16,11 +16,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._diagnostics import warn
-from .._errors import InputError
+from ..._diagnostics import warn
+from ..._errors import InputError
 from ._config import TrackConfig
 from ._geometry import PlaneMap, fit_similarity
-from ._detectors import make_detector
+from .targets._detectors import make_detector
 from ._plane import make_plane_map
 from ._motion import TableMotion, table_motion
 

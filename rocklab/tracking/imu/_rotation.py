@@ -50,13 +50,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._diagnostics import warn
-from .._errors import InputError
-from ..blocks import G
-from ._imu_motion import (axis_vector, cumtrapz, first_motion, forced_run, last_motion_end,
+from ..._diagnostics import warn
+from ..._errors import InputError
+from ...blocks import G
+from ._motion import (axis_vector, cumtrapz, first_motion, forced_run, last_motion_end,
                           motion_mask, moving_average, quat_mul, rownorm, still_acc_start,
                           tilt_about, twist_angle)
-from ._imu_read import ImuLog
+from ._read import ImuLog
 
 __all__ = ["ImuRotation", "block_rotation", "ahrs_rotation", "ahrs_quaternions"]
 

@@ -7,7 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._errors import InputError
+from ..._errors import InputError
 
 __all__ = ["TableMotion", "table_motion", "estimate_noise", "choose_sg_window"]
 
@@ -55,7 +55,7 @@ class TableMotion:
 
     def to_base_motion(self, name: str | None = None):
         """As a :class:`rocklab.models.BaseMotion` (gaps filled with 0 m/s²), to drive the simulator."""
-        from ..models import BaseMotion
+        from ...models import BaseMotion
 
         a = np.where(np.isfinite(self.ax_m_s2), self.ax_m_s2, 0.0)
         return BaseMotion.from_arrays(self.t_s - self.t_s[0], a, "m/s2",

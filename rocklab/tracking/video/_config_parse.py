@@ -12,7 +12,7 @@ from dataclasses import fields
 
 import numpy as np
 
-from .._errors import InputError, where
+from ..._errors import InputError, where
 from ._config import (CORNER_REFINEMENTS, LEVEL_MODES, OBJECT_KINDS, TARGET_STYLES, BoardConfig,
                       MotionConfig, ObjectConfig, ReferenceConfig, TargetsConfig, TrackConfig,
                       VideoConfig)
@@ -62,7 +62,7 @@ class ConfigParser:
     # -- typed getters
     def _take(self, d, section, cls, index=None, skip=()):
         if not isinstance(d, dict):
-            self.err(section, None, "must be a table; see rocklab/tracking/_config.py", index)
+            self.err(section, None, "must be a table; see docs/track-toml.md", index)
         names = {f.name for f in fields(cls)} - {"source"}
         for k in d:
             if k not in names and k not in skip:

@@ -56,7 +56,7 @@ import tomllib
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
-from .._errors import InputError
+from ..._errors import InputError
 
 __all__ = [
     "TrackConfig", "VideoConfig", "TargetsConfig", "ReferenceConfig", "BoardConfig",
@@ -108,7 +108,7 @@ class TargetsConfig:
         How every object is followed unless it names its own ``style``: printed
         markers, dot targets, the block's outline, optical flow in a region, or
         ``markerless`` (the region's own texture and edges registered against a
-        keyframe; see :mod:`rocklab.tracking._markerless`).
+        keyframe; see :mod:`rocklab.tracking.video.targets._markerless`).
     dictionary : str
         OpenCV predefined dictionary name (``DICT_4X4_50``, ``DICT_APRILTAG_36h11``...).
     marker_size_m : float or None

@@ -24,7 +24,7 @@ import math
 
 import numpy as np
 
-from .._errors import InputError
+from ...._errors import InputError
 from ._detection import Detection
 
 __all__ = ["MarkerlessTracker", "MarkerlessDetector", "MIN_CC", "REKEY_CC"]

@@ -66,7 +66,7 @@ def main() -> int:
     # the same sampled runs through the OAS's batch path, one numba thread (per core)
     import numba
 
-    from rocklab.models._oas import OAS_DEFAULTS, _CRIT, _runs
+    from rocklab.models.spectra._oas import OAS_DEFAULTS, _CRIT, _runs
 
     nt = numba.get_num_threads()
     numba.set_num_threads(1)

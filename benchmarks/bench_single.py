@@ -21,10 +21,10 @@ import numba
 import numpy as np
 from scipy.integrate import solve_ivp
 
-import rocklab.models._single as single_mod
+import rocklab.models.rocking._single as single_mod
 from rocklab import Block
 from rocklab.models import bundled_record, simulate, simulate_batch
-from rocklab.models._newmark import run_single
+from rocklab.models.rocking._newmark import run_single
 
 
 def plain_dop853(blk, theta0, eta, t_grid, n_impacts, rtol=1e-10):

@@ -36,9 +36,9 @@ def run_cli(capsys):
 def simulate_loop(monkeypatch):
     """``simulate`` with the kernel's lean loops on (``lean=True``) or off (every step in the
     general Newton loop, the reference for the lean loops): ``simulate_loop(lean, block, **kw)``."""
-    import rocklab.models._single as single_mod
+    import rocklab.models.rocking._single as single_mod
     from rocklab.models import simulate
-    from rocklab.models._newmark import run_single
+    from rocklab.models.rocking._newmark import run_single
 
     def run(lean, blk, *args, **kw):
         monkeypatch.setattr(single_mod, "run_single", lambda *a: run_single(*a, lean))

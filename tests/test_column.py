@@ -100,7 +100,7 @@ def test_app_c_inclined_upper_block(appc):
 
 def test_kernel_closed_forms_equal_app_c_products():
     """The simulator's closed-form M and Q equal B^T M B and B^T p for any geometry."""
-    from rocklab.models._column_kernels import geometry, pivots, system
+    from rocklab.models.column._kernels import geometry, pivots, system
 
     rng = np.random.default_rng(3)
     col = Column((Block(0.3, 1.0, mass_kg=2.0), Block(0.25, 0.7, mass_kg=1.0), Block(0.2, 0.5, mass_kg=0.7)),
@@ -232,9 +232,9 @@ def test_enumeration_fallback_stays_admissible():
 
 def test_opening_model_picks_admissible_and_consistent_configuration():
     """Two blocks pushed hard at rest (thesis Fig. 18-19): the chosen opening accelerates into Eq. (5)."""
-    from rocklab.models._column_events import opening_model
-    from rocklab.models._column_kernels import make_work
-    from rocklab.models._column_step import evaluate
+    from rocklab.models.column._events import opening_model
+    from rocklab.models.column._kernels import make_work
+    from rocklab.models.column._step import evaluate
 
     col = Column((Block(0.2, 0.6, mass_kg=3.0), Block(0.2, 0.4, mass_kg=1.0)))
     blk = col.block_array()
@@ -329,7 +329,7 @@ def test_fig40_single_block_overturns_over_a_wider_region():
 
 def test_state_checks_flag_tension_and_uplift_level():
     from rocklab.models import uplift_acc_m_s2
-    from rocklab.models._column_step import state_checks
+    from rocklab.models.column._step import state_checks
 
     col = Column((Block(0.1, 0.2, mass_kg=2.0), Block(0.1, 0.2, mass_kg=1.0)), cut_m=[0.0, 0.01])
     blk = col.block_array()

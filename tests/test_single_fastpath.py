@@ -1,4 +1,4 @@
-"""The free-rocking fast loop (rocklab.models._newmark_free) solves the same Newmark step as the general loop.
+"""The free-rocking fast loop (rocklab.models.rocking._newmark_free) solves the same Newmark step as the general loop.
 
 Free rocking runs between impacts in a lean loop (fixed-point update with a
 Taylor-shifted sin/cos); the general Newton loop (the kernel's ``lean=False``) is

@@ -1,31 +1,34 @@
-"""Physics: single-block rocking, restitution laws, integrators, columns, spectra."""
+"""Physics: single-block rocking, columns, spectra and records, equivalent mechanisms.
 
-from ._records import BUNDLED_RECORDS, UNITS_TO_M_S2, BaseMotion, bundled_record, load_base_motion
-from ._restitution import RESTITUTION_LAWS, Restitution, make_restitution
-from ._batch import free_rocking_overturns, simulate_batch
-from ._result import BatchResult, RockingResult, block_energy
-from ._single import simulate
-from ._pulses import (F_SINE, PULSE_KINDS, PulseParameters, lobe_impulses, pulse_fullness, pulse_motion,
-                      pulse_parameters, pulse_shape)
-from ._oas import (OASResult, OverturningCurve, critical_impulse, fit_inclined_line,
-                   normalised_critical_impulse, overturning_curve, overturning_spectrum, simplified_oas)
-from ._oas_band import BAND_ENSEMBLE, TIBand, t_I_band
-from ._design import DesignCheck, design_check, required_width, required_width_slender
-from ._equivalent import (FundamentalParameters, Mechanism, block_parameters, equivalence_errors,
-                          frame_parameters, free_rocking_period_eq24, linear_sine_pulse_response,
-                          overturning_time_eq25, sine_pulse_max_response, strut_parameters,
-                          wall_mechanism, wall_parameters)
-from ._mechanisms import arch_mechanism, asymmetric_frame, four_bar_mechanism
-from ._column_sim import STATE_NAMES, Column, ColumnResult, simulate_column, uplift_acc_m_s2
-from ._column_geometry import ImpactOutcome, app_c_reduction, column_impact, full_mass_matrix, mass_points
-from ._column_maps import ColumnMaps, column_overturning_maps, sine_pulse
-from ._column_compare import (ColumnComparison, SequenceComparison, compare_sequences, compare_to_measurement,
-                              joint_sequence)
+Sub-packages, one subject each (the paper equations they implement are in each docstring):
+
+- :mod:`rocklab.models.rocking`: one block, restitution laws, integrators;
+- :mod:`rocklab.models.column`: multi-block columns;
+- :mod:`rocklab.models.spectra`: records, pulses, OAS, t_I, design;
+- :mod:`rocklab.models.mechanisms`: equivalent rocking mechanisms.
+
+Every public name of the sub-packages is also here.
+"""
+
+from .column import (STATE_NAMES, Column, ColumnComparison, ColumnMaps, ColumnResult, ImpactOutcome,
+                     SequenceComparison, app_c_reduction, column_impact, column_overturning_maps, compare_sequences,
+                     compare_to_measurement, full_mass_matrix, joint_sequence, mass_points, simulate_column,
+                     sine_pulse, uplift_acc_m_s2)
+from .mechanisms import (FundamentalParameters, Mechanism, arch_mechanism, asymmetric_frame, block_parameters,
+                         equivalence_errors, four_bar_mechanism, frame_parameters, free_rocking_period_eq24,
+                         linear_sine_pulse_response, overturning_time_eq25, sine_pulse_max_response,
+                         strut_parameters, wall_mechanism, wall_parameters)
+from .rocking import (RESTITUTION_LAWS, BatchResult, Restitution, RockingResult, block_energy,
+                      free_rocking_overturns, make_restitution, simulate, simulate_batch)
+from .spectra import (BAND_ENSEMBLE, BUNDLED_RECORDS, F_SINE, PULSE_KINDS, UNITS_TO_M_S2, BaseMotion, DesignCheck,
+                      OASResult, OverturningCurve, PulseParameters, TIBand, bundled_record, critical_impulse,
+                      design_check, fit_inclined_line, load_base_motion, lobe_impulses, normalised_critical_impulse,
+                      overturning_curve, overturning_spectrum, pulse_fullness, pulse_motion, pulse_parameters,
+                      pulse_shape, required_width, required_width_slender, simplified_oas, t_I_band)
 
 __all__ = ["BaseMotion", "load_base_motion", "UNITS_TO_M_S2", "bundled_record", "BUNDLED_RECORDS",
            "simulate", "RockingResult", "block_energy", "simulate_batch", "free_rocking_overturns", "BatchResult",
            "RESTITUTION_LAWS", "Restitution", "make_restitution",
-           # spectra (helper "spectra")
            "PulseParameters", "pulse_parameters", "lobe_impulses", "pulse_shape", "pulse_motion",
            "pulse_fullness", "PULSE_KINDS", "F_SINE",
            "OASResult", "overturning_spectrum", "OverturningCurve", "overturning_curve",
@@ -37,7 +40,6 @@ __all__ = ["BaseMotion", "load_base_motion", "UNITS_TO_M_S2", "bundled_record", 
            "asymmetric_frame", "free_rocking_period_eq24", "overturning_time_eq25",
            "sine_pulse_max_response", "linear_sine_pulse_response", "arch_mechanism",
            "equivalence_errors",
-           # columns (helper "column")
            "Column", "ColumnResult", "simulate_column", "uplift_acc_m_s2", "STATE_NAMES",
            "ImpactOutcome", "app_c_reduction", "column_impact", "full_mass_matrix", "mass_points",
            "ColumnMaps", "column_overturning_maps", "sine_pulse",

@@ -1,4 +1,4 @@
-"""Numba: the lean time loop of :func:`~rocklab.models._newmark.run_block` for free rocking.
+"""Numba: the lean time loop of :func:`~rocklab.models.rocking._newmark.run_block` for free rocking.
 
 Free rocking (no base record, full nonlinear equation) is the case the
 single-block benchmark times (issue 2 §4). Between impacts every step is the

@@ -24,9 +24,9 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from .._errors import InputError
-from .._errors import positive as _pos
-from ..blocks import G
+from ..._errors import InputError
+from ..._errors import positive as _pos
+from ...blocks import G
 
 __all__ = ["FundamentalParameters", "Mechanism", "block_parameters", "strut_parameters",
            "frame_parameters", "wall_parameters", "wall_mechanism", "free_rocking_period_eq24",

@@ -13,8 +13,8 @@ import math
 
 import numpy as np
 
-from .._errors import InputError
-from ..blocks import G
+from ..._errors import InputError
+from ...blocks import G
 from ._equivalent import Mechanism, _pos
 
 __all__ = ["four_bar_mechanism", "asymmetric_frame", "arch_mechanism"]

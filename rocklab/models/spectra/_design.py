@@ -18,9 +18,9 @@ from __future__ import annotations
 import math
 from dataclasses import asdict, dataclass
 
-from .._errors import InputError
-from .._errors import positive as _pos
-from ..blocks import G, Block
+from ..._errors import InputError
+from ..._errors import positive as _pos
+from ...blocks import G, Block
 
 __all__ = ["DesignCheck", "design_check", "required_width", "required_width_slender"]
 

@@ -25,7 +25,7 @@ def block_energy(block, theta_rad, omega_rad_s, linearized: bool = False) -> np.
     a, I_O = block.alpha_rad, block.I_O_kg_m2
     if linearized:
         return I_O * (0.5 * w * w + block.p_rad_s ** 2 * (a * th - 0.5 * th * th))
-    from ..blocks import G
+    from ...blocks import G
 
     return 0.5 * I_O * w * w + block.mass_kg * G * block.R_m * (np.cos(a - th) - math.cos(a))
 

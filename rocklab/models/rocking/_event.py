@@ -14,7 +14,7 @@ import math
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from ..blocks import G
+from ...blocks import G
 
 __all__ = ["run_event"]
 

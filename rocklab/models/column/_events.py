@@ -15,8 +15,8 @@ from __future__ import annotations
 import numpy as np
 from numba.extending import register_jitable
 
-from ._column_kernels import base_acc, geometry, pivots, quad_acc, reactions, solve_small, system
-from ._column_step import P_DT, P_G, P_T0, P_VEL
+from ._kernels import base_acc, geometry, pivots, quad_acc, reactions, solve_small, system
+from ._step import P_DT, P_G, P_T0, P_VEL
 
 __all__: list[str] = []
 

@@ -20,10 +20,10 @@ import numpy as np
 from numba import njit
 from numba.extending import register_jitable
 
-from ._column_events import impact_model, opening_model
-from ._column_kernels import active_dofs, base_acc, geometry, kinetic_energy, make_work, pivots
-from ._column_step import evaluate, locate_closing, nm_step, state_checks
-from ._numba_cache import drop_stale_cache
+from ._events import impact_model, opening_model
+from ._kernels import active_dofs, base_acc, geometry, kinetic_energy, make_work, pivots
+from ._step import evaluate, locate_closing, nm_step, state_checks
+from .._numba_cache import drop_stale_cache
 
 __all__: list[str] = []
 

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._errors import InputError
+from ..._errors import InputError
 
 __all__ = ["joint_sequence", "compare_sequences", "SequenceComparison", "compare_to_measurement", "ColumnComparison"]
 

@@ -1,4 +1,4 @@
-"""Numba: the lean time loop of :func:`~rocklab.models._newmark.run_block` under a base record.
+"""Numba: the lean time loop of :func:`~rocklab.models.rocking._newmark.run_block` under a base record.
 
 The same idea as the free-rocking loop (:mod:`._newmark_free`) with the base
 acceleration ``u = ug/g`` in the equation,
@@ -75,7 +75,7 @@ def forced_steps(th, w, a, sc, cc, s, step, n_steps, h, p2, alpha, cos_a, max_ab
                  n_out, countdown, out_every, e_scale, acc, acc_t0, inv_dta, fac, lip):
     """Whole steps under the record from ``step`` on, as long as none needs the general loop.
 
-    State in and out as :func:`~rocklab.models._newmark_free.free_steps` (theta
+    State in and out as :func:`~rocklab.models.rocking._newmark_free.free_steps` (theta
     ``th`` rad on side ``s``, omega ``w`` rad/s, theta'' ``a`` rad/s^2, ``sc, cc``
     = sin, cos of ``alpha s - th``, step counter, running max |theta|, output
     buffers with fill count and countdown). The record: ``acc`` (n,) m/s^2 from

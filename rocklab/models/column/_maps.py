@@ -13,9 +13,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._errors import InputError
-from ._column_sim import Column, simulate_column
-from ._records import BaseMotion
+from ..._errors import InputError
+from ._sim import Column, simulate_column
+from ..spectra._records import BaseMotion
 
 __all__ = ["sine_pulse", "ColumnMaps", "column_overturning_maps"]
 

@@ -19,7 +19,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from .._errors import InputError
+from ..._errors import InputError
 from ._records import MIN_SAMPLES, BaseMotion
 
 __all__ = ["PulseParameters", "pulse_parameters", "lobe_impulses", "pulse_shape", "pulse_motion",
@@ -173,7 +173,7 @@ def pulse_parameters(base: BaseMotion, F: float = F_SINE) -> PulseParameters:
     ts[j], te[j] = t_lo, t_hi
     dur = t_hi - t_lo
     if i_max / (F * a_max) < 2.0 * base.dt_s:
-        from .._diagnostics import warn
+        from ..._diagnostics import warn
 
         warn("W-RECORD-PULSE", f"{base.name}: main pulse t_p = {i_max / (F * a_max):.4g} s is shorter than 2 "
                                f"samples (dt = {base.dt_s:.4g} s); t_I and spectra from it are unreliable")

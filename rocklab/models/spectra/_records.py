@@ -22,8 +22,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .._errors import InputError
-from ..blocks import G
+from ..._errors import InputError
+from ...blocks import G
 
 __all__ = ["BaseMotion", "load_base_motion", "check_plausible", "MIN_SAMPLES", "UNITS_TO_M_S2", "bundled_record", "BUNDLED_RECORDS"]
 
@@ -315,7 +315,7 @@ MIN_SAMPLES = 16
 def check_plausible(bm: BaseMotion) -> BaseMotion:
     """Warn (``W-RECORD-*``) when a record's amplitude, step or length is implausible for an
     earthquake or shake-table record. Returns ``bm``."""
-    from .._diagnostics import warn
+    from ..._diagnostics import warn
 
     src = f"{bm.source}: " if bm.source != "array" else f"{bm.name}: "
     pga_g = bm.pga_m_s2 / G

@@ -20,8 +20,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._errors import InputError
-from ..blocks import G as G_STD
+from ..._errors import InputError
+from ...blocks import G as G_STD
 
 __all__ = ["mass_points", "app_c_reduction", "full_mass_matrix", "column_impact", "ImpactOutcome"]
 
@@ -48,7 +48,7 @@ def mass_points(block):
 
 def _geometry(column, phi_ccw):
     """Block frames for joint rotations ``phi_ccw`` (CCW positive, pivots from their signs)."""
-    from ._column_kernels import geometry
+    from ._kernels import geometry
 
     n = column.n
     blk = column.block_array()
@@ -169,7 +169,7 @@ def column_impact(column, closing_joint: int, omega_rad_s, states, theta_rad=Non
     n_impacts : int
         Consecutive impacts (1 Housner, 2 one mid-joint bump).
     """
-    from ._column_events import impact_model
+    from ._events import impact_model
 
     n = column.n
     inv = {"closed": 0, "cw": -1, "ccw": 1}
@@ -208,7 +208,7 @@ def column_impact(column, closing_joint: int, omega_rad_s, states, theta_rad=Non
 
 
 def _ke(column, phi, v, s, px):
-    from ._column_kernels import kinetic_energy, pivots
+    from ._kernels import kinetic_energy, pivots
 
     blk, theta, thlow, C, G = _geometry(column, phi)
     dj = np.array([j for j in range(column.n) if s[j] != 0], np.int64)

@@ -12,9 +12,9 @@ import math
 
 import numpy as np
 
-from .._errors import InputError
+from ..._errors import InputError
 from ._newmark import run_batch
-from ._records import BaseMotion
+from ..spectra._records import BaseMotion
 from ._result import BatchResult
 
 __all__ = ["simulate_batch", "free_rocking_overturns"]

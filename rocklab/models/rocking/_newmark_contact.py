@@ -4,7 +4,7 @@
 (Čeh Eq. 8–9, a cubic when the base acceleration varies linearly over the
 step); :func:`cross_fraction` is where the cubic Hermite of a step reaches a
 given |theta| (overturning and fall times). Used by
-:func:`~rocklab.models._newmark.run_block`, which drops its on-disk numba cache
+:func:`~rocklab.models.rocking._newmark.run_block`, which drops its on-disk numba cache
 when this file is newer (numba only tracks the caller's file).
 """
 

@@ -56,9 +56,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._errors import InputError
-from ..blocks import G
-from ._batch import free_rocking_overturns, simulate_batch
+from ..._errors import InputError
+from ...blocks import G
+from ..rocking._batch import free_rocking_overturns, simulate_batch
 from ._records import BaseMotion
 
 __all__ = ["OASResult", "overturning_spectrum", "OverturningCurve", "overturning_curve",
@@ -235,7 +235,7 @@ def overturning_spectrum(base: BaseMotion, slenderness: float = 12.0, *, levels:
     sl = _check_opts(slenderness, levels, sizes, R_max_m, R_min_m, level_max, alpha_I)
     if not isinstance(base, BaseMotion):
         raise InputError(f"base={type(base).__name__}: expected a BaseMotion (load_base_motion)")
-    from .._errors import check_memory
+    from ..._errors import check_memory
     from ._pulses import _check_record
 
     base = _check_record(base)  # enough samples, not all zeros

@@ -27,7 +27,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._errors import InputError
+from ..._errors import InputError
 
 __all__ = ["Restitution", "RESTITUTION_LAWS", "make_restitution", "eta_housner", "eta_modified",
            "eta_axes", "eta_bumps"]

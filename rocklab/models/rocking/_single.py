@@ -30,10 +30,10 @@ import math
 
 import numpy as np
 
-from .._errors import InputError, check_memory
-from ..blocks import G
+from ..._errors import InputError, check_memory
+from ...blocks import G
 from ._newmark import STATUS_NAMES, run_single
-from ._records import BaseMotion
+from ..spectra._records import BaseMotion
 from ._restitution import make_restitution
 from ._result import RockingResult, block_energy
 
@@ -112,7 +112,7 @@ def check_step(p_rad_s: float, dt_s: float, option: str = "dt_s") -> None:
         raise InputError(f"{option}={dt_s:g} s: too coarse for this block (p = {p_rad_s:.4g} rad/s, p dt = "
                          f"{pdt:.4g} > {P_DT_MAX}); use dt <= {P_DT_WARN / p_rad_s:.4g} s")
     if pdt > P_DT_WARN:
-        from .._diagnostics import warn
+        from ..._diagnostics import warn
 
         warn("W-SIM-DT", f"{option}={dt_s:g} s gives p dt = {pdt:.4g} (> {P_DT_WARN}) for p = {p_rad_s:.4g} "
                          f"rad/s; use dt <= {P_DT_WARN / p_rad_s:.4g} s for converged impacts")

@@ -23,10 +23,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._errors import InputError
-from ..blocks import G as G_STD
-from ..blocks import Block
-from ._records import BaseMotion
+from ..._errors import InputError
+from ...blocks import G as G_STD
+from ...blocks import Block
+from ..spectra._records import BaseMotion
 
 __all__ = ["Column", "ColumnResult", "simulate_column", "uplift_acc_m_s2", "STATE_NAMES"]
 
@@ -205,7 +205,7 @@ class ColumnResult:
         (so at the ``output_dt_s`` resolution); the exact model events are in
         :attr:`configurations`.
         """
-        from ._column_compare import joint_sequence
+        from ._compare import joint_sequence
 
         return joint_sequence(self.t_s, self.theta_rad, threshold_rad, min_duration_s=min_duration_s)
 
@@ -352,7 +352,7 @@ def simulate_column(column: Column, base: BaseMotion | None = None, *, theta0_ra
     """
     import pandas as pd
 
-    from ._column_core import run_core, run_core_jit
+    from ._core import run_core, run_core_jit
 
     if not isinstance(column, Column):
         raise InputError("column: must be a rocklab.models.Column")
@@ -366,7 +366,7 @@ def simulate_column(column: Column, base: BaseMotion | None = None, *, theta0_ra
         duration_s = (float(base.t_s[-1]) + 5.0) if base is not None else 10.0
     if not (math.isfinite(duration_s) and duration_s > 0):
         raise InputError(f"duration_s={duration_s!r}: must be positive (s)")
-    from ._single import check_step
+    from ..rocking._single import check_step
 
     check_step(max(b.p_rad_s for b in column.blocks), dt_s, "dt_s")
     phi0, v0, s0 = _initial_state(column, theta0_rad, omega0_rad_s)
@@ -385,7 +385,7 @@ def simulate_column(column: Column, base: BaseMotion | None = None, *, theta0_ra
     n_steps = int(math.ceil(duration_s / dt_s - 1e-9))
     stride = _stride(output_dt_s, dt_s, n_steps)
     n_rows = n_steps // stride + 2
-    from .._errors import check_memory
+    from ..._errors import check_memory
 
     check_memory(8.0 * n_rows * (4 * column.n + 4), f"{duration_s:g} s of a {column.n}-block column at "
                  f"{dt_s:g} s ({n_rows} stored rows)", "shorten duration_s or give a coarser output_dt_s")

@@ -20,10 +20,10 @@ restitution law gives omega+ and the rest of the step continues with the other
 equation (several impacts per step are allowed).
 
 Free rocking (full equation, no base record or past its end) runs its steps
-between impacts in the lean loop :func:`~rocklab.models._newmark_free.free_steps`
+between impacts in the lean loop :func:`~rocklab.models.rocking._newmark_free.free_steps`
 (same trapezoidal step, solved by a jerk-corrected predictor and a checked
 fixed-point update), rocking under the record in its twin
-:func:`~rocklab.models._newmark_forced.forced_steps`, and steps at rest in which
+:func:`~rocklab.models.rocking._newmark_forced.forced_steps`, and steps at rest in which
 the base stays below the uplift level in a short scan; impacts, uplift,
 overturning and anything else the lean loops decline are handled by the
 general step here (``lean=False``: every step, the reference in the tests).
@@ -41,11 +41,11 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from ..blocks import G
+from ...blocks import G
 from ._newmark_contact import contact_tau, cross_fraction
 from ._newmark_forced import forced_steps
 from ._newmark_free import free_steps, sdcd
-from ._numba_cache import drop_stale_cache
+from .._numba_cache import drop_stale_cache
 
 
 # run_block compiles in the kernels of _newmark_free, _newmark_forced and _newmark_contact (see _numba_cache)

@@ -1,0 +1,15 @@
+"""Single-block rocking: the equations of motion, restitution laws and the integrators.
+
+Čeh et al. (2018) Eq. 1-4 (motion), Eq. 5-11 (Newmark trapezoidal steps with exact contact),
+Eq. 13-14 (Housner's and the modified restitution); thesis §3.1 and App. A (impacts at
+arbitrary axes, consecutive "bump" impacts). :func:`simulate` runs one block (numba Newmark
+kernel, or scipy's DOP853 with impact events as the reference); :func:`simulate_batch` many.
+"""
+
+from ._batch import free_rocking_overturns, simulate_batch
+from ._restitution import RESTITUTION_LAWS, Restitution, make_restitution
+from ._result import BatchResult, RockingResult, block_energy
+from ._single import simulate
+
+__all__ = ["simulate", "simulate_batch", "free_rocking_overturns", "RockingResult", "BatchResult", "block_energy",
+           "RESTITUTION_LAWS", "Restitution", "make_restitution"]

@@ -21,7 +21,7 @@ CHECKS = ("check_output_dir", "check_unknown", "check_plausible", "check_imu_log
 
 
 def main() -> None:
-    from rocklab.pipelines._experiment import run_experiment
+    from rocklab.pipelines.experiment._experiment import run_experiment
     from rocklab.synth import synth_session
 
     with tempfile.TemporaryDirectory() as tmp:

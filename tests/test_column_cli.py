@@ -68,7 +68,7 @@ def test_column_cli_maps_png(run_cli, tmp_path):
 def test_plot_column_response_png(tmp_path):
     from rocklab.blocks import Block
     from rocklab.models import Column, simulate_column
-    from rocklab.pipelines._plots_column import plot_column_response
+    from rocklab.pipelines.experiment._plots_column import plot_column_response
 
     r = simulate_column(Column((Block(0.1, 0.2),) * 2), theta0_rad=[0.0, 0.04], duration_s=0.3, dt_s=1e-3)
     png = tmp_path / "resp.png"

@@ -114,7 +114,7 @@ def test_file_outputs_checked_before_work(tmp_path, run_cli):
 
 
 def test_internal_error_is_one_line_exit_3(monkeypatch, run_cli):
-    import rocklab.pipelines._cmd_simulate as S
+    import rocklab.pipelines.cli.commands._cmd_simulate as S
 
     def boom(args):
         raise ZeroDivisionError("float division by zero")

@@ -8,7 +8,7 @@ import pytest
 
 from rocklab.fitting import catalogue_block, edge_contact_k, eta_modified
 from rocklab.models import simulate
-from rocklab.pipelines._rerun import read_rrd_summary
+from rocklab.pipelines.experiment._rerun import read_rrd_summary
 
 ETA_MAT = 0.985
 L_C = 0.0015
@@ -78,14 +78,14 @@ def test_campaign_recovers_eta_mat_and_reports_failure(tmp_path, run_cli):
 def test_campaign_on_a_dask_cluster_matches_local(tmp_path):
     """``--scheduler ADDR`` runs the same tasks on a Dask distributed cluster, same answers."""
     distributed = pytest.importorskip("distributed")
-    from rocklab.pipelines import _campaign as C
+    from rocklab.pipelines.campaign import _campaign as C
 
     root = tmp_path / "c"
     _exp(root, "B4M_full", "B4M", "full", 0.882, 3)
     _exp(root, "B6M_full", "B6M", "full", 0.941, 4)
     local = C.run_campaign(root, tmp_path / "local", workers=1, progress=False)
     with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
-                                  dashboard_address=None) as cluster:
+                                  dashboard_address=":0") as cluster:  # any free port: 8787 may be taken
         remote = C.run_campaign(root, tmp_path / "remote", scheduler=cluster.scheduler_address, progress=False)
     assert remote.n_ok == local.n_ok == 2
     assert remote.table["eta_e"].tolist() == pytest.approx(local.table["eta_e"].tolist(), abs=1e-12)

@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from rocklab.pipelines._rerun import (experiment_blueprint, log_events, log_series, open_recording,
+from rocklab.pipelines.experiment._rerun import (experiment_blueprint, log_events, log_series, open_recording,
                                       read_rrd_scalars, read_rrd_summary)
 
 

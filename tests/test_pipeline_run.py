@@ -8,7 +8,7 @@ import pytest
 
 from rocklab import Block
 from rocklab.models import simulate
-from rocklab.pipelines._rerun import read_rrd_scalars, read_rrd_summary
+from rocklab.pipelines.experiment._rerun import read_rrd_scalars, read_rrd_summary
 
 ETA_TRUE = 0.93
 FPS = 150.0
@@ -89,8 +89,8 @@ def test_failing_stage_leaves_previous_output_intact(tmp_path, run_cli, monkeypa
     out = tmp_path / "out"
     assert run_cli("run", cfg, "--out", out)[0] == 0
     before = (out / "report.json").read_text()
-    import rocklab.pipelines._experiment as E
-    import rocklab.pipelines._report as R
+    import rocklab.pipelines.experiment._experiment as E
+    import rocklab.pipelines.experiment._report as R
 
     def boom(*a, **k):
         raise RuntimeError("figure backend exploded")

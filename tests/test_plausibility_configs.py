@@ -4,7 +4,7 @@ import pytest
 
 from rocklab import InputError
 from rocklab._diagnostics import collecting
-from rocklab.pipelines._config import load_experiment
+from rocklab.pipelines.experiment._config import load_experiment
 from rocklab.tracking import load_track_config, track_video
 
 

@@ -69,13 +69,13 @@ def test_oas_bad_input(run_cli, shared_data, tmp_path):
 
 def test_oas_many_on_a_dask_cluster(shared_data):
     distributed = pytest.importorskip("distributed")
-    from rocklab.pipelines._spectra_batch import oas_many
+    from rocklab.pipelines.spectra._spectra_batch import oas_many
 
     recs = [shared_data / FF.format(r) for r in ("120111", "120112")]
     kw = dict(levels=8, sizes=20, refine=3)
     local = oas_many(recs, units="g", oas_kwargs=kw, workers=1, progress=False)
     with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
-                                  dashboard_address=None) as cluster:
+                                  dashboard_address=":0") as cluster:  # any free port: 8787 may be taken
         remote = oas_many(recs, units="g", oas_kwargs=kw, scheduler=cluster.scheduler_address, progress=False)
     assert list(remote["record"]) == [str(r) for r in recs]
     assert remote["t_I_s"].tolist() == pytest.approx(local["t_I_s"].tolist())

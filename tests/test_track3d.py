@@ -296,7 +296,7 @@ def test_cli_track3d_c3d_then_fit_restitution(tmp_path, run_cli):
                            *body, "--up=-y", "--rrd", tmp_path / "t" / "review.rrd")
     assert rc == 0, err
     # the Rerun review: every sample's targets, the pivot, the plots, one text row per impact and flag
-    from rocklab.pipelines._rerun import read_rrd_summary
+    from rocklab.pipelines.experiment._rerun import read_rrd_summary
 
     rows = read_rrd_summary(tmp_path / "t" / "review.rrd")
     n = len(pd.read_csv(tmp_path / "s" / "truth.csv"))

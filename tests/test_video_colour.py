@@ -41,7 +41,7 @@ def videos(tmp_path_factory):
 
 
 def _track(path, decimation=2):
-    from rocklab.pipelines._experiment import _frame_keeper
+    from rocklab.pipelines.experiment._experiment import _frame_keeper
     from rocklab.tracking import TrackConfig, track_video
 
     cfg = TrackConfig.from_dict({"targets": {"style": "aruco", "marker_size_m": 0.05},
@@ -57,7 +57,7 @@ def _decode(data):
 
 
 def test_colour_source_gives_colour_jpeg_through_rrd(videos, tmp_path):
-    from rocklab.pipelines._rerun import log_video_frames, open_recording
+    from rocklab.pipelines.experiment._rerun import log_video_frames, open_recording
     import rerun.chunk as rc
 
     tr, jpeg = _track(videos["colour"])
@@ -108,7 +108,7 @@ def test_grey_source_stays_one_channel(videos):
 
 
 def test_is_grey_detects_colour_hidden_from_the_sample():
-    from rocklab.pipelines._experiment import _is_grey
+    from rocklab.pipelines.experiment._experiment import _is_grey
 
     g = np.random.default_rng(1).integers(0, 256, (H, W), dtype=np.uint8)
     img = cv2.merge([g, g, g])

@@ -1,5 +1,8 @@
 """Experiment pipelines, Rerun logging, reports and the ``rocklab`` CLI.
 
+Sub-packages: :mod:`.experiment` (one experiment), :mod:`.campaign` (many, and the demo),
+:mod:`.spectra` (record studies), :mod:`.cli` (the command line).
+
 The only subpackage that imports rerun or matplotlib (always inside functions, so
 importing it stays light).
 
@@ -12,12 +15,10 @@ importing it stays light).
 - :func:`read_rrd_summary` / :func:`read_rrd_scalars` read a written ``.rrd`` back with Rerun's reader.
 """
 
-from ._campaign import CampaignResult, find_experiments, run_campaign
-from ._cli import main
-from ._config import EXAMPLE_TOML, ExperimentConfig, load_experiment
-from ._demo import make_demo_campaign, run_demo
-from ._experiment import ExperimentResult, analyse_experiment, run_experiment
-from ._rerun import read_rrd_scalars, read_rrd_summary
+from .campaign import CampaignResult, find_experiments, make_demo_campaign, run_campaign, run_demo
+from .cli import main
+from .experiment import (EXAMPLE_TOML, ExperimentConfig, ExperimentResult, analyse_experiment, load_experiment,
+                         read_rrd_scalars, read_rrd_summary, run_experiment)
 
 __all__ = ["main", "load_experiment", "ExperimentConfig", "EXAMPLE_TOML", "run_experiment",
            "analyse_experiment", "ExperimentResult", "run_campaign", "find_experiments", "CampaignResult",

@@ -28,7 +28,7 @@ import os
 import time
 from pathlib import Path
 
-from .._procs import pool_initializer
+from ..._procs import pool_initializer
 
 __all__ = ["DEMO_RUNS", "make_demo_campaign", "run_demo"]
 
@@ -51,7 +51,7 @@ DEMO_RUNS = (
 
 
 def _true_eta(block_id: str, contact: str) -> float:
-    from ..fitting import catalogue_block, ceh_catalogue, edge_contact_k, eta_modified
+    from ...fitting import catalogue_block, ceh_catalogue, edge_contact_k, eta_modified
 
     b = catalogue_block(block_id)
     if contact == "edge":
@@ -92,8 +92,8 @@ def _edit_experiment(path: Path, name: str, block_id: str, contact: str, table: 
 
 
 def _render_one(d: Path, seed: int, name: str, bid: str, contact: str, table: str, size, fps) -> Path:
-    from ..fitting import catalogue_block
-    from ..synth import synth_session
+    from ...fitting import catalogue_block
+    from ...synth import synth_session
 
     cfg = d / "experiment.toml"
     if bid == "column":
@@ -145,7 +145,7 @@ def run_demo(out_dir="demo_out", *, workers: int = 2, progress: bool = True, siz
     """Make the demo campaign under ``out_dir/sessions`` and run it into ``out_dir/results``."""
     from ._campaign import run_campaign
 
-    from .._outdir import check_output_dir, claim_dir
+    from ..._outdir import check_output_dir, claim_dir
 
     out_dir = check_output_dir(out_dir, need_bytes=300 * 1024 * 1024)
     claim_dir(out_dir, ("sessions", "results"), command="demo")

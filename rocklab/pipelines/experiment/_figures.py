@@ -6,7 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .._io import atomic_path
+from ..._io import atomic_path
 
 __all__ = ["experiment_figures", "campaign_figures", "pyplot", "save_png"]
 
@@ -152,7 +152,7 @@ def campaign_figures(table, out_dir, regression=None) -> dict[str, Path]:
     ``table`` is the campaign DataFrame (columns block, b_m, h_m, contact, eta_e,
     ci_lo, ci_hi, eta_H, eta_M, ...).
     """
-    from ..blocks import Block
+    from ...blocks import Block
 
     plt = pyplot()
     out = Path(out_dir)

@@ -18,7 +18,7 @@ import math
 import sys
 from pathlib import Path
 
-from .._errors import InputError, where
+from ...._errors import InputError, where
 
 
 def register(sub):
@@ -74,7 +74,7 @@ def _common(p):
 
 def _emit(args, payload: dict, text: str) -> None:
     if args.json:
-        from ._cli_base import emit_json
+        from .._cli_base import emit_json
 
         emit_json(payload)
     else:
@@ -129,8 +129,8 @@ def _read_track(path: Path, obj: str | None, nan: str):
 
 
 def _run_restitution(args) -> int:
-    from ..blocks import Block
-    from ..fitting import fit_restitution
+    from ....blocks import Block
+    from ....fitting import fit_restitution
 
     block = Block(b_m=args.width, h_m=args.height, name=Path(args.track).stem)
     t, y, n_skip = _read_track(Path(args.track), args.object, args.nan)
@@ -150,7 +150,7 @@ def _run_restitution(args) -> int:
 
 
 def _run_eta_mat(args) -> int:
-    from ..fitting import fit_eta_mat, read_block_table
+    from ....fitting import fit_eta_mat, read_block_table
 
     table = read_block_table(Path(args.table), nan=args.nan)
     res = fit_eta_mat(table, l_c_m=args.lc_m, contact=args.contact, rule=args.rule, min_hb=args.min_hb)
@@ -162,7 +162,7 @@ def _run_eta_mat(args) -> int:
 
 
 def _run_k_table(args) -> int:
-    from ..fitting import k_table
+    from ....fitting import k_table
 
     res = k_table(Path(args.table), args.eta_mat, form=args.form, feasible_only=args.feasible_only, nan=args.nan)
     d = res.to_dict()
@@ -172,7 +172,7 @@ def _run_k_table(args) -> int:
 
 
 def _run_k_predict(args) -> int:
-    from ..fitting import KRegression
+    from ....fitting import KRegression
 
     if args.coefficients is None:
         reg = KRegression.ceh2018()

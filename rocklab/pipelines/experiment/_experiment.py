@@ -22,8 +22,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import __version__
-from .._errors import InputError
+from ... import __version__
+from ..._errors import InputError
 from ._config import ExperimentConfig, load_experiment
 from ._report import write_outputs
 
@@ -77,10 +77,10 @@ class ExperimentResult:
     messages: list = field(default_factory=list)
     timings_s: dict = field(default_factory=dict)
     frames: object = None  # optional per-frame overlay data from the tracker
-    column: dict | None = None  # column experiments: see rocklab.pipelines._column_run
+    column: dict | None = None  # column experiments: see rocklab.pipelines.experiment._column_run
     video_jpeg: list | None = None  # (frame index, JPEG bytes) of the frames to show in Rerun
     diagnostics: tuple = ()  # rocklab._diagnostics.Diagnostic raised while analysing
-    audit: dict | None = None  # rocklab.pipelines._audit_stage.audit_experiment
+    audit: dict | None = None  # rocklab.pipelines.experiment._audit_stage.audit_experiment
 
     def to_dict(self) -> dict:
         """The numbers of ``report.json`` (units in keys)."""
@@ -202,7 +202,7 @@ def _frame_keeper(decimation: int):
 
 
 def _measure_video(cfg: ExperimentConfig, progress: bool, keep_jpeg: bool):
-    from ..tracking import load_track_config, track_video
+    from ...tracking import load_track_config, track_video
 
     tcfg = load_track_config(cfg.video.track_config) if cfg.video.track_config else None
     jpeg, keep = _frame_keeper(cfg.video_decimation)
@@ -222,7 +222,7 @@ def _measure_video(cfg: ExperimentConfig, progress: bool, keep_jpeg: bool):
 
 
 def _measure_imu(cfg: ExperimentConfig):
-    from ..tracking import block_rotation, read_imu
+    from ...tracking import block_rotation, read_imu
 
     log = read_imu(cfg.imu.path, rate_hz=cfg.imu.rate_hz)
     axis = None if cfg.imu.axis == "auto" else cfg.imu.axis
@@ -238,7 +238,7 @@ def _table_from_imu(cfg: ExperimentConfig, video_table: dict | None, msgs: list)
     one), so the IMU (~256 Hz) drives the simulation; its clock is found by cross-correlating its
     acceleration with the video's (t_imu = t_video + offset + drift t_video).
     """
-    from ..tracking import read_imu, sync_offset, table_acceleration
+    from ...tracking import read_imu, sync_offset, table_acceleration
 
     log = read_imu(cfg.table.imu)
     ta = table_acceleration(log, axis=None)
@@ -259,7 +259,7 @@ def _table_from_imu(cfg: ExperimentConfig, video_table: dict | None, msgs: list)
 
 def _sync(ref, rot, max_offset_s):
     """Clock model t_imu = t_ref + offset + drift * t_ref from the rocking rates."""
-    from ..tracking import sync_imu_to_track
+    from ...tracking import sync_imu_to_track
 
     return sync_imu_to_track(rot, ref[0], ref[1], max_offset_s=max_offset_s)
 
@@ -293,7 +293,7 @@ def analyse_experiment(cfg: ExperimentConfig, progress: bool = False,
     if cfg.table.source == "imu":
         table, table_sync = _table_from_imu(cfg, table, msgs)
     elif cfg.table.source == "record":
-        from ..models import load_base_motion
+        from ...models import load_base_motion
 
         bm = load_base_motion(cfg.table.record, units=cfg.table.units)
         table = {"t_s": bm.t_s, "acc_m_s2": bm.acc_m_s2}
@@ -336,7 +336,7 @@ def analyse_experiment(cfg: ExperimentConfig, progress: bool = False,
 
     audit = audit_experiment(cfg, measured, tr)
     if cfg.fit_restitution:
-        from ..fitting import fit_restitution
+        from ...fitting import fit_restitution
 
         t2 = time.perf_counter()
         n_lost = int((~np.isfinite(prim[1])).sum())
@@ -375,7 +375,7 @@ def _eta_for_law(law, cfg, block, fit_d, msgs):
         v = (fit_d or {}).get(key)
         return float(v) if v is not None and np.isfinite(v) else None
     if law == "modified":
-        from ..fitting import KRegression, edge_contact_k, eta_modified
+        from ...fitting import KRegression, edge_contact_k, eta_modified
 
         if cfg.k is not None:
             k = cfg.k
@@ -391,7 +391,7 @@ def _eta_for_law(law, cfg, block, fit_d, msgs):
 
 
 def _simulate_laws(cfg, block, prim, fit_d, table, msgs) -> dict:
-    from ..models import simulate
+    from ...models import simulate
 
     t_meas, th_meas = prim
     ok = np.isfinite(th_meas)
@@ -465,7 +465,7 @@ def run_experiment(config_path, out_dir, *, force: bool = False, spawn: bool = F
     ran : bool
         False when the inputs and config were unchanged and nothing was done.
     """
-    from .._outdir import check_output_dir, publish_dir, stage_dir
+    from ..._outdir import check_output_dir, publish_dir, stage_dir
 
     cfg = load_experiment(config_path)
     out_dir = check_output_dir(out_dir, force=force, need_bytes=_space_needed(cfg))
@@ -478,7 +478,7 @@ def run_experiment(config_path, out_dir, *, force: bool = False, spawn: bool = F
             old = {}
         if old.get("fingerprint") == fp:
             return old, False
-    from .._diagnostics import collecting, stderr_echo, worst_status
+    from ..._diagnostics import collecting, stderr_echo, worst_status
 
     # in a campaign worker no CLI collector is active: the run prints its own warnings
     with collecting(echo=stderr_echo("run")) as diags:

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .._io import write_frame_atomic, write_json_atomic, write_text_atomic
+from ..._io import write_frame_atomic, write_json_atomic, write_text_atomic
 
 __all__ = ["series_frame", "write_outputs"]
 

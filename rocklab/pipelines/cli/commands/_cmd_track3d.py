@@ -20,7 +20,7 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-from .._errors import InputError
+from ...._errors import InputError
 
 
 def register(sub):
@@ -62,9 +62,9 @@ def _rest(spec: str):
 
 def run(args) -> int:
     """Run ``rocklab track3d`` with parsed ``args``; returns the exit status (0 ok)."""
-    from .._errors import positive
-    from .._io import write_frame_atomic, write_json_atomic
-    from ..tracking.rigid import AuditTolerances, parse_bodies, read_points, track_points3d
+    from ...._errors import positive
+    from ...._io import write_frame_atomic, write_json_atomic
+    from ....tracking.rigid import AuditTolerances, parse_bodies, read_points, track_points3d
 
     src = Path(args.points)
     tol = AuditTolerances(slide_m=positive("--slide-tol (mm)", args.slide_tol) * 1e-3,
@@ -85,12 +85,12 @@ def run(args) -> int:
     summary = res.to_dict()
     summary.update(tracks_csv=str(out), audit_json=str(audit_path), verdict=audit["verdict"])
     if args.rrd:
-        from ._rerun3d import write_track3d_rrd
+        from ...experiment._rerun3d import write_track3d_rrd
 
         write_track3d_rrd(args.rrd, series, res)
         summary["rrd"] = str(args.rrd)
     if args.json:
-        from ._cli_base import emit_json
+        from .._cli_base import emit_json
 
         emit_json(summary)
         return 0

@@ -17,7 +17,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from .._errors import InputError
+from ...._errors import InputError
 
 
 def register(sub):
@@ -54,8 +54,8 @@ def run(args) -> int:
         raise InputError(f"unexpected second argument {args.video2!r}; use 'rocklab track VIDEO', "
                          "'rocklab track init VIDEO' or 'rocklab track preview VIDEO'")
 
-    from .._io import write_frame_atomic
-    from ..tracking import load_track_config, track_video
+    from ...._io import write_frame_atomic
+    from ....tracking import load_track_config, track_video
 
     video = Path(args.video)
     cfg_path = Path(args.config) if args.config else video.parent / "track.toml"
@@ -73,7 +73,7 @@ def run(args) -> int:
         try:
             tm = res.table_motion()
         except InputError as e:
-            from .._diagnostics import warn
+            from ...._diagnostics import warn
 
             summary["table_motion"] = {"error": str(e)}
             warn("W-TABLE-MOTION", f"{video}: no table motion for {cfg.table.id!r}: {e}")
@@ -82,7 +82,7 @@ def run(args) -> int:
             write_frame_atomic(tpath, tm.to_frame(), float_format="%.9g")
             summary["table_motion"] = {**tm.to_dict(), "csv": str(tpath)}
     if args.json:
-        from ._cli_base import emit_json
+        from .._cli_base import emit_json
 
         emit_json(summary)
     else:
@@ -94,7 +94,7 @@ def run(args) -> int:
 
 
 def _tools(args) -> int:
-    from ._track_tools import track_init, track_preview
+    from .._track_tools import track_init, track_preview
 
     if args.video2 is None:
         raise InputError(f"rocklab track {args.video}: give the video, e.g. 'rocklab track {args.video} film.mp4'")
@@ -107,7 +107,7 @@ def _tools(args) -> int:
         cfg, notes = track_init(video, out, objects=args.object, table=args.table,
                                 marker_size_m=args.marker_size, preview=preview)
         if args.json:
-            from ._cli_base import emit_json
+            from .._cli_base import emit_json
 
             emit_json({"config": str(out), "preview": str(preview), "objects": [o.id for o in cfg.objects],
                        "style": cfg.targets.style, "notes": notes})

@@ -17,7 +17,7 @@ from __future__ import annotations
 import math
 import sys
 
-from ._cli_base import add_base_motion_args, base_motion_from_args
+from .._cli_base import add_base_motion_args, base_motion_from_args
 
 _MAX_LINES = 40
 
@@ -55,7 +55,7 @@ def register(sub):
 
 
 def _floats(text, name, n=None):
-    from .._errors import InputError
+    from ...._errors import InputError
 
     try:
         vals = [float(x) for x in str(text).split(",") if x.strip()]
@@ -67,8 +67,8 @@ def _floats(text, name, n=None):
 
 
 def _blocks(text, density):
-    from .._errors import InputError
-    from ..blocks import Block
+    from ...._errors import InputError
+    from ....blocks import Block
 
     out = []
     for i, tok in enumerate(str(text).split(",")):
@@ -87,9 +87,9 @@ def _blocks(text, density):
 
 def run(args) -> int:
     """Run ``rocklab column`` with parsed ``args``; returns the exit status (0 ok)."""
-    from .._errors import InputError
-    from .._io import write_frame_atomic
-    from ..models import Column, simulate_column
+    from ...._errors import InputError
+    from ...._io import write_frame_atomic
+    from ....models import Column, simulate_column
 
     if args.blocks is None and args.maps_png is None:
         raise InputError("give --blocks WIDTHxHEIGHT,... (and/or --maps-png FILE)")
@@ -114,7 +114,7 @@ def run(args) -> int:
     if args.maps_png is not None:
         out["maps"] = _maps(args)
     if args.json:
-        from ._cli_base import emit_json
+        from .._cli_base import emit_json
 
         emit_json(out)
         return 0
@@ -151,8 +151,8 @@ def _maps(args):
     import numpy as np
     from tqdm import tqdm
 
-    from ..models import column_overturning_maps
-    from ._plots_column import plot_column_maps
+    from ....models import column_overturning_maps
+    from ...experiment._plots_column import plot_column_maps
 
     k = max(int(args.maps_grid), 2)
     # the region where the columns' overturning boundaries differ (thesis Fig. 40)

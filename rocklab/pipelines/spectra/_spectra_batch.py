@@ -13,7 +13,7 @@ import math
 import os
 import sys
 
-from .._procs import dask_client, pool_initializer
+from ..._procs import dask_client, pool_initializer
 
 __all__ = ["oas_summary_row", "oas_many", "expand_records", "thesis_table4", "table4_row"]
 
@@ -70,7 +70,7 @@ def expand_records(paths, list_file=None) -> list:
         try:
             lines = lf.read_text(encoding="utf-8").splitlines()
         except (OSError, UnicodeDecodeError) as e:
-            from .._errors import InputError
+            from ..._errors import InputError
 
             raise InputError(f"--list {lf}: cannot read the list ({type(e).__name__}); give a text file with one "
                              "record path per line") from None
@@ -99,8 +99,8 @@ def oas_summary_row(path: str, units: str | None = None, slenderness: float = 12
     :data:`rocklab.models.BAND_ENSEMBLE` (``t_I_p05_s, t_I_p95_s`` and the same for
     t'_I and beta), and ``t_I_s`` etc. are the ensemble's medians.
     """
-    from .._errors import InputError
-    from ..models import load_base_motion, overturning_spectrum, pulse_parameters, t_I_band
+    from ..._errors import InputError
+    from ...models import load_base_motion, overturning_spectrum, pulse_parameters, t_I_band
 
     row = dict(record=str(path), t_p_s=math.nan, t_I_s=math.nan, t_I_prime_s=math.nan, beta=math.nan,
                f_min=math.nan, f_min_level=math.nan, f_min_R_m=math.nan, error="")

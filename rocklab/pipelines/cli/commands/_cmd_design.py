@@ -15,10 +15,10 @@ from __future__ import annotations
 import math
 import sys
 
-from .._errors import InputError
+from ...._errors import InputError
 
 
-from ._cli_base import emit_json as _emit
+from .._cli_base import emit_json as _emit
 
 
 def register(sub):
@@ -95,7 +95,7 @@ def run(args) -> int:
 
 
 def run_pulse(args) -> int:
-    from ..models import load_base_motion, pulse_parameters
+    from ....models import load_base_motion, pulse_parameters
 
     pp = pulse_parameters(load_base_motion(args.record, units=args.units))
     d = pp.to_dict()
@@ -117,7 +117,7 @@ def _free(v):
 
 
 def run_oas(args) -> int:
-    from .._io import write_frame_atomic
+    from ...._io import write_frame_atomic
 
     kw = dict(levels=args.levels, level_max=args.level_max, sizes=args.sizes, refine=args.refine,
               criterion=args.criterion, free=_free(args.free), search=args.search, eta=args.eta)
@@ -129,14 +129,14 @@ def run_oas(args) -> int:
         raise InputError("rocklab oas: give record files, folders of records, or --list FILE")
     if args.list or args.band or len(args.record) > 1 or any(Path(r).is_dir() for r in args.record):
         return _run_oas_batch(args, kw)
-    from ..models import load_base_motion, overturning_spectrum, pulse_parameters
+    from ....models import load_base_motion, overturning_spectrum, pulse_parameters
 
     rec = load_base_motion(args.record[0], units=args.units)
     o = overturning_spectrum(rec, args.slenderness, **kw)
     if args.out:
         write_frame_atomic(args.out, o.to_frame())
     if args.plot:
-        from ._plots_spectra import plot_oas
+        from ...spectra._plots_spectra import plot_oas
 
         plot_oas(o, args.plot)
     d = o.to_dict()
@@ -155,8 +155,8 @@ def _run_oas_batch(args, kw) -> int:
     import sys
     from pathlib import Path
 
-    from .._io import write_frame_atomic
-    from ._spectra_batch import expand_records, oas_table
+    from ...._io import write_frame_atomic
+    from ...spectra._spectra_batch import expand_records, oas_table
 
     items = expand_records(args.record, args.list)
     if not items:
@@ -172,12 +172,12 @@ def _run_oas_batch(args, kw) -> int:
     if args.out:
         out = Path(args.out)
         write_frame_atomic(out, tab, float_format="%.6g")
-        from .._io import atomic_path
+        from ...._io import atomic_path
 
         with atomic_path(out.with_suffix(".parquet")) as tmp:
             tab.to_parquet(tmp, index=False)
     if args.plot:
-        from ._plots_spectra import plot_tI_vs_tp
+        from ...spectra._plots_spectra import plot_tI_vs_tp
 
         plot_tI_vs_tp(tab, args.plot, args.slenderness)
     n_bad = int((tab["error"] != "").sum())
@@ -193,8 +193,8 @@ def _run_oas_batch(args, kw) -> int:
 
 
 def run_design(args) -> int:
-    from ..blocks import G
-    from ..models import required_width, required_width_slender
+    from ....blocks import G
+    from ....models import required_width, required_width_slender
 
     g = G if args.g is None else args.g
     c = args.cm_ratio if args.cm_ratio is not None else (1.0 if args.mass_at_top else 0.5)
@@ -228,7 +228,7 @@ def _R_alpha(args):
 
 
 def run_equivalent(args) -> int:
-    from .. import models as m
+    from .... import models as m
 
     mech = args.mechanism
     extra = {}

@@ -25,7 +25,7 @@ _3D_COLUMNS = ("pivot_slide_m", "pivot_uplift_m", "twist_rad", "out_of_plane_rad
 def _from_tracks_csv(cfg):
     import pandas as pd
 
-    from ..tracking.rigid import audit_rocking
+    from ...tracking.rigid import audit_rocking
 
     df = pd.read_csv(cfg.track.path)
     if cfg.track.object is not None and "object" in df.columns:
@@ -44,7 +44,7 @@ def _from_tracks_csv(cfg):
 def _theta_only(t, th, sig, source, why):
     from dataclasses import replace
 
-    from ..tracking.rigid import audit_rocking
+    from ...tracking.rigid import audit_rocking
 
     res = audit_rocking(t, th, sigma_theta_rad=sig, source=source)
     return replace(res, notes=res.notes + (why,))
@@ -62,7 +62,7 @@ def _from_video(cfg, tr, measured):
 
 def audit_experiment(cfg, measured: dict, tr) -> dict:
     """The ``audit`` object of ``report.json`` for the experiment's primary source."""
-    from .._diagnostics import warn
+    from ..._diagnostics import warn
 
     if cfg.primary == "video" and tr is not None:
         res = _from_video(cfg, tr, measured)

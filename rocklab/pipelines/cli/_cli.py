@@ -26,7 +26,7 @@ import importlib
 import sys
 import threading
 
-from .._errors import InputError
+from ..._errors import InputError
 
 #: Subcommand modules, in help order.
 COMMAND_MODULES = (
@@ -43,7 +43,7 @@ class _Parser(argparse.ArgumentParser):
 
 def build_parser() -> argparse.ArgumentParser:
     """The ``rocklab`` argument parser with every subcommand registered."""
-    from .. import __version__
+    from ... import __version__
 
     p = _Parser(prog="rocklab", description="Rocking-block experiments to calibrated physics.")
     p.add_argument("--version", action="version", version=f"rocklab {__version__}")
@@ -52,13 +52,13 @@ def build_parser() -> argparse.ArgumentParser:
                                                          "of severity suspect)")
     sub = p.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     for mod in COMMAND_MODULES:
-        importlib.import_module(f"{__package__}.{mod}").register(sub)
+        importlib.import_module(f"{__package__}.commands.{mod}").register(sub)
     return p
 
 
 def _check_file_outputs(args) -> None:
     """Output files named on the command line are checked before any work starts."""
-    from .._outdir import check_output_file
+    from ..._outdir import check_output_file
 
     for attr, opt in (("output", "-o"), ("plot", "--plot"), ("maps_png", "--maps-png"), ("rrd", "--rrd")):
         v = getattr(args, attr, None)
@@ -97,7 +97,7 @@ def main(argv=None) -> int:
     import signal
     import warnings
 
-    from .._diagnostics import collecting, stderr_echo
+    from ..._diagnostics import collecting, stderr_echo
 
     parser = build_parser()
     args = parser.parse_args(argv)

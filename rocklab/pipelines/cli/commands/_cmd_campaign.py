@@ -19,12 +19,12 @@ def register(sub):
 
 def run(args) -> int:
     """Run ``rocklab campaign`` with parsed ``args``; returns the exit status (0 ok)."""
-    from ._campaign import run_campaign
+    from ...campaign._campaign import run_campaign
 
     res = run_campaign(args.dir, args.out, workers=args.workers, scheduler=args.scheduler,
                        force=args.force, progress=not args.no_progress)
     if args.json:
-        from ._cli_base import emit_json
+        from .._cli_base import emit_json
 
         emit_json(res.to_dict())
     else:

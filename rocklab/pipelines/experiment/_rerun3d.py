@@ -95,7 +95,7 @@ def track3d_blueprint(result):
 
 def write_track3d_rrd(path, series, result) -> None:
     """Write the review of a 3D record to ``path`` (atomically)."""
-    from .._io import atomic_path
+    from ..._io import atomic_path
 
     with atomic_path(path) as tmp:
         rec = open_recording("rocklab_track3d", rrd_path=tmp)

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from .._errors import InputError
+from ..._errors import InputError
 
 __all__ = ["add_base_motion_args", "base_motion_from_args", "emit_json"]
 
@@ -16,7 +16,7 @@ def add_base_motion_args(p) -> None:
 
 def base_motion_from_args(args):
     """The :class:`BaseMotion` the options name (SI units), or None for free rocking."""
-    from ..models import load_base_motion
+    from ...models import load_base_motion
 
     if args.base_motion is None:
         if args.scale_pga is not None or args.units is not None:
@@ -36,8 +36,8 @@ def emit_json(obj: dict) -> None:
     """
     import sys
 
-    from .._diagnostics import collected, worst_status
-    from .._io import dumps_json
+    from ..._diagnostics import collected, worst_status
+    from ..._io import dumps_json
 
     diags = collected()
     out = dict(obj)

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._figures import pyplot, save_png
+from ..experiment._figures import pyplot, save_png
 
 __all__ = ["plot_oas", "plot_overturning_curve", "plot_wall_error_maps", "plot_frame_error_maps"]
 
@@ -24,7 +24,7 @@ def _fig(ncols, w=4.2, h=3.6):
 
 def plot_oas(o, path):
     """Three-panel OAS figure of an :class:`rocklab.models.OASResult`; writes a PNG to ``path``."""
-    from ..models import simplified_oas
+    from ...models import simplified_oas
 
     plt, fig, ax = _fig(3)
     L, P = np.meshgrid(o.levels, o.p_rad_s, indexing="ij")
@@ -80,7 +80,7 @@ def plot_overturning_curve(c, path):
 
 
 def _error_maps(mechs, ys, ylabel, path, ratios, accs, title):
-    from ..models import equivalence_errors
+    from ...models import equivalence_errors
 
     errs = [equivalence_errors(m, ratios, accs) for m in mechs]
     T = np.array([e["period_ratio"] for e in errs])
@@ -103,7 +103,7 @@ def _error_maps(mechs, ys, ylabel, path, ratios, accs, title):
 def plot_wall_error_maps(path, alphas=None, ratios=None, accs=None, R_m=1.0):
     """Rocking wall: T_eq24/T_wall over (phi/phi_cr, alpha) and t_eq25/t_wall over (u/(g lambda),
     alpha) for kappa1 and kappa2 (DeJong & Dimitrakopoulos Fig. 3). Returns the arrays."""
-    from ..models import wall_mechanism
+    from ...models import wall_mechanism
 
     alphas = np.linspace(0.05, 0.4, 8) if alphas is None else np.asarray(alphas)
     ratios = np.linspace(0.05, 0.95, 10) if ratios is None else np.asarray(ratios)
@@ -116,7 +116,7 @@ def plot_frame_error_maps(path, H1_over_H=None, direction="+", b_m=0.3, H_m=2.0,
                           masses=(1.0, 1.0, 1.0), ratios=None, accs=None):
     """Asymmetric frame error maps over (phi/phi_cr or u/(g lambda), H1/H) for one rocking
     direction (paper Fig. 6–8). Returns the arrays."""
-    from ..models import asymmetric_frame
+    from ...models import asymmetric_frame
 
     hs = np.linspace(1.0, 1.5, 6) if H1_over_H is None else np.asarray(H1_over_H)
     ratios = np.linspace(0.05, 0.95, 10) if ratios is None else np.asarray(ratios)

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import sys
 
-from ._cli_base import add_base_motion_args, base_motion_from_args
+from .._cli_base import add_base_motion_args, base_motion_from_args
 
 
 def register(sub):
@@ -48,10 +48,10 @@ def register(sub):
 
 def run(args) -> int:
     """Run ``rocklab simulate`` with parsed ``args``; returns the exit status (0 ok)."""
-    from .._errors import InputError
-    from .._io import write_frame_atomic
-    from ..blocks import Block
-    from ..models import simulate
+    from ...._errors import InputError
+    from ...._io import write_frame_atomic
+    from ....blocks import Block
+    from ....models import simulate
 
     block = Block(args.width, args.height, alpha_I=args.alpha_I)
     law = {}
@@ -74,7 +74,7 @@ def run(args) -> int:
         write_frame_atomic(args.output, res.to_frame())
     d = res.to_dict()
     if args.json:
-        from ._cli_base import emit_json
+        from .._cli_base import emit_json
 
         emit_json(d)
     else:

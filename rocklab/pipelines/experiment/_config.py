@@ -78,7 +78,7 @@ import tomllib
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
-from .._errors import InputError
+from ..._errors import InputError
 
 __all__ = ["ExperimentConfig", "load_experiment", "EXAMPLE_TOML"]
 
@@ -155,7 +155,7 @@ class ExperimentConfig:
 
     def block(self):
         """The :class:`rocklab.Block` of this experiment."""
-        from ..blocks import Block
+        from ...blocks import Block
 
         return Block(self.b_m, self.h_m, mass_kg=self.mass_kg, name=self.block_id or self.name)
 
@@ -430,7 +430,7 @@ def _video_missing(data: dict) -> bool:
 
 def _catalogue() -> dict:
     """Čeh Table 2 as {id: {b_m, h_m, mass_kg}} (from rocklab.fitting's package data)."""
-    from ..fitting import ceh_catalogue
+    from ...fitting import ceh_catalogue
 
     return {str(r["block"]): {"b_m": float(r["b_m"]), "h_m": float(r["h_m"]), "mass_kg": float(r["mass_kg"])}
             for _, r in ceh_catalogue().iterrows()}

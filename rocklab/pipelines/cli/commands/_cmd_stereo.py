@@ -17,7 +17,7 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-from .._errors import InputError
+from ...._errors import InputError
 
 
 def register(sub):
@@ -70,7 +70,7 @@ def run(args) -> int:
 
 def _emit(args, d, lines):
     if args.json:
-        from ._cli_base import emit_json
+        from .._cli_base import emit_json
 
         emit_json(d)
     else:
@@ -80,7 +80,7 @@ def _emit(args, d, lines):
 def _calibrate(args) -> int:
     import cv2
 
-    from ..tracking.stereo import calibrate_stereo
+    from ....tracking.stereo import calibrate_stereo
 
     board = _board(args.board)
     if board is not None and not hasattr(cv2.aruco, board["dictionary"]):
@@ -98,9 +98,9 @@ def _calibrate(args) -> int:
 
 
 def _track(args) -> int:
-    from .._io import write_frame_atomic, write_json_atomic
-    from ..tracking.rigid import parse_bodies, track_points3d, write_points_csv
-    from ..tracking.stereo import load_rig, stereo_point_series, track_dots_stereo
+    from ...._io import write_frame_atomic, write_json_atomic
+    from ....tracking.rigid import parse_bodies, track_points3d, write_points_csv
+    from ....tracking.stereo import load_rig, stereo_point_series, track_dots_stereo
     from ._cmd_track3d import _rest
 
     if not args.calib:
@@ -111,7 +111,7 @@ def _track(args) -> int:
     rest = _rest(args.rest)
     out = Path(args.out) if args.out else Path(args.film1).parent / "tracks.csv"
     if args.targets == "aruco":
-        from ..tracking.stereo import track_markers_stereo
+        from ....tracking.stereo import track_markers_stereo
 
         sp = track_markers_stereo(args.film1, args.film2, rig, dictionary=args.dictionary, fps=args.fps,
                                   sync=not args.no_sync)
@@ -131,7 +131,7 @@ def _track(args) -> int:
     audit_path = out.with_name("audit.json")
     write_json_atomic(audit_path, audit)
     if args.rrd:
-        from ._rerun3d import write_track3d_rrd
+        from ...experiment._rerun3d import write_track3d_rrd
 
         write_track3d_rrd(args.rrd, series, res)
     d = res.to_dict()

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._errors import InputError
+from ..._errors import InputError
 
 __all__ = ["analyse_column", "base_from_table"]
 
@@ -26,7 +26,7 @@ def base_from_table(table: dict, t0_s: float, where: str, *, sign: float = 1.0, 
     """
     from scipy.interpolate import CubicSpline
 
-    from ..models import BaseMotion
+    from ...models import BaseMotion
 
     tt = np.asarray(table["t_s"], float)
     aa = np.asarray(table["acc_m_s2"], float)
@@ -57,7 +57,7 @@ def analyse_column(cfg, track_result, table, truth_path=None) -> dict:
     """
     import pandas as pd
 
-    from ..models import Column, compare_sequences, compare_to_measurement, joint_sequence, simulate_column
+    from ...models import Column, compare_sequences, compare_to_measurement, joint_sequence, simulate_column
 
     objs = cfg.columns
     t, th = _by_object(track_result.to_frame(), objs)

@@ -19,9 +19,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .._errors import InputError
-from .._procs import dask_client, pool_initializer
-from .._io import write_frame_atomic, write_json_atomic
+from ..._errors import InputError
+from ..._procs import dask_client, pool_initializer
+from ..._io import write_frame_atomic, write_json_atomic
 
 __all__ = ["CampaignResult", "run_campaign", "find_experiments"]
 
@@ -43,8 +43,8 @@ def find_experiments(root) -> list[Path]:
 
 def _one(config: str, out: str, force: bool) -> dict:
     """Worker: run one experiment; never raises (the failure is the result)."""
-    from .._errors import InputError as _IE
-    from ._experiment import run_experiment
+    from ..._errors import InputError as _IE
+    from ..experiment._experiment import run_experiment
 
     try:
         report, ran = run_experiment(config, out, force=force)
@@ -196,7 +196,7 @@ def _column_summary(col: dict) -> dict:
 
 
 def _campaign_fits(table, msgs):
-    from .. import fitting as F
+    from ... import fitting as F
 
     eta_mat = k_tab = None
     edge = table[(table["contact"] == "edge") & np.isfinite(table["eta_e"])]
@@ -224,7 +224,7 @@ def run_campaign(root, out_dir, *, workers: int = 2, scheduler: str | None = Non
     import pandas as pd
     from tqdm import tqdm
 
-    from .._outdir import check_output_dir, claim_dir
+    from ..._outdir import check_output_dir, claim_dir
 
     root = Path(root).resolve()
     configs = find_experiments(root)
@@ -275,14 +275,14 @@ def run_campaign(root, out_dir, *, workers: int = 2, scheduler: str | None = Non
 
 
 def _write_campaign(res: CampaignResult) -> None:
-    from ._figures import campaign_figures
+    from ..experiment._figures import campaign_figures
 
     out = res.out_dir
     out.mkdir(parents=True, exist_ok=True)
     if res.table is not None and len(res.table):
         write_frame_atomic(out / "campaign.csv", res.table)
         reg = None
-        from ..fitting import KRegression
+        from ...fitting import KRegression
 
         reg = KRegression.ceh2018()
         if res.k_table and res.k_table.get("coefficients"):
@@ -296,8 +296,8 @@ def _write_campaign(res: CampaignResult) -> None:
 def _campaign_rrd(res: CampaignResult, path: Path) -> None:
     import rerun as rr
 
-    from .._io import atomic_path
-    from ._rerun import campaign_blueprint, close_recording, open_recording
+    from ..._io import atomic_path
+    from ..experiment._rerun import campaign_blueprint, close_recording, open_recording
 
     with atomic_path(path, suffix=".rrd") as tmp:
         rec = open_recording("rocklab", tmp, recording_id="campaign")

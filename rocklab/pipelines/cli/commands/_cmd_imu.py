@@ -42,8 +42,8 @@ def run(args) -> int:
     """Run ``rocklab imu`` with parsed ``args``; returns the exit status (0 ok)."""
     import math
 
-    from .._io import write_frame_atomic
-    from ..tracking import block_rotation, read_imu, table_acceleration
+    from ...._io import write_frame_atomic
+    from ....tracking import block_rotation, read_imu, table_acceleration
 
     log = read_imu(args.path, rate_hz=args.rate)
     if args.table:
@@ -56,7 +56,7 @@ def run(args) -> int:
         write_frame_atomic(args.out, res.to_frame())
         summary["output"] = str(args.out)
     if args.json:
-        from ._cli_base import emit_json
+        from .._cli_base import emit_json
 
         emit_json(summary)
         return 0

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import sys
 
-from .._errors import InputError
+from ...._errors import InputError
 
 
 def register(sub):
@@ -73,9 +73,9 @@ def _event(spec, option, scale):
 def _run_stereo(args, out, events) -> int:
     import shutil
 
-    from .._outdir import publish_dir, stage_dir
-    from ..synth import synth_stereo
-    from ..synth._session import parse_size
+    from ...._outdir import publish_dir, stage_dir
+    from ....synth import synth_stereo
+    from ....synth._session import parse_size
 
     size = parse_size(args.size if args.size != "1920x1080" else "2400x1728")
     tmp = stage_dir(out)
@@ -95,7 +95,7 @@ def _run_stereo(args, out, events) -> int:
     d = {"out_dir": str(out), "files": sorted(p.name for p in r["paths"].values()), "frames": int(r["t_s"].size),
          "size": list(size), "offset_s": r["offset_s"], "injected": r["session"].injected}
     if args.json:
-        from ._cli_base import emit_json
+        from .._cli_base import emit_json
 
         emit_json(d)
     else:
@@ -110,8 +110,8 @@ def _run_points3d(args) -> int:
     import math
     import shutil
 
-    from .._outdir import check_output_dir, publish_dir, stage_dir
-    from ..synth import synth_points3d
+    from ...._outdir import check_output_dir, publish_dir, stage_dir
+    from ....synth import synth_points3d
 
     out = check_output_dir(args.out, force=args.force)
     if out.is_dir() and any(out.iterdir()) and not args.force:
@@ -135,7 +135,7 @@ def _run_points3d(args) -> int:
          "samples": int(s.series.t_s.size), "rate_hz": s.series.rate_hz, "impacts": int(s.impacts_t_s.size),
          "bodies": {k: list(v) for k, v in s.bodies.items()}, "injected": s.injected}
     if args.json:
-        from ._cli_base import emit_json
+        from .._cli_base import emit_json
 
         emit_json(d)
     else:
@@ -147,8 +147,8 @@ def _run_points3d(args) -> int:
 
 def run(args) -> int:
     """Run ``rocklab synth`` with parsed ``args``; returns the exit status (0 ok)."""
-    from ..synth import synth_session
-    from ..synth._session import parse_size
+    from ....synth import synth_session
+    from ....synth._session import parse_size
 
     if args.points3d or args.stereo:
         return _run_points3d(args)
@@ -177,7 +177,7 @@ def run(args) -> int:
                       progress=args.progress)
     d = s.to_dict()
     if args.json:
-        from ._cli_base import emit_json
+        from .._cli_base import emit_json
 
         emit_json(d)
     else:

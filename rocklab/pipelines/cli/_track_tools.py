@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .._errors import InputError
+from ..._errors import InputError
 
 __all__ = ["track_init", "track_preview", "draw_init_preview", "contact_sheet"]
 
@@ -16,7 +16,7 @@ _COLOURS = [(0, 200, 255), (255, 120, 0), (0, 220, 0), (220, 0, 220), (0, 0, 255
 
 
 def _first_frame(video: Path):
-    from ..tracking.video._video import iter_video_frames, probe_video
+    from ...tracking.video._video import iter_video_frames, probe_video
 
     if not video.exists():
         raise InputError(f"{video}: video not found; check the path")
@@ -40,8 +40,8 @@ def track_init(video, out, *, objects=(), table=None, marker_size_m=None, previe
     preview : path or None
         PNG with every detection, region and the level line drawn on the first frame.
     """
-    from .._io import write_text_atomic
-    from ..tracking.video._init import parse_region, suggest_config
+    from ..._io import write_text_atomic
+    from ...tracking.video._init import parse_region, suggest_config
 
     video, out = Path(video), Path(out)
     info, gray, img = _first_frame(video)
@@ -65,7 +65,7 @@ def track_init(video, out, *, objects=(), table=None, marker_size_m=None, previe
     head += [f"# {n}" for n in notes]
     write_text_atomic(out, "\n".join(head) + "\n\n" + cfg.to_toml())
     if preview is not None:
-        from ._figures import save_bgr_png
+        from ..experiment._figures import save_bgr_png
 
         save_bgr_png(Path(preview), draw_init_preview(img, cfg, found))
     return cfg, notes
@@ -102,12 +102,12 @@ def draw_init_preview(img, cfg, found):
 
 def track_preview(video, config, out, *, n_frames: int = 6, progress: bool = False):
     """Track ``video`` and write a contact sheet of ``n_frames`` frames spread over it (PNG)."""
-    from ..tracking import load_track_config, track_video
+    from ...tracking import load_track_config, track_video
 
     video = Path(video)
     if not 1 <= int(n_frames) <= 48:
         raise InputError(f"--frames {n_frames}: give 1 to 48 frames for the sheet")
-    from ..tracking.video._video import iter_video_frames
+    from ...tracking.video._video import iter_video_frames
 
     cfg = load_track_config(config)
     res = track_video(video, cfg, progress=progress)
@@ -117,7 +117,7 @@ def track_preview(video, config, out, *, n_frames: int = 6, progress: bool = Fal
     for f in pick:  # decode only the frames shown (a long film is not kept in memory)
         for i, _, img in iter_video_frames(video, int(f), int(f) + 1, prefetch=0, color=True):
             tiles.append(_draw_pose(img, res, i))
-    from ._figures import save_bgr_png
+    from ..experiment._figures import save_bgr_png
 
     save_bgr_png(Path(out), contact_sheet(tiles))
     return res, [int(f) for f in pick]

@@ -4,7 +4,7 @@ For the FEMA P695 far-field pair FF-1 / FF-2 (Northridge, Beverly Hills MUL009 /
 NGA-West1 processing, as in the thesis) and, when present, the NGA-West2 file of FF-41
 (San Fernando, LA Hollywood Stor PEL090), prints t_I, t'_I and beta of the defaults and
 of one changed option at a time, next to Table 4. The table in the docstring of
-``rocklab/models/_oas.py`` is this script's output.
+``rocklab/models/spectra/_oas.py`` is this script's output.
 
 Not part of ``make bench`` (about 1-2 min on 2 cores). Needs ../shared.
 Run: ``.venv/bin/python benchmarks/oas_sensitivity.py``.

@@ -124,7 +124,7 @@ def write_track_toml(path: Path, *, style, fps, camera, objects, marker_size_m, 
 
 
 def write_experiment_toml(path: Path, *, name, block, table_kind, imu_objects, column=None) -> str:
-    """``experiment.toml`` for ``rocklab run`` (schema: ``rocklab/pipelines/_config.py``).
+    """``experiment.toml`` for ``rocklab run`` (schema: ``rocklab/pipelines/experiment/_config.py``).
 
     ``block``: dict with ``id, b_m, h_m, mass_kg`` of the block the run fits;
     ``imu_objects``: object ids that have ``imu/<id>/`` logs; ``column``: object
@@ -147,7 +147,7 @@ def write_experiment_toml(path: Path, *, name, block, table_kind, imu_objects, c
         lines += ["[sources.table]", 'from = "video"', 'object = "table"', ""]
     if column:
         lines += ["[column]", "objects = [" + ", ".join(f'"{c}"' for c in column) + "]", ""]
-    text = "# Experiment config written by 'rocklab synth' (schema: rocklab/pipelines/_config.py).\n" \
+    text = "# Experiment config written by 'rocklab synth' (schema: rocklab/pipelines/experiment/_config.py).\n" \
         + "\n".join(lines)
     write_text_atomic(path, text)
     return text

@@ -156,3 +156,9 @@ def test_packages_hold_at_most_12_modules_where_split():
                 "pipelines/experiment", "pipelines/campaign", "pipelines/spectra"):
         mods = [p for p in (PKG / pkg).glob("*.py") if p.name != "__init__.py"]
         assert len(mods) <= 12, (pkg, len(mods))
+
+
+def test_no_module_over_500_lines():
+    long = {str(p.relative_to(PKG)): n for p in PKG.rglob("*.py")
+            if (n := len(p.read_text(encoding="utf-8").splitlines())) > 500}
+    assert not long

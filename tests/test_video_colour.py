@@ -41,7 +41,7 @@ def videos(tmp_path_factory):
 
 
 def _track(path, decimation=2):
-    from rocklab.pipelines.experiment._experiment import _frame_keeper
+    from rocklab.pipelines.experiment._measure import _frame_keeper
     from rocklab.tracking import TrackConfig, track_video
 
     cfg = TrackConfig.from_dict({"targets": {"style": "aruco", "marker_size_m": 0.05},
@@ -108,7 +108,7 @@ def test_grey_source_stays_one_channel(videos):
 
 
 def test_is_grey_detects_colour_hidden_from_the_sample():
-    from rocklab.pipelines.experiment._experiment import _is_grey
+    from rocklab.pipelines.experiment._measure import _is_grey
 
     g = np.random.default_rng(1).integers(0, 256, (H, W), dtype=np.uint8)
     img = cv2.merge([g, g, g])

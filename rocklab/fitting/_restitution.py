@@ -33,6 +33,7 @@ from .._diagnostics import warn
 from .._errors import InputError
 from ..blocks import is_lab_size
 from ._impacts import _crossings, arch_peaks, check_record, detect_release, per_impact_eta
+from ._fit_checks import RESIDUAL_FACTOR, RESIDUAL_FLOOR_RAD, _cut_at_gap, _suspicion
 from ._simfit import _ac_factor, _grid_then_brent, _Problem, _profile_ci
 
 __all__ = ["RestitutionFit", "fit_restitution", "WINDOWS", "OBJECTIVES"]
@@ -430,85 +431,3 @@ def fit_restitution(t_s, theta_rad, block, window: str = "middle50", objective: 
         n_evaluations=sum(q.n_sim for q in probs.values()),
         status="suspect" if any(d.severity == "suspect" for d in diags) else "ok", message=msg, per_impact=pie,
         warnings=tuple(d.code for d in diags))
-
-
-#: A fit whose residual RMS exceeds this multiple of the measurement noise is flagged
-#: W-FIT-RESIDUAL: the model (or the block's dimensions) does not describe the test.
-RESIDUAL_FACTOR = 20.0
-#: Smallest noise the residual is compared with, rad (0.057 deg): the rest plateau's noise
-#: understates what a tracker does in motion (blur at impacts: the demo's slender blocks fit
-#: to 3.6e-3 and 8.7e-3 rad RMS with the true eta and 2e-5 rad of plateau noise).
-RESIDUAL_FLOOR_RAD = 1e-3
-
-
-def _cut_at_gap(t, y, t_release_s, sigma_rad):
-    """Keep the record up to the first gap after the release that could hide an impact.
-
-    Impacts inside a gap cannot be seen, so counting half-cycles across it makes every
-    later impact one off (a 0.4 s occlusion turned eta_e 0.75 into 0.53). A gap is
-    dangerous when it lasts more than half of the shortest half-cycle seen before it;
-    the fit then uses the data before the gap and says so (``W-FIT-GAP``).
-    """
-    d = np.diff(t)
-    med = float(np.median(d))
-    cand = np.flatnonzero((d > 1.5 * med) & (t[:-1] >= t_release_s))
-    if not cand.size:
-        return t, y, None
-    # sign changes of theta away from the noise band: the impacts seen so far
-    big = np.abs(y) > 5.0 * max(sigma_rad, 1e-9)
-    idx = np.flatnonzero(big & (t >= t_release_s))
-    sgn = np.sign(y[idx])
-    t_cross = t[idx[1:][sgn[1:] != sgn[:-1]]]
-    for i in cand:
-        before = t_cross[t_cross <= t[i]]
-        half = float(np.min(np.diff(before))) if before.size >= 2 else float(t[i] - t_release_s)
-        if d[i] > 0.5 * half:
-            n_lost = int(round(d[i] / med)) - 1
-            diag = warn("W-FIT-GAP", f"theta(t) has a {d[i]:.4g} s gap ({n_lost} samples) at t = {t[i]:.4g} s, "
-                                     f"longer than half the shortest half-cycle before it ({half:.4g} s); the "
-                                     f"fit uses the {i + 1} samples before the gap")
-            return t[:i + 1], y[:i + 1], diag
-    return t, y, None
-
-
-def _suspicion(t, y, res, rms, sigma, pie, tc, alpha):
-    """Symptoms of slip or jumping: structured residuals, asymmetric decay, offset rest, jumps."""
-    flags = []
-    if res.size >= 20 and rms > 3.0 * sigma:
-        s = np.sign(res)
-        s = s[s != 0]
-        runs = 1 + int(np.sum(s[1:] != s[:-1]))
-        n1, n2 = int(np.sum(s > 0)), int(np.sum(s < 0))
-        n = n1 + n2
-        if n1 and n2:
-            mu = 2.0 * n1 * n2 / n + 1
-            var = (mu - 1) * (mu - 2) / (n - 1)
-            z = (runs - mu) / math.sqrt(max(var, 1e-12))
-            if z < -4:
-                flags.append(f"structured residuals: RMS {rms / sigma:.1f}x the noise and a runs test z = {z:.1f} "
-                             "(misfit: slip, jump or a restitution that changes during rocking)")
-        big = np.abs(res) > 8.0 * max(rms, sigma)
-        if big.any():
-            flags.append(f"{int(big.sum())} residual(s) above 8x RMS: isolated jump or tracking glitch")
-    ok = pie[pie["ok"]] if len(pie) else pie
-    if len(ok) >= 4:
-        # alternation between the two corners: median of (−1)^k (η_k − η_{k+1}) / 2 over consecutive
-        # impacts; a steady trend or a single odd impact drops out, unequal corners do not
-        e = ok["eta_peaks"].to_numpy()
-        k = ok["impact"].to_numpy()
-        se = ok["eta_peaks_se"].to_numpy()
-        pair = np.flatnonzero(np.diff(k) == 1)
-        if pair.size >= 3:
-            a = ((-1.0) ** k[pair]) * (e[pair] - e[pair + 1]) / 2
-            sd = float(np.sqrt(np.mean(se[pair] ** 2 + se[pair + 1] ** 2) / 4 / pair.size) + 1e-12)
-            d = float(np.median(a))
-            if abs(d) > max(4 * sd, 0.005):
-                flags.append(f"asymmetric amplitudes: per-impact eta alternates by {2 * d:+.3f} between the two "
-                             "corners (tilted base, slip or unequal corners)")
-    after = t > tc[-1] + 2 * (tc[-1] - tc[-2]) if tc.size >= 2 else np.zeros_like(t, bool)
-    if after.sum() >= 10:
-        rest = float(np.median(y[after]))
-        if abs(rest) > max(10 * sigma / math.sqrt(after.sum()) + 3 * sigma, 0.01 * alpha):
-            flags.append(f"block came to rest at {rest:+.4f} rad, not 0: it slipped or jumped (or the level "
-                         "reference is off: try fit_offset=True)")
-    return flags

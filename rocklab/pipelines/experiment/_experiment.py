@@ -23,8 +23,8 @@ from pathlib import Path
 import numpy as np
 
 from ... import __version__
-from ..._errors import InputError
 from ._config import ExperimentConfig, load_experiment
+from ._measure import _measure_imu, _measure_video, _read_track_csv, _sync, _table_from_imu
 from ._report import write_outputs
 
 __all__ = ["ExperimentResult", "run_experiment", "analyse_experiment", "fingerprint"]
@@ -147,122 +147,6 @@ def fingerprint(cfg: ExperimentConfig) -> str:
 
 # ---------------------------------------------------------------------------
 # measurement stages
-
-def _read_track_csv(path: Path, obj: str | None):
-    import pandas as pd
-
-    try:
-        df = pd.read_csv(path)
-    except Exception as e:  # noqa: BLE001 - pandas raises many types
-        raise InputError(f"{path}: not a readable CSV ({type(e).__name__})") from None
-    for c in ("t_s", "theta_rad"):
-        if c not in df.columns:
-            raise InputError(f"{path}, line 1: missing column {c!r}; a track CSV needs t_s, theta_rad")
-    if obj is not None and "object" in df.columns:
-        df = df[df["object"].astype(str) == obj]
-        if df.empty:
-            raise InputError(f"{path}: no rows for object {obj!r}; check [sources.track] object")
-    return df["t_s"].to_numpy(float), df["theta_rad"].to_numpy(float)
-
-
-def _is_grey(gray, image) -> bool:
-    """True when a decoded frame ``image`` (BGR) is ``gray`` in all three channels, i.e. carries
-    no colour (a grey source decodes to equal channels, which BGR→grey maps to themselves)."""
-    import cv2
-
-    if image.ndim == 2:
-        return True
-    s = image[::16, ::16]  # a colour picture almost always shows in the sample: skip the full check
-    if not (np.array_equal(s[..., 0], s[..., 1]) and np.array_equal(s[..., 1], s[..., 2])):
-        return False
-    # full check in OpenCV: ~1 ms at 1080p, a quarter of numpy's strided channel compare
-    return cv2.norm(image, cv2.cvtColor(gray, cv2.COLOR_GRAY2BGR), cv2.NORM_INF) == 0
-
-
-def _frame_keeper(decimation: int):
-    """``(jpeg, on_frame)``: ``on_frame(index, gray, image)`` (the ``track_video`` callback)
-    appends ``(index, JPEG bytes)`` for every ``decimation``-th frame to the list ``jpeg``.
-
-    The JPEG is in colour when the picture has colour, else one channel (smaller and
-    faster). ``cv2.imencode`` takes BGR and writes standard YCbCr JPEG, which Rerun's
-    ``EncodedImage`` decodes to RGB: no channel swap needed.
-    """
-    import cv2
-
-    jpeg: list = []
-
-    def keep(i, gray, image):  # encode the frames Rerun will show while they are decoded for tracking
-        if i % decimation == 0:
-            ok, buf = cv2.imencode(".jpg", gray if _is_grey(gray, image) else image,
-                                   [cv2.IMWRITE_JPEG_QUALITY, 80])
-            if ok:
-                jpeg.append((i, buf.tobytes()))
-
-    return jpeg, keep
-
-
-def _measure_video(cfg: ExperimentConfig, progress: bool, keep_jpeg: bool):
-    from ...tracking import load_track_config, track_video
-
-    tcfg = load_track_config(cfg.video.track_config) if cfg.video.track_config else None
-    jpeg, keep = _frame_keeper(cfg.video_decimation)
-    tr = track_video(cfg.video.path, tcfg, fps=cfg.video.fps, progress=progress,
-                     on_frame=keep if keep_jpeg else None)
-    df = tr.to_frame()
-    sel = df[df["object"] == cfg.video.object]
-    if sel.empty:
-        raise InputError(f"{cfg.path}: [sources.video] object {cfg.video.object!r} was never tracked in "
-                         f"{cfg.video.path.name}; objects seen: {sorted(set(df['object']))}")
-    table = None
-    if cfg.table.source in ("video", "imu") and tcfg is not None and tcfg.table is not None:
-        tm = tr.table_motion(cfg.table.object)
-        table = {"t_s": np.asarray(tm.t_s), "disp_m": np.asarray(tm.x_m),
-                 "vel_m_s": np.asarray(tm.vx_m_s), "acc_m_s2": np.asarray(tm.ax_m_s2)}
-    return (sel["t_s"].to_numpy(float), sel["theta_rad"].to_numpy(float)), table, tr, (jpeg if keep_jpeg else None)
-
-
-def _measure_imu(cfg: ExperimentConfig):
-    from ...tracking import block_rotation, read_imu
-
-    log = read_imu(cfg.imu.path, rate_hz=cfg.imu.rate_hz)
-    axis = None if cfg.imu.axis == "auto" else cfg.imu.axis
-    rot = block_rotation(log, axis=axis)
-    return (np.asarray(rot.t_s, float), np.asarray(rot.theta_rad, float)), rot
-
-
-def _table_from_imu(cfg: ExperimentConfig, video_table: dict | None, msgs: list):
-    """Table acceleration from the table IMU, on the video clock when the video tracked the table.
-
-    A 50 fps camera cannot measure a record's table acceleration (content above 25 Hz is lost;
-    on a synthetic El Centro run the 50 Hz samples turned a surviving block into an overturning
-    one), so the IMU (~256 Hz) drives the simulation; its clock is found by cross-correlating its
-    acceleration with the video's (t_imu = t_video + offset + drift t_video).
-    """
-    from ...tracking import read_imu, sync_offset, table_acceleration
-
-    log = read_imu(cfg.table.imu)
-    ta = table_acceleration(log, axis=None)
-    t, a = np.asarray(ta.t_s, float), np.asarray(ta.acc_m_s2, float)
-    out = {"t_s": t, "acc_m_s2": a}
-    sync = None
-    if video_table is not None:
-        s = sync_offset(t, a, video_table["t_s"], video_table["acc_m_s2"], max_offset_s=cfg.max_offset_s)
-        sync = s.to_dict()
-        # the video's sense of x is the reference: a_video = sign * a_imu
-        out = {"t_s": (t - s.offset_s) / (1.0 + s.drift), "acc_m_s2": s.sign * a}
-        for k in ("disp_m", "vel_m_s"):  # displacement and velocity stay the video's
-            out[k] = np.interp(out["t_s"], video_table["t_s"], video_table[k], left=np.nan, right=np.nan)
-    else:
-        msgs.append("table IMU used on its own clock: no tracked table on video to sync it with")
-    return out, sync
-
-
-def _sync(ref, rot, max_offset_s):
-    """Clock model t_imu = t_ref + offset + drift * t_ref from the rocking rates."""
-    from ...tracking import sync_imu_to_track
-
-    return sync_imu_to_track(rot, ref[0], ref[1], max_offset_s=max_offset_s)
-
 
 def analyse_experiment(cfg: ExperimentConfig, progress: bool = False,
                        keep_video: bool | None = None) -> ExperimentResult:

@@ -335,13 +335,21 @@ def _check_rigid(name, labels, xyz, poses, source) -> None:
                      f"to another body; list each body's points, e.g. {hint or '--body NAME=P1,P2,P3'}")
 
 
-def _body(name, labels, t, xyz, up, rest, tolerances, source, is_table=False, axes=None):
+def _fit_body(name, labels, t, xyz, rest, source):
+    """``(reference shape, rest used, notes, BodyPoses)`` of one body: its rest, then its pose in every sample."""
     ref, rest_used, notes = _choose_rest(t, xyz, rest, name, source)
     if (~np.isfinite(ref).all(axis=1)).sum() > len(labels) - MIN_POINTS:
         raise InputError(f"{where(source)}body {name!r}: fewer than {MIN_POINTS} of its points are placed at rest; "
                          "give --rest T0,T1 where the points are seen, or fix the --body list")
     poses = body_poses(xyz, ref)
     _check_rigid(name, labels, xyz, poses, source)
+    return ref, rest_used, notes, poses
+
+
+def _body(name, labels, t, up, tolerances, fitted, is_table=False, axes=None):
+    """:class:`Body3D` from a body's :func:`_fit_body` result (``axes``: the rocking axes to use)."""
+    ref, rest_used, notes, poses = fitted
+    notes = list(notes)
     R, tr = poses.R, poses.t_m
     if axes is None:
         axis, e_r, max_rot = rocking_axes(R, up)
@@ -432,16 +440,17 @@ def track_points3d(series: PointSeries, bodies: dict | None = None, up: str = "z
     notes = list(series.notes)
     out = []
     frame_xyz = None
+    table_rest = "first" if rest == "auto" else rest
     if tables:
         name = tables[0]
         sel = series.select(bodies[name])
-        tb, tnotes = _body(name, sel.labels, series.t_s, sel.xyz_m, u, "first" if rest == "auto" else rest,
-                           tolerances, series.source, is_table=True)
-        notes += tnotes
-        R_s = _smooth_rotations(tb.poses.R, series.t_s, TABLE_SMOOTH_S)
+        table_fit = _fit_body(name, sel.labels, series.t_s, sel.xyz_m, table_rest, series.source)
+        notes += table_fit[2]
+        poses = table_fit[3]
+        R_s = _smooth_rotations(poses.R, series.t_s, TABLE_SMOOTH_S)
         # the translation that goes with the averaged rotation, about the table targets' centroid
-        c_ref = np.nanmean(tb.poses.ref_m, axis=0)
-        t_s = tb.poses.t_m + np.einsum("nij,j->ni", tb.poses.R - R_s, c_ref)
+        c_ref = np.nanmean(poses.ref_m, axis=0)
+        t_s = poses.t_m + np.einsum("nij,j->ni", poses.R - R_s, c_ref)
         frame_xyz = (R_s, t_s)
     blocks = []
     for name, labels in bodies.items():
@@ -449,14 +458,14 @@ def track_points3d(series: PointSeries, bodies: dict | None = None, up: str = "z
             continue
         sel = series.select(labels)
         xyz = sel.xyz_m if frame_xyz is None else _in_frame(*frame_xyz, sel.xyz_m)
-        b, bnotes = _body(name, sel.labels, series.t_s, xyz, u, rest, tolerances, series.source)
+        b, bnotes = _body(name, sel.labels, series.t_s, u, tolerances,
+                          _fit_body(name, sel.labels, series.t_s, xyz, rest, series.source))
         notes += bnotes
         blocks.append(b)
     if tables:
         # the table's angles in the first block's rocking frame, so its x_m is the shake direction
         geo = blocks[0].geometry
-        tb, _ = _body(tables[0], tuple(bodies[tables[0]]), series.t_s, series.select(bodies[tables[0]]).xyz_m, u,
-                      "first" if rest == "auto" else rest, tolerances, series.source, is_table=True,
+        tb, _ = _body(tables[0], tuple(bodies[tables[0]]), series.t_s, u, tolerances, table_fit, is_table=True,
                       axes=(geo.axis, geo.e_r))
         out.append(tb)
     out += blocks

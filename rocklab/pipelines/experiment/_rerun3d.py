@@ -30,12 +30,13 @@ _TABLE = (140, 140, 140)
 
 
 def _pivot_world(b):
-    """The active pivot edge's position in the body's analysis axes, (n, 3) m (NaN where unknown)."""
+    """The active pivot edge's position in the body's analysis axes, (n, 3) m (NaN where unknown):
+    its rest position plus the displacement the tracker measured."""
     g = b.geometry
-    R, t = b.poses.R, b.poses.t_m
     c = np.where((b.theta_rad >= 0)[:, None], g.pivot_pos_m[None], g.pivot_neg_m[None])
-    tc = t + np.einsum("nij,j->ni", R, g.origin_m) - g.origin_m
-    return np.einsum("nij,nj->ni", R, c) + tc + g.origin_m
+    disp = (np.outer(b.pivot_slide_m, g.e_r) + np.outer(b.pivot_across_m, g.axis)
+            + np.outer(b.pivot_uplift_m, g.up))
+    return g.origin_m + c + disp
 
 
 def log_track3d(rec, series, result) -> None:

@@ -98,10 +98,11 @@ def _calibrate(args) -> int:
 
 
 def _track(args) -> int:
-    from ...._io import write_frame_atomic, write_json_atomic
+    import numpy as np
+
     from ....tracking.rigid import parse_bodies, track_points3d, write_points_csv
     from ....tracking.stereo import load_rig, stereo_point_series, track_dots_stereo
-    from ._cmd_track3d import _rest
+    from ._cmd_track3d import _rest, write_track3d_outputs
 
     if not args.calib:
         raise InputError("rocklab stereo track: give --calib stereo.json (from 'rocklab stereo calibrate')")
@@ -126,18 +127,9 @@ def _track(args) -> int:
     res = track_points3d(series, bodies, up="z", rest=rest)
     pts_path = out.with_name("points.csv")
     write_points_csv(series, pts_path)
-    write_frame_atomic(out, res.to_frame(), float_format="%.9g")
-    audit = res.audit_dict()
-    audit_path = out.with_name("audit.json")
-    write_json_atomic(audit_path, audit)
-    if args.rrd:
-        from ...experiment._rerun3d import write_track3d_rrd
-
-        write_track3d_rrd(args.rrd, series, res)
-    d = res.to_dict()
-    d.update(tracks_csv=str(out), audit_json=str(audit_path), points_csv=str(pts_path), verdict=audit["verdict"],
-             sync=None if sp.sync is None else sp.sync.to_dict(), bodies={k: list(v) for k, v in bodies.items()},
-             median_reprojection_px=float(__import__("numpy").nanmedian(sp.reproj_px)))
+    d = write_track3d_outputs(out, series, res, args.rrd)
+    d.update(points_csv=str(pts_path), sync=None if sp.sync is None else sp.sync.to_dict(),
+             bodies={k: list(v) for k, v in bodies.items()}, median_reprojection_px=float(np.nanmedian(sp.reproj_px)))
     lines = [f"note: {n}" for n in notes]
     if sp.sync is not None:
         lines.append(f"clock offset: camera 2 exposes {1e3 * sp.sync.offset_s:.4g} ms after camera 1 "
@@ -146,6 +138,6 @@ def _track(args) -> int:
                  f"bodies: " + ", ".join(f"{k} ({len(v)} points)" for k, v in bodies.items()))
     for b in res.blocks:
         lines.append(b.audit.report())
-    lines.append(f"wrote {pts_path}, {out} and {audit_path} (verdict {audit['verdict']})")
+    lines.append(f"wrote {pts_path}, {out} and {d['audit_json']} (verdict {d['verdict']})")
     _emit(args, d, lines)
     return 0

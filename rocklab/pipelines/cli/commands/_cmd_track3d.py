@@ -60,10 +60,28 @@ def _rest(spec: str):
     return (t0, t1)
 
 
+def write_track3d_outputs(out: Path, series, res, rrd=None) -> dict:
+    """Write ``tracks.csv`` at ``out``, ``audit.json`` beside it and the Rerun review at ``rrd`` (if given);
+    returns the summary (:meth:`Track3DResult.to_dict` with the paths and the verdict)."""
+    from ...._io import write_frame_atomic, write_json_atomic
+
+    write_frame_atomic(out, res.to_frame(), float_format="%.9g")
+    audit = res.audit_dict()
+    audit_path = out.with_name("audit.json")
+    write_json_atomic(audit_path, audit)
+    summary = res.to_dict()
+    summary.update(tracks_csv=str(out), audit_json=str(audit_path), verdict=audit["verdict"])
+    if rrd:
+        from ...experiment._rerun3d import write_track3d_rrd
+
+        write_track3d_rrd(rrd, series, res)
+        summary["rrd"] = str(rrd)
+    return summary
+
+
 def run(args) -> int:
     """Run ``rocklab track3d`` with parsed ``args``; returns the exit status (0 ok)."""
     from ...._errors import positive
-    from ...._io import write_frame_atomic, write_json_atomic
     from ....tracking.rigid import AuditTolerances, parse_bodies, read_points, track_points3d
 
     src = Path(args.points)
@@ -79,16 +97,7 @@ def run(args) -> int:
     series = read_points(src)
     bodies = parse_bodies(args.body, series.labels, series.source)
     res = track_points3d(series, bodies, up=args.up, rest=rest, tolerances=tol)
-    write_frame_atomic(out, res.to_frame(), float_format="%.9g")
-    audit = res.audit_dict()
-    write_json_atomic(audit_path, audit)
-    summary = res.to_dict()
-    summary.update(tracks_csv=str(out), audit_json=str(audit_path), verdict=audit["verdict"])
-    if args.rrd:
-        from ...experiment._rerun3d import write_track3d_rrd
-
-        write_track3d_rrd(args.rrd, series, res)
-        summary["rrd"] = str(args.rrd)
+    summary = write_track3d_outputs(out, series, res, args.rrd)
     if args.json:
         from .._cli_base import emit_json
 
@@ -106,5 +115,5 @@ def run(args) -> int:
         print(line)
         if b.audit is not None:
             print(b.audit.report())
-    print(f"wrote {out} and {audit_path} (verdict {audit['verdict']})")
+    print(f"wrote {out} and {audit_path} (verdict {summary['verdict']})")
     return 0

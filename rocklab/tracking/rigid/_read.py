@@ -147,8 +147,7 @@ def read_points_csv(path) -> PointSeries:
     times, ti = np.unique(t, return_inverse=True)
     if times.size < 2:
         raise InputError(f"{where(path)}only one sample time; need a time series")
-    pi = np.array([labels.index(s) for s in names]) if len(labels) < 64 else \
-        pd.Index(labels).get_indexer(names)
+    pi = pd.Index(labels).get_indexer(names)
     key = ti * len(labels) + pi
     _, first, counts = np.unique(key, return_index=True, return_counts=True)
     if (counts > 1).any():

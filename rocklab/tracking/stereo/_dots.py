@@ -435,13 +435,12 @@ def track_dots_stereo(film1, film2, rig: StereoRig, fps: float | None = None, sy
     """
     from ..video._video import iter_video_frames, probe_video
 
-    i1, i2 = probe_video(film1), probe_video(film2)
     rate1 = check_films(film1, film2, rig, fps)
     bar = None
     if progress:
         from tqdm import tqdm
 
-        bar = tqdm(total=i1.n_frames + i2.n_frames, unit="frame", desc="stereo", file=__import__("sys").stderr)
+        bar = tqdm(total=probe_video(film1).n_frames + probe_video(film2).n_frames, unit="frame", desc="stereo", file=__import__("sys").stderr)
     from concurrent.futures import ThreadPoolExecutor
 
     # one film per thread: decoding and the detector's OpenCV calls release the GIL, so two cores work

@@ -166,9 +166,9 @@ def _run_oas_batch(args, kw) -> int:
             sys.stderr.write(f"rocklab oas: error: {err}\n")
     tab = oas_table(items, units=args.units, slenderness=args.slenderness, oas_kwargs=kw, workers=args.workers,
                     scheduler=args.scheduler, progress=not args.no_progress, band=args.band)
-    for _, r in tab.iterrows():
-        if r["error"] and r["record"] not in [p for _, p, e in items if e]:
-            sys.stderr.write(f"rocklab oas: error: {r['error']}\n")
+    for (_, _, err), row_err in zip(items, tab["error"]):     # the table keeps the items' order
+        if row_err and not err:                                  # the expansion's errors are printed above
+            sys.stderr.write(f"rocklab oas: error: {row_err}\n")
     if args.out:
         out = Path(args.out)
         write_frame_atomic(out, tab, float_format="%.6g")

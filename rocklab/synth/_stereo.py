@@ -31,10 +31,12 @@ from pathlib import Path
 
 import numpy as np
 
+from ..tracking.stereo import DEFAULT_BOARD, charuco_board
+
 __all__ = ["StereoCamera", "synth_stereo", "look_at", "CHARUCO"]
 
-#: The calibration board: squares x rows, square and marker side (m), ArUco dictionary.
-CHARUCO = {"squares": (9, 6), "square_m": 0.03, "marker_m": 0.022, "dictionary": "DICT_5X5_100"}
+#: The calibration board: the one ``rocklab stereo calibrate`` expects by default.
+CHARUCO = DEFAULT_BOARD
 
 
 @dataclass(frozen=True)
@@ -102,13 +104,6 @@ def _cameras(size, f_px):
     c1 = StereoCamera(K, np.array([-0.06, 0.02, 0.0, 0.0, 0.0]), *look_at((-0.15, -0.98, 0.38), target), size)
     c2 = StereoCamera(K2, np.array([-0.05, 0.015, 0.0, 0.0, 0.0]), *look_at((0.15, -0.98, 0.38), target), size)
     return c1, c2
-
-
-def _board():
-    import cv2
-
-    d = cv2.aruco.getPredefinedDictionary(getattr(cv2.aruco, CHARUCO["dictionary"]))
-    return cv2.aruco.CharucoBoard(CHARUCO["squares"], CHARUCO["square_m"], CHARUCO["marker_m"], d)
 
 
 _RAYS: dict = {}
@@ -327,7 +322,7 @@ def synth_stereo(out_dir, *, size=(2400, 1728), fps: float = 150.0, f_px: float 
     rng = np.random.default_rng(seed)
     cams = _cameras(tuple(size), f_px)
     # the calibration film
-    board = _board()
+    board = charuco_board(CHARUCO)
     ppm = 4000.0
     bw = int(round(CHARUCO["squares"][0] * CHARUCO["square_m"] * ppm))
     bh = int(round(CHARUCO["squares"][1] * CHARUCO["square_m"] * ppm))

@@ -14,7 +14,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..._errors import InputError, where
 
 __all__ = ["kabsch", "BodyPoses", "body_poses", "reference_shape"]
 
@@ -201,9 +200,3 @@ def body_poses(xyz, ref, outlier_m: float | None = None) -> BodyPoses:
     rms[lost] = np.nan
     return BodyPoses(rot, t, rms, n_pts, status.astype(str), np.asarray(ref, float), int(drop.sum()))
 
-
-def check_body(series, labels, name: str) -> None:
-    """:class:`InputError` unless body ``name`` has three points seen together at least once."""
-    if len(labels) < MIN_POINTS:
-        raise InputError(f"{where(series.source)}body {name!r} has {len(labels)} point(s); a rigid pose needs at "
-                         f"least {MIN_POINTS} not on one line; add points to --body {name}=...")

@@ -19,7 +19,7 @@ import numpy as np
 
 from ..._errors import InputError, where
 
-__all__ = ["StereoRig", "calibrate_stereo", "load_rig", "DEFAULT_BOARD"]
+__all__ = ["StereoRig", "calibrate_stereo", "load_rig", "DEFAULT_BOARD", "charuco_board"]
 
 #: Default board: 9 x 6 squares of 30 mm, 22 mm markers, DICT_5X5_100.
 DEFAULT_BOARD = {"squares": (9, 6), "square_m": 0.03, "marker_m": 0.022, "dictionary": "DICT_5X5_100"}
@@ -100,7 +100,8 @@ def load_rig(path) -> StereoRig:
                          "'rocklab stereo calibrate'") from None
 
 
-def _board(spec):
+def charuco_board(spec: dict):
+    """The OpenCV ``CharucoBoard`` of a board ``spec`` (see :data:`DEFAULT_BOARD`)."""
     import cv2
 
     d = cv2.aruco.getPredefinedDictionary(getattr(cv2.aruco, spec["dictionary"]))
@@ -140,7 +141,7 @@ def calibrate_stereo(film1, film2, board: dict | None = None) -> StereoRig:
     import cv2
 
     spec = dict(DEFAULT_BOARD, **(board or {}))
-    b = _board(spec)
+    b = charuco_board(spec)
     obj_all = b.getChessboardCorners()
     det1, size1 = _detect(film1, b)
     det2, size2 = _detect(film2, b)

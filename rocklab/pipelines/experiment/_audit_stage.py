@@ -22,14 +22,9 @@ __all__ = ["audit_experiment", "fit_exclusions"]
 _3D_COLUMNS = ("pivot_slide_m", "pivot_uplift_m", "twist_rad", "out_of_plane_rad")
 
 
-def _from_tracks_csv(cfg):
-    import pandas as pd
-
+def _from_tracks_csv(df):
     from ...tracking.rigid import audit_rocking
 
-    df = pd.read_csv(cfg.track.path)
-    if cfg.track.object is not None and "object" in df.columns:
-        df = df[df["object"].astype(str) == cfg.track.object]
     t, th = df["t_s"].to_numpy(float), df["theta_rad"].to_numpy(float)
     sig = float(np.nanmedian(df["sigma_theta_rad"])) if "sigma_theta_rad" in df.columns else None
     if all(c in df.columns for c in _3D_COLUMNS):
@@ -60,14 +55,17 @@ def _from_video(cfg, tr, measured):
                                          "(use 3D points, rocklab track3d)")
 
 
-def audit_experiment(cfg, measured: dict, tr) -> dict:
-    """The ``audit`` object of ``report.json`` for the experiment's primary source."""
+def audit_experiment(cfg, measured: dict, tr, track_rows=None) -> dict:
+    """The ``audit`` object of ``report.json`` for the experiment's primary source.
+
+    ``tr`` is the video's TrackResult and ``track_rows`` the tracked CSV's rows (when those are sources).
+    """
     from ..._diagnostics import warn
 
     if cfg.primary == "video" and tr is not None:
         res = _from_video(cfg, tr, measured)
     elif cfg.primary == "track":
-        res = _from_tracks_csv(cfg)
+        res = _from_tracks_csv(track_rows)
     else:
         t, th = measured[cfg.primary]
         res = _theta_only(t, th, None, "imu", "an IMU: sliding, uplift and twist not checked")

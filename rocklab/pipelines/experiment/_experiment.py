@@ -160,6 +160,7 @@ def analyse_experiment(cfg: ExperimentConfig, progress: bool = False,
     measured: dict = {}
     table = None
     tr = None
+    track_rows = None
     jpeg = None
     t0 = time.perf_counter()
     if cfg.video is not None:
@@ -167,7 +168,8 @@ def analyse_experiment(cfg: ExperimentConfig, progress: bool = False,
         measured["video"], table, tr, jpeg = _measure_video(cfg, progress, keep_jpeg=keep)
         timings["track_s"] = time.perf_counter() - t0
     if cfg.track is not None:
-        measured["track"] = _read_track_csv(cfg.track.path, cfg.track.object)
+        track_rows = _read_track_csv(cfg.track.path, cfg.track.object)
+        measured["track"] = (track_rows["t_s"].to_numpy(float), track_rows["theta_rad"].to_numpy(float))
     rot = None
     if cfg.imu is not None:
         t1 = time.perf_counter()
@@ -218,7 +220,7 @@ def analyse_experiment(cfg: ExperimentConfig, progress: bool = False,
                                 timings_s=timings, frames=tr, column=column, video_jpeg=jpeg)
     from ._audit_stage import audit_experiment
 
-    audit = audit_experiment(cfg, measured, tr)
+    audit = audit_experiment(cfg, measured, tr, track_rows)
     if cfg.fit_restitution:
         from ...fitting import fit_restitution
 

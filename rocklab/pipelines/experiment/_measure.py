@@ -17,6 +17,7 @@ __all__: list[str] = []
 
 
 def _read_track_csv(path: Path, obj: str | None):
+    """The rows of ``obj`` in a tracked CSV (``t_s, theta_rad`` and whatever else it has), checked."""
     import pandas as pd
 
     try:
@@ -30,7 +31,7 @@ def _read_track_csv(path: Path, obj: str | None):
         df = df[df["object"].astype(str) == obj]
         if df.empty:
             raise InputError(f"{path}: no rows for object {obj!r}; check [sources.track] object")
-    return df["t_s"].to_numpy(float), df["theta_rad"].to_numpy(float)
+    return df
 
 
 def _is_grey(gray, image) -> bool:

@@ -341,16 +341,21 @@ def test_cli_track3d_real_qualisys_pelvis_is_not_planar_rocking(tmp_path, run_cl
 
 # --- the audit in an experiment run, and on a plane track ----------------------------------------
 
-def test_run_with_a_track3d_source_reports_the_audit(tmp_path, run_cli):
-    s = synth_points3d(seed=12, slide=(5, 1.5e-3))
+def _run_on_track3d(session, tmp_path, run_cli, figures: bool):
+    """``rocklab run`` of an experiment whose source is the session's track3d output; returns stderr."""
     with collecting():
-        res = track_points3d(s.series, s.bodies)
+        res = track_points3d(session.series, session.bodies)
     res.to_frame().to_csv(tmp_path / "tracks.csv", index=False)
     (tmp_path / "experiment.toml").write_text(
         '[block]\nb_m = 0.1\nh_m = 0.4\n[sources.track]\npath = "tracks.csv"\nobject = "block"\n'
-        '[simulate]\nlaws = ["eta_e"]\n[output]\nrrd = false\nfigures = false\n')
+        f'[simulate]\nlaws = ["eta_e"]\n[output]\nrrd = false\nfigures = {str(figures).lower()}\n')
     rc, out, err = run_cli("run", tmp_path / "experiment.toml", "--out", tmp_path / "out")
     assert rc == 0, err
+    return err
+
+
+def test_run_with_a_track3d_source_reports_the_audit(tmp_path, run_cli):
+    err = _run_on_track3d(synth_points3d(seed=12, slide=(5, 1.5e-3)), tmp_path, run_cli, figures=False)
     assert "W-AUDIT" in err
     rep = json.loads((tmp_path / "out" / "report.json").read_text())
     assert rep["status"] == "suspect"
@@ -383,14 +388,7 @@ def test_audit_plane_track_finds_a_slide_in_a_plane_track():
 
 def test_run_names_the_fit_impacts_the_audit_flagged(tmp_path, run_cli):
     s = synth_points3d(seed=14, jump=(4, 3e-3))
-    with collecting():
-        res = track_points3d(s.series, s.bodies)
-    res.to_frame().to_csv(tmp_path / "tracks.csv", index=False)
-    (tmp_path / "experiment.toml").write_text(
-        '[block]\nb_m = 0.1\nh_m = 0.4\n[sources.track]\npath = "tracks.csv"\nobject = "block"\n'
-        '[simulate]\nlaws = ["eta_e"]\n[output]\nrrd = false\nfigures = true\n')
-    rc, out, err = run_cli("run", tmp_path / "experiment.toml", "--out", tmp_path / "out")
-    assert rc == 0, err
+    _run_on_track3d(s, tmp_path, run_cli, figures=True)
     assert (tmp_path / "out" / "figures" / "theta.png").stat().st_size > 10_000
     rep = json.loads((tmp_path / "out" / "report.json").read_text())
     ex = rep["fit"]["excluded_impacts"]

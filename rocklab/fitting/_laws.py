@@ -8,6 +8,7 @@ from __future__ import annotations
 import numpy as np
 
 from .._errors import InputError
+from ..models import eta_housner, eta_modified  # noqa: F401  (re-exported: the calibration's laws)
 
 __all__ = ["eta_housner", "eta_modified", "k_from_eta", "edge_contact_k", "alpha_from_hb"]
 
@@ -16,30 +17,6 @@ def alpha_from_hb(hb):
     """Slenderness angle α = atan(b/h) from the aspect ratio h/b, rad."""
     hb = np.asarray(hb, dtype=float)
     return np.arctan2(1.0, hb)
-
-
-def eta_housner(alpha_rad):
-    """Housner's restitution η_H = 1 − 3/2 sin²α (Čeh Eq. 13, uniform prism)."""
-    s2 = np.sin(np.asarray(alpha_rad, dtype=float)) ** 2
-    return 1.0 - 1.5 * s2
-
-
-def eta_modified(alpha_rad, k):
-    """Modified restitution η_M(α, k) of Kalliontzis/Chatzis (Čeh Eq. 14).
-
-    η_M = [4 − 3 sin²α (1 + k²)] / [4 − 3 sin²α (1 − k²)], k = 2 b̄ / b the
-    position of the contact impulse (k = 1: Housner, impulse at the corner).
-
-    Parameters
-    ----------
-    alpha_rad : float or array
-        Slenderness angle, rad.
-    k : float or array
-        Dimensionless impulse position, 0 ≤ k (k > 1 is returned but unphysical).
-    """
-    s2 = np.sin(np.asarray(alpha_rad, dtype=float)) ** 2
-    k2 = np.asarray(k, dtype=float) ** 2
-    return (4.0 - 3.0 * s2 * (1.0 + k2)) / (4.0 - 3.0 * s2 * (1.0 - k2))
 
 
 def k_from_eta(alpha_rad, eta_rb):

@@ -18,7 +18,8 @@ from .mechanisms import (FundamentalParameters, Mechanism, arch_mechanism, asymm
                          equivalence_errors, four_bar_mechanism, frame_parameters, free_rocking_period_eq24,
                          linear_sine_pulse_response, overturning_time_eq25, sine_pulse_max_response,
                          strut_parameters, wall_mechanism, wall_parameters)
-from .rocking import (RESTITUTION_LAWS, BatchResult, Restitution, RockingResult, block_energy,
+from .rocking import (RESTITUTION_LAWS, BatchResult, Restitution, RockingResult, block_energy, eta_axes,
+                      eta_bumps, eta_housner, eta_modified,
                       free_rocking_overturns, make_restitution, simulate, simulate_batch)
 from .spectra import (BAND_ENSEMBLE, BUNDLED_RECORDS, F_SINE, PULSE_KINDS, UNITS_TO_M_S2, BaseMotion, DesignCheck,
                       OASResult, OverturningCurve, PulseParameters, TIBand, bundled_record, critical_impulse,
@@ -27,7 +28,7 @@ from .spectra import (BAND_ENSEMBLE, BUNDLED_RECORDS, F_SINE, PULSE_KINDS, UNITS
                       pulse_shape, required_width, required_width_slender, simplified_oas, t_I_band)
 
 __all__ = ["BaseMotion", "load_base_motion", "UNITS_TO_M_S2", "bundled_record", "BUNDLED_RECORDS",
-           "simulate", "RockingResult", "block_energy", "simulate_batch", "free_rocking_overturns", "BatchResult",
+           "simulate", "eta_housner", "eta_modified", "eta_axes", "eta_bumps", "RockingResult", "block_energy", "simulate_batch", "free_rocking_overturns", "BatchResult",
            "RESTITUTION_LAWS", "Restitution", "make_restitution",
            "PulseParameters", "pulse_parameters", "lobe_impulses", "pulse_shape", "pulse_motion",
            "pulse_fullness", "PULSE_KINDS", "F_SINE",

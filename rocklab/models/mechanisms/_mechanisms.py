@@ -44,7 +44,15 @@ def four_bar_mechanism(A, B, C, D, bodies, name: str = "four-bar") -> Mechanism:
         Rigid bodies attached to link AB, coupler BC and link CD: mass, centre of
         mass at rest (m) and moment of inertia about it.
     name : str
+        Label used in errors and reports.
 
+    Returns
+    -------
+    Mechanism
+        The one-degree-of-freedom mechanism in the coordinate phi.
+
+    Notes
+    -----
     The coordinate phi is the clockwise rotation of AB about A (paper: phi = phi_0 - varphi);
     C follows from the loop closure on the branch of the rest configuration.
     Derivatives are central differences of the exact kinematics.

@@ -104,20 +104,30 @@ def _geom(block):
     return K, R * math.sin(a)
 
 
-def eta_housner(alpha_rad: float, alpha_I: float = 4.0 / 3.0) -> float:
-    """Housner's eta = 1 - 2 sin^2(alpha)/alpha_I (Čeh Eq. 13 for alpha_I = 4/3; thesis Eq. 1)."""
-    return 1.0 - 2.0 * math.sin(alpha_rad) ** 2 / alpha_I
+def _out(x):
+    """A 0-d result as a Python float, arrays unchanged."""
+    return float(x) if np.ndim(x) == 0 else x
 
 
-def eta_modified(alpha_rad: float, k: float, alpha_I: float = 4.0 / 3.0) -> float:
+def eta_housner(alpha_rad, alpha_I: float = 4.0 / 3.0):
+    """Housner's eta = 1 - 2 sin^2(alpha)/alpha_I (Čeh Eq. 13 for alpha_I = 4/3; thesis Eq. 1).
+
+    Vectorised: ``alpha_rad`` (rad) may be a float or an array of any shape.
+    """
+    return _out(1.0 - 2.0 * np.sin(np.asarray(alpha_rad, float)) ** 2 / alpha_I)
+
+
+def eta_modified(alpha_rad, k, alpha_I: float = 4.0 / 3.0):
     """Modified eta_M(k) (Čeh Eq. 14): impulse resultant at ``k`` half-widths from the middle.
 
     For alpha_I = 4/3 this is ``(4 - 3 s^2 (1 + k^2)) / (4 - 3 s^2 (1 - k^2))``,
     s = sin(alpha); it equals thesis Eq. A3 with axes at ``-k b/2`` and ``+k b/2``.
-    ``k = 1`` is Housner, ``k = 0`` no loss.
+    ``k = 1`` is Housner, ``k = 0`` no loss. Vectorised over ``alpha_rad`` (rad) and ``k``;
+    k > 1 (impulse outside the base) is returned as computed but is unphysical.
     """
-    s2 = math.sin(alpha_rad) ** 2
-    return (alpha_I - s2 - k * k * s2) / (alpha_I - s2 + k * k * s2)
+    s2 = np.sin(np.asarray(alpha_rad, float)) ** 2
+    k2 = np.asarray(k, float) ** 2
+    return _out((alpha_I - s2 - k2 * s2) / (alpha_I - s2 + k2 * s2))
 
 
 def eta_axes(block, x1_m: float, x2_m: float) -> float:

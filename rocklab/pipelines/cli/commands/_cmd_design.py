@@ -208,8 +208,8 @@ def run_design(args) -> int:
     if args.json:
         _emit(d)
     else:
-        print(f"required width {d['width_m']:.4f} m (Eq. 21 exact; i_cr = 1: {d['width_eq31_m']:.4f} m, "
-              f"slender: {d['width_slender_m']:.4f} m, no uplift: {d['width_no_uplift_m']:.4f} m)")
+        print(f"required width {d['width_m']:.4g} m (Eq. 21 exact; i_cr = 1: {d['width_eq31_m']:.4g} m, "
+              f"slender: {d['width_slender_m']:.4g} m, no uplift: {d['width_no_uplift_m']:.4g} m)")
     return 0
 
 

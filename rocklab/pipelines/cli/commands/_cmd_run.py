@@ -34,6 +34,8 @@ def run(args) -> int:
         print(f"{args.out}: inputs and config unchanged; nothing to do (use --force to re-run)")
     else:
         f = report.get("fit") or {}
-        print(f"{report['name']}: {report['status']}; eta_e = {f.get('eta_e')}, "
+        eta = f.get("eta_e")
+        eta_s = f"{eta:.4g}" if isinstance(eta, (int, float)) else "not fitted"
+        print(f"{report['name']}: {report['status']}; eta_e = {eta_s}, "
               f"outputs in {args.out} (summary.md, report.json, session.rrd)", file=sys.stdout)
     return 0 if report.get("status") != "failed" else 1

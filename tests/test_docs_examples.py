@@ -1,0 +1,66 @@
+"""The documentation's examples run as written: ``console`` blocks as shell commands, ``pycon`` as doctests.
+
+A ``console`` block holds ``$ command`` lines, each followed by its expected output; ``...``
+matches anything (doctest's ELLIPSIS), whitespace differences are ignored. All blocks of a page
+run in order in one empty folder, so later commands use earlier outputs, as a reader would.
+"""
+
+from __future__ import annotations
+
+import doctest
+import os
+import re
+import shlex
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+PAGES = ["getting-started.md"]
+FENCE = re.compile(r"^```(console|pycon)\n(.*?)^```", re.M | re.S)
+CHECK = doctest.OutputChecker()
+FLAGS = doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE
+
+
+def _console_steps(body: str):
+    """(command, expected output) pairs of one console block."""
+    steps: list[list] = []
+    for line in body.splitlines():
+        if line.startswith("$ "):
+            steps.append([line[2:], []])
+        elif steps:
+            steps[-1][1].append(line)
+    return [(cmd, "\n".join(out).strip() + "\n") for cmd, out in steps]
+
+
+def _env():
+    env = dict(os.environ)
+    env["PATH"] = str(Path(sys.executable).parent) + os.pathsep + env.get("PATH", "")
+    env["COLUMNS"] = "200"
+    return env
+
+
+@pytest.mark.parametrize("page", PAGES)
+def test_page_examples_run_as_written(page, tmp_path, monkeypatch):
+    text = (ROOT / "docs" / page).read_text(encoding="utf-8")
+    blocks = FENCE.findall(text)
+    assert sum(kind == "console" for kind, _ in blocks) >= 3
+    monkeypatch.chdir(tmp_path)
+    n_cmd = 0
+    for kind, body in blocks:
+        if kind == "pycon":
+            test = doctest.DocTestParser().get_doctest(body, {}, page, page, 0)
+            runner = doctest.DocTestRunner(optionflags=FLAGS)
+            runner.run(test, out=lambda s: pytest.fail(f"{page}: doctest failed:\n{s}"))
+            assert runner.tries >= 3
+            continue
+        for cmd, want in _console_steps(body):
+            argv = shlex.split(cmd)
+            assert argv[0] == "rocklab", cmd
+            p = subprocess.run(argv, capture_output=True, text=True, env=_env(), timeout=300)
+            assert p.returncode == 0, f"{cmd}\n{p.stderr}"
+            assert CHECK.check_output(want, p.stdout, FLAGS), f"{cmd}\nexpected:\n{want}\ngot:\n{p.stdout}"
+            n_cmd += 1
+    assert n_cmd >= 6

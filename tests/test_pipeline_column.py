@@ -57,17 +57,20 @@ def test_model_follows_the_tracked_blocks(column_run):
         assert rows[f"/experiment/{o}/theta/measured_video"] > 100
         assert f"/experiment/{o}/theta/sim_column" in rows
     assert rows["/experiment/column/configurations"] >= 4
-    # every 10th frame of the video, encoded while it was decoded for tracking
+    # every frame of the film (video_decimation is for the JPEG fallback only): one AV1 asset
+    # (a static row) and a frame reference per frame, encoded while decoded for tracking
     n_frames = json.loads((out.parent / "s" / "session.json").read_text())["n_frames"]
-    assert rows["/experiment/video"] == -(-n_frames // 10)
+    assert rows["/experiment/video"] == n_frames + 1
+    rep = json.loads((out / "report.json").read_text())
+    assert rep["review_video"]["kind"] == "av1" and rep["review_video"]["frames"] == n_frames
     assert (out / "figures" / "column.png").is_file()
     assert json.loads((out / "report.json").read_text())["column"]["status"] in ("rest", "rocking")
 
 
 def test_video_overlays_in_rrd(column_run):
-    """Target points and block outlines are logged on the decimated video frames."""
+    """Target points and block outlines are logged on every video frame."""
     _, out = column_run
     rows = read_rrd_summary(out / "session.rrd")
-    n_video = rows["/experiment/video"]
+    n_video = rows["/experiment/video"] - 1  # less the static video asset
     assert rows["/experiment/video/outline"] == n_video   # three outlines per frame, one entity row
     assert rows["/experiment/video/targets"] == n_video

@@ -26,3 +26,29 @@ def test_series_and_events_round_trip(tmp_path):
     tt, vv = read_rrd_scalars(path, "experiment/block_1/theta/sim_housner")
     assert tt.size == 401
     assert np.allclose(tt, t, atol=1e-9) and np.allclose(vv, th, rtol=0, atol=1e-12)
+
+
+def test_review_opens_on_the_impact_with_the_largest_residual(tmp_path):
+    from types import SimpleNamespace
+
+    import pandas as pd
+
+    from rocklab.pipelines.experiment._log_experiment import _focus
+
+    t = np.linspace(0, 3, 3001)
+    sim = 0.05 * np.cos(6 * t)
+    impacts = pd.DataFrame({"t_s": [0.25, 0.77, 1.30, 1.82, 2.35]})
+    measured = sim.copy()
+    measured[(t > 1.75) & (t < 1.86)] += 0.004  # the model misses most around the 4th impact
+    res = SimpleNamespace(simulations={"eta_e": {"t_s": t, "theta_rad": sim, "impacts": impacts}})
+    t_imp, t0, t1 = _focus(res, t, measured)
+    assert t_imp == 1.82 and t0 < 1.82 - 0.5 < 1.82 + 0.5 < t1 < 1.82 + 2  # a few half-cycles around it
+    assert _focus(SimpleNamespace(simulations={}), t, measured) is None
+    # the blueprint carries that window to the time panel and the plots
+    path = tmp_path / "b.rrd"
+    rec = open_recording("rocklab_test", path, recording_id="b")
+    log_series(rec, "experiment/block_1/theta/measured_video", t, measured)
+    rec.send_blueprint(experiment_blueprint(["experiment/block_1"], has_video=True, focus=(t_imp, t0, t1)))
+    rec.flush()
+    rec.disconnect()
+    assert read_rrd_summary(path)["/experiment/block_1/theta/measured_video"] == t.size

@@ -36,6 +36,24 @@ def _session(tmp_path, seed=0, eta=ETA_TRUE, contact="full"):
     return d / "experiment.toml"
 
 
+def _series_styles(rrd):
+    """Entity → (RGBA, width, name) of every static SeriesLines style in a recording."""
+    import rerun.chunk as rc
+
+    out = {}
+    for ch in rc.RrdReader(str(rrd)).stream().collect().stream():
+        if not ch.is_static:
+            continue
+        rb = ch.to_record_batch()
+        cols = {n.split(":")[-1]: rb.column(i).to_pylist()[0] for i, n in enumerate(rb.schema.names)
+                if n.startswith("SeriesLines:")}
+        if "colors" in cols:
+            c = int(cols["colors"][0])
+            out[str(ch.entity_path)] = ([(c >> 24) & 255, (c >> 16) & 255, (c >> 8) & 255, c & 255],
+                                        float((cols.get("widths") or [0.0])[0]), (cols.get("names") or [""])[0])
+    return out
+
+
 def test_run_writes_report_figures_and_rrd(tmp_path, run_cli):
     cfg = _session(tmp_path)
     out = tmp_path / "out"
@@ -66,6 +84,17 @@ def test_run_writes_report_figures_and_rrd(tmp_path, run_cli):
     assert "/experiment/block_1/theta/sim_eta_e" in rows and "/experiment/block_1/impacts" in rows
     tt, vv = read_rrd_scalars(out / "session.rrd", "experiment/block_1/theta/measured_track")
     assert np.allclose(vv, ser["theta_track_rad"].to_numpy()[np.isfinite(ser["theta_track_rad"])])
+    td, vd = read_rrd_scalars(out / "session.rrd", "experiment/block_1/theta_deg/measured_track")
+    assert np.allclose(td, tt) and np.allclose(vd, np.degrees(vv), rtol=1e-12)  # θ also in degrees
+    # measured bold and dark, each simulation its own colour and named with its η
+    styles = _series_styles(out / "session.rrd")
+    colour, width, _ = styles["/experiment/block_1/theta/measured_track"]
+    assert max(colour[:3]) <= 60 and width >= 2.5
+    sims = {k: v for k, v in styles.items() if "/theta/sim_" in k}
+    assert len(sims) >= 3 and len({tuple(c[:3]) for c, _, _ in sims.values()}) == len(sims)
+    assert all(w < width for _, w, _ in sims.values())
+    eta_e = rep["simulations"]["eta_e"]["eta"]
+    assert styles["/experiment/block_1/theta/sim_eta_e"][2] == f"sim eta_e (η = {eta_e:.4g})"
 
     # unchanged inputs: a no-op; --force re-runs
     mtime = (out / "report.json").stat().st_mtime_ns

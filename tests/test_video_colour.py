@@ -40,16 +40,19 @@ def videos(tmp_path_factory):
     return out
 
 
-def _track(path, decimation=2):
-    from rocklab.pipelines.experiment._measure import _frame_keeper
+def _track(path, decimation=2, codec="jpeg"):
+    """Track the clip while the review film is made; (tracking, [(index, JPEG)]) or, for AV1,
+    (tracking, ReviewVideo)."""
+    from rocklab.pipelines.experiment._review_video import ReviewFilm
     from rocklab.tracking import TrackConfig, track_video
 
     cfg = TrackConfig.from_dict({"targets": {"style": "aruco", "marker_size_m": 0.05},
                                  "reference": {"level": "none"},  # rendered level
                                  "objects": [{"id": "block_1", "markers": [1]}]})
-    jpeg, keep = _frame_keeper(decimation)
-    tr = track_video(path, cfg, fps=50.0, on_frame=keep)
-    return tr, jpeg
+    film = ReviewFilm(50.0, decimation, codec=codec)
+    tr = track_video(path, cfg, fps=50.0, on_frame=film)
+    out = film.finish()
+    return tr, (out if codec != "jpeg" else list(zip(out.frame_index, out.stills)))
 
 
 def _decode(data):
@@ -108,10 +111,48 @@ def test_grey_source_stays_one_channel(videos):
 
 
 def test_is_grey_detects_colour_hidden_from_the_sample():
-    from rocklab.pipelines.experiment._measure import _is_grey
+    from rocklab.pipelines.experiment._review_video import _is_grey
 
     g = np.random.default_rng(1).integers(0, 256, (H, W), dtype=np.uint8)
     img = cv2.merge([g, g, g])
     assert _is_grey(cv2.cvtColor(img, cv2.COLOR_BGR2GRAY), img) and _is_grey(g, g)
     img[5, 7, 2] ^= 1  # one unit of red, off the 16-px sample grid
     assert not _is_grey(cv2.cvtColor(img, cv2.COLOR_BGR2GRAY), img)
+
+
+def test_av1_film_has_every_frame_in_order_and_in_colour(videos, tmp_path):
+    """The review film: one AV1 asset, a frame reference per frame, each frame the right picture."""
+    import av
+    import io
+
+    import rerun.chunk as rc
+
+    from rocklab.pipelines.experiment._rerun import log_video_asset, open_recording
+
+    tr, film = _track(videos["colour"], codec="libsvtav1")
+    assert film.kind == "av1" and film.frame_index == tuple(range(N)) and film.size_px == (W, H)
+    # each decoded frame shows frame i's red square where frame i has it (not a neighbour's):
+    # the square moves 4 px per frame, so a one-frame slip moves its left edge by 4 px
+    with av.open(io.BytesIO(film.data)) as c:
+        dec = [f.to_ndarray(format="bgr24") for f in c.decode(video=0)]
+    assert len(dec) == N
+    for i, bgr in enumerate(dec):
+        bgr = bgr[:H, :W]
+        x0 = 20 + 4 * i
+        b, g, r = bgr[25:75, x0 + 5:x0 + 55].reshape(-1, 3).mean(axis=0)
+        assert r > 150 and b < 90 and g < 90, (i, b, g, r)
+        assert bgr[50, x0 + 2, 2] > 150 and bgr[50, x0 - 3, 0] > 150, i
+    rrd = tmp_path / "v.rrd"
+    rec = open_recording("test_av1", rrd)
+    assert log_video_asset(rec, "experiment/video", film.data, film.frame_index, 50.0) == N
+    rec.flush()
+    rec.disconnect()
+    refs, asset = 0, 0
+    for ch in rc.RrdReader(str(rrd)).stream().collect().stream():
+        if str(ch.entity_path) == "/experiment/video":
+            names = ch.to_record_batch().schema.names
+            refs += ch.num_rows if any("VideoFrameReference" in n for n in names) else 0
+            asset += ch.num_rows if any("AssetVideo:blob" in n for n in names) else 0
+    assert refs == N and asset == 1
+    with pytest.raises(ValueError, match="frames"):
+        log_video_asset(open_recording("x", tmp_path / "x.rrd"), "v", film.data, film.frame_index[:-1], 50.0)

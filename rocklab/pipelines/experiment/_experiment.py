@@ -78,7 +78,7 @@ class ExperimentResult:
     timings_s: dict = field(default_factory=dict)
     frames: object = None  # optional per-frame overlay data from the tracker
     column: dict | None = None  # column experiments: see rocklab.pipelines.experiment._column_run
-    video_jpeg: list | None = None  # (frame index, JPEG bytes) of the frames to show in Rerun
+    video: object = None  # the review film (rocklab.pipelines.experiment._review_video.ReviewVideo)
     diagnostics: tuple = ()  # rocklab._diagnostics.Diagnostic raised while analysing
     audit: dict | None = None  # rocklab.pipelines.experiment._audit_stage.audit_experiment
 
@@ -114,6 +114,9 @@ class ExperimentResult:
             "column": None if self.column is None else {
                 k: self.column[k] for k in ("objects", "status", "comparison", "cut_m", "impacts_per_closing",
                                             "sequence_vs_truth", "theta_rms_error_rad") if k in self.column},
+            "review_video": None if self.video is None else {
+                "kind": self.video.kind, "frames": len(self.video.frame_index), "bytes": self.video.n_bytes,
+                "note": self.video.note},
             "timings_s": self.timings_s,
             "units": {"t": "s", "theta": "rad", "omega": "rad/s", "length": "m", "energy": "J",
                       "acceleration": "m/s^2"},
@@ -126,7 +129,7 @@ def _versions() -> dict:
     import importlib.metadata as md
 
     out = {"rocklab": __version__}
-    for pkg in ("numpy", "scipy", "pandas", "numba", "opencv-python-headless", "rerun-sdk", "imufusion"):
+    for pkg in ("numpy", "scipy", "pandas", "numba", "opencv-python-headless", "rerun-sdk", "imufusion", "av"):
         try:
             out[pkg] = md.version(pkg)
         except md.PackageNotFoundError:
@@ -152,7 +155,7 @@ def analyse_experiment(cfg: ExperimentConfig, progress: bool = False,
                        keep_video: bool | None = None) -> ExperimentResult:
     """Run every stage of one experiment in memory (no files written).
 
-    ``keep_video``: JPEG-encode the frames Rerun will show while they are decoded for
+    ``keep_video``: encode the review film (every frame, AV1) while the frames are decoded for
     tracking (default: when the config writes ``session.rrd``).
     """
     msgs: list[str] = []
@@ -161,11 +164,13 @@ def analyse_experiment(cfg: ExperimentConfig, progress: bool = False,
     table = None
     tr = None
     track_rows = None
-    jpeg = None
+    film = None
     t0 = time.perf_counter()
     if cfg.video is not None:
         keep = cfg.rrd if keep_video is None else keep_video
-        measured["video"], table, tr, jpeg = _measure_video(cfg, progress, keep_jpeg=keep)
+        measured["video"], table, tr, film = _measure_video(cfg, progress, keep_film=keep)
+        if film is not None and film.kind != "av1":
+            msgs.append(f"review video: {film.note}")
         timings["track_s"] = time.perf_counter() - t0
     if cfg.track is not None:
         track_rows = _read_track_csv(cfg.track.path, cfg.track.object)
@@ -217,7 +222,7 @@ def analyse_experiment(cfg: ExperimentConfig, progress: bool = False,
         return ExperimentResult(name=cfg.name, config=cfg, block=block, measured=measured, primary=cfg.primary,
                                 sync=sync, video_imu_residual=residual, fit=None, per_impact_eta=per_imp,
                                 simulations={}, table=table, truth=None, status=status, messages=msgs,
-                                timings_s=timings, frames=tr, column=column, video_jpeg=jpeg)
+                                timings_s=timings, frames=tr, column=column, video=film)
     from ._audit_stage import audit_experiment
 
     audit = audit_experiment(cfg, measured, tr, track_rows)
@@ -248,7 +253,7 @@ def analyse_experiment(cfg: ExperimentConfig, progress: bool = False,
     return ExperimentResult(name=cfg.name, config=cfg, block=block, measured=measured,
                             primary=cfg.primary, sync=sync, video_imu_residual=residual, fit=fit_d,
                             per_impact_eta=per_imp, simulations=sims, table=table, truth=truth,
-                            status=status, messages=msgs, timings_s=timings, frames=tr, video_jpeg=jpeg, audit=audit)
+                            status=status, messages=msgs, timings_s=timings, frames=tr, video=film, audit=audit)
 
 
 def _eta_for_law(law, cfg, block, fit_d, msgs):
@@ -384,7 +389,7 @@ def run_experiment(config_path, out_dir, *, force: bool = False, spawn: bool = F
 
 def _space_needed(cfg: ExperimentConfig) -> int:
     """Bytes an experiment's outputs may take: 20 MB of tables and figures plus, for the Rerun
-    recording, half the size of the video (JPEG frames at the tracker's decimation)."""
+    recording, at most half the size of the video (the AV1 review film is far smaller)."""
     need = 20 * 1024 * 1024
     if cfg.rrd and cfg.video is not None:
         try:

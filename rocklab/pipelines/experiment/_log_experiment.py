@@ -5,11 +5,56 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._rerun import close_recording, experiment_blueprint, log_events, log_series, log_video_frames, open_recording
+from ._rerun import (close_recording, experiment_blueprint, log_events, log_series, log_video_asset, log_video_frames,
+                     open_recording)
 
 __all__ = ["log_experiment"]
 
 ROOT = "experiment"
+
+#: Measured data dark and bold, every simulation its own colour (Okabe-Ito, colour-blind safe),
+#: the synthetic truth thin grey: (RGB, line width in points).
+STYLE = {
+    "measured_video": ([0, 0, 0], 3.0), "measured_imu": ([90, 55, 20], 2.5), "measured_track": ([0, 0, 0], 3.0),
+    "truth": ([150, 150, 150], 1.0), "sim_column": ([0, 114, 178], 1.5),
+}
+SIM_COLOURS = {"housner": [230, 159, 0], "eta_e": [0, 114, 178], "modified": [0, 158, 115],
+               "eta_e_first": [204, 121, 167], "given": [213, 94, 0]}
+_SPARE = [[86, 180, 233], [240, 228, 66], [204, 121, 167]]
+
+
+def _style(key: str, i: int = 0):
+    if key in STYLE:
+        return STYLE[key]
+    law = key.removeprefix("sim_")
+    return SIM_COLOURS.get(law, _SPARE[i % len(_SPARE)]), 1.5
+
+
+def _theta(rec, bp: str, key: str, t, th, name: str, i: int = 0) -> int:
+    """θ of one series in rad and in degrees (``theta`` and ``theta_deg``), in its colour."""
+    colour, width = _style(key, i)
+    n = log_series(rec, f"{bp}/theta/{key}", t, th, color=colour, width=width, name=name)
+    log_series(rec, f"{bp}/theta_deg/{key}", t, np.degrees(np.asarray(th, float)), color=colour, width=width,
+               name=name)
+    return n
+
+
+def _focus(res, t_p, th_p):
+    """(t_impact_s, t0_s, t1_s): the impact nearest the largest |measured − simulated| and a
+    window of a few half-cycles around it, for the blueprint to open on; None without one."""
+    ref = res.simulations.get("eta_e") or next(iter(res.simulations.values()), None)
+    if ref is None or ref.get("impacts") is None or not len(ref["impacts"]):
+        return None
+    sim_on = np.interp(t_p, ref["t_s"], ref["theta_rad"], left=np.nan, right=np.nan)
+    r = np.abs(np.asarray(th_p, float) - sim_on)
+    if not np.isfinite(r).any():
+        return None
+    t_worst = float(np.asarray(t_p, float)[int(np.nanargmax(r))])
+    ti = ref["impacts"]["t_s"].to_numpy(float)
+    k = int(np.argmin(np.abs(ti - t_worst)))
+    gap = np.diff(ti)
+    half = float(np.median(gap)) if len(gap) else 0.2
+    return float(ti[k]), float(ti[k] - 2.5 * half), float(ti[k] + 2.5 * half)
 
 
 def _overlay_fn(res):
@@ -64,23 +109,25 @@ def log_experiment(res, rrd_path=None, *, spawn: bool = False, connect: str | No
         f"contact {res.config.contact}", media_type="text/markdown"), static=True)
 
     for name, (t, th) in res.measured.items():
-        rows[f"{blk}/theta/measured_{name}"] = log_series(rec, f"{blk}/theta/measured_{name}", t, th,
-                                                          name=f"measured ({name})")
-    for law, s in res.simulations.items():
-        p = f"{blk}/theta/sim_{law}"
-        rows[p] = log_series(rec, p, s["t_s"], s["theta_rad"], name=f"sim {law} η={s['eta']:.3f}")
-        rows[f"{blk}/energy/sim_{law}"] = log_series(rec, f"{blk}/energy/sim_{law}", s["t_s"], s["energy_J"])
+        rows[f"{blk}/theta/measured_{name}"] = _theta(rec, blk, f"measured_{name}", t, th, f"measured ({name})")
+    for i, (law, s) in enumerate(res.simulations.items()):
+        rows[f"{blk}/theta/sim_{law}"] = _theta(rec, blk, f"sim_{law}", s["t_s"], s["theta_rad"],
+                                                f"sim {law} (η = {s['eta']:.4g})", i)
+        colour, width = _style(f"sim_{law}", i)
+        rows[f"{blk}/energy/sim_{law}"] = log_series(rec, f"{blk}/energy/sim_{law}", s["t_s"], s["energy_J"],
+                                                     color=colour, width=width, name=f"sim {law} (J)")
     if res.truth is not None:
-        rows[f"{blk}/theta/truth"] = log_series(rec, f"{blk}/theta/truth", res.truth["t_s"],
-                                                res.truth["theta_rad"], name="truth")
+        rows[f"{blk}/theta/truth"] = _theta(rec, blk, "truth", res.truth["t_s"], res.truth["theta_rad"], "truth")
     if res.video_imu_residual is not None:
         rows[f"{blk}/residual/video_minus_imu"] = log_series(
             rec, f"{blk}/residual/video_minus_imu", *res.video_imu_residual)
     t_p, th_p = res.measured[res.primary]
-    for law, s in res.simulations.items():
+    for i, (law, s) in enumerate(res.simulations.items()):
         sim_on = np.interp(t_p, s["t_s"], s["theta_rad"], left=np.nan, right=np.nan)
         rows[f"{blk}/residual/measured_minus_sim_{law}"] = log_series(
-            rec, f"{blk}/residual/measured_minus_sim_{law}", t_p, th_p - sim_on)
+            rec, f"{blk}/residual/measured_minus_sim_{law}", t_p, th_p - sim_on, color=_style(f"sim_{law}", i)[0],
+            name=f"measured − sim {law} (rad)")
+    focus = _focus(res, t_p, th_p)
     ref = res.simulations.get("eta_e") or next(iter(res.simulations.values()), None)
     if ref is not None and len(ref["impacts"]):
         imp = ref["impacts"]
@@ -93,16 +140,16 @@ def log_experiment(res, rrd_path=None, *, spawn: bool = False, connect: str | No
         c = res.column
         block_paths = [f"{ROOT}/{o}" for o in c["objects"]]
         for i, bp in enumerate(block_paths):
-            rows[f"{bp}/theta/measured_video"] = log_series(rec, f"{bp}/theta/measured_video", c["t_s"],
-                                                            c["theta_measured_rad"][:, i], name="measured (video)")
-            rows[f"{bp}/theta/sim_column"] = log_series(rec, f"{bp}/theta/sim_column", c["sim_t_s"],
-                                                        c["theta_sim_rad"][:, i], name="column model")
+            rows[f"{bp}/theta/measured_video"] = _theta(rec, bp, "measured_video", c["t_s"],
+                                                        c["theta_measured_rad"][:, i], "measured (video)")
+            rows[f"{bp}/theta/sim_column"] = _theta(rec, bp, "sim_column", c["sim_t_s"], c["theta_sim_rad"][:, i],
+                                                    "column model")
             sim_on = np.interp(c["t_s"], c["sim_t_s"], c["theta_sim_rad"][:, i], left=np.nan, right=np.nan)
             rows[f"{bp}/residual/measured_minus_sim"] = log_series(
                 rec, f"{bp}/residual/measured_minus_sim", c["t_s"], c["theta_measured_rad"][:, i] - sim_on)
             if "theta_truth_rad" in c:
                 tt, th = c["theta_truth_rad"]
-                rows[f"{bp}/theta/truth"] = log_series(rec, f"{bp}/theta/truth", tt, th[:, i], name="truth")
+                rows[f"{bp}/theta/truth"] = _theta(rec, bp, "truth", tt, th[:, i], "truth")
         conf = c["configurations"]
         if len(conf):
             log_events(rec, f"{ROOT}/column/configurations", conf["t_s"].to_numpy(float),
@@ -120,13 +167,19 @@ def log_experiment(res, rrd_path=None, *, spawn: bool = False, connect: str | No
             from tqdm import tqdm
 
             bar = tqdm(desc="rerun: video frames", unit="frame", leave=False)
-        # frames were JPEG-encoded while the tracker decoded them (analyse_experiment(keep_video=...))
+        # the film was encoded while the tracker decoded it (analyse_experiment(keep_video=...))
         fps = res.frames.fps
-        frames = ((i, i / fps, data) for i, data in (res.video_jpeg or ()))
-        rows[f"{ROOT}/video"] = log_video_frames(
-            rec, f"{ROOT}/video", frames, overlays=_overlay_fn(res), progress=bar)
+        film = res.video
+        if film is not None and film.kind == "av1":
+            rows[f"{ROOT}/video"] = log_video_asset(rec, f"{ROOT}/video", film.data, film.frame_index, fps,
+                                                    overlays=_overlay_fn(res), progress=bar)
+        else:
+            frames = ((i, i / fps, data) for i, data in
+                      (zip(film.frame_index, film.stills) if film is not None else ()))
+            rows[f"{ROOT}/video"] = log_video_frames(
+                rec, f"{ROOT}/video", frames, overlays=_overlay_fn(res), progress=bar)
         if bar is not None:
             bar.close()
-    rec.send_blueprint(experiment_blueprint(block_paths, has_video=has_video))
+    rec.send_blueprint(experiment_blueprint(block_paths, has_video=has_video, focus=focus))
     close_recording(rec, rrd_path)
     return rows

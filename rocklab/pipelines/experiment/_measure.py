@@ -12,6 +12,7 @@ import numpy as np
 
 from ..._errors import InputError
 from ._config import ExperimentConfig
+from ._review_video import ReviewFilm
 
 __all__: list[str] = []
 
@@ -34,49 +35,24 @@ def _read_track_csv(path: Path, obj: str | None):
     return df
 
 
-def _is_grey(gray, image) -> bool:
-    """True when a decoded frame ``image`` (BGR) is ``gray`` in all three channels, i.e. carries
-    no colour (a grey source decodes to equal channels, which BGR→grey maps to themselves)."""
+def _probe_fps(path, given: float | None) -> float:
+    """Frame rate for the review film's container, Hz (the timeline uses the tracker's own)."""
+    if given:
+        return float(given)
     import cv2
 
-    if image.ndim == 2:
-        return True
-    s = image[::16, ::16]  # a colour picture almost always shows in the sample: skip the full check
-    if not (np.array_equal(s[..., 0], s[..., 1]) and np.array_equal(s[..., 1], s[..., 2])):
-        return False
-    # full check in OpenCV: ~1 ms at 1080p, a quarter of numpy's strided channel compare
-    return cv2.norm(image, cv2.cvtColor(gray, cv2.COLOR_GRAY2BGR), cv2.NORM_INF) == 0
+    cap = cv2.VideoCapture(str(path))
+    fps = cap.get(cv2.CAP_PROP_FPS) if cap.isOpened() else 0.0
+    cap.release()
+    return float(fps) if fps and np.isfinite(fps) and fps > 0 else 50.0
 
 
-def _frame_keeper(decimation: int):
-    """``(jpeg, on_frame)``: ``on_frame(index, gray, image)`` (the ``track_video`` callback)
-    appends ``(index, JPEG bytes)`` for every ``decimation``-th frame to the list ``jpeg``.
-
-    The JPEG is in colour when the picture has colour, else one channel (smaller and
-    faster). ``cv2.imencode`` takes BGR and writes standard YCbCr JPEG, which Rerun's
-    ``EncodedImage`` decodes to RGB: no channel swap needed.
-    """
-    import cv2
-
-    jpeg: list = []
-
-    def keep(i, gray, image):  # encode the frames Rerun will show while they are decoded for tracking
-        if i % decimation == 0:
-            ok, buf = cv2.imencode(".jpg", gray if _is_grey(gray, image) else image,
-                                   [cv2.IMWRITE_JPEG_QUALITY, 80])
-            if ok:
-                jpeg.append((i, buf.tobytes()))
-
-    return jpeg, keep
-
-
-def _measure_video(cfg: ExperimentConfig, progress: bool, keep_jpeg: bool):
+def _measure_video(cfg: ExperimentConfig, progress: bool, keep_film: bool):
     from ...tracking import load_track_config, track_video
 
     tcfg = load_track_config(cfg.video.track_config) if cfg.video.track_config else None
-    jpeg, keep = _frame_keeper(cfg.video_decimation)
-    tr = track_video(cfg.video.path, tcfg, fps=cfg.video.fps, progress=progress,
-                     on_frame=keep if keep_jpeg else None)
+    film = ReviewFilm(_probe_fps(cfg.video.path, cfg.video.fps), cfg.video_decimation) if keep_film else None
+    tr = track_video(cfg.video.path, tcfg, fps=cfg.video.fps, progress=progress, on_frame=film)
     df = tr.to_frame()
     sel = df[df["object"] == cfg.video.object]
     if sel.empty:
@@ -87,7 +63,8 @@ def _measure_video(cfg: ExperimentConfig, progress: bool, keep_jpeg: bool):
         tm = tr.table_motion(cfg.table.object)
         table = {"t_s": np.asarray(tm.t_s), "disp_m": np.asarray(tm.x_m),
                  "vel_m_s": np.asarray(tm.vx_m_s), "acc_m_s2": np.asarray(tm.ax_m_s2)}
-    return (sel["t_s"].to_numpy(float), sel["theta_rad"].to_numpy(float)), table, tr, (jpeg if keep_jpeg else None)
+    review = film.finish() if film is not None else None
+    return (sel["t_s"].to_numpy(float), sel["theta_rad"].to_numpy(float)), table, tr, review
 
 
 def _measure_imu(cfg: ExperimentConfig):

@@ -2,7 +2,8 @@
 
 Entity paths form a hierarchy::
 
-    experiment/video                       encoded frames (JPEG), decimated
+    experiment/video                       the film: an AV1 video asset + a frame reference per
+                                           frame (JPEG stills only as the fallback)
     experiment/video/targets               tracked target points (per frame)
     experiment/video/outline               block outline (per frame)
     experiment/video/label                 θ label (per frame)
@@ -10,6 +11,7 @@ Entity paths form a hierarchy::
     experiment/<block>/theta/measured_imu      θ from IMU (synced), rad
     experiment/<block>/theta/sim_<law>         simulations, rad
     experiment/<block>/theta/truth             synthetic truth, rad
+    experiment/<block>/theta_deg/...           the same θ series in degrees
     experiment/<block>/residual/video_minus_imu, .../measured_minus_sim_eta_e
     experiment/<block>/energy/sim_<law>    energy, J
     experiment/<block>/impacts             impacts as events (TextLog + points)
@@ -27,7 +29,8 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["open_recording", "close_recording", "log_series", "log_events", "log_video_frames", "read_rrd_scalars",
+__all__ = ["open_recording", "close_recording", "log_series", "log_events", "log_video_frames", "log_video_asset",
+           "read_rrd_scalars",
            "experiment_blueprint", "campaign_blueprint", "read_rrd_summary"]
 
 TIMELINE = "time"
@@ -87,8 +90,12 @@ def close_recording(rec, rrd_path=None) -> None:
                           str(p))
 
 
-def log_series(rec, path: str, t_s, values, *, color=None, name: str | None = None) -> int:
-    """Send a whole scalar series on the ``time`` timeline (NaNs dropped). Returns rows sent."""
+def log_series(rec, path: str, t_s, values, *, color=None, width: float | None = None,
+               name: str | None = None) -> int:
+    """Send a whole scalar series on the ``time`` timeline (NaNs dropped). Returns rows sent.
+
+    ``color`` (RGB 0-255), ``width`` (points) and ``name`` style the line (static).
+    """
     import rerun as rr
 
     t = np.asarray(t_s, float)
@@ -98,8 +105,8 @@ def log_series(rec, path: str, t_s, values, *, color=None, name: str | None = No
         return 0
     rec.send_columns(path, indexes=[rr.TimeColumn(TIMELINE, duration=t[ok])],
                      columns=rr.Scalars.columns(scalars=v[ok]))
-    if color is not None or name is not None:
-        rec.log(path, rr.SeriesLines(colors=color, names=name), static=True)
+    if color is not None or name is not None or width is not None:
+        rec.log(path, rr.SeriesLines(colors=color, widths=width, names=name), static=True)
     return int(ok.sum())
 
 
@@ -119,7 +126,8 @@ def log_events(rec, path: str, t_s, texts, values=None) -> None:
 
 
 def log_video_frames(rec, path: str, frames, *, overlays=None, progress=None) -> int:
-    """Log video frames (JPEG-encoded) on the ``time`` and ``frame`` timelines.
+    """Log video frames (JPEG stills, the fallback of :func:`log_video_asset`) on the ``time`` and
+    ``frame`` timelines.
 
     Parameters
     ----------
@@ -137,13 +145,7 @@ def log_video_frames(rec, path: str, frames, *, overlays=None, progress=None) ->
         rec.set_time("frame", sequence=int(idx))
         rec.log(path, rr.EncodedImage(contents=data, media_type="image/jpeg"))
         if overlays is not None:
-            ov = overlays(idx) or {}
-            if ov.get("points") is not None and len(ov["points"]):
-                rec.log(f"{path}/targets", rr.Points2D(ov["points"], radii=3.0, colors=[0, 255, 0]))
-            if ov.get("outlines"):
-                rec.log(f"{path}/outline", rr.LineStrips2D(ov["outlines"], colors=[255, 128, 0]))
-            if ov.get("label"):
-                rec.log(f"{path}/label", rr.TextLog(ov["label"]))
+            _log_overlay(rec, path, overlays(idx) or {})
         n += 1
         if progress is not None:
             progress.update(1)
@@ -151,24 +153,100 @@ def log_video_frames(rec, path: str, frames, *, overlays=None, progress=None) ->
     return n
 
 
-def experiment_blueprint(block_paths: list[str], has_video: bool = True):
-    """Video + θ plot + residual plot (and energy, table) for one experiment."""
-    import rerun.blueprint as rrb
+def log_video_asset(rec, path: str, mp4: bytes, frame_index, fps: float, *, overlays=None, progress=None) -> int:
+    """Log a film as one Rerun ``AssetVideo`` and a ``VideoFrameReference`` per frame.
 
+    Parameters
+    ----------
+    mp4 : bytes
+        The MP4 (AV1 plays in every Rerun viewer).
+    frame_index : sequence of int, shape (n,)
+        Source frame index of each of the film's n frames, in order; frame ``i`` is shown at
+        ``t = i / fps`` s on the ``time`` timeline and at ``i`` on ``frame``.
+    fps : float
+        The tracker's frame rate, Hz.
+    overlays : callable(frame_index) -> dict, optional
+        As in :func:`log_video_frames`.
+
+    Returns the number of frames referenced.
+
+    Raises
+    ------
+    ValueError
+        The film's frame count differs from ``frame_index`` (a truncated encode).
+    """
+    import rerun as rr
+
+    asset = rr.AssetVideo(contents=mp4, media_type="video/mp4")
+    rec.log(path, asset, static=True)
+    ts_ns = np.asarray(asset.read_frame_timestamps_nanos(), np.int64)
+    idx = np.asarray(frame_index, np.int64)
+    if len(ts_ns) != len(idx):
+        raise ValueError(f"review film has {len(ts_ns)} frames, the tracker decoded {len(idx)}")
+    rec.send_columns(path, indexes=[rr.TimeColumn(TIMELINE, duration=idx / float(fps)),
+                                    rr.TimeColumn("frame", sequence=idx)],
+                     columns=rr.VideoFrameReference.columns_nanos(ts_ns))
+    if overlays is not None:
+        for i in idx:
+            rec.set_time(TIMELINE, duration=float(i) / fps)
+            rec.set_time("frame", sequence=int(i))
+            _log_overlay(rec, path, overlays(int(i)) or {})
+            if progress is not None:
+                progress.update(1)
+        rec.reset_time()
+    return int(len(idx))
+
+
+def _log_overlay(rec, path: str, ov: dict) -> None:
+    import rerun as rr
+
+    if ov.get("points") is not None and len(ov["points"]):
+        rec.log(f"{path}/targets", rr.Points2D(ov["points"], radii=3.0, colors=[0, 255, 0]))
+    if ov.get("outlines"):
+        rec.log(f"{path}/outline", rr.LineStrips2D(ov["outlines"], colors=[255, 128, 0]))
+    if ov.get("label"):
+        rec.log(f"{path}/label", rr.TextLog(ov["label"]))
+
+
+def experiment_blueprint(block_paths: list[str], has_video: bool = True, focus=None):
+    """Video + θ plots (rad, degrees) + residual plot (and energy, table) for one experiment.
+
+    ``focus``: ``(t_impact_s, t0_s, t1_s)``: the review opens on that window (the impact with
+    the largest residual), looping over it at quarter speed; the plots show it zoomed.
+    """
+    import rerun.blueprint as rrb
+    import rerun.encodings as enc
+
+    ranges = None
+    if focus is not None:
+        _, t0, t1 = focus
+        ranges = [rrb.VisibleTimeRange(TIMELINE, start=rrb.TimeRangeBoundary.absolute(seconds=max(t0, 0.0)),
+                                       end=rrb.TimeRangeBoundary.absolute(seconds=t1))]
     plots = []
     for bp in block_paths:
-        plots.append(rrb.TimeSeriesView(origin=f"{bp}/theta", name=f"θ {bp.split('/')[-1]} (rad)"))
-    res = [rrb.TimeSeriesView(origin=f"{bp}/residual", name="residual (rad)") for bp in block_paths]
+        short = bp.split('/')[-1]
+        plots.append(rrb.Tabs(
+            rrb.TimeSeriesView(origin=f"{bp}/theta_deg", name=f"θ {short} (°)", time_ranges=ranges),
+            rrb.TimeSeriesView(origin=f"{bp}/theta", name=f"θ {short} (rad)", time_ranges=ranges),
+            rrb.TimeSeriesView(origin=f"{bp}/theta_deg", name=f"θ {short} (°), whole run")))
+    res = [rrb.TimeSeriesView(origin=f"{bp}/residual", name="residual (rad)", time_ranges=ranges)
+           for bp in block_paths]
     extra = [rrb.TimeSeriesView(origin=f"{bp}/energy", name="energy (J)") for bp in block_paths]
     extra.append(rrb.TimeSeriesView(origin="experiment/table", name="table"))
     left = [rrb.Spatial2DView(origin="experiment/video", name="video")] if has_video else []
     left.append(rrb.TextLogView(origin="experiment", name="events"))
+    panel = None
+    if focus is not None:
+        _, t0, t1 = focus
+        panel = rrb.TimePanel(timeline=TIMELINE, play_state="playing", loop_mode="selection", playback_speed=0.25,
+                              time_selection=enc.AbsoluteTimeRange(int(max(t0, 0.0) * 1e9), int(t1 * 1e9)))
     return rrb.Blueprint(
         rrb.Horizontal(
             rrb.Vertical(*left, row_shares=[3, 1] if has_video else None),
             rrb.Vertical(rrb.Vertical(*plots), rrb.Vertical(*res), rrb.Tabs(*extra), row_shares=[3, 2, 2]),
             column_shares=[1, 1],
         ),
+        *([panel] if panel is not None else []),
         collapse_panels=True,
     )
 

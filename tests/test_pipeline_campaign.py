@@ -72,7 +72,19 @@ def test_campaign_recovers_eta_mat_and_reports_failure(tmp_path, run_cli):
             assert r["eta_e"] == pytest.approx(truth[r["experiment"]], abs=0.002)
     rows = read_rrd_summary(out / "campaign.rrd")
     assert rows["/campaign/experiments"] == 3
+    # one clickable point per fitted experiment, carrying its name and where its report is
+    assert {k for k in rows if k.startswith("/campaign/eta_vs_hb/")} == {
+        "/campaign/eta_vs_hb/edge/B3M_edge", "/campaign/eta_vs_hb/edge/B6M_edge", "/campaign/eta_vs_hb/full/B4M_full"}
     assert (out / "figures" / "eta_vs_hb.png").is_file()
+    # the people's report: the same numbers in Markdown and in one offline HTML file
+    md = (out / "summary.md").read_text(encoding="utf-8")
+    html = (out / "report.html").read_text(encoding="utf-8")
+    eta_mat = res["eta_mat"]["eta_mat"]
+    assert f"{eta_mat:.4g}" in md and f"{eta_mat:.4g}" in html
+    assert "broken" in md and "FAILED" in html
+    assert "[B4M_full](experiments/B4M_full/report.html)" in md and 'href="experiments/B4M_full/report.html"' in html
+    assert html.count("data:image/png;base64,") == md.count("![") >= 1 and 'src="figures/' not in html
+    assert (out / "experiments" / "B4M_full" / "report.html").is_file()
 
 
 def test_campaign_on_a_dask_cluster_matches_local(tmp_path):

@@ -73,8 +73,12 @@ def test_run_writes_report_figures_and_rrd(tmp_path, run_cli):
     assert sims["housner"]["eta"] == pytest.approx(Block(0.045, 0.2025).eta_H)
     assert rep["truth"]["theta_rms_error_rad"] == pytest.approx(np.radians(0.02), rel=0.2)
     assert rep["versions"]["rocklab"] and rep["units"]["theta"] == "rad"
-    for f in ("summary.md", "series.csv", "figures/theta.png", "figures/per_impact_eta.png", "session.rrd"):
+    for f in ("summary.md", "report.html", "series.csv", "figures/theta.png", "figures/per_impact_eta.png",
+              "session.rrd"):
         assert (out / f).is_file(), f
+    md, html = (out / "summary.md").read_text(encoding="utf-8"), (out / "report.html").read_text(encoding="utf-8")
+    assert f"η_e = {rep['fit']['eta_e']:.4g}" in md and f"η_e = {rep['fit']['eta_e']:.4g}" in html
+    assert html.count("data:image/png;base64,") == len(rep["outputs"]["figures"]) >= 2
     ser = pd.read_csv(out / "series.csv")
     assert {"t_s", "theta_track_rad", "theta_sim_eta_e_rad", "theta_truth_rad"} <= set(ser.columns)
 

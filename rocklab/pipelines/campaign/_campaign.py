@@ -21,13 +21,14 @@ import numpy as np
 
 from ..._errors import InputError
 from ..._procs import dask_client, pool_initializer
-from ..._io import write_frame_atomic, write_json_atomic
+from ..._io import write_frame_atomic, write_json_atomic, write_text_atomic
 
 __all__ = ["CampaignResult", "run_campaign", "find_experiments"]
 
 
 #: What a campaign writes in its output folder.
-CAMPAIGN_ENTRIES = ("experiments", "campaign.csv", "campaign.json", "campaign.rrd", "figures")
+CAMPAIGN_ENTRIES = ("experiments", "campaign.csv", "campaign.json", "campaign.rrd", "figures", "summary.md",
+                    "report.html")
 
 
 def find_experiments(root) -> list[Path]:
@@ -106,6 +107,54 @@ class CampaignResult:
                 "failures": [{"config": r["config"], "error": r["error"]} for r in self.runs if not r["ok"]],
                 "experiments": self.table.to_dict(orient="records") if self.table is not None else [],
                 "eta_mat": self.eta_mat, "k_table": self.k_table, "messages": list(self.messages)}
+
+    def summary_md(self, figures: dict | None = None) -> str:
+        """The campaign's one-page Markdown report: experiments, campaign fits, figures, failures."""
+        def g(x):
+            try:
+                v = float(x)
+            except (TypeError, ValueError):
+                return "–"
+            return f"{v:.4g}" if np.isfinite(v) else "–"
+
+        n_sus = sum(1 for r in self.runs if r["ok"] and (r.get("report") or {}).get("status") == "suspect")
+        lines = [f"# Campaign {self.out_dir.name}", "",
+                 f"{self.n_ok} of {len(self.runs)} experiments ran"
+                 + (f", **{n_sus} suspect** (see their warnings)" if n_sus else "")
+                 + (f", **{self.n_failed} failed**" if self.n_failed else "") + ".", ""]
+        t = self.ok_table
+        if t is not None and len(t):
+            lines += ["| experiment | block | contact | h/b | η_H | η_e | 95 % CI | η_M | truth | status |",
+                      "|---|---|---|---|---|---|---|---|---|---|"]
+            for _, r in t.iterrows():
+                name = str(r["experiment"])
+                ci = f"{g(r.get('ci_lo'))} – {g(r.get('ci_hi'))}" if np.isfinite(r.get("ci_lo", np.nan)) else "–"
+                eta_e = g(r["eta_e"]) if np.isfinite(r["eta_e"]) else "(forced)"
+                lines.append(f"| [{name}](experiments/{name}/report.html) | {r['block']} | {r['contact']} | "
+                             f"{g(r.get('hb'))} | {g(r['eta_H'])} | {eta_e} | {ci} | {g(r.get('eta_M'))} | "
+                             f"{g(r.get('eta_true'))} | {r.get('status', '')} |")
+            lines.append("")
+        if self.eta_mat:
+            lines += [f"η_mat (edge contact, Čeh Eq. 16) = {g(self.eta_mat.get('eta_mat'))} ± "
+                      f"{g(self.eta_mat.get('std'))} ({self.eta_mat.get('n')} blocks)", ""]
+        if self.k_table:
+            ks = ", ".join(f"{r['block']}: {g(r['k'])}" for r in self.k_table.get("per_block", []))
+            lines += [f"k per full-contact block (Čeh Eq. 18, η_mat = {g(self.k_table.get('eta_mat'))}): {ks}", ""]
+            co = self.k_table.get("coefficients")
+            if co:
+                terms = " ".join(f"{v:+.4g}·{k}" if k != "const" else f"{v:+.4g}" for k, v in co.items())
+                lines += [f"k(h/b, b) regression (Čeh Eq. 19 form, b in cm): k = {terms}; "
+                          f"R² = {g(self.k_table.get('r2'))}, RMSE = {g(self.k_table.get('rmse'))}", ""]
+        for r in self.runs:
+            if not r["ok"]:
+                lines.append(f"- **FAILED** {r['config']}: {r['error']}")
+        for m in self.messages:
+            lines.append(f"- note: {m}")
+        if figures:
+            lines += ["", "## Figures", ""] + [f"![{k}](figures/{Path(p).name})" for k, p in figures.items()]
+        lines += ["", "Data: [campaign.csv](campaign.csv), [campaign.json](campaign.json); "
+                  "visual review: `rerun campaign.rrd`"]
+        return "\n".join(lines) + "\n"
 
     def summary_text(self) -> str:
         """The table the CLI prints: per experiment η_H, η_e ± CI, η_M, truth; then the campaign fits."""
@@ -276,6 +325,7 @@ def run_campaign(root, out_dir, *, workers: int = 2, scheduler: str | None = Non
 
 def _write_campaign(res: CampaignResult) -> None:
     from ..experiment._figures import campaign_figures
+    from ..reports import write_html_report
 
     out = res.out_dir
     out.mkdir(parents=True, exist_ok=True)
@@ -287,10 +337,14 @@ def _write_campaign(res: CampaignResult) -> None:
         reg = KRegression.ceh2018()
         if res.k_table and res.k_table.get("coefficients"):
             reg = KRegression.from_coefficients(res.k_table["coefficients"])
-        if len(res.ok_table):
-            campaign_figures(res.ok_table, out / "figures", regression=reg)
+        figs = campaign_figures(res.ok_table, out / "figures", regression=reg) if len(res.ok_table) else {}
         _campaign_rrd(res, out / "campaign.rrd")
+    else:
+        figs = {}
     write_json_atomic(out / "campaign.json", json.loads(json.dumps(res.to_dict(), default=str)))
+    md = res.summary_md(figs if isinstance(figs, dict) else {})
+    write_text_atomic(out / "summary.md", md)
+    write_html_report(md, out / "report.html", out, title=f"rocklab campaign: {out.name}")
 
 
 def _campaign_rrd(res: CampaignResult, path: Path) -> None:
@@ -314,5 +368,20 @@ def _campaign_rrd(res: CampaignResult, path: Path) -> None:
                 f"{r['experiment']}: block {r['block']} ({r['contact']}), η_e = {r['eta_e']:.4f}, "
                 f"η_H = {r['eta_H']:.4f}"))
         rec.reset_time()
+        # η_e against h/b as labelled points, one entity per experiment: clicking a point selects
+        # that experiment and shows where its own report and recording are
+        for _, r in t.iterrows():
+            if not np.isfinite(r["eta_e"]):
+                continue
+            name = str(r["experiment"])
+            ent = f"campaign/eta_vs_hb/{r['contact']}/{name}"
+            colour = [0, 114, 178] if r["contact"] == "full" else [213, 94, 0]
+            rec.log(ent, rr.Points2D([[float(r["hb"]), -float(r["eta_e"])]], labels=[name], colors=[colour],
+                                     radii=[0.06], show_labels=False), static=True)
+            rec.log(ent, rr.TextDocument(
+                f"**{name}**: block {r['block']} ({r['contact']} contact), h/b = {r['hb']:.4g}, "
+                f"η_e = {r['eta_e']:.4g}, η_H = {r['eta_H']:.4g}\n\n"
+                f"report: [experiments/{name}/report.html](experiments/{name}/report.html); "
+                f"review: `rerun experiments/{name}/session.rrd`", media_type="text/markdown"), static=True)
         rec.send_blueprint(campaign_blueprint())
         close_recording(rec, tmp)

@@ -52,9 +52,10 @@ def _focus(res, t_p, th_p):
     t_worst = float(np.asarray(t_p, float)[int(np.nanargmax(r))])
     ti = ref["impacts"]["t_s"].to_numpy(float)
     k = int(np.argmin(np.abs(ti - t_worst)))
-    gap = np.diff(ti)
-    half = float(np.median(gap)) if len(gap) else 0.2
-    return float(ti[k]), float(ti[k] - 2.5 * half), float(ti[k] + 2.5 * half)
+    # two half-cycles either side (impacts k-2 .. k+2), never less than 0.15 s each way
+    t0 = min(float(ti[max(k - 2, 0)]), float(ti[k]) - 0.15)
+    t1 = max(float(ti[min(k + 2, len(ti) - 1)]), float(ti[k]) + 0.15)
+    return float(ti[k]), t0, t1
 
 
 def _overlay_fn(res):

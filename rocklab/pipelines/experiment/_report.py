@@ -95,11 +95,11 @@ def _summary_md(res, figs: dict, rrd: bool) -> str:
                   "|---|---|---|---|"]
         for o, r, pm, ps in zip(c["objects"], cmp_["rms_theta_rad"], cmp_["peak_measured_rad"],
                                 cmp_["peak_simulated_rad"]):
-            lines.append(f"| {o} | {r:.4f} | {pm:.4f} | {ps:.4f} |")
+            lines.append(f"| {o} | {_g(r)} | {_g(pm)} | {_g(ps)} |")
         sq = cmp_["sequence"]
         lines += ["", f"Opening/closing sequence, measured vs simulated: {sq['n_matched']} of "
                       f"{sq['n_measured']} measured / {sq['n_simulated']} simulated events matched "
-                      f"(median timing error {sq['timing_error_s']:.3f} s)"]
+                      f"(median timing error {_g(sq['timing_error_s'])} s)"]
         if "sequence_vs_truth" in c:
             st = c["sequence_vs_truth"]
             lines += [f"Measured sequence vs truth: same sequence = {st['same_sequence']} "
@@ -118,7 +118,8 @@ def _summary_md(res, figs: dict, rrd: bool) -> str:
 
 def write_outputs(res, out_dir: Path, fp: str, *, spawn=False, connect=None,
                   progress=False) -> dict:
-    """Write report.json, series.csv, figures, summary.md and session.rrd into ``out_dir``."""
+    """Write report.json, series.csv, figures, summary.md, report.html and session.rrd into ``out_dir``."""
+    from ..reports import write_html_report
     from ._figures import experiment_figures
     from ._log_experiment import log_experiment
 
@@ -134,6 +135,8 @@ def write_outputs(res, out_dir: Path, fp: str, *, spawn=False, connect=None,
     report["outputs"] = {"figures": {k: f"figures/{p.name}" for k, p in figs.items()},
                          "series": "series.csv", "rrd": "session.rrd" if res.config.rrd else None,
                          "rrd_rows": rrd_rows}
-    write_text_atomic(out_dir / "summary.md", _summary_md(res, figs, bool(res.config.rrd)))
+    md = _summary_md(res, figs, bool(res.config.rrd))
+    write_text_atomic(out_dir / "summary.md", md)
+    write_html_report(md, out_dir / "report.html", out_dir, title=f"rocklab: {res.name}")
     write_json_atomic(out_dir / "report.json", report)
     return report

@@ -256,8 +256,12 @@ def campaign_blueprint():
     import rerun.blueprint as rrb
 
     return rrb.Blueprint(rrb.Horizontal(
-        rrb.TimeSeriesView(origin="campaign/eta", name="η vs h/b (x axis: h/b)"),
-        rrb.TextLogView(origin="campaign", name="experiments"),
+        rrb.Vertical(
+            rrb.Spatial2DView(origin="campaign/eta_vs_hb", name="η_e vs h/b (y down: −η_e); click a point"),
+            rrb.TimeSeriesView(origin="campaign/eta", name="η vs h/b (x axis: h/b × 1000)"),
+        ),
+        rrb.Vertical(rrb.TextDocumentView(origin="campaign/eta_vs_hb", name="experiment"),
+                     rrb.TextLogView(origin="campaign", name="experiments")),
     ))
 
 

@@ -119,7 +119,7 @@ class Block:
     @property
     def I_O_kg_m2(self) -> float:
         """Moment of inertia about a rocking corner, kg m^2."""
-        return self.alpha_I * self.mass_kg * self.R_m ** 2
+        return self.alpha_I * float(self.mass_kg or 0.0) * self.R_m ** 2  # mass is set in __post_init__
 
     @property
     def p_rad_s(self) -> float:

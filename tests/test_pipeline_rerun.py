@@ -52,3 +52,13 @@ def test_review_opens_on_the_impact_with_the_largest_residual(tmp_path):
     rec.flush()
     rec.disconnect()
     assert read_rrd_summary(path)["/experiment/block_1/theta/measured_video"] == t.size
+    import rerun.chunk as rc
+
+    reader = rc.RrdReader(str(path))
+    (bp,) = reader.blueprints()
+    sel = []
+    for ch in reader.stream(store=bp).collect().stream():
+        rb = ch.to_record_batch()
+        if "TimePanelBlueprint:time_selection" in rb.schema.names:
+            sel += rb.column(rb.schema.names.index("TimePanelBlueprint:time_selection")).to_pylist()
+    assert sel == [[{"min": int(t0 * 1e9), "max": int(t1 * 1e9)}]]

@@ -79,7 +79,9 @@ def summarize_repeats(fits, z_max: float = 3.5) -> RepeatSummary:
     z_max : float
         Robust z-score (median/MAD) above which a run is an outlier (Iglewicz–Hoaglin 3.5).
     """
-    vals, failed, susp = [], [], []
+    vals: list[float] = []
+    failed: list[int] = []
+    susp: list[int] = []
     for i, f in enumerate(fits):
         if isinstance(f, RestitutionFit):
             vals.append(f.eta_e if f.ok else np.nan)
@@ -88,9 +90,9 @@ def summarize_repeats(fits, z_max: float = 3.5) -> RepeatSummary:
             elif f.suspicious:
                 susp.append(i)
         else:
-            v = float(f)
-            vals.append(v)
-            if not np.isfinite(v):
+            x = float(f)
+            vals.append(x)
+            if not np.isfinite(x):
                 failed.append(i)
     v = np.asarray(vals, float)
     good = np.isfinite(v)

@@ -123,7 +123,7 @@ def column_overturning_maps(H_m: float = 12.0, B_m: float = 1.0, n_blocks=(1, 2,
                 r = simulate_column(col, sine_pulse(a, t, dt_s=min(dt_s, t / 50)), duration_s=t + free_s,
                                     dt_s=dt_s, n_impacts=n_impacts, **run_kwargs)
                 over[k, i, j] = r.overturned
-                peak[k, i, j] = float(np.max(r.max_abs_theta_rad)) / alpha
+                peak[k, i, j] = float(np.max(np.asarray(r.max_abs_theta_rad))) / alpha
                 done += 1
                 if progress is not None:
                     progress(done)

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -27,6 +28,9 @@ from ..._errors import InputError
 from ...blocks import G as G_STD
 from ...blocks import Block
 from ..spectra._records import BaseMotion
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 __all__ = ["Column", "ColumnResult", "simulate_column", "uplift_acc_m_s2", "STATE_NAMES"]
 
@@ -62,7 +66,7 @@ class Column:
     """
 
     blocks: tuple
-    cut_m: tuple = 0.0
+    cut_m: tuple | float = 0.0
     mu: float = math.inf
 
     def __post_init__(self):
@@ -119,7 +123,7 @@ class Column:
 
     def to_dict(self) -> dict:
         """Plain dict of the fields, JSON-ready (SI units in the keys)."""
-        return {"blocks": [b.to_dict() for b in self.blocks], "cut_m": list(self.cut_m), "mu": self.mu}
+        return {"blocks": [b.to_dict() for b in self.blocks], "cut_m": [float(x) for x in np.atleast_1d(self.cut_m)], "mu": self.mu}
 
 
 @dataclass(frozen=True)
@@ -172,14 +176,14 @@ class ColumnResult:
     theta_rad: np.ndarray
     energy_J: np.ndarray
     kinetic_J: np.ndarray
-    configurations: object
-    impacts: object
+    configurations: pd.DataFrame
+    impacts: pd.DataFrame
     status: str
     t_status_s: float
     message: str = ""
     params: dict = field(default_factory=dict)
-    max_abs_theta_rad: np.ndarray = None
-    max_abs_phi_rad: np.ndarray = None
+    max_abs_theta_rad: np.ndarray | None = None
+    max_abs_phi_rad: np.ndarray | None = None
 
     def __post_init__(self):
         # results built by hand (no kernel peaks): the peaks of the stored samples
@@ -228,7 +232,7 @@ class ColumnResult:
         return {
             "status": self.status, "t_status_s": self.t_status_s, "message": self.message,
             "n_blocks": self.column.n,
-            "max_abs_theta_rad": [float(x) for x in self.max_abs_theta_rad],
+            "max_abs_theta_rad": [float(x) for x in (self.max_abs_theta_rad if self.max_abs_theta_rad is not None else ())],
             "n_impacts": int(len(self.impacts)),
             "configurations": [
                 {"t_s": float(r.t_s), "joint": int(r.joint), "state": r.state, "event": r.event}

@@ -20,6 +20,7 @@ four-bar linkages (asymmetric frame §5.1, arch §5.2) are in ``_mechanisms.py``
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import asdict, dataclass
 
 import numpy as np
@@ -161,13 +162,13 @@ class Mechanism:
         Restitution if known (else NaN).
     """
 
-    M: object
-    V: object
-    B: object
+    M: Callable[[float], float]
+    V: Callable[[float], float]
+    B: Callable[[float], float]
     phi_max: float = math.pi / 2
     name: str = ""
     eta: float = float("nan")
-    eom: object = None  # optional fast callable phi -> (M, dM/dphi, dV/dphi, B)
+    eom: Callable | None = None  # optional fast callable phi -> (M, dM/dphi, dV/dphi, B)
 
     def _eom(self, phi):
         if self.eom is not None:
@@ -236,7 +237,7 @@ class Mechanism:
 
         def hit(t, y):
             return y[0] - pc
-        hit.terminal = True
+        hit.terminal = True  # type: ignore[attr-defined]  # scipy's event protocol
         sol = solve_ivp(f, (0, 1e4), [0.0, 0.0], events=hit, rtol=1e-9, atol=1e-12)
         return float(sol.t_events[0][0]) if sol.t_events[0].size else float("inf")
 
@@ -329,12 +330,12 @@ def linear_sine_pulse_response(omega: float, a: float, eta: float, tau_max: floa
 
     def over(tt, y, s):
         return abs(y[0]) - 1.0
-    imp.terminal = True
-    over.terminal = True
+    imp.terminal = True  # type: ignore[attr-defined]  # scipy's event protocol
+    over.terminal = True  # type: ignore[attr-defined]
     phase_end = True
     while t < tau_max:
         stop = t_end if (phase_end and t < t_end) else tau_max
-        imp.direction = -s
+        imp.direction = -s  # type: ignore[attr-defined]
         sol = solve_ivp(rhs, (t, stop), state, args=(s,), events=[imp, over], rtol=1e-11, atol=1e-13,
                         max_step=0.01)
         if impacts_after == 1:

@@ -233,7 +233,7 @@ def arch_mechanism(inclusion_angle_rad: float, thickness_m: float, radius_m: flo
         raise InputError(f"arch: need inclusion angle < 1.9 pi and thickness < radius (got {beta}, {t}, {r})")
     faces, mirror = (True, False, True, False), False
     if hinges is None:
-        best = (math.inf, None)
+        best: tuple[float, tuple | None] = (math.inf, None)
         g = np.linspace(0, 1, int(grid))
         for fc in ((True, False, True, False), (False, True, False, True)):
             for mir in (False, True):
@@ -243,28 +243,28 @@ def arch_mechanism(inclusion_angle_rad: float, thickness_m: float, radius_m: flo
                     for ib in range(ia + 2, g.size):
                         for ic in range(ib + 2, g.size):
                             for id_ in range(max(ic + 2, g.size // 2 + 1), g.size):
-                                u = (g[ia], g[ib], g[ic], g[id_])
-                                lam = _lambda_at_rest(*_arch_hinges(beta, t, r, u, fc, mir))
+                                trial = (g[ia], g[ib], g[ic], g[id_])
+                                lam = _lambda_at_rest(*_arch_hinges(beta, t, r, trial, fc, mir))
                                 if lam < best[0]:
-                                    best, faces, mirror = (lam, u), fc, mir
+                                    best, faces, mirror = (lam, trial), fc, mir
         if best[1] is None:
             raise InputError("arch: no admissible four-hinge mechanism found; check the geometry")
-        u = np.array(best[1])
+        ua = np.array(best[1])
         step = 1.0 / (grid - 1)
         for _ in range(4):  # local refinement of the hinge positions
             step /= 3
-            cand = u
+            cand = ua
             lam0 = best[0]
             for k in range(4):
                 for sgn in (-1, 1):
-                    v = u.copy()
+                    v = ua.copy()
                     v[k] = min(1.0, max(0.0, v[k] + sgn * step))
                     if np.all(np.diff(v) > 0):
                         lam = _lambda_at_rest(*_arch_hinges(beta, t, r, v, faces, mirror))
                         if lam < lam0:
                             lam0, cand = lam, v
-            u = cand
-            best = (lam0, tuple(u))
+            ua = cand
+            best = (lam0, tuple(ua))
         hinges = best[1]
     u = tuple(float(x) for x in hinges)
     if len(u) != 4 or not all(0 <= a < b_ for a, b_ in zip(u, u[1:])) or u[-1] > 1:

@@ -8,6 +8,12 @@ from functools import cached_property
 
 import numpy as np
 
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from ...blocks import Block
+    from ._restitution import Restitution
+
 __all__ = ["RockingResult", "BatchResult", "block_energy"]
 
 
@@ -80,8 +86,8 @@ class RockingResult:
     overturn_t_s: float
     fall_t_s: float
     max_abs_theta_rad: float
-    block: object
-    restitution: object
+    block: "Block"
+    restitution: "Restitution"
     method: str
     dt_s: float
     n_impacts: int

@@ -124,4 +124,4 @@ def t_I_band(base, slenderness: float = 12.0, ensemble: dict | None = None, **op
     ti = _stats([m["t_I_s"] for m in members])
     tp = _stats([m["t_I_prime_s"] for m in members])
     be = _stats([m["beta"] for m in members])
-    return TIBand(*ti, *tp, *be, tuple(members))
+    return TIBand(ti[0], ti[1], ti[2], tp[0], tp[1], tp[2], be[0], be[1], be[2], tuple(members))

@@ -219,7 +219,7 @@ def _read_at2(path: Path, text: str, units: str | None, name: str) -> BaseMotion
     if units is None:
         units = file_units or "g"  # PEER's documented convention when the file names no units
     f = _unit_factor(units, f"{path}: ")
-    vals = []
+    vals: list[float] = []
     for j, ln in enumerate(lines[hdr_i + 1:], start=hdr_i + 2):
         toks = ln.split()
         for tok in toks:
@@ -264,7 +264,7 @@ def _at2_units(path: Path, header: list[str], given: str | None = None) -> str |
     found = {}
     for i, ln in enumerate(header, start=1):
         if re.search(r"\b(VELOCITY|DISPLACEMENT)\s+TIME\s+SERIES\b", ln, re.I):
-            kind = re.search(r"VELOCITY|DISPLACEMENT", ln, re.I).group(0).lower()
+            kind = re.search(r"VELOCITY|DISPLACEMENT", ln, re.I).group(0).lower()  # type: ignore[union-attr]
             raise InputError(f"{path}, line {i}: this is a {kind} time series, not acceleration; give the "
                              "matching .AT2 acceleration file")
         for m in _UNITS_FIELD.finditer(ln):
@@ -355,7 +355,7 @@ def _read_csv(path: Path, units: str | None, name: str) -> BaseMotion:
         i = int(np.flatnonzero(bad)[0])
         raise InputError(f"{path}, line {i + 2}: NaN or non-numeric value; clean the record")
     _check_time(path, t, first_line=2)
-    f = _unit_factor(units or file_units, f"{path}: ")
+    f = _unit_factor(units or str(file_units), f"{path}: ")
     return BaseMotion(t, a * f, name=name, source=str(path), meta={"format": "csv"})
 
 

@@ -212,7 +212,8 @@ def experiment_blueprint(block_paths: list[str], has_video: bool = True, focus=N
     """Video + θ plots (rad, degrees) + residual plot (and energy, table) for one experiment.
 
     ``focus``: ``(t_impact_s, t0_s, t1_s)``: the review opens on that window (the impact with
-    the largest residual), looping over it at quarter speed; the plots show it zoomed.
+    the largest residual): the plots zoomed on it, the time panel's loop selection on it (play
+    loops over it at quarter speed).
     """
     import rerun.blueprint as rrb
     import rerun.encodings as enc
@@ -238,7 +239,7 @@ def experiment_blueprint(block_paths: list[str], has_video: bool = True, focus=N
     panel = None
     if focus is not None:
         _, t0, t1 = focus
-        panel = rrb.TimePanel(timeline=TIMELINE, play_state="playing", loop_mode="selection", playback_speed=0.25,
+        panel = rrb.TimePanel(timeline=TIMELINE, play_state="paused", loop_mode="selection", playback_speed=0.25,
                               time_selection=enc.AbsoluteTimeRange(int(max(t0, 0.0) * 1e9), int(t1 * 1e9)))
     return rrb.Blueprint(
         rrb.Horizontal(

@@ -21,7 +21,7 @@ def _first_frame(video: Path):
     if not video.exists():
         raise InputError(f"{video}: video not found; check the path")
     info = probe_video(video)
-    for _, gray, img in iter_video_frames(video, 0, 1, color=True):
+    for _, gray, img in iter_video_frames(video, 0, 1, color=True, pixel_aspect=info.pixel_aspect):
         return info, gray, img
     raise InputError(f"{video}: no frame could be decoded; check the file")
 
@@ -107,15 +107,17 @@ def track_preview(video, config, out, *, n_frames: int = 6, progress: bool = Fal
     video = Path(video)
     if not 1 <= int(n_frames) <= 48:
         raise InputError(f"--frames {n_frames}: give 1 to 48 frames for the sheet")
-    from ...tracking.video._video import iter_video_frames
+    from ...tracking.video._video import iter_video_frames, probe_video
 
+    aspect = probe_video(video).pixel_aspect  # the sheet shows the square-pixel frames that were tracked
     cfg = load_track_config(config)
     res = track_video(video, cfg, progress=progress)
     frames = np.asarray(res.tracks[0].frame)
     pick = frames[np.unique(np.round(np.linspace(0, frames.size - 1, int(n_frames))).astype(int))]
     tiles = []
     for f in pick:  # decode only the frames shown (a long film is not kept in memory)
-        for i, _, img in iter_video_frames(video, int(f), int(f) + 1, prefetch=0, color=True):
+        for i, _, img in iter_video_frames(video, int(f), int(f) + 1, prefetch=0, color=True,
+                                           pixel_aspect=aspect):
             tiles.append(_draw_pose(img, res, i))
     from ..experiment._figures import save_bgr_png
 

@@ -172,8 +172,11 @@ def log_experiment(res, rrd_path=None, *, spawn: bool = False, connect: str | No
         fps = res.frames.fps
         film = res.video
         if film is not None and film.kind == "av1":
+            tr0 = res.frames.tracks[0]  # the tracker's own frame times (a variable-rate film's)
+            t_of = dict(zip(np.asarray(tr0.frame, int).tolist(), np.asarray(tr0.t_s, float).tolist()))
+            t_film = [t_of.get(int(i), i / fps) for i in film.frame_index]
             rows[f"{ROOT}/video"] = log_video_asset(rec, f"{ROOT}/video", film.data, film.frame_index, fps,
-                                                    overlays=_overlay_fn(res), progress=bar)
+                                                    overlays=_overlay_fn(res), progress=bar, frame_t_s=t_film)
         else:
             frames = ((i, i / fps, data) for i, data in
                       (zip(film.frame_index, film.stills) if film is not None else ()))

@@ -153,7 +153,8 @@ def log_video_frames(rec, path: str, frames, *, overlays=None, progress=None) ->
     return n
 
 
-def log_video_asset(rec, path: str, mp4: bytes, frame_index, fps: float, *, overlays=None, progress=None) -> int:
+def log_video_asset(rec, path: str, mp4: bytes, frame_index, fps: float, *, overlays=None, progress=None,
+                    frame_t_s=None) -> int:
     """Log a film as one Rerun ``AssetVideo`` and a ``VideoFrameReference`` per frame.
 
     Parameters
@@ -167,6 +168,8 @@ def log_video_asset(rec, path: str, mp4: bytes, frame_index, fps: float, *, over
         The tracker's frame rate, Hz.
     overlays : callable(frame_index) -> dict, optional
         As in :func:`log_video_frames`.
+    frame_t_s : ndarray (n,), optional
+        Each frame's time, s (a variable-rate film's own times); default ``frame_index / fps``.
 
     Returns the number of frames referenced.
 
@@ -183,12 +186,12 @@ def log_video_asset(rec, path: str, mp4: bytes, frame_index, fps: float, *, over
     idx = np.asarray(frame_index, np.int64)
     if len(ts_ns) != len(idx):
         raise ValueError(f"review film has {len(ts_ns)} frames, the tracker decoded {len(idx)}")
-    rec.send_columns(path, indexes=[rr.TimeColumn(TIMELINE, duration=idx / float(fps)),
-                                    rr.TimeColumn("frame", sequence=idx)],
+    t = idx / float(fps) if frame_t_s is None else np.asarray(frame_t_s, float)
+    rec.send_columns(path, indexes=[rr.TimeColumn(TIMELINE, duration=t), rr.TimeColumn("frame", sequence=idx)],
                      columns=rr.VideoFrameReference.columns_nanos(ts_ns))
     if overlays is not None:
-        for i in idx:
-            rec.set_time(TIMELINE, duration=float(i) / fps)
+        for i, ti in zip(idx, t):
+            rec.set_time(TIMELINE, duration=float(ti))
             rec.set_time("frame", sequence=int(i))
             _log_overlay(rec, path, overlays(int(i)) or {})
             if progress is not None:

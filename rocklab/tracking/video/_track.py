@@ -322,7 +322,7 @@ def _interpolate(arrs, status, max_gap):
 
 
 def assemble_tracks(observations, config: TrackConfig, fps: float, width_px: int, height_px: int,
-                    plane_map: PlaneMap | None = None, source=None) -> TrackResult:
+                    plane_map: PlaneMap | None = None, source=None, frame_times_s=None) -> TrackResult:
     """Convert per-frame observations (plane units) into a :class:`TrackResult` (m, levelled rad).
 
     Parameters
@@ -330,7 +330,9 @@ def assemble_tracks(observations, config: TrackConfig, fps: float, width_px: int
     observations : iterable of list of Observation
         As yielded by :func:`track_frames`.
     fps : float
-        Frame rate; ``t_s = frame / fps``.
+        Frame rate; ``t_s = frame / fps`` unless ``frame_times_s`` is given.
+    frame_times_s : ndarray, optional
+        Each frame's own time from the container, s (indexed by frame number).
     """
     rows = [o for frame_obs in observations for o in frame_obs]
     if not rows:
@@ -409,7 +411,9 @@ def assemble_tracks(observations, config: TrackConfig, fps: float, width_px: int
             u = v = np.full(n, np.nan)
         if config.motion.interpolate_max_gap_frames:
             _interpolate([x, y, th, u, v], st, config.motion.interpolate_max_gap_frames)
-        tracks.append(ObjectTrack(o.id, o.kind, frames.copy(), frames / float(fps), x, y, th, sig,
+        t_s = (np.asarray(frame_times_s, float)[frames] if frame_times_s is not None
+               else frames / float(fps))
+        tracks.append(ObjectTrack(o.id, o.kind, frames.copy(), t_s, x, y, th, sig,
                                   q, st.astype(str), m_per[o.id], u, v))
     return TrackResult(tuple(tracks), float(fps), level, n, int(width_px), int(height_px),
                        None if source is None else str(source), config, plane, plane_map, level_src, level_sig)
@@ -443,6 +447,8 @@ def track_video(path, config: TrackConfig, fps: float | None = None, progress: b
 
     info = probe_video(path)
     rate = fps or config.video.fps or info.fps
+    # the container's own frame times, unless the user overrides the rate (a clock known wrong)
+    times = info.frame_times_s if not (fps or config.video.fps) and info.variable_rate else None
     if rate is None:
         raise InputError(f"{path}: the container has no frame rate; pass --fps N "
                          "(or set [video] fps in the config)")
@@ -450,13 +456,13 @@ def track_video(path, config: TrackConfig, fps: float | None = None, progress: b
     start, stop = v.start_frame, v.stop_frame
     ref_frame = config.reference.board.frame if config.reference.board is not None else start
     first = None
-    for _, g in iter_video_frames(path, ref_frame, ref_frame + 1, prefetch=0):
+    for _, g in iter_video_frames(path, ref_frame, ref_frame + 1, prefetch=0, pixel_aspect=info.pixel_aspect):
         first = g
     if first is None:
         raise InputError(f"{path}: frame {ref_frame} is past the end of the video "
                          f"({info.n_frames} frames); check start_frame / reference.board.frame")
     pm = make_plane_map(config, info.width_px, info.height_px, first)
-    frames = iter_video_frames(path, start, stop, color=on_frame is not None)
+    frames = iter_video_frames(path, start, stop, color=on_frame is not None, pixel_aspect=info.pixel_aspect)
     if on_frame is not None:
         frames = _tee(frames, on_frame)
     if progress:
@@ -466,7 +472,8 @@ def track_video(path, config: TrackConfig, fps: float | None = None, progress: b
         frames = tqdm(frames, total=total if total > 0 else None, unit="frame", desc="track",
                       leave=False)
     obs = track_frames(frames, config, pm)
-    res = assemble_tracks(obs, config, rate, info.width_px, info.height_px, pm, path)
+    res = assemble_tracks(obs, config, rate, info.width_px, info.height_px, pm, path,
+                          frame_times_s=times if times is not None and len(times) >= info.n_frames else None)
     expected = (min(stop, info.n_frames) if stop else info.n_frames) - start
     _check_frames(res, expected, path)
     return res

@@ -1,6 +1,12 @@
 """Video input: probe a file and stream grey frames (OpenCV ``VideoCapture``), optionally
 with the decoded colour picture alongside.
 
+What OpenCV does not give is read from the container with PyAV (demuxing only, no decoding):
+each frame's presentation time (phones record at a variable frame rate) and the pixel aspect
+ratio (SD camcorders store 4:3 and 16:9 pictures with non-square pixels, PAL 16:15 or 64:45,
+NTSC 8:9 or 32:27). Frames with non-square pixels are resampled to square pixels as they are
+read, so every angle and distance downstream is measured on the true picture.
+
 Decoding runs in a background thread (OpenCV releases the GIL) so it overlaps
 with detection on a second core.
 """
@@ -17,7 +23,7 @@ import numpy as np
 
 from ..._errors import InputError
 
-__all__ = ["VideoInfo", "probe_video", "iter_video_frames"]
+__all__ = ["VideoInfo", "probe_video", "iter_video_frames", "container_timing"]
 
 
 @dataclass(frozen=True)
@@ -32,6 +38,12 @@ class VideoInfo:
     fps : float or None
         Frames per second (None when the container has no rate).
     width_px, height_px : int
+        Size of the frames as yielded: square pixels (the stored width times ``pixel_aspect``).
+    pixel_aspect : float
+        Width / height of one stored pixel (the container's sample aspect ratio; 1 if it says none).
+    frame_times_s : ndarray (n,) or None
+        Each frame's presentation time from the container, s, the first frame at 0 (None when
+        PyAV cannot read the container, e.g. an image sequence).
     """
 
     path: str
@@ -39,11 +51,24 @@ class VideoInfo:
     fps: float | None
     width_px: int
     height_px: int
+    pixel_aspect: float = 1.0
+    frame_times_s: np.ndarray | None = None
+
+    @property
+    def variable_rate(self) -> bool:
+        """True when the frame intervals differ by more than 1 % from their median."""
+        t = self.frame_times_s
+        if t is None or len(t) < 3:
+            return False
+        d = np.diff(t)
+        med = float(np.median(d))
+        return bool(med > 0 and np.max(np.abs(d - med)) > 0.01 * med)
 
     def to_dict(self) -> dict:
         """Plain dict of the fields, JSON-ready (SI units in the keys)."""
         return dict(path=self.path, n_frames=self.n_frames, fps=self.fps,
-                    width_px=self.width_px, height_px=self.height_px)
+                    width_px=self.width_px, height_px=self.height_px, pixel_aspect=self.pixel_aspect,
+                    variable_rate=self.variable_rate)
 
 
 def _open(path):
@@ -62,8 +87,36 @@ def _open(path):
     return cap
 
 
+def container_timing(path) -> tuple[np.ndarray | None, float]:
+    """Per-frame presentation times (s, first frame at 0) and the pixel aspect ratio of a video.
+
+    Read with PyAV from the container's packets (no decoding). Returns ``(None, 1.0)`` where
+    PyAV is missing or cannot open the file (image sequences, exotic containers): the caller
+    then uses frame / fps and square pixels.
+    """
+    if "%" in str(path):
+        return None, 1.0
+    try:
+        import av
+    except ImportError:
+        return None, 1.0
+    try:
+        with av.open(str(path)) as c:
+            s = c.streams.video[0]
+            sar = s.sample_aspect_ratio or s.codec_context.sample_aspect_ratio
+            tb = s.time_base
+            pts = [p.pts for p in c.demux(s) if p.pts is not None and p.size]
+    except Exception:  # noqa: BLE001 - PyAV raises many types; the frame rate stays the fallback
+        return None, 1.0
+    aspect = float(sar) if sar and float(sar) > 0 else 1.0
+    if not pts or tb is None:
+        return None, aspect
+    p = np.sort(np.asarray(pts, np.int64))
+    return (p - p[0]) * float(tb), aspect
+
+
 def probe_video(path) -> VideoInfo:
-    """Open ``path`` and read its frame count, rate and size.
+    """Open ``path`` and read its frame count, rate, size, pixel aspect and frame times.
 
     Raises
     ------
@@ -86,7 +139,29 @@ def probe_video(path) -> VideoInfo:
     # Image sequences report a nominal rate (or none); only trust real containers.
     if not np.isfinite(fps) or fps <= 0 or fps > 1e5 or "%" in str(path):
         fps = None
-    return VideoInfo(str(path), max(n, 0), fps, int(w), int(h))
+    times, aspect = container_timing(path)
+    if times is not None and len(times) > 1:
+        # where OpenCV's nominal rate contradicts the packets (variable-rate files often report
+        # the time base: 1000 fps and 681 "frames" for 24), count and rate come from the packets;
+        # otherwise the header's count stays, so a cut file is still noticed (W-VIDEO-SHORT)
+        rate = 1.0 / float(np.median(np.diff(times)))
+        if fps is None or abs(fps - rate) > 0.01 * rate:
+            fps, n = rate, len(times)
+    return VideoInfo(str(path), max(n, 0), fps, _square_width(int(w), aspect), int(h), aspect, times)
+
+
+def _square_width(w: int, aspect: float) -> int:
+    return int(round(w * aspect)) if abs(aspect - 1.0) > 1e-6 else w
+
+
+def _squared(img, aspect: float):
+    """The picture resampled to square pixels (width times ``aspect``)."""
+    if abs(aspect - 1.0) <= 1e-6:
+        return img
+    import cv2
+
+    w = _square_width(img.shape[1], aspect)
+    return cv2.resize(img, (w, img.shape[0]), interpolation=cv2.INTER_LINEAR if aspect > 1 else cv2.INTER_AREA)
 
 
 def _to_gray(img):
@@ -98,7 +173,7 @@ def _to_gray(img):
 
 
 def iter_video_frames(path, start: int = 0, stop: int | None = None, prefetch: int = 8,
-                      color: bool = False):
+                      color: bool = False, pixel_aspect: float = 1.0):
     """Yield ``(index, gray)`` (``(index, gray, image)`` with ``color``) for frames
     ``start <= index < stop``.
 
@@ -113,6 +188,9 @@ def iter_video_frames(path, start: int = 0, stop: int | None = None, prefetch: i
     color : bool
         Also yield the decoded picture, so a caller can show the frames in colour
         without decoding the video a second time.
+    pixel_aspect : float
+        Width / height of a stored pixel (:attr:`VideoInfo.pixel_aspect`): frames are resampled
+        to square pixels, ``width * pixel_aspect`` wide.
 
     Yields
     ------
@@ -135,6 +213,7 @@ def iter_video_frames(path, start: int = 0, stop: int | None = None, prefetch: i
                 ok, img = cap.read()
                 if not ok or img is None:
                     return
+                img = _squared(img, pixel_aspect)
                 yield (i, _to_gray(img), img) if color else (i, _to_gray(img))
                 i += 1
         finally:

@@ -1,0 +1,118 @@
+"""What the container says and OpenCV does not: per-frame timestamps (variable frame rate) and
+non-square pixels (SD camcorder footage). Videos are written with PyAV with known truth."""
+
+from __future__ import annotations
+
+import math
+from fractions import Fraction
+
+import cv2
+import numpy as np
+import pytest
+
+from rocklab.tracking import TrackConfig, probe_video, track_video
+
+av = pytest.importorskip("av")
+
+W, H = 401, 301  # odd sizes: nothing may assume even frames
+MARKER_PX = 90
+CFG = {"targets": {"style": "aruco", "marker_size_m": 0.05},
+       "reference": {"level": "none"},  # rendered level
+       "objects": [{"id": "block_1", "markers": [3]}]}
+
+
+def _marker_frame(theta_rad: float, w: int = W, h: int = H) -> np.ndarray:
+    """ArUco 4x4_50 id 3 on white, rotated counter-clockwise by ``theta_rad`` about the centre."""
+    d = cv2.aruco.getPredefinedDictionary(cv2.aruco.DICT_4X4_50)
+    m = cv2.aruco.generateImageMarker(d, 3, MARKER_PX, borderBits=1)
+    img = np.full((h, w), 255, np.uint8)
+    y0, x0 = (h - MARKER_PX) // 2, (w - MARKER_PX) // 2
+    img[y0:y0 + MARKER_PX, x0:x0 + MARKER_PX] = m
+    R = cv2.getRotationMatrix2D(((w - 1) / 2, (h - 1) / 2), math.degrees(theta_rad), 1.0)
+    return cv2.warpAffine(img, R, (w, h), flags=cv2.INTER_CUBIC, borderValue=255)
+
+
+def _write(path, frames, pts, time_base, sar=None, codec="ffv1"):
+    with av.open(str(path), "w") as c:
+        s = c.add_stream(codec, rate=Fraction(1, time_base))
+        s.width, s.height = frames[0].shape[1], frames[0].shape[0]
+        s.pix_fmt = "gray" if codec == "ffv1" else "yuv420p"
+        if codec == "libx264":
+            s.options = {"crf": "0"}  # lossless luma
+        s.time_base = time_base
+        if sar is not None:
+            s.codec_context.sample_aspect_ratio = sar
+        for f, p in zip(frames, pts):
+            vf = av.VideoFrame.from_ndarray(f, format="gray")
+            vf.pts, vf.time_base = int(p), time_base
+            for pkt in s.encode(vf):
+                c.mux(pkt)
+        for pkt in s.encode():
+            c.mux(pkt)
+
+
+def test_variable_frame_rate_times_come_from_the_container(tmp_path):
+    """Phone footage: frame intervals alternate 20 ms / 40 ms; t_s is each frame's own time."""
+    n = 24
+    dt_ms = np.where(np.arange(n) % 2 == 0, 20, 40)
+    pts_ms = np.concatenate(([0], np.cumsum(dt_ms[:-1])))
+    theta = 0.2 * np.sin(2 * np.pi * pts_ms / 1000.0)  # a function of the true time
+    path = tmp_path / "vfr.mkv"
+    _write(path, [_marker_frame(t) for t in theta], pts_ms, Fraction(1, 1000))
+    info = probe_video(path)
+    assert info.frame_times_s is not None and info.variable_rate
+    np.testing.assert_allclose(info.frame_times_s[:n], pts_ms / 1000.0, atol=1e-9)
+    tr = track_video(path, TrackConfig.from_dict(CFG))
+    b = tr["block_1"]
+    np.testing.assert_allclose(b.t_s, pts_ms / 1000.0, atol=1e-9)
+    # θ lines up with the truth at those times (at a constant 1/fps the phase would drift)
+    assert np.nanmax(np.abs(b.theta_rad - theta)) < math.radians(0.3)
+    # --fps still overrides the container (a file whose clock is known to be wrong)
+    tr30 = track_video(path, TrackConfig.from_dict(CFG), fps=30.0)
+    np.testing.assert_allclose(tr30["block_1"].t_s, np.arange(n) / 30.0, atol=1e-12)
+
+
+def test_constant_rate_file_keeps_frame_over_fps(tmp_path):
+    n = 6
+    path = tmp_path / "cfr.mkv"
+    _write(path, [_marker_frame(0.1)] * n, np.arange(n) * 40, Fraction(1, 1000))
+    info = probe_video(path)
+    assert not info.variable_rate and info.fps == pytest.approx(25.0)
+    tr = track_video(path, TrackConfig.from_dict(CFG))
+    np.testing.assert_allclose(tr["block_1"].t_s, np.arange(n) / 25.0, atol=1e-9)
+
+
+@pytest.mark.parametrize("sar", [Fraction(16, 15), Fraction(8, 9)])
+def test_non_square_pixels_are_made_square_before_any_geometry(tmp_path, sar):
+    """SD camcorders store 4:3 or 16:9 pictures with non-square pixels (PAL 16:15, NTSC 8:9).
+    A marker turned by 20° is filmed squeezed; read as square pixels it would measure
+    atan(sar · tan 20°); the container's aspect ratio restores 20°."""
+    theta = math.radians(20.0)
+    square = _marker_frame(theta, 480, 360)  # 4:2:0 H.264 (as camcorders write) needs even sizes
+    stored_w = int(round(square.shape[1] / float(sar)))
+    stored = cv2.resize(square, (stored_w, square.shape[0]), interpolation=cv2.INTER_AREA)
+    path = tmp_path / "sd.mp4"  # the aspect ratio travels in the H.264 stream (VUI), as from a camera
+    _write(path, [stored] * 3, np.arange(3) * 40, Fraction(1, 1000), sar=sar, codec="libx264")
+    info = probe_video(path)
+    assert info.pixel_aspect == pytest.approx(float(sar), rel=1e-9)
+    assert info.width_px == int(round(stored_w * float(sar)))  # the square-pixel picture's width
+    tr = track_video(path, TrackConfig.from_dict(CFG))
+    th = tr["block_1"].theta_rad
+    assert np.all(np.abs(th - theta) < math.radians(0.15)), np.degrees(th)
+    naive = math.atan(math.tan(theta) * float(sar))
+    assert abs(naive - theta) > math.radians(0.6)  # the error the correction removes
+
+
+def test_real_film_timestamps_show_its_one_dropped_frame(shared_data):
+    """The real pendulum film (60 fps, 2057 frames): its packets carry one doubled interval, a
+    frame the camera dropped; with frame / fps every later time would be 16.7 ms early."""
+    info = probe_video(shared_data / "video" / "pendulum_film2_vga.mp4")
+    t = info.frame_times_s
+    assert t is not None and len(t) == info.n_frames == 2057
+    d = np.diff(t)
+    long = np.flatnonzero(d > 1.5 / 60)
+    assert len(long) == 1 and d[long[0]] == pytest.approx(2 / 60, rel=1e-3)
+    assert info.variable_rate
+    assert t[-1] == pytest.approx(2057 / 60, abs=1e-3)  # frame / fps would say 2056 / 60
+    # its stored pixels are 496:495, not square: 550 stored columns are 551 square ones
+    assert info.pixel_aspect == pytest.approx(496 / 495, rel=1e-6) and info.width_px == 551

@@ -26,6 +26,7 @@ import numpy as np
 
 from ...._errors import InputError
 from ._detection import Detection
+from ._ic import ICAffine, ICRigid
 
 __all__ = ["MarkerlessTracker", "MarkerlessDetector", "MIN_CC", "REKEY_CC"]
 
@@ -37,6 +38,14 @@ REKEY_CC = 0.9
 CORRELATION_INFLATION = 3.0
 #: Smallest grey-level standard deviation of a region worth tracking.
 MIN_TEXTURE_STD = 3.0
+#: Margin of the full-resolution ECC window round the coarse footprint, px (the half-resolution
+#: pose is good to about a pixel; ECC's 5x5 smoothing needs a border).
+FINE_MARGIN_PX = 12
+#: Correlation the fast (inverse-compositional) fit must reach to be kept; below it, the frame is
+#: registered by OpenCV's ECC on the wide window (a spinning or changing object).
+FAST_CC = 0.97
+#: ECC stopping rule: 60 iterations or a correlation gain below 1e-5.
+ECC_CRITERIA = (3, 60, 1e-5)  # cv2.TERM_CRITERIA_EPS | cv2.TERM_CRITERIA_COUNT
 
 
 def _euclid(theta, tx, ty):
@@ -96,6 +105,7 @@ class MarkerlessTracker:
         self.origin = np.array([u0, v0], float)  # template pixel (0, 0) in the first frame
         self.tmpl0 = tmpl
         self.key = tmpl
+        self._ic: list = []  # (template, ICAffine): the first template's, then the keyframe's
         self.size = (u1 - u0, v1 - v0)
         self.poses: list = []  # last two accepted (theta, tx, ty): first-frame px -> image px
         # reference points: a 3x3 grid over the template, as plane points of the first frame
@@ -124,49 +134,120 @@ class MarkerlessTracker:
         return gray[y0:y1, x0:x1].astype(np.float32), np.array([x0, y0], np.float32)
 
     def _ecc(self, tmpl, gray, W0, levels=3):
-        """ECC of ``tmpl`` in ``gray`` from the warp W0 (first-frame px -> image px); (W, cc) or None."""
+        """ECC of ``tmpl`` in ``gray`` from the warp W0 (first-frame px -> image px); (W, cc) or None.
+
+        The reduced levels run on a window wide enough for the prediction's error; the full-
+        resolution pass on a window a few pixels round the coarse footprint (ECC takes the
+        gradient of its whole input image, so the window's size is its cost).
+        """
         crop, off = self._window(gray, W0, 0.5 * max(self.size) + 16)
         if crop is None:
             return None
-        W0 = W0.copy()
-        W0[:, 2] -= off
-        r = self._ecc_full(tmpl, crop, W0, levels)
+        W = W0.copy()
+        W[:, 2] -= off
+        W = self._ecc_coarse(tmpl, crop, W, levels)
+        if W is None:
+            return None
+        Wg = W.copy()
+        Wg[:, 2] += off
+        fine, off2 = self._window(gray, Wg, FINE_MARGIN_PX)
+        if fine is not None:
+            Wg[:, 2] -= off2
+            r = self._ic_fine(tmpl, fine, Wg)
+            if r is not None:
+                r[0][:, 2] += off2
+                return r
+        r = self._ecc_fine(tmpl, crop, W)  # the robust path, on the wide window
         if r is None:
             return None
-        W, cc = r
-        W[:, 2] += off
-        return W, cc
+        r[0][:, 2] += off
+        return r
 
-    def _ecc_full(self, tmpl, gray_f, W0, levels=3):
+    def _ic_for(self, tmpl):
+        """(:class:`ICRigid`, :class:`ICAffine`) of ``tmpl`` (the first template's are kept, the
+        keyframe's renewed with it)."""
+        for t, ic in self._ic:
+            if t is tmpl:
+                return ic
+        ic = (ICRigid(tmpl), ICAffine(tmpl))
+        self._ic = [self._ic[0], (tmpl, ic)] if self._ic else [(tmpl, ic)]
+        return ic
+
+    def _to_tmpl(self, W):
+        """First-frame px -> image px  into  template px -> image px (and back with ``sign=-1``)."""
+        W = W.copy()
+        W[:, 2] += (W[:, :2] @ self.origin).astype(np.float32)
+        return W
+
+    def _from_tmpl(self, W):
+        W = W.copy()
+        W[:, 2] -= (W[:, :2] @ self.origin).astype(np.float32)
+        return W
+
+    def _ecc_coarse(self, tmpl, gray_f, W0, levels=3):
+        """Rigid ECC on the reduced pyramid levels (robust, 3 parameters); W0 and the result map
+        first-frame px -> ``gray_f`` px. None when a level fails."""
         cv2 = self._cv2
-        crit = (cv2.TERM_CRITERIA_EPS | cv2.TERM_CRITERIA_COUNT, 60, 1e-5)
-        W = _rigid(W0)  # coarse levels: rigid (3 parameters, robust); the finest adds affine terms
-        W[:, 2] += (W[:, :2] @ self.origin).astype(np.float32)  # template px -> image px incl. origin
-        for lvl in range(levels - 1, -1, -1):
+        W = self._to_tmpl(_rigid(W0))
+        for lvl in range(levels - 1, 0, -1):
             f = 0.5 ** lvl
-            t = cv2.resize(tmpl, None, fx=f, fy=f, interpolation=cv2.INTER_AREA) if lvl else tmpl
+            t = cv2.resize(tmpl, None, fx=f, fy=f, interpolation=cv2.INTER_AREA)
             if min(t.shape) < 8:
                 continue
-            img = cv2.resize(gray_f, None, fx=f, fy=f, interpolation=cv2.INTER_AREA) if lvl else gray_f
+            img = cv2.resize(gray_f, None, fx=f, fy=f, interpolation=cv2.INTER_AREA)
             Wl = W.copy()
             Wl[:, 2] *= f
             try:
-                cc, Wl = cv2.findTransformECC(t, img, Wl, cv2.MOTION_EUCLIDEAN, crit, None, 3 if lvl else 5)
+                _, Wl = cv2.findTransformECC(t, img, Wl, cv2.MOTION_EUCLIDEAN, ECC_CRITERIA, None, 3)
             except cv2.error:
                 return None
             Wl[:, 2] /= f
             W = Wl
-        # perspective and lens distortion make a planar object's image motion slightly non-rigid
-        # (0.7 % in scale across a table on the demo render): refine with an affine warp; the
-        # rigid pose comes from the warped points in the plane afterwards
+        return self._from_tmpl(W)
+
+    def _ic_fine(self, tmpl, gray_f, W0):
+        """Full-resolution inverse-compositional fit (:mod:`._ic`) from the coarse pose: (W, cc),
+        or None when it fails or matches poorly (appearance changing, a spinning object).
+
+        Rigid first, then affine from the rigid pose: perspective and lens distortion make a
+        planar object's image motion slightly non-rigid (0.7 % in scale across a table on the
+        demo render); the affine fit is kept when it is near-rigid and matches at least as well,
+        and the rigid pose comes from the warped points in the plane afterwards.
+        """
+        rigid, affine = self._ic_for(tmpl)
+        fit = rigid.refine(gray_f, self._to_tmpl(W0))
+        if fit is None or fit[1] < FAST_CC:
+            return None
+        aff = affine.refine(gray_f, fit[0])
+        if aff is None or aff[1] < fit[1]:
+            # a thin template (a table edge) leaves the affine terms weakly determined; OpenCV's
+            # ECC from the rigid pose finds their optimum where the fast fit does not
+            try:
+                cv2 = self._cv2
+                cc_a, Wa = cv2.findTransformECC(tmpl, gray_f, fit[0].copy(), cv2.MOTION_AFFINE, ECC_CRITERIA,
+                                                None, 5)
+                aff = (Wa, float(cc_a))
+            except cv2.error:
+                aff = None
+        if aff is not None and aff[1] >= fit[1] and _near_rigid(aff[0]):
+            fit = aff
+        return self._from_tmpl(fit[0]), float(fit[1])
+
+    def _ecc_fine(self, tmpl, gray_f, W0):
+        """The same two steps with OpenCV's ECC (slower, wider basin): (W, cc) or None."""
+        W = self._to_tmpl(W0)
+        cv2 = self._cv2
         try:
-            cc_a, Wa = cv2.findTransformECC(tmpl, gray_f, W.copy(), cv2.MOTION_AFFINE, crit, None, 5)
+            cc, W = cv2.findTransformECC(tmpl, gray_f, W.copy(), cv2.MOTION_EUCLIDEAN, ECC_CRITERIA, None, 5)
+        except cv2.error:
+            return None
+        try:
+            cc_a, Wa = cv2.findTransformECC(tmpl, gray_f, W.copy(), cv2.MOTION_AFFINE, ECC_CRITERIA, None, 5)
             if cc_a >= cc and _near_rigid(Wa):
                 cc, W = cc_a, Wa
         except cv2.error:
             pass
-        W[:, 2] -= (W[:, :2] @ self.origin).astype(np.float32)
-        return W, float(cc)
+        return self._from_tmpl(W), float(cc)
 
     def _search(self, tmpl, gray, W_pred):
         """Re-acquire by normalised cross-correlation of the (rotated) template round the prediction."""
@@ -205,10 +286,14 @@ class MarkerlessTracker:
         r = a - b
         gx = cv2.Sobel(b, cv2.CV_32F, 1, 0, ksize=3) / 8.0
         gy = cv2.Sobel(b, cv2.CV_32F, 0, 1, ksize=3) / 8.0
-        yy, xx = np.mgrid[0:h, 0:w].astype(np.float32)
+        # every 2nd pixel each way: JᵀJ of the full grid is 4 times the subsample's to well under
+        # a percent on any textured region, at a quarter of the cost
+        k = 2 if min(h, w) >= 32 else 1
+        gx, gy, r = gx[::k, ::k], gy[::k, ::k], r[::k, ::k]
+        yy, xx = np.mgrid[0:h:k, 0:w:k].astype(np.float32)
         xc, yc = xx - w / 2, yy - h / 2
         J = np.column_stack(((-yc * gx + xc * gy).ravel(), gx.ravel(), gy.ravel())).astype(float)
-        JTJ = J.T @ J
+        JTJ = (k * k) * (J.T @ J)
         s2 = float(np.sum(r.astype(float) ** 2)) / max(r.size - 3, 1)
         try:
             cov = s2 * np.linalg.inv(JTJ)

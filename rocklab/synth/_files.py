@@ -15,8 +15,48 @@ import numpy as np
 __all__ = ["VideoPair", "write_track_toml", "write_experiment_toml"]
 
 
+#: A camcorder's H.264 bit rate at 1920x1080 (AVCHD's 17 Mbit/s), scaled by the pixel count.
+CAMCORDER_BITRATE_1080P = 17_000_000
+
+
+class _H264Writer:
+    """``cv2.VideoWriter``-like (``write``/``release``) H.264 MP4 writer (PyAV, libx264), grey frames
+    at a camcorder's bit rate for the frame size."""
+
+    def __init__(self, path: Path, fps: float, size):
+        from fractions import Fraction
+
+        import av
+
+        W, H = size
+        if (W | H) & 1:
+            raise ValueError("4:2:0 H.264 needs even frame sizes")
+        self._c = av.open(str(path), "w")
+        try:
+            s = self._c.add_stream("libx264", rate=Fraction(float(fps)).limit_denominator(1001))
+            s.width, s.height, s.pix_fmt = W, H, "yuv420p"
+            s.bit_rate = int(max(2e6, CAMCORDER_BITRATE_1080P * W * H / (1920 * 1080)))
+            s.options = {"preset": "veryfast"}
+        except Exception:
+            self._c.close()
+            raise
+        self._s = s
+
+    def write(self, frame):
+        import av
+
+        for pkt in self._s.encode(av.VideoFrame.from_ndarray(np.ascontiguousarray(frame), format="gray")):
+            self._c.mux(pkt)
+
+    def release(self):
+        for pkt in self._s.encode():
+            self._c.mux(pkt)
+        self._c.close()
+
+
 class VideoPair:
-    """Write the same grey frames to ``STEM.mkv`` (FFV1, lossless) and ``STEM.mp4`` (mp4v); STEM = ``video``.
+    """Write the same grey frames to ``STEM.mkv`` (FFV1, lossless) and ``STEM.mp4`` (H.264 at a
+    camcorder's bit rate, or OpenCV's MPEG-4 without PyAV/libx264); STEM = ``video``.
 
     Encoding runs in a background thread (OpenCV releases the GIL while
     encoding), overlapping with the rendering of the next frame. If this
@@ -43,12 +83,17 @@ class VideoPair:
         if self.codec is None:
             raise RuntimeError("this OpenCV build writes neither FFV1 nor PNG into .mkv; "
                                "install an opencv build with FFmpeg")
+        self.lossy_codec = None
         if mp4:
-            w = cv2.VideoWriter(str(folder / f"{stem}.mp4"), cv2.VideoWriter_fourcc(*"mp4v"), float(fps),
-                                (W, H), isColor=False)
-            if w.isOpened():
-                self.writers.append(w)
-                self.paths["mp4"] = folder / f"{stem}.mp4"
+            try:  # what a camcorder writes: H.264 at an AVCHD bit rate
+                self.writers.append(_H264Writer(folder / f"{stem}.mp4", fps, (W, H)))
+                self.paths["mp4"], self.lossy_codec = folder / f"{stem}.mp4", "h264"
+            except Exception:  # noqa: BLE001 - no PyAV or no libx264 in its FFmpeg: OpenCV's MPEG-4
+                w = cv2.VideoWriter(str(folder / f"{stem}.mp4"), cv2.VideoWriter_fourcc(*"mp4v"), float(fps),
+                                    (W, H), isColor=False)
+                if w.isOpened():
+                    self.writers.append(w)
+                    self.paths["mp4"], self.lossy_codec = folder / f"{stem}.mp4", "mp4v"
         self._q: queue.Queue = queue.Queue(maxsize=4)
         self._err: list = []
         self._t = threading.Thread(target=self._run, daemon=True)

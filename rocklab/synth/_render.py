@@ -77,6 +77,8 @@ class Renderer:
         Shutter open time and rolling-shutter readout (0: global shutter), s.
     noise_dn : float
         Sensor noise standard deviation, grey levels.
+    flicker : float
+        Relative amplitude of the exposure flicker (see :meth:`exposure_gain`); 0: none.
     rng : numpy Generator (noise draws; consumed in frame order).
     psf_px : float
         Optical blur sigma used for the texture prefilter, px (for ROI margins).
@@ -84,7 +86,7 @@ class Renderer:
 
     def __init__(self, camera: SynthCamera, objects, background, illumination, *, exposure_s,
                  readout_s=0.0, noise_dn=1.0, rng, psf_px=0.5, blur_step_px=0.5, max_sub=32,
-                 occluders=(), plane_maps=None):
+                 occluders=(), plane_maps=None, flicker=0.0, flicker_seed=0):
         self.cam = camera
         self.W, self.H = camera.size
         self.X, self.Y = plane_maps if plane_maps is not None else camera.plane_maps()
@@ -110,6 +112,21 @@ class Renderer:
         self.noise_bank = [np.rint(rng.normal(0.0, noise_dn, (self.H + 16, self.W + 16))).astype(np.int16)
                            for _ in range(3)] if noise_dn > 0 else None
         self.last_subframes = 1
+        # an integer of its own from the seed (an int or a SeedSequence), not drawn from ``rng``
+        self.flicker = float(flicker)
+        self.flicker_seed = int(np.random.default_rng(flicker_seed).integers(2 ** 31))
+        self.flicker_phase = float(np.random.default_rng((self.flicker_seed, 7)).uniform(0, 2 * math.pi))
+
+    def exposure_gain(self, t_s: float) -> float:
+        """Brightness gain of the frame at ``t_s`` (1 without flicker).
+
+        A camcorder's automatic exposure hunting under mains lighting: a slow swing (1.3 Hz,
+        60 % of ``flicker``) plus a level that jumps every 0.6 s (40 %), deterministic per seed.
+        """
+        if self.flicker <= 0:
+            return 1.0
+        step = float(np.random.default_rng((self.flicker_seed, int(math.floor(t_s / 0.6)))).uniform(-1, 1))
+        return 1.0 + self.flicker * (0.6 * math.sin(2 * math.pi * 1.3 * t_s + self.flicker_phase) + 0.4 * step)
 
     # ----------------------------------------------------------------- geometry
     def _span(self, t):
@@ -205,6 +222,8 @@ class Renderer:
                 acc[r0 - R0:r1 - R0, c0 - C0:c1 - C0] = 38.0     # a dark hand in front
             acc *= self.illum[R0:R1, C0:C1]
             frame[R0:R1, C0:C1] = np.clip(np.rint(acc), 0, 255).astype(np.uint8)
+        if self.flicker > 0:
+            frame = cv2.convertScaleAbs(frame, alpha=self.exposure_gain(t_s))  # rounds and saturates
         if self.noise_bank is not None:
             k = int(self.rng.integers(len(self.noise_bank)))
             dy, dx = (int(v) for v in self.rng.integers(0, 17, 2))

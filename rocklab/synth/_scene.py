@@ -101,6 +101,7 @@ class Scene:
     table_width_m: float
     video_info: dict = field(default_factory=dict)
     layout: str = "single"
+    flicker: float = 0.0  # relative amplitude of the exposure flicker (Renderer.exposure_gain)
 
     def renderer(self):
         from ._render import Renderer
@@ -108,7 +109,7 @@ class Scene:
         return Renderer(self.camera, self.objects, self.background, self.illumination,
                         exposure_s=self.exposure_s, readout_s=self.readout_s, noise_dn=self.noise_dn,
                         rng=np.random.default_rng(self.noise_seed), occluders=self.occluders,
-                        plane_maps=self.plane_maps)
+                        plane_maps=self.plane_maps, flicker=self.flicker, flicker_seed=self.noise_seed)
 
     # ------------------------------------------------------------------ truth
     def truth_frame(self):

@@ -157,7 +157,7 @@ def synth_session(out_dir, seed: int = 0, blocks: int = 1, table: str = "none", 
                   noise_dn: float = 1.0, distortion: bool = True, imu: bool = True,
                   imu_rate_hz: float = 256.0, mp4: bool = True, calibrated: bool = True,
                   layout: str | None = None, force: bool = False,
-                  progress: bool = False) -> SynthSession:
+                  progress: bool = False, flicker: float = 0.0) -> SynthSession:
     """Render a synthetic lab session into ``out_dir`` (see the module doc for the layout).
 
     Parameters
@@ -206,6 +206,9 @@ def synth_session(out_dir, seed: int = 0, blocks: int = 1, table: str = "none", 
         Shutter time, s (default half a frame period); motion blur integrates over it.
     noise_dn : float
         Sensor noise, grey levels (sigma).
+    flicker : float
+        Exposure flicker, relative amplitude (0 to 0.5): a camcorder's automatic exposure
+        hunting under mains light (``Renderer.exposure_gain``); the frames' brightness follows it.
     imu : bool
         Write IMU logs (one per block and one on the table), x-IMU GUI format. They
         start 0.5..1.5 s before the video and run on 0.5 s after its last frame (the
@@ -226,6 +229,8 @@ def synth_session(out_dir, seed: int = 0, blocks: int = 1, table: str = "none", 
     size = parse_size(size)
     fps = float(fps) if isinstance(fps, (int, float, np.number)) and not isinstance(fps, bool) else fps
     _check(seed, blocks, table, fps, targets, duration_s, exposure_s, noise_dn)
+    if not (isinstance(flicker, (int, float)) and not isinstance(flicker, bool) and 0 <= flicker <= 0.5):
+        raise InputError(f"flicker={flicker!r}: exposure flicker must be a relative amplitude from 0 to 0.5")
     out_dir = Path(out_dir)
     tmp = _prepare_out(out_dir, force)
     t_start = time.perf_counter()
@@ -237,8 +242,10 @@ def synth_session(out_dir, seed: int = 0, blocks: int = 1, table: str = "none", 
                             table_period_s=table_period_s, table_stroke_m=table_stroke_m,
                             exposure_s=exposure_s, noise_dn=noise_dn, distortion=distortion,
                             layout=layout)
+        scene.flicker = float(flicker)
         _render_video(scene, tmp, mp4, progress)
         meta = scene.write_files(tmp, imu=imu, imu_rate_hz=imu_rate_hz, calibrated=calibrated)
+        meta["flicker"] = float(flicker)
         render_s = time.perf_counter() - t_start
         meta["render_s"] = render_s
         from .._io import write_json_atomic
@@ -277,9 +284,12 @@ def _render_video(scene, folder: Path, mp4: bool, progress: bool):
             bar.close()
     scene.video_info = {"lossless_codec": writer.codec, "lossless_file": "video.mkv",
                         "lossy_file": "video.mp4" if "mp4" in writer.paths else None,
-                        "lossy_codec": "mp4v" if "mp4" in writer.paths else None,
+                        "lossy_codec": writer.lossy_codec,
                         "color": "grey (one channel; readers return BGR with equal channels)",
                         "max_subframes": int(max(subframes, default=1)),
+                        # brightness gain of each frame (exposure flicker; all 1 without it)
+                        "exposure_gain": [round(renderer.exposure_gain(i / scene.fps), 6)
+                                          for i in range(scene.n_frames)] if scene.flicker > 0 else None,
                         "mean_subframes": float(np.mean(subframes)) if subframes else 1.0}
 
 

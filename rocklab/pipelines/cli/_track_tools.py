@@ -21,7 +21,8 @@ def _first_frame(video: Path):
     if not video.exists():
         raise InputError(f"{video}: video not found; check the path")
     info = probe_video(video)
-    for _, gray, img in iter_video_frames(video, 0, 1, color=True, pixel_aspect=info.pixel_aspect):
+    for _, gray, img in iter_video_frames(video, 0, 1, color=True, pixel_aspect=info.pixel_aspect,
+                                          fields=info.field_order):
         return info, gray, img
     raise InputError(f"{video}: no frame could be decoded; check the file")
 
@@ -109,7 +110,7 @@ def track_preview(video, config, out, *, n_frames: int = 6, progress: bool = Fal
         raise InputError(f"--frames {n_frames}: give 1 to 48 frames for the sheet")
     from ...tracking.video._video import iter_video_frames, probe_video
 
-    aspect = probe_video(video).pixel_aspect  # the sheet shows the square-pixel frames that were tracked
+    vinfo = probe_video(video)  # the sheet shows the frames (fields) as tracked: square pixels
     cfg = load_track_config(config)
     res = track_video(video, cfg, progress=progress)
     frames = np.asarray(res.tracks[0].frame)
@@ -117,7 +118,7 @@ def track_preview(video, config, out, *, n_frames: int = 6, progress: bool = Fal
     tiles = []
     for f in pick:  # decode only the frames shown (a long film is not kept in memory)
         for i, _, img in iter_video_frames(video, int(f), int(f) + 1, prefetch=0, color=True,
-                                           pixel_aspect=aspect):
+                                           pixel_aspect=vinfo.pixel_aspect, fields=vinfo.field_order):
             tiles.append(_draw_pose(img, res, i))
     from ..experiment._figures import save_bgr_png
 

@@ -446,9 +446,18 @@ def track_video(path, config: TrackConfig, fps: float | None = None, progress: b
     from ._video import iter_video_frames, probe_video
 
     info = probe_video(path)
+    fields = info.field_order
     rate = fps or config.video.fps or info.fps
     # the container's own frame times, unless the user overrides the rate (a clock known wrong)
     times = info.frame_times_s if not (fps or config.video.fps) and info.variable_rate else None
+    n_expected = info.n_frames
+    if fields is not None:  # deinterlaced: two fields per frame, half a frame apart
+        if rate is not None and not (fps or config.video.fps):
+            rate = 2.0 * rate
+        if times is not None:
+            half = 0.5 * float(np.median(np.diff(times)))
+            times = np.column_stack((times, times + half)).ravel()
+        n_expected = 2 * info.n_frames
     if rate is None:
         raise InputError(f"{path}: the container has no frame rate; pass --fps N "
                          "(or set [video] fps in the config)")
@@ -456,24 +465,26 @@ def track_video(path, config: TrackConfig, fps: float | None = None, progress: b
     start, stop = v.start_frame, v.stop_frame
     ref_frame = config.reference.board.frame if config.reference.board is not None else start
     first = None
-    for _, g in iter_video_frames(path, ref_frame, ref_frame + 1, prefetch=0, pixel_aspect=info.pixel_aspect):
+    for _, g in iter_video_frames(path, ref_frame, ref_frame + 1, prefetch=0, pixel_aspect=info.pixel_aspect,
+                                  fields=fields):
         first = g
     if first is None:
         raise InputError(f"{path}: frame {ref_frame} is past the end of the video "
                          f"({info.n_frames} frames); check start_frame / reference.board.frame")
     pm = make_plane_map(config, info.width_px, info.height_px, first)
-    frames = iter_video_frames(path, start, stop, color=on_frame is not None, pixel_aspect=info.pixel_aspect)
+    frames = iter_video_frames(path, start, stop, color=on_frame is not None, pixel_aspect=info.pixel_aspect,
+                               fields=fields)
     if on_frame is not None:
         frames = _tee(frames, on_frame)
     if progress:
         from tqdm import tqdm
 
-        total = (min(stop, info.n_frames) if stop else info.n_frames) - start
+        total = (min(stop, n_expected) if stop else n_expected) - start
         frames = tqdm(frames, total=total if total > 0 else None, unit="frame", desc="track",
                       leave=False)
     obs = track_frames(frames, config, pm)
     res = assemble_tracks(obs, config, rate, info.width_px, info.height_px, pm, path,
-                          frame_times_s=times if times is not None and len(times) >= info.n_frames else None)
-    expected = (min(stop, info.n_frames) if stop else info.n_frames) - start
+                          frame_times_s=times if times is not None and len(times) >= n_expected else None)
+    expected = (min(stop, n_expected) if stop else n_expected) - start
     _check_frames(res, expected, path)
     return res

@@ -5,7 +5,10 @@ What OpenCV does not give is read from the container with PyAV (demuxing only, n
 each frame's presentation time (phones record at a variable frame rate) and the pixel aspect
 ratio (SD camcorders store 4:3 and 16:9 pictures with non-square pixels, PAL 16:15 or 64:45,
 NTSC 8:9 or 32:27). Frames with non-square pixels are resampled to square pixels as they are
-read, so every angle and distance downstream is measured on the true picture.
+read, so every angle and distance downstream is measured on the true picture. Interlaced video
+(camcorders' 1080i50: each frame two fields exposed 20 ms apart) is deinterlaced on read by
+splitting the fields ("bob"): twice the frame rate, each field brought to full height on its own
+rows, so a rocking block is sampled at 50 Hz without combing.
 
 Decoding runs in a background thread (OpenCV releases the GIL) so it overlaps
 with detection on a second core.
@@ -23,7 +26,7 @@ import numpy as np
 
 from ..._errors import InputError
 
-__all__ = ["VideoInfo", "probe_video", "iter_video_frames", "container_timing"]
+__all__ = ["VideoInfo", "probe_video", "iter_video_frames", "container_timing", "field_order"]
 
 
 @dataclass(frozen=True)
@@ -44,6 +47,8 @@ class VideoInfo:
     frame_times_s : ndarray (n,) or None
         Each frame's presentation time from the container, s, the first frame at 0 (None when
         PyAV cannot read the container, e.g. an image sequence).
+    field_order : {"tff", "bff"} or None
+        Interlaced video: which field is exposed first (top or bottom); None for progressive.
     """
 
     path: str
@@ -53,6 +58,7 @@ class VideoInfo:
     height_px: int
     pixel_aspect: float = 1.0
     frame_times_s: np.ndarray | None = None
+    field_order: str | None = None
 
     @property
     def variable_rate(self) -> bool:
@@ -68,7 +74,7 @@ class VideoInfo:
         """Plain dict of the fields, JSON-ready (SI units in the keys)."""
         return dict(path=self.path, n_frames=self.n_frames, fps=self.fps,
                     width_px=self.width_px, height_px=self.height_px, pixel_aspect=self.pixel_aspect,
-                    variable_rate=self.variable_rate)
+                    variable_rate=self.variable_rate, field_order=self.field_order)
 
 
 def _open(path):
@@ -115,6 +121,33 @@ def container_timing(path) -> tuple[np.ndarray | None, float]:
     return (p - p[0]) * float(tb), aspect
 
 
+#: FFmpeg's AVFieldOrder: TT and TB code/show the top field first, BB and BT the bottom one.
+_FIELD_ORDER = {2: "tff", 4: "tff", 3: "bff", 5: "bff"}
+
+
+def field_order(path) -> str | None:
+    """``"tff"``/``"bff"`` for interlaced video, None for progressive or unknown (PyAV, first frame).
+
+    The stream's field order where the codec states it; else a first frame flagged interlaced is
+    taken as top field first (HD camcorders; PAL DV is bottom first and says so).
+    """
+    if "%" in str(path):
+        return None
+    try:
+        import av
+    except ImportError:
+        return None
+    try:
+        with av.open(str(path)) as c:
+            s = c.streams.video[0]
+            f = next(c.decode(s), None)
+            fo = int(s.codec_context.field_order or 0)
+            flagged = bool(f is not None and f.interlaced_frame)
+    except Exception:  # noqa: BLE001 - PyAV raises many types; progressive is the fallback
+        return None
+    return _FIELD_ORDER.get(fo, "tff" if flagged else None)
+
+
 def probe_video(path) -> VideoInfo:
     """Open ``path`` and read its frame count, rate, size, pixel aspect and frame times.
 
@@ -147,7 +180,8 @@ def probe_video(path) -> VideoInfo:
         rate = 1.0 / float(np.median(np.diff(times)))
         if fps is None or abs(fps - rate) > 0.01 * rate:
             fps, n = rate, len(times)
-    return VideoInfo(str(path), max(n, 0), fps, _square_width(int(w), aspect), int(h), aspect, times)
+    return VideoInfo(str(path), max(n, 0), fps, _square_width(int(w), aspect), int(h), aspect, times,
+                     field_order(path))
 
 
 def _square_width(w: int, aspect: float) -> int:
@@ -172,8 +206,44 @@ def _to_gray(img):
     return cv2.cvtColor(img, cv2.COLOR_BGR2GRAY)
 
 
+class _PyAVReader:
+    """``cv2.VideoCapture``'s ``read``/``release`` over PyAV's decoder (BGR pictures), from frame ``first``."""
+
+    def __init__(self, path, first: int = 0):
+        import av
+
+        self._c = av.open(str(path))
+        self._it = self._c.decode(video=0)
+        for _ in range(int(first)):  # interlaced camcorder files are read from the start
+            if next(self._it, None) is None:
+                break
+
+    def read(self):
+        f = next(self._it, None)
+        return (False, None) if f is None else (True, f.to_ndarray(format="bgr24"))
+
+    def release(self):
+        self._c.close()
+
+
+def _fields(img, order: str):
+    """The two fields of an interlaced frame, in exposure order, each at full height on its own rows."""
+    import cv2
+
+    h, w = img.shape[:2]
+    out = []
+    for first in ((True, False) if order == "tff" else (False, True)):
+        off = 0 if first else 1
+        field = img[off::2]
+        # output row y lies at field row (y - off) / 2: the field's lines keep their height
+        M = np.array([[1.0, 0.0, 0.0], [0.0, 0.5, -0.5 * off]], np.float32)
+        out.append(cv2.warpAffine(field, M, (w, h), flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP,
+                                  borderMode=cv2.BORDER_REPLICATE))
+    return out
+
+
 def iter_video_frames(path, start: int = 0, stop: int | None = None, prefetch: int = 8,
-                      color: bool = False, pixel_aspect: float = 1.0):
+                      color: bool = False, pixel_aspect: float = 1.0, fields: str | None = None):
     """Yield ``(index, gray)`` (``(index, gray, image)`` with ``color``) for frames
     ``start <= index < stop``.
 
@@ -191,6 +261,9 @@ def iter_video_frames(path, start: int = 0, stop: int | None = None, prefetch: i
     pixel_aspect : float
         Width / height of a stored pixel (:attr:`VideoInfo.pixel_aspect`): frames are resampled
         to square pixels, ``width * pixel_aspect`` wide.
+    fields : {"tff", "bff"} or None
+        Deinterlace (:attr:`VideoInfo.field_order`): every frame yields its two fields in exposure
+        order, indices ``2 k`` and ``2 k + 1``; ``start`` and ``stop`` count fields.
 
     Yields
     ------
@@ -202,19 +275,31 @@ def iter_video_frames(path, start: int = 0, stop: int | None = None, prefetch: i
     """
     import cv2
 
-    cap = _open(path)
-    if start:
-        cap.set(cv2.CAP_PROP_POS_FRAMES, start)
+    first = start // 2 if fields else start
+    if fields:
+        # OpenCV's FFmpeg reader cannot convert interlaced pictures ("Cannot convert interlaced to
+        # progressive frames") and returns the previous picture again, silently: decode with PyAV
+        cap = _PyAVReader(path, first)
+    else:
+        cap = _open(path)
+        if first:
+            cap.set(cv2.CAP_PROP_POS_FRAMES, first)
 
     def read():
-        i = start
+        i = first
         try:
-            while stop is None or i < stop:
+            while stop is None or (2 * i if fields else i) < stop:
                 ok, img = cap.read()
                 if not ok or img is None:
                     return
                 img = _squared(img, pixel_aspect)
-                yield (i, _to_gray(img), img) if color else (i, _to_gray(img))
+                if fields:
+                    for k, f in enumerate(_fields(img, fields)):
+                        j = 2 * i + k
+                        if j >= start and (stop is None or j < stop):
+                            yield (j, _to_gray(f), f) if color else (j, _to_gray(f))
+                else:
+                    yield (i, _to_gray(img), img) if color else (i, _to_gray(img))
                 i += 1
         finally:
             cap.release()

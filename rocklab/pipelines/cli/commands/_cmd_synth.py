@@ -38,6 +38,9 @@ def register(sub):
                    help="shutter time, s (default half a frame period; 0: no motion blur)")
     p.add_argument("--noise", type=float, default=1.0, metavar="DN",
                    help="sensor noise sigma, grey levels (default 1)")
+    p.add_argument("--flicker", type=float, default=0.0, metavar="A",
+                   help="exposure flicker, relative amplitude 0-0.5 (automatic exposure hunting under "
+                        "mains light; default 0)")
     p.add_argument("--no-imu", action="store_true", help="do not write IMU logs")
     p.add_argument("--uncalibrated", action="store_true",
                    help="leave the camera matrix, distortion and plane homography out of track.toml "
@@ -173,7 +176,7 @@ def run(args) -> int:
                       size=size, targets=args.targets, duration_s=args.duration, occlusion=occ,
                       rolling_shutter=args.rolling_shutter, record=args.record, imu=not args.no_imu,
                       layout=args.layout, calibrated=not args.uncalibrated, force=args.force,
-                      exposure_s=args.exposure, noise_dn=args.noise,
+                      exposure_s=args.exposure, noise_dn=args.noise, flicker=args.flicker,
                       progress=args.progress)
     d = s.to_dict()
     if args.json:

@@ -37,6 +37,7 @@ demo: $(STAMP)
 lint: $(STAMP)
 	$(PY) -m pip install --quiet -e ".[lint]"
 	$(VENV)/bin/ruff check rocklab tests benchmarks examples
+	$(VENV)/bin/ruff format --check rocklab tests benchmarks examples
 	$(VENV)/bin/mypy
 
 # the documentation site (MkDocs Material + mkdocstrings), warnings are errors; the pages'

@@ -15,9 +15,23 @@ import tempfile
 import time
 from pathlib import Path
 
-CHECKS = ("check_output_dir", "check_unknown", "check_plausible", "check_imu_log", "_check_gyro_vs_tilt",
-          "_check_still_tilt", "_cut_at_gap", "_check_frames", "check_step", "check_memory",
-          "_check_block_rows", "_complete_rows", "_check_last_token", "_at2_units", "clean_stale")
+CHECKS = (
+    "check_output_dir",
+    "check_unknown",
+    "check_plausible",
+    "check_imu_log",
+    "_check_gyro_vs_tilt",
+    "_check_still_tilt",
+    "_cut_at_gap",
+    "_check_frames",
+    "check_step",
+    "check_memory",
+    "_check_block_rows",
+    "_complete_rows",
+    "_check_last_token",
+    "_at2_units",
+    "clean_stale",
+)
 
 
 def main() -> None:
@@ -39,8 +53,7 @@ def main() -> None:
     total = max(v[3] for v in st.stats.values())  # the outermost call's cumulative time
     checks = sum(v[3] for (f, ln, name), v in st.stats.items() if name in CHECKS)
     print(f"baseline: the same run_experiment call, total {plain_s:.4g} s unprofiled, {total:.4g} s profiled")
-    print(f"plausibility checks: {checks * 1e3:.4g} ms = {100 * checks / total:.3g} % of the run "
-          f"(target < 2 %)")
+    print(f"plausibility checks: {checks * 1e3:.4g} ms = {100 * checks / total:.3g} % of the run (target < 2 %)")
 
 
 if __name__ == "__main__":

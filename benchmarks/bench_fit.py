@@ -74,8 +74,10 @@ def main():
     t_camp = time.perf_counter() - t0
     errs = np.array([f.eta_e - e for f, e in zip(cf, rows.eta_e_full)])
     n_ok = sum(f.ok for f in cf)
-    print(f"30-experiment campaign:              {t_camp:.2f} s  (target <= 30 s), {n_ok}/30 ok, "
-          f"max |err| = {np.nanmax(np.abs(errs)):.2e}")
+    print(
+        f"30-experiment campaign:              {t_camp:.2f} s  (target <= 30 s), {n_ok}/30 ok, "
+        f"max |err| = {np.nanmax(np.abs(errs)):.2e}"
+    )
     if t_fit > 1.0 or t_camp > 30.0:
         print("WARNING: speed target missed on this machine")
 

@@ -56,8 +56,16 @@ def main() -> None:
     block = Block(b_m=0.1, h_m=0.8)
     res = simulate(block, theta0_rad=0.6 * block.alpha_rad, duration_s=30.0, dt_s=1e-3)
     # One rocking episode inside a long, mostly resting log (a lab session).
-    log = simulate_imu_log(res.t_s, res.theta_rad, block, omega_rad_s=res.omega_rad_s,
-                           rate_hz=256.0, rest_before_s=60.0, rest_after_s=1700.0, seed=0)
+    log = simulate_imu_log(
+        res.t_s,
+        res.theta_rad,
+        block,
+        omega_rad_s=res.omega_rad_s,
+        rate_hz=256.0,
+        rest_before_s=60.0,
+        rest_after_s=1700.0,
+        seed=0,
+    )
     with tempfile.TemporaryDirectory() as d:
         inert, _ = write_ximu_csv(log, Path(d) / "00000")
         n = log.n
@@ -70,11 +78,12 @@ def main() -> None:
     print(f"IMU log: {n} rows, {mb:.1f} MB, {len(rot.impact_t_s)} impacts found")
     print("                            rows/s (wall)   rows/s (CPU)")
     print(f"read_imu                 : {n / t_read:14,.0f} {n / c_read:14,.0f}")
-    print(f"read_imu + block_rotation: {n / t_all:14,.0f} {n / c_all:14,.0f}   "
-          f"target >= 1,000,000 rows/s (CPU): {'OK' if n / c_all >= 1e6 else 'BELOW'}")
+    print(
+        f"read_imu + block_rotation: {n / t_all:14,.0f} {n / c_all:14,.0f}   "
+        f"target >= 1,000,000 rows/s (CPU): {'OK' if n / c_all >= 1e6 else 'BELOW'}"
+    )
     print(f"csv module baseline      : {n / t_base:14,.0f} {n / c_base:14,.0f}")
-    print(f"ratio parse+process / csv baseline: {t_base / t_all:.1f}x wall, "
-          f"{c_base / c_all:.1f}x CPU")
+    print(f"ratio parse+process / csv baseline: {t_base / t_all:.1f}x wall, {c_base / c_all:.1f}x CPU")
 
 
 if __name__ == "__main__":

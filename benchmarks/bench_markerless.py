@@ -49,7 +49,7 @@ def render(seed=0):
 def plain_opencv(frames, roi):
     x, y, w, h = (int(v) for v in roi)
     mask = np.zeros_like(frames[0])
-    mask[y:y + h, x:x + w] = 255
+    mask[y : y + h, x : x + w] = 255
     p0 = cv2.goodFeaturesToTrack(frames[0], 200, 0.01, 5, mask=mask)
     out = []
     for f in frames:
@@ -61,8 +61,9 @@ def plain_opencv(frames, roi):
 
 
 def ours(frames, roi):
-    cfg = TrackConfig.from_dict({"targets": {"style": "markerless"}, "reference": {"level": "none"},
-                                 "objects": [{"id": "b", "roi": list(roi)}]})
+    cfg = TrackConfig.from_dict(
+        {"targets": {"style": "markerless"}, "reference": {"level": "none"}, "objects": [{"id": "b", "roi": list(roi)}]}
+    )
     obs = [o for fr in track_frames(frames, cfg) for o in fr]
     return np.array([o.theta_rad for o in obs])
 
@@ -70,8 +71,10 @@ def ours(frames, roi):
 def main() -> None:
     frames, theta, roi = render()
     nt = cv2.getNumThreads()
-    print(f"baseline: plain OpenCV (goodFeaturesToTrack + LK to the first frame + estimateAffinePartial2D), "
-          f"same {N} frames {W}x{H}, same process")
+    print(
+        f"baseline: plain OpenCV (goodFeaturesToTrack + LK to the first frame + estimateAffinePartial2D), "
+        f"same {N} frames {W}x{H}, same process"
+    )
     for threads in sorted({1, nt}):
         cv2.setNumThreads(threads)
         res = {}
@@ -82,8 +85,10 @@ def main() -> None:
             dt = time.perf_counter() - t0
             err = np.degrees(th - theta)
             res[name] = N / dt
-            print(f"  {threads} thread(s) {name:>20}: {N / dt:7.1f} frames/s, theta RMS error "
-                  f"{np.sqrt(np.nanmean(err ** 2)):.4f} deg, {np.isfinite(th).sum()}/{N} frames")
+            print(
+                f"  {threads} thread(s) {name:>20}: {N / dt:7.1f} frames/s, theta RMS error "
+                f"{np.sqrt(np.nanmean(err**2)):.4f} deg, {np.isfinite(th).sum()}/{N} frames"
+            )
     cv2.setNumThreads(nt)
 
 

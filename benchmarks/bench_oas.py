@@ -31,8 +31,15 @@ FF1 = Path(__file__).resolve().parents[2] / "shared/data/records/fema-p695-far-f
 
 def ivp_run(block, base, eta):
     """The package's event-driven reference (scipy solve_ivp DOP853 with impact events)."""
-    r = simulate(block, base=base, duration_s=float(base.t_s[-1]), method="event", restitution=eta,
-                 fall_rad=block.alpha_rad, rtol=1e-9)
+    r = simulate(
+        block,
+        base=base,
+        duration_s=float(base.t_s[-1]),
+        method="event",
+        restitution=eta,
+        fall_rad=block.alpha_rad,
+        rtol=1e-9,
+    )
     return bool(r.overturned)
 
 
@@ -47,9 +54,11 @@ def main() -> int:
     o = overturning_spectrum(rec, 12)
     t_oas = time.perf_counter() - t0
     n_runs = o.overturned.size + o.options["refine"] * int(np.isfinite(o.p_min_rad_s).sum())
-    print(f"OAS 80 x 120 + 10 bisections, H/B = 12: {t_oas:.2f} s ({n_runs} runs, "
-          f"{1e3 * t_oas / n_runs:.3f} ms/run); t_I = {o.t_I_s:.4f} s; target <= 10 s: "
-          f"{'OK' if t_oas <= 10 else 'MISSED'}")
+    print(
+        f"OAS 80 x 120 + 10 bisections, H/B = 12: {t_oas:.2f} s ({n_runs} runs, "
+        f"{1e3 * t_oas / n_runs:.3f} ms/run); t_I = {o.t_I_s:.4f} s; target <= 10 s: "
+        f"{'OK' if t_oas <= 10 else 'MISSED'}"
+    )
 
     # baseline in the same process: solve_ivp on a sample of grid runs that uplift
     alpha = o.alpha_rad
@@ -79,11 +88,15 @@ def main() -> int:
         _runs(rec, sc, pp, args)
     t_b1 = (time.perf_counter() - t0) / 5 / len(sample)
     numba.set_num_threads(nt)
-    print("baseline: solve_ivp DOP853 with events (1 thread) on the same sampled runs; ratio per core "
-          "against the batch path on 1 numba thread")
-    print(f"  solve_ivp: {1e3 * t_ivp:.1f} ms/run on {len(sample)} sampled grid runs (levels > 1.5); batch, "
-          f"1 thread: {1e3 * t_b1:.3f} ms/run -> {t_ivp / t_b1:.4g}x per core; verdicts agree on "
-          f"{agree}/{len(sample)}; the full OAS by solve_ivp would take ~{t_ivp * n_runs / 60:.0f} CPU-min")
+    print(
+        "baseline: solve_ivp DOP853 with events (1 thread) on the same sampled runs; ratio per core "
+        "against the batch path on 1 numba thread"
+    )
+    print(
+        f"  solve_ivp: {1e3 * t_ivp:.1f} ms/run on {len(sample)} sampled grid runs (levels > 1.5); batch, "
+        f"1 thread: {1e3 * t_b1:.3f} ms/run -> {t_ivp / t_b1:.4g}x per core; verdicts agree on "
+        f"{agree}/{len(sample)}; the full OAS by solve_ivp would take ~{t_ivp * n_runs / 60:.0f} CPU-min"
+    )
     return 0 if t_oas <= 10 else 1
 
 

@@ -29,7 +29,7 @@ from rocklab.models.rocking._newmark import run_single
 
 def plain_dop853(blk, theta0, eta, t_grid, n_impacts, rtol=1e-10):
     """What a competent user writes: DOP853 with one terminal event per half-cycle."""
-    p2, a = blk.p_rad_s ** 2, blk.alpha_rad
+    p2, a = blk.p_rad_s**2, blk.alpha_rad
 
     def rhs(t, y, s):
         return (y[1], -p2 * math.sin(a * s - y[0]))
@@ -44,8 +44,9 @@ def plain_dop853(blk, theta0, eta, t_grid, n_impacts, rtol=1e-10):
     while len(impacts) < n_impacts:
         hit.direction = -s  # towards theta = 0 from the side the block leans on (not the restart point)
         idx = np.flatnonzero(t_grid >= t)
-        sol = solve_ivp(rhs, (t, t_grid[-1]), y, method="DOP853", rtol=rtol, atol=1e-13, events=hit,
-                        args=(s,), t_eval=t_grid[idx])
+        sol = solve_ivp(
+            rhs, (t, t_grid[-1]), y, method="DOP853", rtol=rtol, atol=1e-13, events=hit, args=(s,), t_eval=t_grid[idx]
+        )
         k = np.shape(sol.y)[-1] if np.size(sol.y) else 0
         theta[idx[:k]] = np.asarray(sol.y)[0][:k] if k else theta[idx[:k]]
         if sol.status != 1:
@@ -80,14 +81,19 @@ def main():
     n = min(n_imp, imp_pl.size, imp_ref.size)
     err_nm = np.abs(nm.impacts.t_s.to_numpy()[:n] - imp_ref[:n])
     err_pl = np.abs(imp_pl[:n] - imp_ref[:n])
-    print("baseline: plain solve_ivp DOP853 (rtol 1e-10, one terminal event per half-cycle, same 1e-4 s "
-          "output grid, same impact count), same process, 1 thread")
-    print(f"B6M free rocking from 0.8 alpha: {t_motion:.4g} s of motion to rest, {n_imp} impacts "
-          f"(Housner eta = {blk.eta_H:.4f})")
-    print(f"  rocklab simulate() newmark dt 1e-4: {t_nm * 1e3:8.3f} ms   impact times within "
-          f"{err_nm.max():.2e} s of DOP853 at rtol 1e-13 (first 20: {err_nm[:20].max():.2e} s)")
-    print(f"  plain DOP853 rtol 1e-10:             {t_pl * 1e3:8.3f} ms   impact times within "
-          f"{err_pl.max():.2e} s")
+    print(
+        "baseline: plain solve_ivp DOP853 (rtol 1e-10, one terminal event per half-cycle, same 1e-4 s "
+        "output grid, same impact count), same process, 1 thread"
+    )
+    print(
+        f"B6M free rocking from 0.8 alpha: {t_motion:.4g} s of motion to rest, {n_imp} impacts "
+        f"(Housner eta = {blk.eta_H:.4f})"
+    )
+    print(
+        f"  rocklab simulate() newmark dt 1e-4: {t_nm * 1e3:8.3f} ms   impact times within "
+        f"{err_nm.max():.2e} s of DOP853 at rtol 1e-13 (first 20: {err_nm[:20].max():.2e} s)"
+    )
+    print(f"  plain DOP853 rtol 1e-10:             {t_pl * 1e3:8.3f} ms   impact times within {err_pl.max():.2e} s")
     print(f"  ratio plain / rocklab: {t_pl / t_nm:.4g}x per {t_motion:.4g} s of motion")
     # equal accuracy: the loosest rtol at which the plain code's impact times are as good as rocklab's
     for rtol in (1e-9, 1e-8, 1e-7, 1e-6, 1e-5):
@@ -98,11 +104,15 @@ def main():
         eq_rtol = rtol
     t_eq, (imp_eq, _) = best(lambda: plain_dop853(blk, th0, blk.eta_H, grid, n_imp, rtol=eq_rtol), 5)
     err_eq = np.abs(imp_eq[:n] - imp_ref[:n]).max()
-    print(f"  plain DOP853 at equal accuracy (rtol {eq_rtol:g}): {t_eq * 1e3:8.3f} ms   impact times within "
-          f"{err_eq:.2e} s -> ratio {t_eq / t_nm:.4g}x")
+    print(
+        f"  plain DOP853 at equal accuracy (rtol {eq_rtol:g}): {t_eq * 1e3:8.3f} ms   impact times within "
+        f"{err_eq:.2e} s -> ratio {t_eq / t_nm:.4g}x"
+    )
     t_ev, ev = best(lambda: simulate(blk, th0, method="event", rtol=1e-10, **kw), 2)
-    print(f"  (rocklab's own event reference, method='event' with three events and dense output: "
-          f"{t_ev * 1e3:.2f} ms, {t_ev / t_nm:.4g}x)")
+    print(
+        f"  (rocklab's own event reference, method='event' with three events and dense output: "
+        f"{t_ev * 1e3:.2f} ms, {t_ev / t_nm:.4g}x)"
+    )
 
     rec = bundled_record("elcentro")
     under_record(rec)
@@ -121,10 +131,14 @@ def main():
         t_b, bat = best(lambda: simulate_batch(P.ravel(), A.ravel(), base=rec, scale=S.ravel()), 2)
         t_f, fr = best(lambda: simulate_batch(np.repeat(p, 25), 0.2, **free_eta1), 2)
         print(f"batch, {nt} thread(s):")
-        print(f"  El Centro grid {P.size} runs (20 sizes x 25 scales, dt 1e-3, {bat.overturned.sum()} fall): "
-              f"{bat.n_steps / t_b:.3g} block-steps/s/core")
-        print(f"  free rocking eta = 1 (always moving), {fr.p_rad_s.size} runs x 10 s: "
-              f"{fr.n_steps / t_f:.3g} block-steps/s/core   (target >= 1e7)")
+        print(
+            f"  El Centro grid {P.size} runs (20 sizes x 25 scales, dt 1e-3, {bat.overturned.sum()} fall): "
+            f"{bat.n_steps / t_b:.3g} block-steps/s/core"
+        )
+        print(
+            f"  free rocking eta = 1 (always moving), {fr.p_rad_s.size} runs x 10 s: "
+            f"{fr.n_steps / t_f:.3g} block-steps/s/core   (target >= 1e7)"
+        )
     numba.set_num_threads(nthreads)
 
 
@@ -148,8 +162,11 @@ def under_record(rec):
         finally:
             single_mod.run_single = run_single
 
-    runs = {"lean": lambda: simulate(big, 0.0, base=base, **kw), "general": general,
-            "free": lambda: simulate(big, 0.5 * big.alpha_rad, **kwf)}
+    runs = {
+        "lean": lambda: simulate(big, 0.0, base=base, **kw),
+        "general": general,
+        "free": lambda: simulate(big, 0.5 * big.alpha_rad, **kwf),
+    }
     for f in runs.values():
         f()  # warm-up
     # interleaved repeats: the three see the same machine state (turbo, neighbours' load)
@@ -164,16 +181,24 @@ def under_record(rec):
     t_ev, ev = best(lambda: simulate(big, 0.0, base=base, method="event", rtol=1e-10, **kwe), 1)
     n_ln, n_fr, n_ev = len(ln.t_s) - 1, len(fr.t_s) - 1, int(round(10.0 / dt))
     d = np.max(np.abs(ln.theta_rad - gn.theta_rad))
-    print(f"{big.name} under El Centro x 1.5, {T:g} s, dt = {dt:g} s, every step stored "
-          f"({ln.n_impacts} impacts, {100 * np.mean(ln.theta_rad == 0):.0f} % of steps at rest):")
+    print(
+        f"{big.name} under El Centro x 1.5, {T:g} s, dt = {dt:g} s, every step stored "
+        f"({ln.n_impacts} impacts, {100 * np.mean(ln.theta_rad == 0):.0f} % of steps at rest):"
+    )
     print(f"  lean loops (default): {t_ln * 1e3:7.2f} ms  {n_ln / t_ln:.3g} block-steps/s/core")
-    print(f"  general loop only:    {t_gn * 1e3:7.2f} ms  {n_ln / t_gn:.3g} block-steps/s/core "
-          f"-> lean is {t_gn / t_ln:.2f}x faster (max |theta difference| {d:.1e} rad, "
-          f"{gn.n_impacts} impacts)")
-    print(f"  free rocking, same block (eta = 1, {fr.n_impacts} impacts): {n_fr / t_fr:.3g} block-steps/s/core "
-          f"-> under the record at {t_fr / n_fr / (t_ln / n_ln):.2f}x its rate")
-    print(f"  event (solve_ivp DOP853 rtol 1e-10, first 10 s): {t_ev * 1e3:.0f} ms  {n_ev / t_ev:.3g} "
-          f"block-steps/s -> ratio {t_ev / n_ev / (t_ln / n_ln):.0f}x per simulated second")
+    print(
+        f"  general loop only:    {t_gn * 1e3:7.2f} ms  {n_ln / t_gn:.3g} block-steps/s/core "
+        f"-> lean is {t_gn / t_ln:.2f}x faster (max |theta difference| {d:.1e} rad, "
+        f"{gn.n_impacts} impacts)"
+    )
+    print(
+        f"  free rocking, same block (eta = 1, {fr.n_impacts} impacts): {n_fr / t_fr:.3g} block-steps/s/core "
+        f"-> under the record at {t_fr / n_fr / (t_ln / n_ln):.2f}x its rate"
+    )
+    print(
+        f"  event (solve_ivp DOP853 rtol 1e-10, first 10 s): {t_ev * 1e3:.0f} ms  {n_ev / t_ev:.3g} "
+        f"block-steps/s -> ratio {t_ev / n_ev / (t_ln / n_ln):.0f}x per simulated second"
+    )
 
 
 if __name__ == "__main__":

@@ -35,7 +35,7 @@ def baseline(film1, film2, rig):
             _, m = cv2.threshold(g, 120, 255, cv2.THRESH_BINARY)
             n, _, st, cen = cv2.connectedComponentsWithStats(m)
             c = cen[1:][st[1:, cv2.CC_STAT_AREA] >= 6]
-            if prev[k] is not None:                      # keep the first frame's order
+            if prev[k] is not None:  # keep the first frame's order
                 d = np.linalg.norm(prev[k][:, None] - c[None], axis=2)
                 c = c[np.argmin(d, axis=1)]
             prev[k] = c
@@ -53,14 +53,17 @@ def baseline(film1, film2, rig):
 def main():
     with tempfile.TemporaryDirectory() as tmp:
         d = Path(tmp)
-        r = synth_stereo(d, size=(2400, 1728), f_px=3000.0, duration_s=1.5, n_board=16, restitution=0.8,
-                         theta0_rad=0.12)
+        r = synth_stereo(
+            d, size=(2400, 1728), f_px=3000.0, duration_s=1.5, n_board=16, restitution=0.8, theta0_rad=0.12
+        )
         rig = calibrate_stereo(d / "calib_cam1.mkv", d / "calib_cam2.mkv")
         n = r["t_s"].size
         c1 = r["cameras"][0]
         X1 = r["X1"] @ c1.R.T + c1.t
-        print(f"2 films x {n} frames at 2400x1728; calibration RMS {rig.rms_px['stereo']:.3g} px, "
-              f"baseline {rig.baseline_m:.5g} m")
+        print(
+            f"2 films x {n} frames at 2400x1728; calibration RMS {rig.rms_px['stereo']:.3g} px, "
+            f"baseline {rig.baseline_m:.5g} m"
+        )
         for threads in (1, 0):
             cv2.setNumThreads(threads if threads else cv2.getNumberOfCPUs())
             t = time.perf_counter()
@@ -70,23 +73,26 @@ def main():
             base = baseline(d / "cam1.mkv", d / "cam2.mkv", rig)
             t_b = time.perf_counter() - t
             label = "1 OpenCV thread" if threads == 1 else "all threads"
-            print(f"[{label}] rocklab {n / t_rl:.4g} pairs/s, baseline {n / t_b:.4g} pairs/s "
-                  f"(x{t_b / t_rl:.3g})")
+            print(f"[{label}] rocklab {n / t_rl:.4g} pairs/s, baseline {n / t_b:.4g} pairs/s (x{t_b / t_rl:.3g})")
         k = int(np.flatnonzero(np.isfinite(sp.xyz_m).all(axis=(1, 2)))[0])
         idx = [int(np.argmin(np.linalg.norm(X1[k] - x, axis=1))) for x in sp.xyz_m[k]]
         A, B = X1[:, idx].reshape(-1, 3), sp.xyz_m.reshape(-1, 3)
         ok = np.isfinite(B).all(axis=1)
         _, _, rms = kabsch(B[ok], A[ok])
-        print(f"rocklab 3D RMS after rigid alignment: {rms * 1e3:.3g} mm; clock offset {sp.sync.offset_s * 1e3:.4g} ms "
-              f"(true {r['offset_s'] * 1e3:.4g} ms)")
+        print(
+            f"rocklab 3D RMS after rigid alignment: {rms * 1e3:.3g} mm; clock offset {sp.sync.offset_s * 1e3:.4g} ms "
+            f"(true {r['offset_s'] * 1e3:.4g} ms)"
+        )
         errs = []
         for i, Xb in enumerate(base):
             if Xb.shape[0] != X1.shape[1]:
                 continue
             d3 = np.linalg.norm(Xb[:, None] - (X1[i])[None], axis=2).min(axis=1)
             errs.append(np.median(d3))
-        print(f"baseline median nearest-target error (no sync, order pairing): {np.median(errs) * 1e3:.3g} mm "
-              "(in calibrated axes, not aligned)")
+        print(
+            f"baseline median nearest-target error (no sync, order pairing): {np.median(errs) * 1e3:.3g} mm "
+            "(in calibrated axes, not aligned)"
+        )
 
 
 if __name__ == "__main__":

@@ -30,11 +30,12 @@ N = int(DURATION_S * FPS)
 def encode_only(folder: Path) -> float:
     rng = np.random.default_rng(0)
     base = np.full(SIZE[::-1], 140, np.uint8)
-    frames = [cv2.add(base, rng.normal(0, 1.0, base.shape).round().astype(np.int16), dtype=cv2.CV_8U)
-              for _ in range(4)]
+    frames = [cv2.add(base, rng.normal(0, 1.0, base.shape).round().astype(np.int16), dtype=cv2.CV_8U) for _ in range(4)]
     t = time.perf_counter()
-    ws = [cv2.VideoWriter(str(folder / "e.mkv"), cv2.VideoWriter_fourcc(*"FFV1"), FPS, SIZE, isColor=False),
-          cv2.VideoWriter(str(folder / "e.mp4"), cv2.VideoWriter_fourcc(*"mp4v"), FPS, SIZE, isColor=False)]
+    ws = [
+        cv2.VideoWriter(str(folder / "e.mkv"), cv2.VideoWriter_fourcc(*"FFV1"), FPS, SIZE, isColor=False),
+        cv2.VideoWriter(str(folder / "e.mp4"), cv2.VideoWriter_fourcc(*"mp4v"), FPS, SIZE, isColor=False),
+    ]
     for i in range(N):
         for w in ws:
             w.write(frames[i % 4])
@@ -44,10 +45,28 @@ def encode_only(folder: Path) -> float:
 
 
 def render_only() -> tuple[float, float]:
-    kw = dict(seed=0, blocks=1, table="none", fps=FPS, size=SIZE, targets="aruco", duration_s=DURATION_S,
-              occlusion=None, rolling_shutter=False, block=None, restitution="constant", eta=0.75,
-              theta0_rad=None, record=None, table_amplitude_m=0.045, table_period_s=0.6,
-              table_stroke_m=0.05, exposure_s=None, noise_dn=1.0, distortion=True)
+    kw = dict(
+        seed=0,
+        blocks=1,
+        table="none",
+        fps=FPS,
+        size=SIZE,
+        targets="aruco",
+        duration_s=DURATION_S,
+        occlusion=None,
+        rolling_shutter=False,
+        block=None,
+        restitution="constant",
+        eta=0.75,
+        theta0_rad=None,
+        record=None,
+        table_amplitude_m=0.045,
+        table_period_s=0.6,
+        table_stroke_m=0.05,
+        exposure_s=None,
+        noise_dn=1.0,
+        distortion=True,
+    )
     t = time.perf_counter()
     scene = build_scene(**kw)
     r = scene.renderer()
@@ -61,19 +80,23 @@ def render_only() -> tuple[float, float]:
 def main():
     with tempfile.TemporaryDirectory() as d:
         d = Path(d)
-        synth_session(d / "warm", seed=0, size=(160, 90), duration_s=0.2)   # numba/imports warm-up
+        synth_session(d / "warm", seed=0, size=(160, 90), duration_s=0.2)  # numba/imports warm-up
         enc = encode_only(d)
         setup, ren = render_only()
         c0, t0 = time.process_time(), time.perf_counter()
         s = synth_session(d / "full", seed=0, size=SIZE, fps=FPS, duration_s=DURATION_S)
         full, cpu = time.perf_counter() - t0, time.process_time() - c0
-    print(f"{N} frames {SIZE[0]}x{SIZE[1]}: encode-only {N / enc:.1f} frames/s, render-only "
-          f"{N / ren:.1f} frames/s (+{setup:.1f} s scene set-up), full session {N / full:.1f} frames/s "
-          f"(wall {full:.1f} s, CPU {cpu:.1f} s, mean sub-frames {s.meta['video']['mean_subframes']:.2f})")
+    print(
+        f"{N} frames {SIZE[0]}x{SIZE[1]}: encode-only {N / enc:.1f} frames/s, render-only "
+        f"{N / ren:.1f} frames/s (+{setup:.1f} s scene set-up), full session {N / full:.1f} frames/s "
+        f"(wall {full:.1f} s, CPU {cpu:.1f} s, mean sub-frames {s.meta['video']['mean_subframes']:.2f})"
+    )
     per_frame = (full - setup) / N
-    print(f"ratio full / encode-only: {full / enc:.2f}; extrapolated 10 s session: "
-          f"{setup + 500 * per_frame:.0f} s wall here, <= {500 * cpu / N:.0f} s of CPU "
-          "(CPU per frame including set-up; the wall time of one idle core)")
+    print(
+        f"ratio full / encode-only: {full / enc:.2f}; extrapolated 10 s session: "
+        f"{setup + 500 * per_frame:.0f} s wall here, <= {500 * cpu / N:.0f} s of CPU "
+        "(CPU per frame including set-up; the wall time of one idle core)"
+    )
 
 
 if __name__ == "__main__":

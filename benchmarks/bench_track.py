@@ -34,35 +34,40 @@ def render(width, height, n, seed=0):
     pats = {}
     for i in (0, 1, 2):
         m = cv2.aruco.generateImageMarker(d, i, side)
-        pats[i] = cv2.copyMakeBorder(m, side // 4, side // 4, side // 4, side // 4,
-                                     cv2.BORDER_CONSTANT, value=255)
+        pats[i] = cv2.copyMakeBorder(m, side // 4, side // 4, side // 4, side // 4, cv2.BORDER_CONSTANT, value=255)
     bg = np.tile(np.linspace(80, 150, width, dtype=np.float32), (height, 1))
     t = np.arange(n) / 50.0
     frames = []
     for j in range(n):
         img = bg.copy()
         xt = 0.02 * np.sin(2 * np.pi * t[j] / 0.6) * k
-        for i, (cx, cy, th) in {0: (0.0, 0.2, 0.0),
-                                1: (-0.25, -0.05, 0.08 * np.sin(2 * np.pi * t[j] / 0.7)),
-                                2: (0.25, -0.05, -0.06 * np.sin(2 * np.pi * t[j] / 0.9))}.items():
+        for i, (cx, cy, th) in {
+            0: (0.0, 0.2, 0.0),
+            1: (-0.25, -0.05, 0.08 * np.sin(2 * np.pi * t[j] / 0.7)),
+            2: (0.25, -0.05, -0.06 * np.sin(2 * np.pi * t[j] / 0.9)),
+        }.items():
             p = pats[i]
             c = (p.shape[1] / 2, p.shape[0] / 2)
             M = cv2.getRotationMatrix2D(c, np.degrees(th), 1.0)
             M[:, 2] += (width / 2 + cx * k + xt - c[0], height / 2 + cy * k - c[1])
-            w = cv2.warpAffine(p.astype(np.float32), M, (width, height), flags=cv2.INTER_LINEAR,
-                               borderValue=0)
-            a = cv2.warpAffine(np.ones_like(p, np.float32), M, (width, height),
-                               flags=cv2.INTER_LINEAR, borderValue=0)
+            w = cv2.warpAffine(p.astype(np.float32), M, (width, height), flags=cv2.INTER_LINEAR, borderValue=0)
+            a = cv2.warpAffine(np.ones_like(p, np.float32), M, (width, height), flags=cv2.INTER_LINEAR, borderValue=0)
             img = img * (1 - a) + w
         img += rng.normal(0, 2.0, img.shape).astype(np.float32)
         frames.append(np.clip(img, 0, 255).astype(np.uint8))
     return frames
 
 
-CONFIG = TrackConfig.from_dict({
-    "targets": {"style": "aruco", "marker_size_m": 0.08},
-    "objects": [{"id": "block_1", "markers": [1]}, {"id": "block_2", "markers": [2]},
-                {"id": "table", "kind": "table", "markers": [0]}]})
+CONFIG = TrackConfig.from_dict(
+    {
+        "targets": {"style": "aruco", "marker_size_m": 0.08},
+        "objects": [
+            {"id": "block_1", "markers": [1]},
+            {"id": "block_2", "markers": [2]},
+            {"id": "table", "kind": "table", "markers": [0]},
+        ],
+    }
+)
 
 
 def bench(width, height):
@@ -97,12 +102,16 @@ def main() -> int:
     for (w, h), target in (((1920, 1080), 100.0), ((2400, 1728), 40.0)):
         base, fps, fps_cpu, e2e = bench(w, h)
         ok &= fps >= target
-        print(f"aruco {w}x{h}: track_frames {fps:7.1f} frames/s wall, {fps_cpu:7.1f} per CPU-second "
-              f"(target >= {target:.0f}); full-frame baseline {base:6.1f} frames/s, ratio "
-              f"{fps / base:5.1f}x; track_video incl. FFV1 decode {e2e:6.1f} frames/s")
+        print(
+            f"aruco {w}x{h}: track_frames {fps:7.1f} frames/s wall, {fps_cpu:7.1f} per CPU-second "
+            f"(target >= {target:.0f}); full-frame baseline {base:6.1f} frames/s, ratio "
+            f"{fps / base:5.1f}x; track_video incl. FFV1 decode {e2e:6.1f} frames/s"
+        )
     load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
-    print(f"load average {load:.1f} on {os.cpu_count()} cores" +
-          ("" if ok else " - below target on wall time (machine shared? rerun when idle)"))
+    print(
+        f"load average {load:.1f} on {os.cpu_count()} cores"
+        + ("" if ok else " - below target on wall time (machine shared? rerun when idle)")
+    )
     return 0
 
 

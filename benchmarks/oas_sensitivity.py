@@ -48,8 +48,7 @@ def main() -> int:
             b = load_base_motion(DATA / name, units=units)
             recs[rid] = b
             pp = pulse_parameters(b)
-            print(f"{rid} {b.name}: t_p {pp.t_p_s:.3f} s (Table 4: {tp}), Table 4 t_I {tI}, "
-                  f"t'_I {tIp}, beta {beta}")
+            print(f"{rid} {b.name}: t_p {pp.t_p_s:.3f} s (Table 4: {tp}), Table 4 t_I {tI}, t'_I {tIp}, beta {beta}")
     overturning_spectrum(next(iter(recs.values())), 12, levels=2, sizes=2, refine=1)  # compile
     print(f"\n{'variant':<20}" + "".join(f"{rid:>26}" for rid in recs) + "   time")
     for label, kw in VARIANTS:
@@ -59,8 +58,7 @@ def main() -> int:
             o = overturning_spectrum(b, 12, **kw)
             dev = 100 * (o.t_I_s / RECORDS[rid][3] - 1)
             cells.append(f"{o.t_I_s:.3f} ({dev:+4.0f} %) {o.t_I_prime_s:.3f}/{o.beta:.2f}")
-        print(f"{label:<20}" + "".join(f"{c:>26}" for c in cells)
-              + f"   {time.perf_counter() - t0:.1f} s", flush=True)
+        print(f"{label:<20}" + "".join(f"{c:>26}" for c in cells) + f"   {time.perf_counter() - t0:.1f} s", flush=True)
     print("\ncells: t_I s (vs Table 4), t'_I s / beta")
     return 0
 

@@ -33,22 +33,32 @@ def main(n: int = 20) -> int:
         block = Block(b_m=b, h_m=b * float(rng.uniform(2.5, 5.0)))
         with tempfile.TemporaryDirectory() as tmp:
             d = Path(tmp)
-            r = synth_stereo(d, size=(801, 577), f_px=1000.0, n_board=14, seed=seed, block=block,
-                             restitution=float(rng.uniform(0.75, 0.9)), theta0_rad=0.5 * block.alpha_rad)
+            r = synth_stereo(
+                d,
+                size=(801, 577),
+                f_px=1000.0,
+                n_board=14,
+                seed=seed,
+                block=block,
+                restitution=float(rng.uniform(0.75, 0.9)),
+                theta0_rad=0.5 * block.alpha_rad,
+            )
             rig = calibrate_stereo(d / "calib_cam1.mkv", d / "calib_cam2.mkv")
             sp = track_dots_stereo(d / "cam1.mkv", d / "cam2.mkv", rig)
             series, bodies, _ = stereo_point_series(sp)
             with collecting() as diags:
                 res = track_points3d(series, bodies)
             blk = res["block"]
-            th = pd.read_csv(d / "truth.csv").theta_rad.to_numpy()[:blk.t_s.size]
+            th = pd.read_csv(d / "truth.csv").theta_rad.to_numpy()[: blk.t_s.size]
             sign = np.sign(np.nansum(blk.theta_rad * th))
             err = math.degrees(float(np.sqrt(np.nanmean((blk.theta_rad - sign * th) ** 2))))
             verdict = blk.audit.verdict
             alarms += verdict != "valid"
-            print(f"run {seed:2d}: b {b * 100:.3g} cm, h/b {block.h_m / b:.3g}: {verdict}, calibration "
-                  f"{rig.rms_px['stereo']:.3g} px, offset error {abs(sp.sync.offset_s - r['offset_s']) * 1e3:.3g} ms, "
-                  f"theta RMS error {err:.3g} deg, warnings {[x.code for x in diags]}")
+            print(
+                f"run {seed:2d}: b {b * 100:.3g} cm, h/b {block.h_m / b:.3g}: {verdict}, calibration "
+                f"{rig.rms_px['stereo']:.3g} px, offset error {abs(sp.sync.offset_s - r['offset_s']) * 1e3:.3g} ms, "
+                f"theta RMS error {err:.3g} deg, warnings {[x.code for x in diags]}"
+            )
     print(f"{alarms} false alarm(s) in {n} clean stereo runs")
     return 1 if alarms else 0
 

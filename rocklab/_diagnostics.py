@@ -26,66 +26,131 @@ import contextvars
 import warnings
 from dataclasses import dataclass
 
-__all__ = ["Diagnostic", "RocklabWarning", "WARNING_CODES", "warn", "collecting", "collected", "stderr_echo",
-           "worst_status", "codes_markdown"]
+__all__ = [
+    "Diagnostic",
+    "RocklabWarning",
+    "WARNING_CODES",
+    "warn",
+    "collecting",
+    "collected",
+    "stderr_echo",
+    "worst_status",
+    "codes_markdown",
+]
 
 #: Every warning code: (severity, what it means and what to check). Documented in
 #: ``docs/warnings.md`` (generated from this table by :func:`codes_markdown`).
 WARNING_CODES: dict[str, tuple[str, str]] = {
     # records
-    "W-RECORD-PGA": ("suspect", "peak acceleration above 5 g: usually a unit error (g read as m/s^2, "
-                                "cm/s^2 read as g); check the units field or --units"),
-    "W-RECORD-DT": ("suspect", "sample step above 0.05 s: too coarse for an earthquake record and "
-                               "often a wrong DT; check the header"),
+    "W-RECORD-PGA": (
+        "suspect",
+        "peak acceleration above 5 g: usually a unit error (g read as m/s^2, "
+        "cm/s^2 read as g); check the units field or --units",
+    ),
+    "W-RECORD-DT": (
+        "suspect",
+        "sample step above 0.05 s: too coarse for an earthquake record and often a wrong DT; check the header",
+    ),
     "W-RECORD-SHORT": ("suspect", "record of fewer than 16 samples or under 0.2 s: check that the whole file was read"),
-    "W-RECORD-PULSE": ("suspect", "the main pulse lasts less than 2 samples: t_p cannot be resolved; "
-                                  "check the record's sampling and zero padding"),
+    "W-RECORD-PULSE": (
+        "suspect",
+        "the main pulse lasts less than 2 samples: t_p cannot be resolved; "
+        "check the record's sampling and zero padding",
+    ),
     # simulation
-    "W-SIM-DT": ("suspect", "time step dt is large against the block's 1/p (p dt > 0.01): "
-                            "impact times and rocking amplitudes are not converged; use a smaller --dt"),
+    "W-SIM-DT": (
+        "suspect",
+        "time step dt is large against the block's 1/p (p dt > 0.01): "
+        "impact times and rocking amplitudes are not converged; use a smaller --dt",
+    ),
     # fitting
-    "W-FIT-GAP": ("suspect", "the measured theta(t) has a gap (lost frames) long enough to hide an impact; the "
-                             "fit uses the data before the gap"),
-    "W-FIT-DUPLICATE": ("suspect", "repeated rows in a block table were dropped (each block counted once); check the "
-                                   "file was not concatenated twice"),
-    "W-FIT-THETA0": ("suspect", "the measured release angle is large for the block's geometry "
-                                "(theta0 above 0.9 alpha): check b and h (swapped, "
-                                "or in cm instead of m)"),
-    "W-FIT-RESIDUAL": ("suspect", "the fitted simulation misses the measurement by more than 20x the noise (at least "
-                                  "1e-3 rad): the model or the block's dimensions do not describe this test"),
+    "W-FIT-GAP": (
+        "suspect",
+        "the measured theta(t) has a gap (lost frames) long enough to hide an impact; the "
+        "fit uses the data before the gap",
+    ),
+    "W-FIT-DUPLICATE": (
+        "suspect",
+        "repeated rows in a block table were dropped (each block counted once); check the "
+        "file was not concatenated twice",
+    ),
+    "W-FIT-THETA0": (
+        "suspect",
+        "the measured release angle is large for the block's geometry "
+        "(theta0 above 0.9 alpha): check b and h (swapped, "
+        "or in cm instead of m)",
+    ),
+    "W-FIT-RESIDUAL": (
+        "suspect",
+        "the fitted simulation misses the measurement by more than 20x the noise (at least "
+        "1e-3 rad): the model or the block's dimensions do not describe this test",
+    ),
     "W-FIT-BOUND": ("suspect", "the fitted parameter sits at a bound of its search range"),
-    "W-FIT-UNITS": ("suspect", "block dimensions outside 1 mm - 20 m or h/b outside 0.5 - 50: probably not in "
-                               "metres, or b and h swapped"),
+    "W-FIT-UNITS": (
+        "suspect",
+        "block dimensions outside 1 mm - 20 m or h/b outside 0.5 - 50: probably not in metres, or b and h swapped",
+    ),
     # IMU
-    "W-IMU-AXES": ("suspect", "the gyro's integral and the accelerometer's tilt disagree in sign or "
-                              "scale: axes swapped, rotation axis wrong, or gyro units wrong "
-                              "(rad/s in a deg/s column); check the column names and --axis"),
-    "W-IMU-CLOCK": ("suspect", "the log's clock jumps or has a gap: samples are missing or the "
-                               "timestamps are corrupt; impacts in the gap are lost"),
-    "W-IMU-RATE": ("suspect", "sample rate disagrees between the option, the log's register and its "
-                              "timestamps; the timestamps were trusted"),
+    "W-IMU-AXES": (
+        "suspect",
+        "the gyro's integral and the accelerometer's tilt disagree in sign or "
+        "scale: axes swapped, rotation axis wrong, or gyro units wrong "
+        "(rad/s in a deg/s column); check the column names and --axis",
+    ),
+    "W-IMU-CLOCK": (
+        "suspect",
+        "the log's clock jumps or has a gap: samples are missing or the "
+        "timestamps are corrupt; impacts in the gap are lost",
+    ),
+    "W-IMU-RATE": (
+        "suspect",
+        "sample rate disagrees between the option, the log's register and its timestamps; the timestamps were trusted",
+    ),
     "W-IMU-TRUNCATED": ("note", "an incomplete final line (logger stopped mid-write) was dropped"),
     # video tracking
-    "W-TRACK-NOSCALE": ("note", "no metric scale (marker size, object size, m_per_px, homography): x_m and y_m "
-                                "are left empty; x_px, y_px and theta_rad are measured"),
-    "W-LEVEL-NONE": ("suspect", "levelling asked for a table that is missing or never seen: the camera's roll "
-                                "stays in every angle; add a level reference or say the camera is level"),
-    "W-TABLE-MOTION": ("suspect", "the table's displacement could not be differentiated into velocity and "
-                                  "acceleration (too few consecutive samples, or no metric scale); no "
-                                  "<stem>_table.csv was written"),
-    "W-TRACK-LATCH": ("suspect", "a tracker follows another object: a table that turns, or two objects on the "
-                                 "same pixels; redraw the region (or fix the marker ids) of the named object"),
-    "W-VIDEO-SHORT": ("note", "fewer frames decoded than the container's header counts: the file was cut or "
-                              "damaged, or its header over-counts; the frames there are measured"),
+    "W-TRACK-NOSCALE": (
+        "note",
+        "no metric scale (marker size, object size, m_per_px, homography): x_m and y_m "
+        "are left empty; x_px, y_px and theta_rad are measured",
+    ),
+    "W-LEVEL-NONE": (
+        "suspect",
+        "levelling asked for a table that is missing or never seen: the camera's roll "
+        "stays in every angle; add a level reference or say the camera is level",
+    ),
+    "W-TABLE-MOTION": (
+        "suspect",
+        "the table's displacement could not be differentiated into velocity and "
+        "acceleration (too few consecutive samples, or no metric scale); no "
+        "<stem>_table.csv was written",
+    ),
+    "W-TRACK-LATCH": (
+        "suspect",
+        "a tracker follows another object: a table that turns, or two objects on the "
+        "same pixels; redraw the region (or fix the marker ids) of the named object",
+    ),
+    "W-VIDEO-SHORT": (
+        "note",
+        "fewer frames decoded than the container's header counts: the file was cut or "
+        "damaged, or its header over-counts; the frames there are measured",
+    ),
     "W-VIDEO-LOST": ("suspect", "an object was lost on more than 1 % of the frames (see the status column)"),
     # 3D points and the assumption audit
-    "W-3D-LOST": ("suspect", "a body had no pose (fewer than 3 of its points seen) in more than 1 % of the "
-                             "samples (see the status column)"),
-    "W-3D-REST": ("suspect", "no upright rest found at the end of the 3D record: theta is measured from another "
-                             "pose and may carry a constant tilt; give --rest T0,T1"),
-    "W-AUDIT": ("suspect", "the test broke the planar-rocking assumptions (sliding, jumping, twist, out-of-plane "
-                           "rotation or a double impact beyond tolerance): see audit.json for the impacts "
-                           "affected; fits through them are not trustworthy"),
+    "W-3D-LOST": (
+        "suspect",
+        "a body had no pose (fewer than 3 of its points seen) in more than 1 % of the samples (see the status column)",
+    ),
+    "W-3D-REST": (
+        "suspect",
+        "no upright rest found at the end of the 3D record: theta is measured from another "
+        "pose and may carry a constant tilt; give --rest T0,T1",
+    ),
+    "W-AUDIT": (
+        "suspect",
+        "the test broke the planar-rocking assumptions (sliding, jumping, twist, out-of-plane "
+        "rotation or a double impact beyond tolerance): see audit.json for the impacts "
+        "affected; fits through them are not trustworthy",
+    ),
 }
 
 

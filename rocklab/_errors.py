@@ -49,7 +49,7 @@ def available_memory_bytes() -> int:
     try:
         return int(os.sysconf("SC_AVPHYS_PAGES")) * int(os.sysconf("SC_PAGE_SIZE"))
     except (ValueError, OSError, AttributeError):
-        return 8 * 1024 ** 3
+        return 8 * 1024**3
 
 
 def check_memory(nbytes: float, what: str, fix: str) -> None:
@@ -59,5 +59,6 @@ def check_memory(nbytes: float, what: str, fix: str) -> None:
     """
     avail = available_memory_bytes()
     if nbytes > 0.5 * avail:
-        raise InputError(f"{what} would need about {nbytes / 1024 ** 3:.4g} GiB of memory "
-                         f"({avail / 1024 ** 3:.4g} GiB available); {fix}")
+        raise InputError(
+            f"{what} would need about {nbytes / 1024**3:.4g} GiB of memory ({avail / 1024**3:.4g} GiB available); {fix}"
+        )

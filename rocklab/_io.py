@@ -12,8 +12,7 @@ import os
 import tempfile
 from pathlib import Path
 
-__all__ = ["atomic_path", "write_text_atomic", "write_json_atomic", "write_frame_atomic", "json_safe",
-           "dumps_json"]
+__all__ = ["atomic_path", "write_text_atomic", "write_json_atomic", "write_frame_atomic", "json_safe", "dumps_json"]
 
 
 @contextlib.contextmanager
@@ -30,8 +29,9 @@ def atomic_path(path, suffix: str | None = None):
         raise InputError(f"{path}: is a folder; give a file name for this output")
     path.parent.mkdir(parents=True, exist_ok=True)
     clean_stale(path.parent, path.name)  # leftovers of a killed writer of this same file
-    fd, tmp = tempfile.mkstemp(prefix=stale_prefix(path.name, "tmp"), suffix=suffix or path.suffix or ".tmp",
-                               dir=path.parent)
+    fd, tmp = tempfile.mkstemp(
+        prefix=stale_prefix(path.name, "tmp"), suffix=suffix or path.suffix or ".tmp", dir=path.parent
+    )
     os.close(fd)
     try:
         yield Path(tmp)

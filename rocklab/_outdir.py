@@ -29,8 +29,19 @@ from pathlib import Path
 
 from ._errors import InputError
 
-__all__ = ["MARKER", "check_output_dir", "check_output_file", "claim_dir", "stage_dir", "publish_dir", "clean_stale",
-           "owned_entries", "foreign_entries", "pid_alive", "stale_prefix"]
+__all__ = [
+    "MARKER",
+    "check_output_dir",
+    "check_output_file",
+    "claim_dir",
+    "stage_dir",
+    "publish_dir",
+    "clean_stale",
+    "owned_entries",
+    "foreign_entries",
+    "pid_alive",
+    "stale_prefix",
+]
 
 #: Name of the marker file in every folder rocklab writes.
 MARKER = ".rocklab-output"
@@ -115,15 +126,17 @@ def _check_parent(path: Path, option: str, need_bytes: int) -> None:
         raise InputError(f"{option} {path}: folder {probe} is not writable; choose a writable location") from None
     except OSError as e:
         if e.errno == errno.ENOSPC:
-            raise InputError(f"{option} {path}: no space left on {probe}; free space or choose "
-                             "another location") from None
-        raise InputError(f"{option} {path}: cannot write in {probe} ({e.strerror}); choose another "
-                         "location") from None
+            raise InputError(
+                f"{option} {path}: no space left on {probe}; free space or choose another location"
+            ) from None
+        raise InputError(f"{option} {path}: cannot write in {probe} ({e.strerror}); choose another location") from None
     if need_bytes > 0:
         free = shutil.disk_usage(probe).free
         if free < need_bytes:
-            raise InputError(f"{option} {path}: {free / _MB:.4g} MB free on {probe} but this run needs "
-                             f"about {need_bytes / _MB:.4g} MB; free space or choose another location")
+            raise InputError(
+                f"{option} {path}: {free / _MB:.4g} MB free on {probe} but this run needs "
+                f"about {need_bytes / _MB:.4g} MB; free space or choose another location"
+            )
 
 
 def check_output_file(path, option: str = "-o", need_bytes: int = 0) -> Path:
@@ -149,8 +162,10 @@ def check_output_dir(path, *, force: bool = False, option: str = "--out", need_b
     """
     path = Path(path).resolve()
     if path.exists() and not path.is_dir():
-        raise InputError(f"{option} {path}: is an existing file; rocklab writes a folder there and never "
-                         "replaces a file; choose another path")
+        raise InputError(
+            f"{option} {path}: is an existing file; rocklab writes a folder there and never "
+            "replaces a file; choose another path"
+        )
     if path.is_dir() and not force:
         try:
             names = foreign_entries(path)
@@ -158,9 +173,11 @@ def check_output_dir(path, *, force: bool = False, option: str = "--out", need_b
             raise InputError(f"{option} {path}: cannot list the folder ({e.strerror})") from None
         if names:
             shown = ", ".join(names[:3]) + (", ..." if len(names) > 3 else "")
-            raise InputError(f"{option} {path}: folder holds files rocklab did not write ({shown}); choose a "
-                             "new or empty folder, or pass --force to write beside them (nothing of "
-                             "yours is deleted)")
+            raise InputError(
+                f"{option} {path}: folder holds files rocklab did not write ({shown}); choose a "
+                "new or empty folder, or pass --force to write beside them (nothing of "
+                "yours is deleted)"
+            )
     _check_parent(path, option, need_bytes)
     clean_stale(path.parent, path.name)
     return path
@@ -178,8 +195,18 @@ def _write_marker(folder: Path, command: str, entries) -> None:
 
     # written here, not through rocklab._io (which uses this module's stale-file helpers): a temporary
     # file renamed over the marker, so a killed writer leaves the old marker or the new one
-    text = json.dumps({"written_by": f"rocklab {__version__}", "command": command, "time_unix_s": time.time(),
-                       "entries": sorted(entries)}, indent=2) + "\n"
+    text = (
+        json.dumps(
+            {
+                "written_by": f"rocklab {__version__}",
+                "command": command,
+                "time_unix_s": time.time(),
+                "entries": sorted(entries),
+            },
+            indent=2,
+        )
+        + "\n"
+    )
     fd, tmp = tempfile.mkstemp(prefix=stale_prefix(MARKER, "tmp"), dir=folder)
     try:
         with os.fdopen(fd, "w", encoding="utf-8") as f:

@@ -69,5 +69,7 @@ def dask_client(address: str, timeout_s: float = 10.0):
         return Client(address, timeout=f"{timeout_s}s")
     except (OSError, TimeoutError, ValueError, TypeError) as e:
         msg = str(e).splitlines()[0] if str(e) else type(e).__name__
-        raise InputError(f"--scheduler {address}: no Dask scheduler answered ({msg[:120]}); start one "
-                         "with 'dask scheduler' and give its address, or drop --scheduler") from None
+        raise InputError(
+            f"--scheduler {address}: no Dask scheduler answered ({msg[:120]}); start one "
+            "with 'dask scheduler' and give its address, or drop --scheduler"
+        ) from None

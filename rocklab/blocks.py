@@ -73,8 +73,10 @@ class Block:
         aI = _positive("alpha_I (corner inertia coefficient)", self.alpha_I)
         if aI < 1.0:
             # I_O = I_C + m R^2 >= m R^2, so alpha_I < 1 is not a physical body.
-            raise InputError(f"alpha_I={aI}: corner inertia coefficient I_O/(m R^2) must be >= 1 "
-                             "(parallel-axis theorem); 4/3 is a uniform block")
+            raise InputError(
+                f"alpha_I={aI}: corner inertia coefficient I_O/(m R^2) must be >= 1 "
+                "(parallel-axis theorem); 4/3 is a uniform block"
+            )
         object.__setattr__(self, "alpha_I", aI)
         if self.mass_kg is not None:
             object.__setattr__(self, "mass_kg", _positive("mass_kg", self.mass_kg))
@@ -85,8 +87,9 @@ class Block:
             object.__setattr__(self, "mass_kg", 1.0 * d)
 
     @classmethod
-    def general(cls, R_m: float, alpha_rad: float, alpha_I: float = 4.0 / 3.0,
-                mass_kg: float | None = None, name: str = "") -> "Block":
+    def general(
+        cls, R_m: float, alpha_rad: float, alpha_I: float = 4.0 / 3.0, mass_kg: float | None = None, name: str = ""
+    ) -> "Block":
         """A general symmetric body from R (m), alpha (rad) and alpha_I = I_O/(m R^2).
 
         Examples: ``alpha_I = 4/3`` uniform prism; ``alpha_I = 1`` mass
@@ -97,8 +100,7 @@ class Block:
         a = _positive("alpha_rad (slenderness angle)", alpha_rad)
         if a >= math.pi / 2:
             raise InputError(f"alpha_rad={alpha_rad}: slenderness angle must be in (0, pi/2) rad")
-        return cls(b_m=2 * R * math.sin(a), h_m=2 * R * math.cos(a), mass_kg=mass_kg,
-                   alpha_I=alpha_I, name=name)
+        return cls(b_m=2 * R * math.sin(a), h_m=2 * R * math.cos(a), mass_kg=mass_kg, alpha_I=alpha_I, name=name)
 
     # -- derived quantities -------------------------------------------------
     @property
@@ -119,7 +121,7 @@ class Block:
     @property
     def I_O_kg_m2(self) -> float:
         """Moment of inertia about a rocking corner, kg m^2."""
-        return self.alpha_I * float(self.mass_kg or 0.0) * self.R_m ** 2  # mass is set in __post_init__
+        return self.alpha_I * float(self.mass_kg or 0.0) * self.R_m**2  # mass is set in __post_init__
 
     @property
     def p_rad_s(self) -> float:
@@ -143,9 +145,15 @@ class Block:
     def to_dict(self) -> dict:
         """All inputs and derived quantities, SI units in the keys."""
         d = asdict(self)
-        d.update(alpha_rad=self.alpha_rad, R_m=self.R_m, slenderness=self.slenderness,
-                 I_O_kg_m2=self.I_O_kg_m2, p_rad_s=self.p_rad_s, eta_H=self.eta_H,
-                 uplift_acc_m_s2=self.uplift_acc_m_s2)
+        d.update(
+            alpha_rad=self.alpha_rad,
+            R_m=self.R_m,
+            slenderness=self.slenderness,
+            I_O_kg_m2=self.I_O_kg_m2,
+            p_rad_s=self.p_rad_s,
+            eta_H=self.eta_H,
+            uplift_acc_m_s2=self.uplift_acc_m_s2,
+        )
         return d
 
 

@@ -16,8 +16,7 @@ import numpy as np
 TEX = 2000.0  # texture px per m (even marker sides and mm positions land on whole texels)
 
 
-def marker_texture(ids, positions_m, size_m, face_m, face_grey=200, dictionary="DICT_4X4_50",
-                   origin_m=(0.0, 0.0)):
+def marker_texture(ids, positions_m, size_m, face_m, face_grey=200, dictionary="DICT_4X4_50", origin_m=(0.0, 0.0)):
     """Grey face (w, h m) with ArUco markers centred at ``positions_m`` (object frame, y up).
 
     Returns ``(texture, origin_px)`` where ``origin_px`` is the texture pixel of the object origin.
@@ -36,8 +35,8 @@ def marker_texture(ids, positions_m, size_m, face_m, face_grey=200, dictionary="
         v0 = oy + 0.5 - cy * TEX - s / 2
         assert abs(u0 - round(u0)) < 1e-6 and abs(v0 - round(v0)) < 1e-6, "off-texel marker"
         u0, v0 = int(round(u0)), int(round(v0))
-        tex[v0 - q:v0 + s + q, u0 - q:u0 + s + q] = 255
-        tex[v0:v0 + s, u0:u0 + s] = img
+        tex[v0 - q : v0 + s + q, u0 - q : u0 + s + q] = 255
+        tex[v0 : v0 + s, u0 : u0 + s] = img
     return tex, (ox, oy)
 
 
@@ -48,8 +47,15 @@ def dots_texture(dots_m, diameter_m, face_m, origin_m=(0.0, 0.0), face_grey=210,
     ox, oy = _origin(big[::scale, ::scale], origin_m)
     for cx, cy in dots_m:
         c = ((ox + cx * TEX) * scale + (scale - 1) / 2, (oy - cy * TEX) * scale + (scale - 1) / 2)
-        cv2.circle(big, (int(round(c[0] * 16)), int(round(c[1] * 16))),
-                   int(round(diameter_m / 2 * TEX * scale * 16)), int(dot_grey), -1, cv2.LINE_AA, 4)
+        cv2.circle(
+            big,
+            (int(round(c[0] * 16)), int(round(c[1] * 16))),
+            int(round(diameter_m / 2 * TEX * scale * 16)),
+            int(dot_grey),
+            -1,
+            cv2.LINE_AA,
+            4,
+        )
     tex = cv2.resize(big, (big.shape[1] // scale, big.shape[0] // scale), interpolation=cv2.INTER_AREA)
     return tex, (ox, oy)
 
@@ -77,8 +83,18 @@ class Scene:
     """``tilt_rad = (about x, about y)``: a pinhole camera at 1 m looking at the plane with
     that pitch/yaw (``K`` in :attr:`K`); 0 gives a fronto-parallel view."""
 
-    def __init__(self, width=640, height=400, px_per_m=1500.0, roll_rad=0.0, noise=2.0,
-                 blur=0.6, seed=0, background=(90, 140), tilt_rad=(0.0, 0.0)):
+    def __init__(
+        self,
+        width=640,
+        height=400,
+        px_per_m=1500.0,
+        roll_rad=0.0,
+        noise=2.0,
+        blur=0.6,
+        seed=0,
+        background=(90, 140),
+        tilt_rad=(0.0, 0.0),
+    ):
         self.W, self.H, self.k, self.roll = width, height, px_per_m, roll_rad
         self.noise, self.blur = noise, blur
         self.rng = np.random.default_rng(seed)
@@ -116,11 +132,17 @@ class Scene:
             T[:2, :2] = L
             T[:2, 2] = np.array([x, y]) - L @ np.array([ox, oy])
             M = self.G @ T
-            warped = cv2.warpPerspective(tex, M, (self.W, self.H), flags=cv2.INTER_LINEAR,
-                                         borderMode=cv2.BORDER_CONSTANT, borderValue=0)
-            alpha = cv2.warpPerspective(np.ones_like(tex), M, (self.W, self.H),
-                                        flags=cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT,
-                                        borderValue=0)
+            warped = cv2.warpPerspective(
+                tex, M, (self.W, self.H), flags=cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT, borderValue=0
+            )
+            alpha = cv2.warpPerspective(
+                np.ones_like(tex),
+                M,
+                (self.W, self.H),
+                flags=cv2.INTER_LINEAR,
+                borderMode=cv2.BORDER_CONSTANT,
+                borderValue=0,
+            )
             img = img * (1 - alpha) + warped
         if self.blur:
             img = cv2.GaussianBlur(img, (0, 0), self.blur)
@@ -148,7 +170,7 @@ def checker_texture(squares_x, squares_y, square_m, margin_m=0.01):
     for j in range(squares_y):
         for i in range(squares_x):
             if (i + j) % 2 == 0:
-                tex[m + j * s:m + (j + 1) * s, m + i * s:m + (i + 1) * s] = 20
+                tex[m + j * s : m + (j + 1) * s, m + i * s : m + (i + 1) * s] = 20
     ox, oy = _origin(tex, (0.0, 0.0))
     # first inner corner: one square in from the top-left board corner
     return tex, (m + s - 0.5, m + s - 0.5)

@@ -35,7 +35,7 @@ def _imports():
             if isinstance(node, ast.ImportFrom):
                 if node.level:
                     base = pkg.split(".")
-                    base = base[:len(base) - (node.level - 1)]
+                    base = base[: len(base) - (node.level - 1)]
                     target = ".".join(base + ([node.module] if node.module else []))
                 else:
                     target = node.module or ""
@@ -108,12 +108,15 @@ def _subpackage(mod):
 ALIASES = {("rocklab.tracking", "rocklab.synth")}
 
 
-@pytest.mark.parametrize("layer, forbidden", [
-    ("models", {"fitting", "pipelines", "tracking", "synth"}),
-    ("fitting", {"pipelines", "tracking", "synth"}),
-    ("tracking", {"pipelines", "fitting", "synth"}),
-    ("synth", {"pipelines", "fitting"}),
-])
+@pytest.mark.parametrize(
+    "layer, forbidden",
+    [
+        ("models", {"fitting", "pipelines", "tracking", "synth"}),
+        ("fitting", {"pipelines", "tracking", "synth"}),
+        ("tracking", {"pipelines", "fitting", "synth"}),
+        ("synth", {"pipelines", "fitting"}),
+    ],
+)
 def test_dependencies_flow_one_way(layer, forbidden):
     bad = []
     for mod, deps in _imports().items():
@@ -126,14 +129,18 @@ def test_dependencies_flow_one_way(layer, forbidden):
 
 
 def test_tracking_uses_the_physics_only_where_known():
-    users = {mod for mod, deps in _imports().items()
-             if _subpackage(mod) == "tracking" and any(_subpackage(d) == "models" for d in deps)}
+    users = {
+        mod
+        for mod, deps in _imports().items()
+        if _subpackage(mod) == "tracking" and any(_subpackage(d) == "models" for d in deps)
+    }
     assert users <= TRACKING_TO_MODELS, users - TRACKING_TO_MODELS
 
 
 def test_only_pipelines_draw_or_log_to_rerun():
-    bad = [mod for mod, deps in _imports().items()
-           if deps & {"matplotlib", "rerun"} and _subpackage(mod) != "pipelines"]
+    bad = [
+        mod for mod, deps in _imports().items() if deps & {"matplotlib", "rerun"} and _subpackage(mod) != "pipelines"
+    ]
     assert not bad
 
 
@@ -150,15 +157,35 @@ def test_moved_names_keep_a_deprecated_alias_for_one_release():
 
 def test_packages_hold_at_most_12_modules_where_split():
     # every package
-    for pkg in ("synth", "tracking", "tracking/video", "tracking/video/targets", "tracking/imu", "tracking/rigid",
-                "tracking/stereo", "models", "models/rocking", "models/column", "models/spectra",
-                "models/mechanisms", "fitting", "pipelines", "pipelines/cli", "pipelines/cli/commands",
-                "pipelines/experiment", "pipelines/campaign", "pipelines/spectra"):
+    for pkg in (
+        "synth",
+        "tracking",
+        "tracking/video",
+        "tracking/video/targets",
+        "tracking/imu",
+        "tracking/rigid",
+        "tracking/stereo",
+        "models",
+        "models/rocking",
+        "models/column",
+        "models/spectra",
+        "models/mechanisms",
+        "fitting",
+        "pipelines",
+        "pipelines/cli",
+        "pipelines/cli/commands",
+        "pipelines/experiment",
+        "pipelines/campaign",
+        "pipelines/spectra",
+    ):
         mods = [p for p in (PKG / pkg).glob("*.py") if p.name != "__init__.py"]
         assert len(mods) <= 12, (pkg, len(mods))
 
 
 def test_no_module_over_500_lines():
-    long = {str(p.relative_to(PKG)): n for p in PKG.rglob("*.py")
-            if (n := len(p.read_text(encoding="utf-8").splitlines())) > 500}
+    long = {
+        str(p.relative_to(PKG)): n
+        for p in PKG.rglob("*.py")
+        if (n := len(p.read_text(encoding="utf-8").splitlines())) > 500
+    }
     assert not long

@@ -42,8 +42,16 @@ def test_stocky_block_bounces_back():
     assert Block(0.1, 0.0707).eta_H < 0 < Block(0.1, 0.0708).eta_H
 
 
-@pytest.mark.parametrize("kw", [dict(b_m=0, h_m=1), dict(b_m=-0.1, h_m=1), dict(b_m=0.1, h_m=float("nan")),
-                                dict(b_m=0.1, h_m=1, mass_kg=-1), dict(b_m=0.1, h_m=1, alpha_I=0.5)])
+@pytest.mark.parametrize(
+    "kw",
+    [
+        dict(b_m=0, h_m=1),
+        dict(b_m=-0.1, h_m=1),
+        dict(b_m=0.1, h_m=float("nan")),
+        dict(b_m=0.1, h_m=1, mass_kg=-1),
+        dict(b_m=0.1, h_m=1, alpha_I=0.5),
+    ],
+)
 def test_invalid_geometry(kw):
     with pytest.raises(InputError) as e:
         Block(**kw)

@@ -9,8 +9,18 @@ import pytest
 
 from rocklab import InputError
 from rocklab.blocks import Block
-from rocklab.models import (BaseMotion, Column, app_c_reduction, column_impact, compare_sequences,
-                            full_mass_matrix, joint_sequence, mass_points, simulate, simulate_column)
+from rocklab.models import (
+    BaseMotion,
+    Column,
+    app_c_reduction,
+    column_impact,
+    compare_sequences,
+    full_mass_matrix,
+    joint_sequence,
+    mass_points,
+    simulate,
+    simulate_column,
+)
 
 
 @pytest.fixture(scope="module")
@@ -27,10 +37,17 @@ def appc():
 
 # -- the thesis's printed numbers ---------------------------------------------------------
 
+
 def test_mass_matrix_eq10(psycharis):
     M = full_mass_matrix(psycharis)
-    eq10 = np.array([[3.700, 1.175, 3.550, 1.100], [1.175, 0.500, 1.100, 0.425],
-                     [3.550, 1.100, 3.700, 1.175], [1.100, 0.425, 1.175, 0.500]])
+    eq10 = np.array(
+        [
+            [3.700, 1.175, 3.550, 1.100],
+            [1.175, 0.500, 1.100, 0.425],
+            [3.550, 1.100, 3.700, 1.175],
+            [1.100, 0.425, 1.175, 0.500],
+        ]
+    )
     np.testing.assert_allclose(M, eq10, atol=5e-4)
 
 
@@ -68,8 +85,9 @@ def test_single_block_impact_is_housner_and_eq_a8():
     # two impacts through a mid bump: Eq. (A8) with half-sizes h, b: (2h^2 + b^2/2) / (2h^2 + 2b^2)
     hh, bb = 0.4, 0.1
     o2 = column_impact(col, 0, [-0.5], ["cw"], n_impacts=2)
-    assert o2.omega_after_rad_s[0] == pytest.approx(-0.5 * (2 * hh**2 + 0.5 * bb**2) / (2 * hh**2 + 2 * bb**2),
-                                                    rel=1e-12)
+    assert o2.omega_after_rad_s[0] == pytest.approx(
+        -0.5 * (2 * hh**2 + 0.5 * bb**2) / (2 * hh**2 + 2 * bb**2), rel=1e-12
+    )
     # squat block (Housner's eta < 0): the joint stays closed instead of bouncing back
     o3 = column_impact(Column((Block(0.5, 0.3),)), 0, [-0.5], ["cw"])
     assert o3.states_after == ("closed",) and o3.ke_after_J == 0.0
@@ -80,12 +98,26 @@ def test_app_c_mass_points_b_matrix_and_load_vectors(appc):
     np.testing.assert_allclose(m, [0.177, 0.646, 0.177], atol=5e-4)  # Eq. (C9)
     np.testing.assert_allclose(y, [0.0, 2.0, 4.0])
     r = app_c_reduction(appc, None, None, ug_m_s2=-1.0, g_m_s2=9.81)
-    B11 = np.array([[0, 0], [-2, 0], [-4, 0], [-4, 0], [-6, -2], [-8, -4],
-                    [-0.5, 0], [-0.5, 0], [-0.5, 0], [-0.5, -0.5], [-0.5, -0.5], [-0.5, -0.5]])
-    np.testing.assert_allclose(r["B"], B11, atol=1e-12)                           # Eq. (C11)
+    B11 = np.array(
+        [
+            [0, 0],
+            [-2, 0],
+            [-4, 0],
+            [-4, 0],
+            [-6, -2],
+            [-8, -4],
+            [-0.5, 0],
+            [-0.5, 0],
+            [-0.5, 0],
+            [-0.5, -0.5],
+            [-0.5, -0.5],
+            [-0.5, -0.5],
+        ]
+    )
+    np.testing.assert_allclose(r["B"], B11, atol=1e-12)  # Eq. (C11)
     np.testing.assert_allclose(r["p"][:6], np.tile([0.177, 0.646, 0.177], 2), atol=5e-4)  # Eq. (C10)
     np.testing.assert_allclose(r["p"][6:], np.tile([-1.74, -6.34, -1.74], 2), atol=5e-3)
-    np.testing.assert_allclose(r["p_red"], [1.810, 2.905], atol=5e-4)              # Eq. (C12)
+    np.testing.assert_allclose(r["p_red"], [1.810, 2.905], atol=5e-4)  # Eq. (C12)
     np.testing.assert_allclose(r["M_red"], [[43.333, 13.667], [13.667, 5.667]], atol=5e-4)  # Eq. (C13)
 
 
@@ -94,7 +126,7 @@ def test_app_c_inclined_upper_block(appc):
     r = app_c_reduction(appc, [0.0, -math.radians(10.0)], None, ug_m_s2=-1.0, g_m_s2=9.81)
     np.testing.assert_allclose(r["B"][3:6], [[-4.087, -0.087], [-6.056, -2.056], [-8.026, -4.026]], atol=5e-4)
     np.testing.assert_allclose(r["B"][9:12], [[-0.492, -0.492], [-0.145, -0.145], [0.202, 0.202]], atol=5e-4)
-    np.testing.assert_allclose(r["p_red"], [-1.728, -0.633], atol=5e-4)           # Eq. (C15)
+    np.testing.assert_allclose(r["p_red"], [-1.728, -0.633], atol=5e-4)  # Eq. (C15)
     np.testing.assert_allclose(r["M_red"], [[43.785, 13.892], [13.892, 5.667]], atol=5e-4)  # Eq. (C16)
 
 
@@ -103,8 +135,10 @@ def test_kernel_closed_forms_equal_app_c_products():
     from rocklab.models.column._kernels import geometry, pivots, system
 
     rng = np.random.default_rng(3)
-    col = Column((Block(0.3, 1.0, mass_kg=2.0), Block(0.25, 0.7, mass_kg=1.0), Block(0.2, 0.5, mass_kg=0.7)),
-                 cut_m=[0.01, 0.0, 0.02])
+    col = Column(
+        (Block(0.3, 1.0, mass_kg=2.0), Block(0.25, 0.7, mass_kg=1.0), Block(0.2, 0.5, mass_kg=0.7)),
+        cut_m=[0.01, 0.0, 0.02],
+    )
     blk = col.block_array()
     for _ in range(5):
         phi = rng.uniform(-0.2, 0.2, 3)
@@ -125,6 +159,7 @@ def test_kernel_closed_forms_equal_app_c_products():
 
 
 # -- one block = the single-block simulator -------------------------------------------------
+
 
 def _rest_omega(b):
     # the single-block simulator's rest threshold (rest_tol = 1e-6 of alpha in amplitude)
@@ -163,6 +198,7 @@ def test_one_block_under_base_motion_equals_single_block_simulator():
 
 
 # -- invariants of the multi-block model ---------------------------------------------------------
+
 
 @pytest.fixture(scope="module")
 def three_block_free():
@@ -221,8 +257,7 @@ def test_enumeration_fallback_stays_admissible():
     from rocklab.models import sine_pulse
 
     col = Column.uniform(0.2, 1.6, 4, mass_kg=1.0)
-    runs = [simulate_column(col, sine_pulse(-3.0, 0.4), duration_s=1.0, dt_s=1e-4, max_enum_closed=m)
-            for m in (9, 0)]
+    runs = [simulate_column(col, sine_pulse(-3.0, 0.4), duration_s=1.0, dt_s=1e-4, max_enum_closed=m) for m in (9, 0)]
     for r in runs:
         _assert_admissible(r)
         assert (r.impacts.ke_after_J <= r.impacts.ke_before_J * (1 + 1e-12)).all()
@@ -270,8 +305,9 @@ def test_overturning_and_status():
     r = simulate_column(Column((b,)), theta0_rad=0.2, omega0_rad_s=0.5, duration_s=3.0, dt_s=1e-4)
     assert r.status == "overturned" and r.overturned
     assert r.theta_rad[-1, 0] == pytest.approx(b.alpha_rad, abs=1e-3)
-    r2 = simulate_column(Column((b,) * 2), base=BaseMotion.from_arrays([0, 1], [0.1, 0.1], "m/s2"),
-                         duration_s=0.5, dt_s=1e-3)
+    r2 = simulate_column(
+        Column((b,) * 2), base=BaseMotion.from_arrays([0, 1], [0.1, 0.1], "m/s2"), duration_s=0.5, dt_s=1e-3
+    )
     assert r2.status == "no_uplift" and np.all(r2.theta_rad == 0)
 
 
@@ -285,6 +321,7 @@ def test_bad_input_is_one_line():
 
 
 # -- opening/closing sequences ----------------------------------------------------------------------
+
 
 def test_joint_sequence_recovers_model_events_and_comparison(three_block_free):
     r = three_block_free
@@ -301,8 +338,9 @@ def test_joint_sequence_recovers_model_events_and_comparison(three_block_free):
     assert same.same_sequence and same.n_matched == len(seq) and same.timing_error_s == 0.0
     # a noisy copy with a time shift still matches; a swapped joint does not
     rng = np.random.default_rng(0)
-    noisy = joint_sequence(r.t_s + 0.004, r.theta_rad + rng.normal(0, 1e-4, r.theta_rad.shape), 1e-3,
-                           min_duration_s=0.002)
+    noisy = joint_sequence(
+        r.t_s + 0.004, r.theta_rad + rng.normal(0, 1e-4, r.theta_rad.shape), 1e-3, min_duration_s=0.002
+    )
     c = compare_sequences(noisy, seq, tol_s=0.02)
     assert c.n_matched >= 0.9 * len(seq) and 0.0 < c.timing_error_s < 0.02
     swapped = [(t, 2 - j, s) for t, j, s in seq]
@@ -311,12 +349,20 @@ def test_joint_sequence_recovers_model_events_and_comparison(three_block_free):
 
 # -- thesis §5.2, Fig. 40 ----------------------------------------------------------------------------
 
+
 def test_fig40_single_block_overturns_over_a_wider_region():
     """H = 12 m, B = 1 m, full-sine pulses: monolithic columns are the more vulnerable ones."""
     from rocklab.models import column_overturning_maps
 
-    m = column_overturning_maps(12.0, 1.0, (1, 2, 3), ap_m_s2=[2.0, 3.5, 5.0, 6.5, 8.0, 12.0],
-                                tp_s=[0.3, 0.5, 0.7, 0.9, 1.2, 2.0], dt_s=2e-3, free_s=8.0)
+    m = column_overturning_maps(
+        12.0,
+        1.0,
+        (1, 2, 3),
+        ap_m_s2=[2.0, 3.5, 5.0, 6.5, 8.0, 12.0],
+        tp_s=[0.3, 0.5, 0.7, 0.9, 1.2, 2.0],
+        dt_s=2e-3,
+        free_s=8.0,
+    )
     one, two, three = m.overturned
     # a_p,min = g B/H = 0.82 m/s2: every column needs several times that, and long pulses topple all
     assert not one[:, 0].any() and one[:, -1].all()
@@ -337,13 +383,23 @@ def test_state_checks_flag_tension_and_uplift_level():
     s = np.zeros(2, np.int64)
     viol = np.zeros(2)
     # compression inside the section: fine; eccentricity beyond a = b/2 - cut: the joint must open
-    assert state_checks(s, np.zeros(2), np.zeros(2), blk, par, np.array([10.0, 5.0]), np.zeros(2),
-                        np.array([0.3, 0.2]), viol) == 0
+    assert (
+        state_checks(
+            s, np.zeros(2), np.zeros(2), blk, par, np.array([10.0, 5.0]), np.zeros(2), np.array([0.3, 0.2]), viol
+        )
+        == 0
+    )
     np.testing.assert_allclose(viol, [0.3 - 0.05 * 10.0, 0.2 - 0.04 * 5.0])
-    assert state_checks(s, np.zeros(2), np.zeros(2), blk, par, np.array([10.0, -1e-3]), np.zeros(2),
-                        np.zeros(2), viol) == 1  # tension at the upper joint
-    assert state_checks(s, np.zeros(2), np.zeros(2), blk, par, np.array([10.0, 5.0]), np.array([0.0, 2.6]),
-                        np.zeros(2), viol) == 2  # |V| > mu N
+    assert (
+        state_checks(s, np.zeros(2), np.zeros(2), blk, par, np.array([10.0, -1e-3]), np.zeros(2), np.zeros(2), viol)
+        == 1
+    )  # tension at the upper joint
+    assert (
+        state_checks(
+            s, np.zeros(2), np.zeros(2), blk, par, np.array([10.0, 5.0]), np.array([0.0, 2.6]), np.zeros(2), viol
+        )
+        == 2
+    )  # |V| > mu N
     # rigid column: joint j opens at g a_j / z_j (z_j: height of the centre of mass above joint j)
     z0 = (2.0 * 0.1 + 1.0 * 0.3) / 3.0
     assert uplift_acc_m_s2(col) == pytest.approx(min(9.80665 * 0.05 / z0, 9.80665 * 0.04 / 0.1), rel=1e-12)
@@ -366,8 +422,9 @@ def test_compare_to_measurement_synthetic_tracking(three_block_free):
     # the mirror image (counter-clockwise data read as clockwise) matches nothing that opened
     m = compare_to_measurement(r, t, -meas, threshold_rad=4e-3, tol_s=0.05, min_duration_s=0.03)
     assert m.sequence.n_matched < c.sequence.n_matched and m.rms_theta_rad[2] > 10 * c.rms_theta_rad[2]
-    assert compare_to_measurement(r, t, -meas, threshold_rad=4e-3, tol_s=0.05, sign=-1.0,
-                                  min_duration_s=0.03).sequence.same_sequence
+    assert compare_to_measurement(
+        r, t, -meas, threshold_rad=4e-3, tol_s=0.05, sign=-1.0, min_duration_s=0.03
+    ).sequence.same_sequence
 
 
 def test_events_converge_with_the_time_step():

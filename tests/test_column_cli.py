@@ -8,13 +8,38 @@ import numpy as np
 
 
 def test_column_cli_text_and_json(run_cli, tmp_path):
-    rc, out, err = run_cli("column", "--blocks", "0.1x0.2,0.1x0.2,0.1x0.2", "--cut", "0.002",
-                           "--theta0", "0,0,0.05", "--duration", "0.5", "--dt", "2e-4")
+    rc, out, err = run_cli(
+        "column",
+        "--blocks",
+        "0.1x0.2,0.1x0.2,0.1x0.2",
+        "--cut",
+        "0.002",
+        "--theta0",
+        "0,0,0.05",
+        "--duration",
+        "0.5",
+        "--dt",
+        "2e-4",
+    )
     assert rc == 0, err
     assert "status rocking" in out and "peak |theta| per block" in out and "configuration changes" in out
     csv = tmp_path / "col.csv"
-    rc, out, err = run_cli("column", "--blocks", "0.1x0.2,0.1x0.2,0.1x0.2", "--cut", "0.002",
-                           "--theta0", "0,0,0.05", "--duration", "0.5", "--dt", "2e-4", "--json", "-o", csv)
+    rc, out, err = run_cli(
+        "column",
+        "--blocks",
+        "0.1x0.2,0.1x0.2,0.1x0.2",
+        "--cut",
+        "0.002",
+        "--theta0",
+        "0,0,0.05",
+        "--duration",
+        "0.5",
+        "--dt",
+        "2e-4",
+        "--json",
+        "-o",
+        csv,
+    )
     assert rc == 0, err
     d = json.loads(out)
     assert d["n_blocks"] == 3 and d["status"] == "rocking" and d["t_status_s"] is None
@@ -33,8 +58,9 @@ def test_column_cli_base_motion(run_cli, tmp_path):
     a = np.where(t < 0.6, -0.3 * np.sin(2 * np.pi * t / 0.6), 0.0)
     rec.write_text("t_s,acc_g\n" + "\n".join(f"{x:.3f},{y:.6f}" for x, y in zip(t, a)) + "\n")
     before = rec.read_bytes()
-    rc, out, err = run_cli("column", "--blocks", "0.1x0.2,0.1x0.2", "--base-motion", rec, "--scale-pga", "0.35",
-                           "--json", "--dt", "2e-4")
+    rc, out, err = run_cli(
+        "column", "--blocks", "0.1x0.2,0.1x0.2", "--base-motion", rec, "--scale-pga", "0.35", "--json", "--dt", "2e-4"
+    )
     assert rc == 0, err
     d = json.loads(out)
     ev = d["configurations"]

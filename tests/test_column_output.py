@@ -31,12 +31,14 @@ THESIS = Column((Block(0.1, 0.2, density_kg_m3=2700.0),) * 3, cut_m=0.002)
 CASES = {
     "free": (THESIS, None, dict(theta0_rad=[0.0, 0.0, 0.08], duration_s=0.3, dt_s=1e-4)),
     "record": (THESIS, "elcentro", dict(duration_s=3.0, dt_s=1e-4, stop_at_rest=False)),
-    "overturn": (Column.uniform(1.0, 12.0, 3, mass_kg=1.0), sine_pulse(8.0, 1.5),
-                 dict(duration_s=11.5, dt_s=2e-3)),
-    "sliding": (Column((Block(0.3, 0.3, mass_kg=1.0),), mu=0.3),
-                BaseMotion.from_arrays(np.arange(0.0, 1.0, 0.01),
-                                       np.where(np.arange(0.0, 1.0, 0.01) > 0.2, 0.5 * 9.81, 0.0), "m/s2"),
-                dict(duration_s=1.0, dt_s=1e-3)),
+    "overturn": (Column.uniform(1.0, 12.0, 3, mass_kg=1.0), sine_pulse(8.0, 1.5), dict(duration_s=11.5, dt_s=2e-3)),
+    "sliding": (
+        Column((Block(0.3, 0.3, mass_kg=1.0),), mu=0.3),
+        BaseMotion.from_arrays(
+            np.arange(0.0, 1.0, 0.01), np.where(np.arange(0.0, 1.0, 0.01) > 0.2, 0.5 * 9.81, 0.0), "m/s2"
+        ),
+        dict(duration_s=1.0, dt_s=1e-3),
+    ),
 }
 
 
@@ -45,8 +47,10 @@ def runs():
     out = {}
     for name, (col, base, kw) in CASES.items():
         base = _elcentro_3s() if base == "elcentro" else base
-        out[name] = {odt: simulate_column(col, base, output_dt_s=odt, **kw)
-                     for odt in (None, 7 * kw["dt_s"], 10 * kw["dt_s"], math.inf)}
+        out[name] = {
+            odt: simulate_column(col, base, output_dt_s=odt, **kw)
+            for odt in (None, 7 * kw["dt_s"], 10 * kw["dt_s"], math.inf)
+        }
     return out
 
 
@@ -64,8 +68,9 @@ def test_decimated_history_is_the_full_one_at_shared_times(runs, name):
         assert len(r.t_s) == len(rows) < len(full.t_s)
         np.testing.assert_allclose(r.t_s, full.t_s[rows], rtol=0, atol=1e-12)
         for attr in ("phi_rad", "omega_rad_s", "theta_rad", "energy_J", "kinetic_J"):
-            np.testing.assert_allclose(getattr(r, attr), getattr(full, attr)[rows], rtol=0, atol=1e-12,
-                                       err_msg=f"{name} {odt} {attr}")
+            np.testing.assert_allclose(
+                getattr(r, attr), getattr(full, attr)[rows], rtol=0, atol=1e-12, err_msg=f"{name} {odt} {attr}"
+            )
 
 
 @pytest.mark.parametrize("name", list(CASES))
@@ -100,8 +105,9 @@ def test_peaks_come_from_every_step_not_the_samples(runs):
 
 def test_stored_arrays_shrink_with_the_spacing(runs):
     full = runs["record"][None]
-    nb = lambda r: sum(getattr(r, a).nbytes for a in ("t_s", "phi_rad", "omega_rad_s", "theta_rad",
-                                                      "energy_J", "kinetic_J"))
+    nb = lambda r: sum(
+        getattr(r, a).nbytes for a in ("t_s", "phi_rad", "omega_rad_s", "theta_rad", "energy_J", "kinetic_J")
+    )
     row = nb(full) / len(full.t_s)
     for k in (7, 10):
         r = runs["record"][k * 1e-4]
@@ -130,8 +136,20 @@ def test_maps_store_no_history_and_match_the_full_runs():
 
 
 def test_cli_output_dt(run_cli, tmp_path):
-    args = ("column", "--blocks", "0.1x0.2,0.1x0.2,0.1x0.2", "--cut", "0.002", "--theta0", "0,0,0.05",
-            "--duration", "0.25", "--dt", "2e-4", "--json")
+    args = (
+        "column",
+        "--blocks",
+        "0.1x0.2,0.1x0.2,0.1x0.2",
+        "--cut",
+        "0.002",
+        "--theta0",
+        "0,0,0.05",
+        "--duration",
+        "0.25",
+        "--dt",
+        "2e-4",
+        "--json",
+    )
     rc, out_full, err = run_cli(*args, "-o", tmp_path / "full.csv")
     assert rc == 0, err
     rc, out_dec, err = run_cli(*args, "-o", tmp_path / "dec.csv", "--output-dt", "1e-3")

@@ -9,9 +9,22 @@ import pandas as pd
 import pytest
 
 from rocklab import Block, InputError
-from rocklab.fitting import (CEH_EQ19, KRegression, alpha_from_hb, catalogue_block, ceh_catalogue, ceh_full_contact,
-                             ceh_table5, edge_contact_k, eta_housner, eta_modified, fit_eta_mat, fit_k_regression,
-                             k_from_eta, k_table)
+from rocklab.fitting import (
+    CEH_EQ19,
+    KRegression,
+    alpha_from_hb,
+    catalogue_block,
+    ceh_catalogue,
+    ceh_full_contact,
+    ceh_table5,
+    edge_contact_k,
+    eta_housner,
+    eta_modified,
+    fit_eta_mat,
+    fit_k_regression,
+    k_from_eta,
+    k_table,
+)
 
 
 # ---------------------------------------------------------------- package data (Tables 2, 3)
@@ -156,11 +169,11 @@ def test_regression_statistics_are_consistent():
     kt = k_table(ceh_full_contact(), eta_mat=0.98895).per_block
     hb, b = kt.h_over_b.to_numpy(), 100 * kt.b_m.to_numpy()
     # least-squares normal equations: residuals orthogonal to every regressor
-    X = np.column_stack([hb ** 2, hb, np.ones_like(hb), b])
+    X = np.column_stack([hb**2, hb, np.ones_like(hb), b])
     assert np.allclose(X.T @ reg.residuals, 0, atol=1e-10)
-    assert reg.rmse == pytest.approx(np.sqrt(np.mean(reg.residuals ** 2)), rel=1e-12)
+    assert reg.rmse == pytest.approx(np.sqrt(np.mean(reg.residuals**2)), rel=1e-12)
     ss = np.sum((kt.k - kt.k.mean()) ** 2)
-    assert reg.r2 == pytest.approx(1 - np.sum(reg.residuals ** 2) / ss, rel=1e-12)
+    assert reg.r2 == pytest.approx(1 - np.sum(reg.residuals**2) / ss, rel=1e-12)
     assert len(reg.loso) == 3 and (reg.loso.rmse > reg.rmse * 0.5).all()
 
 
@@ -169,7 +182,7 @@ def test_regression_exact_on_synthetic_surface_and_loso():
     hb = rng.uniform(1.5, 10, 40)
     b = rng.choice([0.03, 0.045, 0.06, 0.08], 40)
     true = {"hb2": 0.003, "hb": -0.02, "const": 1.1, "b_cm": -0.05}
-    k = true["hb2"] * hb ** 2 + true["hb"] * hb + true["const"] + true["b_cm"] * 100 * b
+    k = true["hb2"] * hb**2 + true["hb"] * hb + true["const"] + true["b_cm"] * 100 * b
     reg = fit_k_regression(hb, b, k)
     for n, v in true.items():
         assert reg.coefficients[n] == pytest.approx(v, abs=1e-10)

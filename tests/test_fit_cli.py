@@ -28,8 +28,19 @@ def track_csv(tmp_path_factory):
     status[lost] = "lost"
     th[lost] = np.nan
     n = t.size
-    blk = pd.DataFrame(dict(frame=np.arange(n), t_s=t, object="block_1", x_m=0.0, y_m=0.0, theta_rad=th,
-                            sigma_theta_rad=math.radians(0.02), quality=1.0, status=status))
+    blk = pd.DataFrame(
+        dict(
+            frame=np.arange(n),
+            t_s=t,
+            object="block_1",
+            x_m=0.0,
+            y_m=0.0,
+            theta_rad=th,
+            sigma_theta_rad=math.radians(0.02),
+            quality=1.0,
+            status=status,
+        )
+    )
     tab = blk.assign(object="table", theta_rad=0.0, status="ok")
     path = tmp_path_factory.mktemp("fit") / "tracks.csv"
     pd.concat([blk, tab]).sort_values(["frame", "object"]).to_csv(path, index=False)
@@ -40,8 +51,16 @@ def test_fit_restitution_json(run_cli, track_csv):
     rc, out, err = run_cli("fit", "restitution", track_csv, "--width", 0.045, "--height", 0.2025, "--json")
     assert rc == 0, err
     d = json.loads(out)
-    for k in ("eta_e", "eta_e_first", "ci95_eta_e", "theta0_rad", "release_t_s", "rms_residual_rad",
-              "per_impact_eta", "status"):
+    for k in (
+        "eta_e",
+        "eta_e_first",
+        "ci95_eta_e",
+        "theta0_rad",
+        "release_t_s",
+        "rms_residual_rad",
+        "per_impact_eta",
+        "status",
+    ):
         assert k in d
     assert d["status"] == "ok" and abs(d["eta_e"] - 0.93) < 0.002
     assert d["ci95_eta_e"][0] < d["eta_e"] < d["ci95_eta_e"][1]
@@ -51,11 +70,9 @@ def test_fit_restitution_json(run_cli, track_csv):
 
 
 def test_fit_restitution_nan_raise_and_bad_object(run_cli, track_csv):
-    rc, out, err = run_cli("fit", "restitution", track_csv, "--width", 0.045, "--height", 0.2025,
-                           "--nan", "raise")
+    rc, out, err = run_cli("fit", "restitution", track_csv, "--width", 0.045, "--height", 0.2025, "--nan", "raise")
     assert rc == 2 and "line" in err and len(err.strip().splitlines()) == 1
-    rc, out, err = run_cli("fit", "restitution", track_csv, "--width", 0.045, "--height", 0.2025,
-                           "--object", "nope")
+    rc, out, err = run_cli("fit", "restitution", track_csv, "--width", 0.045, "--height", 0.2025, "--object", "nope")
     assert rc == 2 and "nope" in err
     rc, out, err = run_cli("fit", "restitution", track_csv, "--width", -0.045, "--height", 0.2025)
     assert rc == 2 and "b_m" in err
@@ -102,7 +119,11 @@ def test_fit_k_table_and_predict(run_cli, tmp_path):
     assert rc == 0, err
     d = json.loads(out)
     assert {k: round(v, 4) for k, v in d["coefficients"].items()} == {
-        "hb2": 0.0047, "hb": -0.0258, "const": 1.0635, "b_cm": -0.0565}
+        "hb2": 0.0047,
+        "hb": -0.0258,
+        "const": 1.0635,
+        "b_cm": -0.0565,
+    }
     assert 0 < d["r2"] < 1 and d["rmse"] > 0
     rows = {r["block"]: r for r in d["per_block"]}
     assert set(rows["B6M"]) == {"block", "k", "b_bar_m", "feasible"}
@@ -110,7 +131,7 @@ def test_fit_k_table_and_predict(run_cli, tmp_path):
     coef = tmp_path / "coef.json"
     coef.write_text(out)
     c = d["coefficients"]
-    k9 = c["hb2"] * 4.5 ** 2 + c["hb"] * 4.5 + c["const"] + c["b_cm"] * 9
+    k9 = c["hb2"] * 4.5**2 + c["hb"] * 4.5 + c["const"] + c["b_cm"] * 9
     # default coefficients: Eq. 19 as printed
     rc, out, err = run_cli("fit", "k-predict", "--hb", 4.5, "--b-cm", 6, "--json")
     d = json.loads(out)

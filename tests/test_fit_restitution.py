@@ -16,8 +16,14 @@ import pytest
 from rocklab._diagnostics import RocklabWarning
 
 from rocklab import InputError
-from rocklab.fitting import (catalogue_block, energy_loss_from_peaks, fit_many, fit_restitution, per_impact_eta,
-                             summarize_repeats)
+from rocklab.fitting import (
+    catalogue_block,
+    energy_loss_from_peaks,
+    fit_many,
+    fit_restitution,
+    per_impact_eta,
+    summarize_repeats,
+)
 from rocklab.models import simulate
 
 B6M = catalogue_block("B6M")
@@ -66,8 +72,18 @@ def test_fit_recovers_release_theta0_and_reports():
     assert f.n_impacts >= 15
     d = f.to_dict()
     json.dumps(d)
-    assert set(["eta_e", "eta_e_first", "ci95_eta_e", "theta0_rad", "release_t_s", "rms_residual_rad",
-                "per_impact_eta", "status"]) <= set(d)
+    assert set(
+        [
+            "eta_e",
+            "eta_e_first",
+            "ci95_eta_e",
+            "theta0_rad",
+            "release_t_s",
+            "rms_residual_rad",
+            "per_impact_eta",
+            "status",
+        ]
+    ) <= set(d)
     rep = f.report()
     assert "eta_e:" in rep and "profile likelihood" in rep and "at bound" not in rep
 
@@ -143,7 +159,7 @@ def test_thesis_eq12_energy_loss_from_peaks():
     t, y, _ = synthetic(4)
     el = energy_loss_from_peaks(t, y, B6M)
     assert el.exact and el.start == 0
-    assert el.mean4 == pytest.approx(1 - 0.93 ** 2, abs=0.004)
+    assert el.mean4 == pytest.approx(1 - 0.93**2, abs=0.004)
     assert el.eta_equivalent == pytest.approx(0.93, abs=0.002)
     assert el.mean4 == pytest.approx(np.mean(el.loss[:4]), rel=1e-14)
     assert "Eq. 12" in el.report()

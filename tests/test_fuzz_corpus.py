@@ -28,9 +28,11 @@ CASES: list[tuple[str, object, tuple]] = []
 
 def case(name, expect, kind=None):
     """Register ``fn(tmp) -> argv`` as a corpus case."""
+
     def deco(fn):
         CASES.append((name, fn, (expect, kind)))
         return fn
+
     return deco
 
 
@@ -44,14 +46,31 @@ def many(prefix, items, expect_of):
 SINE = 0.1 * np.sin(np.linspace(0, 12, 200))
 
 
-def at2(values=SINE, units="ACCELERATION TIME SERIES IN UNITS OF G", npts=None, dt=".0100",
-        station="Imperial Valley-02, El Centro", fmt="{: .7E}", tail=None):
+def at2(
+    values=SINE,
+    units="ACCELERATION TIME SERIES IN UNITS OF G",
+    npts=None,
+    dt=".0100",
+    station="Imperial Valley-02, El Centro",
+    fmt="{: .7E}",
+    tail=None,
+):
     toks = [fmt.format(v) for v in values]
     if tail is not None:
         toks[-1] = tail
-    rows = [" ".join(toks[i:i + 5]) for i in range(0, len(toks), 5)]
-    return "\n".join(["PEER NGA STRONG MOTION DATABASE RECORD", station, units,
-                      f"NPTS= {npts if npts is not None else len(values):6d}, DT=   {dt} SEC,"] + rows) + "\n"
+    rows = [" ".join(toks[i : i + 5]) for i in range(0, len(toks), 5)]
+    return (
+        "\n".join(
+            [
+                "PEER NGA STRONG MOTION DATABASE RECORD",
+                station,
+                units,
+                f"NPTS= {npts if npts is not None else len(values):6d}, DT=   {dt} SEC,",
+            ]
+            + rows
+        )
+        + "\n"
+    )
 
 
 def _rec(text, name="r.AT2", binary=False):
@@ -59,47 +78,58 @@ def _rec(text, name="r.AT2", binary=False):
         p = tmp / name
         (p.write_bytes if binary else p.write_text)(text)
         return ["pulse", p, "--json"]
+
     return build
 
 
-many("record", [
-    ("empty", _rec(""), "error", "empty"),
-    ("binary", _rec(b"\x00\x01\x02NPTS=3" * 50, binary=True), "error", "binary"),
-    ("header-only", _rec(at2(values=[])[:200], "h.AT2"), "error", "0 samples|NPTS"),
-    ("npts-mismatch", _rec(at2(npts=300)), "error", "NPTS=300"),
-    ("dt-zero", _rec(at2(dt="0.0")), "error", "DT"),
-    ("dt-negative", _rec(at2(dt="-.01")), "error", "DT"),
-    ("letters", _rec(at2(tail="abc")), "error", "not a number"),
-    ("velocity", _rec(at2(units="VELOCITY TIME SERIES IN UNITS OF CM/S")), "error", "velocity"),
-    ("displacement", _rec(at2(units="DISPLACEMENT TIME SERIES IN UNITS OF CM")), "error", "displacement"),
-    ("velocity-units", _rec(at2(units="TIME SERIES IN UNITS OF CM/SEC")), "error", "velocity"),
-    ("unknown-units", _rec(at2(units="TIME SERIES IN UNITS OF FURLONGS")), "error", "unknown units"),
-    ("two-units", _rec(at2(units="UNITS OF G   and also UNITS OF CM/S/S")), "error", "two units"),
-    ("cut-token", _rec(at2(tail="-.17901")), "error", "cut off"),
-    ("galway", _rec(at2(station="Galway, Ireland")), "ok", None),
-    ("portugal", _rec(at2(station="Portugal GAL station, CM/S")), "ok", None),
-    ("cm-s2", _rec(at2(units="UNITS OF CM/S/S", values=SINE * 981)), "ok", None),
-    ("old-style", _rec(at2(units="The units are (g)", fmt="{:10.5f}")), "ok", None),
-    ("no-units-field", _rec(at2(units="a record without a units line")), "ok", None),
-    ("pga-60g", _rec(at2(values=600 * SINE)), "warn", "W-RECORD-PGA"),
-    ("dt-0.5", _rec(at2(dt=".5000")), "warn", "W-RECORD-DT"),
-    ("two-samples", _rec(at2(values=[0.1, -0.1])), "error", "needs at least 16"),
-    ("all-zero", _rec(at2(values=np.zeros(50))), "error", "all zeros"),
-    ("nan", _rec(at2(tail="NaN")), "error", "NaN"),
-    ("csv-no-time", _rec("a,b\n1,2\n2,3\n", "r.csv"), "error", "t_s"),
-    ("csv-no-acc", _rec("t_s,x\n0,1\n0.01,2\n", "r.csv"), "error", "acceleration column"),
-    ("csv-text", _rec("t_s,acc_g\n0,1\n0.01,oops\n", "r.csv"), "error", "non-numeric"),
-    ("csv-decreasing", _rec("t_s,acc_g\n0,1\n0.02,2\n0.01,3\n", "r.csv"), "error", "does not increase"),
-    ("csv-duplicate", _rec("t_s,acc_g\n0,1\n0.01,2\n0.01,3\n", "r.csv"), "error", "does not increase"),
-    ("csv-gap", _rec("t_s,acc_g\n" + "\n".join(f"{t:.2f},{math.sin(t)}" for t in
-                                              list(np.arange(0, 1, 0.01)) + [1.5, 1.51]), "r.csv"),
-     "error", "non-uniform"),
-    ("cols-no-units", _rec("0 0.1\n0.01 0.2\n", "r.txt"), "error", "units"),
-    ("cols-ragged", _rec("0 0.1\n0.01 0.2 5\n", "r.txt"), "error", "columns"),
-    ("cols-text", _rec("0 0.1\n0.01 abc\n", "r.txt"), "error", "not numeric"),
-    ("missing-file", lambda tmp: ["pulse", tmp / "nope.AT2"], "error", "not found"),
-    ("folder", lambda tmp: ["pulse", tmp], "error", "is a folder"),
-], None)
+many(
+    "record",
+    [
+        ("empty", _rec(""), "error", "empty"),
+        ("binary", _rec(b"\x00\x01\x02NPTS=3" * 50, binary=True), "error", "binary"),
+        ("header-only", _rec(at2(values=[])[:200], "h.AT2"), "error", "0 samples|NPTS"),
+        ("npts-mismatch", _rec(at2(npts=300)), "error", "NPTS=300"),
+        ("dt-zero", _rec(at2(dt="0.0")), "error", "DT"),
+        ("dt-negative", _rec(at2(dt="-.01")), "error", "DT"),
+        ("letters", _rec(at2(tail="abc")), "error", "not a number"),
+        ("velocity", _rec(at2(units="VELOCITY TIME SERIES IN UNITS OF CM/S")), "error", "velocity"),
+        ("displacement", _rec(at2(units="DISPLACEMENT TIME SERIES IN UNITS OF CM")), "error", "displacement"),
+        ("velocity-units", _rec(at2(units="TIME SERIES IN UNITS OF CM/SEC")), "error", "velocity"),
+        ("unknown-units", _rec(at2(units="TIME SERIES IN UNITS OF FURLONGS")), "error", "unknown units"),
+        ("two-units", _rec(at2(units="UNITS OF G   and also UNITS OF CM/S/S")), "error", "two units"),
+        ("cut-token", _rec(at2(tail="-.17901")), "error", "cut off"),
+        ("galway", _rec(at2(station="Galway, Ireland")), "ok", None),
+        ("portugal", _rec(at2(station="Portugal GAL station, CM/S")), "ok", None),
+        ("cm-s2", _rec(at2(units="UNITS OF CM/S/S", values=SINE * 981)), "ok", None),
+        ("old-style", _rec(at2(units="The units are (g)", fmt="{:10.5f}")), "ok", None),
+        ("no-units-field", _rec(at2(units="a record without a units line")), "ok", None),
+        ("pga-60g", _rec(at2(values=600 * SINE)), "warn", "W-RECORD-PGA"),
+        ("dt-0.5", _rec(at2(dt=".5000")), "warn", "W-RECORD-DT"),
+        ("two-samples", _rec(at2(values=[0.1, -0.1])), "error", "needs at least 16"),
+        ("all-zero", _rec(at2(values=np.zeros(50))), "error", "all zeros"),
+        ("nan", _rec(at2(tail="NaN")), "error", "NaN"),
+        ("csv-no-time", _rec("a,b\n1,2\n2,3\n", "r.csv"), "error", "t_s"),
+        ("csv-no-acc", _rec("t_s,x\n0,1\n0.01,2\n", "r.csv"), "error", "acceleration column"),
+        ("csv-text", _rec("t_s,acc_g\n0,1\n0.01,oops\n", "r.csv"), "error", "non-numeric"),
+        ("csv-decreasing", _rec("t_s,acc_g\n0,1\n0.02,2\n0.01,3\n", "r.csv"), "error", "does not increase"),
+        ("csv-duplicate", _rec("t_s,acc_g\n0,1\n0.01,2\n0.01,3\n", "r.csv"), "error", "does not increase"),
+        (
+            "csv-gap",
+            _rec(
+                "t_s,acc_g\n" + "\n".join(f"{t:.2f},{math.sin(t)}" for t in list(np.arange(0, 1, 0.01)) + [1.5, 1.51]),
+                "r.csv",
+            ),
+            "error",
+            "non-uniform",
+        ),
+        ("cols-no-units", _rec("0 0.1\n0.01 0.2\n", "r.txt"), "error", "units"),
+        ("cols-ragged", _rec("0 0.1\n0.01 0.2 5\n", "r.txt"), "error", "columns"),
+        ("cols-text", _rec("0 0.1\n0.01 abc\n", "r.txt"), "error", "not numeric"),
+        ("missing-file", lambda tmp: ["pulse", tmp / "nope.AT2"], "error", "not found"),
+        ("folder", lambda tmp: ["pulse", tmp], "error", "is a folder"),
+    ],
+    None,
+)
 
 
 def _zero_sine(tmp):
@@ -119,37 +149,72 @@ def _sim(*extra, width=0.045, height=0.2025):
     return lambda tmp: ["simulate", "--width", width, "--height", height, *extra]
 
 
-many("simulate", [
-    ("width-0", _sim(width=0), "error", "width"),
-    ("width-neg", _sim(width=-1), "error", "width"),
-    ("width-nan", _sim(width="nan"), "error", "width"),
-    ("width-inf", _sim(width="inf"), "error", "width"),
-    ("width-text", _sim(width="abc"), "error", "invalid float"),
-    ("height-0", _sim(height=0), "error", "height"),
-    ("theta0-alpha", _sim("--theta0", 0.3), "error", "alpha"),
-    ("theta0-nan", _sim("--theta0", "nan"), "error", "theta0"),
-    ("dt-1", _sim("--theta0", 0.05, "--dt", 1), "error", "too coarse"),
-    ("dt-neg", _sim("--theta0", 0.05, "--dt", -1e-4), "error", "dt"),
-    ("dt-coarse", _sim("--theta0", 0.05, "--dt", 0.005, "--duration", 3), "warn", "W-SIM-DT"),
-    ("nano-block", _sim("--theta0", 1e-10, width=1e-9, height=2e-9), "error", "too coarse"),
-    ("duration-neg", _sim("--theta0", 0.05, "--duration", -3), "error", "duration"),
-    ("duration-huge", _sim("--theta0", 0.05, "--duration", 1e9), "error", "GiB of memory"),
-    ("output-dt-small", _sim("--theta0", 0.05, "--output-dt", 1e-5), "error", "output_dt"),
-    ("constant-no-eta", _sim("--theta0", 0.05, "--restitution", "constant"), "error", "--eta"),
-    ("eta-2", _sim("--theta0", 0.05, "--restitution", "constant", "--eta", 2), "error", "eta"),
-    ("bad-law", _sim("--restitution", "magic"), "error", "invalid choice"),
-    ("scale-no-base", _sim("--scale-pga", 0.3), "error", "--base-motion"),
-    ("base-missing", _sim("--base-motion", "nope.AT2"), "error", "not found"),
-    ("units-bad", lambda tmp: ["simulate", "--width", 0.045, "--height", 0.2, "--base-motion",
-                               _write(tmp / "r.txt", "0 0.1\n0.01 0.2\n0.02 0.1\n"), "--units", "furlong"],
-     "error", "unknown acceleration unit"),
-    ("out-is-dir", lambda tmp: ["simulate", "--width", 0.045, "--height", 0.2, "--theta0", 0.05, "-o", tmp],
-     "error", "is a folder"),
-    ("out-under-file", lambda tmp: ["simulate", "--width", 0.045, "--height", 0.2, "--theta0", 0.05,
-                                    "-o", _write(tmp / "f", "x") / "o.csv"], "error", "is a file"),
-    ("free-ok", _sim("--theta0", 0.05, "--duration", 2, "--json"), "ok", None),
-    ("zero-motion", _sim("--duration", 1, "--json"), "ok", None),
-], None)
+many(
+    "simulate",
+    [
+        ("width-0", _sim(width=0), "error", "width"),
+        ("width-neg", _sim(width=-1), "error", "width"),
+        ("width-nan", _sim(width="nan"), "error", "width"),
+        ("width-inf", _sim(width="inf"), "error", "width"),
+        ("width-text", _sim(width="abc"), "error", "invalid float"),
+        ("height-0", _sim(height=0), "error", "height"),
+        ("theta0-alpha", _sim("--theta0", 0.3), "error", "alpha"),
+        ("theta0-nan", _sim("--theta0", "nan"), "error", "theta0"),
+        ("dt-1", _sim("--theta0", 0.05, "--dt", 1), "error", "too coarse"),
+        ("dt-neg", _sim("--theta0", 0.05, "--dt", -1e-4), "error", "dt"),
+        ("dt-coarse", _sim("--theta0", 0.05, "--dt", 0.005, "--duration", 3), "warn", "W-SIM-DT"),
+        ("nano-block", _sim("--theta0", 1e-10, width=1e-9, height=2e-9), "error", "too coarse"),
+        ("duration-neg", _sim("--theta0", 0.05, "--duration", -3), "error", "duration"),
+        ("duration-huge", _sim("--theta0", 0.05, "--duration", 1e9), "error", "GiB of memory"),
+        ("output-dt-small", _sim("--theta0", 0.05, "--output-dt", 1e-5), "error", "output_dt"),
+        ("constant-no-eta", _sim("--theta0", 0.05, "--restitution", "constant"), "error", "--eta"),
+        ("eta-2", _sim("--theta0", 0.05, "--restitution", "constant", "--eta", 2), "error", "eta"),
+        ("bad-law", _sim("--restitution", "magic"), "error", "invalid choice"),
+        ("scale-no-base", _sim("--scale-pga", 0.3), "error", "--base-motion"),
+        ("base-missing", _sim("--base-motion", "nope.AT2"), "error", "not found"),
+        (
+            "units-bad",
+            lambda tmp: [
+                "simulate",
+                "--width",
+                0.045,
+                "--height",
+                0.2,
+                "--base-motion",
+                _write(tmp / "r.txt", "0 0.1\n0.01 0.2\n0.02 0.1\n"),
+                "--units",
+                "furlong",
+            ],
+            "error",
+            "unknown acceleration unit",
+        ),
+        (
+            "out-is-dir",
+            lambda tmp: ["simulate", "--width", 0.045, "--height", 0.2, "--theta0", 0.05, "-o", tmp],
+            "error",
+            "is a folder",
+        ),
+        (
+            "out-under-file",
+            lambda tmp: [
+                "simulate",
+                "--width",
+                0.045,
+                "--height",
+                0.2,
+                "--theta0",
+                0.05,
+                "-o",
+                _write(tmp / "f", "x") / "o.csv",
+            ],
+            "error",
+            "is a file",
+        ),
+        ("free-ok", _sim("--theta0", 0.05, "--duration", 2, "--json"), "ok", None),
+        ("zero-motion", _sim("--duration", 1, "--json"), "ok", None),
+    ],
+    None,
+)
 
 
 def _write(p: Path, text: str) -> Path:
@@ -162,27 +227,45 @@ def _col(*extra):
     return lambda tmp: ["column", *extra]
 
 
-many("column", [
-    ("no-blocks", _col("--theta0", 0.05), "error", "blocks"),
-    ("bad-spec", _col("--blocks", "0.1by0.2", "--theta0", 0.01), "error", "WIDTHxHEIGHT"),
-    ("neg-size", _col("--blocks=-0.1x0.2", "--theta0", 0.01), "error", "positive|WIDTHxHEIGHT"),
-    ("neg-size-argparse", _col("--blocks", "-0.1x0.2", "--theta0", 0.01), "error", "expected one argument"),
-    ("theta0-alpha", _col("--blocks", "0.1x0.2,0.1x0.2", "--theta0", "0.6,0.6"), "error", "alpha"),
-    ("dt-0.5", _col("--blocks", "0.1x0.2,0.1x0.2", "--theta0", "0.05,0.05", "--dt", 0.5), "error",
-     "too coarse"),
-    ("theta-count", _col("--blocks", "0.1x0.2,0.1x0.2", "--theta0", "0.05,0.05,0.05"), "error", "theta0"),
-    ("cut-big", _col("--blocks", "0.1x0.2", "--theta0", 0.05, "--cut", 0.06), "error", "cut"),
-    ("nothing-moves", _col("--blocks", "0.1x0.2"), "error", "--theta0"),
-    ("duration-huge", lambda tmp: ["column", "--blocks", "0.1x0.2,0.1x0.2", "--theta0", "0.02,0.02",
-                                   "--duration", 1e9, "-o", tmp / "c.csv"], "error", "GiB of memory"),
-    ("ok", _col("--blocks", "0.1x0.2,0.1x0.2", "--theta0", "0.02,0.02", "--duration", 1, "--json"), "ok",
-     None),
-], None)
+many(
+    "column",
+    [
+        ("no-blocks", _col("--theta0", 0.05), "error", "blocks"),
+        ("bad-spec", _col("--blocks", "0.1by0.2", "--theta0", 0.01), "error", "WIDTHxHEIGHT"),
+        ("neg-size", _col("--blocks=-0.1x0.2", "--theta0", 0.01), "error", "positive|WIDTHxHEIGHT"),
+        ("neg-size-argparse", _col("--blocks", "-0.1x0.2", "--theta0", 0.01), "error", "expected one argument"),
+        ("theta0-alpha", _col("--blocks", "0.1x0.2,0.1x0.2", "--theta0", "0.6,0.6"), "error", "alpha"),
+        ("dt-0.5", _col("--blocks", "0.1x0.2,0.1x0.2", "--theta0", "0.05,0.05", "--dt", 0.5), "error", "too coarse"),
+        ("theta-count", _col("--blocks", "0.1x0.2,0.1x0.2", "--theta0", "0.05,0.05,0.05"), "error", "theta0"),
+        ("cut-big", _col("--blocks", "0.1x0.2", "--theta0", 0.05, "--cut", 0.06), "error", "cut"),
+        ("nothing-moves", _col("--blocks", "0.1x0.2"), "error", "--theta0"),
+        (
+            "duration-huge",
+            lambda tmp: [
+                "column",
+                "--blocks",
+                "0.1x0.2,0.1x0.2",
+                "--theta0",
+                "0.02,0.02",
+                "--duration",
+                1e9,
+                "-o",
+                tmp / "c.csv",
+            ],
+            "error",
+            "GiB of memory",
+        ),
+        ("ok", _col("--blocks", "0.1x0.2,0.1x0.2", "--theta0", "0.02,0.02", "--duration", 1, "--json"), "ok", None),
+    ],
+    None,
+)
 
 
 # -- IMU -----------------------------------------------------------------------------------------------
-IMU_HEAD = ("Timestamp (us),Gyroscope X (deg/s),Gyroscope Y (deg/s),Gyroscope Z (deg/s),"
-            "Accelerometer X (g),Accelerometer Y (g),Accelerometer Z (g)")
+IMU_HEAD = (
+    "Timestamp (us),Gyroscope X (deg/s),Gyroscope Y (deg/s),Gyroscope Z (deg/s),"
+    "Accelerometer X (g),Accelerometer Y (g),Accelerometer Z (g)"
+)
 
 
 def _imu_rows(n=1024, rate=256.0, t0=19150794):
@@ -196,33 +279,62 @@ def _imu(text, name="Inertial.csv", extra=()):
         d.mkdir()
         (d / name).write_text(text) if isinstance(text, str) else (d / name).write_bytes(text)
         return ["imu", d, "--json", *extra]
+
     return build
 
 
 ROWS = _imu_rows()
-many("imu", [
-    ("empty", _imu(""), "error", "empty"),
-    ("header-only", _imu(IMU_HEAD + "\n"), "error", "no data rows"),
-    ("no-gyro", _imu("Timestamp (us),Accelerometer X (g),Accelerometer Y (g),Accelerometer Z (g)\n1,0,0,1\n"),
-     "error", "missing columns"),
-    ("unknown-unit", _imu(IMU_HEAD.replace("(deg/s)", "(furlong/s)", 1) + "\n" + "\n".join(ROWS) + "\n"),
-     "error", "unknown unit"),
-    ("text-cell", _imu(IMU_HEAD + "\n" + "\n".join(ROWS[:10] + ["1,a,b,c,d,e,f"] + ROWS[10:]) + "\n"),
-     "error", "not a number"),
-    ("decreasing", _imu(IMU_HEAD + "\n" + "\n".join(ROWS[:10] + ROWS[5:]) + "\n"), "error", "time"),
-    ("ms-as-us", _imu(IMU_HEAD + "\n" + "\n".join(",".join([f"{i * 3.906:.3f}"] + r.split(",")[1:])
-                                                   for i, r in enumerate(ROWS)) + "\n"),
-     "error", "not an IMU sample rate"),
-    ("truncated-last", _imu(IMU_HEAD + "\n" + "\n".join(ROWS) + "\n19150794,0.0"), "warn", "W-IMU-TRUNCATED"),
-    ("rate-option", _imu(IMU_HEAD + "\n" + "\n".join(ROWS) + "\n", extra=("--rate", 100)), "warn", "W-IMU-RATE"),
-    ("clock-jump", _imu(IMU_HEAD + "\n" + "\n".join(ROWS[:500] + _imu_rows(524, t0=19150794 + 7_000_000))
-                        + "\n"), "warn", "W-IMU-CLOCK"),
-    ("rate-zero", _imu(IMU_HEAD + "\n" + "\n".join(ROWS) + "\n", extra=("--rate", 0)), "error", "rate"),
-    ("binary", _imu(b"\x00\xff" * 400), "error", "not a text file|not a number|missing columns"),
-    ("still", _imu(IMU_HEAD + "\n" + "\n".join(ROWS) + "\n"), "ok", None),
-    ("missing", lambda tmp: ["imu", tmp / "nope"], "error", "not found"),
-    ("two-csv", lambda tmp: ["imu", _two_csv(tmp)], "error", "no IMU log found"),
-], None)
+many(
+    "imu",
+    [
+        ("empty", _imu(""), "error", "empty"),
+        ("header-only", _imu(IMU_HEAD + "\n"), "error", "no data rows"),
+        (
+            "no-gyro",
+            _imu("Timestamp (us),Accelerometer X (g),Accelerometer Y (g),Accelerometer Z (g)\n1,0,0,1\n"),
+            "error",
+            "missing columns",
+        ),
+        (
+            "unknown-unit",
+            _imu(IMU_HEAD.replace("(deg/s)", "(furlong/s)", 1) + "\n" + "\n".join(ROWS) + "\n"),
+            "error",
+            "unknown unit",
+        ),
+        (
+            "text-cell",
+            _imu(IMU_HEAD + "\n" + "\n".join(ROWS[:10] + ["1,a,b,c,d,e,f"] + ROWS[10:]) + "\n"),
+            "error",
+            "not a number",
+        ),
+        ("decreasing", _imu(IMU_HEAD + "\n" + "\n".join(ROWS[:10] + ROWS[5:]) + "\n"), "error", "time"),
+        (
+            "ms-as-us",
+            _imu(
+                IMU_HEAD
+                + "\n"
+                + "\n".join(",".join([f"{i * 3.906:.3f}"] + r.split(",")[1:]) for i, r in enumerate(ROWS))
+                + "\n"
+            ),
+            "error",
+            "not an IMU sample rate",
+        ),
+        ("truncated-last", _imu(IMU_HEAD + "\n" + "\n".join(ROWS) + "\n19150794,0.0"), "warn", "W-IMU-TRUNCATED"),
+        ("rate-option", _imu(IMU_HEAD + "\n" + "\n".join(ROWS) + "\n", extra=("--rate", 100)), "warn", "W-IMU-RATE"),
+        (
+            "clock-jump",
+            _imu(IMU_HEAD + "\n" + "\n".join(ROWS[:500] + _imu_rows(524, t0=19150794 + 7_000_000)) + "\n"),
+            "warn",
+            "W-IMU-CLOCK",
+        ),
+        ("rate-zero", _imu(IMU_HEAD + "\n" + "\n".join(ROWS) + "\n", extra=("--rate", 0)), "error", "rate"),
+        ("binary", _imu(b"\x00\xff" * 400), "error", "not a text file|not a number|missing columns"),
+        ("still", _imu(IMU_HEAD + "\n" + "\n".join(ROWS) + "\n"), "ok", None),
+        ("missing", lambda tmp: ["imu", tmp / "nope"], "error", "not found"),
+        ("two-csv", lambda tmp: ["imu", _two_csv(tmp)], "error", "no IMU log found"),
+    ],
+    None,
+)
 
 
 def _two_csv(tmp):
@@ -259,38 +371,87 @@ def _table(rows, name="t.csv"):
         p = tmp / name
         p.write_text(rows)
         return ["fit", cmd, p, *extra]
+
     return build
 
 
-many("fit", [
-    ("ok", _fit("--json"), "ok", None),
-    ("occlusion", _fit("--json", gap=(1.9, 2.3)), "warn", "W-FIT-GAP"),
-    ("width-cm", lambda tmp: ["fit", "restitution", _track_csv(tmp), "--width", 10, "--height", 0.2],
-     "warn", "W-FIT-UNITS"),
-    ("swapped", lambda tmp: ["fit", "restitution", _track_csv(tmp), "--width", 0.2, "--height", 0.1, "--json"],
-     "warn", "W-FIT-RESIDUAL"),
-    ("duplicated", _fit(dup=True), "error", "increase"),
-    ("video-as-csv", lambda tmp: ["fit", "restitution", _write_bytes(tmp / "v.csv", b"\x1aE\xdf\xa3\x00\x81" * 99),
-                                  "--width", 0.1, "--height", 0.2], "error", ""),
-    ("missing", lambda tmp: ["fit", "restitution", tmp / "no.csv", "--width", 0.1, "--height", 0.2],
-     "error", "not found"),
-    ("no-theta", lambda tmp: ["fit", "restitution", _write(tmp / "x.csv", "t_s,x\n0,1\n"), "--width", 0.1,
-                              "--height", 0.2], "error", "theta"),
-    ("width-0", lambda tmp: ["fit", "restitution", _track_csv(tmp), "--width", 0, "--height", 0.2],
-     "error", "width"),
-    ("eta-mat-cm", _table("block,b_m,h_m,eta_e\nB3M,4.5,0.1,0.85\nB6M,4.5,0.2,0.93\n"), "fail", "W-FIT-UNITS"),
-    ("eta-mat-dup", _table("block,b_m,h_m,eta_e\nB3M,0.03,0.1,0.85\nB3M,0.03,0.1,0.85\nB6M,0.045,0.2025,0.93\n"),
-     "warn", "W-FIT-DUPLICATE"),
-    ("eta-mat-eta-1", _table("block,b_m,h_m,eta_e\nB3M,0.03,0.1,1.2\n"), "error", "restitution"),
-    ("eta-mat-cols", _table("block,b,h\nB3M,1,2\n"), "error", "missing column"),
-    ("eta-mat-empty", _table(""), "error", "empty"),
-    ("eta-mat-nan", _table("block,b_m,h_m,eta_e\nB3M,0.03,,0.85\n"), "error", "missing"),
-    ("k-table-bad-eta", lambda tmp: _table("block,b_m,h_m,eta_e\nB3M,0.03,0.1,0.85\n")(
-        tmp, "k-table", ("--eta-mat", 1.5)), "error", "eta_mat"),
-    ("k-predict-hb-neg", lambda tmp: ["fit", "k-predict", "--hb", -1, "--b-cm", 9], "error", "hb"),
-    ("k-predict-json-bad", lambda tmp: ["fit", "k-predict", "--hb", 4, "--b-cm", 9, "--coefficients",
-                                        _write(tmp / "c.json", "{oops")], "error", "JSON"),
-], None)
+many(
+    "fit",
+    [
+        ("ok", _fit("--json"), "ok", None),
+        ("occlusion", _fit("--json", gap=(1.9, 2.3)), "warn", "W-FIT-GAP"),
+        (
+            "width-cm",
+            lambda tmp: ["fit", "restitution", _track_csv(tmp), "--width", 10, "--height", 0.2],
+            "warn",
+            "W-FIT-UNITS",
+        ),
+        (
+            "swapped",
+            lambda tmp: ["fit", "restitution", _track_csv(tmp), "--width", 0.2, "--height", 0.1, "--json"],
+            "warn",
+            "W-FIT-RESIDUAL",
+        ),
+        ("duplicated", _fit(dup=True), "error", "increase"),
+        (
+            "video-as-csv",
+            lambda tmp: [
+                "fit",
+                "restitution",
+                _write_bytes(tmp / "v.csv", b"\x1aE\xdf\xa3\x00\x81" * 99),
+                "--width",
+                0.1,
+                "--height",
+                0.2,
+            ],
+            "error",
+            "",
+        ),
+        (
+            "missing",
+            lambda tmp: ["fit", "restitution", tmp / "no.csv", "--width", 0.1, "--height", 0.2],
+            "error",
+            "not found",
+        ),
+        (
+            "no-theta",
+            lambda tmp: ["fit", "restitution", _write(tmp / "x.csv", "t_s,x\n0,1\n"), "--width", 0.1, "--height", 0.2],
+            "error",
+            "theta",
+        ),
+        (
+            "width-0",
+            lambda tmp: ["fit", "restitution", _track_csv(tmp), "--width", 0, "--height", 0.2],
+            "error",
+            "width",
+        ),
+        ("eta-mat-cm", _table("block,b_m,h_m,eta_e\nB3M,4.5,0.1,0.85\nB6M,4.5,0.2,0.93\n"), "fail", "W-FIT-UNITS"),
+        (
+            "eta-mat-dup",
+            _table("block,b_m,h_m,eta_e\nB3M,0.03,0.1,0.85\nB3M,0.03,0.1,0.85\nB6M,0.045,0.2025,0.93\n"),
+            "warn",
+            "W-FIT-DUPLICATE",
+        ),
+        ("eta-mat-eta-1", _table("block,b_m,h_m,eta_e\nB3M,0.03,0.1,1.2\n"), "error", "restitution"),
+        ("eta-mat-cols", _table("block,b,h\nB3M,1,2\n"), "error", "missing column"),
+        ("eta-mat-empty", _table(""), "error", "empty"),
+        ("eta-mat-nan", _table("block,b_m,h_m,eta_e\nB3M,0.03,,0.85\n"), "error", "missing"),
+        (
+            "k-table-bad-eta",
+            lambda tmp: _table("block,b_m,h_m,eta_e\nB3M,0.03,0.1,0.85\n")(tmp, "k-table", ("--eta-mat", 1.5)),
+            "error",
+            "eta_mat",
+        ),
+        ("k-predict-hb-neg", lambda tmp: ["fit", "k-predict", "--hb", -1, "--b-cm", 9], "error", "hb"),
+        (
+            "k-predict-json-bad",
+            lambda tmp: ["fit", "k-predict", "--hb", 4, "--b-cm", 9, "--coefficients", _write(tmp / "c.json", "{oops")],
+            "error",
+            "JSON",
+        ),
+    ],
+    None,
+)
 
 
 def _write_bytes(p: Path, b: bytes) -> Path:
@@ -306,39 +467,58 @@ def _run(toml, make_track=True, out="out"):
         p = tmp / "experiment.toml"
         p.write_text(toml)
         return ["run", p, "--out", tmp / out]
+
     return build
 
 
-GOOD = ('name = "e"\n[block]\nb_m = 0.1\nh_m = 0.2\n[sources.track]\npath = "tracks.csv"\n'
-        '[output]\nrrd = false\nfigures = false\n')
-many("run", [
-    ("toml-syntax", _run("name = \n"), "error", "TOML syntax"),
-    ("unknown-section", _run(GOOD + "[magic]\nx = 1\n"), "error", "not a known"),
-    ("typo-key", _run(GOOD.replace('path = "tracks.csv"', 'path = "tracks.csv"\nobjekt = "b"')), "error",
-     "did you mean 'object'"),
-    ("typo-output", _run(GOOD + "videos = 1\n"), "error", "not a known key"),
-    ("no-block", _run('[sources.track]\npath = "tracks.csv"\n'), "error", "[block]"),
-    ("b-neg", _run(GOOD.replace("b_m = 0.1", "b_m = -0.1")), "error", "positive"),
-    ("b-text", _run(GOOD.replace("b_m = 0.1", 'b_m = "wide"')), "error", "number"),
-    ("unknown-id", _run(GOOD.replace("b_m = 0.1\nh_m = 0.2", 'id = "B99Q"')), "error", "catalogue"),
-    ("missing-source", _run(GOOD, make_track=False), "error", "does not exist"),
-    ("no-source", _run('[block]\nb_m = 0.1\nh_m = 0.2\n'), "error", "at least one"),
-    ("primary-missing", _run(GOOD + '[sources]\nprimary = "imu"\n'), "error", "TOML syntax|primary"),
-    ("edge-no-lc", _run(GOOD + '[contact]\ntype = "edge"\n'), "error", "l_c_m"),
-    ("lc-too-big", _run(GOOD + '[contact]\ntype = "edge"\nl_c_m = 0.09\n'), "error", "half the block"),
-    ("law-unknown", _run(GOOD + '[simulate]\nlaws = ["magic"]\n'), "error", "allowed"),
-    ("eta-out", _run(GOOD + '[simulate]\neta = 1.5\n'), "error", "(-1, 1)"),
-    ("duration-neg", _run(GOOD + '[simulate]\nduration_s = -3\n'), "error", ">= 0"),
-    ("given-no-eta", _run(GOOD + '[simulate]\nlaws = ["given"]\n'), "error", "eta is not set"),
-    ("decimation-0", _run(GOOD.replace("figures = false", "figures = false\nvideo_decimation = 0")), "error",
-     "positive"),
-    ("window-bad", _run(GOOD + '[fit]\nwindow = "best"\n'), "error", "must be one of"),
-    ("h-too-big", _run(GOOD.replace("h_m = 0.2", "h_m = 0.5")), "ok", None),
-    ("out-is-file", lambda tmp: _run(GOOD)(tmp)[:2] + ["--out", _write(tmp / "afile.txt", "mine")], "error",
-     "existing file"),
-    ("out-foreign", lambda tmp: _run(GOOD)(tmp)[:2] + ["--out", _foreign(tmp)], "error", "did not write"),
-    ("ok", _run(GOOD), "ok", None),
-], None)
+GOOD = (
+    'name = "e"\n[block]\nb_m = 0.1\nh_m = 0.2\n[sources.track]\npath = "tracks.csv"\n'
+    "[output]\nrrd = false\nfigures = false\n"
+)
+many(
+    "run",
+    [
+        ("toml-syntax", _run("name = \n"), "error", "TOML syntax"),
+        ("unknown-section", _run(GOOD + "[magic]\nx = 1\n"), "error", "not a known"),
+        (
+            "typo-key",
+            _run(GOOD.replace('path = "tracks.csv"', 'path = "tracks.csv"\nobjekt = "b"')),
+            "error",
+            "did you mean 'object'",
+        ),
+        ("typo-output", _run(GOOD + "videos = 1\n"), "error", "not a known key"),
+        ("no-block", _run('[sources.track]\npath = "tracks.csv"\n'), "error", "[block]"),
+        ("b-neg", _run(GOOD.replace("b_m = 0.1", "b_m = -0.1")), "error", "positive"),
+        ("b-text", _run(GOOD.replace("b_m = 0.1", 'b_m = "wide"')), "error", "number"),
+        ("unknown-id", _run(GOOD.replace("b_m = 0.1\nh_m = 0.2", 'id = "B99Q"')), "error", "catalogue"),
+        ("missing-source", _run(GOOD, make_track=False), "error", "does not exist"),
+        ("no-source", _run("[block]\nb_m = 0.1\nh_m = 0.2\n"), "error", "at least one"),
+        ("primary-missing", _run(GOOD + '[sources]\nprimary = "imu"\n'), "error", "TOML syntax|primary"),
+        ("edge-no-lc", _run(GOOD + '[contact]\ntype = "edge"\n'), "error", "l_c_m"),
+        ("lc-too-big", _run(GOOD + '[contact]\ntype = "edge"\nl_c_m = 0.09\n'), "error", "half the block"),
+        ("law-unknown", _run(GOOD + '[simulate]\nlaws = ["magic"]\n'), "error", "allowed"),
+        ("eta-out", _run(GOOD + "[simulate]\neta = 1.5\n"), "error", "(-1, 1)"),
+        ("duration-neg", _run(GOOD + "[simulate]\nduration_s = -3\n"), "error", ">= 0"),
+        ("given-no-eta", _run(GOOD + '[simulate]\nlaws = ["given"]\n'), "error", "eta is not set"),
+        (
+            "decimation-0",
+            _run(GOOD.replace("figures = false", "figures = false\nvideo_decimation = 0")),
+            "error",
+            "positive",
+        ),
+        ("window-bad", _run(GOOD + '[fit]\nwindow = "best"\n'), "error", "must be one of"),
+        ("h-too-big", _run(GOOD.replace("h_m = 0.2", "h_m = 0.5")), "ok", None),
+        (
+            "out-is-file",
+            lambda tmp: _run(GOOD)(tmp)[:2] + ["--out", _write(tmp / "afile.txt", "mine")],
+            "error",
+            "existing file",
+        ),
+        ("out-foreign", lambda tmp: _run(GOOD)(tmp)[:2] + ["--out", _foreign(tmp)], "error", "did not write"),
+        ("ok", _run(GOOD), "ok", None),
+    ],
+    None,
+)
 
 
 def _foreign(tmp):
@@ -349,8 +529,7 @@ def _foreign(tmp):
 
 
 # -- track configs: `rocklab track` -------------------------------------------------------------------------
-OBJ = ('[targets]\nstyle = "aruco"\nmarker_size_m = 0.02\n\n'
-       '[[objects]]\nid = "block_1"\nkind = "block"\nmarkers = [0]\n')
+OBJ = '[targets]\nstyle = "aruco"\nmarker_size_m = 0.02\n\n[[objects]]\nid = "block_1"\nkind = "block"\nmarkers = [0]\n'
 
 
 def _trk(toml, video=b"not a video"):
@@ -360,27 +539,48 @@ def _trk(toml, video=b"not a video"):
         c = tmp / "track.toml"
         c.write_text(toml)
         return ["track", v, "--config", c, "-o", tmp / "tracks.csv"]
+
     return build
 
 
-many("track", [
-    ("toml-syntax", _trk("[video\n"), "error", "TOML|line"),
-    ("unknown-table", _trk("[magic]\nx = 1\n" + OBJ), "error", "unknown table"),
-    ("unknown-key", _trk("[video]\nfsp = 50\n" + OBJ), "error", "unknown key"),
-    ("fx-zero", _trk("[video]\ncamera_matrix = [[0, 0, 320], [0, 900, 180], [0, 0, 1]]\n" + OBJ), "error",
-     "fx, fy > 0"),
-    ("singular-h", _trk("[reference]\nhomography = [[1, 2, 0], [2, 4, 0], [0, 0, 1]]\n" + OBJ), "error",
-     "singular"),
-    ("bad-dict", _trk(OBJ.replace('style = "aruco"', 'style = "aruco"\ndictionary = "DICT_MAGIC"')), "error",
-     "dictionary"),
-    ("no-objects", _trk("[video]\nfps = 50\n"), "error", "object"),
-    ("bad-style", _trk(OBJ.replace('"aruco"', '"laser"')), "error", "style"),
-    ("not-a-video", _trk(OBJ), "error", "video|decode|open"),
-    ("missing-video", lambda tmp: ["track", tmp / "none.mkv", "--config", _write(tmp / "t.toml", OBJ)],
-     "error", "not found"),
-    ("stop-before-start", _trk("[video]\nstart_frame = 5\nstop_frame = 2\n" + OBJ), "error", "start_frame"),
-    ("fps-neg", _trk("[video]\nfps = -5\n" + OBJ), "error", "> 0|positive"),
-], None)
+many(
+    "track",
+    [
+        ("toml-syntax", _trk("[video\n"), "error", "TOML|line"),
+        ("unknown-table", _trk("[magic]\nx = 1\n" + OBJ), "error", "unknown table"),
+        ("unknown-key", _trk("[video]\nfsp = 50\n" + OBJ), "error", "unknown key"),
+        (
+            "fx-zero",
+            _trk("[video]\ncamera_matrix = [[0, 0, 320], [0, 900, 180], [0, 0, 1]]\n" + OBJ),
+            "error",
+            "fx, fy > 0",
+        ),
+        (
+            "singular-h",
+            _trk("[reference]\nhomography = [[1, 2, 0], [2, 4, 0], [0, 0, 1]]\n" + OBJ),
+            "error",
+            "singular",
+        ),
+        (
+            "bad-dict",
+            _trk(OBJ.replace('style = "aruco"', 'style = "aruco"\ndictionary = "DICT_MAGIC"')),
+            "error",
+            "dictionary",
+        ),
+        ("no-objects", _trk("[video]\nfps = 50\n"), "error", "object"),
+        ("bad-style", _trk(OBJ.replace('"aruco"', '"laser"')), "error", "style"),
+        ("not-a-video", _trk(OBJ), "error", "video|decode|open"),
+        (
+            "missing-video",
+            lambda tmp: ["track", tmp / "none.mkv", "--config", _write(tmp / "t.toml", OBJ)],
+            "error",
+            "not found",
+        ),
+        ("stop-before-start", _trk("[video]\nstart_frame = 5\nstop_frame = 2\n" + OBJ), "error", "start_frame"),
+        ("fps-neg", _trk("[video]\nfps = -5\n" + OBJ), "error", "> 0|positive"),
+    ],
+    None,
+)
 
 
 # -- spectra and design --------------------------------------------------------------------------------------
@@ -388,40 +588,68 @@ def _good_record(tmp):
     return _write(tmp / "r.AT2", at2())
 
 
-many("spectra", [
-    ("oas-huge-grid", lambda tmp: ["oas", _good_record(tmp), "--levels", 100000, "--sizes", 100000],
-     "error", "GiB of memory"),
-    ("oas-two-samples", lambda tmp: ["oas", _write(tmp / "r.AT2", at2(values=[0.1, -0.1]))], "error",
-     "needs at least 16"),
-    ("oas-sizes-1", lambda tmp: ["oas", _good_record(tmp), "--sizes", 1], "error", "sizes"),
-    ("oas-slender-0", lambda tmp: ["oas", _good_record(tmp), "--slenderness", 0], "error", "slenderness"),
-    ("oas-not-record", lambda tmp: ["oas", _write(tmp / "notes.txt", "hello world\n")], "error", ""),
-    ("oas-plot-dir", lambda tmp: ["oas", _good_record(tmp), "--plot", tmp], "error", "is a folder"),
-    ("design-neg-h", lambda tmp: ["design", "--height", -12, "--ag", 0.14, "--tI", 0.7], "error", "height"),
-    ("design-ti-0", lambda tmp: ["design", "--height", 12, "--ag", 0.14, "--tI", 0], "error", "t"),
-    ("design-ag-nan", lambda tmp: ["design", "--height", 12, "--ag", "nan", "--tI", 0.7], "error", "a"),
-    ("design-ok", lambda tmp: ["design", "--height", 12, "--ag", 0.14, "--tI", 0.7, "--json"], "ok", None),
-    ("equivalent-missing", lambda tmp: ["equivalent", "wall"], "error", ""),
-    ("equivalent-neg", lambda tmp: ["equivalent", "block", "--b", -1, "--h", 2], "error", ""),
-    ("pulse-cm-file", lambda tmp: ["pulse", _write(tmp / "r.AT2", at2(units="UNITS OF CM/S/S",
-                                                                       values=SINE * 981))], "ok", None),
-], None)
+many(
+    "spectra",
+    [
+        (
+            "oas-huge-grid",
+            lambda tmp: ["oas", _good_record(tmp), "--levels", 100000, "--sizes", 100000],
+            "error",
+            "GiB of memory",
+        ),
+        (
+            "oas-two-samples",
+            lambda tmp: ["oas", _write(tmp / "r.AT2", at2(values=[0.1, -0.1]))],
+            "error",
+            "needs at least 16",
+        ),
+        ("oas-sizes-1", lambda tmp: ["oas", _good_record(tmp), "--sizes", 1], "error", "sizes"),
+        ("oas-slender-0", lambda tmp: ["oas", _good_record(tmp), "--slenderness", 0], "error", "slenderness"),
+        ("oas-not-record", lambda tmp: ["oas", _write(tmp / "notes.txt", "hello world\n")], "error", ""),
+        ("oas-plot-dir", lambda tmp: ["oas", _good_record(tmp), "--plot", tmp], "error", "is a folder"),
+        ("design-neg-h", lambda tmp: ["design", "--height", -12, "--ag", 0.14, "--tI", 0.7], "error", "height"),
+        ("design-ti-0", lambda tmp: ["design", "--height", 12, "--ag", 0.14, "--tI", 0], "error", "t"),
+        ("design-ag-nan", lambda tmp: ["design", "--height", 12, "--ag", "nan", "--tI", 0.7], "error", "a"),
+        ("design-ok", lambda tmp: ["design", "--height", 12, "--ag", 0.14, "--tI", 0.7, "--json"], "ok", None),
+        ("equivalent-missing", lambda tmp: ["equivalent", "wall"], "error", ""),
+        ("equivalent-neg", lambda tmp: ["equivalent", "block", "--b", -1, "--h", 2], "error", ""),
+        (
+            "pulse-cm-file",
+            lambda tmp: ["pulse", _write(tmp / "r.AT2", at2(units="UNITS OF CM/S/S", values=SINE * 981))],
+            "ok",
+            None,
+        ),
+    ],
+    None,
+)
 
 
 # -- campaign and synth -------------------------------------------------------------------------------------------
-many("campaign", [
-    ("missing", lambda tmp: ["campaign", tmp / "none", "--out", tmp / "o", "--no-progress"], "error", "not found"),
-    ("empty", lambda tmp: ["campaign", tmp, "--out", tmp / "o", "--no-progress"], "error", "no experiment"),
-    ("out-file", lambda tmp: ["campaign", _run(GOOD)(tmp)[1].parent, "--out", _write(tmp / "o.txt", "x"),
-                              "--no-progress"], "error", "existing file"),
-    ("one-broken", lambda tmp: _broken_campaign(tmp), "fail", "FAILED"),
-], None)
-many("synth", [
-    ("size-odd", lambda tmp: ["synth", "--out", tmp / "s", "--size", "10x10"], "error", "size"),
-    ("fps-0", lambda tmp: ["synth", "--out", tmp / "s", "--fps", 0], "error", "fps"),
-    ("out-foreign", lambda tmp: ["synth", "--out", _foreign(tmp)], "error", "did not write"),
-    ("duration-neg", lambda tmp: ["synth", "--out", tmp / "s", "--duration", -1], "error", "duration"),
-], None)
+many(
+    "campaign",
+    [
+        ("missing", lambda tmp: ["campaign", tmp / "none", "--out", tmp / "o", "--no-progress"], "error", "not found"),
+        ("empty", lambda tmp: ["campaign", tmp, "--out", tmp / "o", "--no-progress"], "error", "no experiment"),
+        (
+            "out-file",
+            lambda tmp: ["campaign", _run(GOOD)(tmp)[1].parent, "--out", _write(tmp / "o.txt", "x"), "--no-progress"],
+            "error",
+            "existing file",
+        ),
+        ("one-broken", lambda tmp: _broken_campaign(tmp), "fail", "FAILED"),
+    ],
+    None,
+)
+many(
+    "synth",
+    [
+        ("size-odd", lambda tmp: ["synth", "--out", tmp / "s", "--size", "10x10"], "error", "size"),
+        ("fps-0", lambda tmp: ["synth", "--out", tmp / "s", "--fps", 0], "error", "fps"),
+        ("out-foreign", lambda tmp: ["synth", "--out", _foreign(tmp)], "error", "did not write"),
+        ("duration-neg", lambda tmp: ["synth", "--out", tmp / "s", "--duration", -1], "error", "duration"),
+    ],
+    None,
+)
 
 
 def _broken_campaign(tmp):

@@ -46,10 +46,19 @@ def forced():
 def _log(forced, t_end_s=None, rest_after_s=2.0):
     block, base, res = forced
     m = slice(None) if t_end_s is None else res.t_s <= t_end_s
-    return simulate_imu_log(res.t_s[m], res.theta_rad[m], block, omega_rad_s=res.omega_rad_s[m],
-                            rate_hz=FS, t_start_s=-1.0, rest_after_s=rest_after_s,
-                            gyro_bias_deg_s=np.array([0.5, -0.5, 0.5]), base=base,
-                            drop_bursts=2, seed=3)
+    return simulate_imu_log(
+        res.t_s[m],
+        res.theta_rad[m],
+        block,
+        omega_rad_s=res.omega_rad_s[m],
+        rate_hz=FS,
+        t_start_s=-1.0,
+        rest_after_s=rest_after_s,
+        gyro_bias_deg_s=np.array([0.5, -0.5, 0.5]),
+        base=base,
+        drop_bursts=2,
+        seed=3,
+    )
 
 
 def _errors(rot, res, t_end_s):

@@ -72,7 +72,7 @@ def test_ximu_example_orientation_agrees_with_device_ahrs(shared_data):
     up_ours = ours.inv().apply([0, 0, 1])
     up_dev = dev.inv().apply([0, 0, 1])
     ang = np.rad2deg(np.arccos(np.clip(np.sum(up_ours * up_dev, axis=1), -1, 1)))
-    assert np.sqrt(np.mean(ang ** 2)) < 0.5
+    assert np.sqrt(np.mean(ang**2)) < 0.5
     assert ang.max() < 1.2
     eul = pd.read_csv(d / "00000_EulerAngles.csv").iloc[:, 2].to_numpy()[ok]
     pitch = np.rad2deg(ours.as_euler("ZYX")[:, 1])
@@ -97,8 +97,9 @@ def _rest_then_spin(seconds=6.0, spin_deg_s=90.0):
 
 def test_ximu3_fixture_drops_and_high_g(tmp_path):
     t = np.arange(0.0, 10.0, 1e-3)
-    log0 = simulate_imu_log(t, np.zeros_like(t), None, rate_hz=400.0, drop_bursts=3, seed=3,
-                            gyro_noise_deg_s=0.1, acc_noise_g=0.005)
+    log0 = simulate_imu_log(
+        t, np.zeros_like(t), None, rate_hz=400.0, drop_bursts=3, seed=3, gyro_noise_deg_s=0.1, acc_noise_g=0.005
+    )
     # An impact: 30 g on x for 5 samples -- beyond the main accelerometer's 16 g.
     acc = log0.acc_m_s2.copy()
     acc[2000:2005, 0] = 30 * G
@@ -117,8 +118,7 @@ def test_ximu3_fixture_drops_and_high_g(tmp_path):
 
 def test_ximu_gui_fixture_round_trip_with_lost_bursts(tmp_path):
     t, th = _rest_then_spin()
-    log0 = simulate_imu_log(t, np.zeros_like(t), None, rate_hz=256.0, drop_bursts=2,
-                            drop_max=8, seed=11)
+    log0 = simulate_imu_log(t, np.zeros_like(t), None, rate_hz=256.0, drop_bursts=2, drop_max=8, seed=11)
     inert, regs = write_ximu_csv(log0, tmp_path / "00000")
     assert inert.name == "00000_CalInertialAndMag.csv" and regs.name == "00000_Registers.csv"
     log = read_imu(tmp_path / "00000")  # base prefix accepted
@@ -145,12 +145,20 @@ def test_legacy_calinertialmagnetic_name_uses_address_54(tmp_path):
 def test_mapping_any_csv(tmp_path):
     rng = np.random.default_rng(0)
     n = 500
-    df = pd.DataFrame({"ms": np.arange(n) * 5.0, "wx": rng.normal(size=n), "wy": 0.0, "wz": 0.0,
-                       "ax": 0.0, "ay": 0.0, "az": 9.81})
+    df = pd.DataFrame(
+        {"ms": np.arange(n) * 5.0, "wx": rng.normal(size=n), "wy": 0.0, "wz": 0.0, "ax": 0.0, "ay": 0.0, "az": 9.81}
+    )
     p = tmp_path / "any.csv"
     df.to_csv(p, index=False)
-    m = {"ms": "t:ms", "wx": "gyro_x:rad/s", "wy": "gyro_y:rad/s", "wz": "gyro_z:rad/s",
-         "ax": "acc_x:m/s2", "ay": "acc_y:m/s2", "az": "acc_z:m/s2"}
+    m = {
+        "ms": "t:ms",
+        "wx": "gyro_x:rad/s",
+        "wy": "gyro_y:rad/s",
+        "wz": "gyro_z:rad/s",
+        "ax": "acc_x:m/s2",
+        "ay": "acc_y:m/s2",
+        "az": "acc_z:m/s2",
+    }
     log = read_imu(p, mapping=m)
     assert log.format == "mapped" and log.rate_hz == pytest.approx(200.0)
     assert np.allclose(log.gyro_rad_s[:, 0], df["wx"]) and log.t_s[-1] == pytest.approx(2.495)
@@ -159,12 +167,18 @@ def test_mapping_any_csv(tmp_path):
 
 
 # ----------------------------------------------------------------------------- bad input
-HEAD = ("Packet number,Gyroscope X (deg/s),Gyroscope Y (deg/s),Gyroscope Z (deg/s),"
-        "Accelerometer X (g),Accelerometer Y (g),Accelerometer Z (g)")
+HEAD = (
+    "Packet number,Gyroscope X (deg/s),Gyroscope Y (deg/s),Gyroscope Z (deg/s),"
+    "Accelerometer X (g),Accelerometer Y (g),Accelerometer Z (g)"
+)
 
 
-def _gui(tmp_path, body, head=HEAD, regs="Packet number,Address,Value,Fixed-point value,Name\n"
-         "1,69,9,NaN,InertialAndMagneticDataRate\n"):
+def _gui(
+    tmp_path,
+    body,
+    head=HEAD,
+    regs="Packet number,Address,Value,Fixed-point value,Name\n1,69,9,NaN,InertialAndMagneticDataRate\n",
+):
     p = tmp_path / "00000_CalInertialAndMag.csv"
     p.write_text(head + "\n" + body)
     if regs is not None:
@@ -175,17 +189,20 @@ def _gui(tmp_path, body, head=HEAD, regs="Packet number,Address,Value,Fixed-poin
 ROWS = "1,0,0,0,0,0,1\n3,0,0,0,0,0,1\n4,0,0,0,0,0,1\n"
 
 
-@pytest.mark.parametrize("case, match", [
-    ("missing_col", r"missing columns Accelerometer Z"),
-    ("units", r"line 1, 'Gyroscope X \(rpm\)': unknown unit 'rpm'"),
-    ("decreasing", r"line 3, 'Packet number': decreasing"),
-    ("duplicate", r"line 4, 'Packet number': duplicate"),
-    ("empty", r"empty file"),
-    ("header_only", r"line 2: no data rows"),
-    ("not_number", r"line 3, 'Gyroscope Y \(deg/s\)'.*'abc' is not a number"),
-    ("no_rate_register", r"00000_Registers.csv: no inertial rate register .*--rate"),
-    ("no_registers", r"no <base>_Registers.csv .*--rate"),
-])
+@pytest.mark.parametrize(
+    "case, match",
+    [
+        ("missing_col", r"missing columns Accelerometer Z"),
+        ("units", r"line 1, 'Gyroscope X \(rpm\)': unknown unit 'rpm'"),
+        ("decreasing", r"line 3, 'Packet number': decreasing"),
+        ("duplicate", r"line 4, 'Packet number': duplicate"),
+        ("empty", r"empty file"),
+        ("header_only", r"line 2: no data rows"),
+        ("not_number", r"line 3, 'Gyroscope Y \(deg/s\)'.*'abc' is not a number"),
+        ("no_rate_register", r"00000_Registers.csv: no inertial rate register .*--rate"),
+        ("no_registers", r"no <base>_Registers.csv .*--rate"),
+    ],
+)
 def test_bad_input_one_line_naming_file_and_line(tmp_path, case, match):
     kw = {}
     if case == "missing_col":
@@ -204,8 +221,11 @@ def test_bad_input_one_line_naming_file_and_line(tmp_path, case, match):
     elif case == "not_number":
         p = _gui(tmp_path, "1,0,0,0,0,0,1\n2,0,abc,0,0,0,1\n")
     elif case == "no_rate_register":
-        p = _gui(tmp_path, ROWS, regs="Packet number,Address,Value,Fixed-point value,Name\n"
-                 "55,54,65386,-0.07,MagnetometerHardIronBiasZ\n")
+        p = _gui(
+            tmp_path,
+            ROWS,
+            regs="Packet number,Address,Value,Fixed-point value,Name\n55,54,65386,-0.07,MagnetometerHardIronBiasZ\n",
+        )
     else:
         p = _gui(tmp_path, ROWS, regs=None)
     with pytest.raises(InputError, match=match) as ei:
@@ -221,9 +241,11 @@ def test_rate_argument_replaces_missing_register(tmp_path):
 
 def test_timestamp_errors_name_the_line(tmp_path):
     p = tmp_path / "Inertial.csv"
-    p.write_text("Timestamp (us),Gyroscope X (deg/s),Gyroscope Y (deg/s),Gyroscope Z (deg/s),"
-                 "Accelerometer X (g),Accelerometer Y (g),Accelerometer Z (g)\n"
-                 "100,0,0,0,0,0,1\n200,0,0,0,0,0,1\n150,0,0,0,0,0,1\n")
+    p.write_text(
+        "Timestamp (us),Gyroscope X (deg/s),Gyroscope Y (deg/s),Gyroscope Z (deg/s),"
+        "Accelerometer X (g),Accelerometer Y (g),Accelerometer Z (g)\n"
+        "100,0,0,0,0,0,1\n200,0,0,0,0,0,1\n150,0,0,0,0,0,1\n"
+    )
     with pytest.raises(InputError, match=r"Inertial.csv, line 4, 'Timestamp \(us\)': decreasing"):
         read_imu(p)
 
@@ -242,8 +264,7 @@ def test_cli_json_and_csv_on_real_log(shared_data, run_cli, tmp_path):
     assert np.all(np.abs(np.rad2deg(d["gyro_bias_rad_s"])) < 2.0)
     assert d["status"] == "no_rest_after"
     df = pd.read_csv(out)
-    assert list(df.columns) == ["t_s", "theta_rad", "omega_rad_s", "acc_x_m_s2", "acc_y_m_s2",
-                                "acc_z_m_s2"]
+    assert list(df.columns) == ["t_s", "theta_rad", "omega_rad_s", "acc_x_m_s2", "acc_y_m_s2", "acc_z_m_s2"]
     assert len(df) == 6959
 
 
@@ -279,7 +300,7 @@ def test_cli_table_mode(run_cli, tmp_path):
     df = pd.read_csv(out)
     assert list(df.columns) == ["t_s", "acc_m_s2"]
     err = df["acc_m_s2"] - np.interp(df["t_s"] - df["t_s"][0], t, a)
-    assert np.sqrt(np.mean(err ** 2)) < 0.06
+    assert np.sqrt(np.mean(err**2)) < 0.06
 
 
 def test_fusion_example_rest_bias_and_first_motion(shared_data):

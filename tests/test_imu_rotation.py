@@ -30,8 +30,16 @@ def truth():
 
 def _log(truth, **kw):
     block, res = truth
-    args = dict(omega_rad_s=res.omega_rad_s, rate_hz=FS, rest_before_s=3.0, rest_after_s=3.0,
-                gyro_noise_deg_s=0.1, gyro_bias_deg_s=BIAS_DEG_S, acc_noise_g=0.005, seed=1)
+    args = dict(
+        omega_rad_s=res.omega_rad_s,
+        rate_hz=FS,
+        rest_before_s=3.0,
+        rest_after_s=3.0,
+        gyro_noise_deg_s=0.1,
+        gyro_bias_deg_s=BIAS_DEG_S,
+        acc_noise_g=0.005,
+        seed=1,
+    )
     args.update(kw)
     return simulate_imu_log(res.t_s, res.theta_rad, block, **args)
 
@@ -44,7 +52,7 @@ def _check(rot, res, rms_deg=0.1):
     # Rotation RMS error over the first 10 s of rocking (issue 3: <= 0.1 deg).
     m = (rot.t_s >= 0.0) & (rot.t_s <= 10.0)
     err = rot.theta_rad[m] - _theta_true(res, rot.t_s[m])
-    rms = np.rad2deg(np.sqrt(np.mean(err ** 2)))
+    rms = np.rad2deg(np.sqrt(np.mean(err**2)))
     assert rms <= rms_deg, rms
     # Release (thread burn at t = 0) within one sample.
     assert abs(rot.release_t_s) <= 1.0 / FS
@@ -107,7 +115,7 @@ def test_rotation_through_ximu_gui_files(truth, tmp_path):
     rot_t = rot.t_s + log0.t_s[0]
     m = (rot_t >= 0) & (rot_t <= 10)
     err = rot.theta_rad[m] - _theta_true(res, rot_t[m])
-    assert np.rad2deg(np.sqrt(np.mean(err ** 2))) <= 0.1
+    assert np.rad2deg(np.sqrt(np.mean(err**2))) <= 0.1
     assert abs(rot.release_t_s + log0.t_s[0]) <= 1.0 / FS
 
 
@@ -133,7 +141,7 @@ def test_table_acceleration_tilted_sensor():
     err = ta.acc_m_s2 - np.interp(ta.t_s, t, a)
     # White noise 5 mg per axis -> 0.049 m/s2; a 3.6 deg tilt left uncorrected would
     # leak G sin(3.6 deg) = 0.6 m/s2 of gravity.
-    assert np.sqrt(np.mean(err ** 2)) < 0.06
+    assert np.sqrt(np.mean(err**2)) < 0.06
     bm = ta.to_base_motion()
     assert bm.dt_s == pytest.approx(1 / 256) and bm.pga_m_s2 == pytest.approx(2.0, abs=0.2)
 
@@ -148,7 +156,7 @@ def test_table_acceleration_finds_direction():
     ta = table_acceleration(log, None)
     assert ta.direction @ (S @ [1.0, 0, 0]) > 0.9995
     err = ta.acc_m_s2 - np.interp(ta.t_s, t, a)
-    assert np.sqrt(np.mean(err ** 2)) < 0.06
+    assert np.sqrt(np.mean(err**2)) < 0.06
     assert float(np.linalg.norm(ta.direction)) == pytest.approx(1.0)
     assert G > 9.8  # units sanity for the noise figure above
 
@@ -159,9 +167,10 @@ def test_overturned_block_keeps_upright_reference():
     block = Block(b_m=0.2, h_m=0.8)
     t = np.arange(0.0, 3.0, 1e-3)
     s = np.clip(t / 1.5, 0.0, 1.0)
-    th = 0.1 + (1.45 - 0.1) * (3 * s ** 2 - 2 * s ** 3)
-    log = simulate_imu_log(t, th, block, rate_hz=FS, rest_before_s=3.0, rest_after_s=3.0,
-                           gyro_bias_deg_s=BIAS_DEG_S, seed=12)
+    th = 0.1 + (1.45 - 0.1) * (3 * s**2 - 2 * s**3)
+    log = simulate_imu_log(
+        t, th, block, rate_hz=FS, rest_before_s=3.0, rest_after_s=3.0, gyro_bias_deg_s=BIAS_DEG_S, seed=12
+    )
     rot = block_rotation(log, "y")
     assert "upright" in rot.message
     err = rot.theta_rad - _theta_true_arr(t, th, rot.t_s)

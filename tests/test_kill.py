@@ -36,7 +36,8 @@ def _experiment(root, name, seed):
     pd.DataFrame({"t_s": t, "theta_rad": th}).to_csv(d / "tracks.csv", index=False)
     (d / "experiment.toml").write_text(
         f'name = "{name}"\n[block]\nb_m = 0.045\nh_m = 0.2025\n[sources.track]\npath = "tracks.csv"\n'
-        '[output]\nrrd = true\nfigures = true\n')
+        "[output]\nrrd = true\nfigures = true\n"
+    )
     return d / "experiment.toml"
 
 
@@ -116,15 +117,17 @@ def test_kill_campaign_no_orphans_and_resume(tmp_path):
 
     for k, delay in enumerate(rng.uniform(0.0, 3.0, 3)):
         # the first kill lands once an experiment has finished (so the re-run can show it resumes)
-        kids = _kill_at(["campaign", root, "--out", out, "--workers", 2, "--no-progress"], delay,
-                        after=one_done if k == 0 else None)
+        kids = _kill_at(
+            ["campaign", root, "--out", out, "--workers", 2, "--no-progress"], delay, after=one_done if k == 0 else None
+        )
         assert _gone(kids) == [], "worker processes outlived the killed campaign"
         for d in (out / "experiments").glob("*") if (out / "experiments").exists() else []:
             if not d.name.startswith("."):
                 assert _complete_experiment(d)
     exp_dir = out / "experiments"
-    done_before = {d.name: (d / "report.json").stat().st_mtime_ns
-                   for d in (exp_dir.glob("e*") if exp_dir.exists() else [])}
+    done_before = {
+        d.name: (d / "report.json").stat().st_mtime_ns for d in (exp_dir.glob("e*") if exp_dir.exists() else [])
+    }
     rc, stdout, err = _finish(["campaign", root, "--out", out, "--workers", 2, "--no-progress", "--json"])
     assert rc == 0, err
     res = json.loads(stdout)
@@ -159,8 +162,9 @@ def test_sigterm_stops_cleanly(tmp_path):
     """SIGTERM (what a scheduler or `timeout` sends) exits 143 and removes the staged output."""
     cfg = _experiment(tmp_path, "e", 1)
     out = tmp_path / "out"
-    proc = subprocess.Popen(CLI + ["run", str(cfg), "--out", str(out)], stdout=subprocess.DEVNULL,
-                            stderr=subprocess.DEVNULL)
+    proc = subprocess.Popen(
+        CLI + ["run", str(cfg), "--out", str(out)], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL
+    )
     t_end = time.time() + 60
     while time.time() < t_end and not list(tmp_path.glob(".out.tmp-*")) and proc.poll() is None:
         time.sleep(0.02)  # wait until the run is staging its outputs

@@ -43,13 +43,28 @@ def test_batch_folder_list_duplicates_and_outputs(tmp_path, run_cli):
     (recs / "README.md").write_text("not a record\n")
     other = tmp_path / "other"
     other.mkdir()
-    _sine_record(other / "pulse_a.csv", 0.8)                     # same name as recs/pulse_a.csv
+    _sine_record(other / "pulse_a.csv", 0.8)  # same name as recs/pulse_a.csv
     lst = tmp_path / "set.txt"
     lst.write_text("other/pulse_a.csv\nnope.csv   # a missing one\n\n")
-    rc, out, err = run_cli("oas", recs, "--list", lst, "--sizes", 30, "--levels", 20, "--workers", 1,
-                           "-o", tmp_path / "t" / "table.csv", "--plot", tmp_path / "t" / "tI.png",
-                           "--no-progress", "--json")
-    assert rc == 1                                               # some failed: say so
+    rc, out, err = run_cli(
+        "oas",
+        recs,
+        "--list",
+        lst,
+        "--sizes",
+        30,
+        "--levels",
+        20,
+        "--workers",
+        1,
+        "-o",
+        tmp_path / "t" / "table.csv",
+        "--plot",
+        tmp_path / "t" / "tI.png",
+        "--no-progress",
+        "--json",
+    )
+    assert rc == 1  # some failed: say so
     tab = pd.DataFrame(json.loads(out)["records"])
     assert list(tab.name) == ["README", "pulse_a", "pulse_b", "pulse_a", "nope"]
     errs = [e for e in err.strip().splitlines()]
@@ -71,8 +86,9 @@ def test_batch_folder_list_duplicates_and_outputs(tmp_path, run_cli):
 
 def test_batch_fema_records_get_the_thesis_values(shared_data, tmp_path, run_cli):
     folder = shared_data / "records" / "fema-p695-far-field"
-    rc, out, err = run_cli("oas", folder, "--units", "g", "--workers", 1, "--no-progress", "--json",
-                           "-o", tmp_path / "t.csv")
+    rc, out, err = run_cli(
+        "oas", folder, "--units", "g", "--workers", 1, "--no-progress", "--json", "-o", tmp_path / "t.csv"
+    )
     assert rc == 0, err
     tab = pd.DataFrame(json.loads(out)["records"])
     assert list(tab.thesis_id) == ["FF-1", "FF-2"]
@@ -108,8 +124,23 @@ def test_t_I_band_members_and_consistency(tmp_path):
 
 def test_cli_band_columns(tmp_path, run_cli):
     _sine_record(tmp_path / "p.csv", 0.5)
-    rc, out, err = run_cli("oas", tmp_path / "p.csv", "--band", "--levels", 12, "--sizes", 20, "--refine", 4,
-                           "--slenderness", 8, "--workers", 1, "--no-progress", "--json")
+    rc, out, err = run_cli(
+        "oas",
+        tmp_path / "p.csv",
+        "--band",
+        "--levels",
+        12,
+        "--sizes",
+        20,
+        "--refine",
+        4,
+        "--slenderness",
+        8,
+        "--workers",
+        1,
+        "--no-progress",
+        "--json",
+    )
     assert rc == 0, err
     r = json.loads(out)["records"][0]
     assert r["t_I_p05_s"] <= r["t_I_s"] <= r["t_I_p95_s"] and r["t_I_default_s"] > 0

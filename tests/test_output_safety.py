@@ -24,7 +24,8 @@ def _experiment(tmp_path, rrd="false"):
     pd.DataFrame({"t_s": t, "theta_rad": th}).to_csv(d / "tracks.csv", index=False)
     (d / "experiment.toml").write_text(
         'name = "safe"\n[block]\nb_m = 0.045\nh_m = 0.2025\n[sources.track]\npath = "tracks.csv"\n'
-        f'[output]\nrrd = {rrd}\nfigures = false\n')
+        f"[output]\nrrd = {rrd}\nfigures = false\n"
+    )
     return d / "experiment.toml"
 
 
@@ -105,11 +106,13 @@ def test_file_outputs_checked_before_work(tmp_path, run_cli):
     rc, out, err = run_cli("simulate", "--width", 0.045, "--height", 0.2, "--theta0", 0.05, "-o", d)
     assert rc == 2 and "is a folder" in err and err.count("\n") == 1 and "Traceback" not in err
     (tmp_path / "f.txt").write_text("x")
-    rc, out, err = run_cli("simulate", "--width", 0.045, "--height", 0.2, "--theta0", 0.05,
-                           "-o", tmp_path / "f.txt" / "x.csv")
+    rc, out, err = run_cli(
+        "simulate", "--width", 0.045, "--height", 0.2, "--theta0", 0.05, "-o", tmp_path / "f.txt" / "x.csv"
+    )
     assert rc == 2 and "is a file, not a folder" in err
-    rc, out, err = run_cli("simulate", "--width", 0.045, "--height", 0.2, "--theta0", 0.05,
-                           "-o", tmp_path / "new" / "deep" / "x.csv")
+    rc, out, err = run_cli(
+        "simulate", "--width", 0.045, "--height", 0.2, "--theta0", 0.05, "-o", tmp_path / "new" / "deep" / "x.csv"
+    )
     assert rc == 0 and (tmp_path / "new" / "deep" / "x.csv").is_file()
 
 
@@ -129,6 +132,7 @@ def test_internal_error_is_one_line_exit_3(monkeypatch, run_cli):
 def test_unreachable_scheduler_is_one_line(tmp_path, run_cli):
     pytest.importorskip("distributed")
     cfg = _experiment(tmp_path)
-    rc, out, err = run_cli("campaign", cfg.parent, "--out", tmp_path / "c", "--scheduler",
-                           "tcp://127.0.0.1:9", "--no-progress")
+    rc, out, err = run_cli(
+        "campaign", cfg.parent, "--out", tmp_path / "c", "--scheduler", "tcp://127.0.0.1:9", "--no-progress"
+    )
     assert rc == 2 and err.count("\n") == 1 and "no Dask scheduler answered" in err

@@ -27,7 +27,8 @@ def _exp(root, name, bid, contact, eta, seed):
     contact_toml = f'[contact]\ntype = "edge"\nl_c_m = {L_C}\n' if contact == "edge" else ""
     (d / "experiment.toml").write_text(
         f'name = "{name}"\n[block]\nid = "{bid}"\n{contact_toml}[sources.track]\npath = "tracks.csv"\n'
-        '[output]\nrrd = false\nfigures = false\n')
+        "[output]\nrrd = false\nfigures = false\n"
+    )
 
 
 def test_campaign_recovers_eta_mat_and_reports_failure(tmp_path, run_cli):
@@ -47,6 +48,7 @@ def test_campaign_recovers_eta_mat_and_reports_failure(tmp_path, run_cli):
     rc, stdout, err = run_cli("campaign", root, "--out", out, "--workers", "2", "--no-progress", "--json")
     assert rc == 1, err  # one experiment failed: the campaign finishes the rest but says so
     assert "1 of 4 experiments FAILED" not in err  # the summary goes to stdout, not stderr
+
     def strict(c):  # NaN/Infinity are not JSON; the CLI must write null
         raise ValueError(f"non-JSON constant {c} in the --json output")
 
@@ -74,7 +76,10 @@ def test_campaign_recovers_eta_mat_and_reports_failure(tmp_path, run_cli):
     assert rows["/campaign/experiments"] == 3
     # one clickable point per fitted experiment, carrying its name and where its report is
     assert {k for k in rows if k.startswith("/campaign/eta_vs_hb/")} == {
-        "/campaign/eta_vs_hb/edge/B3M_edge", "/campaign/eta_vs_hb/edge/B6M_edge", "/campaign/eta_vs_hb/full/B4M_full"}
+        "/campaign/eta_vs_hb/edge/B3M_edge",
+        "/campaign/eta_vs_hb/edge/B6M_edge",
+        "/campaign/eta_vs_hb/full/B4M_full",
+    }
     assert (out / "figures" / "eta_vs_hb.png").is_file()
     # the people's report: the same numbers in Markdown and in one offline HTML file
     md = (out / "summary.md").read_text(encoding="utf-8")
@@ -96,8 +101,9 @@ def test_campaign_on_a_dask_cluster_matches_local(tmp_path):
     _exp(root, "B4M_full", "B4M", "full", 0.882, 3)
     _exp(root, "B6M_full", "B6M", "full", 0.941, 4)
     local = C.run_campaign(root, tmp_path / "local", workers=1, progress=False)
-    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
-                                  dashboard_address=":0") as cluster:  # any free port: 8787 may be taken
+    with distributed.LocalCluster(
+        n_workers=1, threads_per_worker=1, processes=False, dashboard_address=":0"
+    ) as cluster:  # any free port: 8787 may be taken
         remote = C.run_campaign(root, tmp_path / "remote", scheduler=cluster.scheduler_address, progress=False)
     assert remote.n_ok == local.n_ok == 2
     assert remote.table["eta_e"].tolist() == pytest.approx(local.table["eta_e"].tolist(), abs=1e-12)

@@ -51,7 +51,7 @@ def test_model_follows_the_tracked_blocks(column_run):
     assert w.sum() >= 10
     for o, pk in zip(("block_1", "block_2", "block_3"), peak):
         d = (ser[f"theta_{o}_video_rad"] - ser[f"theta_{o}_sim_column_rad"])[w].dropna()
-        assert np.sqrt(np.mean(d ** 2)) < 0.1 * pk
+        assert np.sqrt(np.mean(d**2)) < 0.1 * pk
     rows = read_rrd_summary(out / "session.rrd")
     for o in ("block_1", "block_2", "block_3"):
         assert rows[f"/experiment/{o}/theta/measured_video"] > 100
@@ -72,5 +72,5 @@ def test_video_overlays_in_rrd(column_run):
     _, out = column_run
     rows = read_rrd_summary(out / "session.rrd")
     n_video = rows["/experiment/video"] - 1  # less the static video asset
-    assert rows["/experiment/video/outline"] == n_video   # three outlines per frame, one entity row
+    assert rows["/experiment/video/outline"] == n_video  # three outlines per frame, one entity row
     assert rows["/experiment/video/targets"] == n_video

@@ -28,19 +28,37 @@ def test_minimal_config_with_dimensions(tmp_path):
     assert cfg.input_files() == [p.resolve(), (tmp_path / "tracks.csv").resolve()]
 
 
-@pytest.mark.parametrize("text,match", [
-    ('[block]\nb_m = -0.045\nh_m = 0.2\n[sources.track]\npath = "tracks.csv"\n', r"line 2: 'block.b_m' must be positive"),
-    ('[block]\nb_m = 0.045\nh_m = 0.2\n[sources.track]\npath = "nope.csv"\n', r"line 5: 'sources.track.path' names 'nope.csv'"),
-    ('[block]\nb_m = 0.045\nh_m = 0.2\n[contact]\ntype = "edge"\n[sources.track]\npath = "tracks.csv"\n',
-     r"'contact.l_c_m' is required for edge contact"),
-    ('[block]\nb_m = 0.045\nh_m = 0.2\n[sources.track]\npath = "tracks.csv"\n[fit]\nwindow = "best"\n',
-     r"line 7: 'fit.window' must be one of middle50, all, first"),
-    ('[block]\nb_m = 0.045\nh_m = 0.2\n[sources.track]\npath = "tracks.csv"\n[simualte]\n', r"'simualte' is not a known"),
-    ('[block]\nb_m = 0.045\nh_m = = 0.2\n', r"TOML syntax error"),
-    ('[block]\nb_m = 0.045\nh_m = 0.2\n[sources]\nprimary = "imu"\n[sources.track]\npath = "tracks.csv"\n',
-     r"'sources.primary' = 'imu' but there is no \[sources.imu\]"),
-    ('[block]\nb_m = 0.045\nh_m = 0.2\n', r"\[sources\] needs at least one"),
-])
+@pytest.mark.parametrize(
+    "text,match",
+    [
+        (
+            '[block]\nb_m = -0.045\nh_m = 0.2\n[sources.track]\npath = "tracks.csv"\n',
+            r"line 2: 'block.b_m' must be positive",
+        ),
+        (
+            '[block]\nb_m = 0.045\nh_m = 0.2\n[sources.track]\npath = "nope.csv"\n',
+            r"line 5: 'sources.track.path' names 'nope.csv'",
+        ),
+        (
+            '[block]\nb_m = 0.045\nh_m = 0.2\n[contact]\ntype = "edge"\n[sources.track]\npath = "tracks.csv"\n',
+            r"'contact.l_c_m' is required for edge contact",
+        ),
+        (
+            '[block]\nb_m = 0.045\nh_m = 0.2\n[sources.track]\npath = "tracks.csv"\n[fit]\nwindow = "best"\n',
+            r"line 7: 'fit.window' must be one of middle50, all, first",
+        ),
+        (
+            '[block]\nb_m = 0.045\nh_m = 0.2\n[sources.track]\npath = "tracks.csv"\n[simualte]\n',
+            r"'simualte' is not a known",
+        ),
+        ("[block]\nb_m = 0.045\nh_m = = 0.2\n", r"TOML syntax error"),
+        (
+            '[block]\nb_m = 0.045\nh_m = 0.2\n[sources]\nprimary = "imu"\n[sources.track]\npath = "tracks.csv"\n',
+            r"'sources.primary' = 'imu' but there is no \[sources.imu\]",
+        ),
+        ("[block]\nb_m = 0.045\nh_m = 0.2\n", r"\[sources\] needs at least one"),
+    ],
+)
 def test_config_errors_name_key_and_line(tmp_path, text, match):
     p = _write(tmp_path, text)
     with pytest.raises(InputError, match=match) as e:

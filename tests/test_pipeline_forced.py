@@ -16,8 +16,10 @@ def sine_session(tmp_path_factory):
     d = tmp_path_factory.mktemp("forced") / "session"
     synth_session(d, seed=2, table="sine", size=(960, 540), duration_s=3.0, imu=False, mp4=False)
     with open(d / "experiment.toml", "a") as f:
-        f.write('\n[fit]\nrestitution = false\n[simulate]\nlaws = ["housner"]\neta = 0.75\n'
-                '[output]\nvideo_decimation = 10\n')
+        f.write(
+            '\n[fit]\nrestitution = false\n[simulate]\nlaws = ["housner"]\neta = 0.75\n'
+            "[output]\nvideo_decimation = 10\n"
+        )
     return d
 
 

@@ -27,12 +27,14 @@ def _session(tmp_path, seed=0, eta=ETA_TRUE, contact="full"):
     d.mkdir()
     pd.DataFrame({"t_s": t, "object": "block_1", "theta_rad": th_meas}).to_csv(d / "tracks.csv", index=False)
     pd.DataFrame({"frame": np.arange(t.size), "t_s": t, "object": "block_1", "theta_rad": th}).to_csv(
-        d / "truth.csv", index=False)
+        d / "truth.csv", index=False
+    )
     (d / "session.json").write_text(json.dumps({"eta": eta}))
     extra = '[contact]\ntype = "edge"\nl_c_m = 0.0015\n' if contact == "edge" else ""
     (d / "experiment.toml").write_text(
         f'name = "b6m_{contact}"\ntruth = "truth.csv"\n[block]\nid = "B6M"\n{extra}'
-        '[sources.track]\npath = "tracks.csv"\nobject = "block_1"\n[output]\nrrd = true\n')
+        '[sources.track]\npath = "tracks.csv"\nobject = "block_1"\n[output]\nrrd = true\n'
+    )
     return d / "experiment.toml"
 
 
@@ -45,12 +47,18 @@ def _series_styles(rrd):
         if not ch.is_static:
             continue
         rb = ch.to_record_batch()
-        cols = {n.split(":")[-1]: rb.column(i).to_pylist()[0] for i, n in enumerate(rb.schema.names)
-                if n.startswith("SeriesLines:")}
+        cols = {
+            n.split(":")[-1]: rb.column(i).to_pylist()[0]
+            for i, n in enumerate(rb.schema.names)
+            if n.startswith("SeriesLines:")
+        }
         if "colors" in cols:
             c = int(cols["colors"][0])
-            out[str(ch.entity_path)] = ([(c >> 24) & 255, (c >> 16) & 255, (c >> 8) & 255, c & 255],
-                                        float((cols.get("widths") or [0.0])[0]), (cols.get("names") or [""])[0])
+            out[str(ch.entity_path)] = (
+                [(c >> 24) & 255, (c >> 16) & 255, (c >> 8) & 255, c & 255],
+                float((cols.get("widths") or [0.0])[0]),
+                (cols.get("names") or [""])[0],
+            )
     return out
 
 
@@ -73,8 +81,14 @@ def test_run_writes_report_figures_and_rrd(tmp_path, run_cli):
     assert sims["housner"]["eta"] == pytest.approx(Block(0.045, 0.2025).eta_H)
     assert rep["truth"]["theta_rms_error_rad"] == pytest.approx(np.radians(0.02), rel=0.2)
     assert rep["versions"]["rocklab"] and rep["units"]["theta"] == "rad"
-    for f in ("summary.md", "report.html", "series.csv", "figures/theta.png", "figures/per_impact_eta.png",
-              "session.rrd"):
+    for f in (
+        "summary.md",
+        "report.html",
+        "series.csv",
+        "figures/theta.png",
+        "figures/per_impact_eta.png",
+        "session.rrd",
+    ):
         assert (out / f).is_file(), f
     md, html = (out / "summary.md").read_text(encoding="utf-8"), (out / "report.html").read_text(encoding="utf-8")
     assert f"η_e = {rep['fit']['eta_e']:.4g}" in md and f"η_e = {rep['fit']['eta_e']:.4g}" in html
@@ -144,6 +158,7 @@ def test_summary_numbers_for_people(tmp_path, run_cli):
     assert run_cli("run", cfg, "--out", out)[0] == 0
     text = (out / "summary.md").read_text()
     assert "95 % CI" in text
+
     def significant(num):
         return len(num.replace(".", "").lstrip("0"))
 

@@ -11,8 +11,7 @@ from rocklab.tracking import load_track_config, track_video
 def _exp(tmp_path, extra_video="", extra=""):
     (tmp_path / "v.mkv").write_bytes(b"")
     p = tmp_path / "experiment.toml"
-    p.write_text(f'name = "x"\n[block]\nb_m = 0.1\nh_m = 0.2\n[sources.video]\npath = "v.mkv"\n{extra_video}'
-                 f'{extra}')
+    p.write_text(f'name = "x"\n[block]\nb_m = 0.1\nh_m = 0.2\n[sources.video]\npath = "v.mkv"\n{extra_video}{extra}')
     return p
 
 
@@ -32,14 +31,19 @@ def test_negative_duration_is_an_error(tmp_path):
         load_experiment(_exp(tmp_path, extra="[simulate]\nduration_s = -3\n"))
 
 
-@pytest.mark.parametrize("section, key, value, words", [
-    ("video", "camera_matrix", "[[0, 0, 320], [0, 900, 180], [0, 0, 1]]", "fx, fy > 0"),
-    ("reference", "homography", "[[1, 2, 0], [2, 4, 0], [0, 0, 1]]", "singular"),
-])
+@pytest.mark.parametrize(
+    "section, key, value, words",
+    [
+        ("video", "camera_matrix", "[[0, 0, 320], [0, 900, 180], [0, 0, 1]]", "fx, fy > 0"),
+        ("reference", "homography", "[[1, 2, 0], [2, 4, 0], [0, 0, 1]]", "singular"),
+    ],
+)
 def test_impossible_geometry_is_an_error(tmp_path, section, key, value, words):
     p = tmp_path / "track.toml"
-    p.write_text(f'[{section}]\n{key} = {value}\n\n[[objects]]\nid = "block_1"\nkind = "block"\n'
-                 'style = "aruco"\nids = [0]\nmarker_size_m = 0.02\n')
+    p.write_text(
+        f'[{section}]\n{key} = {value}\n\n[[objects]]\nid = "block_1"\nkind = "block"\n'
+        'style = "aruco"\nids = [0]\nmarker_size_m = 0.02\n'
+    )
     with pytest.raises(InputError, match=words) as e:
         load_track_config(p)
     assert "\n" not in str(e.value) and key in str(e.value)

@@ -65,14 +65,21 @@ def test_block_tables_in_cm_and_duplicates(tmp_path):
     p = tmp_path / "edge.csv"
     # widths in cm in a b_m column: 4.5 "m" wide, 0.2 m tall blocks (was eta_mat = -1.83, status ok)
     pd.DataFrame({"block": ["B3M", "B6M"], "b_m": [4.5, 4.5], "h_m": [0.1, 0.2], "eta_e": [0.85, 0.93]}).to_csv(
-        p, index=False)
+        p, index=False
+    )
     with collecting() as found:
         res = fit_eta_mat(read_block_table(p))
     assert "W-FIT-UNITS" in [d.code for d in found]
     assert res.status == "failed" and "outside (0, 1]" in res.message
     q = tmp_path / "dup.csv"
-    pd.DataFrame({"block": ["B3M", "B3M", "B6M"], "b_m": [0.03, 0.03, 0.045], "h_m": [0.1, 0.1, 0.2025],
-                  "eta_e": [0.85, 0.85, 0.93]}).to_csv(q, index=False)
+    pd.DataFrame(
+        {
+            "block": ["B3M", "B3M", "B6M"],
+            "b_m": [0.03, 0.03, 0.045],
+            "h_m": [0.1, 0.1, 0.2025],
+            "eta_e": [0.85, 0.85, 0.93],
+        }
+    ).to_csv(q, index=False)
     with collecting() as found:
         tab = read_block_table(q)
     assert [d.code for d in found] == ["W-FIT-DUPLICATE"] and len(tab) == 2 and "line 3" in found[0].message

@@ -17,9 +17,19 @@ FS = 256.0
 def folder(tmp_path_factory):
     block = Block(b_m=0.1, h_m=0.4)
     res = simulate(block, theta0_rad=0.9 * block.alpha_rad, duration_s=8.0, dt_s=1e-4)
-    log = simulate_imu_log(res.t_s, res.theta_rad, block, omega_rad_s=res.omega_rad_s, rate_hz=FS,
-                           rest_before_s=2.0, rest_after_s=2.0, gyro_noise_deg_s=0.1,
-                           gyro_bias_deg_s=np.array([0.5, -0.5, 0.5]), acc_noise_g=0.005, seed=2)
+    log = simulate_imu_log(
+        res.t_s,
+        res.theta_rad,
+        block,
+        omega_rad_s=res.omega_rad_s,
+        rate_hz=FS,
+        rest_before_s=2.0,
+        rest_after_s=2.0,
+        gyro_noise_deg_s=0.1,
+        gyro_bias_deg_s=np.array([0.5, -0.5, 0.5]),
+        acc_noise_g=0.005,
+        seed=2,
+    )
     d = tmp_path_factory.mktemp("imu")
     write_ximu3_csv(log, d)
     return d, 0.9 * block.alpha_rad
@@ -119,6 +129,5 @@ def test_truncated_final_line_dropped_with_a_note(folder, tmp_path):
 
 
 def test_real_logs_raise_no_warning(shared_data):
-    for p in (shared_data / "imu/fusion-example/sensor_data.csv",
-              shared_data / "imu/x-imu-matlab-library-example"):
+    for p in (shared_data / "imu/fusion-example/sensor_data.csv", shared_data / "imu/x-imu-matlab-library-example"):
         block_rotation(read_imu(p))  # filterwarnings=error: any W- warning fails here

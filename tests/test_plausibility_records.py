@@ -13,11 +13,27 @@ from rocklab.models.spectra._pulses import lobe_impulses
 VALUES = [f"{v: .7E}" for v in 0.1 * np.sin(np.linspace(0, 6, 40))]
 
 
-def _at2(tmp_path, station="El Centro Array #9, 180", units_line="ACCELERATION TIME SERIES IN UNITS OF G",
-         values=VALUES, name="r.AT2", npts=None):
-    rows = [" ".join(values[i:i + 5]) for i in range(0, len(values), 5)]
-    text = "\n".join(["PEER NGA STRONG MOTION DATABASE RECORD", f"Imperial Valley-02, 5/19/1940, {station}",
-                      units_line, f"NPTS= {npts or len(values):6d}, DT=   .0100 SEC,"] + rows) + "\n"
+def _at2(
+    tmp_path,
+    station="El Centro Array #9, 180",
+    units_line="ACCELERATION TIME SERIES IN UNITS OF G",
+    values=VALUES,
+    name="r.AT2",
+    npts=None,
+):
+    rows = [" ".join(values[i : i + 5]) for i in range(0, len(values), 5)]
+    text = (
+        "\n".join(
+            [
+                "PEER NGA STRONG MOTION DATABASE RECORD",
+                f"Imperial Valley-02, 5/19/1940, {station}",
+                units_line,
+                f"NPTS= {npts or len(values):6d}, DT=   .0100 SEC,",
+            ]
+            + rows
+        )
+        + "\n"
+    )
     p = tmp_path / name
     p.write_text(text)
     return p
@@ -31,17 +47,24 @@ def test_units_never_guessed_from_free_text(tmp_path, station):
     assert rec.meta["units_from"] == "header"
 
 
-@pytest.mark.parametrize("line, factor", [("ACCELERATION TIME SERIES IN UNITS OF CM/S/S", 0.01),
-                                          ("The units are (g)", G), ("UNITS: m/s2", 1.0)])
+@pytest.mark.parametrize(
+    "line, factor",
+    [("ACCELERATION TIME SERIES IN UNITS OF CM/S/S", 0.01), ("The units are (g)", G), ("UNITS: m/s2", 1.0)],
+)
 def test_units_field_forms(tmp_path, line, factor):
     rec = load_base_motion(_at2(tmp_path, units_line=line))
     assert rec.pga_m_s2 == pytest.approx(factor * 0.1 * np.max(np.abs(np.sin(np.linspace(0, 6, 40)))), rel=1e-6)
 
 
-@pytest.mark.parametrize("line, words", [("VELOCITY TIME SERIES IN UNITS OF CM/S", "velocity"),
-                                         ("DISPLACEMENT TIME SERIES IN UNITS OF CM", "displacement"),
-                                         ("TIME SERIES IN UNITS OF CM/S", "velocity"),
-                                         ("TIME SERIES IN UNITS OF FURLONGS", "unknown units")])
+@pytest.mark.parametrize(
+    "line, words",
+    [
+        ("VELOCITY TIME SERIES IN UNITS OF CM/S", "velocity"),
+        ("DISPLACEMENT TIME SERIES IN UNITS OF CM", "displacement"),
+        ("TIME SERIES IN UNITS OF CM/S", "velocity"),
+        ("TIME SERIES IN UNITS OF FURLONGS", "unknown units"),
+    ],
+)
 def test_not_acceleration_is_an_error(tmp_path, line, words):
     with pytest.raises(InputError, match=words) as e:
         load_base_motion(_at2(tmp_path, units_line=line))
@@ -74,8 +97,9 @@ def test_exact_zero_crossings_split_lobes():
     # a plateau of zeros between pulses of one sign keeps them apart too
     b = np.concatenate((np.sin(np.linspace(0, np.pi, 101)), np.zeros(50), np.sin(np.linspace(0, np.pi, 101))))
     imp, _, _ = lobe_impulses(b, 0.01)
-    assert np.sort(np.abs(imp))[-2:] == pytest.approx([np.sum(np.sin(np.linspace(0, np.pi, 101))[:-1]) * 0.01] * 2,
-                                                      rel=1e-3)
+    assert np.sort(np.abs(imp))[-2:] == pytest.approx(
+        [np.sum(np.sin(np.linspace(0, np.pi, 101))[:-1]) * 0.01] * 2, rel=1e-3
+    )
 
 
 def test_plausibility_warnings(tmp_path):
@@ -128,8 +152,11 @@ def test_warning_codes_documented():
     page = (Path(__file__).resolve().parents[1] / "docs" / "warnings.md").read_text(encoding="utf-8")
     assert page.endswith(codes_markdown())
     # every code is raised somewhere in the package (no dead entries)
-    src = "".join(p.read_text(encoding="utf-8") for p in (Path(__file__).resolve().parents[1] / "rocklab")
-                  .rglob("*.py") if p.name != "_diagnostics.py")
+    src = "".join(
+        p.read_text(encoding="utf-8")
+        for p in (Path(__file__).resolve().parents[1] / "rocklab").rglob("*.py")
+        if p.name != "_diagnostics.py"
+    )
     assert [c for c in WARNING_CODES if f'"{c}"' not in src] == []
 
 
@@ -140,5 +167,4 @@ def test_given_units_decide_over_an_unknown_header(tmp_path):
     assert rec.pga_m_s2 == pytest.approx(0.1 * G * np.max(np.abs(np.sin(np.linspace(0, 6, 40)))), rel=1e-6)
     assert rec.meta["units_from"] == "option"
     with pytest.raises(InputError, match="velocity"):
-        load_base_motion(_at2(tmp_path, units_line="VELOCITY TIME SERIES IN UNITS OF CM/S", name="v.AT2"),
-                         units="g")
+        load_base_motion(_at2(tmp_path, units_line="VELOCITY TIME SERIES IN UNITS OF CM/S", name="v.AT2"), units="g")

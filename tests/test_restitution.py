@@ -75,8 +75,7 @@ def test_general_alpha_I_housner():
 
 
 def test_registry_and_objects():
-    assert set(RESTITUTION_LAWS) >= {"housner", "modified", "constant", "bumps", "cut_corner",
-                                     "axes", "per_impact"}
+    assert set(RESTITUTION_LAWS) >= {"housner", "modified", "constant", "bumps", "cut_corner", "axes", "per_impact"}
     blk = Block(0.1, 0.4)
     r = make_restitution(0.9, blk)
     assert isinstance(r, Restitution) and r.eta == 0.9 and r(1.0, 5) == 0.9
@@ -86,9 +85,17 @@ def test_registry_and_objects():
     assert v(2.0) == pytest.approx(0.92, abs=1e-12)
 
 
-@pytest.mark.parametrize("law,kw", [("constant", {"eta": 1.2}), ("bumps", {"n": -1}), ("bumps", {"n": 1.5}),
-                                    ("modified", {"k": "x"}), ("per_impact", {}),
-                                    ("per_impact", {"eta": [0.9, 0.8], "omega_rad_s": [1.0, 0.5]})])
+@pytest.mark.parametrize(
+    "law,kw",
+    [
+        ("constant", {"eta": 1.2}),
+        ("bumps", {"n": -1}),
+        ("bumps", {"n": 1.5}),
+        ("modified", {"k": "x"}),
+        ("per_impact", {}),
+        ("per_impact", {"eta": [0.9, 0.8], "omega_rad_s": [1.0, 0.5]}),
+    ],
+)
 def test_bad_law_parameters(law, kw):
     with pytest.raises(InputError):
         make_restitution(law, Block(0.1, 0.4), **kw)

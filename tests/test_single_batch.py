@@ -25,16 +25,24 @@ def pulse():
 def test_batch_matches_simulate_entry_by_entry(pulse):
     blocks = [Block(0.2, 1.0), Block(0.3, 1.2), Block(0.1, 0.8)]
     scales = [0.25, 0.45, 0.7]
-    bat = simulate_batch([b.p_rad_s for b in blocks], [b.alpha_rad for b in blocks], base=pulse,
-                         scale=scales, dt_s=1e-3, free_after_s=0.0, max_p_dt=1.0)
+    bat = simulate_batch(
+        [b.p_rad_s for b in blocks],
+        [b.alpha_rad for b in blocks],
+        base=pulse,
+        scale=scales,
+        dt_s=1e-3,
+        free_after_s=0.0,
+        max_p_dt=1.0,
+    )
     assert bat.overturned.shape == (3,)
     for i, (b, s) in enumerate(zip(blocks, scales)):
         r = simulate(b, 0.0, duration_s=pulse.t_s[-1], dt_s=1e-3, base=pulse.scaled(s))
         assert bat.overturned[i] == r.overturned
         assert bat.n_impacts[i] == r.n_impacts
         assert bat.max_abs_theta_over_alpha[i] == pytest.approx(r.max_abs_theta_over_alpha, rel=1e-9)
-        assert (math.isnan(bat.overturn_t_s[i]) and math.isnan(r.overturn_t_s)) or \
-            bat.overturn_t_s[i] == pytest.approx(r.overturn_t_s, abs=1e-9)
+        assert (math.isnan(bat.overturn_t_s[i]) and math.isnan(r.overturn_t_s)) or bat.overturn_t_s[i] == pytest.approx(
+            r.overturn_t_s, abs=1e-9
+        )
     # the three cases cover the outcomes: something rocks and something falls
     assert bat.overturned.any() and not bat.overturned.all()
 
@@ -81,9 +89,18 @@ def test_fall_criterion_alpha(pulse):
     assert np.all(at_alpha.overturned >= falls.overturned)
 
 
-@pytest.mark.parametrize("kw", [{"p_rad_s": [1.0, -1.0]}, {"theta0_rad": 0.5}, {"alpha_rad": 2.0},
-                                {"scale": [1.0, 2.0, 3.0]}, {"eta": 1.5}, {"duration_s": None},
-                                {"dt_s": 0.0}])
+@pytest.mark.parametrize(
+    "kw",
+    [
+        {"p_rad_s": [1.0, -1.0]},
+        {"theta0_rad": 0.5},
+        {"alpha_rad": 2.0},
+        {"scale": [1.0, 2.0, 3.0]},
+        {"eta": 1.5},
+        {"duration_s": None},
+        {"dt_s": 0.0},
+    ],
+)
 def test_bad_input(kw):
     args = {"p_rad_s": [3.0, 4.0], "alpha_rad": 0.2, "duration_s": 1.0} | kw
     with pytest.raises(InputError):

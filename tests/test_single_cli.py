@@ -12,8 +12,9 @@ from rocklab import Block
 
 
 def test_json_keys_and_values(run_cli):
-    rc, out, err = run_cli("simulate", "--width", 0.045, "--height", 0.2025, "--theta0", 0.15,
-                           "--duration", 3, "--json")
+    rc, out, err = run_cli(
+        "simulate", "--width", 0.045, "--height", 0.2025, "--theta0", 0.15, "--duration", 3, "--json"
+    )
     assert rc == 0, err
     d = json.loads(out)
     b = Block(0.045, 0.2025)
@@ -28,9 +29,24 @@ def test_json_keys_and_values(run_cli):
 
 def test_constant_law_and_csv_output(run_cli, tmp_path):
     out_csv = tmp_path / "h.csv"
-    rc, out, err = run_cli("simulate", "--width", 0.045, "--height", 0.2025, "--theta0", 0.1,
-                           "--duration", 1, "--restitution", "constant", "--eta", 0.95, "-o", out_csv,
-                           "--json")
+    rc, out, err = run_cli(
+        "simulate",
+        "--width",
+        0.045,
+        "--height",
+        0.2025,
+        "--theta0",
+        0.1,
+        "--duration",
+        1,
+        "--restitution",
+        "constant",
+        "--eta",
+        0.95,
+        "-o",
+        out_csv,
+        "--json",
+    )
     assert rc == 0, err
     d = json.loads(out)
     f = pd.read_csv(out_csv)
@@ -44,36 +60,75 @@ def test_base_motion_scaled(run_cli, tmp_path):
     rec = tmp_path / "rec.csv"
     t = np.arange(0, 2, 0.01)
     pd.DataFrame({"t_s": t, "acc_m_s2": np.sin(2 * np.pi * t)}).to_csv(rec, index=False)
-    rc, out, err = run_cli("simulate", "--width", 0.2, "--height", 1.0, "--duration", 2, "--dt", 1e-3,
-                           "--base-motion", rec, "--scale-pga", 0.1, "--json")
+    rc, out, err = run_cli(
+        "simulate",
+        "--width",
+        0.2,
+        "--height",
+        1.0,
+        "--duration",
+        2,
+        "--dt",
+        1e-3,
+        "--base-motion",
+        rec,
+        "--scale-pga",
+        0.1,
+        "--json",
+    )
     assert rc == 0, err
     assert json.loads(out)["status"] == "no_uplift"  # 0.1 g < tan(alpha) = 0.2
-    rc, out, err = run_cli("simulate", "--width", 0.2, "--height", 1.0, "--duration", 2, "--dt", 1e-3,
-                           "--base-motion", rec, "--units", "m/s2", "--scale-pga", 3.0, "--json")
+    rc, out, err = run_cli(
+        "simulate",
+        "--width",
+        0.2,
+        "--height",
+        1.0,
+        "--duration",
+        2,
+        "--dt",
+        1e-3,
+        "--base-motion",
+        rec,
+        "--units",
+        "m/s2",
+        "--scale-pga",
+        3.0,
+        "--json",
+    )
     assert rc == 0 and json.loads(out)["max_abs_theta_over_alpha"] > 0
 
 
-@pytest.mark.parametrize("argv", [
-    ("--width", 0.045, "--height", 0.2025, "--theta0", 0.3),
-    ("--width", -1, "--height", 0.2),
-    ("--width", 0.045, "--height", 0.2025, "--restitution", "constant"),
-    ("--width", 0.045, "--height", 0.2025, "--base-motion", "/nonexistent/rec.AT2"),
-    ("--width", 0.045, "--height", 0.2025, "--scale-pga", 0.3),
-])
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ("--width", 0.045, "--height", 0.2025, "--theta0", 0.3),
+        ("--width", -1, "--height", 0.2),
+        ("--width", 0.045, "--height", 0.2025, "--restitution", "constant"),
+        ("--width", 0.045, "--height", 0.2025, "--base-motion", "/nonexistent/rec.AT2"),
+        ("--width", 0.045, "--height", 0.2025, "--scale-pga", 0.3),
+    ],
+)
 def test_bad_input_exit_2_one_line(run_cli, argv):
     rc, out, err = run_cli("simulate", *argv)
     assert rc == 2 and out == ""
     assert err.count("\n") == 1 and err.startswith("rocklab simulate: error:")
 
 
-@pytest.mark.parametrize("argv,expect", [
-    (("--restitution", "modified", "--k", 1.0), lambda b: b.eta_H),
-    (("--restitution", "bumps", "--bumps", 1),
-     lambda b: (2 * (b.h_m / 2) ** 2 + 0.5 * (b.b_m / 2) ** 2) / (2 * (b.h_m / 2) ** 2 + 2 * (b.b_m / 2) ** 2)),
-])
+@pytest.mark.parametrize(
+    "argv,expect",
+    [
+        (("--restitution", "modified", "--k", 1.0), lambda b: b.eta_H),
+        (
+            ("--restitution", "bumps", "--bumps", 1),
+            lambda b: (2 * (b.h_m / 2) ** 2 + 0.5 * (b.b_m / 2) ** 2) / (2 * (b.h_m / 2) ** 2 + 2 * (b.b_m / 2) ** 2),
+        ),
+    ],
+)
 def test_laws_from_cli(run_cli, argv, expect):
-    rc, out, err = run_cli("simulate", "--width", 0.045, "--height", 0.2025, "--theta0", 0.1,
-                           "--duration", 1, "--json", *argv)
+    rc, out, err = run_cli(
+        "simulate", "--width", 0.045, "--height", 0.2025, "--theta0", 0.1, "--duration", 1, "--json", *argv
+    )
     assert rc == 0, err
     imp = json.loads(out)["impacts"][0]
     assert imp["omega_after_rad_s"] / imp["omega_before_rad_s"] == pytest.approx(expect(Block(0.045, 0.2025)))

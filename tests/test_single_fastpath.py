@@ -24,11 +24,14 @@ def _zeros(T_s, dt_s=1e-3):
 
 # coarse steps (p dt up to 0.017, W-SIM-DT) on purpose: the two loops must agree even there
 @pytest.mark.filterwarnings("ignore::rocklab._diagnostics.RocklabWarning")
-@pytest.mark.parametrize("dt_s, f, law", [
-    (1e-4, 0.8, {}),                                      # the benchmark case: one step shifts < 2e-4 rad
-    (2e-3, 0.95, {}),                                     # larger increments: the longer Taylor forms
-    (1e-4, 0.5, {"restitution": "constant", "eta": -0.6}),  # bounce back onto the same corner
-])
+@pytest.mark.parametrize(
+    "dt_s, f, law",
+    [
+        (1e-4, 0.8, {}),  # the benchmark case: one step shifts < 2e-4 rad
+        (2e-3, 0.95, {}),  # larger increments: the longer Taylor forms
+        (1e-4, 0.5, {"restitution": "constant", "eta": -0.6}),  # bounce back onto the same corner
+    ],
+)
 def test_fast_loop_equals_general_loop(simulate_loop, dt_s, f, law):
     T = 3.0
     kw = dict(duration_s=T, dt_s=dt_s, **law)

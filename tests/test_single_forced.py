@@ -41,11 +41,14 @@ def elcentro():
     return bundled_record("elcentro")
 
 
-@pytest.mark.parametrize("blk, scale, T, extra", [
-    (Block(0.2, 1.0), 1.0, 20.0, {"output_dt_s": 7e-4}),                # 98 impacts, rests, rocks again
-    (Block(0.3, 1.5), 1.2, 12.0, {"fall_rad": "alpha"}),               # overturns (|theta| >= alpha) at 9.1 s
-    (Block(0.045, 0.2025), 1.0, 5.0, {}),                              # B6M: falls over (pi/2) at 2.8 s
-])
+@pytest.mark.parametrize(
+    "blk, scale, T, extra",
+    [
+        (Block(0.2, 1.0), 1.0, 20.0, {"output_dt_s": 7e-4}),  # 98 impacts, rests, rocks again
+        (Block(0.3, 1.5), 1.2, 12.0, {"fall_rad": "alpha"}),  # overturns (|theta| >= alpha) at 9.1 s
+        (Block(0.045, 0.2025), 1.0, 5.0, {}),  # B6M: falls over (pi/2) at 2.8 s
+    ],
+)
 def test_forced_loop_equals_general_loop_elcentro(simulate_loop, elcentro, blk, scale, T, extra):
     if extra.get("fall_rad") == "alpha":
         extra = dict(extra, fall_rad=blk.alpha_rad)

@@ -62,15 +62,25 @@ def test_housner_linearised_period():
     a = B6M.alpha_rad
     p = B6M.p_rad_s
     for f in (0.3, 0.8):
-        r = simulate(B6M, f * a, duration_s=3.0, dt_s=1e-4, restitution="constant", eta=1.0,
-                     linearized=True, stop_at_rest=False)
+        r = simulate(
+            B6M, f * a, duration_s=3.0, dt_s=1e-4, restitution="constant", eta=1.0, linearized=True, stop_at_rest=False
+        )
         ti = r.impacts.t_s.to_numpy()
         T = 4.0 / p * math.acosh(1.0 / (1.0 - f))
         # first impact after a quarter period, then one every half period
         assert ti[0] == pytest.approx(T / 4, abs=1e-7)
         assert np.diff(ti) == pytest.approx(np.full(len(ti) - 1, T / 2), abs=2e-7)
-        ev = simulate(B6M, f * a, duration_s=3.0, dt_s=1e-3, restitution="constant", eta=1.0,
-                      linearized=True, stop_at_rest=False, method="event")
+        ev = simulate(
+            B6M,
+            f * a,
+            duration_s=3.0,
+            dt_s=1e-3,
+            restitution="constant",
+            eta=1.0,
+            linearized=True,
+            stop_at_rest=False,
+            method="event",
+        )
         # the adaptive reference is closer still (Newmark drifts ~(p dt)^2/12 per unit time)
         tk = T / 4 + T / 2 * np.arange(4)
         assert ev.impacts.t_s.to_numpy()[:4] == pytest.approx(tk, abs=1e-9)
@@ -90,8 +100,17 @@ def test_rectangular_pulse_linearised_closed_form():
     a, p = blk.alpha_rad, blk.p_rad_s
     A, tp, dt = 0.35, 0.15, 1e-4  # A > tan(alpha) = 0.2: uplift at t = 0 towards theta > 0
     base = _pulse(A, tp, dt, 3.0)
-    r = simulate(blk, 0.0, duration_s=2.5, dt_s=dt, base=base, linearized=True, restitution="constant",
-                 eta=1.0, stop_at_rest=False)
+    r = simulate(
+        blk,
+        0.0,
+        duration_s=2.5,
+        dt_s=dt,
+        base=base,
+        linearized=True,
+        restitution="constant",
+        eta=1.0,
+        stop_at_rest=False,
+    )
     # A linear ramp over [tp - dt, tp] equals a sharp end at tp - dt/2 to O(dt^2).
     te = tp - dt / 2
     c = A - a
@@ -102,7 +121,7 @@ def test_rectangular_pulse_linearised_closed_form():
     psi_p = c * (math.cosh(p * te) - 1.0) - a
     w_p = c * p * math.sinh(p * te)
     assert abs(psi_p) > w_p / p  # below the overturning threshold of this pulse
-    th_max = a - math.sqrt(psi_p ** 2 - (w_p / p) ** 2)
+    th_max = a - math.sqrt(psi_p**2 - (w_p / p) ** 2)
     t_max = te + math.atanh(-w_p / (p * psi_p)) / p
     k = int(np.argmax(r.theta_rad[r.t_s < 1.5]))
     assert r.theta_rad[k] == pytest.approx(th_max, abs=1e-6 * a)
@@ -136,8 +155,7 @@ def test_uplift_direction_and_threshold(sign):
     assert r.t_s[moved[0]] == pytest.approx(0.099, abs=2e-3)  # record ramps up over [0.099, 0.1]
     # a_g > 0 (base pushed to +x) tips the block onto corner B: theta < 0
     assert np.sign(r.theta_rad[moved[0]]) == -sign
-    below = simulate(blk, 0.0, duration_s=2.0, dt_s=1e-4,
-                     base=BaseMotion.from_samples(acc * 0.19 / 0.25, dt, "g"))
+    below = simulate(blk, 0.0, duration_s=2.0, dt_s=1e-4, base=BaseMotion.from_samples(acc * 0.19 / 0.25, dt, "g"))
     assert below.status == "no_uplift" and below.max_abs_theta_rad == 0.0
 
 
@@ -169,8 +187,7 @@ def test_per_impact_eta_table_applied_in_both_methods():
 
 def test_eta_function_of_velocity():
     a = B6M.alpha_rad
-    r = simulate(B6M, 0.6 * a, duration_s=3.0, restitution="per_impact",
-                 omega_rad_s=[0.0, 2.0], eta=[0.6, 0.99])
+    r = simulate(B6M, 0.6 * a, duration_s=3.0, restitution="per_impact", omega_rad_s=[0.0, 2.0], eta=[0.6, 0.99])
     wb = np.abs(r.impacts.omega_before_rad_s.to_numpy())
     assert r.impacts.eta.to_numpy() == pytest.approx(0.6 + 0.39 * wb / 2.0, rel=1e-12)
 
@@ -188,12 +205,22 @@ def test_rest_and_output_fields(b6m_pair):
     assert len(d["impacts"]) == nm.n_impacts
 
 
-@pytest.mark.parametrize("kw", [
-    {"theta0_rad": 0.3}, {"theta0_rad": -0.3}, {"theta0_rad": float("nan")}, {"dt_s": 0.0},
-    {"duration_s": -1.0}, {"restitution": "nope"}, {"method": "rk4"},
-    {"restitution": "constant", "eta": 1.5}, {"restitution": "constant"},
-    {"restitution": "modified", "k": 2.0}, {"base": np.zeros(10)},
-])
+@pytest.mark.parametrize(
+    "kw",
+    [
+        {"theta0_rad": 0.3},
+        {"theta0_rad": -0.3},
+        {"theta0_rad": float("nan")},
+        {"dt_s": 0.0},
+        {"duration_s": -1.0},
+        {"restitution": "nope"},
+        {"method": "rk4"},
+        {"restitution": "constant", "eta": 1.5},
+        {"restitution": "constant"},
+        {"restitution": "modified", "k": 2.0},
+        {"base": np.zeros(10)},
+    ],
+)
 def test_bad_input_raises_one_line(kw):
     with pytest.raises(InputError) as e:
         simulate(B6M, **({"theta0_rad": 0.05} | kw))
@@ -264,8 +291,9 @@ def test_rest_then_uplift_again():
     # two short pulses, opposite directions: rock, come to rest, uplift again the other way
     blk = Block(0.2, 1.0)
     t = np.arange(0.0, 8.0, 0.002)
-    a = np.where((t > 0.5) & (t < 0.8), -0.25 * np.sin(2 * np.pi * (t - 0.5) / 0.3), 0.0) \
-        + np.where((t > 4.0) & (t < 4.3), 0.26 * np.sin(2 * np.pi * (t - 4.0) / 0.3), 0.0)
+    a = np.where((t > 0.5) & (t < 0.8), -0.25 * np.sin(2 * np.pi * (t - 0.5) / 0.3), 0.0) + np.where(
+        (t > 4.0) & (t < 4.3), 0.26 * np.sin(2 * np.pi * (t - 4.0) / 0.3), 0.0
+    )
     base = BaseMotion.from_samples(a, 0.002, "g")
     law = dict(restitution="constant", eta=0.8)  # settles well before the second pulse
     nm = simulate(blk, 0.0, duration_s=8.0, dt_s=1e-4, base=base, **law)

@@ -6,9 +6,18 @@ import numpy as np
 import pytest
 
 from rocklab import G, InputError
-from rocklab.models import (asymmetric_frame, block_parameters, frame_parameters,
-                            free_rocking_period_eq24, linear_sine_pulse_response, overturning_time_eq25,
-                            sine_pulse_max_response, strut_parameters, wall_mechanism, wall_parameters)
+from rocklab.models import (
+    asymmetric_frame,
+    block_parameters,
+    frame_parameters,
+    free_rocking_period_eq24,
+    linear_sine_pulse_response,
+    overturning_time_eq25,
+    sine_pulse_max_response,
+    strut_parameters,
+    wall_mechanism,
+    wall_parameters,
+)
 
 
 def test_table1_block_strut_frame():
@@ -58,6 +67,7 @@ def test_asymmetric_frame_directions_and_eq33():
         num = 1 + (1 + r - sign * (2 * b / L) * (1 - r)) + r
         den = 1 + 2 * ((b * h / (L * H)) * (1 - r) + 1) + 1
         return b / H * num / den
+
     assert fp.lambda_ == pytest.approx(eq33(+1), rel=0.005)
     assert fn.lambda_ == pytest.approx(eq33(-1), rel=0.005)
     with pytest.raises(InputError, match="overlap"):
@@ -81,8 +91,9 @@ def test_wall_free_rocking_period_error_trend_fig3():
     for a in (0.05, 0.15, 0.3):
         m = wall_mechanism(1.0, a)
         fp = m.parameters()
-        ratios[a] = [free_rocking_period_eq24(fp.p_rad_s, x) / m.free_rocking_period(x * fp.phi_cr_rad)
-                     for x in (0.1, 0.5, 0.95)]
+        ratios[a] = [
+            free_rocking_period_eq24(fp.p_rad_s, x) / m.free_rocking_period(x * fp.phi_cr_rad) for x in (0.1, 0.5, 0.95)
+        ]
         r = ratios[a]
         assert abs(1 - r[2]) < abs(1 - r[1]) < abs(1 - r[0])
     assert abs(1 - ratios[0.05][1]) < abs(1 - ratios[0.15][1]) < abs(1 - ratios[0.3][1])

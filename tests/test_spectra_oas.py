@@ -7,10 +7,20 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from rocklab import G, InputError
-from rocklab.models import (F_SINE, BaseMotion, fit_inclined_line, free_rocking_overturns,
-                            load_base_motion, normalised_critical_impulse, overturning_curve,
-                            overturning_spectrum, pulse_motion, pulse_parameters, simplified_oas,
-                            simulate_batch)
+from rocklab.models import (
+    F_SINE,
+    BaseMotion,
+    fit_inclined_line,
+    free_rocking_overturns,
+    load_base_motion,
+    normalised_critical_impulse,
+    overturning_curve,
+    overturning_spectrum,
+    pulse_motion,
+    pulse_parameters,
+    simplified_oas,
+    simulate_batch,
+)
 
 FF = "records/fema-p695-far-field/SortedEQFile_{}.txt"
 
@@ -25,16 +35,19 @@ def _reference(acc, dt, scale, p, alpha, eta):
     t = (i - 1 + (math.copysign(thr, a1) - a0) / (a1 - a0)) * dt
     s, y, T = -np.sign(a1), [0.0, 0.0], t_rec[-1]
     while t < T:
+
         def f(t, y, s=s):
             a = alpha * s - y[0]
             return [y[1], -p * p * (math.sin(a) + scale * np.interp(t, t_rec, acc) * math.cos(a))]
 
         def cross(t, y):
             return y[0]
+
         cross.terminal, cross.direction = True, -s
 
         def over(t, y):
             return abs(y[0]) - alpha
+
         over.terminal = True
         sol = solve_ivp(f, (t, T), y, events=[cross, over], rtol=1e-9, atol=1e-11, max_step=2 * dt)
         if sol.t_events[1].size:
@@ -63,8 +76,7 @@ def test_oas_runs_match_event_driven_reference(shared_data):
     base = BaseMotion.from_samples(r.acc_m_s2[:1500], r.dt_s)
     # the verdicts here are chaotic: p h <= 0.02 flips the middle one, 0.005 the first;
     # from 0.001 down they are converged and equal the reference
-    got = simulate_batch(ps, alpha, base=base, scale=scale, eta=eta, dt_s=r.dt_s, fall_rad=alpha,
-                         max_p_dt=0.001)
+    got = simulate_batch(ps, alpha, base=base, scale=scale, eta=eta, dt_s=r.dt_s, fall_rad=alpha, max_p_dt=0.001)
     want = [_reference(acc, r.dt_s, scale, p, alpha, eta) for p in ps]
     assert list(got.overturned) == want and any(want) and not all(want)
 
@@ -81,8 +93,9 @@ def test_free_rocking_verdict_equals_integration():
     eta = 1 - 1.5 * np.sin(alpha) ** 2
     verdict = free_rocking_overturns(th, w, p, alpha, eta)
     ok = np.abs(th) < alpha  # simulate_batch starts below the top
-    run = simulate_batch(p[ok], alpha[ok], theta0_rad=th[ok], omega0_rad_s=w[ok], eta=eta[ok],
-                         duration_s=60.0, fall_rad=alpha[ok])
+    run = simulate_batch(
+        p[ok], alpha[ok], theta0_rad=th[ok], omega0_rad_s=w[ok], eta=eta[ok], duration_s=60.0, fall_rad=alpha[ok]
+    )
     assert np.array_equal(verdict[ok], run.overturned)
     assert 0.2 < verdict.mean() < 0.8  # both outcomes are exercised
     # beyond the top: outward always falls; inward falls only when too slow to climb back
@@ -90,8 +103,7 @@ def test_free_rocking_verdict_equals_integration():
     e = 0.5 * w[past] ** 2 + p[past] ** 2 * np.cos(alpha[past] - np.abs(th[past]))
     inward = th[past] * w[past] < 0
     assert np.array_equal(verdict[past][~inward], np.ones((~inward).sum(), bool))
-    assert np.array_equal(verdict[past][inward] | (e[inward] >= p[past][inward] ** 2),
-                          np.ones(inward.sum(), bool))
+    assert np.array_equal(verdict[past][inward] | (e[inward] >= p[past][inward] ** 2), np.ones(inward.sum(), bool))
     assert not free_rocking_overturns(0.0, 0.0, 2.0, 0.2, 1.0)  # at rest
     for bad in (dict(p_rad_s=0.0), dict(alpha_rad=2.0), dict(eta=1.5), dict(theta_rad=np.nan)):
         kw = dict(theta_rad=0.1, omega_rad_s=0.0, p_rad_s=2.0, alpha_rad=0.2, eta=0.9) | bad

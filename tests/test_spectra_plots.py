@@ -7,8 +7,7 @@ from rocklab.pipelines.spectra._plots_spectra import plot_oas, plot_overturning_
 
 
 def test_wall_error_maps_fig3_trends(tmp_path):
-    r = plot_wall_error_maps(tmp_path / "wall.png", alphas=[0.05, 0.2, 0.4], ratios=[0.1, 0.9],
-                             accs=[1.1, 3.0])
+    r = plot_wall_error_maps(tmp_path / "wall.png", alphas=[0.05, 0.2, 0.4], ratios=[0.1, 0.9], accs=[1.1, 3.0])
     assert (tmp_path / "wall.png").stat().st_size > 10_000
     T, t1, t2 = r["period_ratio"], r["t_ratio_kappa1"], r["t_ratio_kappa2"]
     # Fig. 3: the linearised block rocks faster (ratio < 1); error grows with alpha, shrinks near phi_cr

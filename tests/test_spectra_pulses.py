@@ -6,8 +6,16 @@ import numpy as np
 import pytest
 
 from rocklab import Block, G, InputError
-from rocklab.models import (BaseMotion, design_check, load_base_motion, pulse_motion, pulse_parameters,
-                            pulse_shape, required_width, required_width_slender)
+from rocklab.models import (
+    BaseMotion,
+    design_check,
+    load_base_motion,
+    pulse_motion,
+    pulse_parameters,
+    pulse_shape,
+    required_width,
+    required_width_slender,
+)
 
 FF = "records/fema-p695-far-field/SortedEQFile_{}.txt"
 
@@ -27,11 +35,13 @@ def test_at2_and_two_column_readers_agree(shared_data, tmp_path):
     r2 = load_base_motion(src, units="g")
     # write the same samples as a PEER .AT2 (NGA-West2 header, 5 values a row, g)
     a = r2.acc_m_s2 / G
-    rows = [" ".join(f"{v:15.7E}" for v in a[i:i + 5]) for i in range(0, a.size, 5)]
+    rows = [" ".join(f"{v:15.7E}" for v in a[i : i + 5]) for i in range(0, a.size, 5)]
     p = tmp_path / "FF1.AT2"
-    p.write_text("PEER NGA STRONG MOTION DATABASE RECORD\nNorthridge MUL009\n"
-                 "ACCELERATION TIME SERIES IN UNITS OF G\n"
-                 f"NPTS=  {a.size}, DT=   .0100 SEC\n" + "\n".join(rows) + "\n")
+    p.write_text(
+        "PEER NGA STRONG MOTION DATABASE RECORD\nNorthridge MUL009\n"
+        "ACCELERATION TIME SERIES IN UNITS OF G\n"
+        f"NPTS=  {a.size}, DT=   .0100 SEC\n" + "\n".join(rows) + "\n"
+    )
     ra = load_base_motion(p)
     pa, pb = pulse_parameters(ra), pulse_parameters(r2)
     assert pa.t_p_s == pytest.approx(pb.t_p_s, rel=1e-6)
@@ -54,9 +64,11 @@ def test_lobe_impulse_of_sampled_sine_is_exact_area():
 def test_pulse_shapes():
     t = np.array([0.0, 0.25, 0.5, 0.75, 1.0, 1.5, 3.5])
     assert pulse_shape("n-half-sines", t, 1.0, n=3) == pytest.approx(
-        [0, math.sin(math.pi / 4), 1, math.sin(3 * math.pi / 4), 0, -1, 0], abs=1e-12)
+        [0, math.sin(math.pi / 4), 1, math.sin(3 * math.pi / 4), 0, -1, 0], abs=1e-12
+    )
     assert pulse_shape("cycloidal-b", t, 1.0) == pytest.approx(
-        [1, math.cos(math.pi / 4), 0, -math.cos(math.pi / 4), -1, 0, 0], abs=1e-12)
+        [1, math.cos(math.pi / 4), 0, -math.cos(math.pi / 4), -1, 0, 0], abs=1e-12
+    )
     with pytest.raises(InputError, match="unknown"):
         pulse_shape("square-wave", t, 1.0)
 
@@ -87,6 +99,7 @@ def test_bad_records_one_line_errors(tmp_path):
 # narrower: 1.2966 / 2.1204 m. Both use g = 9.81 m/s^2 as the thesis does; with
 # g = 9.80665 the roots shift by
 # 0.2 mm. All four printed numbers are reproduced within 5 mm.
+
 
 @pytest.mark.parametrize("c, aI, printed, exact", [(0.5, 4 / 3, 1.299, 1.2966), (1.0, 1.0, 2.122, 2.1204)])
 def test_pier_width_example(c, aI, printed, exact):

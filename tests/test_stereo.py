@@ -22,8 +22,18 @@ OFFSET_S = 0.0027
 def session(tmp_path_factory):
     # odd frame size; a short test (eta 0.8) with a 1 mm slide at impact 3
     d = tmp_path_factory.mktemp("stereo")
-    r = synth_stereo(d, size=(961, 703), f_px=1200.0, fps=150.0, offset_s=OFFSET_S, n_board=20, seed=3,
-                     restitution=0.8, theta0_rad=0.12, slide=(3, 1e-3))
+    r = synth_stereo(
+        d,
+        size=(961, 703),
+        f_px=1200.0,
+        fps=150.0,
+        offset_s=OFFSET_S,
+        n_board=20,
+        seed=3,
+        restitution=0.8,
+        theta0_rad=0.12,
+        slide=(3, 1e-3),
+    )
     rig = calibrate_stereo(d / "calib_cam1.mkv", d / "calib_cam2.mkv")
     sp = track_dots_stereo(d / "cam1.mkv", d / "cam2.mkv", rig)
     return d, r, rig, sp
@@ -43,20 +53,20 @@ def test_calibration_reprojection_and_baseline(session):
 
 def test_sync_offset_without_shared_trigger(session):
     _, _, _, sp = session
-    assert sp.sync.offset_s == pytest.approx(OFFSET_S, abs=1e-3)      # the issue's bound: 1 ms at 150 fps
-    assert abs(sp.sync.offset_s - OFFSET_S) < 0.2e-3                  # what it does: 0.02-0.08 ms
+    assert sp.sync.offset_s == pytest.approx(OFFSET_S, abs=1e-3)  # the issue's bound: 1 ms at 150 fps
+    assert abs(sp.sync.offset_s - OFFSET_S) < 0.2e-3  # what it does: 0.02-0.08 ms
     assert 0 < sp.sync.sigma_s < 0.5e-3
 
 
 def test_triangulated_targets_match_truth(session):
     d, r, rig, sp = session
     c1 = r["cameras"][0]
-    X1 = r["X1"] @ c1.R.T + c1.t                    # truth in camera 1's axes
+    X1 = r["X1"] @ c1.R.T + c1.t  # truth in camera 1's axes
     n = sp.xyz_m.shape[0]
     # each triangulated target is the nearest true target (in a frame where all are seen)
     k = int(np.flatnonzero(np.isfinite(sp.xyz_m).all(axis=(1, 2)))[0])
     idx = [int(np.argmin(np.linalg.norm(X1[k] - x, axis=1))) for x in sp.xyz_m[k]]
-    assert sorted(idx) == list(range(X1.shape[1]))                  # every target once
+    assert sorted(idx) == list(range(X1.shape[1]))  # every target once
     A = X1[:n, idx].reshape(-1, 3)
     B = sp.xyz_m.reshape(-1, 3)
     ok = np.isfinite(B).all(axis=1)
@@ -64,7 +74,7 @@ def test_triangulated_targets_match_truth(session):
     # the calibrated camera-1 axes differ from the true ones by a small rigid motion (principal point):
     # compare shapes after the best rigid alignment
     R, t, rms = kabsch(B[ok], A[ok])
-    assert rms < 1.5e-4                                              # 0.12 mm at f = 1200 px, 1 m
+    assert rms < 1.5e-4  # 0.12 mm at f = 1200 px, 1 m
 
 
 def test_rocking_from_stereo_and_the_audit(session):
@@ -75,11 +85,11 @@ def test_rocking_from_stereo_and_the_audit(session):
         res = track_points3d(series, bodies, up="z")
     b = res["block"]
     truth = pd.read_csv(d / "truth.csv")
-    th = truth.theta_rad.to_numpy()[:b.t_s.size]
+    th = truth.theta_rad.to_numpy()[: b.t_s.size]
     sign = np.sign(np.nansum(b.theta_rad * th))
     assert np.sqrt(np.nanmean((b.theta_rad - sign * th) ** 2)) < math.radians(0.02)
-    assert np.sqrt(np.nanmean(b.twist_rad ** 2)) < math.radians(0.05)
-    assert np.sqrt(np.nanmean(b.out_of_plane_rad ** 2)) < math.radians(0.05)
+    assert np.sqrt(np.nanmean(b.twist_rad**2)) < math.radians(0.05)
+    assert np.sqrt(np.nanmean(b.out_of_plane_rad**2)) < math.radians(0.05)
     assert b.geometry.base_width_m == pytest.approx(0.1, abs=1e-3)
     assert [(f.kind, f.impact) for f in b.audit.flags] == [("slide", 3)]
     assert b.audit.flags[0].value == pytest.approx(1e-3, rel=0.1)
@@ -88,13 +98,23 @@ def test_rocking_from_stereo_and_the_audit(session):
 
 def test_cli_stereo_calibrate_and_track(session, tmp_path, run_cli):
     d, _, _, _ = session
-    rc, out, err = run_cli("stereo", "calibrate", d / "calib_cam1.mkv", d / "calib_cam2.mkv", "-o",
-                           tmp_path / "stereo.json", "--json")
+    rc, out, err = run_cli(
+        "stereo", "calibrate", d / "calib_cam1.mkv", d / "calib_cam2.mkv", "-o", tmp_path / "stereo.json", "--json"
+    )
     assert rc == 0, err
     cal = json.loads(out)
     assert cal["rms_px"]["stereo"] <= 0.3
-    rc, out, err = run_cli("stereo", "track", d / "cam1.mkv", d / "cam2.mkv", "--calib", tmp_path / "stereo.json",
-                           "-o", tmp_path / "t" / "tracks.csv", "--json")
+    rc, out, err = run_cli(
+        "stereo",
+        "track",
+        d / "cam1.mkv",
+        d / "cam2.mkv",
+        "--calib",
+        tmp_path / "stereo.json",
+        "-o",
+        tmp_path / "t" / "tracks.csv",
+        "--json",
+    )
     assert rc == 0, err
     s = json.loads(out)
     assert s["verdict"] == "suspect" and abs(s["sync"]["offset_s"] - OFFSET_S) < 1e-3
@@ -124,24 +144,46 @@ def test_stereo_bad_input(session, tmp_path, run_cli):
 def test_aruco_corners_in_stereo(tmp_path, run_cli):
     # two markers on the block's face, two on an upright plate at the table's edge; odd frame size
     d = tmp_path / "aruco"
-    r = synth_stereo(d, size=(641, 463), f_px=800.0, fps=150.0, offset_s=OFFSET_S, n_board=16, seed=4,
-                     restitution=0.7, theta0_rad=0.1, targets="aruco")
-    rc, out, err = run_cli("stereo", "calibrate", d / "calib_cam1.mkv", d / "calib_cam2.mkv", "-o",
-                           d / "stereo.json")
+    r = synth_stereo(
+        d,
+        size=(641, 463),
+        f_px=800.0,
+        fps=150.0,
+        offset_s=OFFSET_S,
+        n_board=16,
+        seed=4,
+        restitution=0.7,
+        theta0_rad=0.1,
+        targets="aruco",
+    )
+    rc, out, err = run_cli("stereo", "calibrate", d / "calib_cam1.mkv", d / "calib_cam2.mkv", "-o", d / "stereo.json")
     assert rc == 0, err
-    rc, out, err = run_cli("stereo", "track", d / "cam1.mkv", d / "cam2.mkv", "--calib", d / "stereo.json",
-                           "--targets", "aruco", "-o", tmp_path / "t" / "tracks.csv", "--json")
+    rc, out, err = run_cli(
+        "stereo",
+        "track",
+        d / "cam1.mkv",
+        d / "cam2.mkv",
+        "--calib",
+        d / "stereo.json",
+        "--targets",
+        "aruco",
+        "-o",
+        tmp_path / "t" / "tracks.csv",
+        "--json",
+    )
     assert rc == 0, err
     s = json.loads(out)
-    assert s["bodies"] == {"block": [f"M{m}c{k}" for m in (0, 1) for k in range(4)],
-                           "table": [f"M{m}c{k}" for m in (2, 3) for k in range(4)]}
+    assert s["bodies"] == {
+        "block": [f"M{m}c{k}" for m in (0, 1) for k in range(4)],
+        "table": [f"M{m}c{k}" for m in (2, 3) for k in range(4)],
+    }
     assert abs(s["sync"]["offset_s"] - OFFSET_S) < 0.5e-3
     assert s["verdict"] == "valid"
     tr = pd.read_csv(tmp_path / "t" / "tracks.csv")
     b = tr[tr.object == "block"]
-    th = pd.read_csv(d / "truth.csv").theta_rad.to_numpy()[:len(b)]
+    th = pd.read_csv(d / "truth.csv").theta_rad.to_numpy()[: len(b)]
     sign = np.sign(np.nansum(b.theta_rad.to_numpy() * th))
     assert np.sqrt(np.nanmean((b.theta_rad.to_numpy() - sign * th) ** 2)) < math.radians(0.02)
     # twist is seen over a 6 cm marker pair only: 0.1 deg here, against 0.02 deg with dots across the face
-    assert np.sqrt(np.nanmean(b.twist_rad ** 2)) < math.radians(0.3)
+    assert np.sqrt(np.nanmean(b.twist_rad**2)) < math.radians(0.3)
     del r

@@ -15,8 +15,16 @@ from rocklab.synth import simulate_imu_log
 def rocking():
     block = Block(b_m=0.1, h_m=0.8)
     res = simulate(block, theta0_rad=0.6 * block.alpha_rad, duration_s=30.0, dt_s=1e-4)
-    log = simulate_imu_log(res.t_s, res.theta_rad, block, omega_rad_s=res.omega_rad_s,
-                           rate_hz=256.0, rest_before_s=3.0, rest_after_s=3.0, seed=1)
+    log = simulate_imu_log(
+        res.t_s,
+        res.theta_rad,
+        block,
+        omega_rad_s=res.omega_rad_s,
+        rate_hz=256.0,
+        rest_before_s=3.0,
+        rest_after_s=3.0,
+        seed=1,
+    )
     return res, block_rotation(log, "y")
 
 
@@ -74,7 +82,7 @@ def test_two_imus_with_clock_drift():
 
 def test_track_rate_central_difference():
     t = np.arange(0.0, 1.0, 0.02)
-    th = 0.3 * t ** 2
+    th = 0.3 * t**2
     th[10] = np.nan
     tt, w = track_rate(t, th)
     # Central difference is exact for a parabola: d/dt 0.3 t^2 = 0.6 t.
@@ -94,9 +102,17 @@ def test_sync_events_from_impacts_of_two_imus(rocking):
     res, rot_a = rocking
     block = Block(b_m=0.1, h_m=0.8)
     # Second IMU on the same block, clock 2.3456 s late and on another seed.
-    log_b = simulate_imu_log(res.t_s, res.theta_rad, block, omega_rad_s=res.omega_rad_s,
-                             rate_hz=256.0, rest_before_s=3.0, rest_after_s=3.0, seed=8,
-                             clock_offset_s=-2.3456)
+    log_b = simulate_imu_log(
+        res.t_s,
+        res.theta_rad,
+        block,
+        omega_rad_s=res.omega_rad_s,
+        rate_hz=256.0,
+        rest_before_s=3.0,
+        rest_after_s=3.0,
+        seed=8,
+        clock_offset_s=-2.3456,
+    )
     rot_b = block_rotation(log_b, "y")
     s = sync_events(rot_a.impact_t_s, rot_b.impact_t_s, tol_s=0.01)
     # Each impact time is within one sample (3.9 ms); ~90 matches average that down.

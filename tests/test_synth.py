@@ -58,27 +58,25 @@ def test_truth_theta_is_the_simulator_with_the_sign_convention(free_session):
     b = s.meta["blocks"][0]
     blk = Block(b["block"]["b_m"], b["block"]["h_m"])
     rel = b["release_s"]
-    res = simulate(blk, theta0_rad=-b["theta0_rad"], duration_s=5.0, dt_s=1e-4,
-                   restitution="constant", eta=b["eta_true"])
+    res = simulate(
+        blk, theta0_rad=-b["theta0_rad"], duration_s=5.0, dt_s=1e-4, restitution="constant", eta=b["eta_true"]
+    )
     tr = s.truth[s.truth.object == "block_1"]
     t = tr["t_s"].to_numpy()
-    expect = np.where(t < rel, b["theta0_rad"],
-                      -np.interp(t - rel, res.t_s, res.theta_rad, right=0.0))
+    expect = np.where(t < rel, b["theta0_rad"], -np.interp(t - rel, res.t_s, res.theta_rad, right=0.0))
     np.testing.assert_allclose(tr["theta_rad"].to_numpy(), expect, rtol=0, atol=1e-12)
     # It rocks (impacts recorded with the true constant eta) and the held block is tilted by +alpha/2.
     assert b["n_impacts"] >= 3 and np.allclose(b["impact_eta"], 0.75)
     assert b["theta0_rad"] == pytest.approx(0.5 * blk.alpha_rad)
     # Pivoting on a bottom corner: the face centre sits at (b/2)|sin|+(h/2)cos above the table.
     phi = tr["theta_rad"].to_numpy()
-    np.testing.assert_allclose(tr["y_m"], blk.b_m / 2 * np.abs(np.sin(phi)) + blk.h_m / 2 * np.cos(phi),
-                               atol=1e-12)
+    np.testing.assert_allclose(tr["y_m"], blk.b_m / 2 * np.abs(np.sin(phi)) + blk.h_m / 2 * np.cos(phi), atol=1e-12)
 
 
 def test_rendered_targets_sit_where_the_camera_projects_them(tmp_path):
     """ArUco corners (cv2 detector, sub-pixel refinement) and dot centroids in a static
     frame land on the truth projected with the camera saved in session.json."""
-    s = synth_session(tmp_path / "a", seed=2, size=(960, 540), duration_s=0.1, imu=False, mp4=False,
-                      noise_dn=0.5)
+    s = synth_session(tmp_path / "a", seed=2, size=(960, 540), duration_s=0.1, imu=False, mp4=False, noise_dn=0.5)
     cam = s.camera
     img = _frames(s.video_mkv, 1)[0]
     params = cv2.aruco.DetectorParameters()
@@ -100,10 +98,11 @@ def test_rendered_targets_sit_where_the_camera_projects_them(tmp_path):
         errs.append(c.reshape(-1, 2) - cam.project(world))
     e = np.concatenate(errs)
     assert np.abs(e).max() < 0.3
-    assert np.abs(e.mean(axis=0)).max() < 0.05         # no systematic offset
+    assert np.abs(e.mean(axis=0)).max() < 0.05  # no systematic offset
 
-    d = synth_session(tmp_path / "d", seed=2, size=(960, 540), duration_s=0.1, imu=False, mp4=False,
-                      targets="dots", noise_dn=0.5)
+    d = synth_session(
+        tmp_path / "d", seed=2, size=(960, 540), duration_s=0.1, imu=False, mp4=False, targets="dots", noise_dn=0.5
+    )
     img = _frames(d.video_mkv, 1)[0].astype(float)
     truth0 = d.truth[d.truth.frame == 0].set_index("object")
     f = d.meta["features_object_frame"]["block_1"]
@@ -111,18 +110,17 @@ def test_rendered_targets_sit_where_the_camera_projects_them(tmp_path):
     rot = np.array([[np.cos(r.theta_rad), -np.sin(r.theta_rad)], [np.sin(r.theta_rad), np.cos(r.theta_rad)]])
     px = d.camera.project(np.array(f["dots"]) @ rot.T + [r.x_m, r.y_m])
     rad = f["dot_diameter_m"] / 2 / d.camera.m_per_px((r.x_m, r.y_m))
-    for u, v in px:   # darkness-weighted centroid in a window of 1.6 dot radii
+    for u, v in px:  # darkness-weighted centroid in a window of 1.6 dot radii
         uu, vv = np.meshgrid(np.arange(img.shape[1]), np.arange(img.shape[0]))
         m = np.hypot(uu - u, vv - v) < 1.6 * rad
-        w = np.clip(235.0 * 0.9 - img, 0, None) * m   # white paper ~ 238 * lighting
+        w = np.clip(235.0 * 0.9 - img, 0, None) * m  # white paper ~ 238 * lighting
         w = np.where(w > 20, w, 0)
         cu, cv = (w * uu).sum() / w.sum(), (w * vv).sum() / w.sum()
         assert np.hypot(cu - u, cv - v) < 0.08
 
 
 def test_table_sine_pulse_truth_is_kinematically_consistent(tmp_path):
-    s = synth_session(tmp_path / "t", seed=1, size=SMALL, table="sine", duration_s=2.0, fps=100,
-                      imu=False, mp4=False)
+    s = synth_session(tmp_path / "t", seed=1, size=SMALL, table="sine", duration_s=2.0, fps=100, imu=False, mp4=False)
     tb = s.truth[s.truth.object == "table"]
     x, v, a = (tb[c].to_numpy() for c in ("x_m", "vx_m_s", "ax_m_s2"))
     dt = 1 / s.fps
@@ -141,8 +139,19 @@ def test_table_sine_pulse_truth_is_kinematically_consistent(tmp_path):
 
 
 def test_record_table_fits_the_stroke_and_three_blocks(tmp_path):
-    s = synth_session(tmp_path / "r", seed=0, size=SMALL, blocks=3, table="record", duration_s=4.0,
-                      layout="side", fps=25, imu=False, mp4=False, table_stroke_m=0.05)
+    s = synth_session(
+        tmp_path / "r",
+        seed=0,
+        size=SMALL,
+        blocks=3,
+        table="record",
+        duration_s=4.0,
+        layout="side",
+        fps=25,
+        imu=False,
+        mp4=False,
+        table_stroke_m=0.05,
+    )
     tb = s.truth[s.truth.object == "table"]
     assert np.abs(tb["x_m"]).max() <= 0.05 + 1e-9
     assert s.meta["table"]["record"] == "elcentro"
@@ -169,7 +178,7 @@ def test_imu_logs_read_back_with_the_x_imu_reader(free_session, shared_data):
     phi0 = s.meta["blocks"][0]["theta0_rad"]
     still = log.t_s + info["t0_video_s"] < s.meta["blocks"][0]["release_s"] - 0.05
     ax, az = np.median(log.acc_m_s2[still, 0]), np.median(log.acc_m_s2[still, 2])
-    assert np.arctan2(ax, az) == pytest.approx(phi0, abs=0.01)   # sensor x tips up when phi > 0
+    assert np.arctan2(ax, az) == pytest.approx(phi0, abs=0.01)  # sensor x tips up when phi > 0
     # IMU y is the rocking axis away from the camera: the integrated rate is -theta_rad.
     rate = log.gyro_rad_s[:, 1] - np.deg2rad(info["gyro_bias_deg_s"][1])
     ang = np.concatenate(([0.0], np.cumsum(0.5 * (rate[1:] + rate[:-1]) * np.diff(log.t_s))))
@@ -195,7 +204,7 @@ def test_configs_load_with_their_readers(free_session):
 def test_bad_input_and_overwrite_protection(tmp_path, run_cli, capsys):
     rc, out, err = run_cli("synth", "--out", tmp_path / "x", "--size", "big")
     assert rc == 2 and len(err.strip().splitlines()) == 1 and "size" in err
-    with pytest.raises(SystemExit) as e:          # argparse choices: one line, status 2
+    with pytest.raises(SystemExit) as e:  # argparse choices: one line, status 2
         run_cli("synth", "--out", tmp_path / "x", "--targets", "qr")
     err = capsys.readouterr().err
     assert e.value.code == 2 and len(err.strip().splitlines()) == 1 and "targets" in err
@@ -206,15 +215,25 @@ def test_bad_input_and_overwrite_protection(tmp_path, run_cli, capsys):
     (tmp_path / "full" / "keep.txt").write_text("mine")
     rc, out, err = run_cli("synth", "--out", tmp_path / "full", "--size", "160x90", "--duration", "0.1")
     assert rc == 2 and "--force" in err and (tmp_path / "full" / "keep.txt").read_text() == "mine"
-    rc, out, err = run_cli("synth", "--out", tmp_path / "ok", "--size", "160x90", "--duration", "0.2",
-                           "--json", "--no-imu", "--uncalibrated")
+    rc, out, err = run_cli(
+        "synth",
+        "--out",
+        tmp_path / "ok",
+        "--size",
+        "160x90",
+        "--duration",
+        "0.2",
+        "--json",
+        "--no-imu",
+        "--uncalibrated",
+    )
     assert rc == 0
     d = json.loads(out)
     assert d["n_frames"] == 10 and d["size"] == [160, 90]
     text = (tmp_path / "ok" / "track.toml").read_text()
     assert "camera_matrix" not in text and "homography" not in text and "marker_size_m = 0.06" in text
     assert not (tmp_path / "ok" / "imu").exists()
-    assert not [p for p in tmp_path.iterdir() if p.name.startswith(".ok.")]   # temp folder renamed
+    assert not [p for p in tmp_path.iterdir() if p.name.startswith(".ok.")]  # temp folder renamed
 
 
 def _aruco_centres(img):
@@ -228,8 +247,16 @@ def _aruco_centres(img):
 def test_rolling_shutter_skews_by_velocity_times_row_delay(tmp_path):
     """A block riding a (gentle, no uplift) table pulse: with the rolling shutter each
     marker is shifted by v(t) * (row / (H - 1) - 1/2) * readout against a global shutter."""
-    kw = dict(seed=4, size=(960, 540), table="sine", duration_s=0.9, imu=False, mp4=False,
-              table_amplitude_m=0.01, noise_dn=0.3)
+    kw = dict(
+        seed=4,
+        size=(960, 540),
+        table="sine",
+        duration_s=0.9,
+        imu=False,
+        mp4=False,
+        table_amplitude_m=0.01,
+        noise_dn=0.3,
+    )
     g = synth_session(tmp_path / "g", **kw)
     r = synth_session(tmp_path / "r", rolling_shutter=True, **kw)
     assert g.meta["blocks"][0]["sim_status"] == "no_uplift"
@@ -242,15 +269,16 @@ def test_rolling_shutter_skews_by_velocity_times_row_delay(tmp_path):
     cr = _aruco_centres(_frames(r.video_mkv, i + 1)[i])
     mpp = g.camera.m_per_px((0.0, 0.1))
     H = g.meta["size_px"][1]
-    for mid in (1, 2):                                  # top and bottom marker of the block
+    for mid in (1, 2):  # top and bottom marker of the block
         expect_px = v * (cg[mid][1] / (H - 1) - 0.5) * readout / mpp
         assert cr[mid][0] - cg[mid][0] == pytest.approx(expect_px, abs=0.1 + 0.05 * abs(expect_px))
-    assert abs(cr[1][0] - cg[1][0] - (cr[2][0] - cg[2][0])) > 0.3   # rows differ -> skew
+    assert abs(cr[1][0] - cg[1][0] - (cr[2][0] - cg[2][0])) > 0.3  # rows differ -> skew
 
 
 def test_occlusion_hides_the_block_only_in_its_interval(tmp_path):
-    s = synth_session(tmp_path / "o", seed=1, size=(640, 360), duration_s=0.8, occlusion=(0.3, 0.5),
-                      imu=False, mp4=False)
+    s = synth_session(
+        tmp_path / "o", seed=1, size=(640, 360), duration_s=0.8, occlusion=(0.3, 0.5), imu=False, mp4=False
+    )
     frames = _frames(s.video_mkv, s.n_frames)
     seen = [set(_aruco_centres(f)) for f in frames]
     t = np.arange(s.n_frames) / s.fps
@@ -258,7 +286,7 @@ def test_occlusion_hides_the_block_only_in_its_interval(tmp_path):
     assert all({1, 2}.isdisjoint(k) and {0, 7} <= k for k, h in zip(seen, hidden) if h)
     assert all({0, 1, 2, 7} <= k for k, h in zip(seen, hidden) if not h)
     assert s.meta["occlusions"] == [{"object": "block_1", "t0_s": 0.3, "t1_s": 0.5}]
-    assert len(s.truth[s.truth.object == "block_1"]) == s.n_frames      # truth is never hidden
+    assert len(s.truth[s.truth.object == "block_1"]) == s.n_frames  # truth is never hidden
 
 
 def test_full_hd_markers_give_theta_to_a_few_hundredths_of_a_degree():
@@ -267,11 +295,28 @@ def test_full_hd_markers_give_theta_to_a_few_hundredths_of_a_degree():
     (Frames rendered in memory: the same renderer as synth_session, without the encoders.)"""
     from rocklab.synth._scene import build_scene
 
-    sc = build_scene(seed=0, blocks=1, table="none", fps=50.0, size=(1920, 1080), targets="aruco",
-                     duration_s=1.2, occlusion=None, rolling_shutter=False, block=None,
-                     restitution="constant", eta=0.75, theta0_rad=None, record=None,
-                     table_amplitude_m=0.045, table_period_s=0.6, table_stroke_m=0.05,
-                     exposure_s=None, noise_dn=1.0, distortion=True)
+    sc = build_scene(
+        seed=0,
+        blocks=1,
+        table="none",
+        fps=50.0,
+        size=(1920, 1080),
+        targets="aruco",
+        duration_s=1.2,
+        occlusion=None,
+        rolling_shutter=False,
+        block=None,
+        restitution="constant",
+        eta=0.75,
+        theta0_rad=None,
+        record=None,
+        table_amplitude_m=0.045,
+        table_period_s=0.6,
+        table_stroke_m=0.05,
+        exposure_s=None,
+        noise_dn=1.0,
+        distortion=True,
+    )
     ren, cam = sc.renderer(), sc.camera
     # The pixel -> plane maps invert the camera to < 1e-3 px (they drive the renderer).
     rng = np.random.default_rng(0)
@@ -299,7 +344,7 @@ def test_full_hd_markers_give_theta_to_a_few_hundredths_of_a_degree():
         a, b = a - a.mean(0), b - b.mean(0)
         th = np.arctan2((a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]).sum(), (a * b).sum())
         err.append(th - th_true)
-    assert np.ptp(truth) > 0.1                              # it did rock during the clip
+    assert np.ptp(truth) > 0.1  # it did rock during the clip
     assert np.degrees(np.sqrt(np.mean(np.square(err)))) < 0.05
 
 
@@ -321,8 +366,7 @@ def test_three_blocks_make_a_column_that_follows_the_column_model(tmp_path):
     for j in range(3):
         th = tr[f"block_{j + 1}"]["theta_rad"].to_numpy()
         np.testing.assert_allclose(th[~moving], phi0, atol=1e-12)
-        np.testing.assert_allclose(th[moving], -np.interp(t[moving] - rel, res.t_s, res.theta_rad[:, j]),
-                                   atol=1e-9)
+        np.testing.assert_allclose(th[moving], -np.interp(t[moving] - rel, res.t_s, res.theta_rad[:, j]), atol=1e-9)
     assert np.ptp(tr["block_3"]["theta_rad"]) > 0.05
     # Shared pivot corners: block j's bottom corners against block j-1's top corners.
     bb, hh = 0.1, 0.2
@@ -331,10 +375,12 @@ def test_three_blocks_make_a_column_that_follows_the_column_model(tmp_path):
 
         def corner(g, sx, sy):
             th = g["theta_rad"].to_numpy()
-            return np.c_[g["x_m"] + np.cos(th) * sx - np.sin(th) * sy,
-                         g["y_m"] + np.sin(th) * sx + np.cos(th) * sy]
-        gap = np.minimum(np.hypot(*(corner(lo, -bb / 2, hh / 2) - corner(up, -bb / 2, -hh / 2)).T),
-                         np.hypot(*(corner(lo, bb / 2, hh / 2) - corner(up, bb / 2, -hh / 2)).T))
+            return np.c_[g["x_m"] + np.cos(th) * sx - np.sin(th) * sy, g["y_m"] + np.sin(th) * sx + np.cos(th) * sy]
+
+        gap = np.minimum(
+            np.hypot(*(corner(lo, -bb / 2, hh / 2) - corner(up, -bb / 2, -hh / 2)).T),
+            np.hypot(*(corner(lo, bb / 2, hh / 2) - corner(up, bb / 2, -hh / 2)).T),
+        )
         assert gap.max() < 1e-9
     assert 'objects = ["block_1", "block_2", "block_3"]' in s.experiment_toml.read_text()
     # The top block's IMU (rigid-body kinematics, not a corner pivot) integrates to its angle.

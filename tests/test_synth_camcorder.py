@@ -16,8 +16,7 @@ av = pytest.importorskip("av")
 def test_tracking_survives_h264_and_exposure_flicker(tmp_path, targets):
     import pandas as pd
 
-    s = synth_session(tmp_path / "s", seed=2, size=(960, 540), duration_s=2.4, imu=False, targets=targets,
-                      flicker=0.12)
+    s = synth_session(tmp_path / "s", seed=2, size=(960, 540), duration_s=2.4, imu=False, targets=targets, flicker=0.12)
     meta = json.loads(s.session_json.read_text())
     assert meta["flicker"] == 0.12 and meta["video"]["lossy_codec"] == "h264"
     with av.open(str(s.video_mp4)) as c:
@@ -29,7 +28,7 @@ def test_tracking_survives_h264_and_exposure_flicker(tmp_path, targets):
     # the brightness swings with the renderer's exposure gain (the flicker is really there)
     gain = np.array(meta["video"]["exposure_gain"], float)
     assert gain.max() - gain.min() > 0.1
-    assert np.corrcoef(lum, gain[:lum.size])[0, 1] > 0.95
+    assert np.corrcoef(lum, gain[: lum.size])[0, 1] > 0.95
     tr = track_video(s.video_mp4, load_track_config(s.track_toml))
     truth = pd.read_csv(s.truth_csv)
     tb = truth[truth.object == "block_1"].sort_values("frame")

@@ -10,9 +10,9 @@ from rocklab import G, Block
 from rocklab.tracking import read_imu
 from rocklab.synth import synth_session
 
-GYRO_NOISE = np.deg2rad(0.1)      # rad/s per sample, the synth's error model (session.json)
-ACC_NOISE = 0.005 * G             # m/s^2 per sample
-MOUNT_FRAC = 0.85                 # sensor height on the block, fraction of h (session.json mount_m)
+GYRO_NOISE = np.deg2rad(0.1)  # rad/s per sample, the synth's error model (session.json)
+ACC_NOISE = 0.005 * G  # m/s^2 per sample
+MOUNT_FRAC = 0.85  # sensor height on the block, fraction of h (session.json mount_m)
 
 
 @pytest.fixture(scope="module")
@@ -25,17 +25,18 @@ def short(tmp_path_factory):
     from rocklab.models import simulate
 
     blk = Block(0.1, 0.2, depth_m=0.3, density_kg_m3=2700.0)
-    s = synth_session(tmp_path_factory.mktemp("tail") / "s", seed=5, size=(160, 90), duration_s=1.0,
-                      mp4=False, block=blk)
+    s = synth_session(
+        tmp_path_factory.mktemp("tail") / "s", seed=5, size=(160, 90), duration_s=1.0, mp4=False, block=blk
+    )
     b = s.meta["blocks"][0]
     rel = b["release_s"]
-    res = simulate(blk, theta0_rad=-b["theta0_rad"], duration_s=3.0, dt_s=1e-4,
-                   restitution="constant", eta=b["eta_true"])
+    res = simulate(
+        blk, theta0_rad=-b["theta0_rad"], duration_s=3.0, dt_s=1e-4, restitution="constant", eta=b["eta_true"]
+    )
 
     def theta_sim(t):
         t = np.asarray(t, float)
-        return np.where(t < rel, -b["theta0_rad"],
-                        np.interp(t - rel, res.t_s, res.theta_rad, right=res.theta_rad[-1]))
+        return np.where(t < rel, -b["theta0_rad"], np.interp(t - rel, res.t_s, res.theta_rad, right=res.theta_rad[-1]))
 
     log = read_imu(s.imu["block_1"])
     tv = log.t_s + s.meta["imu"]["block_1"]["t0_video_s"]
@@ -47,7 +48,7 @@ def _last_contiguous_tail(log, tv, t_from):
     k = np.rint(log.t_s * log.rate_hz).astype(np.int64)
     idx = np.flatnonzero(tv > t_from)
     gaps = np.flatnonzero(np.diff(k[idx]) != 1)
-    return idx[gaps[-1] + 1:] if len(gaps) else idx
+    return idx[gaps[-1] + 1 :] if len(gaps) else idx
 
 
 def test_log_outlasts_the_video_and_truth_covers_the_frames_only(short):
@@ -83,8 +84,8 @@ def test_gyro_keeps_following_the_rotation_after_the_video(short):
     expect = (theta_sim(t + dt / 2) - theta_sim(t - dt / 2)) / dt
     # Still rocking: the rate is far above the noise (a block frozen at its last pose reads
     # noise only, RMS 0.1 deg/s) ...
-    assert np.sqrt(np.mean(expect ** 2)) > 50 * GYRO_NOISE
-    assert np.sqrt(np.mean(g ** 2)) > 50 * GYRO_NOISE
+    assert np.sqrt(np.mean(expect**2)) > 50 * GYRO_NOISE
+    assert np.sqrt(np.mean(g**2)) > 50 * GYRO_NOISE
     # ... and follows the simulator sample by sample to within the white noise.
     assert np.sqrt(np.mean((g - expect) ** 2)) < 1.3 * GYRO_NOISE
     # The integrated rate is the simulator's change of angle over the tail: noise of the
@@ -107,7 +108,7 @@ def test_accelerometer_keeps_following_the_rotation_after_the_video(short):
 
     def pos(tt):
         th = theta_sim(tt)
-        piv = np.where(th >= 0, blk.b_m / 2, -blk.b_m / 2)    # theta > 0 pivots on corner A, +x
+        piv = np.where(th >= 0, blk.b_m / 2, -blk.b_m / 2)  # theta > 0 pivots on corner A, +x
         c, sn = np.cos(th), np.sin(th)
         return np.stack([piv + c * (rx - piv) + sn * rz, -sn * (rx - piv) + c * rz], -1)
 
@@ -117,7 +118,7 @@ def test_accelerometer_keeps_following_the_rotation_after_the_video(short):
     th = theta_sim(t)
     c, sn = np.cos(th), np.sin(th)
     fx, fz = a[:, 0], a[:, 1] + G
-    expect = np.stack([c * fx - sn * fz, sn * fx + c * fz], -1)     # R(theta)^T f, sensor x and z
+    expect = np.stack([c * fx - sn * fz, sn * fx + c * fz], -1)  # R(theta)^T f, sensor x and z
     # The impacts' velocity jumps are one-sample spikes whose size depends on where in the
     # sample they fall: compare away from them.
     imp = np.array(s.meta["blocks"][0]["impact_t_s"])
@@ -130,4 +131,4 @@ def test_accelerometer_keeps_following_the_rotation_after_the_video(short):
     # (Along z it stays near G cos(theta): nothing to tell there beyond the residual.)
     assert np.std(expect[far, 0]) > 20 * ACC_NOISE and np.std(got[far, 0]) > 20 * ACC_NOISE
     res = got[far] - expect[far]
-    assert np.sqrt(np.mean(res ** 2, axis=0)).max() < 1.3 * ACC_NOISE
+    assert np.sqrt(np.mean(res**2, axis=0)).max() < 1.3 * ACC_NOISE

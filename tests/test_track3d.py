@@ -14,8 +14,19 @@ from rocklab import Block
 from rocklab._diagnostics import collecting
 from rocklab._errors import InputError
 from rocklab.synth import synth_points3d
-from rocklab.tracking.rigid import (PointSeries, audit_rocking, body_poses, kabsch, read_c3d, read_points,
-                                    read_points_csv, reference_shape, track_points3d, write_c3d, write_points_csv)
+from rocklab.tracking.rigid import (
+    PointSeries,
+    audit_rocking,
+    body_poses,
+    kabsch,
+    read_c3d,
+    read_points,
+    read_points_csv,
+    reference_shape,
+    track_points3d,
+    write_c3d,
+    write_points_csv,
+)
 from rocklab.tracking.rigid._track3d import TRACK3D_COLUMNS, rigid_groups
 
 C3D = Path(__file__).parent / "data" / "c3d"
@@ -35,10 +46,11 @@ def _track(session, **kw):
 
 def _rms(x):
     x = np.asarray(x, float)
-    return float(np.sqrt(np.nanmean(x ** 2)))
+    return float(np.sqrt(np.nanmean(x**2)))
 
 
 # --- readers -------------------------------------------------------------------------------------
+
 
 def test_csv_round_trip_and_mm_columns(tmp_path):
     s = synth_points3d(seed=3, table=False)
@@ -49,25 +61,30 @@ def test_csv_round_trip_and_mm_columns(tmp_path):
     np.testing.assert_allclose(back.t_s, s.series.t_s, atol=1e-9)
     # the same numbers in millimetre columns, one point unseen in one sample
     df = s.series.to_frame()
-    mm = pd.DataFrame({"t_s": df.t_s, "point": df.point, "x_mm": df.x_m * 1e3, "y_mm": df.y_m * 1e3,
-                       "z_mm": df.z_m * 1e3})
+    mm = pd.DataFrame(
+        {"t_s": df.t_s, "point": df.point, "x_mm": df.x_m * 1e3, "y_mm": df.y_m * 1e3, "z_mm": df.z_m * 1e3}
+    )
     mm.loc[5, ["x_mm", "y_mm", "z_mm"]] = np.nan
     mm.to_csv(tmp_path / "mm.csv", index=False)
     b2 = read_points(tmp_path / "mm.csv")
     assert np.isnan(b2.xyz_m).any(axis=2).sum() == 1
-    np.testing.assert_allclose(np.nan_to_num(b2.xyz_m), np.nan_to_num(
-        np.where(np.isnan(b2.xyz_m), np.nan, s.series.xyz_m)), atol=1e-9)
+    np.testing.assert_allclose(
+        np.nan_to_num(b2.xyz_m), np.nan_to_num(np.where(np.isnan(b2.xyz_m), np.nan, s.series.xyz_m)), atol=1e-9
+    )
     assert "from mm to m" in b2.notes[0]
 
 
-@pytest.mark.parametrize("text, match", [
-    ("t_s,point,x_m,y_m\n0,A,1,2\n", "no coordinate columns"),
-    ("time,point,x_m,y_m,z_m\n0,A,1,2,3\n", r"missing column\(s\) \['t_s'\]"),
-    ("t_s,point,x_m,y_m,z_m\n0,A,1,2,3\n0.1,A,abc,2,3\n", r"line 3, 'x_m': not a number"),
-    ("t_s,point,x_m,y_m,z_m\n0,A,1,2,3\n0,A,1,2,3\n0.1,A,1,2,3\n", r"line 3: point 'A' appears twice"),
-    ("t_s,point,x_m,y_m,z_m\n0,A,1,2,3\n0,B,1,2,3\n", "only one sample time"),
-    ("", "empty file"),
-])
+@pytest.mark.parametrize(
+    "text, match",
+    [
+        ("t_s,point,x_m,y_m\n0,A,1,2\n", "no coordinate columns"),
+        ("time,point,x_m,y_m,z_m\n0,A,1,2,3\n", r"missing column\(s\) \['t_s'\]"),
+        ("t_s,point,x_m,y_m,z_m\n0,A,1,2,3\n0.1,A,abc,2,3\n", r"line 3, 'x_m': not a number"),
+        ("t_s,point,x_m,y_m,z_m\n0,A,1,2,3\n0,A,1,2,3\n0.1,A,1,2,3\n", r"line 3: point 'A' appears twice"),
+        ("t_s,point,x_m,y_m,z_m\n0,A,1,2,3\n0,B,1,2,3\n", "only one sample time"),
+        ("", "empty file"),
+    ],
+)
 def test_csv_errors_name_line_and_fix(tmp_path, text, match):
     p = tmp_path / "bad.csv"
     p.write_text(text)
@@ -120,14 +137,15 @@ def test_not_a_c3d_file(tmp_path):
 
 # --- rigid poses ---------------------------------------------------------------------------------
 
+
 def test_kabsch_recovers_exact_pose_with_missing_points():
     rng = np.random.default_rng(0)
     ref = rng.normal(size=(7, 3)) * 0.1
     R = np.stack([_random_rotation(rng) for _ in range(50)])
     t = rng.normal(size=(50, 3))
     cur = np.einsum("nij,pj->npi", R, ref) + t[:, None]
-    cur[3, [0, 4]] = np.nan                      # two points unseen in one sample
-    cur[7, :5] = np.nan                          # only two left: no pose
+    cur[3, [0, 4]] = np.nan  # two points unseen in one sample
+    cur[7, :5] = np.nan  # only two left: no pose
     R2, t2, rms = kabsch(ref, cur)
     ok = np.arange(50) != 7
     np.testing.assert_allclose(R2[ok], R[ok], atol=1e-10)
@@ -140,7 +158,7 @@ def test_body_poses_reject_a_swapped_marker():
     rng = np.random.default_rng(2)
     ref = rng.normal(size=(6, 3)) * 0.1
     cur = np.repeat(ref[None], 20, axis=0) + rng.normal(0, 5e-5, (20, 6, 3))
-    cur[9, 2] += 0.02                            # one marker jumps 20 mm in one sample
+    cur[9, 2] += 0.02  # one marker jumps 20 mm in one sample
     p = body_poses(cur, ref)
     assert p.n_rejected == 1
     assert p.rms_m[9] < 2e-4 and np.allclose(p.R[9], np.eye(3), atol=2e-3)
@@ -151,8 +169,8 @@ def test_reference_shape_places_a_point_unseen_at_rest():
     ref = rng.normal(size=(5, 3)) * 0.1
     R = np.stack([_random_rotation(rng) for _ in range(30)])
     cur = np.einsum("nij,pj->npi", R, ref)
-    cur[:10] = ref                               # at rest for the first ten samples
-    cur[:10, 4] = np.nan                         # ... where point 5 is hidden
+    cur[:10] = ref  # at rest for the first ten samples
+    cur[:10, 4] = np.nan  # ... where point 5 is hidden
     got = reference_shape(cur, np.arange(10))
     np.testing.assert_allclose(got, ref, atol=1e-9)
 
@@ -167,11 +185,12 @@ def test_real_optotrak_rigid_clusters_hold_their_shape():
         sub = s.select(g)
         p = body_poses(sub.xyz_m, reference_shape(sub.xyz_m, np.arange(1)))
         moved = np.nanmax(np.ptp(np.nanmean(sub.xyz_m, axis=1), axis=0))
-        assert moved > 0.05                      # each cluster travels more than 50 mm ...
-        assert np.nanmax(p.rms_m) < 1e-3         # ... and keeps its shape within 1 mm
+        assert moved > 0.05  # each cluster travels more than 50 mm ...
+        assert np.nanmax(p.rms_m) < 1e-3  # ... and keeps its shape within 1 mm
 
 
 # --- the rocking decomposition on simulated motion capture ---------------------------------------
+
 
 @pytest.mark.parametrize("up, yaw", [("z", 27.0), ("-y", -140.0), ("x", 95.0)])
 def test_track_points3d_accuracy(up, yaw):
@@ -180,7 +199,7 @@ def test_track_points3d_accuracy(up, yaw):
     assert not diags
     b = res["block"]
     sign = float(np.sign(b.geometry.e_r @ s.e_r))
-    assert abs(b.geometry.e_r @ s.e_r) > 0.9999          # the rocking direction from the data alone
+    assert abs(b.geometry.e_r @ s.e_r) > 0.9999  # the rocking direction from the data alone
     truth = s.truth
     assert _rms(b.theta_rad - sign * truth.theta_rad) < math.radians(0.02)
     assert _rms(b.twist_rad) < math.radians(0.05)
@@ -205,12 +224,15 @@ def test_track_points3d_rows_have_the_2d_columns():
     assert tab.theta_rad.abs().max() < math.radians(0.1) and tab.pivot_slide_m.isna().all()
 
 
-@pytest.mark.parametrize("kw, kind, impact, value, rel", [
-    (dict(slide=(3, 1e-3)), "slide", 3, 1e-3, 0.1),
-    (dict(jump=(6, 2e-3)), "jump", 6, 2e-3, 0.1),
-    (dict(twist=(9, math.radians(1.0))), "twist", 9, math.radians(1.0), 0.1),
-    (dict(double_impact=12), "double_impact", 12, None, None),
-])
+@pytest.mark.parametrize(
+    "kw, kind, impact, value, rel",
+    [
+        (dict(slide=(3, 1e-3)), "slide", 3, 1e-3, 0.1),
+        (dict(jump=(6, 2e-3)), "jump", 6, 2e-3, 0.1),
+        (dict(twist=(9, math.radians(1.0))), "twist", 9, math.radians(1.0), 0.1),
+        (dict(double_impact=12), "double_impact", 12, None, None),
+    ],
+)
 def test_audit_finds_each_injected_departure_at_its_impact(kw, kind, impact, value, rel):
     s = synth_points3d(seed=7, **kw)
     res, diags = _track(s)
@@ -228,9 +250,15 @@ def test_audit_no_false_alarms_over_20_clean_runs():
     for seed in range(20):
         b = rng.uniform(0.06, 0.25)
         block = Block(b_m=b, h_m=b * rng.uniform(2.5, 6.0))
-        s = synth_points3d(block=block, theta0_rad=rng.uniform(0.3, 0.8) * block.alpha_rad, seed=seed,
-                           yaw_deg=rng.uniform(-180, 180), up=("z", "y", "-x")[seed % 3],
-                           restitution=float(rng.uniform(0.8, 0.95)), table=bool(seed % 2))
+        s = synth_points3d(
+            block=block,
+            theta0_rad=rng.uniform(0.3, 0.8) * block.alpha_rad,
+            seed=seed,
+            yaw_deg=rng.uniform(-180, 180),
+            up=("z", "y", "-x")[seed % 3],
+            restitution=float(rng.uniform(0.8, 0.95)),
+            table=bool(seed % 2),
+        )
         res, diags = _track(s, up=("z", "y", "-x")[seed % 3])
         verdicts.append(res["block"].audit.verdict)
         assert not diags, (seed, [d.message for d in diags])
@@ -251,7 +279,7 @@ def test_audit_on_a_plain_theta_series_double_impact_by_short_half_cycle():
     edges = np.r_[0.0, impacts, 4.0]
     for j, (a, b) in enumerate(zip(edges[:-1], edges[1:])):
         w = (t >= a) & (t < b)
-        th[w] = (-1) ** j * 0.05 * 0.9 ** j * np.sin(np.pi * (t[w] - a) / (b - a))
+        th[w] = (-1) ** j * 0.05 * 0.9**j * np.sin(np.pi * (t[w] - a) / (b - a))
     a = audit_rocking(t, th)
     assert np.allclose(a.impacts_t_s, impacts, atol=2e-3)
     # flagged at the impact that began the short half-cycle
@@ -288,12 +316,21 @@ def test_errors_non_rigid_body_and_bad_options():
 
 # --- the command ---------------------------------------------------------------------------------
 
+
 def test_cli_track3d_c3d_then_fit_restitution(tmp_path, run_cli):
     rc, out, err = run_cli("synth", "--points3d", "--out", tmp_path / "s", "--slide", "4,1.2", "--up=-y")
     assert rc == 0, err
     body = ["--body", "block=" + ",".join(f"B{i}" for i in range(1, 11)), "--body", "table=T1,T2,T3,T4"]
-    rc, out, err = run_cli("track3d", tmp_path / "s" / "points.c3d", "-o", tmp_path / "t" / "tracks.csv",
-                           *body, "--up=-y", "--rrd", tmp_path / "t" / "review.rrd")
+    rc, out, err = run_cli(
+        "track3d",
+        tmp_path / "s" / "points.c3d",
+        "-o",
+        tmp_path / "t" / "tracks.csv",
+        *body,
+        "--up=-y",
+        "--rrd",
+        tmp_path / "t" / "review.rrd",
+    )
     assert rc == 0, err
     # the Rerun review: every sample's targets, the pivot, the plots, one text row per impact and flag
     from rocklab.pipelines.experiment._rerun import read_rrd_summary
@@ -313,8 +350,18 @@ def test_cli_track3d_c3d_then_fit_restitution(tmp_path, run_cli):
     df = pd.read_csv(tmp_path / "t" / "tracks.csv")
     assert list(df.columns) == list(TRACK3D_COLUMNS)
     # the 3D track feeds the restitution fit: Housner's eta for b/h = 1/4 (the simulated law)
-    rc, out, err = run_cli("fit", "restitution", tmp_path / "t" / "tracks.csv", "--object", "block",
-                           "--width", 0.1, "--height", 0.4, "--json")
+    rc, out, err = run_cli(
+        "fit",
+        "restitution",
+        tmp_path / "t" / "tracks.csv",
+        "--object",
+        "block",
+        "--width",
+        0.1,
+        "--height",
+        0.4,
+        "--json",
+    )
     assert rc == 0, err
     eta_h = 1.0 - 1.5 * math.sin(math.atan(0.25)) ** 2
     assert json.loads(out)["eta_e"] == pytest.approx(eta_h, abs=2e-3)
@@ -331,8 +378,9 @@ def test_cli_track3d_bad_input_exits_2(tmp_path, run_cli):
 
 def test_cli_track3d_real_qualisys_pelvis_is_not_planar_rocking(tmp_path, run_cli):
     # a walking subject's pelvis is no block rocking on an edge: the audit must say so, not pass it
-    rc, out, err = run_cli("track3d", C3D / "Qualisys.c3d", "-o", tmp_path / "t.csv",
-                           "--body", "pelvis=L_IAS,L_IPS,R_IPS,R_IAS")
+    rc, out, err = run_cli(
+        "track3d", C3D / "Qualisys.c3d", "-o", tmp_path / "t.csv", "--body", "pelvis=L_IAS,L_IPS,R_IPS,R_IAS"
+    )
     assert rc == 0
     audit = json.loads((tmp_path / "audit.json").read_text())
     assert audit["verdict"] == "invalid"
@@ -341,6 +389,7 @@ def test_cli_track3d_real_qualisys_pelvis_is_not_planar_rocking(tmp_path, run_cl
 
 # --- the audit in an experiment run, and on a plane track ----------------------------------------
 
+
 def _run_on_track3d(session, tmp_path, run_cli, figures: bool):
     """``rocklab run`` of an experiment whose source is the session's track3d output; returns stderr."""
     with collecting():
@@ -348,7 +397,8 @@ def _run_on_track3d(session, tmp_path, run_cli, figures: bool):
     res.to_frame().to_csv(tmp_path / "tracks.csv", index=False)
     (tmp_path / "experiment.toml").write_text(
         '[block]\nb_m = 0.1\nh_m = 0.4\n[sources.track]\npath = "tracks.csv"\nobject = "block"\n'
-        f'[simulate]\nlaws = ["eta_e"]\n[output]\nrrd = false\nfigures = {str(figures).lower()}\n')
+        f'[simulate]\nlaws = ["eta_e"]\n[output]\nrrd = false\nfigures = {str(figures).lower()}\n'
+    )
     rc, out, err = run_cli("run", tmp_path / "experiment.toml", "--out", tmp_path / "out")
     assert rc == 0, err
     return err
@@ -381,8 +431,14 @@ def test_audit_plane_track_finds_a_slide_in_a_plane_track():
     # exact data: the arms are the block's half-width and half-height, the slide a 1 mm step
     np.testing.assert_allclose(np.abs(arms[0]), [half, hc], atol=1e-9)
     assert np.nanmax(sl) - np.nanmin(sl) == pytest.approx(1e-3, abs=1e-6) and rms < 1e-9
-    a = audit_plane_track(tr.t_s, -th + rng.normal(0, 1.7e-4, n), x + rng.normal(0, 5e-5, n),
-                          y + rng.normal(0, 5e-5, n), 1.7e-4, base_width_m=s.block.b_m)
+    a = audit_plane_track(
+        tr.t_s,
+        -th + rng.normal(0, 1.7e-4, n),
+        x + rng.normal(0, 5e-5, n),
+        y + rng.normal(0, 5e-5, n),
+        1.7e-4,
+        base_width_m=s.block.b_m,
+    )
     assert [(f.kind, f.impact) for f in a.flags] == [("slide", 4)] and a.source == "2d"
 
 

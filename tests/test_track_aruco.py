@@ -12,9 +12,13 @@ FPS = 50.0
 
 
 def _config(**extra):
-    d = {"targets": {"style": "aruco", "marker_size_m": 0.08},
-         "objects": [{"id": "block_1", "markers": [1]},
-                     {"id": "table", "kind": "table", "markers": [0], "marker_size_m": 0.05}]}
+    d = {
+        "targets": {"style": "aruco", "marker_size_m": 0.08},
+        "objects": [
+            {"id": "block_1", "markers": [1]},
+            {"id": "table", "kind": "table", "markers": [0], "marker_size_m": 0.05},
+        ],
+    }
     for k, v in extra.items():
         d.setdefault(k, {}).update(v)
     return TrackConfig.from_dict(d)
@@ -30,8 +34,8 @@ def _scene(width, height, px_per_m, roll=0.0, seed=0):
 
 def _truth(n, fps=FPS):
     t = np.arange(n) / fps
-    theta = 0.08 * np.sin(2 * np.pi * t / 0.8)          # rocking-like, up to 4.6 degrees
-    xt = 0.02 * np.sin(2 * np.pi * t / 0.6)            # table displacement, m
+    theta = 0.08 * np.sin(2 * np.pi * t / 0.8)  # rocking-like, up to 4.6 degrees
+    xt = 0.02 * np.sin(2 * np.pi * t / 0.6)  # table displacement, m
     return t, theta, xt
 
 
@@ -51,13 +55,13 @@ def test_full_hd_rotation_and_table_accuracy():
     b = res["block_1"]
     assert np.all(b.status == "ok")
     err_deg = np.degrees(b.theta_rad - theta)
-    assert np.sqrt(np.mean(err_deg ** 2)) <= 0.05
+    assert np.sqrt(np.mean(err_deg**2)) <= 0.05
     # The reported sigma is an honest 1-sigma figure: the same order as the real error.
-    ratio = np.sqrt(np.mean(err_deg ** 2)) / np.degrees(np.median(b.sigma_theta_rad))
+    ratio = np.sqrt(np.mean(err_deg**2)) / np.degrees(np.median(b.sigma_theta_rad))
     assert 0.3 < ratio < 5
     tab = res["table"]
     dx = (tab.x_m - tab.x_m[0]) - (xt - xt[0])
-    assert np.sqrt(np.mean(dx ** 2)) <= 1e-4
+    assert np.sqrt(np.mean(dx**2)) <= 1e-4
     # Block position follows the table; its origin is the marker centre (world y = 0.05 m).
     assert np.sqrt(np.mean(((b.x_m - b.x_m[0]) - (xt - xt[0])) ** 2)) <= 1e-4
     assert b.m_per_unit == pytest.approx(1 / 1800.0, rel=5e-3)
@@ -101,8 +105,7 @@ def test_multi_marker_layout_learnt_and_partial_occlusion(tmp_path):
     W, H, k = 520, 360, 700.0
     sc = Scene(W, H, px_per_m=k, noise=1.5, blur=0.6, seed=5)
     # Origin at the first marker; second marker 0.18 m above it.
-    sc.add(*marker_texture([3, 4], [(0.0, 0.0), (0.0, 0.18)], 0.07, (0.12, 0.32),
-                           origin_m=(-0.06, -0.06)))
+    sc.add(*marker_texture([3, 4], [(0.0, 0.0), (0.0, 0.18)], 0.07, (0.12, 0.32), origin_m=(-0.06, -0.06)))
     n = 20
     theta = np.linspace(-0.1, 0.12, n)
     frames = []
@@ -111,8 +114,13 @@ def test_multi_marker_layout_learnt_and_partial_occlusion(tmp_path):
         if i >= 10:
             f[:160, :] = 100  # hide the upper marker (image rows 99..148)
         frames.append(f)
-    cfg = TrackConfig.from_dict({"targets": {"marker_size_m": 0.07}, "reference": {"level": "none"},
-                                 "objects": [{"id": "b", "markers": [3, 4]}]})
+    cfg = TrackConfig.from_dict(
+        {
+            "targets": {"marker_size_m": 0.07},
+            "reference": {"level": "none"},
+            "objects": [{"id": "b", "markers": [3, 4]}],
+        }
+    )
     res = assemble_tracks(track_frames(frames, cfg), cfg, FPS, W, H)
     b = res["b"]
     assert np.all(b.status == "ok")
@@ -137,16 +145,28 @@ def test_track_video_file_matches_in_memory(tmp_path):
     mem = assemble_tracks(track_frames(frames, cfg), cfg, FPS, W, H)
     np.testing.assert_allclose(res["block_1"].theta_rad, mem["block_1"].theta_rad, atol=1e-12)
     df = res.to_frame()
-    assert list(df.columns) == ["frame", "t_s", "object", "x_px", "y_px", "x_m", "y_m", "theta_rad",
-                                "sigma_theta_rad", "quality", "status"]
+    assert list(df.columns) == [
+        "frame",
+        "t_s",
+        "object",
+        "x_px",
+        "y_px",
+        "x_m",
+        "y_m",
+        "theta_rad",
+        "sigma_theta_rad",
+        "quality",
+        "status",
+    ]
     assert len(df) == 2 * n
     np.testing.assert_allclose(df.loc[df.object == "block_1", "t_s"], np.arange(n) / FPS)
     # a frame range keeps absolute frame numbers and times
     part = track_video(tmp_path / "v.mkv", _config(video={"start_frame": 4, "stop_frame": 9}))
     np.testing.assert_array_equal(part["block_1"].frame, np.arange(4, 9))
     # (the level is the median table angle over the tracked frames, so compare unlevelled)
-    np.testing.assert_allclose(part["block_1"].theta_rad + part.level_rad,
-                               mem["block_1"].theta_rad[4:9] + mem.level_rad, atol=1e-5)
+    np.testing.assert_allclose(
+        part["block_1"].theta_rad + part.level_rad, mem["block_1"].theta_rad[4:9] + mem.level_rad, atol=1e-5
+    )
 
 
 @pytest.mark.parametrize("with_K", [True, False])
@@ -154,19 +174,26 @@ def test_tilted_camera_plane_from_table_markers(with_K):
     """Camera pitched/yawed by ~3°: the table's two markers give the plane homography
     (planar PnP with K, else a homography fit), removing the perspective bias of θ."""
     W, H, k = 960, 540, 900.0
-    sc = Scene(W, H, px_per_m=k, tilt_rad=(0.05, -0.045), roll_rad=0.008, noise=1.5, blur=0.6,
-               seed=11)
+    sc = Scene(W, H, px_per_m=k, tilt_rad=(0.05, -0.045), roll_rad=0.008, noise=1.5, blur=0.6, seed=11)
     sc.add(*marker_texture([1], [(0.0, 0.0)], 0.08, (0.12, 0.2), origin_m=(-0.06, -0.1)))
-    sc.add(*marker_texture([0, 7], [(-0.2, 0.0), (0.2, 0.0)], 0.05, (0.5, 0.07),
-                           origin_m=(-0.25, -0.035)))
+    sc.add(*marker_texture([0, 7], [(-0.2, 0.0), (0.2, 0.0)], 0.05, (0.5, 0.07), origin_m=(-0.25, -0.035)))
     n = 16
     t, theta, xt = _truth(n)
     bx = 0.18  # block off-centre, where perspective distorts angles most
     frames = [sc.render([(bx + xt[i], 0.08, theta[i]), (xt[i], -0.15, 0.0)]) for i in range(n)]
-    d = {"targets": {"marker_size_m": 0.08},
-         "objects": [{"id": "block_1", "markers": [1]},
-                     {"id": "table", "kind": "table", "markers": [0, 7], "marker_size_m": 0.05,
-                      "marker_positions_m": [[-0.2, 0.0], [0.2, 0.0]]}]}
+    d = {
+        "targets": {"marker_size_m": 0.08},
+        "objects": [
+            {"id": "block_1", "markers": [1]},
+            {
+                "id": "table",
+                "kind": "table",
+                "markers": [0, 7],
+                "marker_size_m": 0.05,
+                "marker_positions_m": [[-0.2, 0.0], [0.2, 0.0]],
+            },
+        ],
+    }
     if with_K:
         d["video"] = {"camera_matrix": sc.K.tolist()}
     else:

@@ -58,8 +58,19 @@ def test_cli_writes_tracks_and_table_motion(session, run_cli, tmp_path):
     summary = json.loads(stdout)
     assert summary["fps"] == FPS and summary["objects"]["block_1"]["n_ok"] == len(frames)
     df = pd.read_csv(out)
-    assert list(df.columns) == ["frame", "t_s", "object", "x_px", "y_px", "x_m", "y_m", "theta_rad",
-                                "sigma_theta_rad", "quality", "status"]
+    assert list(df.columns) == [
+        "frame",
+        "t_s",
+        "object",
+        "x_px",
+        "y_px",
+        "x_m",
+        "y_m",
+        "theta_rad",
+        "sigma_theta_rad",
+        "quality",
+        "status",
+    ]
     blk = df[df.object == "block_1"]
     assert np.sqrt(np.mean(np.degrees(blk.theta_rad.to_numpy() - th) ** 2)) < 0.15
     tab = pd.read_csv(summary["table_motion"]["csv"])
@@ -109,8 +120,9 @@ def test_unknown_marker_and_unseen_object(tmp_path, run_cli, session):
     assert "DICT_4X4_50" in err
     unseen = tmp_path / "unseen.toml"
     unseen.write_text(TOML.replace("markers = [1]", "markers = [7]"))
-    _one_line_error(run_cli, d / "video.mkv", "--config", unseen, "-o", tmp_path / "x.csv",
-                    match="'block_1' is never seen")
+    _one_line_error(
+        run_cli, d / "video.mkv", "--config", unseen, "-o", tmp_path / "x.csv", match="'block_1' is never seen"
+    )
     assert not (tmp_path / "x.csv").exists()
 
 

@@ -42,17 +42,19 @@ def test_brief_example_loads_and_round_trips(tmp_path):
     assert again.reference == cfg.reference and again.video == cfg.video
 
 
-@pytest.mark.parametrize("edit, key, line", [
-    (("markers = [0]", "markers = [0]\nfoo = 3"), "objects[1].foo", 17),
-    (('style = "aruco"', 'style = "qr"'), "targets.style", 4),
-    (('dictionary = "DICT_4X4_50"', 'dictionary = "DICT_9X9"'), "targets.dictionary", 5),
-    (("markers = [1]", "markers = [0]"), "objects[1].markers", 16),
-    (("fps = 50", "fps = -5"), "video.fps", 2),
-])
+@pytest.mark.parametrize(
+    "edit, key, line",
+    [
+        (("markers = [0]", "markers = [0]\nfoo = 3"), "objects[1].foo", 17),
+        (('style = "aruco"', 'style = "qr"'), "targets.style", 4),
+        (('dictionary = "DICT_4X4_50"', 'dictionary = "DICT_9X9"'), "targets.dictionary", 5),
+        (("markers = [1]", "markers = [0]"), "objects[1].markers", 16),
+        (("fps = 50", "fps = -5"), "video.fps", 2),
+    ],
+)
 def test_errors_name_key_and_line(tmp_path, edit, key, line):
     p = tmp_path / "track.toml"
-    p.write_text(EXAMPLE.replace(*edit, 1) if edit[0] != "markers = [0]" else
-                 EXAMPLE.replace(*edit))
+    p.write_text(EXAMPLE.replace(*edit, 1) if edit[0] != "markers = [0]" else EXAMPLE.replace(*edit))
     with pytest.raises(InputError) as e:
         load_track_config(p)
     msg = str(e.value)
@@ -61,12 +63,10 @@ def test_errors_name_key_and_line(tmp_path, edit, key, line):
 
 def test_dots_need_two_and_edges_need_roi():
     with pytest.raises(InputError, match="at least two"):
-        TrackConfig.from_dict({"targets": {"style": "dots"},
-                               "objects": [{"id": "b", "dots": [[0.0, 0.0]]}]})
+        TrackConfig.from_dict({"targets": {"style": "dots"}, "objects": [{"id": "b", "dots": [[0.0, 0.0]]}]})
     with pytest.raises(InputError, match="roi"):
         TrackConfig.from_dict({"targets": {"style": "edges"}, "objects": [{"id": "b"}]})
-    cfg = TrackConfig.from_dict({"targets": {"style": "dots"},
-                                 "objects": [{"id": "b", "dots": [[0, 0], [0.1, 0.05]]}]})
+    cfg = TrackConfig.from_dict({"targets": {"style": "dots"}, "objects": [{"id": "b", "dots": [[0, 0], [0.1, 0.05]]}]})
     assert cfg.objects[0].dots == ((0.0, 0.0), (0.1, 0.05))
     assert cfg.reference.level == "table"  # kept as written: tracking warns W-LEVEL-NONE (no table)
 

@@ -7,8 +7,7 @@ import pytest
 
 from _render import Scene, checker_texture, marker_texture
 from rocklab import InputError
-from rocklab.tracking import (BoardConfig, TrackConfig, assemble_tracks, calibrate_camera,
-                              fit_similarity, track_frames)
+from rocklab.tracking import BoardConfig, TrackConfig, assemble_tracks, calibrate_camera, fit_similarity, track_frames
 
 BOARD = {"kind": "checkerboard", "squares_x": 9, "squares_y": 6, "square_m": 0.02}
 
@@ -34,19 +33,21 @@ def test_similarity_fit_exact_and_sigma_matches_monte_carlo():
 def test_board_gives_metric_plane_under_perspective():
     """A checkerboard in frame 0 fixes the plane (origin: its top-left inner corner, y up)."""
     W, H, k = 960, 540, 900.0
-    sc = Scene(W, H, px_per_m=k, tilt_rad=(0.05, -0.045), roll_rad=0.01, noise=1.5, blur=0.6,
-               seed=2)
+    sc = Scene(W, H, px_per_m=k, tilt_rad=(0.05, -0.045), roll_rad=0.01, noise=1.5, blur=0.6, seed=2)
     sc.add(*checker_texture(9, 6, 0.02))
     sc.add(*marker_texture([1], [(0.0, 0.0)], 0.08, (0.12, 0.2), origin_m=(-0.06, -0.1)))
     n = 8
     theta = np.linspace(-0.05, 0.05, n)
     # the board is shown in frame 0 only, then taken away
-    frames = [sc.render([(-0.25, 0.1, 0.0) if i == 0 else (5.0, 5.0, 0.0), (0.2, 0.0, theta[i])])
-              for i in range(n)]
-    cfg = TrackConfig.from_dict({"video": {"camera_matrix": sc.K.tolist()},
-                                 "targets": {"marker_size_m": 0.08},
-                                 "reference": {"board": BOARD},
-                                 "objects": [{"id": "b", "markers": [1]}]})
+    frames = [sc.render([(-0.25, 0.1, 0.0) if i == 0 else (5.0, 5.0, 0.0), (0.2, 0.0, theta[i])]) for i in range(n)]
+    cfg = TrackConfig.from_dict(
+        {
+            "video": {"camera_matrix": sc.K.tolist()},
+            "targets": {"marker_size_m": 0.08},
+            "reference": {"board": BOARD},
+            "objects": [{"id": "b", "markers": [1]}],
+        }
+    )
     res = assemble_tracks(track_frames(frames, cfg), cfg, 50.0, W, H)
     assert res.plane == "board"
     b = res["b"]
@@ -59,8 +60,9 @@ def test_board_missing_is_an_input_error():
     sc = Scene(320, 240, px_per_m=600.0, seed=1)
     sc.add(*marker_texture([1], [(0.0, 0.0)], 0.08, (0.12, 0.2), origin_m=(-0.06, -0.1)))
     frames = [sc.render([(0.0, 0.0, 0.0)])]
-    cfg = TrackConfig.from_dict({"targets": {"marker_size_m": 0.08}, "reference": {"board": BOARD},
-                                 "objects": [{"id": "b", "markers": [1]}]})
+    cfg = TrackConfig.from_dict(
+        {"targets": {"marker_size_m": 0.08}, "reference": {"board": BOARD}, "objects": [{"id": "b", "markers": [1]}]}
+    )
     with pytest.raises(InputError, match="checkerboard 9x6"):
         list(track_frames(frames, cfg))
 
@@ -68,13 +70,13 @@ def test_board_missing_is_an_input_error():
 def test_calibrate_camera_recovers_focal_length(tmp_path):
     W, H, f = 640, 480, 700.0
     frames = []
-    for i, (ax, ay) in enumerate([(0.3, 0.0), (-0.3, 0.1), (0.0, 0.35), (0.2, -0.3), (-0.2, -0.25),
-                                  (0.1, 0.2)]):
+    for i, (ax, ay) in enumerate([(0.3, 0.0), (-0.3, 0.1), (0.0, 0.35), (0.2, -0.3), (-0.2, -0.25), (0.1, 0.2)]):
         sc = Scene(W, H, px_per_m=f, tilt_rad=(ax, ay), noise=1.0, blur=0.6, seed=i)
         sc.add(*checker_texture(9, 6, 0.03))
         frames.append((i, sc.render([(-0.12, 0.075, 0.0)])))
-    K, dist, rms = calibrate_camera(frames, BoardConfig(squares_x=9, squares_y=6, square_m=0.03),
-                                    every=1, out=tmp_path / "cal.npz")
+    K, dist, rms = calibrate_camera(
+        frames, BoardConfig(squares_x=9, squares_y=6, square_m=0.03), every=1, out=tmp_path / "cal.npz"
+    )
     assert rms < 0.1
     assert K[0, 0] == pytest.approx(f, rel=0.01) and K[1, 1] == pytest.approx(f, rel=0.01)
     with np.load(tmp_path / "cal.npz") as z:
@@ -88,21 +90,23 @@ def test_charuco_board_plane():
 
     W, H, k = 960, 540, 900.0
     d = cv2.aruco.getPredefinedDictionary(cv2.aruco.DICT_4X4_50)
-    tex = cv2.aruco.CharucoBoard((7, 5), 0.03, 0.022, d).generateImage(
-        (int(0.21 * TEX), int(0.15 * TEX)))
-    sc = Scene(W, H, px_per_m=k, tilt_rad=(0.04, -0.03), roll_rad=0.01, noise=1.5, blur=0.6,
-               seed=2)
+    tex = cv2.aruco.CharucoBoard((7, 5), 0.03, 0.022, d).generateImage((int(0.21 * TEX), int(0.15 * TEX)))
+    sc = Scene(W, H, px_per_m=k, tilt_rad=(0.04, -0.03), roll_rad=0.01, noise=1.5, blur=0.6, seed=2)
     sc.add(tex, (-0.5, -0.5))  # origin: the board's top-left corner (OpenCV's board frame)
     sc.add(*marker_texture([30], [(0.0, 0.0)], 0.08, (0.12, 0.2), origin_m=(-0.06, -0.1)))
     n = 5
     theta = np.linspace(-0.05, 0.05, n)
-    frames = [sc.render([(-0.4, 0.2, 0.0) if i == 0 else (5.0, 5.0, 0.0), (0.2, 0.0, theta[i])])
-              for i in range(n)]
-    cfg = TrackConfig.from_dict({
-        "video": {"camera_matrix": sc.K.tolist()}, "targets": {"marker_size_m": 0.08},
-        "reference": {"board": {"kind": "charuco", "squares_x": 7, "squares_y": 5,
-                                "square_m": 0.03, "marker_m": 0.022}},
-        "objects": [{"id": "b", "markers": [30]}]})
+    frames = [sc.render([(-0.4, 0.2, 0.0) if i == 0 else (5.0, 5.0, 0.0), (0.2, 0.0, theta[i])]) for i in range(n)]
+    cfg = TrackConfig.from_dict(
+        {
+            "video": {"camera_matrix": sc.K.tolist()},
+            "targets": {"marker_size_m": 0.08},
+            "reference": {
+                "board": {"kind": "charuco", "squares_x": 7, "squares_y": 5, "square_m": 0.03, "marker_m": 0.022}
+            },
+            "objects": [{"id": "b", "markers": [30]}],
+        }
+    )
     res = assemble_tracks(track_frames(frames, cfg), cfg, 50.0, W, H)
     b = res["b"]
     assert res.plane == "board"

@@ -17,17 +17,25 @@ def _scene(seed=0, h=301, w=401):
 
 def _warp(img, W):
     """The picture seen through W (template px -> image px) as a new image of the same size."""
-    return cv2.warpAffine(img, W, (img.shape[1], img.shape[0]), flags=cv2.INTER_CUBIC | cv2.WARP_INVERSE_MAP,
-                          borderMode=cv2.BORDER_REFLECT)
+    return cv2.warpAffine(
+        img,
+        W,
+        (img.shape[1], img.shape[0]),
+        flags=cv2.INTER_CUBIC | cv2.WARP_INVERSE_MAP,
+        borderMode=cv2.BORDER_REFLECT,
+    )
 
 
 U0, V0, TW, TH = 120, 90, 151, 97  # template box in the reference image (odd sizes)
 
 
-@pytest.mark.parametrize("cls, truth", [
-    (ICRigid, (math.radians(1.5), 2.7, -1.9, 1.0, 0.0)),
-    (ICAffine, (math.radians(-2.0), -1.3, 2.2, 1.004, 0.003)),  # + 0.4 % scale, 0.3 % shear
-])
+@pytest.mark.parametrize(
+    "cls, truth",
+    [
+        (ICRigid, (math.radians(1.5), 2.7, -1.9, 1.0, 0.0)),
+        (ICAffine, (math.radians(-2.0), -1.3, 2.2, 1.004, 0.003)),  # + 0.4 % scale, 0.3 % shear
+    ],
+)
 def test_recovers_the_true_warp_under_gain_and_offset(cls, truth):
     ref = _scene()
     th, tx, ty, sx, sh = truth
@@ -35,7 +43,7 @@ def test_recovers_the_true_warp_under_gain_and_offset(cls, truth):
     # image pixel = A @ template pixel + t, about the template's own origin (U0, V0)
     A = np.array([[c, -s], [s, c]]) @ np.array([[sx, sh], [0.0, 1.0]])
     W_true = np.hstack((A, [[U0 + tx], [V0 + ty]])).astype(np.float32)
-    tmpl = ref[V0:V0 + TH, U0:U0 + TW].copy()
+    tmpl = ref[V0 : V0 + TH, U0 : U0 + TW].copy()
     # the new picture: the template placed by W_true, then 1.3x gain and -20 offset (lighting)
     M = np.hstack((A, np.array([[U0 + tx], [V0 + ty]]))) @ np.array([[1, 0, -U0], [0, 1, -V0], [0, 0, 1.0]])
     big = cv2.warpAffine(ref, M, (ref.shape[1], ref.shape[0]), flags=cv2.INTER_CUBIC, borderMode=cv2.BORDER_REFLECT)
@@ -45,10 +53,12 @@ def test_recovers_the_true_warp_under_gain_and_offset(cls, truth):
     corners = np.array([[0, 0], [TW - 1, 0], [0, TH - 1], [TW - 1, TH - 1]], float)
     got = corners @ W[:, :2].T + W[:, 2]
     true = corners @ W_true[:, :2].T + W_true[:, 2]
-    assert np.abs(got - true).max() < 0.03, (got - true)  # px, at every corner
+    assert np.abs(got - true).max() < 0.03, got - true  # px, at every corner
     assert cc > 0.999  # gain and offset do not lower the correlation
 
 
 def test_no_contrast_is_none_not_a_number():
     tmpl = _scene()[:50, :60].copy()
-    assert ICRigid(tmpl).refine(np.full((200, 200), 90, np.float32), np.array([[1, 0, 5], [0, 1, 5]], np.float32)) is None
+    assert (
+        ICRigid(tmpl).refine(np.full((200, 200), 90, np.float32), np.array([[1, 0, 5], [0, 1, 5]], np.float32)) is None
+    )

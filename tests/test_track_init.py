@@ -62,20 +62,24 @@ def test_preview_sheet(session, tmp_path, run_cli):
 
     cfg = tmp_path / "t.toml"
     assert run_cli("track", "init", session / "video.mkv", "-o", cfg)[0] == 0
-    rc, out, err = run_cli("track", "preview", session / "video.mkv", "--config", cfg, "-o", tmp_path / "s.png",
-                           "--frames", 4)
+    rc, out, err = run_cli(
+        "track", "preview", session / "video.mkv", "--config", cfg, "-o", tmp_path / "s.png", "--frames", 4
+    )
     assert rc == 0, err
     img = cv2.imread(str(tmp_path / "s.png"))
     assert img.shape[1] == 1800 and img.shape[0] == 2 * int(540 * 1800 / (3 * 960))
 
 
-@pytest.mark.parametrize("extra, words", [
-    (["--object", "a=900,500,200,100"], "leaves the 960x540"),
-    (["--object", "a=100,100,200,100", "--object", "b=150,120,200,100"], "overlap"),
-    (["--object", "a=1,2,3"], "x,y,w,h"),
-    (["--object", "a=100,100,200,100", "--object", "a=300,100,50,50"], "given twice"),
-    (["--table", "0,0,-5,5"], "w, h > 0"),
-])
+@pytest.mark.parametrize(
+    "extra, words",
+    [
+        (["--object", "a=900,500,200,100"], "leaves the 960x540"),
+        (["--object", "a=100,100,200,100", "--object", "b=150,120,200,100"], "overlap"),
+        (["--object", "a=1,2,3"], "x,y,w,h"),
+        (["--object", "a=100,100,200,100", "--object", "a=300,100,50,50"], "given twice"),
+        (["--table", "0,0,-5,5"], "w, h > 0"),
+    ],
+)
 def test_init_bad_regions(session, tmp_path, run_cli, extra, words):
     rc, out, err = run_cli("track", "init", session / "video.mkv", "-o", tmp_path / "t.toml", *extra)
     assert rc == 2 and err.count("\n") == 1 and words in err

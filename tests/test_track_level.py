@@ -28,8 +28,9 @@ def scene():
 
 
 def _run(frames, reference, objects):
-    cfg = TrackConfig.from_dict({"targets": {"style": "aruco", "marker_size_m": 0.06},
-                                 "reference": reference, "objects": objects})
+    cfg = TrackConfig.from_dict(
+        {"targets": {"style": "aruco", "marker_size_m": 0.06}, "reference": reference, "objects": objects}
+    )
     return assemble_tracks(track_frames(frames, cfg), cfg, FPS, 1280, 720)
 
 
@@ -73,8 +74,12 @@ def test_level_from_markerless_table_top_edge(scene):
     uv = sc.world_to_image([(-0.24, -0.115), (0.24, -0.145)])
     x0, y0 = uv.min(axis=0)
     x1, y1 = uv.max(axis=0)
-    table = {"id": "table", "kind": "table", "style": "markerless", "roi": [float(x0), float(y0) - 8,
-                                                                              float(x1 - x0), float(y1 - y0) + 8]}
+    table = {
+        "id": "table",
+        "kind": "table",
+        "style": "markerless",
+        "roi": [float(x0), float(y0) - 8, float(x1 - x0), float(y1 - y0) + 8],
+    }
     res = _run(frames, {"level": "table", "m_per_px": 1 / 1500.0}, [BLOCK, table])
     assert abs(res.level_rad - ROLL) <= TOL, math.degrees(res.level_rad - ROLL)
     assert res.level_source == "table table"

@@ -28,7 +28,7 @@ def _scene(n=60, W=481, H=361, k=1000.0, seed=6, occlude=None):
     sc = Scene(W, H, px_per_m=k, noise=1.5, blur=0.6, seed=seed)
     sc.add(_textured_block(), (0.05 * TEX - 0.5, 0.075 * TEX - 0.5))
     t = np.arange(n) / FPS
-    theta = 0.35 * np.sin(2 * np.pi * t / 1.0)          # up to 20 deg
+    theta = 0.35 * np.sin(2 * np.pi * t / 1.0)  # up to 20 deg
     xt = 0.03 * np.sin(2 * np.pi * t / 0.7)
     frames = []
     for i in range(n):
@@ -43,13 +43,18 @@ def _scene(n=60, W=481, H=361, k=1000.0, seed=6, occlude=None):
 def test_markerless_block_rotation_position_and_sigma():
     sc, frames, theta, xt = _scene()
     roi = _roi(sc, (-0.045, 0.07), (0.045, -0.07))
-    cfg = TrackConfig.from_dict({"targets": {"style": "markerless"}, "reference": {"m_per_px": 1e-3, "level": "none"},
-                                 "objects": [{"id": "b", "roi": roi, "theta0_rad": float(theta[0])}]})
+    cfg = TrackConfig.from_dict(
+        {
+            "targets": {"style": "markerless"},
+            "reference": {"m_per_px": 1e-3, "level": "none"},
+            "objects": [{"id": "b", "roi": roi, "theta0_rad": float(theta[0])}],
+        }
+    )
     res = assemble_tracks(track_frames(frames, cfg), cfg, FPS, 481, 361)
     b = res["b"]
     assert np.all(b.status == "ok")
     err_deg = np.degrees(b.theta_rad - theta)
-    rms = float(np.sqrt(np.mean(err_deg ** 2)))
+    rms = float(np.sqrt(np.mean(err_deg**2)))
     assert rms <= 0.05, rms
     assert np.sqrt(np.mean((b.x_m - xt) ** 2)) < 1e-4
     # the reported sigma means something: within a factor 5 of the actual error, never ~1e-17
@@ -60,8 +65,13 @@ def test_markerless_block_rotation_position_and_sigma():
 def test_markerless_occlusion_lost_then_reacquired():
     sc, frames, theta, xt = _scene(occlude=(20, 26))
     roi = _roi(sc, (-0.045, 0.07), (0.045, -0.07))
-    cfg = TrackConfig.from_dict({"targets": {"style": "markerless"}, "reference": {"m_per_px": 1e-3, "level": "none"},
-                                 "objects": [{"id": "b", "roi": roi, "theta0_rad": float(theta[0])}]})
+    cfg = TrackConfig.from_dict(
+        {
+            "targets": {"style": "markerless"},
+            "reference": {"m_per_px": 1e-3, "level": "none"},
+            "objects": [{"id": "b", "roi": roi, "theta0_rad": float(theta[0])}],
+        }
+    )
     res = assemble_tracks(track_frames(frames, cfg), cfg, FPS, 481, 361)
     b = res["b"]
     hidden = np.arange(20, 26)
@@ -73,8 +83,13 @@ def test_markerless_occlusion_lost_then_reacquired():
 
 def test_markerless_region_without_texture_is_an_error():
     frame = np.full((120, 160), 128, np.uint8)
-    cfg = TrackConfig.from_dict({"targets": {"style": "markerless"}, "reference": {"m_per_px": 1e-3, "level": "none"},
-                                 "objects": [{"id": "wall", "roi": [20, 20, 40, 40]}]})
+    cfg = TrackConfig.from_dict(
+        {
+            "targets": {"style": "markerless"},
+            "reference": {"m_per_px": 1e-3, "level": "none"},
+            "objects": [{"id": "wall", "roi": [20, 20, 40, 40]}],
+        }
+    )
     with pytest.raises(InputError, match="'wall'.*no texture") as e:
         list(track_frames([frame, frame], cfg))
     assert "\n" not in str(e.value)
@@ -100,8 +115,13 @@ def test_real_pendulum_footage(shared_data):
         ys, xs = np.nonzero(m)
         blob_x.append(xs.mean() if xs.size > 30 else np.nan)
     blob_x = np.array(blob_x)
-    cfg = TrackConfig.from_dict({"targets": {"style": "markerless"}, "reference": {"level": "none"},
-                                 "objects": [{"id": "ball", "roi": [310, 66, 70, 74]}]})
+    cfg = TrackConfig.from_dict(
+        {
+            "targets": {"style": "markerless"},
+            "reference": {"level": "none"},
+            "objects": [{"id": "ball", "roi": [310, 66, 70, 74]}],
+        }
+    )
     obs = [o for fr in track_frames(((i, g) for i, g in iter_video_frames(path)), cfg) for o in fr]
     ok = np.array([o.status == "ok" for o in obs])
     assert ok.mean() >= 0.99, ok.mean()
@@ -136,8 +156,11 @@ def test_mixed_styles_aruco_block_on_markerless_table(tmp_path):
     text = (out / "track.toml").read_text()
     # the table object becomes markerless: a roi round the left part of its top edge (texture, a
     # marker, and the top edge that levels the angles)
-    text = text.replace('id = "table"\nkind = "table"\n', 'id = "table"\nkind = "table"\nstyle = "markerless"\n'
-                        'roi = [125.0, 322.0, 290.0, 44.0]\n', 1)
+    text = text.replace(
+        'id = "table"\nkind = "table"\n',
+        'id = "table"\nkind = "table"\nstyle = "markerless"\nroi = [125.0, 322.0, 290.0, 44.0]\n',
+        1,
+    )
     (out / "track.toml").write_text(text)
     cfg = load_track_config(out / "track.toml")
     assert cfg.object("table").style == "markerless" and cfg.targets.style == "aruco"
@@ -166,8 +189,16 @@ def test_markerless_synth_session_granite_block(tmp_path, table, size):
     from rocklab.synth import synth_session
 
     out = tmp_path / "s"
-    synth_session(out, seed=1 if table == "none" else 3, table=table, size=size,
-                  duration_s=4.0 if table == "none" else 1.8, imu=False, mp4=False, targets="markerless")
+    synth_session(
+        out,
+        seed=1 if table == "none" else 3,
+        table=table,
+        size=size,
+        duration_s=4.0 if table == "none" else 1.8,
+        imu=False,
+        mp4=False,
+        targets="markerless",
+    )
     res = track_video(out / "video.mkv", load_track_config(out / "track.toml"))
     truth = pd.read_csv(out / "truth.csv")
     tb = truth[truth.object == "block_1"].sort_values("frame")
@@ -200,8 +231,11 @@ def test_table_region_on_the_block_is_flagged(tmp_path):
     synth_session(out, seed=1, size=(960, 540), duration_s=1.5, imu=False, mp4=False, targets="markerless")
     text = (out / "track.toml").read_text()
     block_roi = re.search(r'id = "block_1"\nkind = "block"\nmarkers = \[\]\ndots = \[\]\nroi = (\[[^\]]*\])', text)
-    text = re.sub(r'(id = "table"\nkind = "table"\nmarkers = \[\]\ndots = \[\]\nroi = )\[[^\]]*\]',
-                  lambda m: m.group(1) + block_roi.group(1), text)
+    text = re.sub(
+        r'(id = "table"\nkind = "table"\nmarkers = \[\]\ndots = \[\]\nroi = )\[[^\]]*\]',
+        lambda m: m.group(1) + block_roi.group(1),
+        text,
+    )
     (out / "t.toml").write_text(text.replace('level = "table"', 'level = "none"'))
     with collecting() as found:
         track_video(out / "video.mkv", load_track_config(out / "t.toml"))

@@ -21,10 +21,10 @@ def _pulse(t):
     e = 0.5 - 0.5 * np.cos(np.pi * u)
     du = np.where((u > 0) & (u < 1), np.where(t - t0 < t1 - t, 1.0, -1.0) / r, 0.0)
     e1 = 0.5 * np.pi * np.sin(np.pi * u) * du
-    e2 = 0.5 * np.pi ** 2 * np.cos(np.pi * u) * du ** 2
+    e2 = 0.5 * np.pi**2 * np.cos(np.pi * u) * du**2
     s, c = np.sin(w * t), np.cos(w * t)
     x = A_M * s * e
-    a = A_M * (-w ** 2 * s * e + 2 * w * c * e1 + s * e2)
+    a = A_M * (-(w**2) * s * e + 2 * w * c * e1 + s * e2)
     return x, a
 
 
@@ -60,7 +60,7 @@ def test_noise_estimate_on_white_noise():
 
 def test_gaps_stay_nan_and_segments_are_differentiated_separately():
     t = np.arange(0, 4.0, 1 / FPS)
-    x = 0.5 * 2.0 * t ** 2  # constant 2 m/s² acceleration
+    x = 0.5 * 2.0 * t**2  # constant 2 m/s² acceleration
     x[80:130] = np.nan
     tm = table_motion(t, x, window_s=0.2, polyorder=2)
     assert np.all(np.isnan(tm.ax_m_s2[80:130]))

@@ -10,8 +10,9 @@ def test_to_pixels_matches_true_projection(tmp_path, calibrated):
     from rocklab.tracking import load_track_config, track_video
     from rocklab.synth import synth_session
 
-    s = synth_session(tmp_path / "s", seed=6, size=(960, 540), duration_s=2.0, imu=False, mp4=False,
-                      calibrated=calibrated)
+    s = synth_session(
+        tmp_path / "s", seed=6, size=(960, 540), duration_s=2.0, imu=False, mp4=False, calibrated=calibrated
+    )
     tr = track_video(s.video_mkv, load_track_config(s.track_toml))
     b = s.meta["blocks"][0]["block"]
     corners = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1]]) * [b["b_m"] / 2, b["h_m"] / 2]
@@ -22,7 +23,9 @@ def test_to_pixels_matches_true_projection(tmp_path, calibrated):
         px = tr.to_pixels("block_1", f, corners)
         x, y, th = truth.loc[f, ["x_m", "y_m", "theta_rad"]]
         c, sn = np.cos(th), np.sin(th)
-        world = np.column_stack((x + c * corners[:, 0] - sn * corners[:, 1], y + sn * corners[:, 0] + c * corners[:, 1]))
+        world = np.column_stack(
+            (x + c * corners[:, 0] - sn * corners[:, 1], y + sn * corners[:, 0] + c * corners[:, 1])
+        )
         errs.append(np.abs(px - cam.project(world)).max())
     # with the homography the overlay is within a few hundredths of a pixel; without it (marker
     # scale, no lens model) within a pixel at the block's corners

@@ -18,8 +18,17 @@ def sine_session(tmp_path_factory, request):
     out = tmp_path_factory.mktemp("synth") / request.param
     # 640x360 keeps the test short; the 45 mm / 0.6 s sine pulse of thesis Fig. 31 at 50 fps,
     # block_1 hidden for 0.5 s while the table is at rest.
-    synth_session(out, seed=3, table="sine", size=(640, 360), duration_s=1.8, imu=False,
-                  mp4=False, occlusion=(0.05, 0.55), targets=request.param)
+    synth_session(
+        out,
+        seed=3,
+        table="sine",
+        size=(640, 360),
+        duration_s=1.8,
+        imu=False,
+        mp4=False,
+        occlusion=(0.05, 0.55),
+        targets=request.param,
+    )
     cfg = load_track_config(out / "track.toml")
     # the occlusion hides block_1 on ~26 % of the frames: the tracker must say so
     with pytest.warns(RocklabWarning, match="W-VIDEO-LOST.*block_1"):
@@ -37,13 +46,13 @@ def test_block_rotation_and_occlusion(sine_session):
     b = res["block_1"]
     tb = _truth(truth, "block_1")
     np.testing.assert_array_equal(b.frame, tb.frame)
-    hidden = (tb.t_s > 0.07) & (tb.t_s < 0.53)   # inside the occlusion (edges blurred by exposure)
+    hidden = (tb.t_s > 0.07) & (tb.t_s < 0.53)  # inside the occlusion (edges blurred by exposure)
     assert hidden.sum() >= 20
     assert np.all(b.status[hidden] != "ok") and np.all(np.isnan(b.theta_rad[hidden]))
     ok = b.status == "ok"
     assert ok.sum() >= 0.6 * len(ok)
     err = np.degrees(b.theta_rad[ok] - tb.theta_rad[ok])
-    assert np.sqrt(np.mean(err ** 2)) <= 0.05
+    assert np.sqrt(np.mean(err**2)) <= 0.05
     # positions are absolute (synth's track.toml carries the plane homography)
     assert np.sqrt(np.mean((b.x_m[ok] - tb.x_m[ok]) ** 2 + (b.y_m[ok] - tb.y_m[ok]) ** 2)) < 3e-4
 
@@ -53,7 +62,7 @@ def test_table_displacement_and_acceleration(sine_session):
     tt = _truth(truth, "table")
     tab = res["table"]
     assert np.all(tab.status == "ok")
-    assert np.sqrt(np.mean((tab.x_m - tt.x_m) ** 2)) <= 1e-4          # <= 0.1 mm
+    assert np.sqrt(np.mean((tab.x_m - tt.x_m) ** 2)) <= 1e-4  # <= 0.1 mm
     tm = res.table_motion()
     a_true = tt.ax_m_s2.to_numpy()
     m = np.isfinite(tm.ax_m_s2)

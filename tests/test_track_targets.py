@@ -39,8 +39,15 @@ def test_dot_centroid_is_subpixel():
         c = rng.uniform(30, 34, 2)
         img = np.full((64, 64), 200.0, np.float32)
         big = np.full((256, 256), 200, np.uint8)
-        cv2.circle(big, (int(round((c[0] * 4 + 1.5) * 16)), int(round((c[1] * 4 + 1.5) * 16))),
-                   9 * 4 * 16, 30, -1, cv2.LINE_AA, 4)
+        cv2.circle(
+            big,
+            (int(round((c[0] * 4 + 1.5) * 16)), int(round((c[1] * 4 + 1.5) * 16))),
+            9 * 4 * 16,
+            30,
+            -1,
+            cv2.LINE_AA,
+            4,
+        )
         img = cv2.resize(big, (64, 64), interpolation=cv2.INTER_AREA).astype(np.float32)
         img += rng.normal(0, 2.0, img.shape)
         u, v, d, _ = dot_centroid(np.clip(img, 0, 255).astype(np.uint8), c + 1.5, 16)
@@ -59,9 +66,12 @@ def test_dots_full_hd_rotation_accuracy():
     n = 20
     theta, xt = _truth(n)
     frames = [sc.render([(xt[i], -0.05, theta[i]), (xt[i], -0.2, 0.0)]) for i in range(n)]
-    cfg = TrackConfig.from_dict({"targets": {"style": "dots", "dot_diameter_m": 0.02},
-                                 "objects": [{"id": "b", "dots": dots},
-                                             {"id": "table", "kind": "table", "dots": tdots}]})
+    cfg = TrackConfig.from_dict(
+        {
+            "targets": {"style": "dots", "dot_diameter_m": 0.02},
+            "objects": [{"id": "b", "dots": dots}, {"id": "table", "kind": "table", "dots": tdots}],
+        }
+    )
     res = assemble_tracks(track_frames(frames, cfg), cfg, FPS, 1920, 1080)
     b, tab = res["b"], res["table"]
     assert np.all(b.status == "ok") and np.all(tab.status == "ok")
@@ -74,17 +84,21 @@ def test_dots_full_hd_rotation_accuracy():
 
 def test_edges_full_hd_rotation_accuracy():
     """Plain light block on a dark background, table levelled from its top edge: RMS <= 0.15°."""
-    sc = Scene(1920, 1080, px_per_m=1800.0, roll_rad=ROLL, noise=2.0, blur=0.7, seed=5,
-               background=(40, 70))
+    sc = Scene(1920, 1080, px_per_m=1800.0, roll_rad=ROLL, noise=2.0, blur=0.7, seed=5, background=(40, 70))
     sc.add(*plain_texture((0.1, 0.2), grey=215, origin_m=(-0.05, -0.1)))
     sc.add(*_textured_table())
     n = 20
     theta, xt = _truth(n)
     frames = [sc.render([(xt[i], -0.05, theta[i]), (xt[i], -0.2, 0.0)]) for i in range(n)]
-    cfg = TrackConfig.from_dict({
-        "targets": {"style": "edges"},
-        "objects": [{"id": "b", "roi": _roi(sc, (-0.06, 0.06), (0.06, -0.16)), "size_m": [0.1, 0.2]},
-                    {"id": "table", "kind": "table", "roi": _roi(sc, (-0.25, -0.16), (0.25, -0.21))}]})
+    cfg = TrackConfig.from_dict(
+        {
+            "targets": {"style": "edges"},
+            "objects": [
+                {"id": "b", "roi": _roi(sc, (-0.06, 0.06), (0.06, -0.16)), "size_m": [0.1, 0.2]},
+                {"id": "table", "kind": "table", "roi": _roi(sc, (-0.25, -0.16), (0.25, -0.21))},
+            ],
+        }
+    )
     res = assemble_tracks(track_frames(frames, cfg), cfg, FPS, 1920, 1080)
     b, tab = res["b"], res["table"]
     assert np.all(b.status == "ok") and np.all(tab.status == "ok")
@@ -107,9 +121,13 @@ def test_region_tracker_rotation_and_scale_from_m_per_px():
     theta = 0.35 * np.sin(2 * np.pi * np.arange(n) / FPS / 1.0)  # up to 20°: beyond LK windows
     frames = [sc.render([(xt[i], 0.0, theta[i])]) for i in range(n)]
     roi = _roi(sc, (-0.035, 0.05), (0.035, -0.05))
-    cfg = TrackConfig.from_dict({"targets": {"style": "region"},
-                                 "reference": {"m_per_px": 1 / k, "level": "none"},
-                                 "objects": [{"id": "b", "roi": roi, "theta0_rad": float(theta[0])}]})
+    cfg = TrackConfig.from_dict(
+        {
+            "targets": {"style": "region"},
+            "reference": {"m_per_px": 1 / k, "level": "none"},
+            "objects": [{"id": "b", "roi": roi, "theta0_rad": float(theta[0])}],
+        }
+    )
     res = assemble_tracks(track_frames(frames, cfg), cfg, FPS, W, H)
     b = res["b"]
     assert np.all(b.status == "ok")
@@ -121,8 +139,13 @@ def test_region_without_any_scale_keeps_pixels_and_leaves_metres_empty():
     sc = Scene(200, 150, px_per_m=500.0, seed=8)
     sc.add(*_textured_table(0.2, 0.1))
     frames = [sc.render([(0.01 * i, 0.0, 0.0)]) for i in range(3)]
-    cfg = TrackConfig.from_dict({"targets": {"style": "region"}, "reference": {"level": "none"},
-                                 "objects": [{"id": "t", "kind": "table", "roi": [60, 40, 80, 60]}]})
+    cfg = TrackConfig.from_dict(
+        {
+            "targets": {"style": "region"},
+            "reference": {"level": "none"},
+            "objects": [{"id": "t", "kind": "table", "roi": [60, 40, 80, 60]}],
+        }
+    )
     with pytest.warns(RocklabWarning, match="W-TRACK-NOSCALE"):  # never a made-up scale
         res = assemble_tracks(track_frames(frames, cfg), cfg, FPS, 200, 150)
     t = res["t"]
@@ -139,14 +162,19 @@ def test_apriltag_style():
 
     W, H, k = 640, 400, 900.0
     sc = Scene(W, H, px_per_m=k, noise=1.5, blur=0.6, seed=1)
-    sc.add(*marker_texture([5], [(0.0, 0.0)], 0.08, (0.12, 0.2), origin_m=(-0.06, -0.1),
-                           dictionary="DICT_APRILTAG_36h11"))
+    sc.add(
+        *marker_texture([5], [(0.0, 0.0)], 0.08, (0.12, 0.2), origin_m=(-0.06, -0.1), dictionary="DICT_APRILTAG_36h11")
+    )
     n = 10
     theta = np.linspace(-0.1, 0.1, n)
     frames = [sc.render([(0.0, 0.0, theta[i])]) for i in range(n)]
-    cfg = TrackConfig.from_dict({"targets": {"style": "apriltag", "marker_size_m": 0.08},
-                                 "reference": {"level": "none"},
-                                 "objects": [{"id": "b", "markers": [5]}]})
+    cfg = TrackConfig.from_dict(
+        {
+            "targets": {"style": "apriltag", "marker_size_m": 0.08},
+            "reference": {"level": "none"},
+            "objects": [{"id": "b", "markers": [5]}],
+        }
+    )
     assert cfg.targets.dictionary == "DICT_APRILTAG_36h11"  # the style's default
     res = assemble_tracks(track_frames(frames, cfg), cfg, FPS, W, H)
     b = res["b"]

@@ -6,21 +6,21 @@ import cv2
 import numpy as np
 import pytest
 
-W, H, N = 320, 200, 6                     # non-square, so a transposed frame would show
+W, H, N = 320, 200, 6  # non-square, so a transposed frame would show
 BLUE, RED = (200, 60, 30), (30, 40, 220)  # BGR
-MARKER = (180, 60, 64)                    # ArUco id 1: left, top, side (px)
+MARKER = (180, 60, 64)  # ArUco id 1: left, top, side (px)
 
 
 def _frame(i):
     img = np.empty((H, W, 3), np.uint8)
     img[:] = BLUE
     x0 = 20 + 4 * i  # the square moves: a frame kept under the wrong index would show
-    img[20:80, x0:x0 + 60] = RED
+    img[20:80, x0 : x0 + 60] = RED
     u, v, s = MARKER
     q = s // 8
-    img[v - q:v + s + q, u - q:u + s + q] = 255
+    img[v - q : v + s + q, u - q : u + s + q] = 255
     m = cv2.aruco.generateImageMarker(cv2.aruco.getPredefinedDictionary(cv2.aruco.DICT_4X4_50), 1, s)
-    img[v:v + s, u:u + s] = m[..., None]
+    img[v : v + s, u : u + s] = m[..., None]
     return img
 
 
@@ -46,9 +46,13 @@ def _track(path, decimation=2, codec="jpeg"):
     from rocklab.pipelines.experiment._review_video import ReviewFilm
     from rocklab.tracking import TrackConfig, track_video
 
-    cfg = TrackConfig.from_dict({"targets": {"style": "aruco", "marker_size_m": 0.05},
-                                 "reference": {"level": "none"},  # rendered level
-                                 "objects": [{"id": "block_1", "markers": [1]}]})
+    cfg = TrackConfig.from_dict(
+        {
+            "targets": {"style": "aruco", "marker_size_m": 0.05},
+            "reference": {"level": "none"},  # rendered level
+            "objects": [{"id": "block_1", "markers": [1]}],
+        }
+    )
     film = ReviewFilm(50.0, decimation, codec=codec)
     tr = track_video(path, cfg, fps=50.0, on_frame=film)
     out = film.finish()
@@ -82,7 +86,7 @@ def test_colour_source_gives_colour_jpeg_through_rrd(videos, tmp_path):
         bgr = _decode(data)
         assert bgr.shape == (H, W, 3)  # overlays are pixels of this frame size
         x0 = 20 + 4 * i
-        b, g, r = bgr[25:75, x0 + 5:x0 + 55].reshape(-1, 3).mean(axis=0)
+        b, g, r = bgr[25:75, x0 + 5 : x0 + 55].reshape(-1, 3).mean(axis=0)
         assert r > 150 and b < 80 and g < 80, (i, b, g, r)  # red square, truth (30, 40, 220) BGR
         b, g, r = bgr[120:190, 20:150].reshape(-1, 3).mean(axis=0)
         assert b > 150 and r < 80, (i, b, g, r)  # blue background, truth (200, 60, 30)
@@ -94,7 +98,7 @@ def test_colour_source_gives_colour_jpeg_through_rrd(videos, tmp_path):
     for i, data in jpeg:
         px = tr.to_pixels("block_1", i, [[0.0, 0.0]])[0]
         assert px == pytest.approx([u + s / 2 - 0.5, v + s / 2 - 0.5], abs=0.5)
-        patch = _decode(data)[v + 4:v + s - 4, u + 4:u + s - 4].astype(float)
+        patch = _decode(data)[v + 4 : v + s - 4, u + 4 : u + s - 4].astype(float)
         assert np.abs(patch[..., 0] - patch[..., 2]).mean() < 25  # background: |B - R| = 170
 
 
@@ -107,7 +111,7 @@ def test_grey_source_stays_one_channel(videos):
         assert img.shape == (H, W)  # one channel: a grey video is not blown up to three
         truth = cv2.cvtColor(_frame(i), cv2.COLOR_BGR2GRAY)
         x0 = 20 + 4 * i
-        assert abs(img[25:75, x0 + 5:x0 + 55].mean() - truth[25:75, x0 + 5:x0 + 55].mean()) < 3
+        assert abs(img[25:75, x0 + 5 : x0 + 55].mean() - truth[25:75, x0 + 5 : x0 + 55].mean()) < 3
 
 
 def test_is_grey_detects_colour_hidden_from_the_sample():
@@ -139,7 +143,7 @@ def test_av1_film_has_every_frame_in_order_and_in_colour(videos, tmp_path):
     for i, bgr in enumerate(dec):
         bgr = bgr[:H, :W]
         x0 = 20 + 4 * i
-        b, g, r = bgr[25:75, x0 + 5:x0 + 55].reshape(-1, 3).mean(axis=0)
+        b, g, r = bgr[25:75, x0 + 5 : x0 + 55].reshape(-1, 3).mean(axis=0)
         assert r > 150 and b < 90 and g < 90, (i, b, g, r)
         assert bgr[50, x0 + 2, 2] > 150 and bgr[50, x0 - 3, 0] > 150, i
     rrd = tmp_path / "v.rrd"

@@ -16,9 +16,11 @@ av = pytest.importorskip("av")
 
 W, H = 401, 301  # odd sizes: nothing may assume even frames
 MARKER_PX = 90
-CFG = {"targets": {"style": "aruco", "marker_size_m": 0.05},
-       "reference": {"level": "none"},  # rendered level
-       "objects": [{"id": "block_1", "markers": [3]}]}
+CFG = {
+    "targets": {"style": "aruco", "marker_size_m": 0.05},
+    "reference": {"level": "none"},  # rendered level
+    "objects": [{"id": "block_1", "markers": [3]}],
+}
 
 
 def _marker_frame(theta_rad: float, w: int = W, h: int = H) -> np.ndarray:
@@ -27,7 +29,7 @@ def _marker_frame(theta_rad: float, w: int = W, h: int = H) -> np.ndarray:
     m = cv2.aruco.generateImageMarker(d, 3, MARKER_PX, borderBits=1)
     img = np.full((h, w), 255, np.uint8)
     y0, x0 = (h - MARKER_PX) // 2, (w - MARKER_PX) // 2
-    img[y0:y0 + MARKER_PX, x0:x0 + MARKER_PX] = m
+    img[y0 : y0 + MARKER_PX, x0 : x0 + MARKER_PX] = m
     R = cv2.getRotationMatrix2D(((w - 1) / 2, (h - 1) / 2), math.degrees(theta_rad), 1.0)
     return cv2.warpAffine(img, R, (w, h), flags=cv2.INTER_CUBIC, borderValue=255)
 
@@ -150,4 +152,4 @@ def test_interlaced_camcorder_video_is_read_field_by_field(tmp_path):
     np.testing.assert_allclose(b.t_s, t_field, atol=1e-9)
     assert np.all(b.status == "ok")
     err = np.degrees(b.theta_rad - theta)
-    assert np.sqrt(np.mean(err ** 2)) < 0.1, err  # each field its own instant
+    assert np.sqrt(np.mean(err**2)) < 0.1, err  # each field its own instant

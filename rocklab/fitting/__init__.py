@@ -11,8 +11,16 @@ flags), :func:`per_impact_eta` (data-only per-impact η), :func:`energy_loss_fro
 
 from ._campaign import ETA_MAT_RULES, EtaMatResult, KTableResult, fit_eta_mat, k_table, read_block_table
 from ._catalogue import catalogue_block, ceh_catalogue, ceh_full_contact, ceh_table5
-from ._impacts import (EnergyLoss, ReleaseInfo, arch_peaks, check_record, detect_release, energy_loss_from_peaks,
-                       find_crossings, per_impact_eta)
+from ._impacts import (
+    EnergyLoss,
+    ReleaseInfo,
+    arch_peaks,
+    check_record,
+    detect_release,
+    energy_loss_from_peaks,
+    find_crossings,
+    per_impact_eta,
+)
 from ._laws import alpha_from_hb, edge_contact_k, eta_housner, eta_modified, k_from_eta
 from ._regression import CEH_EQ19, REGRESSION_FORMS, KPrediction, KRegression, fit_k_regression
 from ._repeats import RepeatSummary, campaign_table, fit_many, summarize_repeats
@@ -20,16 +28,44 @@ from ._restitution import OBJECTIVES, WINDOWS, RestitutionFit, fit_restitution
 
 __all__ = [
     # per experiment
-    "fit_restitution", "RestitutionFit", "WINDOWS", "OBJECTIVES",
-    "per_impact_eta", "energy_loss_from_peaks", "EnergyLoss", "detect_release", "ReleaseInfo",
-    "find_crossings", "arch_peaks", "check_record",
+    "fit_restitution",
+    "RestitutionFit",
+    "WINDOWS",
+    "OBJECTIVES",
+    "per_impact_eta",
+    "energy_loss_from_peaks",
+    "EnergyLoss",
+    "detect_release",
+    "ReleaseInfo",
+    "find_crossings",
+    "arch_peaks",
+    "check_record",
     # repeats
-    "fit_many", "summarize_repeats", "RepeatSummary", "campaign_table",
+    "fit_many",
+    "summarize_repeats",
+    "RepeatSummary",
+    "campaign_table",
     # campaign
-    "fit_eta_mat", "EtaMatResult", "ETA_MAT_RULES", "k_table", "KTableResult", "read_block_table",
-    "fit_k_regression", "KRegression", "KPrediction", "REGRESSION_FORMS", "CEH_EQ19",
+    "fit_eta_mat",
+    "EtaMatResult",
+    "ETA_MAT_RULES",
+    "k_table",
+    "KTableResult",
+    "read_block_table",
+    "fit_k_regression",
+    "KRegression",
+    "KPrediction",
+    "REGRESSION_FORMS",
+    "CEH_EQ19",
     # closed forms
-    "eta_housner", "eta_modified", "k_from_eta", "edge_contact_k", "alpha_from_hb",
+    "eta_housner",
+    "eta_modified",
+    "k_from_eta",
+    "edge_contact_k",
+    "alpha_from_hb",
     # Čeh 2018 package data
-    "ceh_catalogue", "catalogue_block", "ceh_full_contact", "ceh_table5",
+    "ceh_catalogue",
+    "catalogue_block",
+    "ceh_full_contact",
+    "ceh_table5",
 ]

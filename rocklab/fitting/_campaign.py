@@ -48,8 +48,9 @@ def read_block_table(src, nan: str = "raise") -> pd.DataFrame:
             raise InputError(f"{where(path)}empty file; give a CSV with columns block,b_m,h_m,eta_e") from None
     missing = [c for c in ("block", "b_m", "h_m", "eta_e") if c not in df.columns]
     if missing:
-        raise InputError(f"{where(path)}missing column(s) {missing}; the table needs block,b_m,h_m,eta_e "
-                         "(widths/heights in metres)")
+        raise InputError(
+            f"{where(path)}missing column(s) {missing}; the table needs block,b_m,h_m,eta_e (widths/heights in metres)"
+        )
     df = df[["block", "b_m", "h_m", "eta_e"]].copy()
     for c in ("b_m", "h_m", "eta_e"):
         df[c] = pd.to_numeric(df[c], errors="coerce")
@@ -69,15 +70,18 @@ def read_block_table(src, nan: str = "raise") -> pd.DataFrame:
     out = (df["eta_e"] >= 1) | (df["eta_e"] <= 0)
     if out.any():
         i = int(df.index[out][0])
-        raise InputError(f"{where(path, i + 2 if path else None, 'eta_e')}restitution must be in (0, 1); "
-                         f"got {df.loc[i, 'eta_e']}")
+        raise InputError(
+            f"{where(path, i + 2 if path else None, 'eta_e')}restitution must be in (0, 1); got {df.loc[i, 'eta_e']}"
+        )
     df["block"] = df["block"].astype(str)
     _check_block_rows(df, path)
     dup = df.duplicated(subset=["block", "b_m", "h_m", "eta_e"])
     if dup.any():
         i = int(df.index[dup][0])
-        warn("W-FIT-DUPLICATE", f"{where(path, i + 2 if path else None)}{int(dup.sum())} repeated row(s) dropped "
-                                "(each block counted once)")
+        warn(
+            "W-FIT-DUPLICATE",
+            f"{where(path, i + 2 if path else None)}{int(dup.sum())} repeated row(s) dropped (each block counted once)",
+        )
         df = df[~dup].copy()
     df["h_over_b"] = df["h_m"] / df["b_m"]
     df["alpha_rad"] = np.arctan2(df["b_m"], df["h_m"])
@@ -117,15 +121,26 @@ class EtaMatResult:
 
     def to_dict(self) -> dict:
         """Plain dict of the fields, JSON-ready (SI units in the keys)."""
-        return dict(eta_mat=self.eta_mat, std=self.std, n=self.n, rule=self.rule, contact=self.contact,
-                    l_c_m=self.l_c_m, min_hb=self.min_hb, status=self.status, message=self.message,
-                    per_block=self.per_block.to_dict(orient="records"))
+        return dict(
+            eta_mat=self.eta_mat,
+            std=self.std,
+            n=self.n,
+            rule=self.rule,
+            contact=self.contact,
+            l_c_m=self.l_c_m,
+            min_hb=self.min_hb,
+            status=self.status,
+            message=self.message,
+            per_block=self.per_block.to_dict(orient="records"),
+        )
 
     def report(self) -> str:
-        lines = ["[[eta_mat (Čeh Eq. 16)]]",
-                 f"    eta_mat = {self.eta_mat:.5f} +/- {self.std:.5f} (std, {self.rule} of {self.n} blocks)",
-                 f"    contact = {self.contact}, l_c = {1000 * self.l_c_m:g} mm, min h/b = {self.min_hb:g}",
-                 f"    ratios > 1 (unphysical): {int(self.per_block['above_one'].sum())}"]
+        lines = [
+            "[[eta_mat (Čeh Eq. 16)]]",
+            f"    eta_mat = {self.eta_mat:.5f} +/- {self.std:.5f} (std, {self.rule} of {self.n} blocks)",
+            f"    contact = {self.contact}, l_c = {1000 * self.l_c_m:g} mm, min h/b = {self.min_hb:g}",
+            f"    ratios > 1 (unphysical): {int(self.per_block['above_one'].sum())}",
+        ]
         if self.message:
             lines.append(f"    note: {self.message}")
         return "\n".join(lines)
@@ -139,13 +154,17 @@ def _check_block_rows(df: pd.DataFrame, path) -> None:
     odd = ~is_lab_size(b, h)
     if odd.any():
         i = int(df.index[odd][0])
-        warn("W-FIT-UNITS", f"{where(path, i + 2 if path else None)}block {df.loc[i, 'block']}: b = "
-                            f"{b[odd][0]:.4g} m, h = {h[odd][0]:.4g} m (h/b = {h[odd][0] / b[odd][0]:.4g}) is not a "
-                            f"rocking block in metres ({int(odd.sum())} such row(s)); check units and column order")
+        warn(
+            "W-FIT-UNITS",
+            f"{where(path, i + 2 if path else None)}block {df.loc[i, 'block']}: b = "
+            f"{b[odd][0]:.4g} m, h = {h[odd][0]:.4g} m (h/b = {h[odd][0] / b[odd][0]:.4g}) is not a "
+            f"rocking block in metres ({int(odd.sum())} such row(s)); check units and column order",
+        )
 
 
-def fit_eta_mat(edge_table, l_c_m: float = 0.0015, contact: str = "inner", rule: str = "mean",
-                min_hb: float = 0.0) -> EtaMatResult:
+def fit_eta_mat(
+    edge_table, l_c_m: float = 0.0015, contact: str = "inner", rule: str = "mean", min_hb: float = 0.0
+) -> EtaMatResult:
     """η_mat = η_e/η_M averaged over edge-contact experiments (Čeh Eq. 16).
 
     Parameters
@@ -182,15 +201,29 @@ def fit_eta_mat(edge_table, l_c_m: float = 0.0015, contact: str = "inner", rule:
     std = float(np.std(r, ddof=1)) if len(r) > 1 else float("nan")
     msg = ""
     if u["above_one"].any():
-        msg = (f"{int(u['above_one'].sum())} block(s) have eta_e/eta_M > 1 (contact further inside than "
-               "assumed); consider contact='inner'")
+        msg = (
+            f"{int(u['above_one'].sum())} block(s) have eta_e/eta_M > 1 (contact further inside than "
+            "assumed); consider contact='inner'"
+        )
     status = "ok"
     if not (0.0 < eta <= 1.05):  # a material restitution outside (0, 1] is not a result
         status = "failed"
-        msg = (f"eta_mat = {eta:.4g} is outside (0, 1]: the table's sizes or eta_e values are not what the "
-               "edge-contact model expects (units? full-contact runs?)")
-    return EtaMatResult(eta_mat=eta, std=std, n=int(len(r)), rule=rule, contact=contact, l_c_m=float(l_c_m),
-                        min_hb=float(min_hb), per_block=df, status=status, message=msg)
+        msg = (
+            f"eta_mat = {eta:.4g} is outside (0, 1]: the table's sizes or eta_e values are not what the "
+            "edge-contact model expects (units? full-contact runs?)"
+        )
+    return EtaMatResult(
+        eta_mat=eta,
+        std=std,
+        n=int(len(r)),
+        rule=rule,
+        contact=contact,
+        l_c_m=float(l_c_m),
+        min_hb=float(min_hb),
+        per_block=df,
+        status=status,
+        message=msg,
+    )
 
 
 @dataclass(frozen=True)
@@ -218,20 +251,34 @@ class KTableResult:
         """Plain dict of the fields, JSON-ready (SI units in the keys)."""
         reg = self.regression
         pb = self.per_block[["block", "b_m", "h_m", "h_over_b", "eta_e", "eta_RB", "k", "b_bar_m", "feasible"]]
-        d = dict(eta_mat=self.eta_mat, per_block=pb.to_dict(orient="records"), n_infeasible=self.n_infeasible,
-                 status=self.status, message=self.message)
+        d = dict(
+            eta_mat=self.eta_mat,
+            per_block=pb.to_dict(orient="records"),
+            n_infeasible=self.n_infeasible,
+            status=self.status,
+            message=self.message,
+        )
         if reg is not None:
-            d.update(coefficients=dict(reg.coefficients), form=reg.form, r2=reg.r2, rmse=reg.rmse,
-                     residuals=[float(x) for x in reg.residuals], loso=reg.loso.to_dict(orient="records"),
-                     hb_range=list(reg.hb_range), b_cm_range=list(reg.b_cm_range))
+            d.update(
+                coefficients=dict(reg.coefficients),
+                form=reg.form,
+                r2=reg.r2,
+                rmse=reg.rmse,
+                residuals=[float(x) for x in reg.residuals],
+                loso=reg.loso.to_dict(orient="records"),
+                hb_range=list(reg.hb_range),
+                b_cm_range=list(reg.b_cm_range),
+            )
         return d
 
     def report(self) -> str:
         lines = [f"[[Inverse k (Čeh Eq. 17-18), eta_mat = {self.eta_mat:.5f}]]"]
         for r in self.per_block.itertuples():
             flag = "" if r.feasible else "   <- infeasible (k > 1)"
-            lines.append(f"    {r.block:6s} h/b={r.h_over_b:5.2f} eta_e={r.eta_e:.3f} eta_RB={r.eta_RB:.4f} "
-                         f"k={r.k:.4f} b_bar={1000 * r.b_bar_m:.2f} mm{flag}")
+            lines.append(
+                f"    {r.block:6s} h/b={r.h_over_b:5.2f} eta_e={r.eta_e:.3f} eta_RB={r.eta_RB:.4f} "
+                f"k={r.k:.4f} b_bar={1000 * r.b_bar_m:.2f} mm{flag}"
+            )
         if self.regression is not None:
             lines.append(self.regression.report())
         if self.message:
@@ -239,8 +286,9 @@ class KTableResult:
         return "\n".join(lines)
 
 
-def k_table(full_table, eta_mat: float, form: str | None = "ceh19", feasible_only: bool = False,
-            nan: str = "raise") -> KTableResult:
+def k_table(
+    full_table, eta_mat: float, form: str | None = "ceh19", feasible_only: bool = False, nan: str = "raise"
+) -> KTableResult:
     """k and b̄ per full-contact block (Čeh Eq. 17–18) and the regression k(h/b, b).
 
     Parameters
@@ -264,11 +312,13 @@ def k_table(full_table, eta_mat: float, form: str | None = "ceh19", feasible_onl
     n_bad = int((~df["feasible"]).sum())
     msg = ""
     if n_bad:
-        msg = (f"{n_bad} block(s) give k > 1 or eta_RB >= 1 (impulse outside the base): "
-               + ", ".join(df.loc[~df["feasible"], "block"]) + "; Čeh attributes this to tape dissipation")
+        msg = (
+            f"{n_bad} block(s) give k > 1 or eta_RB >= 1 (impulse outside the base): "
+            + ", ".join(df.loc[~df["feasible"], "block"])
+            + "; Čeh attributes this to tape dissipation"
+        )
     reg = None
     if form is not None:
         sel = df[df["feasible"]] if feasible_only else df[np.isfinite(df["k"])]
         reg = fit_k_regression(sel["h_over_b"], sel["b_m"], sel["k"], form=form)
     return KTableResult(eta_mat=eta_mat, per_block=df, regression=reg, n_infeasible=n_bad, message=msg)
-

@@ -49,8 +49,7 @@ def ceh_catalogue() -> pd.DataFrame:
 def ceh_full_contact() -> pd.DataFrame:
     """The 27 full-contact results of Table 3: ``block, b_m, h_m, eta_e`` (a FULL.csv table)."""
     df = _catalogue().dropna(subset=["eta_e_full"])
-    return df[["block", "b_m", "h_m", "eta_e_full"]].rename(columns={"eta_e_full": "eta_e"}).reset_index(
-        drop=True)
+    return df[["block", "b_m", "h_m", "eta_e_full"]].rename(columns={"eta_e_full": "eta_e"}).reset_index(drop=True)
 
 
 def ceh_table5() -> pd.DataFrame:
@@ -64,8 +63,8 @@ def catalogue_block(block_id: str) -> Block:
     key = str(block_id).strip().upper()
     row = df[df["block"].str.upper() == key]
     if row.empty:
-        raise InputError(f"block id {block_id!r}: not in the Čeh 2018 catalogue; use B1S..B10S, "
-                         "B1M..B10M or B1L..B10L")
+        raise InputError(f"block id {block_id!r}: not in the Čeh 2018 catalogue; use B1S..B10S, B1M..B10M or B1L..B10L")
     r = row.iloc[0]
-    return Block(b_m=float(r.b_m), h_m=float(r.h_m), depth_m=float(r.depth_m), mass_kg=float(r.mass_kg),
-                 name=str(r.block))
+    return Block(
+        b_m=float(r.b_m), h_m=float(r.h_m), depth_m=float(r.depth_m), mass_kg=float(r.mass_kg), name=str(r.block)
+    )

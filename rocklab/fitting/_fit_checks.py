@@ -47,10 +47,13 @@ def _cut_at_gap(t, y, t_release_s, sigma_rad):
         half = float(np.min(np.diff(before))) if before.size >= 2 else float(t[i] - t_release_s)
         if d[i] > 0.5 * half:
             n_lost = int(round(d[i] / med)) - 1
-            diag = warn("W-FIT-GAP", f"theta(t) has a {d[i]:.4g} s gap ({n_lost} samples) at t = {t[i]:.4g} s, "
-                                     f"longer than half the shortest half-cycle before it ({half:.4g} s); the "
-                                     f"fit uses the {i + 1} samples before the gap")
-            return t[:i + 1], y[:i + 1], diag
+            diag = warn(
+                "W-FIT-GAP",
+                f"theta(t) has a {d[i]:.4g} s gap ({n_lost} samples) at t = {t[i]:.4g} s, "
+                f"longer than half the shortest half-cycle before it ({half:.4g} s); the "
+                f"fit uses the {i + 1} samples before the gap",
+            )
+            return t[: i + 1], y[: i + 1], diag
     return t, y, None
 
 
@@ -68,8 +71,10 @@ def _suspicion(t, y, res, rms, sigma, pie, tc, alpha):
             var = (mu - 1) * (mu - 2) / (n - 1)
             z = (runs - mu) / math.sqrt(max(var, 1e-12))
             if z < -4:
-                flags.append(f"structured residuals: RMS {rms / sigma:.1f}x the noise and a runs test z = {z:.1f} "
-                             "(misfit: slip, jump or a restitution that changes during rocking)")
+                flags.append(
+                    f"structured residuals: RMS {rms / sigma:.1f}x the noise and a runs test z = {z:.1f} "
+                    "(misfit: slip, jump or a restitution that changes during rocking)"
+                )
         big = np.abs(res) > 8.0 * max(rms, sigma)
         if big.any():
             flags.append(f"{int(big.sum())} residual(s) above 8x RMS: isolated jump or tracking glitch")
@@ -86,12 +91,16 @@ def _suspicion(t, y, res, rms, sigma, pie, tc, alpha):
             sd = float(np.sqrt(np.mean(se[pair] ** 2 + se[pair + 1] ** 2) / 4 / pair.size) + 1e-12)
             d = float(np.median(a))
             if abs(d) > max(4 * sd, 0.005):
-                flags.append(f"asymmetric amplitudes: per-impact eta alternates by {2 * d:+.3f} between the two "
-                             "corners (tilted base, slip or unequal corners)")
+                flags.append(
+                    f"asymmetric amplitudes: per-impact eta alternates by {2 * d:+.3f} between the two "
+                    "corners (tilted base, slip or unequal corners)"
+                )
     after = t > tc[-1] + 2 * (tc[-1] - tc[-2]) if tc.size >= 2 else np.zeros_like(t, bool)
     if after.sum() >= 10:
         rest = float(np.median(y[after]))
         if abs(rest) > max(10 * sigma / math.sqrt(after.sum()) + 3 * sigma, 0.01 * alpha):
-            flags.append(f"block came to rest at {rest:+.4f} rad, not 0: it slipped or jumped (or the level "
-                         "reference is off: try fit_offset=True)")
+            flags.append(
+                f"block came to rest at {rest:+.4f} rad, not 0: it slipped or jumped (or the level "
+                "reference is off: try fit_offset=True)"
+            )
     return flags

@@ -14,7 +14,7 @@ __all__ = ["KRegression", "KPrediction", "fit_k_regression", "CEH_EQ19", "REGRES
 
 #: Regressor columns of each selectable form (b in cm, as in the paper).
 REGRESSION_FORMS = {
-    "ceh19": ("hb2", "hb", "const", "b_cm"),           # Čeh Eq. 19: linear-quadratic
+    "ceh19": ("hb2", "hb", "const", "b_cm"),  # Čeh Eq. 19: linear-quadratic
     "linear": ("hb", "const", "b_cm"),
     "quadratic_b": ("hb2", "hb", "const", "b_cm", "b_cm2"),
     "hb_only": ("hb2", "hb", "const"),
@@ -28,8 +28,7 @@ CEH_EQ19_RANGE = {"hb": (1.5, 9.75), "b_cm": (3.0, 6.0)}
 
 
 def _design(names, hb, b_cm) -> np.ndarray:
-    cols = {"hb2": hb ** 2, "hb": hb, "const": np.ones_like(hb), "b_cm": b_cm, "b_cm2": b_cm ** 2,
-            "hb_b_cm": hb * b_cm}
+    cols = {"hb2": hb**2, "hb": hb, "const": np.ones_like(hb), "b_cm": b_cm, "b_cm2": b_cm**2, "hb_b_cm": hb * b_cm}
     return np.column_stack([cols[n] for n in names])
 
 
@@ -59,14 +58,24 @@ class KPrediction:
 
     def to_dict(self) -> dict:
         """Plain dict of the fields, JSON-ready (SI units in the keys)."""
-        return dict(hb=self.hb, b_m=self.b_m, b_cm=100 * self.b_m, k=self.k, eta_M=self.eta_M,
-                    b_bar_m=self.b_bar_m, extrapolated=self.extrapolated, feasible=self.feasible,
-                    message=self.message)
+        return dict(
+            hb=self.hb,
+            b_m=self.b_m,
+            b_cm=100 * self.b_m,
+            k=self.k,
+            eta_M=self.eta_M,
+            b_bar_m=self.b_bar_m,
+            extrapolated=self.extrapolated,
+            feasible=self.feasible,
+            message=self.message,
+        )
 
     def report(self) -> str:
-        lines = ["[[k prediction (Čeh Eq. 19, Eq. 14)]]",
-                 f"    h/b = {self.hb:g}, b = {100 * self.b_m:g} cm",
-                 f"    k = {self.k:.4f}, eta_M = {self.eta_M:.4f}, b_bar = {1000 * self.b_bar_m:.2f} mm"]
+        lines = [
+            "[[k prediction (Čeh Eq. 19, Eq. 14)]]",
+            f"    h/b = {self.hb:g}, b = {100 * self.b_m:g} cm",
+            f"    k = {self.k:.4f}, eta_M = {self.eta_M:.4f}, b_bar = {1000 * self.b_bar_m:.2f} mm",
+        ]
         if self.message:
             lines.append(f"    WARNING: {self.message}")
         return "\n".join(lines)
@@ -101,19 +110,30 @@ class KRegression:
     @classmethod
     def ceh2018(cls) -> "KRegression":
         """Eq. 19 as printed (no residuals: r2/rmse NaN), range of Čeh Table 3."""
-        return cls(form="ceh19", coefficients=dict(CEH_EQ19), r2=float("nan"), rmse=float("nan"), n=27,
-                   residuals=np.array([]), loso=pd.DataFrame(columns=["b_cm", "n", "rmse", "max_abs_error"]),
-                   hb_range=CEH_EQ19_RANGE["hb"], b_cm_range=CEH_EQ19_RANGE["b_cm"])
+        return cls(
+            form="ceh19",
+            coefficients=dict(CEH_EQ19),
+            r2=float("nan"),
+            rmse=float("nan"),
+            n=27,
+            residuals=np.array([]),
+            loso=pd.DataFrame(columns=["b_cm", "n", "rmse", "max_abs_error"]),
+            hb_range=CEH_EQ19_RANGE["hb"],
+            b_cm_range=CEH_EQ19_RANGE["b_cm"],
+        )
 
     @classmethod
-    def from_coefficients(cls, coefficients: dict, hb_range=(np.nan, np.nan),
-                          b_cm_range=(np.nan, np.nan)) -> "KRegression":
+    def from_coefficients(
+        cls, coefficients: dict, hb_range=(np.nan, np.nan), b_cm_range=(np.nan, np.nan)
+    ) -> "KRegression":
         """A regression from stored coefficients (e.g. a ``k-table --json`` output)."""
         names = tuple(coefficients)
         form = next((f for f, n in REGRESSION_FORMS.items() if set(n) == set(names)), None)
         if form is None:
-            raise InputError(f"coefficients {sorted(names)}: not a known regression form; expected the keys "
-                             f"of one of {sorted(REGRESSION_FORMS)} e.g. {list(REGRESSION_FORMS['ceh19'])}")
+            raise InputError(
+                f"coefficients {sorted(names)}: not a known regression form; expected the keys "
+                f"of one of {sorted(REGRESSION_FORMS)} e.g. {list(REGRESSION_FORMS['ceh19'])}"
+            )
         try:
             coefs = {n: float(coefficients[n]) for n in REGRESSION_FORMS[form]}
         except (TypeError, ValueError):
@@ -125,9 +145,17 @@ class KRegression:
                 raise InputError(f"range {r}: must be [min, max]")
             return tuple(float("nan") if v is None else float(v) for v in r)
 
-        return cls(form=form, coefficients=coefs, r2=float("nan"), rmse=float("nan"), n=0,
-                   residuals=np.array([]), loso=pd.DataFrame(columns=["b_cm", "n", "rmse", "max_abs_error"]),
-                   hb_range=rng(hb_range), b_cm_range=rng(b_cm_range))
+        return cls(
+            form=form,
+            coefficients=coefs,
+            r2=float("nan"),
+            rmse=float("nan"),
+            n=0,
+            residuals=np.array([]),
+            loso=pd.DataFrame(columns=["b_cm", "n", "rmse", "max_abs_error"]),
+            hb_range=rng(hb_range),
+            b_cm_range=rng(b_cm_range),
+        )
 
     def k(self, hb, b_m):
         """k̂ at aspect ratio ``hb`` and width ``b_m`` (m; converted to cm for the formula)."""
@@ -161,26 +189,49 @@ class KRegression:
         feasible = bool(0 < k <= 1)
         if not feasible:
             msgs.append(f"k={k:.4f} outside (0, 1]: impulse outside the base")
-        return KPrediction(hb=hb, b_m=b_m, k=float(k), eta_M=eta, b_bar_m=0.5 * b_m * float(k),
-                           extrapolated=extrap, feasible=feasible, message="; ".join(msgs))
+        return KPrediction(
+            hb=hb,
+            b_m=b_m,
+            k=float(k),
+            eta_M=eta,
+            b_bar_m=0.5 * b_m * float(k),
+            extrapolated=extrap,
+            feasible=feasible,
+            message="; ".join(msgs),
+        )
 
     def to_dict(self) -> dict:
         """Plain dict of the fields, JSON-ready (SI units in the keys)."""
-        return dict(form=self.form, coefficients=dict(self.coefficients), r2=self.r2, rmse=self.rmse, n=self.n,
-                    residuals=[float(x) for x in self.residuals], hb_range=list(self.hb_range),
-                    b_cm_range=list(self.b_cm_range), loso=self.loso.to_dict(orient="records"))
+        return dict(
+            form=self.form,
+            coefficients=dict(self.coefficients),
+            r2=self.r2,
+            rmse=self.rmse,
+            n=self.n,
+            residuals=[float(x) for x in self.residuals],
+            hb_range=list(self.hb_range),
+            b_cm_range=list(self.b_cm_range),
+            loso=self.loso.to_dict(orient="records"),
+        )
 
     def report(self) -> str:
         names = REGRESSION_FORMS[self.form]
-        lines = ["[[Model]]", f"    k(h/b, b) form {self.form!r}: " + " + ".join(
-            f"{n}" for n in names) + "  (b in cm)",
-            "[[Fit Statistics]]", f"    data points = {self.n}", f"    R-squared   = {self.r2:.5f}",
-            f"    RMSE        = {self.rmse:.5f}", "[[Coefficients]]"]
+        lines = [
+            "[[Model]]",
+            f"    k(h/b, b) form {self.form!r}: " + " + ".join(f"{n}" for n in names) + "  (b in cm)",
+            "[[Fit Statistics]]",
+            f"    data points = {self.n}",
+            f"    R-squared   = {self.r2:.5f}",
+            f"    RMSE        = {self.rmse:.5f}",
+            "[[Coefficients]]",
+        ]
         lines += [f"    {n:6s} = {self.coefficients[n]: .5f}" for n in names]
         if len(self.loso):
             lines.append("[[Leave-one-scale-out]]")
             for r in self.loso.itertuples():
-                lines.append(f"    b = {r.b_cm:g} cm: n = {r.n}, RMSE = {r.rmse:.4f}, max |err| = {r.max_abs_error:.4f}")
+                lines.append(
+                    f"    b = {r.b_cm:g} cm: n = {r.n}, RMSE = {r.rmse:.4f}, max |err| = {r.max_abs_error:.4f}"
+                )
         return "\n".join(lines)
 
 
@@ -214,13 +265,15 @@ def fit_k_regression(hb, b_m, k, form: str = "ceh19") -> KRegression:
         raise InputError(f"k regression '{form}': needs more than {len(names)} blocks with finite k, got {len(k)}")
     X = _design(names, hb, b_cm)
     if np.linalg.matrix_rank(X) < len(names):
-        raise InputError(f"k regression '{form}': data do not identify all terms {names} "
-                         "(e.g. a single width cannot fit a b term); choose another form")
+        raise InputError(
+            f"k regression '{form}': data do not identify all terms {names} "
+            "(e.g. a single width cannot fit a b term); choose another form"
+        )
     coef, *_ = np.linalg.lstsq(X, k, rcond=None)
     res = k - X @ coef
     ss_tot = float(np.sum((k - k.mean()) ** 2))
     r2 = 1.0 - float(res @ res) / ss_tot if ss_tot > 0 else float("nan")
-    rmse = float(np.sqrt(np.mean(res ** 2)))
+    rmse = float(np.sqrt(np.mean(res**2)))
     rows = []
     for bc in np.unique(b_cm):
         held = np.isclose(b_cm, bc)
@@ -230,9 +283,22 @@ def fit_k_regression(hb, b_m, k, form: str = "ceh19") -> KRegression:
             continue
         c, *_ = np.linalg.lstsq(Xt, k[~held], rcond=None)
         err = k[held] - X[held] @ c
-        rows.append(dict(b_cm=float(bc), n=int(held.sum()), rmse=float(np.sqrt(np.mean(err ** 2))),
-                         max_abs_error=float(np.max(np.abs(err)))))
-    return KRegression(form=form, coefficients={n: float(c) for n, c in zip(names, coef)}, r2=r2, rmse=rmse,
-                       n=int(len(k)), residuals=res, loso=pd.DataFrame(rows, columns=["b_cm", "n", "rmse",
-                                                                                      "max_abs_error"]),
-                       hb_range=(float(hb.min()), float(hb.max())), b_cm_range=(float(b_cm.min()), float(b_cm.max())))
+        rows.append(
+            dict(
+                b_cm=float(bc),
+                n=int(held.sum()),
+                rmse=float(np.sqrt(np.mean(err**2))),
+                max_abs_error=float(np.max(np.abs(err))),
+            )
+        )
+    return KRegression(
+        form=form,
+        coefficients={n: float(c) for n, c in zip(names, coef)},
+        r2=r2,
+        rmse=rmse,
+        n=int(len(k)),
+        residuals=res,
+        loso=pd.DataFrame(rows, columns=["b_cm", "n", "rmse", "max_abs_error"]),
+        hb_range=(float(hb.min()), float(hb.max())),
+        b_cm_range=(float(b_cm.min()), float(b_cm.max())),
+    )

@@ -50,17 +50,32 @@ class RepeatSummary:
 
     def to_dict(self) -> dict:
         """Plain dict of the fields, JSON-ready (SI units in the keys)."""
-        return dict(mean=self.mean, std=self.std, median=self.median, n=self.n, n_used=self.n_used,
-                    values=[float(v) for v in self.values], outliers=list(self.outliers), failed=list(self.failed),
-                    suspicious=list(self.suspicious), z_max=self.z_max, status=self.status, message=self.message)
+        return dict(
+            mean=self.mean,
+            std=self.std,
+            median=self.median,
+            n=self.n,
+            n_used=self.n_used,
+            values=[float(v) for v in self.values],
+            outliers=list(self.outliers),
+            failed=list(self.failed),
+            suspicious=list(self.suspicious),
+            z_max=self.z_max,
+            status=self.status,
+            message=self.message,
+        )
 
     def report(self) -> str:
-        lines = ["[[Repeats]]",
-                 f"    eta_e = {self.mean:.5f} +/- {self.std:.5f} (mean +/- std of {self.n_used} of {self.n} runs)",
-                 f"    median = {self.median:.5f}"]
+        lines = [
+            "[[Repeats]]",
+            f"    eta_e = {self.mean:.5f} +/- {self.std:.5f} (mean +/- std of {self.n_used} of {self.n} runs)",
+            f"    median = {self.median:.5f}",
+        ]
         if self.outliers:
-            lines.append(f"    outliers (robust z > {self.z_max:g}): runs {list(self.outliers)} = "
-                         + ", ".join(f"{self.values[i]:.4f}" for i in self.outliers))
+            lines.append(
+                f"    outliers (robust z > {self.z_max:g}): runs {list(self.outliers)} = "
+                + ", ".join(f"{self.values[i]:.4f}" for i in self.outliers)
+            )
         if self.failed:
             lines.append(f"    failed fits: runs {list(self.failed)}")
         if self.suspicious:
@@ -98,8 +113,20 @@ def summarize_repeats(fits, z_max: float = 3.5) -> RepeatSummary:
     good = np.isfinite(v)
     nan = float("nan")
     if good.sum() == 0:
-        return RepeatSummary(nan, nan, nan, len(v), 0, tuple(v), (), tuple(failed), tuple(susp), z_max,
-                             status="failed", message="no successful fit among the runs")
+        return RepeatSummary(
+            nan,
+            nan,
+            nan,
+            len(v),
+            0,
+            tuple(v),
+            (),
+            tuple(failed),
+            tuple(susp),
+            z_max,
+            status="failed",
+            message="no successful fit among the runs",
+        )
     med = float(np.median(v[good]))
     mad = float(np.median(np.abs(v[good] - med)))
     scale = 1.4826 * mad
@@ -113,9 +140,19 @@ def summarize_repeats(fits, z_max: float = 3.5) -> RepeatSummary:
     kv = v[keep]
     std = float(np.std(kv, ddof=1)) if kv.size > 1 else nan
     msg = "" if kv.size > 1 else "a single usable run: no spread"
-    return RepeatSummary(mean=float(np.mean(kv)), std=std, median=med, n=int(v.size), n_used=int(kv.size),
-                         values=tuple(float(x) for x in v), outliers=tuple(int(i) for i in out),
-                         failed=tuple(failed), suspicious=tuple(susp), z_max=float(z_max), message=msg)
+    return RepeatSummary(
+        mean=float(np.mean(kv)),
+        std=std,
+        median=med,
+        n=int(v.size),
+        n_used=int(kv.size),
+        values=tuple(float(x) for x in v),
+        outliers=tuple(int(i) for i in out),
+        failed=tuple(failed),
+        suspicious=tuple(susp),
+        z_max=float(z_max),
+        message=msg,
+    )
 
 
 def fit_many(runs, block=None, progress: bool = False, **kwargs) -> list:
@@ -174,7 +211,16 @@ def campaign_table(results, z_max: float = 3.5):
     rows = []
     for key, (blk, fits) in groups.items():
         s = summarize_repeats(fits, z_max=z_max)
-        rows.append(dict(block=key, b_m=blk.b_m, h_m=blk.h_m, eta_e=s.mean, eta_e_std=s.std, n_runs=s.n,
-                         n_used=s.n_used, n_outliers=len(s.outliers)))
-    return pd.DataFrame(rows, columns=["block", "b_m", "h_m", "eta_e", "eta_e_std", "n_runs", "n_used",
-                                       "n_outliers"])
+        rows.append(
+            dict(
+                block=key,
+                b_m=blk.b_m,
+                h_m=blk.h_m,
+                eta_e=s.mean,
+                eta_e_std=s.std,
+                n_runs=s.n,
+                n_used=s.n_used,
+                n_outliers=len(s.outliers),
+            )
+        )
+    return pd.DataFrame(rows, columns=["block", "b_m", "h_m", "eta_e", "eta_e_std", "n_runs", "n_used", "n_outliers"])

@@ -38,9 +38,17 @@ class _Problem:
     def _run(self, th0, eta):
         self.n_sim += 1
         # output every 2nd step: linear interpolation error ~ θ'' (2 dt)² / 8, far below noise
-        return self._simulate(self.block, theta0_rad=th0, omega0_rad_s=0.0, duration_s=self.duration,
-                              dt_s=self.dt, restitution="constant", eta=float(eta), stop_at_rest=True,
-                              output_dt_s=2 * self.dt)
+        return self._simulate(
+            self.block,
+            theta0_rad=th0,
+            omega0_rad_s=0.0,
+            duration_s=self.duration,
+            dt_s=self.dt,
+            restitution="constant",
+            eta=float(eta),
+            stop_at_rest=True,
+            output_dt_s=2 * self.dt,
+        )
 
     def sim(self, eta, sens=True):
         key = (round(float(eta), 12), bool(sens))
@@ -91,8 +99,7 @@ class _Problem:
             d, dl, c = self._linear(yy - m0, S, yy.size)
             return float(d @ d), dl, c
 
-        res = minimize_scalar(lambda tr: inner(tr)[0], bounds=t_r_bounds, method="bounded",
-                              options=dict(xatol=1e-7))
+        res = minimize_scalar(lambda tr: inner(tr)[0], bounds=t_r_bounds, method="bounded", options=dict(xatol=1e-7))
         sse, dl, c = inner(float(res.x))
         return sse, float(res.x), self.theta0 + dl, c
 
@@ -111,7 +118,7 @@ class _Problem:
         """Amplitude (rad) and half-period (scaled to rad by 2A/T) residuals of arches arch_ids."""
         r = self.sim(eta, sens=False)[0]
         imp = r.impacts
-        p2 = self.block.p_rad_s ** 2
+        p2 = self.block.p_rad_s**2
         a = self.block.alpha_rad
         w = np.abs(imp["omega_after_rad_s"].to_numpy())
         amp = a - np.arccos(np.clip(math.cos(a) + w * w / (2 * p2), -1, 1))
@@ -172,8 +179,9 @@ def _profile_ci(fun, x_hat, f_hat, thresh, lo, hi):
             for _ in range(40):
                 x = x_hat + direction * min(step, room)
                 if fun(x) - f_hat > thresh:
-                    edge = brentq(lambda z: fun(z) - f_hat - thresh, *sorted((x_in, x)),
-                                  xtol=max(0.02 * guess, 1e-8), rtol=1e-12)
+                    edge = brentq(
+                        lambda z: fun(z) - f_hat - thresh, *sorted((x_in, x)), xtol=max(0.02 * guess, 1e-8), rtol=1e-12
+                    )
                     break
                 if step >= room:
                     break

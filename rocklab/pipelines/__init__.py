@@ -17,9 +17,30 @@ importing it stays light).
 
 from .campaign import CampaignResult, find_experiments, make_demo_campaign, run_campaign, run_demo
 from .cli import main
-from .experiment import (EXAMPLE_TOML, ExperimentConfig, ExperimentResult, analyse_experiment, load_experiment,
-                         read_rrd_scalars, read_rrd_summary, run_experiment)
+from .experiment import (
+    EXAMPLE_TOML,
+    ExperimentConfig,
+    ExperimentResult,
+    analyse_experiment,
+    load_experiment,
+    read_rrd_scalars,
+    read_rrd_summary,
+    run_experiment,
+)
 
-__all__ = ["main", "load_experiment", "ExperimentConfig", "EXAMPLE_TOML", "run_experiment",
-           "analyse_experiment", "ExperimentResult", "run_campaign", "find_experiments", "CampaignResult",
-           "run_demo", "make_demo_campaign", "read_rrd_summary", "read_rrd_scalars"]
+__all__ = [
+    "main",
+    "load_experiment",
+    "ExperimentConfig",
+    "EXAMPLE_TOML",
+    "run_experiment",
+    "analyse_experiment",
+    "ExperimentResult",
+    "run_campaign",
+    "find_experiments",
+    "CampaignResult",
+    "run_demo",
+    "make_demo_campaign",
+    "read_rrd_summary",
+    "read_rrd_scalars",
+]

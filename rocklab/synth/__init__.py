@@ -19,6 +19,15 @@ from ._points3d import Points3DSession, synth_points3d
 from ._session import SynthSession, load_synth_session, synth_session
 from ._stereo import StereoCamera, synth_stereo
 
-__all__ = ["synth_session", "SynthSession", "load_synth_session",
-           "simulate_imu_log", "write_ximu_csv", "write_ximu3_csv",
-           "Points3DSession", "synth_points3d", "StereoCamera", "synth_stereo"]
+__all__ = [
+    "synth_session",
+    "SynthSession",
+    "load_synth_session",
+    "simulate_imu_log",
+    "write_ximu_csv",
+    "write_ximu3_csv",
+    "Points3DSession",
+    "synth_points3d",
+    "StereoCamera",
+    "synth_stereo",
+]

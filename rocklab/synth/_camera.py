@@ -74,8 +74,7 @@ class SynthCamera:
         k1, k2, p1, p2, k3 = self.dist
         r2 = x * x + y * y
         rad = 1 + r2 * (k1 + r2 * (k2 + r2 * k3))
-        return (x * rad + 2 * p1 * x * y + p2 * (r2 + 2 * x * x),
-                y * rad + p1 * (r2 + 2 * y * y) + 2 * p2 * x * y)
+        return (x * rad + 2 * p1 * x * y + p2 * (r2 + 2 * x * x), y * rad + p1 * (r2 + 2 * y * y) + 2 * p2 * x * y)
 
     def undistort_normalized(self, u, v, iters: int = 8):
         """Pixel coordinates -> ideal normalized coordinates by Newton iteration.
@@ -129,13 +128,13 @@ class SynthCamera:
         if step is None:
             step = 4 if W >= 1280 else 2
         nc, nr = (W + step - 1) // step + 3, (H + step - 1) // step + 3
-        off = (step - 1) / 2.0 - step           # coarse node j sits at pixel off + step * j
+        off = (step - 1) / 2.0 - step  # coarse node j sits at pixel off + step * j
         u = off + step * np.arange(nc, dtype=float)
         v = off + step * np.arange(nr, dtype=float)
         X, Y = (a.astype(np.float32) for a in self.pixel_to_plane(*np.meshgrid(u, v)))
         big = (nc * step, nr * step)
-        X = cv2.resize(X, big, interpolation=cv2.INTER_LINEAR)[step:step + H, step:step + W]
-        Y = cv2.resize(Y, big, interpolation=cv2.INTER_LINEAR)[step:step + H, step:step + W]
+        X = cv2.resize(X, big, interpolation=cv2.INTER_LINEAR)[step : step + H, step : step + W]
+        Y = cv2.resize(Y, big, interpolation=cv2.INTER_LINEAR)[step : step + H, step : step + W]
         return np.ascontiguousarray(X, np.float32), np.ascontiguousarray(Y, np.float32)
 
     def plane_homography(self) -> np.ndarray:
@@ -151,22 +150,30 @@ class SynthCamera:
 
     def to_dict(self) -> dict:
         """JSON-ready: ``size_px``, ``camera_matrix``, ``dist_coeffs``, ``rvec``, ``tvec_m``, ``R``."""
-        return {"size_px": [int(self.size[0]), int(self.size[1])],
-                "camera_matrix": self.K.tolist(), "dist_coeffs": self.dist.tolist(),
-                "rvec": self.rvec.tolist(), "tvec_m": self.t.tolist(), "R": self.R.tolist(),
-                "homography_undistorted_px_to_plane_m": self.plane_homography().tolist(),
-                "model": "OpenCV pinhole + (k1, k2, p1, p2, k3); world plane z=0, x right, "
-                         "y up, z towards the camera; x_cam = R x_world + t"}
+        return {
+            "size_px": [int(self.size[0]), int(self.size[1])],
+            "camera_matrix": self.K.tolist(),
+            "dist_coeffs": self.dist.tolist(),
+            "rvec": self.rvec.tolist(),
+            "tvec_m": self.t.tolist(),
+            "R": self.R.tolist(),
+            "homography_undistorted_px_to_plane_m": self.plane_homography().tolist(),
+            "model": "OpenCV pinhole + (k1, k2, p1, p2, k3); world plane z=0, x right, "
+            "y up, z towards the camera; x_cam = R x_world + t",
+        }
 
     @classmethod
     def from_dict(cls, d: dict) -> "SynthCamera":
-        return cls(tuple(d["size_px"]), np.array(d["camera_matrix"], float),
-                   np.array(d["dist_coeffs"], float), np.array(d["R"], float),
-                   np.array(d["tvec_m"], float))
+        return cls(
+            tuple(d["size_px"]),
+            np.array(d["camera_matrix"], float),
+            np.array(d["dist_coeffs"], float),
+            np.array(d["R"], float),
+            np.array(d["tvec_m"], float),
+        )
 
 
-def make_camera(size, center_m, view_height_m: float, rng: np.random.Generator,
-                distortion: bool = True) -> SynthCamera:
+def make_camera(size, center_m, view_height_m: float, rng: np.random.Generator, distortion: bool = True) -> SynthCamera:
     """A camera framing ``view_height_m`` of the plane around ``center_m``.
 
     The focal length is 1.25 image widths (about a 44° horizontal field);
@@ -179,15 +186,27 @@ def make_camera(size, center_m, view_height_m: float, rng: np.random.Generator,
     cx = (W - 1) / 2 + rng.uniform(-0.004, 0.004) * W
     cy = (H - 1) / 2 + rng.uniform(-0.004, 0.004) * H
     K = np.array([[f, 0.0, cx], [0.0, f * (1 + rng.uniform(-5e-4, 5e-4)), cy], [0.0, 0.0, 1.0]])
-    dist = np.array([rng.uniform(-0.12, -0.06), rng.uniform(0.02, 0.08),
-                     rng.uniform(-5e-4, 5e-4), rng.uniform(-5e-4, 5e-4), 0.0]) if distortion else np.zeros(5)
+    dist = (
+        np.array(
+            [
+                rng.uniform(-0.12, -0.06),
+                rng.uniform(0.02, 0.08),
+                rng.uniform(-5e-4, 5e-4),
+                rng.uniform(-5e-4, 5e-4),
+                0.0,
+            ]
+        )
+        if distortion
+        else np.zeros(5)
+    )
     # Looking along -z with image y down: x_cam = x, y_cam = -y, z_cam = -z, then a small tilt.
     R0 = np.diag([1.0, -1.0, -1.0])
-    tilt = _rot(math.radians(rng.uniform(-3, 3)), math.radians(rng.uniform(-3, 3)),
-                math.radians(rng.uniform(-1.5, 1.5)))
+    tilt = _rot(
+        math.radians(rng.uniform(-3, 3)), math.radians(rng.uniform(-3, 3)), math.radians(rng.uniform(-1.5, 1.5))
+    )
     R = tilt @ R0
     # Put the camera so that the optical axis hits the plane at center_m.
-    axis_w = R.T @ np.array([0.0, 0.0, 1.0])          # optical axis in the world
+    axis_w = R.T @ np.array([0.0, 0.0, 1.0])  # optical axis in the world
     target = np.array([center_m[0], center_m[1], 0.0])
     C = target - D * axis_w / (-axis_w[2])
     t = -R @ C

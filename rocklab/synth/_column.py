@@ -68,12 +68,12 @@ class ColumnMotion:
         jy = np.zeros_like(jx)
         ang = np.zeros_like(jx)
         for k in range(j + 1):
-            if k > 0:   # joint k sits on the top centre of block k - 1
+            if k > 0:  # joint k sits on the top centre of block k - 1
                 jx = jx - self.h_m[k - 1] * np.sin(ang)
                 jy = jy + self.h_m[k - 1] * np.cos(ang)
             psi = self.joint(k, t)
-            px = -np.where(psi >= 0, 1.0, -1.0) * self.half_width_m[k]      # pivot in the joint frame
-            qx = px - np.cos(psi) * px                                       # q = p - R(psi) p
+            px = -np.where(psi >= 0, 1.0, -1.0) * self.half_width_m[k]  # pivot in the joint frame
+            qx = px - np.cos(psi) * px  # q = p - R(psi) p
             qy = -np.sin(psi) * px
             c, s = np.cos(ang), np.sin(ang)
             jx, jy = jx + c * qx - s * qy, jy + s * qx + c * qy

@@ -72,8 +72,9 @@ class VideoPair:
         self.paths = {}
         self.writers = []
         for fourcc in ("FFV1", "png "):
-            w = cv2.VideoWriter(str(folder / f"{stem}.mkv"), cv2.VideoWriter_fourcc(*fourcc), float(fps),
-                                (W, H), isColor=False)
+            w = cv2.VideoWriter(
+                str(folder / f"{stem}.mkv"), cv2.VideoWriter_fourcc(*fourcc), float(fps), (W, H), isColor=False
+            )
             if w.isOpened():
                 self.codec = fourcc.strip()
                 self.writers.append(w)
@@ -81,16 +82,18 @@ class VideoPair:
                 break
             w.release()
         if self.codec is None:
-            raise RuntimeError("this OpenCV build writes neither FFV1 nor PNG into .mkv; "
-                               "install an opencv build with FFmpeg")
+            raise RuntimeError(
+                "this OpenCV build writes neither FFV1 nor PNG into .mkv; install an opencv build with FFmpeg"
+            )
         self.lossy_codec = None
         if mp4:
             try:  # what a camcorder writes: H.264 at an AVCHD bit rate
                 self.writers.append(_H264Writer(folder / f"{stem}.mp4", fps, (W, H)))
                 self.paths["mp4"], self.lossy_codec = folder / f"{stem}.mp4", "h264"
             except Exception:  # noqa: BLE001 - no PyAV or no libx264 in its FFmpeg: OpenCV's MPEG-4
-                w = cv2.VideoWriter(str(folder / f"{stem}.mp4"), cv2.VideoWriter_fourcc(*"mp4v"), float(fps),
-                                    (W, H), isColor=False)
+                w = cv2.VideoWriter(
+                    str(folder / f"{stem}.mp4"), cv2.VideoWriter_fourcc(*"mp4v"), float(fps), (W, H), isColor=False
+                )
                 if w.isOpened():
                     self.writers.append(w)
                     self.paths["mp4"], self.lossy_codec = folder / f"{stem}.mp4", "mp4v"
@@ -124,8 +127,7 @@ class VideoPair:
             raise self._err[0]
 
 
-def write_track_toml(path: Path, *, style, fps, camera, objects, marker_size_m, dot_diameter_m,
-                     calibrated=True) -> str:
+def write_track_toml(path: Path, *, style, fps, camera, objects, marker_size_m, dot_diameter_m, calibrated=True) -> str:
     """``track.toml`` through the tracker's own schema (:class:`TrackConfig`).
 
     ``calibrated``: write the camera matrix, distortion and plane homography
@@ -137,10 +139,7 @@ def write_track_toml(path: Path, *, style, fps, camera, objects, marker_size_m, 
     from .._io import write_text_atomic
     from ..tracking.video._config import TrackConfig, load_track_config
 
-    d = {"video": {"fps": float(fps)},
-         "targets": {"style": style},
-         "reference": {"level": "table"},
-         "objects": []}
+    d = {"video": {"fps": float(fps)}, "targets": {"style": style}, "reference": {"level": "table"}, "objects": []}
     if calibrated:
         # A calibrated lab: lens model plus the plane homography (undistorted px -> m), so
         # tracked positions are absolute in the session's world frame and perspective does
@@ -160,11 +159,12 @@ def write_track_toml(path: Path, *, style, fps, camera, objects, marker_size_m, 
                 e[k] = v.tolist() if isinstance(v, np.ndarray) else v
         d["objects"].append(e)
     cfg = TrackConfig.from_dict(d)
-    text = ("# Tracking config written by 'rocklab synth' (schema: rocklab/tracking/video/_config.py).\n"
-            "# Object origins: block = centre of its front face, table = top centre of its front face.\n"
-            + cfg.to_toml())
+    text = (
+        "# Tracking config written by 'rocklab synth' (schema: rocklab/tracking/video/_config.py).\n"
+        "# Object origins: block = centre of its front face, table = top centre of its front face.\n" + cfg.to_toml()
+    )
     write_text_atomic(path, text)
-    load_track_config(path)           # round-trip check: the tracker can read what we wrote
+    load_track_config(path)  # round-trip check: the tracker can read what we wrote
     return text
 
 
@@ -177,13 +177,27 @@ def write_experiment_toml(path: Path, *, name, block, table_kind, imu_objects, c
     """
     from .._io import write_text_atomic
 
-    lines = [f'name = "{name}"', 'truth = "truth.csv"', "",
-             "[block]", f"b_m = {block['b_m']!r}", f"h_m = {block['h_m']!r}",
-             f"mass_kg = {block['mass_kg']!r}", "",
-             "[contact]", 'type = "full"', "",
-             "[sources]", 'primary = "video"', "",
-             "[sources.video]", 'path = "video.mkv"', 'track_config = "track.toml"',
-             f'object = "{block["id"]}"', ""]
+    lines = [
+        f'name = "{name}"',
+        'truth = "truth.csv"',
+        "",
+        "[block]",
+        f"b_m = {block['b_m']!r}",
+        f"h_m = {block['h_m']!r}",
+        f"mass_kg = {block['mass_kg']!r}",
+        "",
+        "[contact]",
+        'type = "full"',
+        "",
+        "[sources]",
+        'primary = "video"',
+        "",
+        "[sources.video]",
+        'path = "video.mkv"',
+        'track_config = "track.toml"',
+        f'object = "{block["id"]}"',
+        "",
+    ]
     if block["id"] in imu_objects:
         lines += ["[sources.imu]", f'path = "imu/{block["id"]}"', 'axis = "y"', ""]
     if table_kind == "none":
@@ -192,7 +206,9 @@ def write_experiment_toml(path: Path, *, name, block, table_kind, imu_objects, c
         lines += ["[sources.table]", 'from = "video"', 'object = "table"', ""]
     if column:
         lines += ["[column]", "objects = [" + ", ".join(f'"{c}"' for c in column) + "]", ""]
-    text = "# Experiment config written by 'rocklab synth' (schema: rocklab/pipelines/experiment/_config.py).\n" \
+    text = (
+        "# Experiment config written by 'rocklab synth' (schema: rocklab/pipelines/experiment/_config.py).\n"
         + "\n".join(lines)
+    )
     write_text_atomic(path, text)
     return text

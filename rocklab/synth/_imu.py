@@ -20,8 +20,18 @@ import numpy as np
 __all__ = ["write_object_imu"]
 
 
-def write_object_imu(folder: Path, oid: str, *, block_motion=None, block=None, table=None,
-                     mount_m=None, t_end_s: float, rate_hz: float, rng: np.random.Generator) -> dict:
+def write_object_imu(
+    folder: Path,
+    oid: str,
+    *,
+    block_motion=None,
+    block=None,
+    table=None,
+    mount_m=None,
+    t_end_s: float,
+    rate_hz: float,
+    rng: np.random.Generator,
+) -> dict:
     """Simulate and write ``folder/<oid>_CalInertialAndMag.csv`` + ``_Registers.csv``.
 
     ``block_motion`` (a ``BlockMotion``) and ``block`` for a sensor on a block;
@@ -50,20 +60,36 @@ def write_object_imu(folder: Path, oid: str, *, block_motion=None, block=None, t
             t, th, blk = block_motion.t_s, -block_motion.phi_rad, block
         else:
             t, th, blk = np.array([0.0, t_end_s]), np.zeros(2), None
-        log = simulate_imu_log(t, th, blk, mount_m=mount_m, rate_hz=rate_hz, t_start_s=t0,
-                               rest_after_s=max(0.0, t_end_s - float(t[-1])), gyro_bias_deg_s=bias,
-                               base=base, drop_bursts=bursts, seed=seed)
+        log = simulate_imu_log(
+            t,
+            th,
+            blk,
+            mount_m=mount_m,
+            rate_hz=rate_hz,
+            t_start_s=t0,
+            rest_after_s=max(0.0, t_end_s - float(t[-1])),
+            gyro_bias_deg_s=bias,
+            base=base,
+            drop_bursts=bursts,
+            seed=seed,
+        )
     folder.mkdir(parents=True, exist_ok=True)
     inertial, regs = write_ximu_csv(log, folder / oid)
-    return {"files": [inertial.name, regs.name], "rate_hz": float(rate_hz),
-            "t0_video_s": t0, "n_samples": int(log.n + log.dropped_samples),
-            "dropped_samples": int(log.dropped_samples), "gyro_bias_deg_s": bias.tolist(),
-            "gyro_noise_deg_s": 0.1, "acc_noise_g": 0.005,
-            "mount_m": None if mount_m is None else [float(v) for v in mount_m],
-            "clock": "sample k (reader index) at video time t0_video_s + k / rate_hz",
-            "axes": "x along the width (+x world when upright), z up, y away from the camera "
-                    "(rocking axis); gyro_y = -d(theta_rad)/dt",
-            "writer": "rocklab.synth._imu_sim.simulate_imu_log + write_ximu_csv"}
+    return {
+        "files": [inertial.name, regs.name],
+        "rate_hz": float(rate_hz),
+        "t0_video_s": t0,
+        "n_samples": int(log.n + log.dropped_samples),
+        "dropped_samples": int(log.dropped_samples),
+        "gyro_bias_deg_s": bias.tolist(),
+        "gyro_noise_deg_s": 0.1,
+        "acc_noise_g": 0.005,
+        "mount_m": None if mount_m is None else [float(v) for v in mount_m],
+        "clock": "sample k (reader index) at video time t0_video_s + k / rate_hz",
+        "axes": "x along the width (+x world when upright), z up, y away from the camera "
+        "(rocking axis); gyro_y = -d(theta_rad)/dt",
+        "writer": "rocklab.synth._imu_sim.simulate_imu_log + write_ximu_csv",
+    }
 
 
 def _rigid_body_log(view, mount_m, t0, t_end_s, rate_hz, bias_deg_s, seed, bursts):
@@ -91,16 +117,15 @@ def _rigid_body_log(view, mount_m, t0, t_end_s, rate_hz, bias_deg_s, seed, burst
     c, s = np.cos(phi), np.sin(phi)
     fx, fy = acc_w[:, 0], acc_w[:, 1] + G
     acc = np.zeros((n, 3))
-    acc[:, 0] = c * fx + s * fy                 # sensor x = (cos, sin) in the world
-    acc[:, 2] = -s * fx + c * fy                # sensor z = (-sin, cos)
+    acc[:, 0] = c * fx + s * fy  # sensor x = (cos, sin) in the world
+    acc[:, 2] = -s * fx + c * fy  # sensor z = (-sin, cos)
     gyro = np.zeros((n, 3))
-    gyro[:, 1] = -(view.phi(tk + dt / 2) - view.phi(tk - dt / 2)) / dt   # y away from the camera
+    gyro[:, 1] = -(view.phi(tk + dt / 2) - view.phi(tk - dt / 2)) / dt  # y away from the camera
     gyro += np.deg2rad(bias_deg_s) + rng.normal(0.0, np.deg2rad(0.1), (n, 3))
     acc += rng.normal(0.0, 0.005 * G, (n, 3))
     keep = np.ones(n, dtype=bool)
     for _ in range(bursts):
         length = int(rng.integers(3, 9))
         start = int(rng.integers(int(0.2 * n), max(int(0.2 * n) + 1, n - length - int(0.2 * n))))
-        keep[start:start + length] = False
-    return ImuLog(tk[keep], gyro[keep], acc[keep], float(rate_hz), int(n - keep.sum()), None,
-                  "simulated", "simulated")
+        keep[start : start + length] = False
+    return ImuLog(tk[keep], gyro[keep], acc[keep], float(rate_hz), int(n - keep.sum()), None, "simulated", "simulated")

@@ -39,8 +39,7 @@ def _rot_y(theta):
     """R(theta) (.., 3, 3): block -> world, positive tilts +z towards +x."""
     c, s = np.cos(theta), np.sin(theta)
     z, o = np.zeros_like(c), np.ones_like(c)
-    return np.stack([np.stack([c, z, s], -1), np.stack([z, o, z], -1),
-                     np.stack([-s, z, c], -1)], -2)
+    return np.stack([np.stack([c, z, s], -1), np.stack([z, o, z], -1), np.stack([-s, z, c], -1)], -2)
 
 
 def _base_fn(base):
@@ -49,17 +48,32 @@ def _base_fn(base):
     tb = np.asarray(getattr(base, "t_s", base[0] if isinstance(base, tuple) else None), float)
     ab = np.asarray(getattr(base, "acc_m_s2", base[1] if isinstance(base, tuple) else None), float)
     vb = np.concatenate(([0.0], np.cumsum(0.5 * (ab[1:] + ab[:-1]) * np.diff(tb))))
-    return (lambda t: np.interp(t, tb, ab, left=0.0, right=0.0),
-            lambda t: np.interp(t, tb, vb, left=0.0, right=vb[-1]))
+    return (lambda t: np.interp(t, tb, ab, left=0.0, right=0.0), lambda t: np.interp(t, tb, vb, left=0.0, right=vb[-1]))
 
 
-def simulate_imu_log(t_s, theta_rad, block=None, *, omega_rad_s=None, mount_m=None,
-                     sensor_rotation=None, rate_hz: float = 256.0, t_start_s: float | None = None,
-                     rest_before_s: float = 0.0, rest_after_s: float = 0.0,
-                     gyro_noise_deg_s: float = 0.1, gyro_bias_deg_s=0.5,
-                     acc_noise_g: float = 0.005, acc_bias_g=0.0, base=None,
-                     drop_bursts: int = 0, drop_max: int = 8, seed: int = 0,
-                     clock_offset_s: float = 0.0, clock_drift: float = 0.0) -> ImuLog:
+def simulate_imu_log(
+    t_s,
+    theta_rad,
+    block=None,
+    *,
+    omega_rad_s=None,
+    mount_m=None,
+    sensor_rotation=None,
+    rate_hz: float = 256.0,
+    t_start_s: float | None = None,
+    rest_before_s: float = 0.0,
+    rest_after_s: float = 0.0,
+    gyro_noise_deg_s: float = 0.1,
+    gyro_bias_deg_s=0.5,
+    acc_noise_g: float = 0.005,
+    acc_bias_g=0.0,
+    base=None,
+    drop_bursts: int = 0,
+    drop_max: int = 8,
+    seed: int = 0,
+    clock_offset_s: float = 0.0,
+    clock_drift: float = 0.0,
+) -> ImuLog:
     """Simulate what an IMU fixed to a rocking block (or the table) logs.
 
     Parameters
@@ -113,7 +127,7 @@ def simulate_imu_log(t_s, theta_rad, block=None, *, omega_rad_s=None, mount_m=No
         raise InputError("simulate_imu_log: t_s must be non-decreasing")
     if not rate_hz > 0:
         raise InputError(f"rate_hz={rate_hz!r}: must be > 0 Hz")
-    om_tr = (np.gradient(th_tr, t_tr) if omega_rad_s is None else np.asarray(omega_rad_s, float))
+    om_tr = np.gradient(th_tr, t_tr) if omega_rad_s is None else np.asarray(omega_rad_s, float)
     if block is None:
         if np.any(th_tr != 0):
             raise InputError("simulate_imu_log: block=None (table sensor) needs theta_rad == 0")
@@ -156,18 +170,21 @@ def simulate_imu_log(t_s, theta_rad, block=None, *, omega_rad_s=None, mount_m=No
     gb = np.asarray(gyro_bias_deg_s, float)
     if gb.ndim == 0:
         gb = gb * rng.choice([-1.0, 1.0], 3)
-    gyro = (w_block @ S.T + np.deg2rad(gb)
-            + rng.normal(0.0, np.deg2rad(gyro_noise_deg_s), (n, 3)))
-    acc = (f_block @ S.T + np.broadcast_to(np.asarray(acc_bias_g, float), (3,)) * G
-           + rng.normal(0.0, acc_noise_g * G, (n, 3)))
+    gyro = w_block @ S.T + np.deg2rad(gb) + rng.normal(0.0, np.deg2rad(gyro_noise_deg_s), (n, 3))
+    acc = (
+        f_block @ S.T
+        + np.broadcast_to(np.asarray(acc_bias_g, float), (3,)) * G
+        + rng.normal(0.0, acc_noise_g * G, (n, 3))
+    )
     keep = np.ones(n, dtype=bool)
     for _ in range(int(drop_bursts)):
         length = int(rng.integers(3, max(4, drop_max + 1)))
         start = int(rng.integers(int(0.2 * n), max(int(0.2 * n) + 1, n - length - int(0.2 * n))))
-        keep[start:start + length] = False
+        keep[start : start + length] = False
     t_dev = tk * (1.0 + clock_drift) + clock_offset_s
-    return ImuLog(t_dev[keep], gyro[keep], acc[keep], float(rate_hz), int(n - keep.sum()),
-                  None, "simulated", "simulated")
+    return ImuLog(
+        t_dev[keep], gyro[keep], acc[keep], float(rate_hz), int(n - keep.sum()), None, "simulated", "simulated"
+    )
 
 
 def _sample_index(log: ImuLog) -> np.ndarray:
@@ -178,8 +195,9 @@ def _fmt(x: np.ndarray) -> np.ndarray:
     return np.char.mod("%.7g", x)
 
 
-def write_ximu_csv(log: ImuLog, base_path, *, full_scale_g: float | None = 8.0,
-                   first_packet: int = 113) -> tuple[Path, Path]:
+def write_ximu_csv(
+    log: ImuLog, base_path, *, full_scale_g: float | None = 8.0, first_packet: int = 113
+) -> tuple[Path, Path]:
     """Write ``log`` as an original x-IMU GUI export (atomic writes).
 
     Writes ``<base>_CalInertialAndMag.csv`` (``Packet number``, gyroscope deg/s,
@@ -209,8 +227,9 @@ def write_ximu_csv(log: ImuLog, base_path, *, full_scale_g: float | None = 8.0,
     fs = float(log.rate_hz)
     code = math.log2(fs) + 1 if fs > 0 else -1
     if code != int(code) or code < 1:
-        raise InputError(f"write_ximu_csv: rate {fs:g} Hz is not a power of two; the x-IMU "
-                         "rate register encodes fs = 2**(value-1)")
+        raise InputError(
+            f"write_ximu_csv: rate {fs:g} Hz is not a power of two; the x-IMU rate register encodes fs = 2**(value-1)"
+        )
     base = Path(base_path)
     k = _sample_index(log)
     # Packets per inertial sample: inertial + quaternion at fs/2 + battery 4 Hz + date 1 Hz.
@@ -221,28 +240,45 @@ def write_ximu_csv(log: ImuLog, base_path, *, full_scale_g: float | None = 8.0,
     if full_scale_g is not None:
         acc = np.clip(acc, -full_scale_g, full_scale_g)
     mag = np.tile(_MAG_WORLD_G, (log.n, 1))
-    cols = [pk.astype(str)] + [_fmt(gyro[:, i]) for i in range(3)] + \
-        [_fmt(acc[:, i]) for i in range(3)] + [_fmt(mag[:, i]) for i in range(3)]
-    head = ("Packet number,Gyroscope X (deg/s),Gyroscope Y (deg/s),Gyroscope Z (deg/s),"
-            "Accelerometer X (g),Accelerometer Y (g),Accelerometer Z (g),"
-            "Magnetometer X (G),Magnetometer Y (G),Magnetometer Z (G)")
+    cols = (
+        [pk.astype(str)]
+        + [_fmt(gyro[:, i]) for i in range(3)]
+        + [_fmt(acc[:, i]) for i in range(3)]
+        + [_fmt(mag[:, i]) for i in range(3)]
+    )
+    head = (
+        "Packet number,Gyroscope X (deg/s),Gyroscope Y (deg/s),Gyroscope Z (deg/s),"
+        "Accelerometer X (g),Accelerometer Y (g),Accelerometer Z (g),"
+        "Magnetometer X (G),Magnetometer Y (G),Magnetometer Z (G)"
+    )
     inertial = base.with_name(base.name + "_CalInertialAndMag.csv")
     regs = base.with_name(base.name + "_Registers.csv")
     _write_lines(inertial, head, cols)
     fsc = {2.0: 0, 4.0: 1, 8.0: 2}.get(float(full_scale_g or 8.0), 2)
-    rows = [(32, fsc, "AccelerometerFullScale"), (67, 1, "DateTimeDataRate"),
-            (68, 3, "BatteryAndThermometerDataRate"), (69, int(code), "InertialAndMagneticDataRate"),
-            (70, int(code) - 1, "QuaternionDataRate")]
+    rows = [
+        (32, fsc, "AccelerometerFullScale"),
+        (67, 1, "DateTimeDataRate"),
+        (68, 3, "BatteryAndThermometerDataRate"),
+        (69, int(code), "InertialAndMagneticDataRate"),
+        (70, int(code) - 1, "QuaternionDataRate"),
+    ]
     text = "Packet number,Address,Value,Fixed-point value,Name\n" + "".join(
-        f"{i + 1},{a},{v},NaN,{nm}\n" for i, (a, v, nm) in enumerate(rows))
+        f"{i + 1},{a},{v},NaN,{nm}\n" for i, (a, v, nm) in enumerate(rows)
+    )
     with atomic_path(regs) as tmp:
         Path(tmp).write_text(text, encoding="utf-8")
     return inertial, regs
 
 
-def write_ximu3_csv(log: ImuLog, folder, *, full_scale_g: float = 16.0,
-                    high_g_noise_g: float = 0.02, clock0_us: int = 19150794,
-                    seed: int = 0) -> tuple[Path, Path]:
+def write_ximu3_csv(
+    log: ImuLog,
+    folder,
+    *,
+    full_scale_g: float = 16.0,
+    high_g_noise_g: float = 0.02,
+    clock0_us: int = 19150794,
+    seed: int = 0,
+) -> tuple[Path, Path]:
     """Write ``log`` as an x-IMU3 device folder: ``Inertial.csv`` + ``HighGAccelerometer.csv``.
 
     ``Inertial.csv``: ``Timestamp (us)`` (device clock from ``clock0_us``),
@@ -262,14 +298,16 @@ def write_ximu3_csv(log: ImuLog, folder, *, full_scale_g: float = 16.0,
     rng = np.random.default_rng(seed)
     hg = acc_g + rng.normal(0.0, high_g_noise_g, acc_g.shape)
     gyro = np.rad2deg(log.gyro_rad_s)
-    head = ("Timestamp (us),Gyroscope X (deg/s),Gyroscope Y (deg/s),Gyroscope Z (deg/s),"
-            "Accelerometer X (g),Accelerometer Y (g),Accelerometer Z (g)")
+    head = (
+        "Timestamp (us),Gyroscope X (deg/s),Gyroscope Y (deg/s),Gyroscope Z (deg/s),"
+        "Accelerometer X (g),Accelerometer Y (g),Accelerometer Z (g)"
+    )
     p1 = folder / "Inertial.csv"
     p2 = folder / "HighGAccelerometer.csv"
-    _write_lines(p1, head, [t_us.astype(str)] + [_fmt(gyro[:, i]) for i in range(3)]
-                 + [_fmt(main[:, i]) for i in range(3)])
-    _write_lines(p2, "Timestamp (us),X (g),Y (g),Z (g)",
-                 [t_us.astype(str)] + [_fmt(hg[:, i]) for i in range(3)])
+    _write_lines(
+        p1, head, [t_us.astype(str)] + [_fmt(gyro[:, i]) for i in range(3)] + [_fmt(main[:, i]) for i in range(3)]
+    )
+    _write_lines(p2, "Timestamp (us),X (g),Y (g),Z (g)", [t_us.astype(str)] + [_fmt(hg[:, i]) for i in range(3)])
     return p1, p2
 
 

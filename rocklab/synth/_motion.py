@@ -23,7 +23,7 @@ from .._errors import InputError
 
 __all__ = ["TableMotion", "sine_pulse_table", "record_table", "still_table", "BlockMotion"]
 
-_SINE_PEAK = 0.6495190525534192      # max |(sin x - sin 2x / 2) / 2| on [0, 2 pi]
+_SINE_PEAK = 0.6495190525534192  # max |(sin x - sin 2x / 2) / 2| on [0, 2 pi]
 
 
 @dataclass(frozen=True)
@@ -57,8 +57,11 @@ class TableMotion:
             w = 2 * math.pi / self._period_s
             x = w * np.clip(tau, 0.0, self._period_s)
             A = self._amp_m / _SINE_PEAK
-            f = [(np.sin(x) - np.sin(2 * x) / 2) / 2, w * (np.cos(x) - np.cos(2 * x)) / 2,
-                 w * w * (-np.sin(x) + 2 * np.sin(2 * x)) / 2][d]
+            f = [
+                (np.sin(x) - np.sin(2 * x) / 2) / 2,
+                w * (np.cos(x) - np.cos(2 * x)) / 2,
+                w * w * (-np.sin(x) + 2 * np.sin(2 * x)) / 2,
+            ][d]
             out = A * f
             if d > 0:
                 out = np.where((tau < 0) | (tau > self._period_s), 0.0, out)
@@ -128,17 +131,26 @@ def sine_pulse_table(start_s: float, period_s: float = 0.6, amplitude_m: float =
         if not (math.isfinite(v) and v > 0):
             raise InputError(f"{name}={v!r}: must be positive")
     w = 2 * math.pi / period_s
-    return TableMotion("sine", float(start_s), {
-        "kind": "sine", "start_s": float(start_s), "period_s": float(period_s),
-        "amplitude_m": float(amplitude_m),
-        "formula": "u = A/0.6495 * (sin x - sin 2x / 2) / 2, x = 2 pi (t - start_s) / period_s, "
-                   "0 <= x <= 2 pi",
-        "peak_acc_m_s2": float(amplitude_m / _SINE_PEAK * w * w * 1.3679075505129872)},
-        None, float(period_s), float(amplitude_m))
+    return TableMotion(
+        "sine",
+        float(start_s),
+        {
+            "kind": "sine",
+            "start_s": float(start_s),
+            "period_s": float(period_s),
+            "amplitude_m": float(amplitude_m),
+            "formula": "u = A/0.6495 * (sin x - sin 2x / 2) / 2, x = 2 pi (t - start_s) / period_s, 0 <= x <= 2 pi",
+            "peak_acc_m_s2": float(amplitude_m / _SINE_PEAK * w * w * 1.3679075505129872),
+        },
+        None,
+        float(period_s),
+        float(amplitude_m),
+    )
 
 
-def record_table(base, start_s: float, length_s: float, stroke_m: float, target_pga_m_s2: float,
-                 name: str = "record") -> TableMotion:
+def record_table(
+    base, start_s: float, length_s: float, stroke_m: float, target_pga_m_s2: float, name: str = "record"
+) -> TableMotion:
     """A ground-motion record made playable by a table of limited stroke.
 
     As shake-table labs do: the record (a :class:`~rocklab.models.BaseMotion`)
@@ -164,7 +176,7 @@ def record_table(base, start_s: float, length_s: float, stroke_m: float, target_
     taper = np.ones(n)
     k = min(n // 4, int(round(1.0 / dt)))
     ramp = 0.5 - 0.5 * np.cos(np.pi * np.arange(k) / k)
-    taper[:k], taper[n - k:] = ramp, ramp[::-1]
+    taper[:k], taper[n - k :] = ramp, ramp[::-1]
     fc, u = None, None
     for fc in (0.1, 0.15, 0.2, 0.3, 0.4, 0.5, 0.7, 1.0, 1.4, 2.0, 2.8, 4.0):
         sos = butter(4, fc, btype="highpass", fs=1.0 / dt, output="sos")
@@ -177,13 +189,21 @@ def record_table(base, start_s: float, length_s: float, stroke_m: float, target_
     scale = min(1.0, stroke_m / np.max(np.abs(u)))
     u = u * scale
     sp = CubicSpline(t, u, bc_type="clamped")
-    info = {"kind": "record", "record": name, "start_s": float(start_s), "length_s": float(t[-1]),
-            "dt_s": dt, "stroke_m": float(stroke_m), "highpass_hz": float(fc),
-            "target_pga_m_s2": float(target_pga_m_s2),
-            "pga_m_s2": float(np.max(np.abs(sp(t, 2)))), "max_abs_u_m": float(np.max(np.abs(u))),
-            "processing": "cut, scaled to target PGA, 4th-order zero-phase Butterworth high-pass "
-                          "at highpass_hz, 1 s cosine tapers, double integration, linear detrend; "
-                          "table = clamped cubic spline through u"}
+    info = {
+        "kind": "record",
+        "record": name,
+        "start_s": float(start_s),
+        "length_s": float(t[-1]),
+        "dt_s": dt,
+        "stroke_m": float(stroke_m),
+        "highpass_hz": float(fc),
+        "target_pga_m_s2": float(target_pga_m_s2),
+        "pga_m_s2": float(np.max(np.abs(sp(t, 2)))),
+        "max_abs_u_m": float(np.max(np.abs(u))),
+        "processing": "cut, scaled to target PGA, 4th-order zero-phase Butterworth high-pass "
+        "at highpass_hz, 1 s cosine tapers, double integration, linear detrend; "
+        "table = clamped cubic spline through u",
+    }
     start = round(start_s / dt) * dt
     return TableMotion("record", float(start), info, sp)
 

@@ -67,8 +67,10 @@ class Points3DSession:
 
         folder = Path(folder)
         folder.mkdir(parents=True, exist_ok=True)
-        paths = {"points_csv": write_points_csv(self.series, folder / "points.csv"),
-                 "truth_csv": write_frame_atomic(folder / "truth.csv", self.truth, float_format="%.9g")}
+        paths = {
+            "points_csv": write_points_csv(self.series, folder / "points.csv"),
+            "truth_csv": write_frame_atomic(folder / "truth.csv", self.truth, float_format="%.9g"),
+        }
         if c3d:
             paths["points_c3d"] = write_c3d(self.series, folder / "points.c3d")
         return paths
@@ -80,9 +82,9 @@ def _targets(block: Block, depth_m: float, side: bool = True):
     pts = []
     for zf in (0.2, 0.45, 0.7, 0.92):
         for xf in (-0.3, 0.3):
-            pts.append((xf * b, -d / 2, zf * h))          # front face, two columns of dots
+            pts.append((xf * b, -d / 2, zf * h))  # front face, two columns of dots
     if side:
-        pts += [(b / 2, 0.15 * d, 0.35 * h), (b / 2, -0.2 * d, 0.8 * h)]     # one side face
+        pts += [(b / 2, 0.15 * d, 0.35 * h), (b / 2, -0.2 * d, 0.8 * h)]  # one side face
     labels = [f"B{i + 1}" for i in range(len(pts))]
     return np.asarray(pts), labels
 
@@ -110,12 +112,26 @@ def _bounce(t, theta, t_k, tau_s, amp_rad):
     return out
 
 
-def synth_points3d(block: Block | None = None, theta0_rad: float | None = None, restitution="housner",
-                   rate_hz: float = 150.0, hold_s: float = 0.3, tail_s: float = 0.6, noise_m: float = 5e-5,
-                   seed: int = 0, up: str = "z", yaw_deg: float = 27.0, offset_m=(0.42, -0.31, 0.05),
-                   slide: tuple | None = None, jump: tuple | None = None, twist: tuple | None = None,
-                   double_impact: int | None = None, depth_m: float | None = None,
-                   table: bool = True, side_targets: bool = True) -> Points3DSession:
+def synth_points3d(
+    block: Block | None = None,
+    theta0_rad: float | None = None,
+    restitution="housner",
+    rate_hz: float = 150.0,
+    hold_s: float = 0.3,
+    tail_s: float = 0.6,
+    noise_m: float = 5e-5,
+    seed: int = 0,
+    up: str = "z",
+    yaw_deg: float = 27.0,
+    offset_m=(0.42, -0.31, 0.05),
+    slide: tuple | None = None,
+    jump: tuple | None = None,
+    twist: tuple | None = None,
+    double_impact: int | None = None,
+    depth_m: float | None = None,
+    table: bool = True,
+    side_targets: bool = True,
+) -> Points3DSession:
     """Simulate a motion-capture record of a free-rocking block (thread-burn release).
 
     Parameters
@@ -209,7 +225,7 @@ def synth_points3d(block: Block | None = None, theta0_rad: float | None = None, 
     n = t.size
     half = block.b_m / 2.0
     c, s = np.cos(theta), np.sin(theta)
-    px = np.where(theta >= 0, half, -half)              # the edge it turns about
+    px = np.where(theta >= 0, half, -half)  # the edge it turns about
     q = body[None, :, :] - np.stack([px, np.zeros(n), np.zeros(n)], axis=1)[:, None, :]
     x = c[:, None] * q[..., 0] + s[:, None] * q[..., 2] + px[:, None]
     z = -s[:, None] * q[..., 0] + c[:, None] * q[..., 2]
@@ -221,8 +237,9 @@ def synth_points3d(block: Block | None = None, theta0_rad: float | None = None, 
     world = np.stack([xw, yw, zw], axis=2)
     all_labels = list(labels)
     if table:
-        tpts = np.array([[-2.5 * half, -depth, 0.0], [2.5 * half, -depth, 0.0], [2.5 * half, depth, 0.0],
-                         [-2.5 * half, depth, 0.0]])
+        tpts = np.array(
+            [[-2.5 * half, -depth, 0.0], [2.5 * half, -depth, 0.0], [2.5 * half, depth, 0.0], [-2.5 * half, depth, 0.0]]
+        )
         world = np.concatenate([world, np.broadcast_to(tpts, (n, 4, 3))], axis=1)
         all_labels += [f"T{i + 1}" for i in range(4)]
     Q = _rig(up, math.radians(yaw_deg))
@@ -233,10 +250,18 @@ def synth_points3d(block: Block | None = None, theta0_rad: float | None = None, 
     # theta about the rocking axis from the truth's body frame: the tracker's e_r is +-Q x; keep its sign rule
     e_r = Q @ np.array([1.0, 0.0, 0.0])
     axis = Q @ np.array([0.0, 1.0, 0.0])
-    truth = pd.DataFrame({"t_s": t, "theta_rad": theta, "twist_rad": psi, "out_of_plane_rad": np.zeros(n),
-                          "slide_m": slide_x, "uplift_m": uplift, "table_x_m": np.zeros(n)})
+    truth = pd.DataFrame(
+        {
+            "t_s": t,
+            "theta_rad": theta,
+            "twist_rad": psi,
+            "out_of_plane_rad": np.zeros(n),
+            "slide_m": slide_x,
+            "uplift_m": uplift,
+            "table_x_m": np.zeros(n),
+        }
+    )
     bodies = {"block": tuple(labels)}
     if table:
-        bodies["table"] = tuple(all_labels[len(labels):])
-    return Points3DSession(series, truth, impacts, block, bodies, e_r, axis, Q @ np.array([0.0, 0.0, 1.0]),
-                           injected)
+        bodies["table"] = tuple(all_labels[len(labels) :])
+    return Points3DSession(series, truth, impacts, block, bodies, e_r, axis, Q @ np.array([0.0, 0.0, 1.0]), injected)

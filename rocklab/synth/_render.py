@@ -84,9 +84,25 @@ class Renderer:
         Optical blur sigma used for the texture prefilter, px (for ROI margins).
     """
 
-    def __init__(self, camera: SynthCamera, objects, background, illumination, *, exposure_s,
-                 readout_s=0.0, noise_dn=1.0, rng, psf_px=0.5, blur_step_px=0.5, max_sub=32,
-                 occluders=(), plane_maps=None, flicker=0.0, flicker_seed=0):
+    def __init__(
+        self,
+        camera: SynthCamera,
+        objects,
+        background,
+        illumination,
+        *,
+        exposure_s,
+        readout_s=0.0,
+        noise_dn=1.0,
+        rng,
+        psf_px=0.5,
+        blur_step_px=0.5,
+        max_sub=32,
+        occluders=(),
+        plane_maps=None,
+        flicker=0.0,
+        flicker_seed=0,
+    ):
         self.cam = camera
         self.W, self.H = camera.size
         self.X, self.Y = plane_maps if plane_maps is not None else camera.plane_maps()
@@ -100,21 +116,25 @@ class Renderer:
         self.static = [o for o in objects if o.static]
         self.order = list(objects)
         bg = background.astype(np.float32).copy()
-        for o in self.static:       # bake static objects once
+        for o in self.static:  # bake static objects once
             box = self._bbox(o, np.array([0.0]))
             if box is not None:
                 r0, r1, c0, c1 = box
                 ox, oy, phi = (np.asarray(v, float) for v in o.pose(np.array([0.0])))
-                self._composite(bg[r0:r1, c0:c1], o, (r0, r1, c0, c1), (r0, r1, c0, c1),
-                                float(ox[0]), float(oy[0]), float(phi[0]))
+                self._composite(
+                    bg[r0:r1, c0:c1], o, (r0, r1, c0, c1), (r0, r1, c0, c1), float(ox[0]), float(oy[0]), float(phi[0])
+                )
         self.bg = bg
         self.bg_u8 = np.clip(np.rint(bg * self.illum), 0, 255).astype(np.uint8)
-        self.noise_bank = [np.rint(rng.normal(0.0, noise_dn, (self.H + 16, self.W + 16))).astype(np.int16)
-                           for _ in range(3)] if noise_dn > 0 else None
+        self.noise_bank = (
+            [np.rint(rng.normal(0.0, noise_dn, (self.H + 16, self.W + 16))).astype(np.int16) for _ in range(3)]
+            if noise_dn > 0
+            else None
+        )
         self.last_subframes = 1
         # an integer of its own from the seed (an int or a SeedSequence), not drawn from ``rng``
         self.flicker = float(flicker)
-        self.flicker_seed = int(np.random.default_rng(flicker_seed).integers(2 ** 31))
+        self.flicker_seed = int(np.random.default_rng(flicker_seed).integers(2**31))
         self.flicker_phase = float(np.random.default_rng((self.flicker_seed, 7)).uniform(0, 2 * math.pi))
 
     def exposure_gain(self, t_s: float) -> float:
@@ -177,9 +197,8 @@ class Renderer:
         inv = np.float32(1.0 / tex.texel_m)
         mapx = (c * dx + s * dy - np.float32(tex.x0_m)) * inv
         mapy = (np.float32(tex.y0_m) - (c * dy - s * dx)) * inv
-        smp = cv2.remap(tex.img, mapx, mapy, cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT,
-                        borderValue=0)
-        sub = canvas[r0 - R0:r1 - R0, c0 - C0:c1 - C0]
+        smp = cv2.remap(tex.img, mapx, mapy, cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT, borderValue=0)
+        sub = canvas[r0 - R0 : r1 - R0, c0 - C0 : c1 - C0]
         sub *= 1.0 - smp[..., 1]
         sub += smp[..., 0]
 
@@ -213,13 +232,13 @@ class Renderer:
                     if rows is None:
                         ox, oy, phi = (float(np.asarray(v).ravel()[0]) for v in o.pose(np.array([tk])))
                     else:
-                        rr = rows[box[0] - R0:box[1] - R0]
+                        rr = rows[box[0] - R0 : box[1] - R0]
                         ox, oy, phi = (np.asarray(v, float).reshape(-1, 1) for v in o.pose((tk + rr).ravel()))
                     self._composite(canvas, o, (R0, R1, C0, C1), box, ox, oy, phi)
                 acc += canvas
             acc *= np.float32(1.0 / n)
             for r0, r1, c0, c1 in occ:
-                acc[r0 - R0:r1 - R0, c0 - C0:c1 - C0] = 38.0     # a dark hand in front
+                acc[r0 - R0 : r1 - R0, c0 - C0 : c1 - C0] = 38.0  # a dark hand in front
             acc *= self.illum[R0:R1, C0:C1]
             frame[R0:R1, C0:C1] = np.clip(np.rint(acc), 0, 255).astype(np.uint8)
         if self.flicker > 0:
@@ -227,8 +246,8 @@ class Renderer:
         if self.noise_bank is not None:
             k = int(self.rng.integers(len(self.noise_bank)))
             dy, dx = (int(v) for v in self.rng.integers(0, 17, 2))
-            noise = self.noise_bank[k][dy:dy + self.H, dx:dx + self.W]
-            frame = cv2.add(frame, noise, dtype=cv2.CV_8U)      # saturating, one pass
+            noise = self.noise_bank[k][dy : dy + self.H, dx : dx + self.W]
+            frame = cv2.add(frame, noise, dtype=cv2.CV_8U)  # saturating, one pass
         return frame
 
     def _occluder_boxes(self, t_s):

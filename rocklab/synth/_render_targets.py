@@ -20,7 +20,7 @@ import numpy as np
 
 __all__ = ["Texture", "block_texture", "table_texture", "BLACK", "WHITE"]
 
-BLACK, WHITE = 22.0, 238.0   # printed black / white paper, grey levels
+BLACK, WHITE = 22.0, 238.0  # printed black / white paper, grey levels
 
 
 @dataclass(frozen=True)
@@ -58,8 +58,8 @@ class _Painter:
         ny = int(np.ceil((ymax - ymin + 2 * pad_m) / s)) + 1
         self.x0 = xmin - pad_m
         self.y0 = ymax + pad_m
-        self.xc = self.x0 + s * np.arange(nx)          # texel centres, columns
-        self.yc = self.y0 - s * np.arange(ny)          # rows, top to bottom
+        self.xc = self.x0 + s * np.arange(nx)  # texel centres, columns
+        self.yc = self.y0 - s * np.arange(ny)  # rows, top to bottom
         self.L = np.zeros((ny, nx), np.float64)
         self.A = np.zeros((ny, nx), np.float64)
 
@@ -88,8 +88,7 @@ class _Painter:
         edges = np.linspace(0.0, size, n + 1)
         cx = np.stack([self._cov1(self.xc[sj], x0 + edges[k], x0 + edges[k + 1]) for k in range(n)], 1)
         # rows of the module image run top (y0 + size) to bottom
-        cy = np.stack([self._cov1(self.yc[si], y0 + size - edges[k + 1], y0 + size - edges[k])
-                       for k in range(n)], 1)
+        cy = np.stack([self._cov1(self.yc[si], y0 + size - edges[k + 1], y0 + size - edges[k]) for k in range(n)], 1)
         vals = np.where(modules > 0, light, dark).astype(float)
         paint = cy @ vals @ cx.T
         cov = np.outer(cy.sum(1), cx.sum(1))
@@ -112,8 +111,14 @@ class _Painter:
         img = np.dstack([self.L * self.A, self.A]).astype(np.float32)
         if psf_texels > 0:
             img = cv2.GaussianBlur(img, (0, 0), psf_texels, borderType=cv2.BORDER_CONSTANT)
-        return Texture(np.ascontiguousarray(img), float(self.x0), float(self.y0), float(self.s),
-                       np.asarray(outline, float), features)
+        return Texture(
+            np.ascontiguousarray(img),
+            float(self.x0),
+            float(self.y0),
+            float(self.s),
+            np.asarray(outline, float),
+            features,
+        )
 
 
 def _aruco_modules(dictionary: str, marker_id: int) -> np.ndarray:
@@ -138,8 +143,20 @@ def _marker_corners(x0, y0, size):
     return np.array([[x0, y0 + size], [x0 + size, y0 + size], [x0 + size, y0], [x0, y0]])
 
 
-def block_texture(b_m, h_m, style, *, marker_ids=(), dictionary="DICT_4X4_50", marker_size_m=None,
-                  dot_diameter_m=None, texel_m, psf_px_m, rng, face_value=None) -> Texture:
+def block_texture(
+    b_m,
+    h_m,
+    style,
+    *,
+    marker_ids=(),
+    dictionary="DICT_4X4_50",
+    marker_size_m=None,
+    dot_diameter_m=None,
+    texel_m,
+    psf_px_m,
+    rng,
+    face_value=None,
+) -> Texture:
     """Front face of a block ``b_m`` x ``h_m`` (m) with its targets.
 
     ``style``: ``"aruco"`` (markers stacked on the centre line, each on a white
@@ -168,7 +185,7 @@ def block_texture(b_m, h_m, style, *, marker_ids=(), dictionary="DICT_4X4_50", m
         feats["markers"] = {}
         for k, mid in enumerate(marker_ids):
             yc = pitch * (k + 0.5)
-            q = s / 6 * 1.0                       # quiet zone: one module width
+            q = s / 6 * 1.0  # quiet zone: one module width
             p.rect(-s / 2 - q, s / 2 + q, yc - s / 2 - q, yc + s / 2 + q, WHITE)
             p.grid(-s / 2, yc - s / 2, s, _aruco_modules(dictionary, mid), BLACK, WHITE)
             feats["markers"][int(mid)] = _marker_corners(-s / 2, yc - s / 2, s)
@@ -176,8 +193,9 @@ def block_texture(b_m, h_m, style, *, marker_ids=(), dictionary="DICT_4X4_50", m
     elif style == "dots":
         p.rect(-b_m / 2, b_m / 2, 0, h_m, WHITE, opaque=True)
         dia = dot_diameter_m or min(0.16 * b_m, 0.08 * h_m)
-        dots = np.array([[-0.28 * b_m, 0.15 * h_m], [0.28 * b_m, 0.15 * h_m],
-                         [-0.28 * b_m, 0.85 * h_m], [0.28 * b_m, 0.62 * h_m]])
+        dots = np.array(
+            [[-0.28 * b_m, 0.15 * h_m], [0.28 * b_m, 0.15 * h_m], [-0.28 * b_m, 0.85 * h_m], [0.28 * b_m, 0.62 * h_m]]
+        )
         for x, y in dots:
             p.circle(x, y, dia / 2, BLACK)
         feats["dots"] = dots
@@ -187,8 +205,19 @@ def block_texture(b_m, h_m, style, *, marker_ids=(), dictionary="DICT_4X4_50", m
     return p.finish(psf_px_m / texel_m, outline, feats)
 
 
-def table_texture(width_m, thick_m, style, *, marker_ids=(), dictionary="DICT_4X4_50",
-                  marker_size_m=None, dot_diameter_m=None, texel_m, psf_px_m, rng) -> Texture:
+def table_texture(
+    width_m,
+    thick_m,
+    style,
+    *,
+    marker_ids=(),
+    dictionary="DICT_4X4_50",
+    marker_size_m=None,
+    dot_diameter_m=None,
+    texel_m,
+    psf_px_m,
+    rng,
+) -> Texture:
     """Front face of the table top (body frame: origin at the top centre, y up).
 
     Markers (or dots) sit near both ends so the tracker can level from the
@@ -196,14 +225,14 @@ def table_texture(width_m, thick_m, style, *, marker_ids=(), dictionary="DICT_4X
     """
     pad = 4 * psf_px_m + 2 * texel_m
     p = _Painter(-width_m / 2, width_m / 2, -thick_m, 0.0, texel_m, pad)
-    outline = np.array([[-width_m / 2, -thick_m], [width_m / 2, -thick_m], [width_m / 2, 0],
-                        [-width_m / 2, 0]])
+    outline = np.array([[-width_m / 2, -thick_m], [width_m / 2, -thick_m], [width_m / 2, 0], [-width_m / 2, 0]])
     feats: dict = {}
     p.rect(-width_m / 2, width_m / 2, -thick_m, 0, 96.0, opaque=True)
     si, sj = p._slices(-width_m / 2, width_m / 2, -thick_m, 0)
     # a markerless steel slab needs visible grain to be followed; the others keep a faint one
-    p.L[si, sj] += (_speckle(p, si, sj, rng, 16.0, 0.004) if style == "markerless"
-                    else _speckle(p, si, sj, rng, 3.0, 0.006))
+    p.L[si, sj] += (
+        _speckle(p, si, sj, rng, 16.0, 0.004) if style == "markerless" else _speckle(p, si, sj, rng, 3.0, 0.006)
+    )
     xs = (-0.4 * width_m, 0.4 * width_m)
     yc = -thick_m / 2
     if style == "aruco":

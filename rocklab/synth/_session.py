@@ -93,14 +93,22 @@ class SynthSession:
 
     def to_dict(self) -> dict:
         """Paths and summary numbers, JSON-ready."""
-        return {"out_dir": str(self.out_dir), "video_mkv": str(self.video_mkv),
-                "video_mp4": None if self.video_mp4 is None else str(self.video_mp4),
-                "truth_csv": str(self.truth_csv), "track_toml": str(self.track_toml),
-                "experiment_toml": str(self.experiment_toml), "session_json": str(self.session_json),
-                "imu": {k: str(v) for k, v in self.imu.items()}, "n_frames": self.n_frames,
-                "fps": self.fps, "size": self.meta["size_px"], "seed": self.meta["seed"],
-                "objects": sorted(self.truth["object"].unique().tolist()),
-                "render_s": self.render_s}
+        return {
+            "out_dir": str(self.out_dir),
+            "video_mkv": str(self.video_mkv),
+            "video_mp4": None if self.video_mp4 is None else str(self.video_mp4),
+            "truth_csv": str(self.truth_csv),
+            "track_toml": str(self.track_toml),
+            "experiment_toml": str(self.experiment_toml),
+            "session_json": str(self.session_json),
+            "imu": {k: str(v) for k, v in self.imu.items()},
+            "n_frames": self.n_frames,
+            "fps": self.fps,
+            "size": self.meta["size_px"],
+            "seed": self.meta["seed"],
+            "objects": sorted(self.truth["object"].unique().tolist()),
+            "render_s": self.render_s,
+        }
 
 
 def parse_size(text) -> tuple[int, int]:
@@ -114,8 +122,7 @@ def parse_size(text) -> tuple[int, int]:
     except (ValueError, TypeError):
         size = None
     if size is None or len(size) != 2 or not (64 <= size[0] <= 8192 and 64 <= size[1] <= 8192):
-        raise InputError(f"size={text!r}: must be WIDTHxHEIGHT in pixels, each 64..8192 "
-                         "(e.g. 1920x1080)")
+        raise InputError(f"size={text!r}: must be WIDTHxHEIGHT in pixels, each 64..8192 (e.g. 1920x1080)")
     return size
 
 
@@ -143,21 +150,45 @@ def _prepare_out(out_dir: Path, force: bool) -> Path:
 
     out_dir = check_output_dir(out_dir, force=force, need_bytes=200 * 1024 * 1024)
     if out_dir.is_dir() and any(out_dir.iterdir()) and not force:
-        raise InputError(f"--out {out_dir}: folder is not empty; choose a new --out or pass --force to "
-                         "replace rocklab's files in it (nothing else is deleted)")
+        raise InputError(
+            f"--out {out_dir}: folder is not empty; choose a new --out or pass --force to "
+            "replace rocklab's files in it (nothing else is deleted)"
+        )
     return stage_dir(out_dir)
 
 
-def synth_session(out_dir, seed: int = 0, blocks: int = 1, table: str = "none", fps: float = 50.0,
-                  size=(1920, 1080), targets: str = "aruco", duration_s: float | None = None,
-                  occlusion=None, rolling_shutter: bool = False, *, block=None,
-                  restitution: str = "constant", eta: float | None = 0.75, theta0_rad=None,
-                  record=None, table_amplitude_m: float | None = None, table_period_s: float = 0.6,
-                  table_stroke_m: float = 0.05, exposure_s: float | None = None,
-                  noise_dn: float = 1.0, distortion: bool = True, imu: bool = True,
-                  imu_rate_hz: float = 256.0, mp4: bool = True, calibrated: bool = True,
-                  layout: str | None = None, force: bool = False,
-                  progress: bool = False, flicker: float = 0.0) -> SynthSession:
+def synth_session(
+    out_dir,
+    seed: int = 0,
+    blocks: int = 1,
+    table: str = "none",
+    fps: float = 50.0,
+    size=(1920, 1080),
+    targets: str = "aruco",
+    duration_s: float | None = None,
+    occlusion=None,
+    rolling_shutter: bool = False,
+    *,
+    block=None,
+    restitution: str = "constant",
+    eta: float | None = 0.75,
+    theta0_rad=None,
+    record=None,
+    table_amplitude_m: float | None = None,
+    table_period_s: float = 0.6,
+    table_stroke_m: float = 0.05,
+    exposure_s: float | None = None,
+    noise_dn: float = 1.0,
+    distortion: bool = True,
+    imu: bool = True,
+    imu_rate_hz: float = 256.0,
+    mp4: bool = True,
+    calibrated: bool = True,
+    layout: str | None = None,
+    force: bool = False,
+    progress: bool = False,
+    flicker: float = 0.0,
+) -> SynthSession:
     """Render a synthetic lab session into ``out_dir`` (see the module doc for the layout).
 
     Parameters
@@ -235,13 +266,29 @@ def synth_session(out_dir, seed: int = 0, blocks: int = 1, table: str = "none", 
     tmp = _prepare_out(out_dir, force)
     t_start = time.perf_counter()
     try:
-        scene = build_scene(seed=int(seed), blocks=blocks, table=table, fps=fps, size=size, targets=targets,
-                            duration_s=duration_s, occlusion=occlusion, rolling_shutter=rolling_shutter,
-                            block=block, restitution=restitution, eta=eta, theta0_rad=theta0_rad,
-                            record=record, table_amplitude_m=table_amplitude_m,
-                            table_period_s=table_period_s, table_stroke_m=table_stroke_m,
-                            exposure_s=exposure_s, noise_dn=noise_dn, distortion=distortion,
-                            layout=layout)
+        scene = build_scene(
+            seed=int(seed),
+            blocks=blocks,
+            table=table,
+            fps=fps,
+            size=size,
+            targets=targets,
+            duration_s=duration_s,
+            occlusion=occlusion,
+            rolling_shutter=rolling_shutter,
+            block=block,
+            restitution=restitution,
+            eta=eta,
+            theta0_rad=theta0_rad,
+            record=record,
+            table_amplitude_m=table_amplitude_m,
+            table_period_s=table_period_s,
+            table_stroke_m=table_stroke_m,
+            exposure_s=exposure_s,
+            noise_dn=noise_dn,
+            distortion=distortion,
+            layout=layout,
+        )
         scene.flicker = float(flicker)
         _render_video(scene, tmp, mp4, progress)
         meta = scene.write_files(tmp, imu=imu, imu_rate_hz=imu_rate_hz, calibrated=calibrated)
@@ -269,8 +316,11 @@ def _render_video(scene, folder: Path, mp4: bool, progress: bool):
         tqdm = None
     renderer = scene.renderer()
     writer = VideoPair(folder, scene.fps, scene.size, mp4=mp4)
-    bar = tqdm(total=scene.n_frames, desc="synth", unit="frame", file=sys.stderr, disable=not progress) \
-        if tqdm else contextlib.nullcontext()
+    bar = (
+        tqdm(total=scene.n_frames, desc="synth", unit="frame", file=sys.stderr, disable=not progress)
+        if tqdm
+        else contextlib.nullcontext()
+    )
     subframes = []
     try:
         for i in range(scene.n_frames):
@@ -282,15 +332,19 @@ def _render_video(scene, folder: Path, mp4: bool, progress: bool):
         writer.close()
         if tqdm:
             bar.close()
-    scene.video_info = {"lossless_codec": writer.codec, "lossless_file": "video.mkv",
-                        "lossy_file": "video.mp4" if "mp4" in writer.paths else None,
-                        "lossy_codec": writer.lossy_codec,
-                        "color": "grey (one channel; readers return BGR with equal channels)",
-                        "max_subframes": int(max(subframes, default=1)),
-                        # brightness gain of each frame (exposure flicker; all 1 without it)
-                        "exposure_gain": [round(renderer.exposure_gain(i / scene.fps), 6)
-                                          for i in range(scene.n_frames)] if scene.flicker > 0 else None,
-                        "mean_subframes": float(np.mean(subframes)) if subframes else 1.0}
+    scene.video_info = {
+        "lossless_codec": writer.codec,
+        "lossless_file": "video.mkv",
+        "lossy_file": "video.mp4" if "mp4" in writer.paths else None,
+        "lossy_codec": writer.lossy_codec,
+        "color": "grey (one channel; readers return BGR with equal channels)",
+        "max_subframes": int(max(subframes, default=1)),
+        # brightness gain of each frame (exposure flicker; all 1 without it)
+        "exposure_gain": [round(renderer.exposure_gain(i / scene.fps), 6) for i in range(scene.n_frames)]
+        if scene.flicker > 0
+        else None,
+        "mean_subframes": float(np.mean(subframes)) if subframes else 1.0,
+    }
 
 
 def load_synth_session(out_dir, render_s: float = float("nan")) -> SynthSession:
@@ -304,6 +358,16 @@ def load_synth_session(out_dir, render_s: float = float("nan")) -> SynthSession:
     meta = json.loads(sj.read_text(encoding="utf-8"))
     truth = pd.read_csv(out_dir / "truth.csv")
     mp4 = out_dir / "video.mp4"
-    return SynthSession(out_dir, out_dir / "video.mkv", mp4 if mp4.is_file() else None,
-                        out_dir / "truth.csv", out_dir / "track.toml", out_dir / "experiment.toml",
-                        sj, {k: out_dir / "imu" / k for k in meta.get("imu", {})}, truth, meta, render_s)
+    return SynthSession(
+        out_dir,
+        out_dir / "video.mkv",
+        mp4 if mp4.is_file() else None,
+        out_dir / "truth.csv",
+        out_dir / "track.toml",
+        out_dir / "experiment.toml",
+        sj,
+        {k: out_dir / "imu" / k for k in meta.get("imu", {})},
+        truth,
+        meta,
+        render_s,
+    )

@@ -77,8 +77,13 @@ class StereoCamera:
         return (np.asarray(X, float).reshape(-1, 3) @ self.R.T + self.t)[:, 2]
 
     def to_dict(self) -> dict:
-        return {"K": self.K.tolist(), "dist": self.dist.tolist(), "R": self.R.tolist(), "t": self.t.tolist(),
-                "size": list(self.size)}
+        return {
+            "K": self.K.tolist(),
+            "dist": self.dist.tolist(),
+            "R": self.R.tolist(),
+            "t": self.t.tolist(),
+            "size": list(self.size),
+        }
 
 
 def look_at(eye, target, up=(0.0, 0.0, 1.0)):
@@ -131,7 +136,7 @@ def _plane_maps(cam: StereoCamera, R_b, t_b, ppm):
     tcb = cam.R @ t_b + cam.t
     # the ray through each pixel in the plane's frame: C + s d, and its crossing of z = 0
     C = -Rcb.T @ tcb
-    d = np.column_stack([n, np.ones(len(n))]) @ Rcb            # rows: Rcb^T ray
+    d = np.column_stack([n, np.ones(len(n))]) @ Rcb  # rows: Rcb^T ray
     with np.errstate(divide="ignore", invalid="ignore"):
         s = -C[2] / d[:, 2]
     X = C[0] + s * d[:, 0]
@@ -161,7 +166,7 @@ def _board_poses(n, rng):
     w, h = CHARUCO["squares"][0] * CHARUCO["square_m"], CHARUCO["squares"][1] * CHARUCO["square_m"]
     for i in range(n):
         # face the cameras (board normal towards -y), then tilt
-        base = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]])      # board x -> world x, y -> -z
+        base = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]])  # board x -> world x, y -> -z
         tilt = Rotation.from_euler("xyz", rng.uniform([-35, -35, -15], [35, 35, 15]), degrees=True).as_matrix()
         R = tilt @ base
         centre = np.array([rng.uniform(-0.22, 0.22), rng.uniform(-0.3, 0.1), rng.uniform(-0.02, 0.42)])
@@ -186,13 +191,13 @@ def _render_dots(cam: StereoCamera, X, radius_m, noise, rng, background=18.0, pe
         if x1 < 0 or y1 < 0 or x0 >= W or y0 >= H:
             continue
         x0, y0, x1, y1 = max(x0, 0), max(y0, 0), min(x1, W - 1), min(y1, H - 1)
-        yy, xx = np.mgrid[y0:y1 + 1, x0:x1 + 1]
+        yy, xx = np.mgrid[y0 : y1 + 1, x0 : x1 + 1]
         # 4x4 supersampled coverage of the disk
         cov = np.zeros(xx.shape, np.float32)
         for dy in (-0.375, -0.125, 0.125, 0.375):
             for dx in (-0.375, -0.125, 0.125, 0.375):
-                cov += ((xx + dx - u0) ** 2 + (yy + dy - v0) ** 2 <= r * r)
-        img[y0:y1 + 1, x0:x1 + 1] += (peak - background) * cov / 16.0
+                cov += (xx + dx - u0) ** 2 + (yy + dy - v0) ** 2 <= r * r
+        img[y0 : y1 + 1, x0 : x1 + 1] += (peak - background) * cov / 16.0
         # sensor noise on the target and a margin round it; the flat background stays flat so the lossless
         # films stay small (a detector only ever looks at the targets' windows)
         m = int(math.ceil(r)) + 6
@@ -222,20 +227,20 @@ def _render_aruco_films(out, cams, sess, X1, X2, fps, size, noise, rng, paths):
     face_corners = {}
     for mid, top in ((0, 0.2 * h), (1, 0.6 * h)):
         x0, y0, n = int(round(0.2 * b * ppm)), int(round(top * ppm)), int(round(side * ppm))
-        face[y0:y0 + n, x0:x0 + n] = cv2.aruco.generateImageMarker(d, mid, n)
+        face[y0 : y0 + n, x0 : x0 + n] = cv2.aruco.generateImageMarker(d, mid, n)
         face_corners[mid] = np.array([[x0, y0], [x0 + n, y0], [x0 + n, y0 + n], [x0, y0 + n]], float) / ppm
     # band-limit the textures to the pixel footprint (about ppm * 1 m / f texels per pixel): remap samples
     # them point-wise, and an unfiltered edge would land on the sample grid, biasing corners by ~0.5 px
     sig = 0.5 * ppm * 1.0 / float(cams[0].K[0, 0])
     face = cv2.GaussianBlur(face, (0, 0), sig)
-    R_fb = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]])       # face x, y, z -> body x, -z, y
+    R_fb = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]])  # face x, y, z -> body x, -z, y
     o_face = np.array([-b / 2, -depth / 2, h])
     # the table's plate: 6 cm tall, standing on the table in front of the block, facing the cameras
     plate = np.full((int(round(0.06 * ppm)), int(round(0.4 * ppm))), 235, np.uint8)
     plate_corners = {}
     for mid, x in ((2, 0.01), (3, 0.35)):
         x0, y0, n = int(round(x * ppm)), int(round(0.01 * ppm)), int(round(0.04 * ppm))
-        plate[y0:y0 + n, x0:x0 + n] = cv2.aruco.generateImageMarker(d, mid, n)
+        plate[y0 : y0 + n, x0 : x0 + n] = cv2.aruco.generateImageMarker(d, mid, n)
         plate_corners[mid] = np.array([[x0, y0], [x0 + n, y0], [x0 + n, y0 + n], [x0, y0 + n]], float) / ppm
     plate = cv2.GaussianBlur(plate, (0, 0), sig)
     R_p = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]])
@@ -253,16 +258,24 @@ def _render_aruco_films(out, cams, sess, X1, X2, fps, size, noise, rng, paths):
         R, t, _ = kabsch(body_pts, X[:, :nb])
         mxp, myp = _plane_maps(cam, R_p, o_p, ppm)
         pimg = cv2.remap(plate, mxp, myp, cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT, borderValue=0)
-        pmask = cv2.remap(np.full_like(plate, 255), mxp, myp, cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT,
-                          borderValue=0).astype(np.float32) / 255.0
+        pmask = (
+            cv2.remap(
+                np.full_like(plate, 255), mxp, myp, cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT, borderValue=0
+            ).astype(np.float32)
+            / 255.0
+        )
         vp = VideoPair(out, fps, size, mp4=False, stem=f"cam{k_cam}")
         for i in range(X.shape[0]):
             mx, my = _plane_maps(cam, R[i] @ R_fb, R[i] @ o_face + t[i], ppm)
             img = cv2.remap(face, mx, my, cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT, borderValue=0)
-            m = cv2.remap(np.full_like(face, 255), mx, my, cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT,
-                          borderValue=0).astype(np.float32) / 255.0
+            m = (
+                cv2.remap(
+                    np.full_like(face, 255), mx, my, cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT, borderValue=0
+                ).astype(np.float32)
+                / 255.0
+            )
             frame = 30.0 * (1 - m) + img.astype(np.float32) * m
-            frame = frame * (1 - pmask) + pimg.astype(np.float32) * pmask       # the plate is in front
+            frame = frame * (1 - pmask) + pimg.astype(np.float32) * pmask  # the plate is in front
             frame = cv2.GaussianBlur(frame, (0, 0), 0.6)
             lit = (m > 0) | (pmask > 0)
             frame[lit] += rng.normal(0.0, noise, int(lit.sum()))
@@ -274,9 +287,21 @@ def _render_aruco_films(out, cams, sess, X1, X2, fps, size, noise, rng, paths):
     return outs[0], outs[1], labels
 
 
-def synth_stereo(out_dir, *, size=(2400, 1728), fps: float = 150.0, f_px: float = 3000.0, offset_s: float = 0.0027,
-                 n_board: int = 24, noise_dn: float = 2.0, dot_radius_m: float = 0.003, seed: int = 0,
-                 duration_s: float | None = None, targets: str = "dots", **motion) -> dict:
+def synth_stereo(
+    out_dir,
+    *,
+    size=(2400, 1728),
+    fps: float = 150.0,
+    f_px: float = 3000.0,
+    offset_s: float = 0.0027,
+    n_board: int = 24,
+    noise_dn: float = 2.0,
+    dot_radius_m: float = 0.003,
+    seed: int = 0,
+    duration_s: float | None = None,
+    targets: str = "dots",
+    **motion,
+) -> dict:
     """Render a stereo session (see the module doc) into ``out_dir``; returns the paths and the truth.
 
     Parameters
@@ -328,7 +353,7 @@ def synth_stereo(out_dir, *, size=(2400, 1728), fps: float = 150.0, f_px: float 
     bh = int(round(CHARUCO["squares"][1] * CHARUCO["square_m"] * ppm))
     texture = board.generateImage((bw, bh), marginSize=0)
     texture = (40 + texture.astype(np.float32) * (200 / 255)).astype(np.uint8)
-    texture = cv2.GaussianBlur(texture, (0, 0), 0.5 * ppm * 0.9 / f_px)        # band-limited (see the markers)
+    texture = cv2.GaussianBlur(texture, (0, 0), 0.5 * ppm * 0.9 / f_px)  # band-limited (see the markers)
     poses = _board_poses(n_board, rng)
     paths = {}
     for k, cam in enumerate(cams, start=1):
@@ -339,8 +364,16 @@ def synth_stereo(out_dir, *, size=(2400, 1728), fps: float = 150.0, f_px: float 
         paths[f"calib_cam{k}"] = vp.paths["mkv"]
     # the rocking film: the motion sampled finely, then read at each camera's frame times
     fine = 20
-    sess = synth_points3d(rate_hz=fps * fine, noise_m=0.0, seed=seed, up="z", yaw_deg=0.0,
-                          offset_m=(0.0, 0.0, 0.0), side_targets=False, **motion)
+    sess = synth_points3d(
+        rate_hz=fps * fine,
+        noise_m=0.0,
+        seed=seed,
+        up="z",
+        yaw_deg=0.0,
+        offset_m=(0.0, 0.0, 0.0),
+        side_targets=False,
+        **motion,
+    )
     t_fine = sess.series.t_s
     labels = sess.series.labels
     t_end = t_fine[-1] if duration_s is None else min(t_fine[-1], float(duration_s))
@@ -371,12 +404,25 @@ def synth_stereo(out_dir, *, size=(2400, 1728), fps: float = 150.0, f_px: float 
     tr["t_s"] = t1
     truth_path = out / "truth.csv"
     tr.to_csv(truth_path, index=False, float_format="%.9g")
-    pts = pd.DataFrame({"t_s": np.repeat(t1, len(labels)), "point": np.tile(np.asarray(labels, dtype=object), t1.size),
-                        "x_m": X1[:, :, 0].ravel(), "y_m": X1[:, :, 1].ravel(), "z_m": X1[:, :, 2].ravel()})
+    pts = pd.DataFrame(
+        {
+            "t_s": np.repeat(t1, len(labels)),
+            "point": np.tile(np.asarray(labels, dtype=object), t1.size),
+            "x_m": X1[:, :, 0].ravel(),
+            "y_m": X1[:, :, 1].ravel(),
+            "z_m": X1[:, :, 2].ravel(),
+        }
+    )
     pts.to_csv(out / "points_truth.csv", index=False, float_format="%.9g")
-    rig = {"cam1": cams[0].to_dict(), "cam2": cams[1].to_dict(), "offset_s": offset_s, "fps": fps,
-           "charuco": CHARUCO, "bodies": {k: list(v) for k, v in sess.bodies.items()},
-           "injected": {k: list(v) for k, v in sess.injected.items()}}
+    rig = {
+        "cam1": cams[0].to_dict(),
+        "cam2": cams[1].to_dict(),
+        "offset_s": offset_s,
+        "fps": fps,
+        "charuco": CHARUCO,
+        "bodies": {k: list(v) for k, v in sess.bodies.items()},
+        "injected": {k: list(v) for k, v in sess.injected.items()},
+    }
     (out / "rig.json").write_text(json.dumps(rig, indent=2))
     paths.update(truth_csv=truth_path, points_truth_csv=out / "points_truth.csv", rig_json=out / "rig.json")
     return {"paths": paths, "cameras": cams, "session": sess, "offset_s": offset_s, "t_s": t1, "X1": X1}

@@ -13,29 +13,99 @@ The clock synchronisation of an IMU to a video track is here (:func:`sync_offset
 """
 
 from ._sync import SyncResult, sync_events, sync_imu_to_track, sync_offset, track_rate
-from .imu import (ImuLog, ImuRotation, TableAcceleration, ahrs_quaternions, block_rotation, read_imu,
-                  read_ximu_registers, table_acceleration, ximu_rate_from_registers)
-from .video import (TRACK_COLUMNS, BoardConfig, MotionConfig, ObjectConfig, ObjectTrack, Observation, PlaneMap,
-                    ReferenceConfig, SimilarityFit, TableMotion, TargetsConfig, TrackConfig, TrackResult, VideoConfig,
-                    VideoInfo, assemble_tracks, calibrate_camera, choose_sg_window, estimate_noise, fit_similarity,
-                    iter_video_frames, load_track_config, probe_video, table_motion, track_frames, track_video)
+from .imu import (
+    ImuLog,
+    ImuRotation,
+    TableAcceleration,
+    ahrs_quaternions,
+    block_rotation,
+    read_imu,
+    read_ximu_registers,
+    table_acceleration,
+    ximu_rate_from_registers,
+)
+from .video import (
+    TRACK_COLUMNS,
+    BoardConfig,
+    MotionConfig,
+    ObjectConfig,
+    ObjectTrack,
+    Observation,
+    PlaneMap,
+    ReferenceConfig,
+    SimilarityFit,
+    TableMotion,
+    TargetsConfig,
+    TrackConfig,
+    TrackResult,
+    VideoConfig,
+    VideoInfo,
+    assemble_tracks,
+    calibrate_camera,
+    choose_sg_window,
+    estimate_noise,
+    fit_similarity,
+    iter_video_frames,
+    load_track_config,
+    probe_video,
+    table_motion,
+    track_frames,
+    track_video,
+)
 
 __all__: list[str] = [
-    "TrackConfig", "VideoConfig", "TargetsConfig", "ReferenceConfig", "BoardConfig",
-    "MotionConfig", "ObjectConfig", "load_track_config",
-    "track_video", "track_frames", "assemble_tracks", "TrackResult", "ObjectTrack", "Observation",
-    "TRACK_COLUMNS", "TableMotion", "table_motion", "choose_sg_window", "estimate_noise",
-    "VideoInfo", "probe_video", "iter_video_frames", "PlaneMap", "SimilarityFit",
-    "fit_similarity", "calibrate_camera",
-    "ImuLog", "read_imu", "read_ximu_registers", "ximu_rate_from_registers",
-    "ImuRotation", "block_rotation", "ahrs_quaternions", "TableAcceleration", "table_acceleration",
-    "SyncResult", "sync_offset", "sync_events", "sync_imu_to_track", "track_rate",
+    "TrackConfig",
+    "VideoConfig",
+    "TargetsConfig",
+    "ReferenceConfig",
+    "BoardConfig",
+    "MotionConfig",
+    "ObjectConfig",
+    "load_track_config",
+    "track_video",
+    "track_frames",
+    "assemble_tracks",
+    "TrackResult",
+    "ObjectTrack",
+    "Observation",
+    "TRACK_COLUMNS",
+    "TableMotion",
+    "table_motion",
+    "choose_sg_window",
+    "estimate_noise",
+    "VideoInfo",
+    "probe_video",
+    "iter_video_frames",
+    "PlaneMap",
+    "SimilarityFit",
+    "fit_similarity",
+    "calibrate_camera",
+    "ImuLog",
+    "read_imu",
+    "read_ximu_registers",
+    "ximu_rate_from_registers",
+    "ImuRotation",
+    "block_rotation",
+    "ahrs_quaternions",
+    "TableAcceleration",
+    "table_acceleration",
+    "SyncResult",
+    "sync_offset",
+    "sync_events",
+    "sync_imu_to_track",
+    "track_rate",
 ]
 
 #: Names that moved to :mod:`rocklab.synth` (simulated lab sessions are a simulator of the lab, not a
 #: measurement); reachable here for one release with a DeprecationWarning.
-_MOVED_TO_SYNTH = ("synth_session", "SynthSession", "load_synth_session", "simulate_imu_log", "write_ximu_csv",
-                   "write_ximu3_csv")
+_MOVED_TO_SYNTH = (
+    "synth_session",
+    "SynthSession",
+    "load_synth_session",
+    "simulate_imu_log",
+    "write_ximu_csv",
+    "write_ximu3_csv",
+)
 
 
 def __getattr__(name):
@@ -44,7 +114,10 @@ def __getattr__(name):
 
         import rocklab.synth as synth
 
-        warnings.warn(f"rocklab.tracking.{name} moved to rocklab.synth.{name}; import it from there",
-                      DeprecationWarning, stacklevel=2)
+        warnings.warn(
+            f"rocklab.tracking.{name} moved to rocklab.synth.{name}; import it from there",
+            DeprecationWarning,
+            stacklevel=2,
+        )
         return getattr(synth, name)
     raise AttributeError(f"module 'rocklab.tracking' has no attribute {name!r}")

@@ -74,18 +74,25 @@ class SyncResult:
 
     def to_dict(self) -> dict:
         """``offset_s, offset_ms, drift, drift_ppm, residual_ms, correlation, n_windows``."""
-        return {"offset_s": float(self.offset_s), "offset_ms": 1e3 * float(self.offset_s),
-                "drift": float(self.drift), "drift_ppm": 1e6 * float(self.drift),
-                "residual_ms": float(self.residual_ms), "correlation": float(self.correlation),
-                "n_windows": int(self.n_windows), "sign": int(self.sign)}
+        return {
+            "offset_s": float(self.offset_s),
+            "offset_ms": 1e3 * float(self.offset_s),
+            "drift": float(self.drift),
+            "drift_ppm": 1e6 * float(self.drift),
+            "residual_ms": float(self.residual_ms),
+            "correlation": float(self.correlation),
+            "n_windows": int(self.n_windows),
+            "sign": int(self.sign),
+        }
 
 
 def _clean(t, y, name):
     t = np.asarray(t, float).ravel()
     y = np.asarray(y, float).ravel()
     if t.shape != y.shape:
-        raise InputError(f"sync: t_{name} and rate_{name} differ in length ({t.size} vs {y.size}); "
-                         "pass matching arrays")
+        raise InputError(
+            f"sync: t_{name} and rate_{name} differ in length ({t.size} vs {y.size}); pass matching arrays"
+        )
     ok = np.isfinite(t) & np.isfinite(y)
     t, y = t[ok], y[ok]
     if t.size < 8:
@@ -137,7 +144,7 @@ def _coarse(span_a, fa, tb, yb, fs, max_offset_s, center=0.0):
     # logs on after the camera stops) says nothing about how well the two agree
     lag = int(lags[k])
     n0, n1 = max(0, lag), min(a.size, b.size + lag)
-    ao, bo = a[n0:n1], b[n0 - lag:n1 - lag]
+    ao, bo = a[n0:n1], b[n0 - lag : n1 - lag]
     den = np.sqrt(np.sum(ao * ao) * np.sum(bo * bo)) or 1.0
     corr = float(c[k] / den)
     if corr < 0:
@@ -181,21 +188,30 @@ def _fine(ta, A, tb, B, guess, half, detrend=True, scan=None):
     if scan is not None and len(scan):
         c = np.array([cost(o) for o in scan])
         guess = float(scan[int(np.argmin(c))])
-    res = minimize_scalar(cost, bounds=(guess - half, guess + half), method="bounded",
-                          options={"xatol": 1e-6})
+    res = minimize_scalar(cost, bounds=(guess - half, guess + half), method="bounded", options={"xatol": 1e-6})
     r0 = resid0(B, x_all)
     var = float(r0 @ r0) / max(1, B.size)
     off = float(res.x)
     m = (tb + off > ta[0]) & (tb + off < ta[-1])
     slope = A.derivative()(tb[m] + off) if hasattr(A, "derivative") else np.gradient(A(tb[m] + off), tb[m])
-    wgt = slope ** 2
+    wgt = slope**2
     t_c = float(wgt @ tb[m] / wgt.sum()) if wgt.sum() > 0 else float(tb[m].mean())
     return off, (1.0 - float(res.fun) / var) if var > 0 else 0.0, t_c
 
 
-def sync_offset(t_a, rate_a, t_b, rate_b, *, max_offset_s: float | None = None,
-                window_b_s: float = 0.0, drift: bool | str = "auto", window_s: float | None = None,
-                grid_hz: float = 1000.0, theta_b=None) -> SyncResult:
+def sync_offset(
+    t_a,
+    rate_a,
+    t_b,
+    rate_b,
+    *,
+    max_offset_s: float | None = None,
+    window_b_s: float = 0.0,
+    drift: bool | str = "auto",
+    window_s: float | None = None,
+    grid_hz: float = 1000.0,
+    theta_b=None,
+) -> SyncResult:
     """Clock offset (and drift) between two angular-rate recordings.
 
     Parameters
@@ -333,8 +349,9 @@ def sync_imu_to_track(rotation, t_s, theta_rad, **kwargs) -> SyncResult:
     return sync_offset(rotation.t_s, rotation.omega_rad_s, t, w, theta_b=theta_rad, **kwargs)
 
 
-def sync_events(t_a, t_b, *, max_offset_s: float | None = None, tol_s: float = 0.02,
-                drift: bool | str = "auto") -> SyncResult:
+def sync_events(
+    t_a, t_b, *, max_offset_s: float | None = None, tol_s: float = 0.02, drift: bool | str = "auto"
+) -> SyncResult:
     """Clock model from matched event instants (e.g. impacts seen by two sensors).
 
     Parameters
@@ -396,5 +413,4 @@ def sync_events(t_a, t_b, *, max_offset_s: float | None = None, tol_s: float = 0
             d, off = 0.0, float(np.mean(diff[ok]))
     model = off + d * b[ok]
     resid = 1e3 * float(np.sqrt(np.mean((diff[ok] - model) ** 2))) if ok.sum() >= 3 else np.nan
-    return SyncResult(float(off), float(d), resid, float(ok.mean()), int(ok.sum()), b[ok],
-                      diff[ok])
+    return SyncResult(float(off), float(d), resid, float(ok.mean()), int(ok.sum()), b[ok], diff[ok])

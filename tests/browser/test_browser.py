@@ -44,10 +44,14 @@ def run_dir(tmp_path_factory):
     starts before the film, so the viewer opens (time 0) on the film's first frame."""
     d = tmp_path_factory.mktemp("browser")
     exe = Path(sys.executable).parent / "rocklab"
-    subprocess.run([exe, "synth", "--out", d / "session", "--seed", "1", "--size", "640x360", "--duration", "4",
-                    "--no-imu"], check=True, capture_output=True)
-    subprocess.run([exe, "run", d / "session" / "experiment.toml", "--out", d / "results"], check=True,
-                   capture_output=True)
+    subprocess.run(
+        [exe, "synth", "--out", d / "session", "--seed", "1", "--size", "640x360", "--duration", "4", "--no-imu"],
+        check=True,
+        capture_output=True,
+    )
+    subprocess.run(
+        [exe, "run", d / "session" / "experiment.toml", "--out", d / "results"], check=True, capture_output=True
+    )
     return d / "results"
 
 
@@ -72,7 +76,7 @@ def _free_port() -> int:
 
 
 def _near(img, rgb, tol=40):
-    return (np.abs(img[..., :3].astype(int) - np.asarray(rgb)).max(axis=-1) <= tol)
+    return np.abs(img[..., :3].astype(int) - np.asarray(rgb)).max(axis=-1) <= tol
 
 
 def test_rerun_web_viewer_draws_the_recording(browser, run_dir, tmp_path):
@@ -83,9 +87,12 @@ def test_rerun_web_viewer_draws_the_recording(browser, run_dir, tmp_path):
 
     web, grpc = _free_port(), _free_port()
     rerun = Path(sys.executable).parent / "rerun"
-    srv = subprocess.Popen([rerun, run_dir / "session.rrd", "--serve-web", "--web-viewer-port", str(web),
-                            "--port", str(grpc)], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-                           start_new_session=True)
+    srv = subprocess.Popen(
+        [rerun, run_dir / "session.rrd", "--serve-web", "--web-viewer-port", str(web), "--port", str(grpc)],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+        start_new_session=True,
+    )
     try:
         page = browser.new_page(viewport={"width": 1400, "height": 900})
         url = urllib.parse.quote(f"rerun+http://localhost:{grpc}/proxy", safe="")
@@ -103,8 +110,11 @@ def test_rerun_web_viewer_draws_the_recording(browser, run_dir, tmp_path):
             img = np.asarray(Image.open(shot).convert("RGB"))
             right = img[60:340, 720:]  # the θ view: top right of the blueprint
             film = img[70:540, 10:690]  # the video view: top left
-            if (_near(right, (0, 114, 178), 30).sum() > 150 and _near(right, (0, 0, 0), 30).sum() > 150
-                    and film.std() > 30):
+            if (
+                _near(right, (0, 114, 178), 30).sum() > 150
+                and _near(right, (0, 0, 0), 30).sum() > 150
+                and film.std() > 30
+            ):
                 break
         assert img is not None and img.std() > 10  # not a blank canvas
         right = img[60:340, 720:]

@@ -11,7 +11,23 @@ from ._geometry import ImpactOutcome, app_c_reduction, column_impact, full_mass_
 from ._maps import ColumnMaps, column_overturning_maps, sine_pulse
 from ._sim import STATE_NAMES, Column, ColumnResult, simulate_column, uplift_acc_m_s2
 
-__all__ = ["Column", "ColumnResult", "simulate_column", "uplift_acc_m_s2", "STATE_NAMES", "ImpactOutcome",
-           "app_c_reduction", "column_impact", "full_mass_matrix", "mass_points", "ColumnMaps",
-           "column_overturning_maps", "sine_pulse", "SequenceComparison", "compare_sequences", "joint_sequence",
-           "ColumnComparison", "compare_to_measurement"]
+__all__ = [
+    "Column",
+    "ColumnResult",
+    "simulate_column",
+    "uplift_acc_m_s2",
+    "STATE_NAMES",
+    "ImpactOutcome",
+    "app_c_reduction",
+    "column_impact",
+    "full_mass_matrix",
+    "mass_points",
+    "ColumnMaps",
+    "column_overturning_maps",
+    "sine_pulse",
+    "SequenceComparison",
+    "compare_sequences",
+    "joint_sequence",
+    "ColumnComparison",
+    "compare_to_measurement",
+]

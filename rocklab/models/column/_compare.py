@@ -20,8 +20,9 @@ from ..._errors import InputError
 __all__ = ["joint_sequence", "compare_sequences", "SequenceComparison", "compare_to_measurement", "ColumnComparison"]
 
 
-def joint_sequence(t_s, theta_rad, threshold_rad: float = 0.005, *, base_theta_rad=None, sign: float = 1.0,
-                   min_duration_s: float = 0.0) -> list[tuple[float, int, str]]:
+def joint_sequence(
+    t_s, theta_rad, threshold_rad: float = 0.005, *, base_theta_rad=None, sign: float = 1.0, min_duration_s: float = 0.0
+) -> list[tuple[float, int, str]]:
     """Configuration changes ``(t_s, joint, state)`` from absolute block angles.
 
     Parameters
@@ -111,9 +112,15 @@ class SequenceComparison:
 
     def to_dict(self) -> dict:
         """Plain dict of the fields, JSON-ready (SI units in the keys)."""
-        return {"n_measured": self.n_measured, "n_simulated": self.n_simulated, "n_matched": self.n_matched,
-                "timing_error_s": self.timing_error_s, "same_sequence": self.same_sequence, "tol_s": self.tol_s,
-                "pairs": [list(p) for p in self.pairs]}
+        return {
+            "n_measured": self.n_measured,
+            "n_simulated": self.n_simulated,
+            "n_matched": self.n_matched,
+            "timing_error_s": self.timing_error_s,
+            "same_sequence": self.same_sequence,
+            "tol_s": self.tol_s,
+            "pairs": [list(p) for p in self.pairs],
+        }
 
 
 def compare_sequences(measured, simulated, tol_s: float = 0.05, t_max_s: float | None = None) -> SequenceComparison:
@@ -178,15 +185,27 @@ class ColumnComparison:
 
     def to_dict(self) -> dict:
         """Plain dict of the fields, JSON-ready (SI units in the keys)."""
-        return {"sequence": self.sequence.to_dict(),
-                "measured_sequence": [list(e) for e in self.measured_sequence],
-                "simulated_sequence": [list(e) for e in self.simulated_sequence],
-                "rms_theta_rad": self.rms_theta_rad.tolist(), "peak_measured_rad": self.peak_measured_rad.tolist(),
-                "peak_simulated_rad": self.peak_simulated_rad.tolist()}
+        return {
+            "sequence": self.sequence.to_dict(),
+            "measured_sequence": [list(e) for e in self.measured_sequence],
+            "simulated_sequence": [list(e) for e in self.simulated_sequence],
+            "rms_theta_rad": self.rms_theta_rad.tolist(),
+            "peak_measured_rad": self.peak_measured_rad.tolist(),
+            "peak_simulated_rad": self.peak_simulated_rad.tolist(),
+        }
 
 
-def compare_to_measurement(result, t_s, theta_rad, *, threshold_rad: float = 0.005, tol_s: float = 0.05,
-                           sign: float = 1.0, base_theta_rad=None, min_duration_s: float = 0.0) -> ColumnComparison:
+def compare_to_measurement(
+    result,
+    t_s,
+    theta_rad,
+    *,
+    threshold_rad: float = 0.005,
+    tol_s: float = 0.05,
+    sign: float = 1.0,
+    base_theta_rad=None,
+    min_duration_s: float = 0.0,
+) -> ColumnComparison:
     """Compare a :class:`ColumnResult` with tracked block angles (thesis §4.3, Fig. 32).
 
     Parameters
@@ -221,5 +240,6 @@ def compare_to_measurement(result, t_s, theta_rad, *, threshold_rad: float = 0.0
     t_max = float(t[inside][-1]) if inside.any() else None
     comp = compare_sequences(mseq, sseq, tol_s=tol_s, t_max_s=t_max)
     peak_m = np.array([np.max(np.abs(meas[ok[:, i], i])) if ok[:, i].any() else np.nan for i in range(n)])
-    return ColumnComparison(comp, mseq, [e for e in sseq if t_max is None or e[0] <= t_max], rms,
-                            peak_m, np.max(np.abs(sim), axis=0))
+    return ColumnComparison(
+        comp, mseq, [e for e in sseq if t_max is None or e[0] <= t_max], rms, peak_m, np.max(np.abs(sim), axis=0)
+    )

@@ -95,8 +95,29 @@ def _apply_opening(t, s, px, s_new, px_new, EVT, EVI, ne):
 
 
 @register_jitable
-def run_core(phi0, v0, s0, blk, par, accb, n_steps, dt, max_enum, n_imp, v_tol, stop_at_rest, ovt_angle,
-             stride, PHI, VEL, EN, EVT, EVI, IMP, PEAK):
+def run_core(
+    phi0,
+    v0,
+    s0,
+    blk,
+    par,
+    accb,
+    n_steps,
+    dt,
+    max_enum,
+    n_imp,
+    v_tol,
+    stop_at_rest,
+    ovt_angle,
+    stride,
+    PHI,
+    VEL,
+    EN,
+    EVT,
+    EVI,
+    IMP,
+    PEAK,
+):
     """Integrate ``n_steps`` steps of ``dt`` (s) from t = 0.
 
     The grid ``t_k = k dt`` is kept: an event inside a step is followed by the
@@ -215,8 +236,7 @@ def run_core(phi0, v0, s0, blk, par, accb, n_steps, dt, max_enum, n_imp, v_tol, 
         while t1 - tc > 1e-12 * dt:
             rem = t1 - tc
             n_sub += 1
-            if n_sub > 100000 or not nm_step(phi, v, acc, s, tc, rem, blk, par, accb, phi1, v1, acc1,
-                                             N1, V1, Mc1, w):
+            if n_sub > 100000 or not nm_step(phi, v, acc, s, tc, rem, blk, par, accb, phi1, v1, acc1, N1, V1, Mc1, w):
                 status = ST_NUMERIC
                 break
             # earliest closing (exact) and opening (linear interpolation) inside the sub-step
@@ -272,8 +292,7 @@ def run_core(phi0, v0, s0, blk, par, accb, n_steps, dt, max_enum, n_imp, v_tol, 
                 ke_a = ke_b
                 for k_imp in range(1, n_imp + 1):
                     px_to = -px0 if k_imp == n_imp else px0 * (1.0 - 2.0 * k_imp / n_imp)
-                    ke_a = impact_model(phi, v, s, px, jc, px_to, sgn, blk, par, max_enum, v_tol,
-                                        s_new, px_new, v_new)
+                    ke_a = impact_model(phi, v, s, px, jc, px_to, sgn, blk, par, max_enum, v_tol, s_new, px_new, v_new)
                     for j in range(n):
                         s[j] = s_new[j]
                         px[j] = px_new[j]
@@ -386,6 +405,7 @@ def run_core(phi0, v0, s0, blk, par, accb, n_steps, dt, max_enum, n_imp, v_tol, 
 
 
 # run_core inlines the kernels of these modules (see _numba_cache)
-drop_stale_cache("_column_core.run_core-*.nbi",
-                 ("_column_kernels.py", "_column_step.py", "_column_events.py", "_column_core.py"))
+drop_stale_cache(
+    "_column_core.run_core-*.nbi", ("_column_kernels.py", "_column_step.py", "_column_events.py", "_column_core.py")
+)
 run_core_jit = njit(cache=True)(run_core)

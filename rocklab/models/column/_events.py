@@ -46,7 +46,7 @@ def _union(s, px, a, extra_j, extra_px, n_extra, dj, dpx):
             closed[nc] = j
             nc += 1
             dj[k] = j
-            dpx[k] = a[j]       # clockwise: pivot at the right corner
+            dpx[k] = a[j]  # clockwise: pivot at the right corner
             dj[k + 1] = j
             dpx[k + 1] = -a[j]  # counter-clockwise: pivot at the left corner
             k += 2
@@ -113,7 +113,7 @@ def opening_model(phi, v, s, px, t, dt, blk, par, accb, max_enum, s_out, px_out)
     best_ke = -1.0
     found = 0
     if nc <= max_enum:
-        total = 3 ** nc
+        total = 3**nc
         cand_range = total - 1
     else:
         cand_range = 0
@@ -252,7 +252,7 @@ def impact_model(phi, v, s, px, jc, px_to, sgn_to, blk, par, max_enum, v_tol, s_
     As = np.empty((n + 1, n + 2))
     digits = np.zeros(max(nc, 1), np.int64)
     best = -1.0
-    total = 2 * 3 ** nc_enum
+    total = 2 * 3**nc_enum
     for cand in range(total):
         reopen = cand % 2
         r = cand // 2

@@ -36,7 +36,7 @@ def mass_points(block):
     to ``d = sqrt(I_G/m)`` with the middle mass zero.
     """
     m = block.mass_kg
-    IG = (block.alpha_I - 1.0) * m * block.R_m ** 2
+    IG = (block.alpha_I - 1.0) * m * block.R_m**2
     d = block.h_m / 2
     m_end = IG / (2 * d * d)
     if m_end > m / 2:
@@ -151,8 +151,16 @@ class ImpactOutcome:
     energy_loss: float
 
 
-def column_impact(column, closing_joint: int, omega_rad_s, states, theta_rad=None, n_impacts: int = 1,
-                  max_enum_closed: int = 9, rest_omega_rad_s: float = 0.0) -> ImpactOutcome:
+def column_impact(
+    column,
+    closing_joint: int,
+    omega_rad_s,
+    states,
+    theta_rad=None,
+    n_impacts: int = 1,
+    max_enum_closed: int = 9,
+    rest_omega_rad_s: float = 0.0,
+) -> ImpactOutcome:
     """Apply the impact model to a column whose joint ``closing_joint`` just closed.
 
     Parameters
@@ -197,14 +205,23 @@ def column_impact(column, closing_joint: int, omega_rad_s, states, theta_rad=Non
     ke_a = ke_b
     for step in range(1, int(n_impacts) + 1):
         px_to = -px0 if step == n_impacts else px0 * (1.0 - 2.0 * step / n_impacts)
-        ke_a = impact_model(phi, v, s, px, jc, px_to, sgn, blk, par, max_enum_closed, rest_omega_rad_s,
-                            s_new, px_new, v_new)
+        ke_a = impact_model(
+            phi, v, s, px, jc, px_to, sgn, blk, par, max_enum_closed, rest_omega_rad_s, s_new, px_new, v_new
+        )
         s, px, v = s_new.copy(), px_new.copy(), v_new.copy()
         if s[jc] == 0:
             break
     names = {0: "closed", -1: "cw", 1: "ccw"}
-    return ImpactOutcome(tuple(names[int(x)] for x in s_b), tuple(names[int(x)] for x in s), -v_b, -v,
-                         np.cumsum(-v), float(ke_b), float(ke_a), float(1 - ke_a / ke_b))
+    return ImpactOutcome(
+        tuple(names[int(x)] for x in s_b),
+        tuple(names[int(x)] for x in s),
+        -v_b,
+        -v,
+        np.cumsum(-v),
+        float(ke_b),
+        float(ke_a),
+        float(1 - ke_a / ke_b),
+    )
 
 
 def _ke(column, phi, v, s, px):

@@ -39,9 +39,22 @@ Work = namedtuple("Work", "theta thlow C G dj dpx PP vk aq M Q x F A")
 @register_jitable
 def make_work(n):
     """Scratch arrays for a column of ``n`` blocks."""
-    return Work(np.empty(n), np.empty(n), np.empty((n, 2)), np.empty((n, 2)), np.empty(n, np.int64),
-                np.empty(n), np.empty((n, 2)), np.empty(n), np.zeros((n, 2)), np.empty((n, n)), np.empty(n),
-                np.zeros(n), np.empty((n, 3)), np.empty((n, n + 1)))
+    return Work(
+        np.empty(n),
+        np.empty(n),
+        np.empty((n, 2)),
+        np.empty((n, 2)),
+        np.empty(n, np.int64),
+        np.empty(n),
+        np.empty((n, 2)),
+        np.empty(n),
+        np.zeros((n, 2)),
+        np.empty((n, n)),
+        np.empty(n),
+        np.zeros(n),
+        np.empty((n, 3)),
+        np.empty((n, n + 1)),
+    )
 
 
 @register_jitable
@@ -154,8 +167,11 @@ def system(dj, k, PP, G, blk, aq, ug, g, M, Q):
             i0 = max(jp, dj[r])
             acc = 0.0
             for i in range(i0, n):
-                acc += (blk[i, 0] * ((G[i, 0] - PP[p, 0]) * (G[i, 0] - PP[r, 0])
-                                     + (G[i, 1] - PP[p, 1]) * (G[i, 1] - PP[r, 1])) + blk[i, 1])
+                acc += (
+                    blk[i, 0]
+                    * ((G[i, 0] - PP[p, 0]) * (G[i, 0] - PP[r, 0]) + (G[i, 1] - PP[p, 1]) * (G[i, 1] - PP[r, 1]))
+                    + blk[i, 1]
+                )
             M[p, r] = acc
             M[r, p] = acc
 

@@ -68,21 +68,43 @@ class ColumnMaps:
 
         k, na, nt = self.overturned.shape
         nb, ap, tp = np.meshgrid(self.n_blocks, self.ap_m_s2, self.tp_s, indexing="ij")
-        return pd.DataFrame({"n_blocks": nb.ravel(), "ap_m_s2": ap.ravel(), "tp_s": tp.ravel(),
-                             "overturned": self.overturned.ravel(),
-                             "max_theta_over_alpha": self.max_theta_over_alpha.ravel()})
+        return pd.DataFrame(
+            {
+                "n_blocks": nb.ravel(),
+                "ap_m_s2": ap.ravel(),
+                "tp_s": tp.ravel(),
+                "overturned": self.overturned.ravel(),
+                "max_theta_over_alpha": self.max_theta_over_alpha.ravel(),
+            }
+        )
 
     def to_dict(self) -> dict:
         """Plain dict of the fields, JSON-ready (SI units in the keys)."""
-        return {"H_m": self.H_m, "B_m": self.B_m, "n_blocks": self.n_blocks.tolist(),
-                "ap_m_s2": self.ap_m_s2.tolist(), "tp_s": self.tp_s.tolist(),
-                "overturned": self.overturned.tolist(),
-                "overturned_fraction": self.overturned_fraction.tolist(), "params": dict(self.params)}
+        return {
+            "H_m": self.H_m,
+            "B_m": self.B_m,
+            "n_blocks": self.n_blocks.tolist(),
+            "ap_m_s2": self.ap_m_s2.tolist(),
+            "tp_s": self.tp_s.tolist(),
+            "overturned": self.overturned.tolist(),
+            "overturned_fraction": self.overturned_fraction.tolist(),
+            "params": dict(self.params),
+        }
 
 
-def column_overturning_maps(H_m: float = 12.0, B_m: float = 1.0, n_blocks=(1, 2, 3), ap_m_s2=None, tp_s=None,
-                            *, n_impacts: int = 1, dt_s: float = 2e-3, free_s: float = 10.0,
-                            progress=None, **sim_kwargs) -> ColumnMaps:
+def column_overturning_maps(
+    H_m: float = 12.0,
+    B_m: float = 1.0,
+    n_blocks=(1, 2, 3),
+    ap_m_s2=None,
+    tp_s=None,
+    *,
+    n_impacts: int = 1,
+    dt_s: float = 2e-3,
+    free_s: float = 10.0,
+    progress=None,
+    **sim_kwargs,
+) -> ColumnMaps:
     """Overturning maps of 1-, 2-, 3-block columns under full-sine pulses (thesis Fig. 40).
 
     Parameters
@@ -120,12 +142,26 @@ def column_overturning_maps(H_m: float = 12.0, B_m: float = 1.0, n_blocks=(1, 2,
         col = Column.uniform(B_m, H_m, int(n), mass_kg=1.0)
         for i, a in enumerate(ap):
             for j, t in enumerate(tp):
-                r = simulate_column(col, sine_pulse(a, t, dt_s=min(dt_s, t / 50)), duration_s=t + free_s,
-                                    dt_s=dt_s, n_impacts=n_impacts, **run_kwargs)
+                r = simulate_column(
+                    col,
+                    sine_pulse(a, t, dt_s=min(dt_s, t / 50)),
+                    duration_s=t + free_s,
+                    dt_s=dt_s,
+                    n_impacts=n_impacts,
+                    **run_kwargs,
+                )
                 over[k, i, j] = r.overturned
                 peak[k, i, j] = float(np.max(np.asarray(r.max_abs_theta_rad))) / alpha
                 done += 1
                 if progress is not None:
                     progress(done)
-    return ColumnMaps(nb, ap, tp, over, peak, float(H_m), float(B_m),
-                      dict(n_impacts=n_impacts, dt_s=dt_s, free_s=free_s, pulse="full sine", **sim_kwargs))
+    return ColumnMaps(
+        nb,
+        ap,
+        tp,
+        over,
+        peak,
+        float(H_m),
+        float(B_m),
+        dict(n_impacts=n_impacts, dt_s=dt_s, free_s=free_s, pulse="full sine", **sim_kwargs),
+    )

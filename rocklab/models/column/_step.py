@@ -19,8 +19,7 @@ from __future__ import annotations
 import numpy as np
 from numba.extending import register_jitable
 
-from ._kernels import (active_dofs, base_acc, geometry, pivots, quad_acc, reactions, solve_small,
-                              system)
+from ._kernels import active_dofs, base_acc, geometry, pivots, quad_acc, reactions, solve_small, system
 
 __all__: list[str] = []
 

@@ -6,12 +6,36 @@ an arch (:func:`block_parameters`, :func:`frame_parameters`, :func:`wall_mechani
 linearised equation's closed forms (Eq. 24-25, 40-42) and the equivalence errors.
 """
 
-from ._equivalent import (FundamentalParameters, Mechanism, block_parameters, equivalence_errors, frame_parameters,
-                          free_rocking_period_eq24, linear_sine_pulse_response, overturning_time_eq25,
-                          sine_pulse_max_response, strut_parameters, wall_mechanism, wall_parameters)
+from ._equivalent import (
+    FundamentalParameters,
+    Mechanism,
+    block_parameters,
+    equivalence_errors,
+    frame_parameters,
+    free_rocking_period_eq24,
+    linear_sine_pulse_response,
+    overturning_time_eq25,
+    sine_pulse_max_response,
+    strut_parameters,
+    wall_mechanism,
+    wall_parameters,
+)
 from ._mechanisms import arch_mechanism, asymmetric_frame, four_bar_mechanism
 
-__all__ = ["FundamentalParameters", "Mechanism", "block_parameters", "strut_parameters", "frame_parameters",
-           "wall_parameters", "wall_mechanism", "four_bar_mechanism", "asymmetric_frame", "arch_mechanism",
-           "free_rocking_period_eq24", "overturning_time_eq25", "sine_pulse_max_response",
-           "linear_sine_pulse_response", "equivalence_errors"]
+__all__ = [
+    "FundamentalParameters",
+    "Mechanism",
+    "block_parameters",
+    "strut_parameters",
+    "frame_parameters",
+    "wall_parameters",
+    "wall_mechanism",
+    "four_bar_mechanism",
+    "asymmetric_frame",
+    "arch_mechanism",
+    "free_rocking_period_eq24",
+    "overturning_time_eq25",
+    "sine_pulse_max_response",
+    "linear_sine_pulse_response",
+    "equivalence_errors",
+]

@@ -29,10 +29,20 @@ from ..._errors import InputError
 from ..._errors import positive as _pos
 from ...blocks import G
 
-__all__ = ["FundamentalParameters", "Mechanism", "block_parameters", "strut_parameters",
-           "frame_parameters", "wall_parameters", "wall_mechanism", "free_rocking_period_eq24",
-           "overturning_time_eq25", "sine_pulse_max_response", "linear_sine_pulse_response",
-           "equivalence_errors"]
+__all__ = [
+    "FundamentalParameters",
+    "Mechanism",
+    "block_parameters",
+    "strut_parameters",
+    "frame_parameters",
+    "wall_parameters",
+    "wall_mechanism",
+    "free_rocking_period_eq24",
+    "overturning_time_eq25",
+    "sine_pulse_max_response",
+    "linear_sine_pulse_response",
+    "equivalence_errors",
+]
 
 
 def _slender(name, a):
@@ -90,12 +100,21 @@ class FundamentalParameters:
 
 def _fp(p, phi_cr, lam, lam_lin, eta, name):
     # theta_cr = phi_cr / kappa1 = lambda_lin (Eq. 17, 19)
-    return FundamentalParameters(p_rad_s=p, theta_cr_rad=lam_lin,
-                                 lambda_=lam, lambda_lin=lam_lin, eta=eta, phi_cr_rad=phi_cr,
-                                 kappa1=phi_cr / lam_lin, kappa2=phi_cr / lam, mechanism=name)
+    return FundamentalParameters(
+        p_rad_s=p,
+        theta_cr_rad=lam_lin,
+        lambda_=lam,
+        lambda_lin=lam_lin,
+        eta=eta,
+        phi_cr_rad=phi_cr,
+        kappa1=phi_cr / lam_lin,
+        kappa2=phi_cr / lam,
+        mechanism=name,
+    )
 
 
 # -- closed forms ---------------------------------------------------------------
+
 
 def block_parameters(R_m: float, alpha_rad: float, alpha_I: float = 4.0 / 3.0) -> FundamentalParameters:
     """Rocking block (Table I): p = sqrt(g/(alpha_I R)), theta_cr = alpha, lambda = tan(alpha),
@@ -111,8 +130,7 @@ def strut_parameters(R_m: float, alpha_rad: float) -> FundamentalParameters:
     return FundamentalParameters(**{**asdict(fp), "mechanism": "strut"})
 
 
-def frame_parameters(R_m: float, alpha_rad: float, gamma: float, alpha_I: float = 4.0 / 3.0
-                     ) -> FundamentalParameters:
+def frame_parameters(R_m: float, alpha_rad: float, gamma: float, alpha_I: float = 4.0 / 3.0) -> FundamentalParameters:
     """Symmetric rocking frame: two equal columns (R, alpha) capped by a free beam (Table I).
 
     ``gamma = m_beam / m_columns`` (both columns together). From Eq. 35:
@@ -142,6 +160,7 @@ def wall_parameters(R_m: float, alpha_rad: float, alpha_I: float = 4.0 / 3.0) ->
 
 
 # -- generic mechanism ------------------------------------------------------------
+
 
 @dataclass(frozen=True)
 class Mechanism:
@@ -189,15 +208,14 @@ class Mechanism:
         d = np.array([self.dV(x) for x in xs])
         k = np.flatnonzero(np.sign(d[:-1]) != np.sign(d[1:]))
         if k.size == 0:
-            raise InputError(f"{self.name}: no unstable equilibrium before the kinematic limit; "
-                             "check the geometry")
+            raise InputError(f"{self.name}: no unstable equilibrium before the kinematic limit; check the geometry")
         return brentq(self.dV, xs[k[0]], xs[k[0] + 1], xtol=1e-13)
 
     def parameters(self) -> FundamentalParameters:
         """Fundamental parameters by linearisation about phi_cr (Eq. 11–20)."""
         pc = self.phi_cr()
         h = 1e-4
-        Geq = -(self.V(pc + h) - 2 * self.V(pc) + self.V(pc - h)) / h ** 2 / G
+        Geq = -(self.V(pc + h) - 2 * self.V(pc) + self.V(pc - h)) / h**2 / G
         Ieq = self.M(pc)
         Beq = self.B(pc)
         lam = self.dV(1e-7, 1e-7) / (G * self.B(0.0))
@@ -237,13 +255,13 @@ class Mechanism:
 
         def hit(t, y):
             return y[0] - pc
+
         hit.terminal = True  # type: ignore[attr-defined]  # scipy's event protocol
         sol = solve_ivp(f, (0, 1e4), [0.0, 0.0], events=hit, rtol=1e-9, atol=1e-12)
         return float(sol.t_events[0][0]) if sol.t_events[0].size else float("inf")
 
 
-def wall_mechanism(R_m: float, alpha_rad: float, mass_kg: float = 1.0, alpha_I: float = 4.0 / 3.0
-                   ) -> Mechanism:
+def wall_mechanism(R_m: float, alpha_rad: float, mass_kg: float = 1.0, alpha_I: float = 4.0 / 3.0) -> Mechanism:
     """Nonlinear two-block wall (slider-crank, Eq. 21) as a :class:`Mechanism`.
 
     Derived from the geometry (bottom block pivoting on its base corner, hinge at
@@ -255,13 +273,17 @@ def wall_mechanism(R_m: float, alpha_rad: float, mass_kg: float = 1.0, alpha_I: 
     """
     R, a, m = _pos("R_m", R_m), _slender("alpha_rad", alpha_rad), _pos("mass_kg", mass_kg)
     IO = alpha_I * m * R * R
-    return Mechanism(M=lambda f: 2 * IO + 8 * m * R * R * math.sin(a - f) ** 2,
-                     V=lambda f: 4 * m * G * R * math.cos(a - f),
-                     B=lambda f: 2 * m * R * math.cos(a - f), phi_max=min(2 * a + 0.5, math.pi / 2),
-                     name="wall")
+    return Mechanism(
+        M=lambda f: 2 * IO + 8 * m * R * R * math.sin(a - f) ** 2,
+        V=lambda f: 4 * m * G * R * math.cos(a - f),
+        B=lambda f: 2 * m * R * math.cos(a - f),
+        phi_max=min(2 * a + 0.5, math.pi / 2),
+        name="wall",
+    )
 
 
 # -- closed-form responses ----------------------------------------------------------------
+
 
 def free_rocking_period_eq24(p_rad_s: float, theta_over_theta_cr) -> np.ndarray:
     """Free-rocking period of the equivalent (linearised) block, Eq. 24, s:
@@ -270,8 +292,9 @@ def free_rocking_period_eq24(p_rad_s: float, theta_over_theta_cr) -> np.ndarray:
     return 4.0 / p_rad_s * np.arccosh(1.0 / (1.0 - x))
 
 
-def overturning_time_eq25(p_rad_s: float, ug_over_g_lambda, lambda_: float, lambda_lin: float,
-                          kappa: str = "kappa1") -> np.ndarray:
+def overturning_time_eq25(
+    p_rad_s: float, ug_over_g_lambda, lambda_: float, lambda_lin: float, kappa: str = "kappa1"
+) -> np.ndarray:
     """Time to reach theta_cr under a constant base acceleration, Eq. 25, s.
 
     ``ug_over_g_lambda`` is u_g''/(g lambda). With ``kappa1`` the linear block uplifts
@@ -298,7 +321,7 @@ def sine_pulse_max_response(omega, a, eta):
     x = (2 * np.pi - np.arcsin(1.0 / a)) / w
     D0 = (w / (w * w + 1)) ** 2 * (w * w - 2 * a * a + 1 + (s + w) * a * np.exp(-x) + (s - w) * a * np.exp(x))
     with np.errstate(invalid="ignore"):
-        out = 1.0 - np.sqrt(1.0 - eta ** 2 * (1.0 - D0))
+        out = 1.0 - np.sqrt(1.0 - eta**2 * (1.0 - D0))
     return np.where((D0 >= 0) & (D0 <= 1), out, np.nan), D0
 
 
@@ -330,14 +353,14 @@ def linear_sine_pulse_response(omega: float, a: float, eta: float, tau_max: floa
 
     def over(tt, y, s):
         return abs(y[0]) - 1.0
+
     imp.terminal = True  # type: ignore[attr-defined]  # scipy's event protocol
     over.terminal = True  # type: ignore[attr-defined]
     phase_end = True
     while t < tau_max:
         stop = t_end if (phase_end and t < t_end) else tau_max
         imp.direction = -s  # type: ignore[attr-defined]
-        sol = solve_ivp(rhs, (t, stop), state, args=(s,), events=[imp, over], rtol=1e-11, atol=1e-13,
-                        max_step=0.01)
+        sol = solve_ivp(rhs, (t, stop), state, args=(s,), events=[imp, over], rtol=1e-11, atol=1e-13, max_step=0.01)
         if impacts_after == 1:
             peak = max(peak, float(np.max(np.abs(sol.y[0]))))
         t = float(sol.t[-1])
@@ -374,10 +397,10 @@ def equivalence_errors(mech: Mechanism, ratios=(0.1, 0.3, 0.5, 0.7, 0.9), accs=(
     fp = mech.parameters()
     ratios = np.asarray(ratios, float)
     accs = np.asarray(accs, float)
-    T = np.array([free_rocking_period_eq24(fp.p_rad_s, x) / mech.free_rocking_period(x * fp.phi_cr_rad)
-                  for x in ratios])
+    T = np.array(
+        [free_rocking_period_eq24(fp.p_rad_s, x) / mech.free_rocking_period(x * fp.phi_cr_rad) for x in ratios]
+    )
     tn = np.array([mech.overturning_time(r * fp.lambda_) for r in accs])
     t1 = overturning_time_eq25(fp.p_rad_s, accs, fp.lambda_, fp.lambda_lin, "kappa1") / tn
     t2 = overturning_time_eq25(fp.p_rad_s, accs, fp.lambda_, fp.lambda_lin, "kappa2") / tn
-    return dict(parameters=fp, ratios=ratios, accs=accs, period_ratio=T, t_ratio_kappa1=t1,
-                t_ratio_kappa2=t2)
+    return dict(parameters=fp, ratios=ratios, accs=accs, period_ratio=T, t_ratio_kappa1=t1, t_ratio_kappa2=t2)

@@ -22,6 +22,7 @@ __all__ = ["four_bar_mechanism", "asymmetric_frame", "arch_mechanism"]
 
 # -- four-bar linkages (asymmetric frame §5.1, arch §5.2) ------------------------------
 
+
 def _cross(u, v) -> float:
     return float(u[0] * v[1] - u[1] * v[0])
 
@@ -103,7 +104,7 @@ def four_bar_mechanism(A, B, C, D, bodies, name: str = "four-bar") -> Mechanism:
 
     def M(phi):
         dr, dt = _derivs(phi)
-        return float(ms @ (dr ** 2).sum(axis=1) + Ic @ dt ** 2)
+        return float(ms @ (dr**2).sum(axis=1) + Ic @ dt**2)
 
     def Bf(phi):
         dr, _ = _derivs(phi)
@@ -112,16 +113,17 @@ def four_bar_mechanism(A, B, C, D, bodies, name: str = "four-bar") -> Mechanism:
     def eom(phi, h=1e-4):
         (rm, tm), (r0, t0), (rp, tp) = config(phi - h), config(phi), config(phi + h)
         dr, dt = (rp - rm) / (2 * h), (tp - tm) / (2 * h)
-        ddr, ddt = (rp - 2 * r0 + rm) / h ** 2, (tp - 2 * t0 + tm) / h ** 2
-        M_ = float(ms @ (dr ** 2).sum(axis=1) + Ic @ dt ** 2)
+        ddr, ddt = (rp - 2 * r0 + rm) / h**2, (tp - 2 * t0 + tm) / h**2
+        M_ = float(ms @ (dr**2).sum(axis=1) + Ic @ dt**2)
         dM_ = float(2 * ms @ (dr * ddr).sum(axis=1) + 2 * Ic @ (dt * ddt))
         return M_, dM_, G * float(ms @ dr[:, 1]), float(ms @ dr[:, 0])
 
     return Mechanism(M=M, V=V, B=Bf, phi_max=phi_max, name=name, eom=eom)
 
 
-def asymmetric_frame(b_m: float, H_m: float, H1_m: float, L_m: float, h_m: float,
-                     m_AB: float, m_BC: float, m_CD: float):
+def asymmetric_frame(
+    b_m: float, H_m: float, H1_m: float, L_m: float, h_m: float, m_AB: float, m_BC: float, m_CD: float
+):
     """Asymmetric rocking frame (paper §5.1, Fig. 4) in both rocking directions.
 
     Geometry (half-dimensions as in Eq. 33): the left column AB is 2b wide and 2H
@@ -137,39 +139,44 @@ def asymmetric_frame(b_m: float, H_m: float, H1_m: float, L_m: float, h_m: float
         bottom-right) and negative direction (the mirror image; the coordinate is
         still the left column's rotation).
     """
-    b, H, H1, L, h = (_pos(n, v) for n, v in (("b_m", b_m), ("H_m", H_m), ("H1_m", H1_m),
-                                               ("L_m", L_m), ("h_m", h_m)))
+    b, H, H1, L, h = (_pos(n, v) for n, v in (("b_m", b_m), ("H_m", H_m), ("H1_m", H1_m), ("L_m", L_m), ("h_m", h_m)))
     if L <= 2 * b:
         raise InputError(f"L_m={L}: columns overlap; the left-face distance L must exceed the width 2b")
     mA, mB, mC = (_pos(n, v) for n, v in (("m_AB", m_AB), ("m_BC", m_BC), ("m_CD", m_CD)))
     yD = 2 * H - 2 * H1
     wbeam = L + 2 * b
     body_ab = (mA, (b, H), mA * (4 * b * b + 4 * H * H) / 12)
-    body_bc = (mB, (wbeam / 2, 2 * H + h), mB * (wbeam ** 2 + 4 * h * h) / 12)
+    body_bc = (mB, (wbeam / 2, 2 * H + h), mB * (wbeam**2 + 4 * h * h) / 12)
     body_cd = (mC, (L + b, yD + H1), mC * (4 * b * b + 4 * H1 * H1) / 12)
 
     def mirror(pt):
         return (-pt[0], pt[1])
 
-    pos = four_bar_mechanism((2 * b, 0), (0, 2 * H), (L, 2 * H), (L + 2 * b, yD),
-                             [body_ab, body_bc, body_cd], name="asymmetric-frame+")
-    neg = four_bar_mechanism(mirror((0, 0)), mirror((2 * b, 2 * H)), mirror((L + 2 * b, 2 * H)),
-                             mirror((L, yD)),
-                             [(m, mirror(c), i) for m, c, i in (body_ab, body_bc, body_cd)],
-                             name="asymmetric-frame-")
+    pos = four_bar_mechanism(
+        (2 * b, 0), (0, 2 * H), (L, 2 * H), (L + 2 * b, yD), [body_ab, body_bc, body_cd], name="asymmetric-frame+"
+    )
+    neg = four_bar_mechanism(
+        mirror((0, 0)),
+        mirror((2 * b, 2 * H)),
+        mirror((L + 2 * b, 2 * H)),
+        mirror((L, yD)),
+        [(m, mirror(c), i) for m, c, i in (body_ab, body_bc, body_cd)],
+        name="asymmetric-frame-",
+    )
     return pos, neg
 
 
 # -- masonry arch (§5.2) -----------------------------------------------------------------
 
+
 def _sector(r_i, r_e, a1, a2):
     """Area, centroid and polar moment about its centroid of an annular sector (unit depth, density 1)."""
     d = a2 - a1
-    area = 0.5 * d * (r_e ** 2 - r_i ** 2)
-    rc = (2.0 / 3.0) * (r_e ** 3 - r_i ** 3) / (r_e ** 2 - r_i ** 2) * math.sin(d / 2) / (d / 2)
+    area = 0.5 * d * (r_e**2 - r_i**2)
+    rc = (2.0 / 3.0) * (r_e**3 - r_i**3) / (r_e**2 - r_i**2) * math.sin(d / 2) / (d / 2)
     am = 0.5 * (a1 + a2)
     cm = np.array([rc * math.cos(am), rc * math.sin(am)])
-    J0 = 0.25 * d * (r_e ** 4 - r_i ** 4)
+    J0 = 0.25 * d * (r_e**4 - r_i**4)
     return area, cm, J0 - area * rc * rc
 
 
@@ -177,8 +184,7 @@ def _arch_hinges(beta, t, r, u, faces, mirror=False):
     """Hinge points and the three moving bodies for hinge fractions u (0 = left springing)."""
     ri, re = r - t / 2, r + t / 2
     ang = math.pi / 2 + beta / 2 - np.asarray(u) * beta  # from the left springing clockwise
-    pts = [np.array([(re if f else ri) * math.cos(a), (re if f else ri) * math.sin(a)])
-           for a, f in zip(ang, faces)]
+    pts = [np.array([(re if f else ri) * math.cos(a), (re if f else ri) * math.sin(a)]) for a, f in zip(ang, faces)]
     bodies = [_sector(ri, re, ang[k + 1], ang[k]) for k in range(3)]
     if mirror:  # x -> -x: the mechanism for the other direction, still a clockwise coordinate
         pts = [np.array([-q[0], q[1]]) for q in pts]
@@ -192,6 +198,7 @@ def _lambda_at_rest(pts, bodies):
 
     def perp(v):
         return np.array([-v[1], v[0]])
+
     vB = -perp(B - A)  # omega_1 = -1 (clockwise)
     M = np.column_stack([perp(C - D), -perp(C - B)])
     if abs(np.linalg.det(M)) < 1e-12:
@@ -203,8 +210,7 @@ def _lambda_at_rest(pts, bodies):
     return num / den if den > 0 and num > 0 else float("nan")
 
 
-def arch_mechanism(inclusion_angle_rad: float, thickness_m: float, radius_m: float,
-                   hinges=None, grid: int = 17):
+def arch_mechanism(inclusion_angle_rad: float, thickness_m: float, radius_m: float, hinges=None, grid: int = 17):
     """Rocking masonry arch as a three-block mechanism (paper §5.2, Oppenheim's mechanism).
 
     Parameters
@@ -270,7 +276,10 @@ def arch_mechanism(inclusion_angle_rad: float, thickness_m: float, radius_m: flo
     if len(u) != 4 or not all(0 <= a < b_ for a, b_ in zip(u, u[1:])) or u[-1] > 1:
         raise InputError(f"hinges={hinges!r}: need 4 increasing fractions in [0, 1]")
     pts, bodies = _arch_hinges(beta, t, r, u, faces, mirror)
-    mech = four_bar_mechanism(pts[0], pts[1], pts[2], pts[3],
-                              [(b[0], tuple(b[1]), b[2]) for b in bodies], name="arch")
-    return mech, {"hinges": u, "faces": ["extrados" if f else "intrados" for f in faces],
-                  "mirrored": mirror, "lambda": _lambda_at_rest(pts, bodies)}
+    mech = four_bar_mechanism(pts[0], pts[1], pts[2], pts[3], [(b[0], tuple(b[1]), b[2]) for b in bodies], name="arch")
+    return mech, {
+        "hinges": u,
+        "faces": ["extrados" if f else "intrados" for f in faces],
+        "mirrored": mirror,
+        "lambda": _lambda_at_rest(pts, bodies),
+    }

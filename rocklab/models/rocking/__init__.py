@@ -7,10 +7,30 @@ kernel, or scipy's DOP853 with impact events as the reference); :func:`simulate_
 """
 
 from ._batch import free_rocking_overturns, simulate_batch
-from ._restitution import RESTITUTION_LAWS, Restitution, eta_axes, eta_bumps, eta_housner, eta_modified, make_restitution
+from ._restitution import (
+    RESTITUTION_LAWS,
+    Restitution,
+    eta_axes,
+    eta_bumps,
+    eta_housner,
+    eta_modified,
+    make_restitution,
+)
 from ._result import BatchResult, RockingResult, block_energy
 from ._single import simulate
 
-__all__ = ["simulate", "simulate_batch", "free_rocking_overturns", "RockingResult", "BatchResult", "block_energy",
-           "RESTITUTION_LAWS", "Restitution", "make_restitution",
-           "eta_housner", "eta_modified", "eta_axes", "eta_bumps"]
+__all__ = [
+    "simulate",
+    "simulate_batch",
+    "free_rocking_overturns",
+    "RockingResult",
+    "BatchResult",
+    "block_energy",
+    "RESTITUTION_LAWS",
+    "Restitution",
+    "make_restitution",
+    "eta_housner",
+    "eta_modified",
+    "eta_axes",
+    "eta_bumps",
+]

@@ -21,11 +21,25 @@ __all__ = ["simulate_batch", "free_rocking_overturns"]
 
 _HALF_PI = 0.5 * math.pi
 
-def simulate_batch(p_rad_s, alpha_rad, *, base: BaseMotion | None = None, scale=1.0, theta0_rad=0.0,
-                   omega0_rad_s=0.0, eta=None, alpha_I=4.0 / 3.0, dt_s: float = 1e-3,
-                   duration_s: float | None = None, free_after_s: float = 0.0,
-                   stop_on_overturn: bool = True, fall_rad=None, max_p_dt: float = 0.02,
-                   rest_tol: float = 1e-6) -> BatchResult:
+
+def simulate_batch(
+    p_rad_s,
+    alpha_rad,
+    *,
+    base: BaseMotion | None = None,
+    scale=1.0,
+    theta0_rad=0.0,
+    omega0_rad_s=0.0,
+    eta=None,
+    alpha_I=4.0 / 3.0,
+    dt_s: float = 1e-3,
+    duration_s: float | None = None,
+    free_after_s: float = 0.0,
+    stop_on_overturn: bool = True,
+    fall_rad=None,
+    max_p_dt: float = 0.02,
+    rest_tol: float = 1e-6,
+) -> BatchResult:
     """Run m independent blocks (broadcast arrays) in parallel; summaries only.
 
     Parameters
@@ -75,12 +89,25 @@ def simulate_batch(p_rad_s, alpha_rad, *, base: BaseMotion | None = None, scale=
         :func:`free_rocking_overturns`).
     """
     try:
-        arrs = np.broadcast_arrays(*(np.asarray(x, float) for x in (
-            p_rad_s, alpha_rad, scale, theta0_rad, omega0_rad_s, alpha_I,
-            np.nan if eta is None else eta, np.nan if fall_rad is None else fall_rad)))
+        arrs = np.broadcast_arrays(
+            *(
+                np.asarray(x, float)
+                for x in (
+                    p_rad_s,
+                    alpha_rad,
+                    scale,
+                    theta0_rad,
+                    omega0_rad_s,
+                    alpha_I,
+                    np.nan if eta is None else eta,
+                    np.nan if fall_rad is None else fall_rad,
+                )
+            )
+        )
     except (ValueError, TypeError) as e:
-        raise InputError(f"simulate_batch: array arguments do not broadcast ({e}); give equal "
-                         "lengths or scalars") from None
+        raise InputError(
+            f"simulate_batch: array arguments do not broadcast ({e}); give equal lengths or scalars"
+        ) from None
     p, al, sc, th0, w0, aI, et, fr = (np.array(a, dtype=float).ravel() for a in arrs)
     for name, v in (("p_rad_s", p), ("alpha_rad", al), ("alpha_I", aI)):
         if not np.all(np.isfinite(v) & (v > 0)):
@@ -115,11 +142,24 @@ def simulate_batch(p_rad_s, alpha_rad, *, base: BaseMotion | None = None, scale=
     else:
         acc, t0, dta = np.ascontiguousarray(base.acc_m_s2, float), float(base.t_s[0]), base.dt_s
     over, t_over, mx, nimp, status, steps, th_end, w_end = run_batch(
-        p, al, th0, w0, et, h, n_steps, acc, t0, dta, sc, float(rest_tol), fr, bool(stop_on_overturn))
-    return BatchResult(overturned=over, overturn_t_s=t_over, max_abs_theta_over_alpha=mx,
-                       n_impacts=nimp, status=status, p_rad_s=p, alpha_rad=al, scale=sc, eta=et,
-                       dt_s=h, n_steps=int(steps.sum()), theta_end_rad=th_end, omega_end_rad_s=w_end,
-                       t_end_s=steps * h)
+        p, al, th0, w0, et, h, n_steps, acc, t0, dta, sc, float(rest_tol), fr, bool(stop_on_overturn)
+    )
+    return BatchResult(
+        overturned=over,
+        overturn_t_s=t_over,
+        max_abs_theta_over_alpha=mx,
+        n_impacts=nimp,
+        status=status,
+        p_rad_s=p,
+        alpha_rad=al,
+        scale=sc,
+        eta=et,
+        dt_s=h,
+        n_steps=int(steps.sum()),
+        theta_end_rad=th_end,
+        omega_end_rad_s=w_end,
+        t_end_s=steps * h,
+    )
 
 
 def free_rocking_overturns(theta_rad, omega_rad_s, p_rad_s, alpha_rad, eta) -> np.ndarray:
@@ -148,11 +188,13 @@ def free_rocking_overturns(theta_rad, omega_rad_s, p_rad_s, alpha_rad, eta) -> n
         a block at rest (theta = omega = 0) never does.
     """
     try:
-        th, w, p, a, e = np.broadcast_arrays(*(np.asarray(x, float) for x in
-                                               (theta_rad, omega_rad_s, p_rad_s, alpha_rad, eta)))
+        th, w, p, a, e = np.broadcast_arrays(
+            *(np.asarray(x, float) for x in (theta_rad, omega_rad_s, p_rad_s, alpha_rad, eta))
+        )
     except (ValueError, TypeError) as err:
-        raise InputError(f"free_rocking_overturns: arguments do not broadcast ({err}); give equal "
-                         "lengths or scalars") from None
+        raise InputError(
+            f"free_rocking_overturns: arguments do not broadcast ({err}); give equal lengths or scalars"
+        ) from None
     if not (np.all(np.isfinite(th)) and np.all(np.isfinite(w))):
         raise InputError("free_rocking_overturns: theta_rad and omega_rad_s must be finite")
     if not np.all((p > 0) & np.isfinite(p)) or not np.all((a > 0) & (a < _HALF_PI)):

@@ -41,8 +41,22 @@ def _next_uplift(t_now, rec_t, rec_a, thr, t_stop):
     return float(t0 + min(max(fr, 0.0), 1.0) * (rec_t[k] - t0))
 
 
-def run_event(block, theta0, omega0, duration_s, law, base, linearized, rest_tol, stop_at_rest,
-              t_out, rtol=1e-10, atol=1e-13, ode_method="DOP853", fall_rad=0.5 * math.pi):
+def run_event(
+    block,
+    theta0,
+    omega0,
+    duration_s,
+    law,
+    base,
+    linearized,
+    rest_tol,
+    stop_at_rest,
+    t_out,
+    rtol=1e-10,
+    atol=1e-13,
+    ode_method="DOP853",
+    fall_rad=0.5 * math.pi,
+):
     """Event-driven integration; returns a dict like the Newmark kernel's output.
 
     ``t_out`` (n,) are the output times (s); samples after a stop are dropped.
@@ -53,7 +67,9 @@ def run_event(block, theta0, omega0, duration_s, law, base, linearized, rest_tol
     rest_w2 = 2.0 * p2 * (math.cos(alpha - rest_tol * alpha) - math.cos(alpha))
     if base is not None:
         rec_t, rec_a = base.t_s, base.acc_m_s2 / G
-        t_last_up = float(rec_t[np.flatnonzero(np.abs(rec_a) > tan_a)][-1]) if np.any(np.abs(rec_a) > tan_a) else -np.inf
+        t_last_up = (
+            float(rec_t[np.flatnonzero(np.abs(rec_a) > tan_a)][-1]) if np.any(np.abs(rec_a) > tan_a) else -np.inf
+        )
         max_step = base.dt_s
     else:
         rec_t = rec_a = None
@@ -102,20 +118,32 @@ def run_event(block, theta0, omega0, duration_s, law, base, linearized, rest_tol
 
         def contact(tt, y):
             return y[0]
+
         contact.terminal = True
         contact.direction = -s
 
         def over(tt, y, s=s):
             return y[0] - s * alpha
+
         over.direction = s
 
         def fall(tt, y, s=s):
             return y[0] - s * fall_rad
+
         fall.terminal = True
         fall.direction = s
 
-        sol = solve_ivp(rhs, (t, duration_s), [th, w], method=ode_method, rtol=rtol, atol=atol,
-                        events=[contact, over, fall], dense_output=True, max_step=max_step)
+        sol = solve_ivp(
+            rhs,
+            (t, duration_s),
+            [th, w],
+            method=ode_method,
+            rtol=rtol,
+            atol=atol,
+            events=[contact, over, fall],
+            dense_output=True,
+            max_step=max_step,
+        )
         t_b = float(sol.t[-1])
         m = (t_out >= t - 1e-12) & (t_out <= t_b)
         if m.any():
@@ -149,5 +177,13 @@ def run_event(block, theta0, omega0, duration_s, law, base, linearized, rest_tol
         status = "rocking"
         break
     keep = t_out <= t_end + 1e-12
-    return dict(t=t_out[keep], theta=th_out[keep], omega=w_out[keep], impacts=imps, status=status,
-                t_over=t_over, t_fall=t_fall, max_abs=max_abs)
+    return dict(
+        t=t_out[keep],
+        theta=th_out[keep],
+        omega=w_out[keep],
+        impacts=imps,
+        status=status,
+        t_over=t_over,
+        t_fall=t_fall,
+        max_abs=max_abs,
+    )

@@ -31,10 +31,8 @@ def cross_fraction(x0, v0, x1, v1, h, level):
     for _ in range(20):
         u2 = u * u
         u3 = u2 * u
-        x = (2 * u3 - 3 * u2 + 1) * x0 + (u3 - 2 * u2 + u) * h * v0 + (-2 * u3 + 3 * u2) * x1 \
-            + (u3 - u2) * h * v1
-        dx = (6 * u2 - 6 * u) * x0 + (3 * u2 - 4 * u + 1) * h * v0 + (6 * u - 6 * u2) * x1 \
-            + (3 * u2 - 2 * u) * h * v1
+        x = (2 * u3 - 3 * u2 + 1) * x0 + (u3 - 2 * u2 + u) * h * v0 + (-2 * u3 + 3 * u2) * x1 + (u3 - u2) * h * v1
+        dx = (6 * u2 - 6 * u) * x0 + (3 * u2 - 4 * u + 1) * h * v0 + (6 * u - 6 * u2) * x1 + (3 * u2 - 2 * u) * h * v1
         if dx <= 0.0:
             break
         du = (x - level) / dx

@@ -71,8 +71,33 @@ def ug_ramp(j, h, acc, t0, inv_dta, fac):
 
 
 @njit(cache=True, fastmath={"contract"})
-def forced_steps(th, w, a, sc, cc, s, step, n_steps, h, p2, alpha, cos_a, max_abs, out_th, out_w, out_e,
-                 n_out, countdown, out_every, e_scale, acc, acc_t0, inv_dta, fac, lip):
+def forced_steps(
+    th,
+    w,
+    a,
+    sc,
+    cc,
+    s,
+    step,
+    n_steps,
+    h,
+    p2,
+    alpha,
+    cos_a,
+    max_abs,
+    out_th,
+    out_w,
+    out_e,
+    n_out,
+    countdown,
+    out_every,
+    e_scale,
+    acc,
+    acc_t0,
+    inv_dta,
+    fac,
+    lip,
+):
     """Whole steps under the record from ``step`` on, as long as none needs the general loop.
 
     State in and out as :func:`~rocklab.models.rocking._newmark_free.free_steps` (theta

@@ -54,10 +54,24 @@ def sdcd(d):
         sd = d * (1.0 - d2 * (1.0 / 6.0) * (1.0 - d2 * (1.0 / 20.0) * (1.0 - d2 * (1.0 / 42.0))))
         cd = 1.0 - d2 * 0.5 * (1.0 - d2 * (1.0 / 12.0) * (1.0 - d2 * (1.0 / 30.0) * (1.0 - d2 * (1.0 / 56.0))))
     else:
-        sd = d * (1.0 - d2 * (1.0 / 6.0) * (1.0 - d2 * (1.0 / 20.0) * (1.0 - d2 * (1.0 / 42.0) * (
-            1.0 - d2 * (1.0 / 72.0) * (1.0 - d2 * (1.0 / 110.0))))))
-        cd = 1.0 - d2 * 0.5 * (1.0 - d2 * (1.0 / 12.0) * (1.0 - d2 * (1.0 / 30.0) * (
-            1.0 - d2 * (1.0 / 56.0) * (1.0 - d2 * (1.0 / 90.0) * (1.0 - d2 * (1.0 / 132.0))))))
+        sd = d * (
+            1.0
+            - d2
+            * (1.0 / 6.0)
+            * (
+                1.0
+                - d2 * (1.0 / 20.0) * (1.0 - d2 * (1.0 / 42.0) * (1.0 - d2 * (1.0 / 72.0) * (1.0 - d2 * (1.0 / 110.0))))
+            )
+        )
+        cd = 1.0 - d2 * 0.5 * (
+            1.0
+            - d2
+            * (1.0 / 12.0)
+            * (
+                1.0
+                - d2 * (1.0 / 30.0) * (1.0 - d2 * (1.0 / 56.0) * (1.0 - d2 * (1.0 / 90.0) * (1.0 - d2 * (1.0 / 132.0))))
+            )
+        )
     return sd, cd
 
 
@@ -81,8 +95,28 @@ def store_sample(out_th, out_w, out_e, n_out, th, w, off, psn, pcc, p2cos_a, e_s
 
 
 @njit(cache=True, fastmath={"contract"})
-def free_steps(th, w, a, sc, cc, s, step, n_steps, h, p2, alpha, cos_a, max_abs, out_th, out_w, out_e,
-               n_out, countdown, out_every, e_scale):
+def free_steps(
+    th,
+    w,
+    a,
+    sc,
+    cc,
+    s,
+    step,
+    n_steps,
+    h,
+    p2,
+    alpha,
+    cos_a,
+    max_abs,
+    out_th,
+    out_w,
+    out_e,
+    n_out,
+    countdown,
+    out_every,
+    e_scale,
+):
     """Whole free-rocking steps from ``step`` on, as long as none needs the general loop.
 
     State in and out: theta ``th`` (rad, side ``s`` = ±1), omega ``w`` (rad/s),

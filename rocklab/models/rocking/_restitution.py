@@ -29,8 +29,15 @@ import numpy as np
 
 from ..._errors import InputError
 
-__all__ = ["Restitution", "RESTITUTION_LAWS", "make_restitution", "eta_housner", "eta_modified",
-           "eta_axes", "eta_bumps"]
+__all__ = [
+    "Restitution",
+    "RESTITUTION_LAWS",
+    "make_restitution",
+    "eta_housner",
+    "eta_modified",
+    "eta_axes",
+    "eta_bumps",
+]
 
 
 @dataclass(frozen=True)
@@ -69,11 +76,13 @@ class Restitution:
         if not (np.all(np.isfinite(y)) and math.isfinite(self.eta)):
             raise InputError(f"restitution {self.name!r}: eta must be finite; got {self.eta!r} / table")
         if np.any(np.abs(y) > 1.0) or abs(self.eta) > 1.0:
-            raise InputError(f"restitution {self.name!r}: |eta| must be <= 1 (an impact cannot add "
-                             "energy); fix the value(s)")
+            raise InputError(
+                f"restitution {self.name!r}: |eta| must be <= 1 (an impact cannot add energy); fix the value(s)"
+            )
         if self.mode == 2 and (x.size != y.size or x.size < 1 or np.any(np.diff(x) <= 0)):
-            raise InputError(f"restitution {self.name!r}: omega table must be strictly increasing "
-                             "and as long as the eta table")
+            raise InputError(
+                f"restitution {self.name!r}: omega table must be strictly increasing and as long as the eta table"
+            )
         x.setflags(write=False)
         y.setflags(write=False)
         object.__setattr__(self, "eta_x", x)
@@ -96,6 +105,7 @@ class Restitution:
 
 
 # -- closed forms ----------------------------------------------------------------
+
 
 def _geom(block):
     """K = I_C/m + (CoM height)^2 (m^2) and half-width (m) of ``block``."""
@@ -156,6 +166,7 @@ def eta_bumps(block, n: int, b2_m: float | None = None) -> float:
 
 # -- the registry ----------------------------------------------------------------
 
+
 def _num(name, v, lo=-math.inf, hi=math.inf):
     try:
         f = float(v)
@@ -209,8 +220,7 @@ def _law_bumps(block, n=1, b2_m=None, **_):
     return Restitution("bumps", eta_bumps(block, n_i, b2), params={"n": n_i, "b2_m": b2})
 
 
-def _law_per_impact(block, eta=None, omega_rad_s=None, func=None, by="number", n_table=4096,
-                    omega_max_rad_s=None, **_):
+def _law_per_impact(block, eta=None, omega_rad_s=None, func=None, by="number", n_table=4096, omega_max_rad_s=None, **_):
     """eta per impact: a sequence by impact number, a table over |omega_before|, or a callable.
 
     ``func`` is tabulated for the kernels: ``by="number"`` -> ``func(i)`` for
@@ -229,8 +239,10 @@ def _law_per_impact(block, eta=None, omega_rad_s=None, func=None, by="number", n
             return Restitution("per_impact", y[0], 2, x, y, {"by": "omega"})
         raise InputError(f"per_impact by={by!r}: use 'number' or 'omega'")
     if eta is None:
-        raise InputError("restitution 'per_impact' needs eta=[...] (per impact number), "
-                         "eta=[...] with omega_rad_s=[...], or func=callable")
+        raise InputError(
+            "restitution 'per_impact' needs eta=[...] (per impact number), "
+            "eta=[...] with omega_rad_s=[...], or func=callable"
+        )
     y = np.atleast_1d(np.asarray(eta, float))
     if omega_rad_s is None:
         return Restitution("per_impact", y[0], 1, np.zeros(1), y, {"by": "number"})

@@ -30,7 +30,7 @@ def block_energy(block, theta_rad, omega_rad_s, linearized: bool = False) -> np.
     w = np.asarray(omega_rad_s, float)
     a, I_O = block.alpha_rad, block.I_O_kg_m2
     if linearized:
-        return I_O * (0.5 * w * w + block.p_rad_s ** 2 * (a * th - 0.5 * th * th))
+        return I_O * (0.5 * w * w + block.p_rad_s**2 * (a * th - 0.5 * th * th))
     from ...blocks import G
 
     return 0.5 * I_O * w * w + block.mass_kg * G * block.R_m * (np.cos(a - th) - math.cos(a))
@@ -101,8 +101,7 @@ class RockingResult:
         import pandas as pd
 
         a = self.impacts_array
-        return pd.DataFrame({"t_s": a[0], "omega_before_rad_s": a[1], "omega_after_rad_s": a[2],
-                             "eta": a[3]})
+        return pd.DataFrame({"t_s": a[0], "omega_before_rad_s": a[1], "omega_after_rad_s": a[2], "eta": a[3]})
 
     @property
     def max_abs_theta_over_alpha(self) -> float:
@@ -141,10 +140,8 @@ class RockingResult:
         u = np.where(h > 0, (t - kt[k]) / hs, 0.0)
         x0, x1, v0, v1 = kx[k], kx[k + 1], kr[k], kl[k + 1]
         u2, u3 = u * u, u * u * u
-        th = (2 * u3 - 3 * u2 + 1) * x0 + (u3 - 2 * u2 + u) * h * v0 + (3 * u2 - 2 * u3) * x1 \
-            + (u3 - u2) * h * v1
-        w = ((6 * u2 - 6 * u) * x0 + (6 * u - 6 * u2) * x1) / hs + (3 * u2 - 4 * u + 1) * v0 \
-            + (3 * u2 - 2 * u) * v1
+        th = (2 * u3 - 3 * u2 + 1) * x0 + (u3 - 2 * u2 + u) * h * v0 + (3 * u2 - 2 * u3) * x1 + (u3 - u2) * h * v1
+        w = ((6 * u2 - 6 * u) * x0 + (6 * u - 6 * u2) * x1) / hs + (3 * u2 - 4 * u + 1) * v0 + (3 * u2 - 2 * u) * v1
         out = (t < self.t_s[0]) | (t > self.t_s[-1]) | ~np.isfinite(t)
         th[out] = np.nan
         w[out] = np.nan
@@ -154,26 +151,34 @@ class RockingResult:
         """DataFrame ``t_s, theta_rad, omega_rad_s, energy_J`` (one row per output sample)."""
         import pandas as pd
 
-        return pd.DataFrame({"t_s": self.t_s, "theta_rad": self.theta_rad,
-                             "omega_rad_s": self.omega_rad_s, "energy_J": self.energy_J})
+        return pd.DataFrame(
+            {"t_s": self.t_s, "theta_rad": self.theta_rad, "omega_rad_s": self.omega_rad_s, "energy_J": self.energy_J}
+        )
 
     def to_dict(self, impacts: bool = True) -> dict:
         """JSON-ready summary: block, law, status, overturning and (optionally) the impacts."""
         b = self.block
         d = {
-            "block": b.to_dict(), "alpha_rad": b.alpha_rad, "p_rad_s": b.p_rad_s, "eta_H": b.eta_H,
-            "restitution": self.restitution.to_dict(), "method": self.method, "dt_s": self.dt_s,
-            "linearized": self.linearized, "base_motion": self.base_name or None,
-            "status": self.status, "overturned": bool(self.overturned),
-            "overturn_t_s": _f(self.overturn_t_s), "fall_t_s": _f(self.fall_t_s),
+            "block": b.to_dict(),
+            "alpha_rad": b.alpha_rad,
+            "p_rad_s": b.p_rad_s,
+            "eta_H": b.eta_H,
+            "restitution": self.restitution.to_dict(),
+            "method": self.method,
+            "dt_s": self.dt_s,
+            "linearized": self.linearized,
+            "base_motion": self.base_name or None,
+            "status": self.status,
+            "overturned": bool(self.overturned),
+            "overturn_t_s": _f(self.overturn_t_s),
+            "fall_t_s": _f(self.fall_t_s),
             "max_abs_theta_rad": _f(self.max_abs_theta_rad),
             "max_abs_theta_over_alpha": _f(self.max_abs_theta_over_alpha),
             "n_impacts": int(self.n_impacts),
             "t_end_s": _f(self.t_s[-1]) if len(self.t_s) else 0.0,
         }
         if impacts:
-            d["impacts"] = [{k: _f(v) for k, v in row.items()}
-                            for row in self.impacts.to_dict(orient="records")]
+            d["impacts"] = [{k: _f(v) for k, v in row.items()} for row in self.impacts.to_dict(orient="records")]
         return d
 
 
@@ -230,10 +235,20 @@ class BatchResult:
         """DataFrame, one row per run."""
         import pandas as pd
 
-        return pd.DataFrame({"p_rad_s": self.p_rad_s, "alpha_rad": self.alpha_rad, "scale": self.scale,
-                             "eta": self.eta, "dt_s": self.dt_s, "overturned": self.overturned,
-                             "overturn_t_s": self.overturn_t_s,
-                             "max_abs_theta_over_alpha": self.max_abs_theta_over_alpha,
-                             "n_impacts": self.n_impacts, "status": self.status,
-                             "theta_end_rad": self.theta_end_rad, "omega_end_rad_s": self.omega_end_rad_s,
-                             "t_end_s": self.t_end_s})
+        return pd.DataFrame(
+            {
+                "p_rad_s": self.p_rad_s,
+                "alpha_rad": self.alpha_rad,
+                "scale": self.scale,
+                "eta": self.eta,
+                "dt_s": self.dt_s,
+                "overturned": self.overturned,
+                "overturn_t_s": self.overturn_t_s,
+                "max_abs_theta_over_alpha": self.max_abs_theta_over_alpha,
+                "n_impacts": self.n_impacts,
+                "status": self.status,
+                "theta_end_rad": self.theta_end_rad,
+                "omega_end_rad_s": self.omega_end_rad_s,
+                "t_end_s": self.t_end_s,
+            }
+        )

@@ -65,8 +65,7 @@ def _law(restitution, block, law_params):
     Building a law validates its tables (~15 us); repeated ``simulate`` calls
     (fits, the benchmark) reuse the frozen result.
     """
-    if type(restitution) is not str or not all(type(v) in (int, float, str, bool)
-                                                for v in law_params.values()):
+    if type(restitution) is not str or not all(type(v) in (int, float, str, bool) for v in law_params.values()):
         return make_restitution(restitution, block, **law_params)
     try:
         key = (restitution, block, tuple((k, type(v), v) for k, v in sorted(law_params.items())))
@@ -86,8 +85,10 @@ def _base_arrays(base):
     if base is None:
         return _EMPTY, 0.0, 1.0
     if not isinstance(base, BaseMotion):
-        raise InputError(f"base={type(base).__name__}: give a rocklab.models.BaseMotion "
-                         "(e.g. BaseMotion.from_samples(acc, dt_s, 'g')) or None")
+        raise InputError(
+            f"base={type(base).__name__}: give a rocklab.models.BaseMotion "
+            "(e.g. BaseMotion.from_samples(acc, dt_s, 'g')) or None"
+        )
     return np.ascontiguousarray(base.acc_m_s2, float), float(base.t_s[0]), base.dt_s
 
 
@@ -109,21 +110,40 @@ def check_step(p_rad_s: float, dt_s: float, option: str = "dt_s") -> None:
     """:class:`InputError` when ``p dt`` > :data:`P_DT_MAX`; warning ``W-SIM-DT`` above :data:`P_DT_WARN`."""
     pdt = p_rad_s * dt_s
     if pdt > P_DT_MAX:
-        raise InputError(f"{option}={dt_s:g} s: too coarse for this block (p = {p_rad_s:.4g} rad/s, p dt = "
-                         f"{pdt:.4g} > {P_DT_MAX}); use dt <= {P_DT_WARN / p_rad_s:.4g} s")
+        raise InputError(
+            f"{option}={dt_s:g} s: too coarse for this block (p = {p_rad_s:.4g} rad/s, p dt = "
+            f"{pdt:.4g} > {P_DT_MAX}); use dt <= {P_DT_WARN / p_rad_s:.4g} s"
+        )
     if pdt > P_DT_WARN:
         from ..._diagnostics import warn
 
-        warn("W-SIM-DT", f"{option}={dt_s:g} s gives p dt = {pdt:.4g} (> {P_DT_WARN}) for p = {p_rad_s:.4g} "
-                         f"rad/s; use dt <= {P_DT_WARN / p_rad_s:.4g} s for converged impacts")
+        warn(
+            "W-SIM-DT",
+            f"{option}={dt_s:g} s gives p dt = {pdt:.4g} (> {P_DT_WARN}) for p = {p_rad_s:.4g} "
+            f"rad/s; use dt <= {P_DT_WARN / p_rad_s:.4g} s for converged impacts",
+        )
 
 
-def simulate(block, theta0_rad: float = 0.0, omega0_rad_s: float = 0.0, duration_s: float = 10.0,
-             dt_s: float = 1e-4, restitution="housner", base: BaseMotion | None = None,
-             method: str = "newmark", stop_at_rest: bool = True, output_dt_s: float | None = None,
-             *, linearized: bool = False, rest_tol: float = 1e-6, max_impacts: int = 100_000,
-             rtol: float = 1e-10, ode_method: str = "DOP853", fall_rad: float | None = None,
-             **law_params) -> RockingResult:
+def simulate(
+    block,
+    theta0_rad: float = 0.0,
+    omega0_rad_s: float = 0.0,
+    duration_s: float = 10.0,
+    dt_s: float = 1e-4,
+    restitution="housner",
+    base: BaseMotion | None = None,
+    method: str = "newmark",
+    stop_at_rest: bool = True,
+    output_dt_s: float | None = None,
+    *,
+    linearized: bool = False,
+    rest_tol: float = 1e-6,
+    max_impacts: int = 100_000,
+    rtol: float = 1e-10,
+    ode_method: str = "DOP853",
+    fall_rad: float | None = None,
+    **law_params,
+) -> RockingResult:
     """Simulate one rocking block.
 
     Parameters
@@ -191,8 +211,10 @@ def simulate(block, theta0_rad: float = 0.0, omega0_rad_s: float = 0.0, duration
     dt = _finite("dt_s", dt_s, positive=True)
     rest_tol = _finite("rest_tol", rest_tol, positive=True)
     if abs(th0) >= alpha:
-        raise InputError(f"theta0_rad={th0}: |theta0| must be < alpha = {alpha:.6g} rad "
-                         "(the block would fall at release); give a smaller initial rotation")
+        raise InputError(
+            f"theta0_rad={th0}: |theta0| must be < alpha = {alpha:.6g} rad "
+            "(the block would fall at release); give a smaller initial rotation"
+        )
     if dt > T:
         raise InputError(f"dt_s={dt}: time step longer than duration_s={T}; use a smaller dt")
     fall = 0.5 * math.pi if fall_rad is None else _finite("fall_rad", fall_rad, positive=True)
@@ -216,21 +238,55 @@ def simulate(block, theta0_rad: float = 0.0, omega0_rad_s: float = 0.0, duration
     meth = str(method).lower()
     if meth == "newmark":
         check_step(p, dt, "dt_s")
-    check_memory(40.0 * n_steps / every, f"{T:g} s at dt = {dt:g} s ({n_steps} steps stored every {every})",
-                 "shorten duration_s or give a coarser output_dt_s")
+    check_memory(
+        40.0 * n_steps / every,
+        f"{T:g} s at dt = {dt:g} s ({n_steps} steps stored every {every})",
+        "shorten duration_s or give a coarser output_dt_s",
+    )
     t_last = _last_uplift_t(base, alpha)
     if meth == "newmark":
         t, th, w, E, imp_cols, n_imp, st, t_over, t_fall, max_abs = run_single(
-            p, alpha, th0, w0, dt, n_steps, acc, acc_t0, acc_dt, law.mode, law.eta_x, law.eta_y,
-            bool(linearized), rest_w2, t_last, bool(stop_at_rest), every, int(max_impacts), fall,
-            block.I_O_kg_m2)
+            p,
+            alpha,
+            th0,
+            w0,
+            dt,
+            n_steps,
+            acc,
+            acc_t0,
+            acc_dt,
+            law.mode,
+            law.eta_x,
+            law.eta_y,
+            bool(linearized),
+            rest_w2,
+            t_last,
+            bool(stop_at_rest),
+            every,
+            int(max_impacts),
+            fall,
+            block.I_O_kg_m2,
+        )
         status = STATUS_NAMES[st]
     elif meth == "event":
         from ._event import run_event
 
         t_grid = np.arange(int(math.floor(T / (dt * every) + 1e-9)) + 1) * (dt * every)
-        r = run_event(block, th0, w0, T, law, base, bool(linearized), rest_tol, bool(stop_at_rest),
-                      t_grid, rtol=rtol, ode_method=ode_method, fall_rad=fall)
+        r = run_event(
+            block,
+            th0,
+            w0,
+            T,
+            law,
+            base,
+            bool(linearized),
+            rest_tol,
+            bool(stop_at_rest),
+            t_grid,
+            rtol=rtol,
+            ode_method=ode_method,
+            fall_rad=fall,
+        )
         t, th, w = r["t"], r["theta"], r["omega"]
         status, t_over, t_fall, max_abs = r["status"], r["t_over"], r["t_fall"], r["max_abs"]
         n_imp = len(r["impacts"])
@@ -240,12 +296,25 @@ def simulate(block, theta0_rad: float = 0.0, omega0_rad_s: float = 0.0, duration
         raise InputError(f"method={method!r}: use 'newmark' or 'event'")
     for a in (t, th, w, E, imp_cols):
         a.setflags(write=False)
-    res = RockingResult(t_s=t, theta_rad=th, omega_rad_s=w, energy_J=E, impacts_array=imp_cols,
-                        status=status, overturned=status == "overturned",
-                        overturn_t_s=float(t_over), fall_t_s=float(t_fall),
-                        max_abs_theta_rad=float(max_abs), block=block, restitution=law, method=meth,
-                        dt_s=dt, n_impacts=int(n_imp), linearized=bool(linearized),
-                        base_name=base.name if base is not None else "")
+    res = RockingResult(
+        t_s=t,
+        theta_rad=th,
+        omega_rad_s=w,
+        energy_J=E,
+        impacts_array=imp_cols,
+        status=status,
+        overturned=status == "overturned",
+        overturn_t_s=float(t_over),
+        fall_t_s=float(t_fall),
+        max_abs_theta_rad=float(max_abs),
+        block=block,
+        restitution=law,
+        method=meth,
+        dt_s=dt,
+        n_impacts=int(n_imp),
+        linearized=bool(linearized),
+        base_name=base.name if base is not None else "",
+    )
     if resample is None:
         return res
     t2 = np.arange(int(math.floor(t[-1] / resample + 1e-9)) + 1) * resample

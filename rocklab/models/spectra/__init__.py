@@ -8,16 +8,56 @@ over the open choices (:func:`t_I_band`), and the design check and required pier
 """
 
 from ._design import DesignCheck, design_check, required_width, required_width_slender
-from ._oas import (OASResult, OverturningCurve, critical_impulse, fit_inclined_line, normalised_critical_impulse,
-                   overturning_curve, overturning_spectrum, simplified_oas)
+from ._oas import (
+    OASResult,
+    OverturningCurve,
+    critical_impulse,
+    fit_inclined_line,
+    normalised_critical_impulse,
+    overturning_curve,
+    overturning_spectrum,
+    simplified_oas,
+)
 from ._oas_band import BAND_ENSEMBLE, TIBand, t_I_band
-from ._pulses import (F_SINE, PULSE_KINDS, PulseParameters, lobe_impulses, pulse_fullness, pulse_motion,
-                      pulse_parameters, pulse_shape)
+from ._pulses import (
+    F_SINE,
+    PULSE_KINDS,
+    PulseParameters,
+    lobe_impulses,
+    pulse_fullness,
+    pulse_motion,
+    pulse_parameters,
+    pulse_shape,
+)
 from ._records import BUNDLED_RECORDS, UNITS_TO_M_S2, BaseMotion, bundled_record, load_base_motion
 
-__all__ = ["BaseMotion", "load_base_motion", "UNITS_TO_M_S2", "bundled_record", "BUNDLED_RECORDS",
-           "PulseParameters", "pulse_parameters", "lobe_impulses", "pulse_shape", "pulse_motion", "pulse_fullness",
-           "PULSE_KINDS", "F_SINE", "OASResult", "overturning_spectrum", "OverturningCurve", "overturning_curve",
-           "critical_impulse", "normalised_critical_impulse", "fit_inclined_line", "simplified_oas",
-           "t_I_band", "TIBand", "BAND_ENSEMBLE", "DesignCheck", "design_check", "required_width",
-           "required_width_slender"]
+__all__ = [
+    "BaseMotion",
+    "load_base_motion",
+    "UNITS_TO_M_S2",
+    "bundled_record",
+    "BUNDLED_RECORDS",
+    "PulseParameters",
+    "pulse_parameters",
+    "lobe_impulses",
+    "pulse_shape",
+    "pulse_motion",
+    "pulse_fullness",
+    "PULSE_KINDS",
+    "F_SINE",
+    "OASResult",
+    "overturning_spectrum",
+    "OverturningCurve",
+    "overturning_curve",
+    "critical_impulse",
+    "normalised_critical_impulse",
+    "fit_inclined_line",
+    "simplified_oas",
+    "t_I_band",
+    "TIBand",
+    "BAND_ENSEMBLE",
+    "DesignCheck",
+    "design_check",
+    "required_width",
+    "required_width_slender",
+]

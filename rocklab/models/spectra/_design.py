@@ -68,12 +68,28 @@ def design_check(block: Block, a_p_m_s2: float, t_I_s: float, exact_icr: bool = 
     icr = math.sqrt(2 / (1 + math.cos(alpha))) if exact_icr else 1.0
     a_min = G * math.tan(alpha)
     allow = a_min * max(icr / (t_I * block.p_rad_s), 1.0)
-    return DesignCheck(safe=a_p <= allow, a_p_m_s2=a_p, a_p_allow_m_s2=allow, a_p_min_m_s2=a_min,
-                       p_rad_s=block.p_rad_s, i_cr=icr, t_I_s=t_I, utilisation=a_p / allow)
+    return DesignCheck(
+        safe=a_p <= allow,
+        a_p_m_s2=a_p,
+        a_p_allow_m_s2=allow,
+        a_p_min_m_s2=a_min,
+        p_rad_s=block.p_rad_s,
+        i_cr=icr,
+        t_I_s=t_I,
+        utilisation=a_p / allow,
+    )
 
 
-def required_width(height_m: float, a_g_m_s2: float, t_I_s: float, *, cm_height_ratio: float = 0.5,
-                   alpha_I: float = 4.0 / 3.0, exact_icr: bool = True, g: float = G) -> float:
+def required_width(
+    height_m: float,
+    a_g_m_s2: float,
+    t_I_s: float,
+    *,
+    cm_height_ratio: float = 0.5,
+    alpha_I: float = 4.0 / 3.0,
+    exact_icr: bool = True,
+    g: float = G,
+) -> float:
     """Smallest pier width B (m) that Eq. 21 declares safe (thesis Eq. 23, §5.3.4).
 
     Solves ``a_g / (g tan alpha) = i_cr sqrt(alpha_I R / g) / t_I`` for B, with
@@ -126,9 +142,15 @@ def required_width(height_m: float, a_g_m_s2: float, t_I_s: float, *, cm_height_
     return brentq(excess, 1e-9 * H, b_uplift, xtol=1e-12, rtol=1e-14)
 
 
-def required_width_slender(height_m: float, a_g_m_s2: float, t_I_s: float, *,
-                           cm_height_ratio: float = 0.5, alpha_I: float = 4.0 / 3.0,
-                           g: float = G) -> float:
+def required_width_slender(
+    height_m: float,
+    a_g_m_s2: float,
+    t_I_s: float,
+    *,
+    cm_height_ratio: float = 0.5,
+    alpha_I: float = 4.0 / 3.0,
+    g: float = G,
+) -> float:
     """Slender approximation of :func:`required_width` (thesis Eq. 24 of §5.3.4).
 
     cos(alpha) ≈ 1, R ≈ cH, i_cr ≈ 1 give ``B = 2 c H a_g t_I / (g sqrt(alpha_I c H / g))``:

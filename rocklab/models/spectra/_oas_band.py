@@ -76,8 +76,20 @@ class TIBand:
 
     def to_dict(self) -> dict:
         """Numbers and members (SI units)."""
-        d = {k: getattr(self, k) for k in ("t_I_s", "t_I_p05_s", "t_I_p95_s", "t_I_prime_s", "t_I_prime_p05_s",
-                                          "t_I_prime_p95_s", "beta", "beta_p05", "beta_p95")}
+        d = {
+            k: getattr(self, k)
+            for k in (
+                "t_I_s",
+                "t_I_p05_s",
+                "t_I_p95_s",
+                "t_I_prime_s",
+                "t_I_prime_p05_s",
+                "t_I_prime_p95_s",
+                "beta",
+                "beta_p05",
+                "beta_p95",
+            )
+        }
         d["members"] = list(self.members)
         return d
 
@@ -119,8 +131,16 @@ def t_I_band(base, slenderness: float = 12.0, ensemble: dict | None = None, **op
             kw["eta"] = eta0 * change["eta_factor"]
         o = overturning_spectrum(base, slenderness, **kw)
         lv, R = o.f_min_at
-        members.append({"name": name, "t_I_s": o.t_I_s, "t_I_prime_s": o.t_I_prime_s, "beta": o.beta,
-                        "f_min_level": float(lv), "f_min_R_m": float(R)})
+        members.append(
+            {
+                "name": name,
+                "t_I_s": o.t_I_s,
+                "t_I_prime_s": o.t_I_prime_s,
+                "beta": o.beta,
+                "f_min_level": float(lv),
+                "f_min_R_m": float(R),
+            }
+        )
     ti = _stats([m["t_I_s"] for m in members])
     tp = _stats([m["t_I_prime_s"] for m in members])
     be = _stats([m["beta"] for m in members])

@@ -22,30 +22,39 @@ import numpy as np
 from ..._errors import InputError
 from ._records import MIN_SAMPLES, BaseMotion
 
-__all__ = ["PulseParameters", "pulse_parameters", "lobe_impulses", "pulse_shape", "pulse_motion",
-           "PULSE_KINDS", "F_SINE", "pulse_fullness"]
+__all__ = [
+    "PulseParameters",
+    "pulse_parameters",
+    "lobe_impulses",
+    "pulse_shape",
+    "pulse_motion",
+    "PULSE_KINDS",
+    "F_SINE",
+    "pulse_fullness",
+]
 
 #: Fullness I/(a_p t_p) of a half-sine lobe, 2/pi (thesis Eq. 16, 25: "F = 0.64").
 F_SINE = 2.0 / math.pi
 
 #: Pulse kinds known to :func:`pulse_shape`.
-PULSE_KINDS = ("half-sine", "full-sine", "n-half-sines", "rectangular", "triangular",
-               "cycloidal-a", "cycloidal-b")
+PULSE_KINDS = ("half-sine", "full-sine", "n-half-sines", "rectangular", "triangular", "cycloidal-a", "cycloidal-b")
 
 
 def _check_record(base: BaseMotion) -> BaseMotion:
     if not isinstance(base, BaseMotion):
-        raise InputError(f"base={type(base).__name__}: expected a BaseMotion; read the record with "
-                         "rocklab.models.load_base_motion")
+        raise InputError(
+            f"base={type(base).__name__}: expected a BaseMotion; read the record with rocklab.models.load_base_motion"
+        )
     # BaseMotion already rejects gaps, non-uniform dt and < 2 samples; an all-zero record has no pulse.
     src = f"{base.source}: " if base.source != "array" else ""
     if base.t_s.size < MIN_SAMPLES:
-        raise InputError(f"{src}record has {base.t_s.size} samples; pulse and spectrum analysis needs at "
-                         f"least {MIN_SAMPLES}; check the file was read whole")
+        raise InputError(
+            f"{src}record has {base.t_s.size} samples; pulse and spectrum analysis needs at "
+            f"least {MIN_SAMPLES}; check the file was read whole"
+        )
     if base.pga_m_s2 == 0.0:
         raise InputError(f"{src}record is all zeros; it has no pulse (check the file or its units)")
     return base
-
 
 
 def lobe_impulses(acc, dt_s: float):
@@ -164,7 +173,7 @@ def pulse_parameters(base: BaseMotion, F: float = F_SINE) -> PulseParameters:
     t0 = base.t_s[0]
     i0 = int(math.floor(ts[j] / base.dt_s + 1e-9))
     i1 = int(math.ceil(te[j] / base.dt_s - 1e-9))
-    seg = a[i0:i1 + 1]
+    seg = a[i0 : i1 + 1]
     lobe_peak = float(np.max(np.abs(seg)))
     # zero samples at the lobe's ends (quiet record parts, padding) are not part of its duration
     nz = np.flatnonzero(seg != 0)
@@ -175,21 +184,39 @@ def pulse_parameters(base: BaseMotion, F: float = F_SINE) -> PulseParameters:
     if i_max / (F * a_max) < 2.0 * base.dt_s:
         from ..._diagnostics import warn
 
-        warn("W-RECORD-PULSE", f"{base.name}: main pulse t_p = {i_max / (F * a_max):.4g} s is shorter than 2 "
-                               f"samples (dt = {base.dt_s:.4g} s); t_I and spectra from it are unreliable")
+        warn(
+            "W-RECORD-PULSE",
+            f"{base.name}: main pulse t_p = {i_max / (F * a_max):.4g} s is shorter than 2 "
+            f"samples (dt = {base.dt_s:.4g} s); t_I and spectra from it are unreliable",
+        )
     return PulseParameters(
-        a_max_m_s2=a_max, I_max_m_s=i_max, t_p_s=i_max / (F * a_max),
+        a_max_m_s2=a_max,
+        I_max_m_s=i_max,
+        t_p_s=i_max / (F * a_max),
         fullness=i_max / (lobe_peak * dur) if dur > 0 else float("nan"),
-        lobe_start_s=float(t0 + ts[j]), lobe_end_s=float(t0 + te[j]), lobe_peak_m_s2=lobe_peak,
-        t_amax_s=float(base.t_s[int(np.argmax(np.abs(a)))]), F=float(F), name=base.name)
+        lobe_start_s=float(t0 + ts[j]),
+        lobe_end_s=float(t0 + te[j]),
+        lobe_peak_m_s2=lobe_peak,
+        t_amax_s=float(base.t_s[int(np.argmax(np.abs(a)))]),
+        F=float(F),
+        name=base.name,
+    )
 
 
 # -- simple pulses -------------------------------------------------------------
 
+
 def _kind(kind: str) -> str:
     k = str(kind).strip().lower().replace("_", "-")
-    k = {"half": "half-sine", "sine": "full-sine", "full": "full-sine", "rect": "rectangular",
-         "tri": "triangular", "cycloidal": "cycloidal-a", "n-half": "n-half-sines"}.get(k, k)
+    k = {
+        "half": "half-sine",
+        "sine": "full-sine",
+        "full": "full-sine",
+        "rect": "rectangular",
+        "tri": "triangular",
+        "cycloidal": "cycloidal-a",
+        "n-half": "n-half-sines",
+    }.get(k, k)
     if k not in PULSE_KINDS:
         raise InputError(f"pulse kind {kind!r}: unknown; use one of {', '.join(PULSE_KINDS)}")
     return k
@@ -252,8 +279,9 @@ def pulse_shape(kind: str, t_s, t_p_s: float, n: int = 1) -> np.ndarray:
     return np.where(inside, y, 0.0)
 
 
-def pulse_motion(kind: str, t_p_s: float, a_p_m_s2: float, n: int = 1, dt_s: float | None = None,
-                 pad_s: float = 0.0) -> BaseMotion:
+def pulse_motion(
+    kind: str, t_p_s: float, a_p_m_s2: float, n: int = 1, dt_s: float | None = None, pad_s: float = 0.0
+) -> BaseMotion:
     """A simple pulse as a :class:`BaseMotion` (peak ``a_p_m_s2``, m/s^2).
 
     ``dt_s`` defaults to t_p/200; ``pad_s`` seconds of zeros are appended.

@@ -25,11 +25,28 @@ import numpy as np
 from ..._errors import InputError
 from ...blocks import G
 
-__all__ = ["BaseMotion", "load_base_motion", "check_plausible", "MIN_SAMPLES", "UNITS_TO_M_S2", "bundled_record", "BUNDLED_RECORDS"]
+__all__ = [
+    "BaseMotion",
+    "load_base_motion",
+    "check_plausible",
+    "MIN_SAMPLES",
+    "UNITS_TO_M_S2",
+    "bundled_record",
+    "BUNDLED_RECORDS",
+]
 
 #: Factors from accepted acceleration units to m/s^2.
-UNITS_TO_M_S2 = {"g": G, "m/s2": 1.0, "m/s^2": 1.0, "m_s2": 1.0, "cm/s2": 0.01,
-                 "cm/s^2": 0.01, "cm_s2": 0.01, "gal": 0.01, "mm/s2": 0.001}
+UNITS_TO_M_S2 = {
+    "g": G,
+    "m/s2": 1.0,
+    "m/s^2": 1.0,
+    "m_s2": 1.0,
+    "cm/s2": 0.01,
+    "cm/s^2": 0.01,
+    "cm_s2": 0.01,
+    "gal": 0.01,
+    "mm/s2": 0.001,
+}
 
 _NUM = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eEdD][-+]?\d+)?")
 
@@ -37,8 +54,9 @@ _NUM = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eEdD][-+]?\d+)?")
 def _unit_factor(units: str, source: str = "") -> float:
     key = str(units).strip().lower().replace(" ", "")
     if key not in UNITS_TO_M_S2:
-        raise InputError(f"{source}units={units!r}: unknown acceleration unit; use one of "
-                         f"{', '.join(sorted(set(UNITS_TO_M_S2)))}")
+        raise InputError(
+            f"{source}units={units!r}: unknown acceleration unit; use one of {', '.join(sorted(set(UNITS_TO_M_S2)))}"
+        )
     return UNITS_TO_M_S2[key]
 
 
@@ -79,13 +97,17 @@ class BaseMotion:
         d = np.diff(t)
         if (d <= 0).any():
             i = int(np.flatnonzero(d <= 0)[0])
-            raise InputError(f"{src}time is not strictly increasing at sample {i + 1} "
-                             f"(t={t[i]} then {t[i + 1]}); sort or de-duplicate the record")
+            raise InputError(
+                f"{src}time is not strictly increasing at sample {i + 1} "
+                f"(t={t[i]} then {t[i + 1]}); sort or de-duplicate the record"
+            )
         dt = float(np.median(d))
         if np.max(np.abs(d - dt)) > 1e-6 * max(dt, 1e-12) + 1e-9:
             i = int(np.argmax(np.abs(d - dt)))
-            raise InputError(f"{src}non-uniform time step at sample {i + 1} (dt={d[i]:g} s vs median "
-                             f"{dt:g} s): gap or jitter; resample with BaseMotion.resample() first")
+            raise InputError(
+                f"{src}non-uniform time step at sample {i + 1} (dt={d[i]:g} s vs median "
+                f"{dt:g} s): gap or jitter; resample with BaseMotion.resample() first"
+            )
         t.setflags(write=False)
         a.setflags(write=False)
         object.__setattr__(self, "t_s", t)
@@ -99,8 +121,9 @@ class BaseMotion:
         return cls(np.asarray(t_s, float), np.asarray(acc, float) * f, name=name)
 
     @classmethod
-    def from_samples(cls, acc, dt_s: float, units: str = "m/s2", t0_s: float = 0.0,
-                     name: str = "record") -> "BaseMotion":
+    def from_samples(
+        cls, acc, dt_s: float, units: str = "m/s2", t0_s: float = 0.0, name: str = "record"
+    ) -> "BaseMotion":
         """From equally spaced samples ``acc`` (in ``units``) at step ``dt_s`` (s)."""
         if not (math.isfinite(dt_s) and dt_s > 0):
             raise InputError(f"dt_s={dt_s!r}: time step must be positive (s)")
@@ -155,8 +178,8 @@ class BaseMotion:
 
 # -- readers ------------------------------------------------------------------
 
-def load_base_motion(path, units: str | None = None, dt_s: float | None = None,
-                     name: str | None = None) -> BaseMotion:
+
+def load_base_motion(path, units: str | None = None, dt_s: float | None = None, name: str | None = None) -> BaseMotion:
     """Read a base-motion record file into SI units.
 
     Parameters
@@ -209,8 +232,7 @@ def _read_at2(path: Path, text: str, units: str | None, name: str) -> BaseMotion
     m_n = re.search(r"NPTS\s*=\s*(\d+)", hdr, re.I)
     m_dt = re.search(r"DT\s*=\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)", hdr, re.I)
     if not (m_n and m_dt):
-        raise InputError(f"{path}, line {hdr_i + 1}: AT2 header must hold 'NPTS=<n>, DT=<s> SEC'; "
-                         "fix the header")
+        raise InputError(f"{path}, line {hdr_i + 1}: AT2 header must hold 'NPTS=<n>, DT=<s> SEC'; fix the header")
     npts, dt = int(m_n.group(1)), float(m_dt.group(1))
     if dt <= 0:
         raise InputError(f"{path}, line {hdr_i + 1}: DT={dt} must be positive")
@@ -220,7 +242,7 @@ def _read_at2(path: Path, text: str, units: str | None, name: str) -> BaseMotion
         units = file_units or "g"  # PEER's documented convention when the file names no units
     f = _unit_factor(units, f"{path}: ")
     vals: list[float] = []
-    for j, ln in enumerate(lines[hdr_i + 1:], start=hdr_i + 2):
+    for j, ln in enumerate(lines[hdr_i + 1 :], start=hdr_i + 2):
         toks = ln.split()
         for tok in toks:
             if not _NUM.fullmatch(tok):
@@ -232,26 +254,60 @@ def _read_at2(path: Path, text: str, units: str | None, name: str) -> BaseMotion
             else:
                 vals.append(float(tok.replace("D", "E").replace("d", "e")))
     a = np.asarray(vals, float)
-    _check_last_token(path, lines[hdr_i + 1:], hdr_i + 2)
+    _check_last_token(path, lines[hdr_i + 1 :], hdr_i + 2)
     if a.size != npts:
-        raise InputError(f"{path}: header says NPTS={npts} but the file holds {a.size} values; "
-                         "the file is truncated or the header is wrong")
-    bm = BaseMotion(dt * np.arange(npts), a * f, name=name, source=str(path),
-                    meta={"format": "AT2", "units_in_file": units, "header": lines[:hdr_i + 1],
-                          "units_from": units_from})
+        raise InputError(
+            f"{path}: header says NPTS={npts} but the file holds {a.size} values; "
+            "the file is truncated or the header is wrong"
+        )
+    bm = BaseMotion(
+        dt * np.arange(npts),
+        a * f,
+        name=name,
+        source=str(path),
+        meta={"format": "AT2", "units_in_file": units, "header": lines[: hdr_i + 1], "units_from": units_from},
+    )
     return bm
 
 
 # units named in an AT2 header ("IN UNITS OF G", "The units are (g)", "UNITS: CM/S/S")
-_UNITS_FIELD = re.compile(r"\bUNITS?\b\s*(?:(?:OF|ARE|IN)\b\s*[(\[]?|[:=(\[])\s*[(\[]?\s*([A-Z][A-Z0-9/*^.\-]*(?:\s*/\s*[A-Z0-9*^]+)*)",
-                          re.I)
-_ACC_UNITS = {"G": "g", "GS": "g", "CM/S/S": "cm/s2", "CM/S2": "cm/s2", "CM/S**2": "cm/s2", "CM/S^2": "cm/s2",
-              "CM/SEC/SEC": "cm/s2", "CM/SEC2": "cm/s2", "CM/SEC**2": "cm/s2", "CM/SEC^2": "cm/s2",
-              "GAL": "cm/s2", "M/S/S": "m/s2", "M/S2": "m/s2", "M/S**2": "m/s2", "M/S^2": "m/s2",
-              "M/SEC/SEC": "m/s2", "M/SEC2": "m/s2", "M/SEC**2": "m/s2", "MM/S/S": "mm/s2", "MM/S2": "mm/s2"}
-_OTHER_QUANTITY = {"CM/S": "velocity", "CM/SEC": "velocity", "M/S": "velocity", "M/SEC": "velocity",
-                   "IN/S": "velocity", "IN/SEC": "velocity", "CM": "displacement", "M": "displacement",
-                   "MM": "displacement", "IN": "displacement"}
+_UNITS_FIELD = re.compile(
+    r"\bUNITS?\b\s*(?:(?:OF|ARE|IN)\b\s*[(\[]?|[:=(\[])\s*[(\[]?\s*([A-Z][A-Z0-9/*^.\-]*(?:\s*/\s*[A-Z0-9*^]+)*)", re.I
+)
+_ACC_UNITS = {
+    "G": "g",
+    "GS": "g",
+    "CM/S/S": "cm/s2",
+    "CM/S2": "cm/s2",
+    "CM/S**2": "cm/s2",
+    "CM/S^2": "cm/s2",
+    "CM/SEC/SEC": "cm/s2",
+    "CM/SEC2": "cm/s2",
+    "CM/SEC**2": "cm/s2",
+    "CM/SEC^2": "cm/s2",
+    "GAL": "cm/s2",
+    "M/S/S": "m/s2",
+    "M/S2": "m/s2",
+    "M/S**2": "m/s2",
+    "M/S^2": "m/s2",
+    "M/SEC/SEC": "m/s2",
+    "M/SEC2": "m/s2",
+    "M/SEC**2": "m/s2",
+    "MM/S/S": "mm/s2",
+    "MM/S2": "mm/s2",
+}
+_OTHER_QUANTITY = {
+    "CM/S": "velocity",
+    "CM/SEC": "velocity",
+    "M/S": "velocity",
+    "M/SEC": "velocity",
+    "IN/S": "velocity",
+    "IN/SEC": "velocity",
+    "CM": "displacement",
+    "M": "displacement",
+    "MM": "displacement",
+    "IN": "displacement",
+}
 
 
 def _at2_units(path: Path, header: list[str], given: str | None = None) -> str | None:
@@ -265,21 +321,28 @@ def _at2_units(path: Path, header: list[str], given: str | None = None) -> str |
     for i, ln in enumerate(header, start=1):
         if re.search(r"\b(VELOCITY|DISPLACEMENT)\s+TIME\s+SERIES\b", ln, re.I):
             kind = re.search(r"VELOCITY|DISPLACEMENT", ln, re.I).group(0).lower()  # type: ignore[union-attr]
-            raise InputError(f"{path}, line {i}: this is a {kind} time series, not acceleration; give the "
-                             "matching .AT2 acceleration file")
+            raise InputError(
+                f"{path}, line {i}: this is a {kind} time series, not acceleration; give the "
+                "matching .AT2 acceleration file"
+            )
         for m in _UNITS_FIELD.finditer(ln):
             tok = re.sub(r"\s+", "", m.group(1)).upper().rstrip(".,;)]")
             if tok in _ACC_UNITS:
                 found[_ACC_UNITS[tok]] = i
             elif tok in _OTHER_QUANTITY:
-                raise InputError(f"{path}, line {i}: units {m.group(1)!r} are {_OTHER_QUANTITY[tok]}, not "
-                                 "acceleration; give the acceleration record")
+                raise InputError(
+                    f"{path}, line {i}: units {m.group(1)!r} are {_OTHER_QUANTITY[tok]}, not "
+                    "acceleration; give the acceleration record"
+                )
             elif given is None:
-                raise InputError(f"{path}, line {i}: unknown units {m.group(1)!r} in the header; give --units "
-                                 "g|m/s2|cm/s2 to say what the file holds")
+                raise InputError(
+                    f"{path}, line {i}: unknown units {m.group(1)!r} in the header; give --units "
+                    "g|m/s2|cm/s2 to say what the file holds"
+                )
     if len(found) > 1 and given is None:
-        raise InputError(f"{path}: header names two units ({', '.join(sorted(found))}); give --units to say "
-                         "which is right")
+        raise InputError(
+            f"{path}: header names two units ({', '.join(sorted(found))}); give --units to say which is right"
+        )
     return next(iter(found), None)
 
 
@@ -303,8 +366,10 @@ def _check_last_token(path: Path, data_lines: list[str], first_lineno: int) -> N
     common = max(set(shapes), key=shapes.count)
     if shapes.count(common) >= 0.9 * len(shapes) and _token_shape(toks[-1]) != common:
         last_line = first_lineno + max(i for i, ln in enumerate(data_lines) if ln.strip())
-        raise InputError(f"{path}, line {last_line}: the last value {toks[-1]!r} is not written like the "
-                         "others (cut off mid-number?); restore the file's end from its source")
+        raise InputError(
+            f"{path}, line {last_line}: the last value {toks[-1]!r} is not written like the "
+            "others (cut off mid-number?); restore the file's end from its source"
+        )
 
 
 #: Fewest samples a record needs for its pulse parameters and spectra (fewer: W-RECORD-SHORT
@@ -320,13 +385,17 @@ def check_plausible(bm: BaseMotion) -> BaseMotion:
     src = f"{bm.source}: " if bm.source != "array" else f"{bm.name}: "
     pga_g = bm.pga_m_s2 / G
     if pga_g > 5.0:
-        warn("W-RECORD-PGA", f"{src}peak acceleration {pga_g:.4g} g is above 5 g; check the units "
-                             f"(read as {bm.meta.get('units_in_file', 'given')}) or --units")
+        warn(
+            "W-RECORD-PGA",
+            f"{src}peak acceleration {pga_g:.4g} g is above 5 g; check the units "
+            f"(read as {bm.meta.get('units_in_file', 'given')}) or --units",
+        )
     if bm.dt_s > 0.05:
         warn("W-RECORD-DT", f"{src}sample step {bm.dt_s:.4g} s is above 0.05 s; check DT in the header")
     if bm.t_s.size < MIN_SAMPLES or bm.duration_s < 0.2:
-        warn("W-RECORD-SHORT", f"{src}only {bm.t_s.size} samples ({bm.duration_s:.4g} s); check the whole "
-                               "file was read")
+        warn(
+            "W-RECORD-SHORT", f"{src}only {bm.t_s.size} samples ({bm.duration_s:.4g} s); check the whole file was read"
+        )
     return bm
 
 
@@ -339,8 +408,7 @@ def _read_csv(path: Path, units: str | None, name: str) -> BaseMotion:
         raise InputError(f"{path}: not a readable CSV ({type(e).__name__}: {str(e).splitlines()[0]})") from None
     cols = {c.strip(): c for c in df.columns}
     if "t_s" not in cols:
-        raise InputError(f"{path}, line 1: missing column 't_s'; header must be 't_s,acc_m_s2' "
-                         "(or acc_g / acc_cm_s2)")
+        raise InputError(f"{path}, line 1: missing column 't_s'; header must be 't_s,acc_m_s2' (or acc_g / acc_cm_s2)")
     acc_col, file_units = None, None
     for c, u in (("acc_m_s2", "m/s2"), ("acc_g", "g"), ("acc_cm_s2", "cm/s2")):
         if c in cols:
@@ -359,8 +427,7 @@ def _read_csv(path: Path, units: str | None, name: str) -> BaseMotion:
     return BaseMotion(t, a * f, name=name, source=str(path), meta={"format": "csv"})
 
 
-def _read_columns(path: Path, text: str, units: str | None, dt_s: float | None,
-                  name: str) -> BaseMotion:
+def _read_columns(path: Path, text: str, units: str | None, dt_s: float | None, name: str) -> BaseMotion:
     rows, linenos = [], []
     for j, ln in enumerate(text.splitlines(), start=1):
         s = ln.strip()
@@ -397,8 +464,9 @@ def _check_time(path, t, first_line: int = 1, linenos=None):
     if (d <= 0).any():
         i = int(np.flatnonzero(d <= 0)[0]) + 1
         ln = linenos[i] if linenos is not None else i + first_line
-        raise InputError(f"{path}, line {ln}: time {t[i]} does not increase (previous {t[i - 1]}); "
-                         "sort or remove duplicate rows")
+        raise InputError(
+            f"{path}, line {ln}: time {t[i]} does not increase (previous {t[i - 1]}); sort or remove duplicate rows"
+        )
 
 
 #: Records bundled in ``rocklab/data/records`` (see PROVENANCE.md there).

@@ -27,8 +27,15 @@ __all__ = ["CampaignResult", "run_campaign", "find_experiments"]
 
 
 #: What a campaign writes in its output folder.
-CAMPAIGN_ENTRIES = ("experiments", "campaign.csv", "campaign.json", "campaign.rrd", "figures", "summary.md",
-                    "report.html")
+CAMPAIGN_ENTRIES = (
+    "experiments",
+    "campaign.csv",
+    "campaign.json",
+    "campaign.rrd",
+    "figures",
+    "summary.md",
+    "report.html",
+)
 
 
 def find_experiments(root) -> list[Path]:
@@ -49,14 +56,26 @@ def _one(config: str, out: str, force: bool) -> dict:
 
     try:
         report, ran = run_experiment(config, out, force=force)
-        return {"config": config, "out": out, "ok": report.get("status") != "failed", "ran": ran,
-                "report": report, "error": None}
+        return {
+            "config": config,
+            "out": out,
+            "ok": report.get("status") != "failed",
+            "ran": ran,
+            "report": report,
+            "error": None,
+        }
     except _IE as e:
         return {"config": config, "out": out, "ok": False, "ran": True, "report": None, "error": str(e)}
     except Exception as e:  # noqa: BLE001 - one broken experiment must not stop the campaign
         tb = traceback.format_exc(limit=3).strip().splitlines()[-1]
-        return {"config": config, "out": out, "ok": False, "ran": True, "report": None,
-                "error": f"{type(e).__name__}: {e} ({tb})"}
+        return {
+            "config": config,
+            "out": out,
+            "ok": False,
+            "ran": True,
+            "report": None,
+            "error": f"{type(e).__name__}: {e} ({tb})",
+        }
 
 
 @dataclass(frozen=True)
@@ -102,14 +121,22 @@ class CampaignResult:
 
     def to_dict(self) -> dict:
         """Plain dict of the fields, JSON-ready (SI units in the keys)."""
-        return {"out_dir": str(self.out_dir), "n_experiments": len(self.runs), "n_ok": self.n_ok,
-                "n_failed": self.n_failed, "status": "ok" if self.n_failed == 0 else "partial",
-                "failures": [{"config": r["config"], "error": r["error"]} for r in self.runs if not r["ok"]],
-                "experiments": self.table.to_dict(orient="records") if self.table is not None else [],
-                "eta_mat": self.eta_mat, "k_table": self.k_table, "messages": list(self.messages)}
+        return {
+            "out_dir": str(self.out_dir),
+            "n_experiments": len(self.runs),
+            "n_ok": self.n_ok,
+            "n_failed": self.n_failed,
+            "status": "ok" if self.n_failed == 0 else "partial",
+            "failures": [{"config": r["config"], "error": r["error"]} for r in self.runs if not r["ok"]],
+            "experiments": self.table.to_dict(orient="records") if self.table is not None else [],
+            "eta_mat": self.eta_mat,
+            "k_table": self.k_table,
+            "messages": list(self.messages),
+        }
 
     def summary_md(self, figures: dict | None = None) -> str:
         """The campaign's one-page Markdown report: experiments, campaign fits, figures, failures."""
+
         def g(x):
             try:
                 v = float(x)
@@ -118,33 +145,48 @@ class CampaignResult:
             return f"{v:.4g}" if np.isfinite(v) else "–"
 
         n_sus = sum(1 for r in self.runs if r["ok"] and (r.get("report") or {}).get("status") == "suspect")
-        lines = [f"# Campaign {self.out_dir.name}", "",
-                 f"{self.n_ok} of {len(self.runs)} experiments ran"
-                 + (f", **{n_sus} suspect** (see their warnings)" if n_sus else "")
-                 + (f", **{self.n_failed} failed**" if self.n_failed else "") + ".", ""]
+        lines = [
+            f"# Campaign {self.out_dir.name}",
+            "",
+            f"{self.n_ok} of {len(self.runs)} experiments ran"
+            + (f", **{n_sus} suspect** (see their warnings)" if n_sus else "")
+            + (f", **{self.n_failed} failed**" if self.n_failed else "")
+            + ".",
+            "",
+        ]
         t = self.ok_table
         if t is not None and len(t):
-            lines += ["| experiment | block | contact | h/b | η_H | η_e | 95 % CI | η_M | truth | status |",
-                      "|---|---|---|---|---|---|---|---|---|---|"]
+            lines += [
+                "| experiment | block | contact | h/b | η_H | η_e | 95 % CI | η_M | truth | status |",
+                "|---|---|---|---|---|---|---|---|---|---|",
+            ]
             for _, r in t.iterrows():
                 name = str(r["experiment"])
                 ci = f"{g(r.get('ci_lo'))} – {g(r.get('ci_hi'))}" if np.isfinite(r.get("ci_lo", np.nan)) else "–"
                 eta_e = g(r["eta_e"]) if np.isfinite(r["eta_e"]) else "(forced)"
-                lines.append(f"| [{name}](experiments/{name}/report.html) | {r['block']} | {r['contact']} | "
-                             f"{g(r.get('hb'))} | {g(r['eta_H'])} | {eta_e} | {ci} | {g(r.get('eta_M'))} | "
-                             f"{g(r.get('eta_true'))} | {r.get('status', '')} |")
+                lines.append(
+                    f"| [{name}](experiments/{name}/report.html) | {r['block']} | {r['contact']} | "
+                    f"{g(r.get('hb'))} | {g(r['eta_H'])} | {eta_e} | {ci} | {g(r.get('eta_M'))} | "
+                    f"{g(r.get('eta_true'))} | {r.get('status', '')} |"
+                )
             lines.append("")
         if self.eta_mat:
-            lines += [f"η_mat (edge contact, Čeh Eq. 16) = {g(self.eta_mat.get('eta_mat'))} ± "
-                      f"{g(self.eta_mat.get('std'))} ({self.eta_mat.get('n')} blocks)", ""]
+            lines += [
+                f"η_mat (edge contact, Čeh Eq. 16) = {g(self.eta_mat.get('eta_mat'))} ± "
+                f"{g(self.eta_mat.get('std'))} ({self.eta_mat.get('n')} blocks)",
+                "",
+            ]
         if self.k_table:
             ks = ", ".join(f"{r['block']}: {g(r['k'])}" for r in self.k_table.get("per_block", []))
             lines += [f"k per full-contact block (Čeh Eq. 18, η_mat = {g(self.k_table.get('eta_mat'))}): {ks}", ""]
             co = self.k_table.get("coefficients")
             if co:
                 terms = " ".join(f"{v:+.4g}·{k}" if k != "const" else f"{v:+.4g}" for k, v in co.items())
-                lines += [f"k(h/b, b) regression (Čeh Eq. 19 form, b in cm): k = {terms}; "
-                          f"R² = {g(self.k_table.get('r2'))}, RMSE = {g(self.k_table.get('rmse'))}", ""]
+                lines += [
+                    f"k(h/b, b) regression (Čeh Eq. 19 form, b in cm): k = {terms}; "
+                    f"R² = {g(self.k_table.get('r2'))}, RMSE = {g(self.k_table.get('rmse'))}",
+                    "",
+                ]
         for r in self.runs:
             if not r["ok"]:
                 lines.append(f"- **FAILED** {r['config']}: {r['error']}")
@@ -152,8 +194,10 @@ class CampaignResult:
             lines.append(f"- note: {m}")
         if figures:
             lines += ["", "## Figures", ""] + [f"![{k}](figures/{Path(p).name})" for k, p in figures.items()]
-        lines += ["", "Data: [campaign.csv](campaign.csv), [campaign.json](campaign.json); "
-                  "visual review: `rerun campaign.rrd`"]
+        lines += [
+            "",
+            "Data: [campaign.csv](campaign.csv), [campaign.json](campaign.json); visual review: `rerun campaign.rrd`",
+        ]
         return "\n".join(lines) + "\n"
 
     def summary_text(self) -> str:
@@ -163,45 +207,57 @@ class CampaignResult:
         lines = [f"campaign: {self.n_ok}/{len(self.runs)} experiments ran{sus}; outputs in {self.out_dir}"]
         t = self.ok_table
         if t is not None and len(t):
-            lines.append(f"{'experiment':<22}{'block':<7}{'contact':<8}{'eta_H':>8}{'eta_e':>8}"
-                         f"{'95% CI':>18}{'eta_M':>8}{'truth':>8}")
+            lines.append(
+                f"{'experiment':<22}{'block':<7}{'contact':<8}{'eta_H':>8}{'eta_e':>8}"
+                f"{'95% CI':>18}{'eta_M':>8}{'truth':>8}"
+            )
             for _, r in t.iterrows():
-                ci = (f"[{r['ci_lo']:.3f}, {r['ci_hi']:.3f}]" if np.isfinite(r.get("ci_lo", np.nan))
-                      else "")
+                ci = f"[{r['ci_lo']:.3f}, {r['ci_hi']:.3f}]" if np.isfinite(r.get("ci_lo", np.nan)) else ""
                 eta_e = f"{r['eta_e']:>8.3f}" if np.isfinite(r["eta_e"]) else f"{'(forced)':>8}"
-                lines.append(f"{str(r['experiment'])[:21]:<22}{str(r['block'])[:6]:<7}{r['contact']:<8}"
-                             f"{r['eta_H']:>8.3f}{eta_e}{ci:>18}"
-                             f"{r.get('eta_M', np.nan):>8.3f}{r.get('eta_true', np.nan):>8.3f}")
+                lines.append(
+                    f"{str(r['experiment'])[:21]:<22}{str(r['block'])[:6]:<7}{r['contact']:<8}"
+                    f"{r['eta_H']:>8.3f}{eta_e}{ci:>18}"
+                    f"{r.get('eta_M', np.nan):>8.3f}{r.get('eta_true', np.nan):>8.3f}"
+                )
             for _, r in t[t.get("column", "") != ""].iterrows() if "column" in t else []:
                 c = json.loads(r["column"])
-                lines.append(f"{r['experiment']}: column of {len(c['rms_theta_rad'])} blocks, model status "
-                             f"{c['status']}, θ RMS measured−model "
-                             f"{', '.join(f'{x:.4f}' for x in c['rms_theta_rad'])} rad, opening sequence "
-                             f"matched by the model {c['sequence_model_matched']}, same as truth: "
-                             f"{c['sequence_same_as_truth']}")
+                lines.append(
+                    f"{r['experiment']}: column of {len(c['rms_theta_rad'])} blocks, model status "
+                    f"{c['status']}, θ RMS measured−model "
+                    f"{', '.join(f'{x:.4f}' for x in c['rms_theta_rad'])} rad, opening sequence "
+                    f"matched by the model {c['sequence_model_matched']}, same as truth: "
+                    f"{c['sequence_same_as_truth']}"
+                )
         if self.eta_mat:
-            lines.append(f"eta_mat (edge contact, Čeh Eq. 16) = {self.eta_mat.get('eta_mat'):.4f} "
-                         f"± {self.eta_mat.get('std', float('nan')):.4f} ({self.eta_mat.get('n')} blocks)")
+            lines.append(
+                f"eta_mat (edge contact, Čeh Eq. 16) = {self.eta_mat.get('eta_mat'):.4f} "
+                f"± {self.eta_mat.get('std', float('nan')):.4f} ({self.eta_mat.get('n')} blocks)"
+            )
         if self.k_table:
             ks = ", ".join(f"{r['block']}: {r['k']:.3f}" for r in self.k_table.get("per_block", []))
             lines.append(f"k per full-contact block (Čeh Eq. 18, eta_mat = {self.k_table.get('eta_mat'):.4f}): {ks}")
             co = self.k_table.get("coefficients")
             if co:
                 terms = " ".join(f"{v:+.4f}·{k}" if k != "const" else f"{v:+.4f}" for k, v in co.items())
-                lines.append(f"k(h/b, b) regression (Čeh Eq. 19 form, b in cm): k = {terms}; "
-                             f"R² = {self.k_table.get('r2', float('nan')):.3f}, "
-                             f"RMSE = {self.k_table.get('rmse', float('nan')):.4f} "
-                             f"(Čeh: +0.0047·hb2 -0.0258·hb +1.0635 -0.0565·b_cm)")
+                lines.append(
+                    f"k(h/b, b) regression (Čeh Eq. 19 form, b in cm): k = {terms}; "
+                    f"R² = {self.k_table.get('r2', float('nan')):.3f}, "
+                    f"RMSE = {self.k_table.get('rmse', float('nan')):.4f} "
+                    f"(Čeh: +0.0047·hb2 -0.0258·hb +1.0635 -0.0565·b_cm)"
+                )
         for r in self.runs:
             if not r["ok"]:
                 lines.append(f"FAILED {r['config']}: {r['error']}")
         for m in self.messages:
             lines.append(f"note: {m}")
         if self.n_failed:
-            lines.append(f"{self.n_failed} of {len(self.runs)} experiments FAILED (listed in campaign.csv "
-                         "with status 'failed'); exit status 1")
-        lines.append(f"look: {self.out_dir / 'campaign.csv'}, {self.out_dir / 'figures'}, "
-                     f"rerun {self.out_dir / 'campaign.rrd'}")
+            lines.append(
+                f"{self.n_failed} of {len(self.runs)} experiments FAILED (listed in campaign.csv "
+                "with status 'failed'); exit status 1"
+            )
+        lines.append(
+            f"look: {self.out_dir / 'campaign.csv'}, {self.out_dir / 'figures'}, rerun {self.out_dir / 'campaign.rrd'}"
+        )
         return "\n".join(lines)
 
 
@@ -215,33 +271,53 @@ def _ok_rows(table):
 def _row(run: dict) -> dict:
     rep = run.get("report")
     if not rep:  # a failed experiment is a row too, so campaign.csv shows it with its error
-        return {"experiment": Path(run["config"]).parent.name, "status": "failed",
-                "error": str(run.get("error") or "")[:300], "config": run["config"], "out": run["out"]}
+        return {
+            "experiment": Path(run["config"]).parent.name,
+            "status": "failed",
+            "error": str(run.get("error") or "")[:300],
+            "config": run["config"],
+            "out": run["out"],
+        }
     b = rep["block"]
     fit = rep.get("fit") or {}
     ci = fit.get("ci95_eta_e") or [np.nan, np.nan]
     sims = rep.get("simulations") or {}
     truth = rep.get("truth") or {}
     warn_codes = sorted({w["code"] for w in rep.get("warnings") or []})
-    return {"experiment": rep["name"], "status": rep.get("status"), "error": "",
-            "warnings": "; ".join(warn_codes), "config": run["config"],
-            "block": b.get("name") or rep["name"], "b_m": b["b_m"], "h_m": b["h_m"],
-            "hb": b["h_m"] / b["b_m"], "contact": rep["contact"]["type"], "l_c_m": rep["contact"]["l_c_m"],
-            "eta_H": b["eta_H"], "eta_e": fit.get("eta_e", np.nan),
-            "ci_lo": ci[0] if ci[0] is not None else np.nan, "ci_hi": ci[1] if ci[1] is not None else np.nan,
-            "eta_e_first": fit.get("eta_e_first", np.nan),
-            "eta_M": (sims.get("modified") or {}).get("eta", np.nan),
-            "eta_true": truth.get("eta") if truth.get("eta") is not None else np.nan,
-            "fit_status": fit.get("status"), "out": run["out"],
-            "column": json.dumps(_column_summary(rep["column"])) if rep.get("column") else ""}
+    return {
+        "experiment": rep["name"],
+        "status": rep.get("status"),
+        "error": "",
+        "warnings": "; ".join(warn_codes),
+        "config": run["config"],
+        "block": b.get("name") or rep["name"],
+        "b_m": b["b_m"],
+        "h_m": b["h_m"],
+        "hb": b["h_m"] / b["b_m"],
+        "contact": rep["contact"]["type"],
+        "l_c_m": rep["contact"]["l_c_m"],
+        "eta_H": b["eta_H"],
+        "eta_e": fit.get("eta_e", np.nan),
+        "ci_lo": ci[0] if ci[0] is not None else np.nan,
+        "ci_hi": ci[1] if ci[1] is not None else np.nan,
+        "eta_e_first": fit.get("eta_e_first", np.nan),
+        "eta_M": (sims.get("modified") or {}).get("eta", np.nan),
+        "eta_true": truth.get("eta") if truth.get("eta") is not None else np.nan,
+        "fit_status": fit.get("status"),
+        "out": run["out"],
+        "column": json.dumps(_column_summary(rep["column"])) if rep.get("column") else "",
+    }
 
 
 def _column_summary(col: dict) -> dict:
     seq = col["comparison"]["sequence"]
     st = col.get("sequence_vs_truth") or {}
-    return {"status": col["status"], "rms_theta_rad": col["comparison"]["rms_theta_rad"],
-            "sequence_model_matched": f"{seq['n_matched']}/{seq['n_measured']}",
-            "sequence_same_as_truth": st.get("same_sequence")}
+    return {
+        "status": col["status"],
+        "rms_theta_rad": col["comparison"]["rms_theta_rad"],
+        "sequence_model_matched": f"{seq['n_matched']}/{seq['n_measured']}",
+        "sequence_same_as_truth": st.get("same_sequence"),
+    }
 
 
 def _campaign_fits(table, msgs):
@@ -267,8 +343,9 @@ def _campaign_fits(table, msgs):
     return eta_mat, k_tab
 
 
-def run_campaign(root, out_dir, *, workers: int = 2, scheduler: str | None = None, force: bool = False,
-                 progress: bool = True) -> CampaignResult:
+def run_campaign(
+    root, out_dir, *, workers: int = 2, scheduler: str | None = None, force: bool = False, progress: bool = True
+) -> CampaignResult:
     """Run every experiment under ``root`` into ``out_dir/experiments/<name>/`` and fit the campaign."""
     import pandas as pd
     from tqdm import tqdm
@@ -301,8 +378,12 @@ def run_campaign(root, out_dir, *, workers: int = 2, scheduler: str | None = Non
     else:
         import multiprocessing as mp
 
-        with ProcessPoolExecutor(max_workers=workers, mp_context=mp.get_context("spawn"),
-                                 initializer=pool_initializer, initargs=(os.getpid(),)) as ex:
+        with ProcessPoolExecutor(
+            max_workers=workers,
+            mp_context=mp.get_context("spawn"),
+            initializer=pool_initializer,
+            initargs=(os.getpid(),),
+        ) as ex:
             futs = [ex.submit(_one, *j) for j in jobs]
             for f in as_completed(futs):
                 runs.append(f.result())
@@ -364,9 +445,13 @@ def _campaign_rrd(res: CampaignResult, path: Path) -> None:
             rec.log(f"{base}/eta_H", rr.Scalars(float(r["eta_H"])))
             if np.isfinite(r.get("eta_true", np.nan)):
                 rec.log(f"{base}/eta_true", rr.Scalars(float(r["eta_true"])))
-            rec.log("campaign/experiments", rr.TextLog(
-                f"{r['experiment']}: block {r['block']} ({r['contact']}), η_e = {r['eta_e']:.4f}, "
-                f"η_H = {r['eta_H']:.4f}"))
+            rec.log(
+                "campaign/experiments",
+                rr.TextLog(
+                    f"{r['experiment']}: block {r['block']} ({r['contact']}), η_e = {r['eta_e']:.4f}, "
+                    f"η_H = {r['eta_H']:.4f}"
+                ),
+            )
         rec.reset_time()
         # η_e against h/b as labelled points, one entity per experiment: clicking a point selects
         # that experiment and shows where its own report and recording are
@@ -376,12 +461,27 @@ def _campaign_rrd(res: CampaignResult, path: Path) -> None:
             name = str(r["experiment"])
             ent = f"campaign/eta_vs_hb/{r['contact']}/{name}"
             colour = [0, 114, 178] if r["contact"] == "full" else [213, 94, 0]
-            rec.log(ent, rr.Points2D([[float(r["hb"]), -float(r["eta_e"])]], labels=[name], colors=[colour],
-                                     radii=[0.06], show_labels=False), static=True)
-            rec.log(ent, rr.TextDocument(
-                f"**{name}**: block {r['block']} ({r['contact']} contact), h/b = {r['hb']:.4g}, "
-                f"η_e = {r['eta_e']:.4g}, η_H = {r['eta_H']:.4g}\n\n"
-                f"report: [experiments/{name}/report.html](experiments/{name}/report.html); "
-                f"review: `rerun experiments/{name}/session.rrd`", media_type="text/markdown"), static=True)
+            rec.log(
+                ent,
+                rr.Points2D(
+                    [[float(r["hb"]), -float(r["eta_e"])]],
+                    labels=[name],
+                    colors=[colour],
+                    radii=[0.06],
+                    show_labels=False,
+                ),
+                static=True,
+            )
+            rec.log(
+                ent,
+                rr.TextDocument(
+                    f"**{name}**: block {r['block']} ({r['contact']} contact), h/b = {r['hb']:.4g}, "
+                    f"η_e = {r['eta_e']:.4g}, η_H = {r['eta_H']:.4g}\n\n"
+                    f"report: [experiments/{name}/report.html](experiments/{name}/report.html); "
+                    f"review: `rerun experiments/{name}/session.rrd`",
+                    media_type="text/markdown",
+                ),
+                static=True,
+            )
         rec.send_blueprint(campaign_blueprint())
         close_recording(rec, tmp)

@@ -83,11 +83,15 @@ def _edit_experiment(path: Path, name: str, block_id: str, contact: str, table: 
         # forced rocking: no free-rocking restitution fit; simulate the table-driven response
         # a record's table acceleration has content a 50 fps camera cannot sample: drive the
         # simulation from the table IMU (256 Hz), synced to the video by its acceleration
-        sub('[sources.table]\nfrom = "video"\nobject = "table"\n',
-            '[sources.table]\nfrom = "imu"\nobject = "table"\nimu = "imu/table"\n')
+        sub(
+            '[sources.table]\nfrom = "video"\nobject = "table"\n',
+            '[sources.table]\nfrom = "imu"\nobject = "table"\nimu = "imu/table"\n',
+        )
         # (the η a lab would have calibrated on free rocking of the same block: here the truth)
-        extra += ('\n[fit]\nrestitution = false\n\n[simulate]\nlaws = ["housner", "modified"]\n'
-                  f'eta = {_true_eta(block_id, contact):.6f}\n')
+        extra += (
+            '\n[fit]\nrestitution = false\n\n[simulate]\nlaws = ["housner", "modified"]\n'
+            f"eta = {_true_eta(block_id, contact):.6f}\n"
+        )
     path.write_text(text + extra, encoding="utf-8")
 
 
@@ -97,23 +101,52 @@ def _render_one(d: Path, seed: int, name: str, bid: str, contact: str, table: st
 
     cfg = d / "experiment.toml"
     if bid == "column":
-        synth_session(d, seed=seed, blocks=3, table=table, fps=fps, size=size, targets="aruco",
-                      duration_s=4.0, mp4=False, imu=False, force=True)
+        synth_session(
+            d,
+            seed=seed,
+            blocks=3,
+            table=table,
+            fps=fps,
+            size=size,
+            targets="aruco",
+            duration_s=4.0,
+            mp4=False,
+            imu=False,
+            force=True,
+        )
         text = cfg.read_text(encoding="utf-8")
-        cfg.write_text(text.replace(f'name = "synth-seed{seed}"', f'name = "{name}"')
-                       + "\n[output]\nvideo_decimation = 5\n", encoding="utf-8")
+        cfg.write_text(
+            text.replace(f'name = "synth-seed{seed}"', f'name = "{name}"') + "\n[output]\nvideo_decimation = 5\n",
+            encoding="utf-8",
+        )
         return cfg
     blk = catalogue_block(bid)
-    kw = dict(theta0_rad=0.8 * blk.alpha_rad, duration_s=4.0) if table == "none" else \
-        dict(duration_s=8.0, table_stroke_m=0.01)  # rocks to ~0.6 alpha, survives
-    synth_session(d, seed=seed, blocks=1, table=table, fps=fps, size=size, targets="aruco",
-                  block=blk, eta=_true_eta(bid, contact), mp4=False, force=True, **kw)
+    kw = (
+        dict(theta0_rad=0.8 * blk.alpha_rad, duration_s=4.0)
+        if table == "none"
+        else dict(duration_s=8.0, table_stroke_m=0.01)
+    )  # rocks to ~0.6 alpha, survives
+    synth_session(
+        d,
+        seed=seed,
+        blocks=1,
+        table=table,
+        fps=fps,
+        size=size,
+        targets="aruco",
+        block=blk,
+        eta=_true_eta(bid, contact),
+        mp4=False,
+        force=True,
+        **kw,
+    )
     _edit_experiment(cfg, name, bid, contact, table)
     return cfg
 
 
-def make_demo_campaign(root, *, size=(960, 540), fps: float = 50.0, progress: bool = True,
-                       runs=DEMO_RUNS, workers: int = 2) -> list[Path]:
+def make_demo_campaign(
+    root, *, size=(960, 540), fps: float = 50.0, progress: bool = True, runs=DEMO_RUNS, workers: int = 2
+) -> list[Path]:
     """Render the demo sessions into ``root/<run>/`` (skips sessions already there), in parallel."""
     import multiprocessing as mp
     from concurrent.futures import ProcessPoolExecutor
@@ -122,13 +155,19 @@ def make_demo_campaign(root, *, size=(960, 540), fps: float = 50.0, progress: bo
 
     root = Path(root)
     root.mkdir(parents=True, exist_ok=True)
-    todo = [(root / name, seed, name, bid, contact, table, size, fps)
-            for seed, (name, bid, contact, table) in enumerate(runs)
-            if not (root / name / "experiment.toml").is_file()]
+    todo = [
+        (root / name, seed, name, bid, contact, table, size, fps)
+        for seed, (name, bid, contact, table) in enumerate(runs)
+        if not (root / name / "experiment.toml").is_file()
+    ]
     bar = tqdm(total=len(todo), desc="demo: render sessions", unit="session", disable=not progress)
     if workers > 1 and len(todo) > 1:
-        with ProcessPoolExecutor(max_workers=workers, mp_context=mp.get_context("spawn"),
-                                 initializer=pool_initializer, initargs=(os.getpid(),)) as ex:
+        with ProcessPoolExecutor(
+            max_workers=workers,
+            mp_context=mp.get_context("spawn"),
+            initializer=pool_initializer,
+            initargs=(os.getpid(),),
+        ) as ex:
             for f in [ex.submit(_render_one, *job) for job in todo]:
                 f.result()
                 bar.update(1)
@@ -140,8 +179,7 @@ def make_demo_campaign(root, *, size=(960, 540), fps: float = 50.0, progress: bo
     return [root / name / "experiment.toml" for name, *_ in runs]
 
 
-def run_demo(out_dir="demo_out", *, workers: int = 2, progress: bool = True, size=(960, 540),
-             runs=DEMO_RUNS):
+def run_demo(out_dir="demo_out", *, workers: int = 2, progress: bool = True, size=(960, 540), runs=DEMO_RUNS):
     """Make the demo campaign under ``out_dir/sessions`` and run it into ``out_dir/results``."""
     from ._campaign import run_campaign
 

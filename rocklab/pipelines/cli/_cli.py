@@ -30,8 +30,18 @@ from ..._errors import InputError
 
 #: Subcommand modules, in help order.
 COMMAND_MODULES = (
-    "_cmd_simulate", "_cmd_imu", "_cmd_track", "_cmd_track3d", "_cmd_stereo", "_cmd_synth", "_cmd_fit", "_cmd_run",
-    "_cmd_campaign", "_cmd_demo", "_cmd_column", "_cmd_design",
+    "_cmd_simulate",
+    "_cmd_imu",
+    "_cmd_track",
+    "_cmd_track3d",
+    "_cmd_stereo",
+    "_cmd_synth",
+    "_cmd_fit",
+    "_cmd_run",
+    "_cmd_campaign",
+    "_cmd_demo",
+    "_cmd_column",
+    "_cmd_design",
 )
 
 
@@ -48,8 +58,9 @@ def build_parser() -> argparse.ArgumentParser:
     p = _Parser(prog="rocklab", description="Rocking-block experiments to calibrated physics.")
     p.add_argument("--version", action="version", version=f"rocklab {__version__}")
     p.add_argument("--debug", action="store_true", help="show Python tracebacks and numerical warnings")
-    p.add_argument("--strict", action="store_true", help="exit 4 when a result is suspect (any W- warning "
-                                                         "of severity suspect)")
+    p.add_argument(
+        "--strict", action="store_true", help="exit 4 when a result is suspect (any W- warning of severity suspect)"
+    )
     sub = p.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     for mod in COMMAND_MODULES:
         importlib.import_module(f"{__package__}.commands.{mod}").register(sub)
@@ -123,12 +134,15 @@ def main(argv=None) -> int:
     except SystemExit:
         raise
     except MemoryError:
-        sys.stderr.write(f"rocklab {cmd}: error: not enough memory for this request; reduce its size "
-                         "(duration, grid, frames)\n")
+        sys.stderr.write(
+            f"rocklab {cmd}: error: not enough memory for this request; reduce its size (duration, grid, frames)\n"
+        )
         return 2
     except UnicodeDecodeError as e:
-        sys.stderr.write(f"rocklab {cmd}: error: an input is not a text file ({e.reason} at byte {e.start}); "
-                         "give the CSV/text file the option expects\n")
+        sys.stderr.write(
+            f"rocklab {cmd}: error: an input is not a text file ({e.reason} at byte {e.start}); "
+            "give the CSV/text file the option expects\n"
+        )
         return 2
     except OSError as e:
         if args.debug:
@@ -139,8 +153,10 @@ def main(argv=None) -> int:
         if args.debug:
             raise
         msg = str(e).splitlines()[0][:200] if str(e) else ""
-        sys.stderr.write(f"rocklab {cmd}: internal error: {type(e).__name__}: {msg} "
-                         "(run with --debug for the traceback, and please report it)\n")
+        sys.stderr.write(
+            f"rocklab {cmd}: internal error: {type(e).__name__}: {msg} "
+            "(run with --debug for the traceback, and please report it)\n"
+        )
         return 3
     if rc == 0 and args.strict and any(d.severity == "suspect" for d in diags):
         return 4

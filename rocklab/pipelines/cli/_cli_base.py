@@ -9,7 +9,9 @@ __all__ = ["add_base_motion_args", "base_motion_from_args", "emit_json"]
 
 def add_base_motion_args(p) -> None:
     """``--base-motion FILE [--units U] [--scale-pga X]``."""
-    p.add_argument("--base-motion", default=None, help="base acceleration record (.AT2, CSV t_s,acc_m_s2, 2-column text)")
+    p.add_argument(
+        "--base-motion", default=None, help="base acceleration record (.AT2, CSV t_s,acc_m_s2, 2-column text)"
+    )
     p.add_argument("--units", default=None, help="record units: g, m/s2, cm/s2 (2-column text needs it)")
     p.add_argument("--scale-pga", type=float, default=None, help="scale the record to this PGA (in --units, default g)")
 

@@ -21,8 +21,9 @@ def _first_frame(video: Path):
     if not video.exists():
         raise InputError(f"{video}: video not found; check the path")
     info = probe_video(video)
-    for _, gray, img in iter_video_frames(video, 0, 1, color=True, pixel_aspect=info.pixel_aspect,
-                                          fields=info.field_order):
+    for _, gray, img in iter_video_frames(
+        video, 0, 1, color=True, pixel_aspect=info.pixel_aspect, fields=info.field_order
+    ):
         return info, gray, img
     raise InputError(f"{video}: no frame could be decoded; check the file")
 
@@ -57,12 +58,16 @@ def track_init(video, out, *, objects=(), table=None, marker_size_m=None, previe
     troi = parse_region(table, "--table") if table is not None else None
     if marker_size_m is not None and not (math.isfinite(marker_size_m) and marker_size_m > 0):
         raise InputError(f"--marker-size {marker_size_m}: give the printed marker side in metres (> 0)")
-    cfg, notes, found = suggest_config(gray, regions=regions or None, table_roi=troi,
-                                       fps=None if info.fps else 50.0, marker_size_m=marker_size_m)
+    cfg, notes, found = suggest_config(
+        gray, regions=regions or None, table_roi=troi, fps=None if info.fps else 50.0, marker_size_m=marker_size_m
+    )
     if not info.fps:
         notes.append("the container has no frame rate: fps = 50 written; correct it")
-    head = [f"# track.toml written by 'rocklab track init' from {video.name} ({info.width_px}x{info.height_px}, "
-            f"{info.n_frames} frames, {info.fps or 'unknown'} fps)", "# Schema: docs/track-toml.md"]
+    head = [
+        f"# track.toml written by 'rocklab track init' from {video.name} ({info.width_px}x{info.height_px}, "
+        f"{info.n_frames} frames, {info.fps or 'unknown'} fps)",
+        "# Schema: docs/track-toml.md",
+    ]
     head += [f"# {n}" for n in notes]
     write_text_atomic(out, "\n".join(head) + "\n\n" + cfg.to_toml())
     if preview is not None:
@@ -83,8 +88,16 @@ def draw_init_preview(img, cfg, found):
             k, o = owner.get(mid, (len(_COLOURS) - 1, None))
             col = _COLOURS[k % len(_COLOURS)]
             cv2.polylines(out, [np.round(c).astype(np.int32)], True, col, 2)
-            cv2.putText(out, f"{mid} {o.id if o else '?'}", tuple(int(x) for x in c[0] - (0, 6)),
-                        cv2.FONT_HERSHEY_SIMPLEX, 0.5, col, 1, cv2.LINE_AA)
+            cv2.putText(
+                out,
+                f"{mid} {o.id if o else '?'}",
+                tuple(int(x) for x in c[0] - (0, 6)),
+                cv2.FONT_HERSHEY_SIMPLEX,
+                0.5,
+                col,
+                1,
+                cv2.LINE_AA,
+            )
         tab = cfg.table
         if tab is not None and len(tab.markers) >= 2:  # the level line through the table's markers
             cs = found.centres_px[[found.ids.index(m) for m in tab.markers]]
@@ -117,8 +130,9 @@ def track_preview(video, config, out, *, n_frames: int = 6, progress: bool = Fal
     pick = frames[np.unique(np.round(np.linspace(0, frames.size - 1, int(n_frames))).astype(int))]
     tiles = []
     for f in pick:  # decode only the frames shown (a long film is not kept in memory)
-        for i, _, img in iter_video_frames(video, int(f), int(f) + 1, prefetch=0, color=True,
-                                           pixel_aspect=vinfo.pixel_aspect, fields=vinfo.field_order):
+        for i, _, img in iter_video_frames(
+            video, int(f), int(f) + 1, prefetch=0, color=True, pixel_aspect=vinfo.pixel_aspect, fields=vinfo.field_order
+        ):
             tiles.append(_draw_pose(img, res, i))
     from ..experiment._figures import save_bgr_png
 
@@ -130,23 +144,41 @@ def _draw_pose(img, res, frame):
     import cv2
 
     out = img.copy() if img.ndim == 3 else cv2.cvtColor(img, cv2.COLOR_GRAY2BGR)
-    cv2.putText(out, f"frame {frame}  t = {frame / res.fps:.3f} s", (8, 22), cv2.FONT_HERSHEY_SIMPLEX, 0.6,
-                (255, 255, 255), 2, cv2.LINE_AA)
+    cv2.putText(
+        out,
+        f"frame {frame}  t = {frame / res.fps:.3f} s",
+        (8, 22),
+        cv2.FONT_HERSHEY_SIMPLEX,
+        0.6,
+        (255, 255, 255),
+        2,
+        cv2.LINE_AA,
+    )
     for k, t in enumerate(res.tracks):
         col = _COLOURS[k % len(_COLOURS)]
         i = int(np.flatnonzero(t.frame == frame)[0])
         if t.status[i] != "ok" or t.x_px is None or not np.isfinite(t.x_px[i]):
-            cv2.putText(out, f"{t.object}: {t.status[i]}", (8, 46 + 20 * k), cv2.FONT_HERSHEY_SIMPLEX, 0.55, col,
-                        2, cv2.LINE_AA)
+            cv2.putText(
+                out, f"{t.object}: {t.status[i]}", (8, 46 + 20 * k), cv2.FONT_HERSHEY_SIMPLEX, 0.55, col, 2, cv2.LINE_AA
+            )
             continue
         u, v, th = float(t.x_px[i]), float(t.y_px[i]), float(t.theta_rad[i] + res.level_rad)
         L = 0.06 * max(out.shape[:2])
         for ang, ln in ((th, L), (th + math.pi / 2, 0.6 * L)):  # object x and y axes (image v points down)
-            cv2.line(out, (int(u), int(v)), (int(u + ln * math.cos(ang)), int(v - ln * math.sin(ang))), col, 2,
-                     cv2.LINE_AA)
+            cv2.line(
+                out, (int(u), int(v)), (int(u + ln * math.cos(ang)), int(v - ln * math.sin(ang))), col, 2, cv2.LINE_AA
+            )
         cv2.circle(out, (int(u), int(v)), 4, col, -1)
-        cv2.putText(out, f"{t.object}: theta {math.degrees(t.theta_rad[i]):.4g} deg", (8, 46 + 20 * k),
-                    cv2.FONT_HERSHEY_SIMPLEX, 0.55, col, 2, cv2.LINE_AA)
+        cv2.putText(
+            out,
+            f"{t.object}: theta {math.degrees(t.theta_rad[i]):.4g} deg",
+            (8, 46 + 20 * k),
+            cv2.FONT_HERSHEY_SIMPLEX,
+            0.55,
+            col,
+            2,
+            cv2.LINE_AA,
+        )
     return out
 
 
@@ -164,5 +196,5 @@ def contact_sheet(tiles, width_px: int = 1800):
     sheet = np.zeros((rows * th, cols * tw, 3), np.uint8)
     for k, t in enumerate(tiles):
         r, c = divmod(k, cols)
-        sheet[r * th:(r + 1) * th, c * tw:(c + 1) * tw] = cv2.resize(t, (tw, th), interpolation=cv2.INTER_AREA)
+        sheet[r * th : (r + 1) * th, c * tw : (c + 1) * tw] = cv2.resize(t, (tw, th), interpolation=cv2.INTER_AREA)
     return sheet

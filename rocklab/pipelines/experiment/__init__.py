@@ -13,5 +13,13 @@ from ._config import EXAMPLE_TOML, ExperimentConfig, load_experiment
 from ._experiment import ExperimentResult, analyse_experiment, run_experiment
 from ._rerun import read_rrd_scalars, read_rrd_summary
 
-__all__ = ["load_experiment", "ExperimentConfig", "EXAMPLE_TOML", "run_experiment", "analyse_experiment",
-           "ExperimentResult", "read_rrd_summary", "read_rrd_scalars"]
+__all__ = [
+    "load_experiment",
+    "ExperimentConfig",
+    "EXAMPLE_TOML",
+    "run_experiment",
+    "analyse_experiment",
+    "ExperimentResult",
+    "read_rrd_summary",
+    "read_rrd_scalars",
+]

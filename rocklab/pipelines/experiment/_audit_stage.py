@@ -28,12 +28,23 @@ def _from_tracks_csv(df):
     t, th = df["t_s"].to_numpy(float), df["theta_rad"].to_numpy(float)
     sig = float(np.nanmedian(df["sigma_theta_rad"])) if "sigma_theta_rad" in df.columns else None
     if all(c in df.columns for c in _3D_COLUMNS):
-        return audit_rocking(t, th, slide_m=df["pivot_slide_m"].to_numpy(float),
-                             uplift_m=df["pivot_uplift_m"].to_numpy(float), twist_rad=df["twist_rad"].to_numpy(float),
-                             out_of_plane_rad=df["out_of_plane_rad"].to_numpy(float), sigma_theta_rad=sig,
-                             source="3d")
-    return _theta_only(t, th, sig, "2d", "a plane track: sliding, uplift, twist and out-of-plane rotation not "
-                                         "checked (use 3D points, rocklab track3d)")
+        return audit_rocking(
+            t,
+            th,
+            slide_m=df["pivot_slide_m"].to_numpy(float),
+            uplift_m=df["pivot_uplift_m"].to_numpy(float),
+            twist_rad=df["twist_rad"].to_numpy(float),
+            out_of_plane_rad=df["out_of_plane_rad"].to_numpy(float),
+            sigma_theta_rad=sig,
+            source="3d",
+        )
+    return _theta_only(
+        t,
+        th,
+        sig,
+        "2d",
+        "a plane track: sliding, uplift, twist and out-of-plane rotation not checked (use 3D points, rocklab track3d)",
+    )
 
 
 def _theta_only(t, th, sig, source, why):
@@ -51,8 +62,13 @@ def _from_video(cfg, tr, measured):
     sig = float(np.nanmedian(b.sigma_theta_rad)) if b is not None and np.isfinite(b.sigma_theta_rad).any() else None
     # one camera's theta and position disagree with rigid rocking by several mm on small, distant blocks even
     # without any slide, so sliding/uplift from a plane track would raise false alarms: impacts only here
-    return _theta_only(t, th, sig, "2d", "one camera: sliding, uplift, twist and out-of-plane rotation not checked "
-                                         "(use 3D points, rocklab track3d)")
+    return _theta_only(
+        t,
+        th,
+        sig,
+        "2d",
+        "one camera: sliding, uplift, twist and out-of-plane rotation not checked (use 3D points, rocklab track3d)",
+    )
 
 
 def audit_experiment(cfg, measured: dict, tr, track_rows=None) -> dict:
@@ -71,9 +87,12 @@ def audit_experiment(cfg, measured: dict, tr, track_rows=None) -> dict:
         res = _theta_only(t, th, None, "imu", "an IMU: sliding, uplift and twist not checked")
     if res.verdict != "valid":
         kinds = ", ".join(sorted({f.kind for f in res.flags}))
-        warn("W-AUDIT", f"{cfg.name}: assumption audit {res.verdict} ({kinds}; impacts "
-                        f"{', '.join(map(str, res.excluded_impacts)) or 'none'}); their per-impact eta "
-                        "are not trustworthy")
+        warn(
+            "W-AUDIT",
+            f"{cfg.name}: assumption audit {res.verdict} ({kinds}; impacts "
+            f"{', '.join(map(str, res.excluded_impacts)) or 'none'}); their per-impact eta "
+            "are not trustworthy",
+        )
     return res.to_dict()
 
 
@@ -107,7 +126,14 @@ def fit_exclusions(audit: dict | None, per_impact, max_dt_s: float = 0.02) -> li
         if abs(fit_t[j] - times[k - 1]) > max_dt_s:
             continue
         row = per_impact.iloc[j]
-        e = out.setdefault(int(row["impact"]), {"impact": int(row["impact"]), "t_s": float(row["t_s"]),
-                                                "eta": float(row.get("eta_peaks", np.nan)), "reasons": []})
+        e = out.setdefault(
+            int(row["impact"]),
+            {
+                "impact": int(row["impact"]),
+                "t_s": float(row["t_s"]),
+                "eta": float(row.get("eta_peaks", np.nan)),
+                "reasons": [],
+            },
+        )
         e["reasons"].append(f"{f['kind']} ({f['detail']}): {f['value']:.4g} against {f['tolerance']:.4g} (SI)")
     return [out[k] for k in sorted(out)]

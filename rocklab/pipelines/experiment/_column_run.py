@@ -32,8 +32,10 @@ def base_from_table(table: dict, t0_s: float, where: str, *, sign: float = 1.0, 
     aa = np.asarray(table["acc_m_s2"], float)
     fin = np.isfinite(tt) & np.isfinite(aa)
     if fin.sum() < 4:
-        raise InputError(f"{where}: the table motion has {int(fin.sum())} valid samples; "
-                         "cannot drive the simulation (check the table object's tracking)")
+        raise InputError(
+            f"{where}: the table motion has {int(fin.sum())} valid samples; "
+            "cannot drive the simulation (check the table object's tracking)"
+        )
     tf = np.arange(tt[fin][0], tt[fin][-1], dt_s)
     af = CubicSpline(tt[fin], aa[fin])(tf)
     return BaseMotion.from_samples(sign * af, dt_s, t0_s=float(tf[0]) - t0_s, units="m/s2", name="table")
@@ -69,15 +71,25 @@ def analyse_column(cfg, track_result, table, truth_path=None) -> dict:
     base = base_from_table(table, t0, str(cfg.path)) if table is not None else None
     # 1 ms samples: far finer than any camera, and they feed only interpolation to the frame
     # times, plots and Rerun (the events are exact at any spacing); every 0.1 ms step would be 10x the rows
-    res = simulate_column(col, base, duration_s=float(t[-1] - t0), n_impacts=cfg.column_impacts,
-                          dt_s=1e-4, output_dt_s=1e-3)
+    res = simulate_column(
+        col, base, duration_s=float(t[-1] - t0), n_impacts=cfg.column_impacts, dt_s=1e-4, output_dt_s=1e-3
+    )
     # measured angles are counter-clockwise, the model's clockwise: sign = -1
     comp = compare_to_measurement(res, t - t0, th, sign=-1.0)
     confs = res.configurations.copy()
     confs["t_s"] = confs["t_s"] + t0
-    out = {"objects": list(objs), "t_s": t, "theta_measured_rad": th, "sim_t_s": np.asarray(res.t_s) + t0,
-           "theta_sim_rad": -np.asarray(res.theta_rad), "status": res.status, "configurations": confs,
-           "comparison": comp.to_dict(), "cut_m": cfg.column_cut_m, "impacts_per_closing": cfg.column_impacts}
+    out = {
+        "objects": list(objs),
+        "t_s": t,
+        "theta_measured_rad": th,
+        "sim_t_s": np.asarray(res.t_s) + t0,
+        "theta_sim_rad": -np.asarray(res.theta_rad),
+        "status": res.status,
+        "configurations": confs,
+        "comparison": comp.to_dict(),
+        "cut_m": cfg.column_cut_m,
+        "impacts_per_closing": cfg.column_impacts,
+    }
     if truth_path is not None:
         tr = pd.read_csv(truth_path)
         tt, tth = _by_object(tr[tr["object"].isin(objs)], objs)
@@ -87,5 +99,5 @@ def analyse_column(cfg, track_result, table, truth_path=None) -> dict:
         out["theta_truth_rad"] = (tt, tth)
         out["sequence_vs_truth"] = compare_sequences(tseq, mseq).to_dict()
         err = th - np.column_stack([np.interp(t, tt, tth[:, i]) for i in range(len(objs))])
-        out["theta_rms_error_rad"] = np.sqrt(np.nanmean(err ** 2, axis=0)).tolist()
+        out["theta_rms_error_rad"] = np.sqrt(np.nanmean(err**2, axis=0)).tolist()
     return out

@@ -89,6 +89,7 @@ _WINDOWS = ("middle50", "all", "first")
 @dataclass(frozen=True)
 class SourceVideo:
     """A video file and the tracking config that reads it."""
+
     path: Path
     track_config: Path | None = None
     object: str = "block_1"
@@ -98,6 +99,7 @@ class SourceVideo:
 @dataclass(frozen=True)
 class SourceTrack:
     """An already tracked CSV with ``t_s, theta_rad`` (and optionally ``object``)."""
+
     path: Path
     object: str | None = None
 
@@ -105,6 +107,7 @@ class SourceTrack:
 @dataclass(frozen=True)
 class SourceImu:
     """An IMU log (folder or CSV) on the block."""
+
     path: Path
     axis: str = "auto"
     rate_hz: float | None = None
@@ -113,7 +116,8 @@ class SourceImu:
 @dataclass(frozen=True)
 class SourceTable:
     """Where the base (table) motion comes from."""
-    source: str = "none"          # video | imu | record | none
+
+    source: str = "none"  # video | imu | record | none
     object: str = "table"
     imu: Path | None = None
     record: Path | None = None
@@ -148,10 +152,10 @@ class ExperimentConfig:
     rrd: bool = True
     video_decimation: int = 1
     figures: bool = True
-    columns: tuple = ()            # for column experiments: object ids bottom to top
+    columns: tuple = ()  # for column experiments: object ids bottom to top
     column_cut_m: float = 0.0
     column_impacts: int = 1
-    truth: Path | None = None      # synthetic sessions: truth.csv for the report
+    truth: Path | None = None  # synthetic sessions: truth.csv for the report
 
     def block(self):
         """The :class:`rocklab.Block` of this experiment."""
@@ -219,8 +223,11 @@ class _Reader:
             known = sorted(a.rpartition(".")[2] for a in self.asked if a.rpartition(".")[0] == section)
             near = difflib.get_close_matches(d.rpartition(".")[2], known, n=1)
             hint = f"did you mean '{near[0]}'? " if near else ""
-            self.fail(d, f"is not a known key{' of [' + section + ']' if section else ''}; {hint}"
-                         f"known: {', '.join(known) or '(none)'}")
+            self.fail(
+                d,
+                f"is not a known key{' of [' + section + ']' if section else ''}; {hint}"
+                f"known: {', '.join(known) or '(none)'}",
+            )
 
     def line_of(self, dotted: str) -> int | None:
         parts = dotted.split(".")
@@ -292,9 +299,7 @@ class _Reader:
         return p
 
 
-_KNOWN = {
-    "name", "block", "contact", "sources", "sync", "fit", "simulate", "output", "column", "truth",
-}
+_KNOWN = {"name", "block", "contact", "sources", "sync", "fit", "simulate", "output", "column", "truth"}
 
 
 def load_experiment(path) -> ExperimentConfig:
@@ -321,7 +326,7 @@ def load_experiment(path) -> ExperimentConfig:
 
     # -- block ----------------------------------------------------------------
     if "block" not in data:
-        raise InputError(f"{path}: missing [block] section; give id = \"B6M\" or b_m/h_m")
+        raise InputError(f'{path}: missing [block] section; give id = "B6M" or b_m/h_m')
     bid = r.get("block.id", kind=str)
     b = r.get("block.b_m", kind=float, positive=True)
     h = r.get("block.h_m", kind=float, positive=True)
@@ -329,8 +334,7 @@ def load_experiment(path) -> ExperimentConfig:
     if bid is not None and (b is None or h is None):
         cat = _catalogue()
         if bid not in cat:
-            r.fail("block.id", f"= {bid!r} is not in the Čeh Table 2 catalogue (B1S..B10L); "
-                               "give b_m and h_m instead")
+            r.fail("block.id", f"= {bid!r} is not in the Čeh Table 2 catalogue (B1S..B10L); give b_m and h_m instead")
             raise AssertionError  # unreachable
         row = cat[bid]
         b = b or row["b_m"]
@@ -350,22 +354,24 @@ def load_experiment(path) -> ExperimentConfig:
     # -- sources --------------------------------------------------------------
     video = track = imu = None
     if "video" in data.get("sources", {}):
-        video = SourceVideo(path=r.file("sources.video.path"),
-                            track_config=r.file("sources.video.track_config", required=False),
-                            object=r.get("sources.video.object", "block_1", kind=str),
-                            fps=r.get("sources.video.fps", kind=float, positive=True))
+        video = SourceVideo(
+            path=r.file("sources.video.path"),
+            track_config=r.file("sources.video.track_config", required=False),
+            object=r.get("sources.video.object", "block_1", kind=str),
+            fps=r.get("sources.video.fps", kind=float, positive=True),
+        )
     if "track" in data.get("sources", {}):
-        track = SourceTrack(path=r.file("sources.track.path"),
-                            object=r.get("sources.track.object", kind=str))
+        track = SourceTrack(path=r.file("sources.track.path"), object=r.get("sources.track.object", kind=str))
     if "imu" in data.get("sources", {}):
-        imu = SourceImu(path=r.file("sources.imu.path", allow_dir=True),
-                        axis=r.get("sources.imu.axis", "auto", kind=str),
-                        rate_hz=r.get("sources.imu.rate_hz", kind=float, positive=True))
+        imu = SourceImu(
+            path=r.file("sources.imu.path", allow_dir=True),
+            axis=r.get("sources.imu.axis", "auto", kind=str),
+            rate_hz=r.get("sources.imu.rate_hz", kind=float, positive=True),
+        )
         if not re.fullmatch(r"auto|[+-]?[xyz]", imu.axis):
             r.fail("sources.imu.axis", f"= {imu.axis!r} must be x, y, z (optionally signed, e.g. -y) or auto")
     if video is None and track is None and imu is None:
-        raise InputError(f"{path}: [sources] needs at least one of [sources.video], "
-                         "[sources.track], [sources.imu]")
+        raise InputError(f"{path}: [sources] needs at least one of [sources.video], [sources.track], [sources.imu]")
     primary = r.get("sources.primary", None, kind=str, choices=("video", "imu", "track"))
     if primary is None:
         primary = "video" if video else "track" if track else "imu"
@@ -405,19 +411,34 @@ def load_experiment(path) -> ExperimentConfig:
     if not (math.isfinite(duration) and duration >= 0):
         r.fail("simulate.duration_s", f"= {duration} must be >= 0 s (0: as long as the measurement)")
     cfg = ExperimentConfig(
-        path=path, name=r.get("name", path.parent.name, kind=str), b_m=b, h_m=h, mass_kg=m,
-        block_id=bid, contact=contact, l_c_m=l_c, k=k, primary=primary, video=video,
-        track=track, imu=imu, table=table,
+        path=path,
+        name=r.get("name", path.parent.name, kind=str),
+        b_m=b,
+        h_m=h,
+        mass_kg=m,
+        block_id=bid,
+        contact=contact,
+        l_c_m=l_c,
+        k=k,
+        primary=primary,
+        video=video,
+        track=track,
+        imu=imu,
+        table=table,
         sync_method=r.get("sync.method", "xcorr", kind=str, choices=("xcorr", "none")),
         max_offset_s=r.get("sync.max_offset_s", 5.0, kind=float, positive=True),
         fit_restitution=r.get("fit.restitution", True, kind=bool),
         fit_window=r.get("fit.window", "middle50", kind=str, choices=_WINDOWS),
         laws=laws,
-        duration_s=duration, eta_given=eta_given,
+        duration_s=duration,
+        eta_given=eta_given,
         rrd=r.get("output.rrd", True, kind=bool),
         video_decimation=r.get("output.video_decimation", 1, kind=int, positive=True),
         figures=r.get("output.figures", True, kind=bool),
-        columns=columns, column_cut_m=cut, column_impacts=n_imp, truth=truth,
+        columns=columns,
+        column_cut_m=cut,
+        column_impacts=n_imp,
+        truth=truth,
     )
     r.check_unknown()
     return cfg
@@ -432,8 +453,10 @@ def _catalogue() -> dict:
     """Čeh Table 2 as {id: {b_m, h_m, mass_kg}} (from rocklab.fitting's package data)."""
     from ...fitting import ceh_catalogue
 
-    return {str(r["block"]): {"b_m": float(r["b_m"]), "h_m": float(r["h_m"]), "mass_kg": float(r["mass_kg"])}
-            for _, r in ceh_catalogue().iterrows()}
+    return {
+        str(r["block"]): {"b_m": float(r["b_m"]), "h_m": float(r["h_m"]), "mass_kg": float(r["mass_kg"])}
+        for _, r in ceh_catalogue().iterrows()
+    }
 
 
 EXAMPLE_TOML = textwrap.dedent(__doc__.split("Schema (all lengths in m, times in s, angles in rad)::\n\n", 1)[1])

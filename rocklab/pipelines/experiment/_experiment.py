@@ -95,31 +95,64 @@ class ExperimentResult:
             "primary_source": self.primary,
             "sources": sorted(self.measured),
             "sync": self.sync,
-            "video_vs_imu_rms_rad": (float(np.sqrt(np.nanmean(np.square(self.video_imu_residual[1]))))
-                                     if self.video_imu_residual is not None else None),
+            "video_vs_imu_rms_rad": (
+                float(np.sqrt(np.nanmean(np.square(self.video_imu_residual[1]))))
+                if self.video_imu_residual is not None
+                else None
+            ),
             "fit": self.fit,
             "audit": self.audit,
             "per_impact_eta": [float(x) for x in self.per_impact_eta],
             "simulations": {
-                law: {"eta": float(s["eta"]), "status": s.get("status"),
-                      "n_impacts": int(len(s["impacts"])) if s.get("impacts") is not None else 0,
-                      "rms_vs_measured_rad": s.get("rms_vs_measured_rad")}
-                for law, s in self.simulations.items()},
-            "table": None if self.table is None else {
+                law: {
+                    "eta": float(s["eta"]),
+                    "status": s.get("status"),
+                    "n_impacts": int(len(s["impacts"])) if s.get("impacts") is not None else 0,
+                    "rms_vs_measured_rad": s.get("rms_vs_measured_rad"),
+                }
+                for law, s in self.simulations.items()
+            },
+            "table": None
+            if self.table is None
+            else {
                 "peak_disp_m": float(np.nanmax(np.abs(self.table["disp_m"]))) if "disp_m" in self.table else None,
                 "peak_acc_m_s2": float(np.nanmax(np.abs(self.table["acc_m_s2"]))),
             },
-            "truth": None if self.truth is None else {"eta": self.truth.get("eta"),
-                                                      "theta_rms_error_rad": self.truth.get("theta_rms_error_rad")},
-            "column": None if self.column is None else {
-                k: self.column[k] for k in ("objects", "status", "comparison", "cut_m", "impacts_per_closing",
-                                            "sequence_vs_truth", "theta_rms_error_rad") if k in self.column},
-            "review_video": None if self.video is None else {
-                "kind": self.video.kind, "frames": len(self.video.frame_index), "bytes": self.video.n_bytes,
-                "note": self.video.note},
+            "truth": None
+            if self.truth is None
+            else {"eta": self.truth.get("eta"), "theta_rms_error_rad": self.truth.get("theta_rms_error_rad")},
+            "column": None
+            if self.column is None
+            else {
+                k: self.column[k]
+                for k in (
+                    "objects",
+                    "status",
+                    "comparison",
+                    "cut_m",
+                    "impacts_per_closing",
+                    "sequence_vs_truth",
+                    "theta_rms_error_rad",
+                )
+                if k in self.column
+            },
+            "review_video": None
+            if self.video is None
+            else {
+                "kind": self.video.kind,
+                "frames": len(self.video.frame_index),
+                "bytes": self.video.n_bytes,
+                "note": self.video.note,
+            },
             "timings_s": self.timings_s,
-            "units": {"t": "s", "theta": "rad", "omega": "rad/s", "length": "m", "energy": "J",
-                      "acceleration": "m/s^2"},
+            "units": {
+                "t": "s",
+                "theta": "rad",
+                "omega": "rad/s",
+                "length": "m",
+                "energy": "J",
+                "acceleration": "m/s^2",
+            },
             "versions": _versions(),
         }
         return d
@@ -151,8 +184,10 @@ def fingerprint(cfg: ExperimentConfig) -> str:
 # ---------------------------------------------------------------------------
 # measurement stages
 
-def analyse_experiment(cfg: ExperimentConfig, progress: bool = False,
-                       keep_video: bool | None = None) -> ExperimentResult:
+
+def analyse_experiment(
+    cfg: ExperimentConfig, progress: bool = False, keep_video: bool | None = None
+) -> ExperimentResult:
     """Run every stage of one experiment in memory (no files written).
 
     ``keep_video``: encode the review film (every frame, AV1) while the frames are decoded for
@@ -219,10 +254,26 @@ def analyse_experiment(cfg: ExperimentConfig, progress: bool = False,
         t3 = time.perf_counter()
         column = analyse_column(cfg, tr, table, cfg.truth)
         timings["column_s"] = time.perf_counter() - t3
-        return ExperimentResult(name=cfg.name, config=cfg, block=block, measured=measured, primary=cfg.primary,
-                                sync=sync, video_imu_residual=residual, fit=None, per_impact_eta=per_imp,
-                                simulations={}, table=table, truth=None, status=status, messages=msgs,
-                                timings_s=timings, frames=tr, column=column, video=film)
+        return ExperimentResult(
+            name=cfg.name,
+            config=cfg,
+            block=block,
+            measured=measured,
+            primary=cfg.primary,
+            sync=sync,
+            video_imu_residual=residual,
+            fit=None,
+            per_impact_eta=per_imp,
+            simulations={},
+            table=table,
+            truth=None,
+            status=status,
+            messages=msgs,
+            timings_s=timings,
+            frames=tr,
+            column=column,
+            video=film,
+        )
     from ._audit_stage import audit_experiment
 
     audit = audit_experiment(cfg, measured, tr, track_rows)
@@ -250,10 +301,26 @@ def analyse_experiment(cfg: ExperimentConfig, progress: bool = False,
     truth = None
     if cfg.truth is not None:
         truth = _truth(cfg, prim, msgs)
-    return ExperimentResult(name=cfg.name, config=cfg, block=block, measured=measured,
-                            primary=cfg.primary, sync=sync, video_imu_residual=residual, fit=fit_d,
-                            per_impact_eta=per_imp, simulations=sims, table=table, truth=truth,
-                            status=status, messages=msgs, timings_s=timings, frames=tr, video=film, audit=audit)
+    return ExperimentResult(
+        name=cfg.name,
+        config=cfg,
+        block=block,
+        measured=measured,
+        primary=cfg.primary,
+        sync=sync,
+        video_imu_residual=residual,
+        fit=fit_d,
+        per_impact_eta=per_imp,
+        simulations=sims,
+        table=table,
+        truth=truth,
+        status=status,
+        messages=msgs,
+        timings_s=timings,
+        frames=tr,
+        video=film,
+        audit=audit,
+    )
 
 
 def _eta_for_law(law, cfg, block, fit_d, msgs):
@@ -286,8 +353,9 @@ def _simulate_laws(cfg, block, prim, fit_d, table, msgs) -> dict:
 
     t_meas, th_meas = prim
     ok = np.isfinite(th_meas)
-    fit_ok = fit_d and all(np.isfinite(fit_d.get(k) if fit_d.get(k) is not None else np.nan)
-                           for k in ("theta0_rad", "release_t_s"))
+    fit_ok = fit_d and all(
+        np.isfinite(fit_d.get(k) if fit_d.get(k) is not None else np.nan) for k in ("theta0_rad", "release_t_s")
+    )
     if table is None and fit_ok:  # thread-burn release as fitted
         theta0, t_rel = float(fit_d["theta0_rad"]), float(fit_d["release_t_s"])
     else:  # forced run or no fit: start at the first valid sample, θ measured there
@@ -310,16 +378,31 @@ def _simulate_laws(cfg, block, prim, fit_d, table, msgs) -> dict:
         if abs(theta0) >= block.alpha_rad:
             msgs.append(f"simulation skipped: θ0 = {theta0:.4f} rad is not below α")
             break
-        r = simulate(block, theta0_rad=theta0, duration_s=max(dur, 1e-3), dt_s=1e-4,
-                     restitution="constant", eta=eta, base=base, output_dt_s=1e-3)
+        r = simulate(
+            block,
+            theta0_rad=theta0,
+            duration_s=max(dur, 1e-3),
+            dt_s=1e-4,
+            restitution="constant",
+            eta=eta,
+            base=base,
+            output_dt_s=1e-3,
+        )
         ts = np.asarray(r.t_s) + t_rel
         th_on_meas = np.interp(t_meas, ts, np.asarray(r.theta_rad), left=np.nan, right=np.nan)
         w = ok & (t_meas >= t_rel) & np.isfinite(th_on_meas)
         rms = float(np.sqrt(np.mean((th_meas[w] - th_on_meas[w]) ** 2))) if w.any() else None
         imp = r.impacts.copy()
         imp["t_s"] = imp["t_s"] + t_rel
-        sims[law] = {"t_s": ts, "theta_rad": np.asarray(r.theta_rad), "energy_J": np.asarray(r.energy_J),
-                     "eta": eta, "impacts": imp, "status": r.status, "rms_vs_measured_rad": rms}
+        sims[law] = {
+            "t_s": ts,
+            "theta_rad": np.asarray(r.theta_rad),
+            "energy_J": np.asarray(r.energy_J),
+            "eta": eta,
+            "impacts": imp,
+            "status": r.status,
+            "rms_vs_measured_rad": rms,
+        }
     return sims
 
 
@@ -341,12 +424,23 @@ def _truth(cfg, prim, msgs):
         for blk in meta.get("blocks", []):  # rocklab synth sessions
             if blk.get("id") == obj:
                 eta = blk.get("eta_true", eta)
-    return {"t_s": t, "theta_rad": th, "eta": eta,
-            "theta_rms_error_rad": float(np.sqrt(np.nanmean(err ** 2))) if np.isfinite(err).any() else None}
+    return {
+        "t_s": t,
+        "theta_rad": th,
+        "eta": eta,
+        "theta_rms_error_rad": float(np.sqrt(np.nanmean(err**2))) if np.isfinite(err).any() else None,
+    }
 
 
-def run_experiment(config_path, out_dir, *, force: bool = False, spawn: bool = False,
-                   connect: str | None = None, progress: bool = False) -> tuple[dict, bool]:
+def run_experiment(
+    config_path,
+    out_dir,
+    *,
+    force: bool = False,
+    spawn: bool = False,
+    connect: str | None = None,
+    progress: bool = False,
+) -> tuple[dict, bool]:
     """Run one experiment and write its outputs into ``out_dir`` atomically.
 
     Returns
@@ -375,8 +469,7 @@ def run_experiment(config_path, out_dir, *, force: bool = False, spawn: bool = F
     with collecting(echo=stderr_echo("run")) as diags:
         res = analyse_experiment(cfg, progress=progress, keep_video=cfg.rrd or spawn or bool(connect))
     if diags:
-        res = dataclasses.replace(res, status=worst_status(res.status, diags),
-                                  diagnostics=tuple(diags))
+        res = dataclasses.replace(res, status=worst_status(res.status, diags), diagnostics=tuple(diags))
     stage = stage_dir(out_dir)
     try:
         report = write_outputs(res, stage, fp, spawn=spawn, connect=connect, progress=progress)

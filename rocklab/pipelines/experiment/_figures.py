@@ -55,17 +55,31 @@ def experiment_figures(res, out_dir) -> dict[str, Path]:
     for name, (t, th) in res.measured.items():
         ax.plot(t, np.asarray(th) / alpha, lw=1.2, label=f"measured ({name})")
     for law, sim in res.simulations.items():
-        ax.plot(sim["t_s"], np.asarray(sim["theta_rad"]) / alpha, lw=0.9, ls="--",
-                label=f"simulated, {law} (η={sim['eta']:.3f})")
+        ax.plot(
+            sim["t_s"],
+            np.asarray(sim["theta_rad"]) / alpha,
+            lw=0.9,
+            ls="--",
+            label=f"simulated, {law} (η={sim['eta']:.3f})",
+        )
     if res.truth is not None:
-        ax.plot(res.truth["t_s"], np.asarray(res.truth["theta_rad"]) / alpha, lw=0.6, color="k",
-                alpha=0.5, label="truth")
+        ax.plot(
+            res.truth["t_s"], np.asarray(res.truth["theta_rad"]) / alpha, lw=0.6, color="k", alpha=0.5, label="truth"
+        )
     # the assumption audit's flags, where they happened (the impacts a fit should not trust)
     flags = (res.audit or {}).get("flags") or []
     for i, f in enumerate(flags):
         ax.axvline(f["t_s"], color="crimson", lw=0.8, alpha=0.7, label="audit flag" if i == 0 else None)
-        ax.annotate(f"{f['kind']}", (f["t_s"], 1.0), xycoords=("data", "axes fraction"), rotation=90,
-                    va="top", ha="right", fontsize=7, color="crimson")
+        ax.annotate(
+            f"{f['kind']}",
+            (f["t_s"], 1.0),
+            xycoords=("data", "axes fraction"),
+            rotation=90,
+            va="top",
+            ha="right",
+            fontsize=7,
+            color="crimson",
+        )
     ax.set_xlabel("t (s)")
     ax.set_ylabel("θ/α (-)")
     verdict = (res.audit or {}).get("verdict")
@@ -80,8 +94,15 @@ def experiment_figures(res, out_dir) -> dict[str, Path]:
         ax.plot(k, res.per_impact_eta, "o-", label="per impact (local fits)")
         ex = [e["impact"] for e in res.fit.get("excluded_impacts") or [] if 1 <= e["impact"] <= len(k)]
         if ex:
-            ax.plot(ex, np.asarray(res.per_impact_eta)[np.asarray(ex) - 1], "x", color="crimson", ms=10, mew=2,
-                    label="flagged by the audit (not to trust)")
+            ax.plot(
+                ex,
+                np.asarray(res.per_impact_eta)[np.asarray(ex) - 1],
+                "x",
+                color="crimson",
+                ms=10,
+                mew=2,
+                label="flagged by the audit (not to trust)",
+            )
         if np.isfinite(res.fit.get("eta_e", np.nan)):
             ax.axhline(res.fit["eta_e"], color="C1", label=f"η_e = {res.fit['eta_e']:.4f}")
         ax.axhline(res.block.eta_H, color="k", ls=":", label=f"η_H = {res.block.eta_H:.4f}")
@@ -134,8 +155,9 @@ def experiment_figures(res, out_dir) -> dict[str, Path]:
     if res.table is not None:
         fig, axs = plt.subplots(3, 1, figsize=(10, 6), sharex=True)
         tt = res.table["t_s"]
-        for ax, key, lab in zip(axs, ("disp_m", "vel_m_s", "acc_m_s2"),
-                                ("displacement (m)", "velocity (m/s)", "acceleration (m/s²)")):
+        for ax, key, lab in zip(
+            axs, ("disp_m", "vel_m_s", "acc_m_s2"), ("displacement (m)", "velocity (m/s)", "acceleration (m/s²)")
+        ):
             if key in res.table:
                 ax.plot(tt, res.table[key], lw=0.9)
             ax.set_ylabel(lab)
@@ -173,8 +195,16 @@ def campaign_figures(table, out_dir, regression=None) -> dict[str, Path]:
             yerr = None
             if {"ci_lo", "ci_hi"} <= set(g.columns):
                 yerr = np.vstack([g["eta_e"] - g["ci_lo"], g["ci_hi"] - g["eta_e"]]).clip(min=0)
-            ax.errorbar(hb, g["eta_e"], yerr=yerr, fmt=mk, color=f"C{i}", ms=5, capsize=2,
-                        label=f"b = {100 * b_m:.1f} cm, {contact} contact")
+            ax.errorbar(
+                hb,
+                g["eta_e"],
+                yerr=yerr,
+                fmt=mk,
+                color=f"C{i}",
+                ms=5,
+                capsize=2,
+                label=f"b = {100 * b_m:.1f} cm, {contact} contact",
+            )
         if regression is not None:
             try:
                 eta_m = [regression.predict(hb, b_m).eta_M for hb in hb_grid]

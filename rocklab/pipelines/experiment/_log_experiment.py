@@ -5,8 +5,15 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._rerun import (close_recording, experiment_blueprint, log_events, log_series, log_video_asset, log_video_frames,
-                     open_recording)
+from ._rerun import (
+    close_recording,
+    experiment_blueprint,
+    log_events,
+    log_series,
+    log_video_asset,
+    log_video_frames,
+    open_recording,
+)
 
 __all__ = ["log_experiment"]
 
@@ -15,11 +22,19 @@ ROOT = "experiment"
 #: Measured data dark and bold, every simulation its own colour (Okabe-Ito, colour-blind safe),
 #: the synthetic truth thin grey: (RGB, line width in points).
 STYLE = {
-    "measured_video": ([0, 0, 0], 3.0), "measured_imu": ([90, 55, 20], 2.5), "measured_track": ([0, 0, 0], 3.0),
-    "truth": ([150, 150, 150], 1.0), "sim_column": ([0, 114, 178], 1.5),
+    "measured_video": ([0, 0, 0], 3.0),
+    "measured_imu": ([90, 55, 20], 2.5),
+    "measured_track": ([0, 0, 0], 3.0),
+    "truth": ([150, 150, 150], 1.0),
+    "sim_column": ([0, 114, 178], 1.5),
 }
-SIM_COLOURS = {"housner": [230, 159, 0], "eta_e": [0, 114, 178], "modified": [0, 158, 115],
-               "eta_e_first": [204, 121, 167], "given": [213, 94, 0]}
+SIM_COLOURS = {
+    "housner": [230, 159, 0],
+    "eta_e": [0, 114, 178],
+    "modified": [0, 158, 115],
+    "eta_e_first": [204, 121, 167],
+    "given": [213, 94, 0],
+}
 _SPARE = [[86, 180, 233], [240, 228, 66], [204, 121, 167]]
 
 
@@ -34,8 +49,7 @@ def _theta(rec, bp: str, key: str, t, th, name: str, i: int = 0) -> int:
     """θ of one series in rad and in degrees (``theta`` and ``theta_deg``), in its colour."""
     colour, width = _style(key, i)
     n = log_series(rec, f"{bp}/theta/{key}", t, th, color=colour, width=width, name=name)
-    log_series(rec, f"{bp}/theta_deg/{key}", t, np.degrees(np.asarray(th, float)), color=colour, width=width,
-               name=name)
+    log_series(rec, f"{bp}/theta_deg/{key}", t, np.degrees(np.asarray(th, float)), color=colour, width=width, name=name)
     return n
 
 
@@ -94,46 +108,62 @@ def _overlay_fn(res):
     return fn
 
 
-def log_experiment(res, rrd_path=None, *, spawn: bool = False, connect: str | None = None,
-                   progress: bool = False) -> dict:
+def log_experiment(
+    res, rrd_path=None, *, spawn: bool = False, connect: str | None = None, progress: bool = False
+) -> dict:
     """Write the experiment to ``rrd_path`` (and/or a live viewer). Returns rows per entity sent."""
     import rerun as rr
 
-    rec = open_recording("rocklab", rrd_path, spawn=spawn, connect=connect,
-                         recording_id=f"experiment-{res.name}")
+    rec = open_recording("rocklab", rrd_path, spawn=spawn, connect=connect, recording_id=f"experiment-{res.name}")
     rows: dict[str, int] = {}
     blk = f"{ROOT}/block_1"
     b = res.block
-    rec.log(f"{ROOT}/geometry", rr.TextDocument(
-        f"block {b.name}: b = {b.b_m} m, h = {b.h_m} m, alpha = {b.alpha_rad:.5f} rad, "
-        f"R = {b.R_m:.5f} m, p = {b.p_rad_s:.4f} rad/s, eta_H = {b.eta_H:.4f}; "
-        f"contact {res.config.contact}", media_type="text/markdown"), static=True)
+    rec.log(
+        f"{ROOT}/geometry",
+        rr.TextDocument(
+            f"block {b.name}: b = {b.b_m} m, h = {b.h_m} m, alpha = {b.alpha_rad:.5f} rad, "
+            f"R = {b.R_m:.5f} m, p = {b.p_rad_s:.4f} rad/s, eta_H = {b.eta_H:.4f}; "
+            f"contact {res.config.contact}",
+            media_type="text/markdown",
+        ),
+        static=True,
+    )
 
     for name, (t, th) in res.measured.items():
         rows[f"{blk}/theta/measured_{name}"] = _theta(rec, blk, f"measured_{name}", t, th, f"measured ({name})")
     for i, (law, s) in enumerate(res.simulations.items()):
-        rows[f"{blk}/theta/sim_{law}"] = _theta(rec, blk, f"sim_{law}", s["t_s"], s["theta_rad"],
-                                                f"sim {law} (η = {s['eta']:.4g})", i)
+        rows[f"{blk}/theta/sim_{law}"] = _theta(
+            rec, blk, f"sim_{law}", s["t_s"], s["theta_rad"], f"sim {law} (η = {s['eta']:.4g})", i
+        )
         colour, width = _style(f"sim_{law}", i)
-        rows[f"{blk}/energy/sim_{law}"] = log_series(rec, f"{blk}/energy/sim_{law}", s["t_s"], s["energy_J"],
-                                                     color=colour, width=width, name=f"sim {law} (J)")
+        rows[f"{blk}/energy/sim_{law}"] = log_series(
+            rec, f"{blk}/energy/sim_{law}", s["t_s"], s["energy_J"], color=colour, width=width, name=f"sim {law} (J)"
+        )
     if res.truth is not None:
         rows[f"{blk}/theta/truth"] = _theta(rec, blk, "truth", res.truth["t_s"], res.truth["theta_rad"], "truth")
     if res.video_imu_residual is not None:
         rows[f"{blk}/residual/video_minus_imu"] = log_series(
-            rec, f"{blk}/residual/video_minus_imu", *res.video_imu_residual)
+            rec, f"{blk}/residual/video_minus_imu", *res.video_imu_residual
+        )
     t_p, th_p = res.measured[res.primary]
     for i, (law, s) in enumerate(res.simulations.items()):
         sim_on = np.interp(t_p, s["t_s"], s["theta_rad"], left=np.nan, right=np.nan)
         rows[f"{blk}/residual/measured_minus_sim_{law}"] = log_series(
-            rec, f"{blk}/residual/measured_minus_sim_{law}", t_p, th_p - sim_on, color=_style(f"sim_{law}", i)[0],
-            name=f"measured − sim {law} (rad)")
+            rec,
+            f"{blk}/residual/measured_minus_sim_{law}",
+            t_p,
+            th_p - sim_on,
+            color=_style(f"sim_{law}", i)[0],
+            name=f"measured − sim {law} (rad)",
+        )
     focus = _focus(res, t_p, th_p)
     ref = res.simulations.get("eta_e") or next(iter(res.simulations.values()), None)
     if ref is not None and len(ref["impacts"]):
         imp = ref["impacts"]
-        txt = [f"impact {i + 1}: ω⁻ = {a:+.3f} rad/s → ω⁺ = {c:+.3f} rad/s (η = {e:.3f})"
-               for i, (a, c, e) in enumerate(zip(imp["omega_before_rad_s"], imp["omega_after_rad_s"], imp["eta"]))]
+        txt = [
+            f"impact {i + 1}: ω⁻ = {a:+.3f} rad/s → ω⁺ = {c:+.3f} rad/s (η = {e:.3f})"
+            for i, (a, c, e) in enumerate(zip(imp["omega_before_rad_s"], imp["omega_after_rad_s"], imp["eta"]))
+        ]
         log_events(rec, f"{blk}/impacts", imp["t_s"].to_numpy(float), txt, values=np.zeros(len(imp)))
         rows[f"{blk}/impacts"] = len(imp)
     block_paths = [blk]
@@ -141,20 +171,27 @@ def log_experiment(res, rrd_path=None, *, spawn: bool = False, connect: str | No
         c = res.column
         block_paths = [f"{ROOT}/{o}" for o in c["objects"]]
         for i, bp in enumerate(block_paths):
-            rows[f"{bp}/theta/measured_video"] = _theta(rec, bp, "measured_video", c["t_s"],
-                                                        c["theta_measured_rad"][:, i], "measured (video)")
-            rows[f"{bp}/theta/sim_column"] = _theta(rec, bp, "sim_column", c["sim_t_s"], c["theta_sim_rad"][:, i],
-                                                    "column model")
+            rows[f"{bp}/theta/measured_video"] = _theta(
+                rec, bp, "measured_video", c["t_s"], c["theta_measured_rad"][:, i], "measured (video)"
+            )
+            rows[f"{bp}/theta/sim_column"] = _theta(
+                rec, bp, "sim_column", c["sim_t_s"], c["theta_sim_rad"][:, i], "column model"
+            )
             sim_on = np.interp(c["t_s"], c["sim_t_s"], c["theta_sim_rad"][:, i], left=np.nan, right=np.nan)
             rows[f"{bp}/residual/measured_minus_sim"] = log_series(
-                rec, f"{bp}/residual/measured_minus_sim", c["t_s"], c["theta_measured_rad"][:, i] - sim_on)
+                rec, f"{bp}/residual/measured_minus_sim", c["t_s"], c["theta_measured_rad"][:, i] - sim_on
+            )
             if "theta_truth_rad" in c:
                 tt, th = c["theta_truth_rad"]
                 rows[f"{bp}/theta/truth"] = _theta(rec, bp, "truth", tt, th[:, i], "truth")
         conf = c["configurations"]
         if len(conf):
-            log_events(rec, f"{ROOT}/column/configurations", conf["t_s"].to_numpy(float),
-                       [f"joint {j}: {st} ({ev})" for j, st, ev in zip(conf["joint"], conf["state"], conf["event"])])
+            log_events(
+                rec,
+                f"{ROOT}/column/configurations",
+                conf["t_s"].to_numpy(float),
+                [f"joint {j}: {st} ({ev})" for j, st, ev in zip(conf["joint"], conf["state"], conf["event"])],
+            )
             rows[f"{ROOT}/column/configurations"] = len(conf)
     if res.table is not None:
         for k in ("disp_m", "vel_m_s", "acc_m_s2"):
@@ -175,13 +212,23 @@ def log_experiment(res, rrd_path=None, *, spawn: bool = False, connect: str | No
             tr0 = res.frames.tracks[0]  # the tracker's own frame times (a variable-rate film's)
             t_of = dict(zip(np.asarray(tr0.frame, int).tolist(), np.asarray(tr0.t_s, float).tolist()))
             t_film = [t_of.get(int(i), i / fps) for i in film.frame_index]
-            rows[f"{ROOT}/video"] = log_video_asset(rec, f"{ROOT}/video", film.data, film.frame_index, fps,
-                                                    overlays=_overlay_fn(res), progress=bar, frame_t_s=t_film)
+            rows[f"{ROOT}/video"] = log_video_asset(
+                rec,
+                f"{ROOT}/video",
+                film.data,
+                film.frame_index,
+                fps,
+                overlays=_overlay_fn(res),
+                progress=bar,
+                frame_t_s=t_film,
+            )
         else:
-            frames = ((i, i / fps, data) for i, data in
-                      (zip(film.frame_index, film.stills) if film is not None else ()))
+            frames = (
+                (i, i / fps, data) for i, data in (zip(film.frame_index, film.stills) if film is not None else ())
+            )
             rows[f"{ROOT}/video"] = log_video_frames(
-                rec, f"{ROOT}/video", frames, overlays=_overlay_fn(res), progress=bar)
+                rec, f"{ROOT}/video", frames, overlays=_overlay_fn(res), progress=bar
+            )
         if bar is not None:
             bar.close()
     rec.send_blueprint(experiment_blueprint(block_paths, has_video=has_video, focus=focus))

@@ -56,13 +56,19 @@ def _measure_video(cfg: ExperimentConfig, progress: bool, keep_film: bool):
     df = tr.to_frame()
     sel = df[df["object"] == cfg.video.object]
     if sel.empty:
-        raise InputError(f"{cfg.path}: [sources.video] object {cfg.video.object!r} was never tracked in "
-                         f"{cfg.video.path.name}; objects seen: {sorted(set(df['object']))}")
+        raise InputError(
+            f"{cfg.path}: [sources.video] object {cfg.video.object!r} was never tracked in "
+            f"{cfg.video.path.name}; objects seen: {sorted(set(df['object']))}"
+        )
     table = None
     if cfg.table.source in ("video", "imu") and tcfg is not None and tcfg.table is not None:
         tm = tr.table_motion(cfg.table.object)
-        table = {"t_s": np.asarray(tm.t_s), "disp_m": np.asarray(tm.x_m),
-                 "vel_m_s": np.asarray(tm.vx_m_s), "acc_m_s2": np.asarray(tm.ax_m_s2)}
+        table = {
+            "t_s": np.asarray(tm.t_s),
+            "disp_m": np.asarray(tm.x_m),
+            "vel_m_s": np.asarray(tm.vx_m_s),
+            "acc_m_s2": np.asarray(tm.ax_m_s2),
+        }
     review = film.finish() if film is not None else None
     return (sel["t_s"].to_numpy(float), sel["theta_rad"].to_numpy(float)), table, tr, review
 

@@ -31,8 +31,12 @@ def plot_column_maps(maps, path=None, title: str | None = None):
         ax.grid(alpha=0.3)
     axes[0, 0].set_ylabel("$a_p$ [m/s$^2$]")
     axes[0, -1].legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), fontsize=8, frameon=False)
-    fig.suptitle(title or f"Column overturning, H = {maps.H_m:g} m, B = {maps.B_m:g} m, full-sine pulse "
-                 f"({maps.params.get('n_impacts', 1)} impact(s) per closing)", fontsize=10)
+    fig.suptitle(
+        title
+        or f"Column overturning, H = {maps.H_m:g} m, B = {maps.B_m:g} m, full-sine pulse "
+        f"({maps.params.get('n_impacts', 1)} impact(s) per closing)",
+        fontsize=10,
+    )
     fig.tight_layout()
     if path is not None:
         save_png(fig, path, dpi=120, tight=False)

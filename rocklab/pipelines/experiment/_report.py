@@ -32,10 +32,12 @@ def series_frame(res):
     if res.column is not None:
         c = res.column
         for i, o in enumerate(c["objects"]):
-            cols[f"theta_{o}_video_rad"] = np.interp(t, c["t_s"], c["theta_measured_rad"][:, i], left=np.nan,
-                                                     right=np.nan)
-            cols[f"theta_{o}_sim_column_rad"] = np.interp(t, c["sim_t_s"], c["theta_sim_rad"][:, i],
-                                                          left=np.nan, right=np.nan)
+            cols[f"theta_{o}_video_rad"] = np.interp(
+                t, c["t_s"], c["theta_measured_rad"][:, i], left=np.nan, right=np.nan
+            )
+            cols[f"theta_{o}_sim_column_rad"] = np.interp(
+                t, c["sim_t_s"], c["theta_sim_rad"][:, i], left=np.nan, right=np.nan
+            )
             if "theta_truth_rad" in c:
                 tt, th = c["theta_truth_rad"]
                 cols[f"theta_{o}_truth_rad"] = np.interp(t, tt, th[:, i], left=np.nan, right=np.nan)
@@ -53,57 +55,93 @@ def _g(x, digits: int = 4) -> str:
 
 def _summary_md(res, figs: dict, rrd: bool) -> str:
     f = res.fit or {}
-    lines = [f"# {res.name}", "", f"Status: **{res.status}**", "",
-             f"Block: b = {_g(res.block.b_m)} m, h = {_g(res.block.h_m)} m, α = {_g(res.block.alpha_rad)} rad, "
-             f"p = {_g(res.block.p_rad_s)} rad/s, η_H = {_g(res.block.eta_H)}; contact: {res.config.contact}", ""]
+    lines = [
+        f"# {res.name}",
+        "",
+        f"Status: **{res.status}**",
+        "",
+        f"Block: b = {_g(res.block.b_m)} m, h = {_g(res.block.h_m)} m, α = {_g(res.block.alpha_rad)} rad, "
+        f"p = {_g(res.block.p_rad_s)} rad/s, η_H = {_g(res.block.eta_H)}; contact: {res.config.contact}",
+        "",
+    ]
     if f:
         ci = f.get("ci95_eta_e") or [None, None]
-        lines += [f"η_e = {_g(f.get('eta_e'))} (95 % CI {_g(ci[0])} – {_g(ci[1])}), "
-                  f"η'_e = {_g(f.get('eta_e_first'))}, θ0 = {_g(f.get('theta0_rad'))} rad, "
-                  f"release at {_g(f.get('release_t_s'))} s, residual RMS {_g(f.get('rms_residual_rad'))} rad "
-                  f"(fit status {f.get('status')})", ""]
+        lines += [
+            f"η_e = {_g(f.get('eta_e'))} (95 % CI {_g(ci[0])} – {_g(ci[1])}), "
+            f"η'_e = {_g(f.get('eta_e_first'))}, θ0 = {_g(f.get('theta0_rad'))} rad, "
+            f"release at {_g(f.get('release_t_s'))} s, residual RMS {_g(f.get('rms_residual_rad'))} rad "
+            f"(fit status {f.get('status')})",
+            "",
+        ]
     if res.audit:
         a = res.audit
-        lines += [f"Assumption audit ({a['source']}): **{a['verdict']}**, checked {', '.join(a['checked']) or 'nothing'}"
-                  + (f"; impacts not to trust: {', '.join(map(str, a['excluded_impacts']))}"
-                     if a["excluded_impacts"] else ""), ""]
-        lines += [f"- {f['kind']} ({f['detail']}) at {_g(f['t_s'])} s, impact {f['impact']}: {_g(f['value'])} "
-                  f"(tolerance {_g(f['tolerance'])}, SI units)" for f in a["flags"]]
+        lines += [
+            f"Assumption audit ({a['source']}): **{a['verdict']}**, checked {', '.join(a['checked']) or 'nothing'}"
+            + (
+                f"; impacts not to trust: {', '.join(map(str, a['excluded_impacts']))}" if a["excluded_impacts"] else ""
+            ),
+            "",
+        ]
+        lines += [
+            f"- {f['kind']} ({f['detail']}) at {_g(f['t_s'])} s, impact {f['impact']}: {_g(f['value'])} "
+            f"(tolerance {_g(f['tolerance'])}, SI units)"
+            for f in a["flags"]
+        ]
         lines += [""] if a["flags"] else []
         for e in (res.fit or {}).get("excluded_impacts") or []:
-            lines.append(f"- per-impact η of fit impact {e['impact']} at {_g(e['t_s'])} s ({_g(e['eta'])}) is not "
-                         f"to be trusted: {'; '.join(e['reasons'])}")
+            lines.append(
+                f"- per-impact η of fit impact {e['impact']} at {_g(e['t_s'])} s ({_g(e['eta'])}) is not "
+                f"to be trusted: {'; '.join(e['reasons'])}"
+            )
         lines += [""] if (res.fit or {}).get("excluded_impacts") else []
     if res.sync:
-        lines += [f"IMU sync: offset {_g(1000 * res.sync.get('offset_s', float('nan')))} ms, "
-                  f"drift {_g(res.sync.get('drift'))}, residual {_g(res.sync.get('residual_ms'))} ms", ""]
+        lines += [
+            f"IMU sync: offset {_g(1000 * res.sync.get('offset_s', float('nan')))} ms, "
+            f"drift {_g(res.sync.get('drift'))}, residual {_g(res.sync.get('residual_ms'))} ms",
+            "",
+        ]
     lines += ["| simulation | η | RMS vs measured (rad) | impacts |", "|---|---|---|---|"]
     for law, s in res.simulations.items():
         rms = s.get("rms_vs_measured_rad")
-        lines.append(f"| {law} | {_g(s['eta'])} | {_g(rms)} | {len(s['impacts'])} |" if rms is not None
-                     else f"| {law} | {_g(s['eta'])} | – | {len(s['impacts'])} |")
+        lines.append(
+            f"| {law} | {_g(s['eta'])} | {_g(rms)} | {len(s['impacts'])} |"
+            if rms is not None
+            else f"| {law} | {_g(s['eta'])} | – | {len(s['impacts'])} |"
+        )
     lines.append("")
     if res.truth is not None:
-        lines += [f"Synthetic truth: η = {_g(res.truth.get('eta'))}, measured θ RMS error "
-                  f"{_g(res.truth.get('theta_rms_error_rad'))} rad", ""]
+        lines += [
+            f"Synthetic truth: η = {_g(res.truth.get('eta'))}, measured θ RMS error "
+            f"{_g(res.truth.get('theta_rms_error_rad'))} rad",
+            "",
+        ]
     if res.column is not None:
         c = res.column
         cmp_ = c["comparison"]
-        lines += [f"Column of {len(c['objects'])} blocks (cut {1000 * c['cut_m']:.1f} mm, "
-                  f"{c['impacts_per_closing']} impact(s) per closing): simulation status {c['status']}", "",
-                  "| block | RMS measured − simulated (rad) | peak measured (rad) | peak simulated (rad) |",
-                  "|---|---|---|---|"]
-        for o, r, pm, ps in zip(c["objects"], cmp_["rms_theta_rad"], cmp_["peak_measured_rad"],
-                                cmp_["peak_simulated_rad"]):
+        lines += [
+            f"Column of {len(c['objects'])} blocks (cut {1000 * c['cut_m']:.1f} mm, "
+            f"{c['impacts_per_closing']} impact(s) per closing): simulation status {c['status']}",
+            "",
+            "| block | RMS measured − simulated (rad) | peak measured (rad) | peak simulated (rad) |",
+            "|---|---|---|---|",
+        ]
+        for o, r, pm, ps in zip(
+            c["objects"], cmp_["rms_theta_rad"], cmp_["peak_measured_rad"], cmp_["peak_simulated_rad"]
+        ):
             lines.append(f"| {o} | {_g(r)} | {_g(pm)} | {_g(ps)} |")
         sq = cmp_["sequence"]
-        lines += ["", f"Opening/closing sequence, measured vs simulated: {sq['n_matched']} of "
-                      f"{sq['n_measured']} measured / {sq['n_simulated']} simulated events matched "
-                      f"(median timing error {_g(sq['timing_error_s'])} s)"]
+        lines += [
+            "",
+            f"Opening/closing sequence, measured vs simulated: {sq['n_matched']} of "
+            f"{sq['n_measured']} measured / {sq['n_simulated']} simulated events matched "
+            f"(median timing error {_g(sq['timing_error_s'])} s)",
+        ]
         if "sequence_vs_truth" in c:
             st = c["sequence_vs_truth"]
-            lines += [f"Measured sequence vs truth: same sequence = {st['same_sequence']} "
-                      f"({st['n_matched']}/{st['n_measured']} events)"]
+            lines += [
+                f"Measured sequence vs truth: same sequence = {st['same_sequence']} "
+                f"({st['n_matched']}/{st['n_measured']} events)"
+            ]
         lines.append("")
     for d in res.diagnostics:
         lines.append(f"- **warning {d.code}**: {d.message}")
@@ -116,8 +154,7 @@ def _summary_md(res, figs: dict, rrd: bool) -> str:
     return "\n".join(lines) + "\n"
 
 
-def write_outputs(res, out_dir: Path, fp: str, *, spawn=False, connect=None,
-                  progress=False) -> dict:
+def write_outputs(res, out_dir: Path, fp: str, *, spawn=False, connect=None, progress=False) -> dict:
     """Write report.json, series.csv, figures, summary.md, report.html and session.rrd into ``out_dir``."""
     from ..reports import write_html_report
     from ._figures import experiment_figures
@@ -132,9 +169,12 @@ def write_outputs(res, out_dir: Path, fp: str, *, spawn=False, connect=None,
         rrd_rows = log_experiment(res, rrd_path, spawn=spawn, connect=connect, progress=progress)
     report = res.to_dict()
     report["fingerprint"] = fp
-    report["outputs"] = {"figures": {k: f"figures/{p.name}" for k, p in figs.items()},
-                         "series": "series.csv", "rrd": "session.rrd" if res.config.rrd else None,
-                         "rrd_rows": rrd_rows}
+    report["outputs"] = {
+        "figures": {k: f"figures/{p.name}" for k, p in figs.items()},
+        "series": "series.csv",
+        "rrd": "session.rrd" if res.config.rrd else None,
+        "rrd_rows": rrd_rows,
+    }
     md = _summary_md(res, figs, bool(res.config.rrd))
     write_text_atomic(out_dir / "summary.md", md)
     write_html_report(md, out_dir / "report.html", out_dir, title=f"rocklab: {res.name}")

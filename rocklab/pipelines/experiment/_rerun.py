@@ -29,15 +29,25 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["open_recording", "close_recording", "log_series", "log_events", "log_video_frames", "log_video_asset",
-           "read_rrd_scalars",
-           "experiment_blueprint", "campaign_blueprint", "read_rrd_summary"]
+__all__ = [
+    "open_recording",
+    "close_recording",
+    "log_series",
+    "log_events",
+    "log_video_frames",
+    "log_video_asset",
+    "read_rrd_scalars",
+    "experiment_blueprint",
+    "campaign_blueprint",
+    "read_rrd_summary",
+]
 
 TIMELINE = "time"
 
 
-def open_recording(app_id: str, rrd_path=None, spawn: bool = False, connect: str | None = None,
-                   recording_id: str | None = None):
+def open_recording(
+    app_id: str, rrd_path=None, spawn: bool = False, connect: str | None = None, recording_id: str | None = None
+):
     """A new :class:`rerun.RecordingStream` writing to ``rrd_path`` and/or a viewer.
 
     Parameters
@@ -86,12 +96,10 @@ def close_recording(rec, rrd_path=None) -> None:
     if rrd_path is not None:
         p = Path(rrd_path)
         if not p.is_file() or p.stat().st_size == 0:
-            raise OSError(errno.EIO, "the Rerun recording was not written (disk full or folder removed?)",
-                          str(p))
+            raise OSError(errno.EIO, "the Rerun recording was not written (disk full or folder removed?)", str(p))
 
 
-def log_series(rec, path: str, t_s, values, *, color=None, width: float | None = None,
-               name: str | None = None) -> int:
+def log_series(rec, path: str, t_s, values, *, color=None, width: float | None = None, name: str | None = None) -> int:
     """Send a whole scalar series on the ``time`` timeline (NaNs dropped). Returns rows sent.
 
     ``color`` (RGB 0-255), ``width`` (points) and ``name`` style the line (static).
@@ -103,8 +111,7 @@ def log_series(rec, path: str, t_s, values, *, color=None, width: float | None =
     ok = np.isfinite(t) & np.isfinite(v)
     if not ok.any():
         return 0
-    rec.send_columns(path, indexes=[rr.TimeColumn(TIMELINE, duration=t[ok])],
-                     columns=rr.Scalars.columns(scalars=v[ok]))
+    rec.send_columns(path, indexes=[rr.TimeColumn(TIMELINE, duration=t[ok])], columns=rr.Scalars.columns(scalars=v[ok]))
     if color is not None or name is not None or width is not None:
         rec.log(path, rr.SeriesLines(colors=color, widths=width, names=name), static=True)
     return int(ok.sum())
@@ -119,8 +126,11 @@ def log_events(rec, path: str, t_s, texts, values=None) -> None:
         rec.set_time(TIMELINE, duration=float(t))
         rec.log(path, rr.TextLog(str(txt)))
     if values is not None and len(t_s):
-        rec.send_columns(f"{path}/marker", indexes=[rr.TimeColumn(TIMELINE, duration=np.asarray(t_s, float))],
-                         columns=rr.Scalars.columns(scalars=np.asarray(values, float)))
+        rec.send_columns(
+            f"{path}/marker",
+            indexes=[rr.TimeColumn(TIMELINE, duration=np.asarray(t_s, float))],
+            columns=rr.Scalars.columns(scalars=np.asarray(values, float)),
+        )
         rec.log(f"{path}/marker", rr.SeriesPoints(markers="circle", marker_sizes=4.0), static=True)
     rec.reset_time()
 
@@ -153,8 +163,9 @@ def log_video_frames(rec, path: str, frames, *, overlays=None, progress=None) ->
     return n
 
 
-def log_video_asset(rec, path: str, mp4: bytes, frame_index, fps: float, *, overlays=None, progress=None,
-                    frame_t_s=None) -> int:
+def log_video_asset(
+    rec, path: str, mp4: bytes, frame_index, fps: float, *, overlays=None, progress=None, frame_t_s=None
+) -> int:
     """Log a film as one Rerun ``AssetVideo`` and a ``VideoFrameReference`` per frame.
 
     Parameters
@@ -187,8 +198,11 @@ def log_video_asset(rec, path: str, mp4: bytes, frame_index, fps: float, *, over
     if len(ts_ns) != len(idx):
         raise ValueError(f"review film has {len(ts_ns)} frames, the tracker decoded {len(idx)}")
     t = idx / float(fps) if frame_t_s is None else np.asarray(frame_t_s, float)
-    rec.send_columns(path, indexes=[rr.TimeColumn(TIMELINE, duration=t), rr.TimeColumn("frame", sequence=idx)],
-                     columns=rr.VideoFrameReference.columns_nanos(ts_ns))
+    rec.send_columns(
+        path,
+        indexes=[rr.TimeColumn(TIMELINE, duration=t), rr.TimeColumn("frame", sequence=idx)],
+        columns=rr.VideoFrameReference.columns_nanos(ts_ns),
+    )
     if overlays is not None:
         for i, ti in zip(idx, t):
             rec.set_time(TIMELINE, duration=float(ti))
@@ -224,17 +238,24 @@ def experiment_blueprint(block_paths: list[str], has_video: bool = True, focus=N
     ranges = None
     if focus is not None:
         _, t0, t1 = focus
-        ranges = [rrb.VisibleTimeRange(TIMELINE, start=rrb.TimeRangeBoundary.absolute(seconds=max(t0, 0.0)),
-                                       end=rrb.TimeRangeBoundary.absolute(seconds=t1))]
+        ranges = [
+            rrb.VisibleTimeRange(
+                TIMELINE,
+                start=rrb.TimeRangeBoundary.absolute(seconds=max(t0, 0.0)),
+                end=rrb.TimeRangeBoundary.absolute(seconds=t1),
+            )
+        ]
     plots = []
     for bp in block_paths:
-        short = bp.split('/')[-1]
-        plots.append(rrb.Tabs(
-            rrb.TimeSeriesView(origin=f"{bp}/theta_deg", name=f"θ {short} (°)", time_ranges=ranges),
-            rrb.TimeSeriesView(origin=f"{bp}/theta", name=f"θ {short} (rad)", time_ranges=ranges),
-            rrb.TimeSeriesView(origin=f"{bp}/theta_deg", name=f"θ {short} (°), whole run")))
-    res = [rrb.TimeSeriesView(origin=f"{bp}/residual", name="residual (rad)", time_ranges=ranges)
-           for bp in block_paths]
+        short = bp.split("/")[-1]
+        plots.append(
+            rrb.Tabs(
+                rrb.TimeSeriesView(origin=f"{bp}/theta_deg", name=f"θ {short} (°)", time_ranges=ranges),
+                rrb.TimeSeriesView(origin=f"{bp}/theta", name=f"θ {short} (rad)", time_ranges=ranges),
+                rrb.TimeSeriesView(origin=f"{bp}/theta_deg", name=f"θ {short} (°), whole run"),
+            )
+        )
+    res = [rrb.TimeSeriesView(origin=f"{bp}/residual", name="residual (rad)", time_ranges=ranges) for bp in block_paths]
     extra = [rrb.TimeSeriesView(origin=f"{bp}/energy", name="energy (J)") for bp in block_paths]
     extra.append(rrb.TimeSeriesView(origin="experiment/table", name="table"))
     left = [rrb.Spatial2DView(origin="experiment/video", name="video")] if has_video else []
@@ -242,8 +263,13 @@ def experiment_blueprint(block_paths: list[str], has_video: bool = True, focus=N
     panel = None
     if focus is not None:
         _, t0, t1 = focus
-        panel = rrb.TimePanel(timeline=TIMELINE, play_state="paused", loop_mode="selection", playback_speed=0.25,
-                              time_selection=enc.AbsoluteTimeRange(int(max(t0, 0.0) * 1e9), int(t1 * 1e9)))
+        panel = rrb.TimePanel(
+            timeline=TIMELINE,
+            play_state="paused",
+            loop_mode="selection",
+            playback_speed=0.25,
+            time_selection=enc.AbsoluteTimeRange(int(max(t0, 0.0) * 1e9), int(t1 * 1e9)),
+        )
     return rrb.Blueprint(
         rrb.Horizontal(
             rrb.Vertical(*left, row_shares=[3, 1] if has_video else None),
@@ -259,14 +285,18 @@ def campaign_blueprint():
     """Restitution vs slenderness plots for a campaign."""
     import rerun.blueprint as rrb
 
-    return rrb.Blueprint(rrb.Horizontal(
-        rrb.Vertical(
-            rrb.Spatial2DView(origin="campaign/eta_vs_hb", name="η_e vs h/b (y down: −η_e); click a point"),
-            rrb.TimeSeriesView(origin="campaign/eta", name="η vs h/b (x axis: h/b × 1000)"),
-        ),
-        rrb.Vertical(rrb.TextDocumentView(origin="campaign/eta_vs_hb", name="experiment"),
-                     rrb.TextLogView(origin="campaign", name="experiments")),
-    ))
+    return rrb.Blueprint(
+        rrb.Horizontal(
+            rrb.Vertical(
+                rrb.Spatial2DView(origin="campaign/eta_vs_hb", name="η_e vs h/b (y down: −η_e); click a point"),
+                rrb.TimeSeriesView(origin="campaign/eta", name="η vs h/b (x axis: h/b × 1000)"),
+            ),
+            rrb.Vertical(
+                rrb.TextDocumentView(origin="campaign/eta_vs_hb", name="experiment"),
+                rrb.TextLogView(origin="campaign", name="experiments"),
+            ),
+        )
+    )
 
 
 def read_rrd_summary(path) -> dict:

@@ -34,8 +34,7 @@ def _pivot_world(b):
     its rest position plus the displacement the tracker measured."""
     g = b.geometry
     c = np.where((b.theta_rad >= 0)[:, None], g.pivot_pos_m[None], g.pivot_neg_m[None])
-    disp = (np.outer(b.pivot_slide_m, g.e_r) + np.outer(b.pivot_across_m, g.axis)
-            + np.outer(b.pivot_uplift_m, g.up))
+    disp = np.outer(b.pivot_slide_m, g.e_r) + np.outer(b.pivot_across_m, g.axis) + np.outer(b.pivot_uplift_m, g.up)
     return g.origin_m + c + disp
 
 
@@ -51,26 +50,39 @@ def log_track3d(rec, series, result) -> None:
         xyz = series.xyz_m[:, idx]
         seen = np.isfinite(xyz).all(axis=2)
         lengths = seen.sum(axis=1)
-        rec.send_columns(f"3d/{b.name}/targets", indexes=[rr.TimeColumn(TIMELINE, duration=t)],
-                         columns=rr.Points3D.columns(positions=xyz[seen]).partition(lengths))
+        rec.send_columns(
+            f"3d/{b.name}/targets",
+            indexes=[rr.TimeColumn(TIMELINE, duration=t)],
+            columns=rr.Points3D.columns(positions=xyz[seen]).partition(lengths),
+        )
         rec.log(f"3d/{b.name}/targets", rr.Points3D.from_fields(colors=[colour], radii=[0.003]), static=True)
         if b.is_table:
             continue
         piv = _pivot_world(b)
         ok = np.isfinite(piv).all(axis=1)
         if ok.any():
-            rec.log(f"3d/{b.name}/pivot_path", rr.LineStrips3D([piv[ok]], colors=[colour], radii=[0.0005]),
-                    static=True)
-            rec.send_columns(f"3d/{b.name}/pivot", indexes=[rr.TimeColumn(TIMELINE, duration=t[ok])],
-                             columns=rr.Points3D.columns(positions=piv[ok]).partition(np.ones(int(ok.sum()), int)))
-            rec.log(f"3d/{b.name}/pivot", rr.Points3D.from_fields(colors=[(255, 127, 14)], radii=[0.004]),
-                    static=True)
-        for name, values, scale in (("theta_deg", b.theta_rad, 180 / math.pi),
-                                    ("twist_deg", b.twist_rad, 180 / math.pi),
-                                    ("out_of_plane_deg", b.out_of_plane_rad, 180 / math.pi),
-                                    ("slide_mm", b.pivot_slide_m, 1e3), ("uplift_mm", b.pivot_uplift_m, 1e3)):
-            log_series(rec, f"plots/{b.name}/{name}", t, np.asarray(values) * scale, color=list(colour),
-                       name=f"{b.name} {name.replace('_', ' ')}")
+            rec.log(f"3d/{b.name}/pivot_path", rr.LineStrips3D([piv[ok]], colors=[colour], radii=[0.0005]), static=True)
+            rec.send_columns(
+                f"3d/{b.name}/pivot",
+                indexes=[rr.TimeColumn(TIMELINE, duration=t[ok])],
+                columns=rr.Points3D.columns(positions=piv[ok]).partition(np.ones(int(ok.sum()), int)),
+            )
+            rec.log(f"3d/{b.name}/pivot", rr.Points3D.from_fields(colors=[(255, 127, 14)], radii=[0.004]), static=True)
+        for name, values, scale in (
+            ("theta_deg", b.theta_rad, 180 / math.pi),
+            ("twist_deg", b.twist_rad, 180 / math.pi),
+            ("out_of_plane_deg", b.out_of_plane_rad, 180 / math.pi),
+            ("slide_mm", b.pivot_slide_m, 1e3),
+            ("uplift_mm", b.pivot_uplift_m, 1e3),
+        ):
+            log_series(
+                rec,
+                f"plots/{b.name}/{name}",
+                t,
+                np.asarray(values) * scale,
+                color=list(colour),
+                name=f"{b.name} {name.replace('_', ' ')}",
+            )
         a = b.audit
         for k, ti in enumerate(a.impacts_t_s, start=1):
             rec.set_time(TIMELINE, duration=float(ti))
@@ -86,12 +98,22 @@ def track3d_blueprint(result):
     """3D view | the blocks' plots | the audit's flags."""
     import rerun.blueprint as rrb
 
-    plots = [rrb.TimeSeriesView(origin=f"plots/{b.name}", name=f"{b.name}: θ, twist, out-of-plane (deg), "
-                                                                 "slide, uplift (mm)") for b in result.blocks]
-    return rrb.Blueprint(rrb.Horizontal(
-        rrb.Vertical(rrb.Spatial3DView(origin="3d", name="targets and pivot"),
-                     rrb.TextLogView(origin="audit", name="impacts and audit flags"), row_shares=[3, 1]),
-        rrb.Vertical(*plots), column_shares=[1, 1]), collapse_panels=True)
+    plots = [
+        rrb.TimeSeriesView(origin=f"plots/{b.name}", name=f"{b.name}: θ, twist, out-of-plane (deg), slide, uplift (mm)")
+        for b in result.blocks
+    ]
+    return rrb.Blueprint(
+        rrb.Horizontal(
+            rrb.Vertical(
+                rrb.Spatial3DView(origin="3d", name="targets and pivot"),
+                rrb.TextLogView(origin="audit", name="impacts and audit flags"),
+                row_shares=[3, 1],
+            ),
+            rrb.Vertical(*plots),
+            column_shares=[1, 1],
+        ),
+        collapse_panels=True,
+    )
 
 
 def write_track3d_rrd(path, series, result) -> None:

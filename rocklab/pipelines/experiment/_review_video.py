@@ -174,8 +174,10 @@ class ReviewFilm:
             except Exception as e:  # noqa: BLE001
                 self._abandon(f"JPEG stills: the {self.codec} encoder failed at the end ({e})")
                 return ReviewVideo("jpeg", (), self.fps, note=self.note, size_px=self._size)
-            return ReviewVideo("av1", tuple(self._index), self.fps, data=self._buf.getvalue(),
-                               note=self.note, size_px=self._size)
+            return ReviewVideo(
+                "av1", tuple(self._index), self.fps, data=self._buf.getvalue(), note=self.note, size_px=self._size
+            )
         note = self.note + (f", every {self.decimation}th frame" if self.decimation > 1 else "")
-        return ReviewVideo("jpeg", tuple(self._index), self.fps, stills=tuple(self._stills), note=note,
-                           size_px=self._size)
+        return ReviewVideo(
+            "jpeg", tuple(self._index), self.fps, stills=tuple(self._stills), note=note, size_px=self._size
+        )

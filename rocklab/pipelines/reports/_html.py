@@ -39,7 +39,7 @@ def _inline(text: str, base: Path | None) -> str:
     out, pos = [], 0
     pat = re.compile(r"!\[([^\]]*)\]\(([^)\s]+)\)|\[([^\]]+)\]\(([^)\s]+)\)|`([^`]+)`")
     for m in pat.finditer(text):
-        out.append(_emph(html.escape(text[pos:m.start()], quote=False)))
+        out.append(_emph(html.escape(text[pos : m.start()], quote=False)))
         if m.group(2) is not None:
             out.append(_image(m.group(1), m.group(2), base))
         elif m.group(4) is not None:
@@ -133,9 +133,12 @@ def markdown_to_html(md: str, base_dir=None, title: str = "rocklab report") -> s
             para.append(line.strip())
         i += 1
     flush()
-    return ("<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
-            f"<title>{html.escape(title)}</title>\n<style>{_CSS}</style>\n</head>\n<body>\n"
-            + "\n".join(body) + "\n</body>\n</html>\n")
+    return (
+        '<!DOCTYPE html>\n<html lang="en">\n<head>\n<meta charset="utf-8">\n'
+        f"<title>{html.escape(title)}</title>\n<style>{_CSS}</style>\n</head>\n<body>\n"
+        + "\n".join(body)
+        + "\n</body>\n</html>\n"
+    )
 
 
 def write_html_report(md: str, out_path, base_dir=None, title: str = "rocklab report") -> Path:

@@ -45,21 +45,33 @@ def plot_oas(o, path):
     ax[1].axvline(o.f_min_rad_s, ls="--", color="C3", label=f"f_min: t_I = {o.t_I_s:.3f} s")
     if np.isfinite(o.t_I_prime_s) and np.isfinite(o.beta):
         A = np.linspace(1, o.levels.max(), 50)
-        ax[1].plot(1 / o.t_I_prime_s + A / o.beta, A, "--", color="C0",
-                   label=f"t'_I = {o.t_I_prime_s:.3f} s, beta = {o.beta:.2f}")
+        ax[1].plot(
+            1 / o.t_I_prime_s + A / o.beta,
+            A,
+            "--",
+            color="C0",
+            label=f"t'_I = {o.t_I_prime_s:.3f} s, beta = {o.beta:.2f}",
+        )
     ax[1].set(xlabel="f = p a_p/a_p,min [1/s]", ylabel="a_p / a_p,min", title="transformed OAS")
     ax[1].legend(fontsize=7)
     p = np.geomspace(max(o.p_rad_s.min(), 0.05), o.p_rad_s.max(), 300)
     ax[2].plot(1 / o.p_min_rad_s, o.levels, "k-", lw=1.2, label="OAS")
     ax[2].plot(1 / p, simplified_oas(p, o.t_I_s, i_cr=o.i_cr), "--", color="C3", label="Eq. 21")
     if np.isfinite(o.t_I_prime_s) and np.isfinite(o.beta):
-        ax[2].plot(1 / p, simplified_oas(p, o.t_I_s, o.t_I_prime_s, o.beta, kind="eq29"), ":", color="C0",
-                   label="Eq. 29")
-        ax[2].plot(1 / p, simplified_oas(p, o.t_I_s, o.t_I_prime_s, o.beta, o.i_cr, kind="eq30"), "-.",
-                   color="C2", label="Eq. 30")
+        ax[2].plot(
+            1 / p, simplified_oas(p, o.t_I_s, o.t_I_prime_s, o.beta, kind="eq29"), ":", color="C0", label="Eq. 29"
+        )
+        ax[2].plot(
+            1 / p,
+            simplified_oas(p, o.t_I_s, o.t_I_prime_s, o.beta, o.i_cr, kind="eq30"),
+            "-.",
+            color="C2",
+            label="Eq. 30",
+        )
     xmax = 1.5 * np.nanmax(1 / o.p_min_rad_s) if np.isfinite(o.p_min_rad_s).any() else 1 / p.min()
-    ax[2].set(xlabel="1/p [s]", ylabel="a_p / a_p,min", ylim=(0, o.levels.max() * 1.05), xlim=(0, xmax),
-              title="over 1/p")
+    ax[2].set(
+        xlabel="1/p [s]", ylabel="a_p / a_p,min", ylim=(0, o.levels.max() * 1.05), xlim=(0, xmax), title="over 1/p"
+    )
     ax[2].legend(fontsize=7)
     ax[0].legend(fontsize=7)
     return save_png(fig, path, dpi=120, tight=False)
@@ -87,8 +99,9 @@ def _error_maps(mechs, ys, ylabel, path, ratios, accs, title):
     t1 = np.array([e["t_ratio_kappa1"] for e in errs])
     t2 = np.array([e["t_ratio_kappa2"] for e in errs])
     plt, fig, ax = _fig(3)
-    for k, (Z, x, lab) in enumerate(((T, ratios, "phi/phi_cr"), (t1, accs, "u_g/(g lambda)  [kappa1]"),
-                                      (t2, accs, "u_g/(g lambda)  [kappa2]"))):
+    for k, (Z, x, lab) in enumerate(
+        ((T, ratios, "phi/phi_cr"), (t1, accs, "u_g/(g lambda)  [kappa1]"), (t2, accs, "u_g/(g lambda)  [kappa2]"))
+    ):
         cs = ax[k].contourf(x, ys, Z, levels=15, cmap="viridis")
         fig.colorbar(cs, ax=ax[k])
         ax[k].set(xlabel=lab, ylabel=ylabel)
@@ -96,8 +109,14 @@ def _error_maps(mechs, ys, ylabel, path, ratios, accs, title):
     ax[1].set_title("t_over,blockeq / t_over")
     ax[2].set_title("t_over,blockeq / t_over")
     save_png(fig, path, dpi=120, tight=False)
-    return dict(y=np.asarray(ys), ratios=np.asarray(ratios), accs=np.asarray(accs), period_ratio=T,
-                t_ratio_kappa1=t1, t_ratio_kappa2=t2)
+    return dict(
+        y=np.asarray(ys),
+        ratios=np.asarray(ratios),
+        accs=np.asarray(accs),
+        period_ratio=T,
+        t_ratio_kappa1=t1,
+        t_ratio_kappa2=t2,
+    )
 
 
 def plot_wall_error_maps(path, alphas=None, ratios=None, accs=None, R_m=1.0):
@@ -108,12 +127,21 @@ def plot_wall_error_maps(path, alphas=None, ratios=None, accs=None, R_m=1.0):
     alphas = np.linspace(0.05, 0.4, 8) if alphas is None else np.asarray(alphas)
     ratios = np.linspace(0.05, 0.95, 10) if ratios is None else np.asarray(ratios)
     accs = np.linspace(1.1, 4.0, 8) if accs is None else np.asarray(accs)
-    return _error_maps([wall_mechanism(R_m, a) for a in alphas], alphas, "alpha [rad]", path, ratios, accs,
-                       "wall")
+    return _error_maps([wall_mechanism(R_m, a) for a in alphas], alphas, "alpha [rad]", path, ratios, accs, "wall")
 
 
-def plot_frame_error_maps(path, H1_over_H=None, direction="+", b_m=0.3, H_m=2.0, L_m=3.0, h_m=0.2,
-                          masses=(1.0, 1.0, 1.0), ratios=None, accs=None):
+def plot_frame_error_maps(
+    path,
+    H1_over_H=None,
+    direction="+",
+    b_m=0.3,
+    H_m=2.0,
+    L_m=3.0,
+    h_m=0.2,
+    masses=(1.0, 1.0, 1.0),
+    ratios=None,
+    accs=None,
+):
     """Asymmetric frame error maps over (phi/phi_cr or u/(g lambda), H1/H) for one rocking
     direction (paper Fig. 6–8). Returns the arrays."""
     from ...models import asymmetric_frame
@@ -137,8 +165,16 @@ def plot_tI_vs_tp(table, path, slenderness: float = 12.0):
     if "t_I_p05_s" in ok.columns:
         lo = (ok["t_I_s"] - ok["t_I_p05_s"]).clip(lower=0)
         hi = (ok["t_I_p95_s"] - ok["t_I_s"]).clip(lower=0)
-        ax.errorbar(ok["t_p_s"], ok["t_I_s"], yerr=[lo, hi], fmt="o", color="C0", ms=4, elinewidth=0.8,
-                    label=f"rocklab, median and 90 % band (H/B = {slenderness:g})")
+        ax.errorbar(
+            ok["t_p_s"],
+            ok["t_I_s"],
+            yerr=[lo, hi],
+            fmt="o",
+            color="C0",
+            ms=4,
+            elinewidth=0.8,
+            label=f"rocklab, median and 90 % band (H/B = {slenderness:g})",
+        )
     else:
         ax.plot(ok["t_p_s"], ok["t_I_s"], "o", color="C0", label=f"rocklab (H/B = {slenderness:g})")
     th = ok[np.isfinite(ok["thesis_t_I_s"].astype(float))]
@@ -147,10 +183,18 @@ def plot_tI_vs_tp(table, path, slenderness: float = 12.0):
         for _, r in th.iterrows():
             ax.plot([r["t_p_s"], r["thesis_t_p_s"]], [r["t_I_s"], r["thesis_t_I_s"]], color="0.6", lw=0.6)
     for _, r in ok.iterrows():
-        ax.annotate(str(r["thesis_id"] or r["name"]), (r["t_p_s"], r["t_I_s"]), fontsize=6, xytext=(3, 2),
-                    textcoords="offset points")
-    lim = float(np.nanmax(np.r_[ok["t_p_s"], ok["t_I_s"], th["thesis_t_I_s"] if len(th) else []])) * 1.1 \
-        if len(ok) else 1.0
+        ax.annotate(
+            str(r["thesis_id"] or r["name"]),
+            (r["t_p_s"], r["t_I_s"]),
+            fontsize=6,
+            xytext=(3, 2),
+            textcoords="offset points",
+        )
+    lim = (
+        float(np.nanmax(np.r_[ok["t_p_s"], ok["t_I_s"], th["thesis_t_I_s"] if len(th) else []])) * 1.1
+        if len(ok)
+        else 1.0
+    )
     ax.plot([0, lim], [0, lim], "k:", lw=0.8, label="t_I = t_p")
     ax.set_xlim(0, lim)
     ax.set_ylim(0, lim)

@@ -18,12 +18,26 @@ from ..._procs import dask_client, pool_initializer
 __all__ = ["oas_summary_row", "oas_many", "expand_records", "thesis_table4", "table4_row"]
 
 #: Extra columns with ``--band``: the 90 % band of each quantity and the default member's t_I.
-BAND_COLUMNS = ["t_I_p05_s", "t_I_p95_s", "t_I_prime_p05_s", "t_I_prime_p95_s", "beta_p05", "beta_p95",
-                "t_I_default_s"]
+BAND_COLUMNS = ["t_I_p05_s", "t_I_p95_s", "t_I_prime_p05_s", "t_I_prime_p95_s", "beta_p05", "beta_p95", "t_I_default_s"]
 #: Columns of the record table (``rocklab oas`` with several records), in order: the first nine as
 #: scripts have always read them, then the record's name and the thesis's Table 4 values.
-TABLE_COLUMNS = ["record", "t_p_s", "t_I_s", "t_I_prime_s", "beta", "f_min", "f_min_level", "f_min_R_m", "error",
-                 "name", "thesis_id", "thesis_t_p_s", "thesis_t_I_s", "thesis_t_I_prime_s", "thesis_beta"]
+TABLE_COLUMNS = [
+    "record",
+    "t_p_s",
+    "t_I_s",
+    "t_I_prime_s",
+    "beta",
+    "f_min",
+    "f_min_level",
+    "f_min_R_m",
+    "error",
+    "name",
+    "thesis_id",
+    "thesis_t_p_s",
+    "thesis_t_I_s",
+    "thesis_t_I_prime_s",
+    "thesis_beta",
+]
 
 
 def thesis_table4():
@@ -72,8 +86,10 @@ def expand_records(paths, list_file=None) -> list:
         except (OSError, UnicodeDecodeError) as e:
             from ..._errors import InputError
 
-            raise InputError(f"--list {lf}: cannot read the list ({type(e).__name__}); give a text file with one "
-                             "record path per line") from None
+            raise InputError(
+                f"--list {lf}: cannot read the list ({type(e).__name__}); give a text file with one "
+                "record path per line"
+            ) from None
         for i, line in enumerate(lines, start=1):
             entry = line.split("#", 1)[0].strip()
             if not entry:
@@ -84,15 +100,16 @@ def expand_records(paths, list_file=None) -> list:
     for f, err in items:
         name = f.stem
         if not err and name in seen:
-            err = (f"{f}: same record name as {seen[name]}; rename one (names key the table and the figure)")
+            err = f"{f}: same record name as {seen[name]}; rename one (names key the table and the figure)"
         elif not err:
             seen[name] = f
         out.append((name, str(f), err))
     return out
 
 
-def oas_summary_row(path: str, units: str | None = None, slenderness: float = 12.0,
-                    oas_kwargs: dict | None = None, band: bool = False) -> dict:
+def oas_summary_row(
+    path: str, units: str | None = None, slenderness: float = 12.0, oas_kwargs: dict | None = None, band: bool = False
+) -> dict:
     """One record's summary row (runs in a worker process). Bad input becomes an ``error`` field.
 
     With ``band`` the row also holds the 5th/95th percentiles over
@@ -102,23 +119,44 @@ def oas_summary_row(path: str, units: str | None = None, slenderness: float = 12
     from ..._errors import InputError
     from ...models import load_base_motion, overturning_spectrum, pulse_parameters, t_I_band
 
-    row = dict(record=str(path), t_p_s=math.nan, t_I_s=math.nan, t_I_prime_s=math.nan, beta=math.nan,
-               f_min=math.nan, f_min_level=math.nan, f_min_R_m=math.nan, error="")
+    row = dict(
+        record=str(path),
+        t_p_s=math.nan,
+        t_I_s=math.nan,
+        t_I_prime_s=math.nan,
+        beta=math.nan,
+        f_min=math.nan,
+        f_min_level=math.nan,
+        f_min_R_m=math.nan,
+        error="",
+    )
     try:
         rec = load_base_motion(path, units=units)
         row["t_p_s"] = pulse_parameters(rec).t_p_s
         if band:
             b = t_I_band(rec, slenderness, **(oas_kwargs or {}))
             d = b.members[0]
-            row.update(t_I_s=b.t_I_s, t_I_prime_s=b.t_I_prime_s, beta=b.beta, f_min=math.nan,
-                       f_min_level=d["f_min_level"], f_min_R_m=d["f_min_R_m"], t_I_p05_s=b.t_I_p05_s,
-                       t_I_p95_s=b.t_I_p95_s, t_I_prime_p05_s=b.t_I_prime_p05_s, t_I_prime_p95_s=b.t_I_prime_p95_s,
-                       beta_p05=b.beta_p05, beta_p95=b.beta_p95, t_I_default_s=d["t_I_s"])
+            row.update(
+                t_I_s=b.t_I_s,
+                t_I_prime_s=b.t_I_prime_s,
+                beta=b.beta,
+                f_min=math.nan,
+                f_min_level=d["f_min_level"],
+                f_min_R_m=d["f_min_R_m"],
+                t_I_p05_s=b.t_I_p05_s,
+                t_I_p95_s=b.t_I_p95_s,
+                t_I_prime_p05_s=b.t_I_prime_p05_s,
+                t_I_prime_p95_s=b.t_I_prime_p95_s,
+                beta_p05=b.beta_p05,
+                beta_p95=b.beta_p95,
+                t_I_default_s=d["t_I_s"],
+            )
         else:
             o = overturning_spectrum(rec, slenderness, **(oas_kwargs or {}))
             lv, R = o.f_min_at
-            row.update(t_I_s=o.t_I_s, t_I_prime_s=o.t_I_prime_s, beta=o.beta, f_min=o.f_min_rad_s,
-                       f_min_level=lv, f_min_R_m=R)
+            row.update(
+                t_I_s=o.t_I_s, t_I_prime_s=o.t_I_prime_s, beta=o.beta, f_min=o.f_min_rad_s, f_min_level=lv, f_min_R_m=R
+            )
     except InputError as e:
         row["error"] = str(e)
     return row
@@ -131,8 +169,16 @@ def _one_numba_thread():
     numba.set_num_threads(1)
 
 
-def oas_many(paths, units: str | None = None, slenderness: float = 12.0, oas_kwargs: dict | None = None,
-             workers: int | None = None, scheduler: str | None = None, progress: bool = True, band: bool = False):
+def oas_many(
+    paths,
+    units: str | None = None,
+    slenderness: float = 12.0,
+    oas_kwargs: dict | None = None,
+    workers: int | None = None,
+    scheduler: str | None = None,
+    progress: bool = True,
+    band: bool = False,
+):
     """Summary table (pandas DataFrame, input order) of many records' OAS.
 
     Parameters
@@ -177,8 +223,9 @@ def oas_many(paths, units: str | None = None, slenderness: float = 12.0, oas_kwa
         else:
             from concurrent.futures import ProcessPoolExecutor, as_completed
 
-            with ProcessPoolExecutor(max_workers=workers, initializer=pool_initializer,
-                                     initargs=(os.getpid(), _one_numba_thread)) as ex:
+            with ProcessPoolExecutor(
+                max_workers=workers, initializer=pool_initializer, initargs=(os.getpid(), _one_numba_thread)
+            ) as ex:
                 futs = {ex.submit(oas_summary_row, p, *args): i for i, p in enumerate(paths)}
                 for f in as_completed(futs):
                     rows[futs[f]] = f.result()
@@ -189,8 +236,16 @@ def oas_many(paths, units: str | None = None, slenderness: float = 12.0, oas_kwa
     return pd.DataFrame(rows, columns=cols + (BAND_COLUMNS if band else []))
 
 
-def oas_table(items, units: str | None = None, slenderness: float = 12.0, oas_kwargs: dict | None = None,
-              workers: int | None = None, scheduler: str | None = None, progress: bool = True, band: bool = False):
+def oas_table(
+    items,
+    units: str | None = None,
+    slenderness: float = 12.0,
+    oas_kwargs: dict | None = None,
+    workers: int | None = None,
+    scheduler: str | None = None,
+    progress: bool = True,
+    band: bool = False,
+):
     """The record table (:data:`TABLE_COLUMNS`) of :func:`expand_records` items.
 
     Records with an error from the expansion are not run; each row carries the
@@ -202,8 +257,16 @@ def oas_table(items, units: str | None = None, slenderness: float = 12.0, oas_kw
     import pandas as pd
 
     ok = [(n, p) for n, p, e in items if not e]
-    res = oas_many([p for _, p in ok], units=units, slenderness=slenderness, oas_kwargs=oas_kwargs,
-                   workers=workers, scheduler=scheduler, progress=progress, band=band)
+    res = oas_many(
+        [p for _, p in ok],
+        units=units,
+        slenderness=slenderness,
+        oas_kwargs=oas_kwargs,
+        workers=workers,
+        scheduler=scheduler,
+        progress=progress,
+        band=band,
+    )
     by_path = {r["record"]: r for r in res.to_dict(orient="records")}
     t4 = thesis_table4()
     rows = []
@@ -215,7 +278,12 @@ def oas_table(items, units: str | None = None, slenderness: float = 12.0, oas_kw
             row.update({k: v for k, v in by_path[path].items() if k in row})
         hit = table4_row(name, t4) if abs(slenderness - 12.0) < 1e-9 else None
         if hit is not None:
-            row.update(thesis_id=hit["ff_id"], thesis_t_p_s=float(hit["t_p_s"]), thesis_t_I_s=float(hit["t_I_s"]),
-                       thesis_t_I_prime_s=float(hit["t_I_prime_s"]), thesis_beta=float(hit["beta"]))
+            row.update(
+                thesis_id=hit["ff_id"],
+                thesis_t_p_s=float(hit["t_p_s"]),
+                thesis_t_I_s=float(hit["t_I_s"]),
+                thesis_t_I_prime_s=float(hit["t_I_prime_s"]),
+                thesis_beta=float(hit["beta"]),
+            )
         rows.append(row)
     return pd.DataFrame(rows, columns=columns)

@@ -12,5 +12,15 @@ from ._read import ImuLog, read_imu, read_ximu_registers, ximu_rate_from_registe
 from ._rotation import ImuRotation, ahrs_quaternions, ahrs_rotation, block_rotation
 from ._table import TableAcceleration, table_acceleration
 
-__all__ = ["ImuLog", "read_imu", "read_ximu_registers", "ximu_rate_from_registers", "ImuRotation",
-           "block_rotation", "ahrs_rotation", "ahrs_quaternions", "TableAcceleration", "table_acceleration"]
+__all__ = [
+    "ImuLog",
+    "read_imu",
+    "read_ximu_registers",
+    "ximu_rate_from_registers",
+    "ImuRotation",
+    "block_rotation",
+    "ahrs_rotation",
+    "ahrs_quaternions",
+    "TableAcceleration",
+    "table_acceleration",
+]

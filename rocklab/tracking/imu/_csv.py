@@ -16,8 +16,7 @@ from ...blocks import G
 
 __all__ = []
 
-_GYRO_UNITS = {"deg/s": math.pi / 180.0, "dps": math.pi / 180.0, "°/s": math.pi / 180.0,
-               "rad/s": 1.0}
+_GYRO_UNITS = {"deg/s": math.pi / 180.0, "dps": math.pi / 180.0, "°/s": math.pi / 180.0, "rad/s": 1.0}
 _ACC_UNITS = {"g": G, "m/s2": 1.0, "m/s^2": 1.0, "m/s²": 1.0}
 _TIME_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "µs": 1e-6}
 _ROLES = ("gyro_x", "gyro_y", "gyro_z", "acc_x", "acc_y", "acc_z")
@@ -53,8 +52,7 @@ def _read_csv(path: Path):
     except pd.errors.EmptyDataError:
         raise InputError(f"{where(path)}empty file; an IMU CSV needs a header and data rows") from None
     if len(df) == 0:
-        raise InputError(f"{where(path, 2)}no data rows after the header; "
-                         "log some samples or pick another file")
+        raise InputError(f"{where(path, 2)}no data rows after the header; log some samples or pick another file")
     df.columns = [str(c).strip() for c in df.columns]
     return df
 
@@ -91,13 +89,13 @@ def _numeric(df, col, path: Path) -> np.ndarray:
         num = pd.to_numeric(df[col], errors="coerce").to_numpy(dtype=float)
         bad = np.flatnonzero(~np.isfinite(num))
         line = int(bad[0]) + 2 if bad.size else None
-        raise InputError(f"{where(path, line, col)}value {df[col].iloc[bad[0]]!r} is not a "
-                         "number; fix or delete that row")
+        raise InputError(
+            f"{where(path, line, col)}value {df[col].iloc[bad[0]]!r} is not a number; fix or delete that row"
+        )
     v = v.astype(float, copy=False)
     bad = np.flatnonzero(~np.isfinite(v))
     if bad.size:
-        raise InputError(f"{where(path, int(bad[0]) + 2, col)}missing or non-finite value; "
-                         "fix or delete that row")
+        raise InputError(f"{where(path, int(bad[0]) + 2, col)}missing or non-finite value; fix or delete that row")
     return v
 
 
@@ -111,16 +109,16 @@ def _inertial_columns(df, path: Path) -> dict[str, tuple[str, float]]:
         kind, ax, unit = m.group(1).lower(), m.group(2).lower(), m.group(3).strip().lower()
         table = _GYRO_UNITS if kind == "gyroscope" else _ACC_UNITS
         if unit not in table:
-            raise InputError(f"{where(path, 1, col)}unknown unit {unit!r}; use one of "
-                             f"{', '.join(table)} in the header")
+            raise InputError(f"{where(path, 1, col)}unknown unit {unit!r}; use one of {', '.join(table)} in the header")
         role = ("gyro_" if kind == "gyroscope" else "acc_") + ax
         found[role] = (col, table[unit])
     missing = [r for r in _ROLES if r not in found]
     if missing:
-        names = ", ".join(("Gyroscope " if r.startswith("gyro") else "Accelerometer ")
-                          + r[-1].upper() for r in missing)
-        raise InputError(f"{where(path, 1)}missing columns {names}; expected x-io headers "
-                         "like 'Gyroscope X (deg/s)', 'Accelerometer X (g)' or pass a mapping")
+        names = ", ".join(("Gyroscope " if r.startswith("gyro") else "Accelerometer ") + r[-1].upper() for r in missing)
+        raise InputError(
+            f"{where(path, 1)}missing columns {names}; expected x-io headers "
+            "like 'Gyroscope X (deg/s)', 'Accelerometer X (g)' or pass a mapping"
+        )
     return found
 
 
@@ -141,8 +139,10 @@ def _check_increasing(t: np.ndarray, path: Path, col: str) -> None:
     if bad.size:
         i = int(bad[0]) + 1
         what = "duplicate" if d[bad[0]] == 0 else "decreasing"
-        raise InputError(f"{where(path, i + 2, col)}{what} time ({t[i]!r} after {t[i - 1]!r}); "
-                         "times must increase strictly: remove repeated rows or split the log")
+        raise InputError(
+            f"{where(path, i + 2, col)}{what} time ({t[i]!r} after {t[i - 1]!r}); "
+            "times must increase strictly: remove repeated rows or split the log"
+        )
 
 
 def _gap_drops(t: np.ndarray, period: float) -> int:

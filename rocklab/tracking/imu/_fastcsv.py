@@ -20,7 +20,7 @@ from numba import njit
 
 __all__ = ["parse_numeric_csv"]
 
-_POW10 = np.array([10.0 ** k for k in range(23)])
+_POW10 = np.array([10.0**k for k in range(23)])
 
 
 @njit(cache=True, nogil=True)
@@ -86,7 +86,7 @@ def _scan(buf, start, ncols, out, pow10):  # pragma: no cover - compiled
                 e10 += -ev if eneg else ev
             v = float(mant)
             if e10 > 0:
-                v = v * pow10[e10] if e10 <= 22 else v * 10.0 ** e10
+                v = v * pow10[e10] if e10 <= 22 else v * 10.0**e10
             elif e10 < 0:
                 v = v / pow10[-e10] if e10 >= -22 else v / 10.0 ** (-e10)
             out[row, col] = -v if neg else v

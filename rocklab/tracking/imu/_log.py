@@ -55,8 +55,10 @@ class ImuLog:
     def __post_init__(self):
         n = len(self.t_s)
         if self.gyro_rad_s.shape != (n, 3) or self.acc_m_s2.shape != (n, 3):
-            raise InputError(f"ImuLog: gyro_rad_s {self.gyro_rad_s.shape} and acc_m_s2 "
-                             f"{self.acc_m_s2.shape} must both be ({n}, 3); pass (n, 3) arrays")
+            raise InputError(
+                f"ImuLog: gyro_rad_s {self.gyro_rad_s.shape} and acc_m_s2 "
+                f"{self.acc_m_s2.shape} must both be ({n}, 3); pass (n, 3) arrays"
+            )
         if self.saturated is None:
             object.__setattr__(self, "saturated", np.zeros(n, dtype=bool))
 
@@ -84,14 +86,28 @@ class ImuLog:
 
     def to_dict(self) -> dict:
         """Summary (no arrays): format, rate, sample count, drops, saturation, source."""
-        return {"format": self.format, "sample_rate_hz": float(self.rate_hz),
-                "n_samples": int(self.n), "dropped_samples": int(self.dropped_samples),
-                "saturated_samples": int(np.count_nonzero(self.saturated)),
-                "high_g_samples": int(self.high_g_samples), "duration_s": self.duration_s,
-                "source": self.source}
+        return {
+            "format": self.format,
+            "sample_rate_hz": float(self.rate_hz),
+            "n_samples": int(self.n),
+            "dropped_samples": int(self.dropped_samples),
+            "saturated_samples": int(np.count_nonzero(self.saturated)),
+            "high_g_samples": int(self.high_g_samples),
+            "duration_s": self.duration_s,
+            "source": self.source,
+        }
 
     def slice(self, i0: int, i1: int) -> "ImuLog":
         """Samples ``i0:i1`` as a new log (same rate and metadata)."""
         pk = None if self.packet is None else self.packet[i0:i1]
-        return ImuLog(self.t_s[i0:i1], self.gyro_rad_s[i0:i1], self.acc_m_s2[i0:i1],
-                      self.rate_hz, 0, self.saturated[i0:i1], self.source, self.format, pk)
+        return ImuLog(
+            self.t_s[i0:i1],
+            self.gyro_rad_s[i0:i1],
+            self.acc_m_s2[i0:i1],
+            self.rate_hz,
+            0,
+            self.saturated[i0:i1],
+            self.source,
+            self.format,
+            pk,
+        )

@@ -39,8 +39,9 @@ def moving_average(x: np.ndarray, w: int) -> np.ndarray:
     return (c[hi] - c[lo]) / cnt
 
 
-def motion_mask(t_s, gyro, acc, rate_hz, gyro_thr=STILL_GYRO_RAD_S, acc_thr=STILL_ACC_M_S2,
-                smooth_s=SMOOTH_S, bias=None):
+def motion_mask(
+    t_s, gyro, acc, rate_hz, gyro_thr=STILL_GYRO_RAD_S, acc_thr=STILL_ACC_M_S2, smooth_s=SMOOTH_S, bias=None
+):
     """Boolean mask of moving samples.
 
     A sample moves when, averaged over ``smooth_s``, the bias-removed gyro
@@ -141,10 +142,15 @@ def quat_mul(p: np.ndarray, q: np.ndarray) -> np.ndarray:
     """Hamilton product of (w, x, y, z) quaternions, broadcasting over rows."""
     pw, px, py, pz = np.moveaxis(np.asarray(p), -1, 0)
     qw, qx, qy, qz = np.moveaxis(np.asarray(q), -1, 0)
-    return np.stack([pw * qw - px * qx - py * qy - pz * qz,
-                     pw * qx + px * qw + py * qz - pz * qy,
-                     pw * qy - px * qz + py * qw + pz * qx,
-                     pw * qz + px * qy - py * qx + pz * qw], axis=-1)
+    return np.stack(
+        [
+            pw * qw - px * qx - py * qy - pz * qz,
+            pw * qx + px * qw + py * qz - pz * qy,
+            pw * qy - px * qz + py * qw + pz * qx,
+            pw * qz + px * qy - py * qx + pz * qw,
+        ],
+        axis=-1,
+    )
 
 
 def twist_angle(q_rel: np.ndarray, u: np.ndarray) -> np.ndarray:
@@ -211,7 +217,7 @@ def still_acc_start(acc, e0, e1, sigma, fs, min_rest) -> int:
     ws = max(2, int(round(0.1 * fs)))
     if e1 - e0 < min_rest:
         return e0
-    f1 = acc[e1 - min_rest:e1].mean(axis=0)
+    f1 = acc[e1 - min_rest : e1].mean(axis=0)
     sm = moving_average(acc[e0:e1], ws)
     busy = np.flatnonzero(rownorm(sm - f1) > max(5.0 * sigma / np.sqrt(ws), _FINE_ACC))
     busy = busy[busy < (e1 - e0) - ws // 2]  # the shrinking edge windows at the end are noisier

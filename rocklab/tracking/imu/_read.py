@@ -43,9 +43,20 @@ import numpy as np
 
 from ..._errors import InputError, where
 from ...blocks import G
-from ._csv import (_ACC_UNITS, _GYRO_UNITS, _ROLES, _TIME_UNITS, XIMU3_FULL_SCALE_G,
-                       _check_increasing, _gap_drops, _inertial_columns, _numeric, _read_csv,
-                       _saturation, _stack)
+from ._csv import (
+    _ACC_UNITS,
+    _GYRO_UNITS,
+    _ROLES,
+    _TIME_UNITS,
+    XIMU3_FULL_SCALE_G,
+    _check_increasing,
+    _gap_drops,
+    _inertial_columns,
+    _numeric,
+    _read_csv,
+    _saturation,
+    _stack,
+)
 from ._log import ImuLog
 from ._ximu import _read_ximu_gui, read_ximu_registers, ximu_rate_from_registers
 
@@ -78,8 +89,9 @@ def _merge_high_g(hg: Path, t: np.ndarray, acc: np.ndarray, sat: np.ndarray):
     need = ["Timestamp (us)", "X (g)", "Y (g)", "Z (g)"]
     miss = [c for c in need if c not in df.columns]
     if miss:
-        raise InputError(f"{where(hg, 1)}missing columns {', '.join(miss)}; expected "
-                         "'Timestamp (us),X (g),Y (g),Z (g)'")
+        raise InputError(
+            f"{where(hg, 1)}missing columns {', '.join(miss)}; expected 'Timestamp (us),X (g),Y (g),Z (g)'"
+        )
     th = _numeric(df, need[0], hg) * 1e-6
     _check_increasing(th, hg, need[0])
     acc = acc.copy()
@@ -99,32 +111,43 @@ def _read_timed(path: Path, rate_hz, full_scale_g, mapping) -> ImuLog:
             role, _, unit = str(spec).partition(":")
             role, unit = role.strip().lower(), unit.strip().lower()
             if name not in df.columns:
-                raise InputError(f"{where(path, 1, name)}mapped column not in the header "
-                                 f"({', '.join(df.columns)}); fix the mapping")
-            table = (_TIME_UNITS if role == "t" else _GYRO_UNITS if role.startswith("gyro_")
-                     else _ACC_UNITS if role.startswith("acc_") else None)
+                raise InputError(
+                    f"{where(path, 1, name)}mapped column not in the header ({', '.join(df.columns)}); fix the mapping"
+                )
+            table = (
+                _TIME_UNITS
+                if role == "t"
+                else _GYRO_UNITS
+                if role.startswith("gyro_")
+                else _ACC_UNITS
+                if role.startswith("acc_")
+                else None
+            )
             if table is None or (role != "t" and role not in _ROLES):
-                raise InputError(f"mapping[{name!r}]: unknown role {role!r}; use t, "
-                                 "gyro_x|y|z or acc_x|y|z as 'role:unit'")
+                raise InputError(
+                    f"mapping[{name!r}]: unknown role {role!r}; use t, gyro_x|y|z or acc_x|y|z as 'role:unit'"
+                )
             if unit not in table:
-                raise InputError(f"mapping[{name!r}]: unknown unit {unit!r} for {role}; "
-                                 f"use one of {', '.join(table)}")
+                raise InputError(f"mapping[{name!r}]: unknown unit {unit!r} for {role}; use one of {', '.join(table)}")
             if role == "t":
                 tcol, tf = name, table[unit]
             else:
                 cols[role] = (name, table[unit])
         missing = [r for r in _ROLES if r not in cols]
         if missing:
-            raise InputError(f"mapping: roles {', '.join(missing)} not mapped; map every "
-                             "gyro_x|y|z and acc_x|y|z column")
+            raise InputError(
+                f"mapping: roles {', '.join(missing)} not mapped; map every gyro_x|y|z and acc_x|y|z column"
+            )
         fmt = "mapped"
     else:
         cols = _inertial_columns(df, path)
         tcol = next((c for c in df.columns if c.lower() in ("time (s)", "t_s")), None)
         tf, fmt = 1.0, "fusion"
         if tcol is None and rate_hz is None:
-            raise InputError(f"{where(path, 1)}no 'Time (s)' column and no rate; add the "
-                             "column, pass a mapping, or give the rate with --rate / rate_hz=")
+            raise InputError(
+                f"{where(path, 1)}no 'Time (s)' column and no rate; add the "
+                "column, pass a mapping, or give the rate with --rate / rate_hz="
+            )
     gyro, acc = _stack(df, cols, path)
     if tcol is None:
         t = np.arange(len(df)) / float(rate_hz)
@@ -132,8 +155,7 @@ def _read_timed(path: Path, rate_hz, full_scale_g, mapping) -> ImuLog:
         t = _numeric(df, tcol, path) * tf
         _check_increasing(t, path, tcol)
     period = 1.0 / rate_hz if rate_hz else float(np.median(np.diff(t))) if len(t) > 1 else 1.0
-    return ImuLog(t, gyro, acc, 1.0 / period, _gap_drops(t, period),
-                  _saturation(acc, full_scale_g), str(path), fmt)
+    return ImuLog(t, gyro, acc, 1.0 / period, _gap_drops(t, period), _saturation(acc, full_scale_g), str(path), fmt)
 
 
 def _resolve(path: Path) -> Path:
@@ -141,20 +163,28 @@ def _resolve(path: Path) -> Path:
     if path.is_file():
         return path
     if path.is_dir():
-        pats = ("*_CalInertialAndMag.csv", "*_CalInertialMagnetic.csv", "Inertial.csv",
-                "*/Inertial.csv", "sensor_data.csv")
+        pats = (
+            "*_CalInertialAndMag.csv",
+            "*_CalInertialMagnetic.csv",
+            "Inertial.csv",
+            "*/Inertial.csv",
+            "sensor_data.csv",
+        )
         for pat in pats:
             hits = sorted(path.glob(pat))
             if len(hits) == 1:
                 return hits[0]
             if len(hits) > 1:
-                raise InputError(f"{where(path)}{len(hits)} logs match {pat} "
-                                 f"({hits[0].name}, {hits[1].name}, ...); give one file")
+                raise InputError(
+                    f"{where(path)}{len(hits)} logs match {pat} ({hits[0].name}, {hits[1].name}, ...); give one file"
+                )
         csvs = sorted(path.glob("*.csv"))
         if len(csvs) == 1:
             return csvs[0]
-        raise InputError(f"{where(path)}no IMU log found (looked for *_CalInertialAndMag.csv, "
-                         "Inertial.csv, a single *.csv); give the file")
+        raise InputError(
+            f"{where(path)}no IMU log found (looked for *_CalInertialAndMag.csv, "
+            "Inertial.csv, a single *.csv); give the file"
+        )
     for suffix in ("_CalInertialAndMag.csv", "_CalInertialMagnetic.csv"):
         cand = path.with_name(path.name + suffix)
         if cand.is_file():
@@ -162,8 +192,9 @@ def _resolve(path: Path) -> Path:
     raise FileNotFoundError(2, "no such file or folder", str(path))
 
 
-def read_imu(path, rate_hz: float | None = None, mapping: dict | None = None,
-             full_scale_g: float | None = None) -> ImuLog:
+def read_imu(
+    path, rate_hz: float | None = None, mapping: dict | None = None, full_scale_g: float | None = None
+) -> ImuLog:
     """Read an IMU log into SI units.
 
     Parameters
@@ -219,24 +250,34 @@ def check_imu_log(log: ImuLog, rate_option_hz: float | None = None) -> ImuLog:
         period = float(np.median(d))
         ts_rate = 1.0 / period
         if not lo <= ts_rate <= hi:
-            raise InputError(f"{log.source}: timestamps give {ts_rate:.4g} Hz, not an IMU sample rate "
-                             f"({lo:g}-{hi:g} Hz); check the time column's units (s/ms/us) or the rate register")
+            raise InputError(
+                f"{log.source}: timestamps give {ts_rate:.4g} Hz, not an IMU sample rate "
+                f"({lo:g}-{hi:g} Hz); check the time column's units (s/ms/us) or the rate register"
+            )
         timed = log.format != "ximu-gui"  # x-IMU GUI times come from packet numbers and the rate
         if timed and rate_option_hz is not None and abs(rate_option_hz / ts_rate - 1) > 0.02:
-            warn("W-IMU-RATE", f"{log.source}: --rate {rate_option_hz:g} Hz but the timestamps say "
-                               f"{ts_rate:.4g} Hz; the timestamps are used")
+            warn(
+                "W-IMU-RATE",
+                f"{log.source}: --rate {rate_option_hz:g} Hz but the timestamps say "
+                f"{ts_rate:.4g} Hz; the timestamps are used",
+            )
             from ._csv import _gap_drops
 
             log = dataclasses.replace(log, rate_hz=ts_rate, dropped_samples=_gap_drops(log.t_s, period))
         gap = d > max(10 * period, 0.05)
         if gap.any():
             i = int(np.argmax(d))
-            warn("W-IMU-CLOCK", f"{log.source}: {int(gap.sum())} gap(s) in the clock, the longest "
-                                f"{d[i]:.4g} s at t = {log.t_s[i]:.4g} s ({int(round(d[i] / period)) - 1} "
-                                "samples missing or a clock jump)")
+            warn(
+                "W-IMU-CLOCK",
+                f"{log.source}: {int(gap.sum())} gap(s) in the clock, the longest "
+                f"{d[i]:.4g} s at t = {log.t_s[i]:.4g} s ({int(round(d[i] / period)) - 1} "
+                "samples missing or a clock jump)",
+            )
     if not lo <= log.rate_hz <= hi:
-        raise InputError(f"{log.source}: sample rate {log.rate_hz:.4g} Hz (rate register or --rate) is not "
-                         f"an IMU rate ({lo:g}-{hi:g} Hz); check the register or give --rate")
+        raise InputError(
+            f"{log.source}: sample rate {log.rate_hz:.4g} Hz (rate register or --rate) is not "
+            f"an IMU rate ({lo:g}-{hi:g} Hz); check the register or give --rate"
+        )
     return log
 
 
@@ -252,7 +293,9 @@ def _read_any(p: Path, rate_hz, mapping, full_scale_g) -> ImuLog:
     if "Packet number" in head:
         # A renamed x-IMU export: needs the rate from the user.
         if rate_hz is None:
-            raise InputError(f"{where(p)}x-IMU 'Packet number' log without a "
-                             "_CalInertialAndMag.csv name; give the rate with --rate / rate_hz=")
+            raise InputError(
+                f"{where(p)}x-IMU 'Packet number' log without a "
+                "_CalInertialAndMag.csv name; give the rate with --rate / rate_hz="
+            )
         return _read_ximu_gui(p, rate_hz, full_scale_g)
     return _read_timed(p, rate_hz, full_scale_g, None)

@@ -62,10 +62,14 @@ class TableAcceleration:
 
     def to_dict(self) -> dict:
         """Summary: direction, tilt, rest window, peak acceleration, rate, source."""
-        return {"direction": [float(v) for v in self.direction], "tilt_rad": float(self.tilt_rad),
-                "rest_s": [float(v) for v in self.rest_s],
-                "pga_m_s2": float(np.max(np.abs(self.acc_m_s2))) if len(self.acc_m_s2) else 0.0,
-                "sample_rate_hz": float(self.rate_hz), "source": self.source}
+        return {
+            "direction": [float(v) for v in self.direction],
+            "tilt_rad": float(self.tilt_rad),
+            "rest_s": [float(v) for v in self.rest_s],
+            "pga_m_s2": float(np.max(np.abs(self.acc_m_s2))) if len(self.acc_m_s2) else 0.0,
+            "sample_rate_hz": float(self.rate_hz),
+            "source": self.source,
+        }
 
     def to_base_motion(self, name: str = "table_imu"):
         """As a :class:`rocklab.models.BaseMotion`: uniform grid at the log rate, time from 0.
@@ -76,12 +80,17 @@ class TableAcceleration:
 
         n = int(np.floor((self.t_s[-1] - self.t_s[0]) * self.rate_hz)) + 1
         t = self.t_s[0] + np.arange(n) / self.rate_hz
-        return BaseMotion.from_samples(np.interp(t, self.t_s, self.acc_m_s2), 1.0 / self.rate_hz,
-                                       "m/s2", name=name)
+        return BaseMotion.from_samples(np.interp(t, self.t_s, self.acc_m_s2), 1.0 / self.rate_hz, "m/s2", name=name)
 
 
-def table_acceleration(log: ImuLog, axis: str | None = "x", *, still_gyro_deg_s: float = 2.0,
-                       still_acc_g: float = 0.03, min_rest_s: float = 0.2) -> TableAcceleration:
+def table_acceleration(
+    log: ImuLog,
+    axis: str | None = "x",
+    *,
+    still_gyro_deg_s: float = 2.0,
+    still_acc_g: float = 0.03,
+    min_rest_s: float = 0.2,
+) -> TableAcceleration:
     """Base acceleration along the shaking direction from a table IMU.
 
     Parameters
@@ -107,14 +116,15 @@ def table_acceleration(log: ImuLog, axis: str | None = "x", *, still_gyro_deg_s:
         No rest window at the start of the log.
     """
     fs = float(log.rate_hz)
-    moving = motion_mask(log.t_s, log.gyro_rad_s, log.acc_m_s2, fs,
-                         np.deg2rad(still_gyro_deg_s), still_acc_g * G)
+    moving = motion_mask(log.t_s, log.gyro_rad_s, log.acc_m_s2, fs, np.deg2rad(still_gyro_deg_s), still_acc_g * G)
     i_move = first_motion(moving, max(2, int(round(0.1 * fs))))
     i_move = log.n if i_move is None else i_move
     s1 = max(0, i_move - max(1, int(round(0.05 * fs))))
     if s1 < max(3, int(round(min_rest_s * fs))):
-        raise InputError(f"{log.source}: no rest of {min_rest_s:g} s before the shaking starts "
-                         f"(first motion at {log.t_s[i_move]:.3f} s); log a still table first")
+        raise InputError(
+            f"{log.source}: no rest of {min_rest_s:g} s before the shaking starts "
+            f"(first motion at {log.t_s[i_move]:.3f} s); log a still table first"
+        )
     g_s = log.acc_m_s2[:s1].mean(axis=0)
     R = rotation_between(g_s, np.array([0.0, 0.0, 1.0]))
     nearest = np.zeros(3)
@@ -135,9 +145,9 @@ def table_acceleration(log: ImuLog, axis: str | None = "x", *, still_gyro_deg_s:
         d = R @ axis_vector(axis)
         d[2] = 0.0
         if np.linalg.norm(d) < 0.2:
-            raise InputError(f"axis={axis!r}: that sensor axis is (nearly) vertical on the "
-                             "table; name a horizontal sensor axis")
+            raise InputError(
+                f"axis={axis!r}: that sensor axis is (nearly) vertical on the table; name a horizontal sensor axis"
+            )
     d /= np.linalg.norm(d)
     acc = a_w @ d
-    return TableAcceleration(log.t_s, acc, R.T @ d, tilt,
-                             (float(log.t_s[0]), float(log.t_s[s1 - 1])), fs, log.source)
+    return TableAcceleration(log.t_s, acc, R.T @ d, tilt, (float(log.t_s[0]), float(log.t_s[s1 - 1])), fs, log.source)

@@ -35,8 +35,10 @@ def read_ximu_registers(path) -> dict:
     df = _read_csv(path)
     for need in ("Address", "Value"):
         if need not in df.columns:
-            raise InputError(f"{where(path, 1)}missing column {need!r}; expected x-IMU "
-                             "'Packet number,Address,Value,Fixed-point value,Name'")
+            raise InputError(
+                f"{where(path, 1)}missing column {need!r}; expected x-IMU "
+                "'Packet number,Address,Value,Fixed-point value,Name'"
+            )
     addr = _numeric(df, "Address", path).astype(int)
     val = _numeric(df, "Value", path)
     names = df["Name"].astype(str).str.strip().tolist() if "Name" in df.columns else [""] * len(df)
@@ -67,13 +69,17 @@ def ximu_rate_from_registers(path, legacy: bool = False) -> float:
         if not has_names and addr in regs:
             value = regs[addr]
     if value is None:
-        raise InputError(f"{where(path)}no inertial rate register (Name "
-                         "'InertialAndMagneticDataRate', address 69; 54 on old firmware); "
-                         "give the rate with --rate / rate_hz=")
+        raise InputError(
+            f"{where(path)}no inertial rate register (Name "
+            "'InertialAndMagneticDataRate', address 69; 54 on old firmware); "
+            "give the rate with --rate / rate_hz="
+        )
     fs = math.floor(2.0 ** (value - 1))
     if fs <= 0:
-        raise InputError(f"{where(path, key='InertialAndMagneticDataRate')}value {value:g} means "
-                         "the inertial data were disabled; give the rate with --rate / rate_hz=")
+        raise InputError(
+            f"{where(path, key='InertialAndMagneticDataRate')}value {value:g} means "
+            "the inertial data were disabled; give the rate with --rate / rate_hz="
+        )
     return float(fs)
 
 
@@ -94,8 +100,10 @@ def _read_ximu_gui(path: Path, rate_hz: float | None, full_scale_g: float | None
     regs = path.with_name(name[: -len(suffix)] + "_Registers.csv") if name.endswith(suffix) else None
     if rate_hz is None:
         if regs is None or not regs.is_file():
-            raise InputError(f"{where(path)}no <base>_Registers.csv next to it to read the sample "
-                             "rate from; give the rate with --rate / rate_hz=")
+            raise InputError(
+                f"{where(path)}no <base>_Registers.csv next to it to read the sample "
+                "rate from; give the rate with --rate / rate_hz="
+            )
         rate_hz = ximu_rate_from_registers(regs, legacy=legacy)
     df = _read_csv(path)
     if "Packet number" not in df.columns:
@@ -112,8 +120,7 @@ def _read_ximu_gui(path: Path, rate_hz: float | None, full_scale_g: float | None
     if full_scale_g is None and regs is not None and regs.is_file():
         full_scale_g = _ximu_full_scale_g(regs)
     sat = _saturation(acc, full_scale_g)
-    return ImuLog(index / rate_hz, gyro, acc, float(rate_hz), dropped, sat, str(path),
-                  "ximu-gui", pk)
+    return ImuLog(index / rate_hz, gyro, acc, float(rate_hz), dropped, sat, str(path), "ximu-gui", pk)
 
 
 def _ximu_sample_index(pk: np.ndarray) -> tuple[np.ndarray, int]:
@@ -145,5 +152,5 @@ def _ximu_sample_index(pk: np.ndarray) -> tuple[np.ndarray, int]:
         s = slice(max(0, g - 63), g + 1)
         phase = float(np.mean(pk[s] - per * index[s]))
         new = max(index[g] + 1.0, float(np.rint((pk[g + 1] - phase) / per)))
-        index[g + 1:] += new - index[g + 1]
+        index[g + 1 :] += new - index[g + 1]
     return index, int(round(index[-1] - (n - 1)))

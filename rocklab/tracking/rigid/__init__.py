@@ -19,8 +19,32 @@ from ._plane import audit_plane_track, plane_pivot_motion
 from ._rocking import RockingGeometry, find_impacts, fit_pivots, rocking_axes, split_rotation
 from ._track3d import TRACK3D_COLUMNS, Body3D, Track3DResult, parse_bodies, track_points3d
 
-__all__ = ["PointSeries", "read_points", "read_points_csv", "read_c3d", "write_points_csv", "write_c3d",
-           "kabsch", "body_poses", "BodyPoses", "reference_shape",
-           "RockingGeometry", "rocking_axes", "split_rotation", "find_impacts", "fit_pivots",
-           "track_points3d", "Track3DResult", "Body3D", "TRACK3D_COLUMNS", "parse_bodies",
-           "audit_rocking", "audit_plane_track", "plane_pivot_motion", "AuditResult", "AuditFlag", "AuditTolerances", "FLAG_KINDS"]
+__all__ = [
+    "PointSeries",
+    "read_points",
+    "read_points_csv",
+    "read_c3d",
+    "write_points_csv",
+    "write_c3d",
+    "kabsch",
+    "body_poses",
+    "BodyPoses",
+    "reference_shape",
+    "RockingGeometry",
+    "rocking_axes",
+    "split_rotation",
+    "find_impacts",
+    "fit_pivots",
+    "track_points3d",
+    "Track3DResult",
+    "Body3D",
+    "TRACK3D_COLUMNS",
+    "parse_bodies",
+    "audit_rocking",
+    "audit_plane_track",
+    "plane_pivot_motion",
+    "AuditResult",
+    "AuditFlag",
+    "AuditTolerances",
+    "FLAG_KINDS",
+]

@@ -107,8 +107,14 @@ class AuditFlag:
 
     def to_dict(self) -> dict:
         """The JSON object of ``audit.json``'s ``flags`` list."""
-        return {"kind": self.kind, "t_s": self.t_s, "value": self.value, "tolerance": self.tolerance,
-                "impact": self.impact, "detail": self.detail}
+        return {
+            "kind": self.kind,
+            "t_s": self.t_s,
+            "value": self.value,
+            "tolerance": self.tolerance,
+            "impact": self.impact,
+            "detail": self.detail,
+        }
 
     def describe(self) -> str:
         """One line for people, 4 significant digits with units."""
@@ -163,23 +169,33 @@ class AuditResult:
 
     def to_dict(self) -> dict:
         """The ``audit.json`` object: ``verdict``, ``flags`` and the context to read them."""
-        return {"verdict": self.verdict, "flags": [f.to_dict() for f in self.flags],
-                "excluded_impacts": list(self.excluded_impacts), "checked": list(self.checked),
-                "impacts_t_s": [float(x) for x in self.impacts_t_s], "maxima": dict(self.maxima),
-                "tolerances": self.tolerances.to_dict(), "source": self.source, "notes": list(self.notes),
-                "noise": dict(self.noise)}
+        return {
+            "verdict": self.verdict,
+            "flags": [f.to_dict() for f in self.flags],
+            "excluded_impacts": list(self.excluded_impacts),
+            "checked": list(self.checked),
+            "impacts_t_s": [float(x) for x in self.impacts_t_s],
+            "maxima": dict(self.maxima),
+            "tolerances": self.tolerances.to_dict(),
+            "source": self.source,
+            "notes": list(self.notes),
+            "noise": dict(self.noise),
+        }
 
     def to_frame(self):
         """One row per flag: ``kind, detail, impact, t_s, value, tolerance``."""
         import pandas as pd
 
-        return pd.DataFrame([f.to_dict() for f in self.flags],
-                            columns=["kind", "detail", "impact", "t_s", "value", "tolerance"])
+        return pd.DataFrame(
+            [f.to_dict() for f in self.flags], columns=["kind", "detail", "impact", "t_s", "value", "tolerance"]
+        )
 
     def report(self) -> str:
         """Readable text: the verdict, then one line per flag."""
-        lines = [f"assumption audit ({self.source}): {self.verdict}; {len(self.impacts_t_s)} impacts, "
-                 f"checked {', '.join(self.checked) or 'nothing'}"]
+        lines = [
+            f"assumption audit ({self.source}): {self.verdict}; {len(self.impacts_t_s)} impacts, "
+            f"checked {', '.join(self.checked) or 'nothing'}"
+        ]
         lines += ["  " + f.describe() for f in self.flags]
         if self.excluded_impacts:
             lines.append(f"  impacts a fit should exclude: {', '.join(map(str, self.excluded_impacts))}")
@@ -237,15 +253,25 @@ def _touches(t, th, seg, hyst):
         a = np.abs(th[idx])
         peaks, _ = find_peaks(a, prominence=2.0 * hyst)
         for p0, p1 in zip(peaks[:-1], peaks[1:]):
-            v = p0 + int(np.argmin(a[p0:p1 + 1]))
+            v = p0 + int(np.argmin(a[p0 : p1 + 1]))
             if a[v] < 0.5 * min(a[p0], a[p1]):
                 out.append((int(idx[v]), float(min(a[p0], a[p1]))))
     return out
 
 
-def audit_rocking(t_s, theta_rad, *, slide_m=None, uplift_m=None, twist_rad=None, out_of_plane_rad=None,
-                  sigma_theta_rad: float | None = None, tolerances: AuditTolerances | None = None,
-                  source: str = "3d", noise_floor: dict | None = None) -> AuditResult:
+def audit_rocking(
+    t_s,
+    theta_rad,
+    *,
+    slide_m=None,
+    uplift_m=None,
+    twist_rad=None,
+    out_of_plane_rad=None,
+    sigma_theta_rad: float | None = None,
+    tolerances: AuditTolerances | None = None,
+    source: str = "3d",
+    noise_floor: dict | None = None,
+) -> AuditResult:
     """Check one block's run against the planar-rocking assumptions.
 
     Parameters
@@ -287,15 +313,17 @@ def audit_rocking(t_s, theta_rad, *, slide_m=None, uplift_m=None, twist_rad=None
     maxima: dict = {}
     noise: dict = {}
     notes: list[str] = []
-    k_sigma = 4.0                   # a flag needs the departure beyond the tolerance by 4 sigma of its noise
+    k_sigma = 4.0  # a flag needs the departure beyond the tolerance by 4 sigma of its noise
 
     floor = noise_floor or {}
 
     def resolvable(kind, sigma, limit, margin):
         noise[kind] = sigma
         if np.isfinite(sigma) and margin > limit:
-            notes.append(f"{kind}: measurement noise {sigma:.3g} (SI) per sample; departures below "
-                         f"{limit + margin:.3g} cannot be told from noise")
+            notes.append(
+                f"{kind}: measurement noise {sigma:.3g} (SI) per sample; departures below "
+                f"{limit + margin:.3g} cannot be told from noise"
+            )
 
     def impact_of(j):
         return int(j) if j >= 1 else None
@@ -351,12 +379,15 @@ def audit_rocking(t_s, theta_rad, *, slide_m=None, uplift_m=None, twist_rad=None
         # the block came down to the table and went back up on the same edge: the next impact was doubled
         flags.append(AuditFlag("double_impact", float(t[k]), float(h), 2.0 * hyst, int(seg[k]) + 1, "bounce"))
     if impacts.size >= 3:
-        dur = np.diff(impacts)                      # half-cycle j (impact j -> j+1) lasts dur[j-1]
+        dur = np.diff(impacts)  # half-cycle j (impact j -> j+1) lasts dur[j-1]
         for i in range(1, dur.size - 1):
             shortest = tol.double_impact_ratio * min(dur[i - 1], dur[i + 1])
             if dur[i] < shortest:
-                flags.append(AuditFlag("double_impact", float(impacts[i]), float(dur[i]), float(shortest),
-                                       i + 1, "short half-cycle"))
+                flags.append(
+                    AuditFlag(
+                        "double_impact", float(impacts[i]), float(dur[i]), float(shortest), i + 1, "short half-cycle"
+                    )
+                )
     flags.sort(key=lambda f: (f.t_s, FLAG_KINDS.index(f.kind)))
     if not flags:
         verdict = "valid"
@@ -365,5 +396,6 @@ def audit_rocking(t_s, theta_rad, *, slide_m=None, uplift_m=None, twist_rad=None
     else:
         verdict = "suspect"
     excluded = tuple(sorted({f.impact for f in flags if f.impact is not None}))
-    return AuditResult(verdict, tuple(flags), impacts, excluded, tuple(checked), maxima, tol, source,
-                       tuple(notes), noise)
+    return AuditResult(
+        verdict, tuple(flags), impacts, excluded, tuple(checked), maxima, tol, source, tuple(notes), noise
+    )

@@ -27,8 +27,11 @@ def _fit_arms(R, o, th, seg, min_theta, width=None, sign=1.0):
     Every sample on side ``s`` of half-cycle ``j`` obeys ``o_k = w_j + R_k d_s``: the
     origin turns about a ground point. With ``width``, ``d+- = d_mid +- sign * width / 2 * e_x``.
     """
-    rows = [(k, side) for side in (1, -1)
-            for k in np.flatnonzero(np.isfinite(th) & (side * th > min_theta) & np.isfinite(o).all(axis=1))]
+    rows = [
+        (k, side)
+        for side in (1, -1)
+        for k in np.flatnonzero(np.isfinite(th) & (side * th > min_theta) & np.isfinite(o).all(axis=1))
+    ]
     if len(rows) < 10 or {side for _, side in rows} != {1, -1}:
         return np.full(2, np.nan), np.full(2, np.nan), float("nan")
     keys = sorted({(int(seg[k]), side) for k, side in rows})
@@ -43,10 +46,10 @@ def _fit_arms(R, o, th, seg, min_theta, width=None, sign=1.0):
             A[sl, :2] = R[k]
             b[sl] = o[k] - side * half * R[k][:, 0]
         else:
-            A[sl, (0 if side > 0 else 2):(2 if side > 0 else 4)] = R[k]
+            A[sl, (0 if side > 0 else 2) : (2 if side > 0 else 4)] = R[k]
             b[sl] = o[k]
         j = n_d + 2 * col[(int(seg[k]), side)]
-        A[sl, j:j + 2] = np.eye(2)
+        A[sl, j : j + 2] = np.eye(2)
     sol, *_ = np.linalg.lstsq(A, b, rcond=None)
     rms = float(np.sqrt(np.mean((A @ sol - b) ** 2)))
     if width is not None:
@@ -98,7 +101,7 @@ def plane_pivot_motion(t_s, theta_rad, x_m, y_m, sigma_theta_rad: float = 0.0, b
     if ok.sum() < 10:
         return nan, nan.copy(), (np.full(2, np.nan), np.full(2, np.nan)), float("nan")
     c, s = np.cos(th), np.sin(th)
-    R = np.stack([np.stack([c, -s], axis=-1), np.stack([s, c], axis=-1)], axis=-2)      # (n, 2, 2)
+    R = np.stack([np.stack([c, -s], axis=-1), np.stack([s, c], axis=-1)], axis=-2)  # (n, 2, 2)
     hyst = max(5.0 * sigma_theta_rad, math.radians(0.05))
     seg = segment_ids(t, find_impacts(t, th, hyst))
     min_theta = max(math.radians(0.3), 10.0 * sigma_theta_rad)
@@ -118,8 +121,15 @@ def plane_pivot_motion(t_s, theta_rad, x_m, y_m, sigma_theta_rad: float = 0.0, b
     return p[:, 0], p[:, 1], (d_pos, d_neg), rms
 
 
-def audit_plane_track(t_s, theta_rad, x_m=None, y_m=None, sigma_theta_rad: float | None = None,
-                      tolerances: AuditTolerances | None = None, base_width_m: float | None = None) -> AuditResult:
+def audit_plane_track(
+    t_s,
+    theta_rad,
+    x_m=None,
+    y_m=None,
+    sigma_theta_rad: float | None = None,
+    tolerances: AuditTolerances | None = None,
+    base_width_m: float | None = None,
+) -> AuditResult:
     """:func:`audit_rocking` for a plane track (see the module doc).
 
     Parameters
@@ -146,8 +156,16 @@ def audit_plane_track(t_s, theta_rad, x_m=None, y_m=None, sigma_theta_rad: float
         floor = {"slide": fit_rms, "jump": fit_rms}
     else:
         notes.append("no metric position: sliding and uplift not checked")
-    res = audit_rocking(t_s, theta_rad, slide_m=slide, uplift_m=uplift, sigma_theta_rad=sig,
-                        tolerances=tolerances, source="2d", noise_floor=floor)
+    res = audit_rocking(
+        t_s,
+        theta_rad,
+        slide_m=slide,
+        uplift_m=uplift,
+        sigma_theta_rad=sig,
+        tolerances=tolerances,
+        source="2d",
+        noise_floor=floor,
+    )
     if notes:
         from dataclasses import replace
 

@@ -47,8 +47,11 @@ def kabsch(ref, cur, weights=None):
     if single:
         cur = cur[None]
     seen = np.isfinite(cur).all(axis=2) & np.isfinite(ref).all(axis=1)[None]
-    w = seen.astype(float) if weights is None else \
-        np.where(seen, np.broadcast_to(np.asarray(weights, float), seen.shape), 0.0)
+    w = (
+        seen.astype(float)
+        if weights is None
+        else np.where(seen, np.broadcast_to(np.asarray(weights, float), seen.shape), 0.0)
+    )
     c = np.where(seen[..., None], cur, 0.0)
     r = np.where(np.isfinite(ref), ref, 0.0)
     sw = w.sum(axis=1)
@@ -66,7 +69,7 @@ def kabsch(ref, cur, weights=None):
     rot = np.transpose(vt, (0, 2, 1)) @ (fix[:, :, None] * np.transpose(u, (0, 2, 1)))
     t = cc - np.einsum("nij,nj->ni", rot, cr)
     res = c - (np.einsum("nij,pj->npi", rot, r) + t[:, None])
-    rms = np.sqrt((w * (res ** 2).sum(axis=2)).sum(axis=1) / sw_safe)
+    rms = np.sqrt((w * (res**2).sum(axis=2)).sum(axis=1) / sw_safe)
     bad = sw < MIN_POINTS - 1e-12
     rot[bad] = np.nan
     t[bad] = np.nan
@@ -94,7 +97,7 @@ def reference_shape(xyz, frames) -> np.ndarray:
     import warnings
 
     with warnings.catch_warnings():
-        warnings.simplefilter("ignore", RuntimeWarning)     # a point never seen at rest stays NaN (filled below)
+        warnings.simplefilter("ignore", RuntimeWarning)  # a point never seen at rest stays NaN (filled below)
         ref = np.nanmedian(xyz[frames], axis=0) if len(frames) else np.full(xyz.shape[1:], np.nan)
     missing = ~np.isfinite(ref).all(axis=1)
     if missing.any() and (~missing).sum() >= MIN_POINTS:
@@ -175,8 +178,7 @@ def body_poses(xyz, ref, outlier_m: float | None = None) -> BodyPoses:
             break
         r_now = np.where(seen[rows] & ~drop[rows], res[rows], -np.inf)
         worst = np.argmax(r_now, axis=1)
-        can = (r_now[np.arange(rows.size), worst] > outlier_m) & \
-            ((seen[rows] & ~drop[rows]).sum(axis=1) > MIN_POINTS)
+        can = (r_now[np.arange(rows.size), worst] > outlier_m) & ((seen[rows] & ~drop[rows]).sum(axis=1) > MIN_POINTS)
         rows, worst = rows[can], worst[can]
         if rows.size == 0:
             break
@@ -199,4 +201,3 @@ def body_poses(xyz, ref, outlier_m: float | None = None) -> BodyPoses:
     t[lost] = np.nan
     rms[lost] = np.nan
     return BodyPoses(rot, t, rms, n_pts, status.astype(str), np.asarray(ref, float), int(drop.sum()))
-

@@ -58,9 +58,11 @@ class PointSeries:
         labels = list(labels)
         missing = [lab for lab in labels if lab not in self.labels]
         if missing:
-            raise InputError(f"{where(self.source)}point(s) {missing} not in the file (it has "
-                             f"{list(self.labels)[:12]}{' ...' if len(self.labels) > 12 else ''}); "
-                             "fix the --body list")
+            raise InputError(
+                f"{where(self.source)}point(s) {missing} not in the file (it has "
+                f"{list(self.labels)[:12]}{' ...' if len(self.labels) > 12 else ''}); "
+                "fix the --body list"
+            )
         idx = [self.labels.index(lab) for lab in labels]
         return PointSeries(self.t_s, tuple(labels), self.xyz_m[:, idx, :], self.source, self.notes)
 
@@ -71,9 +73,15 @@ class PointSeries:
         n, p, _ = self.xyz_m.shape
         ok = np.isfinite(self.xyz_m).all(axis=2)
         ti, pi = np.nonzero(ok)
-        return pd.DataFrame({"t_s": self.t_s[ti], "point": np.asarray(self.labels, dtype=object)[pi],
-                             "x_m": self.xyz_m[ti, pi, 0], "y_m": self.xyz_m[ti, pi, 1],
-                             "z_m": self.xyz_m[ti, pi, 2]})
+        return pd.DataFrame(
+            {
+                "t_s": self.t_s[ti],
+                "point": np.asarray(self.labels, dtype=object)[pi],
+                "x_m": self.xyz_m[ti, pi, 0],
+                "y_m": self.xyz_m[ti, pi, 1],
+                "z_m": self.xyz_m[ti, pi, 2],
+            }
+        )
 
 
 def read_points(path) -> PointSeries:
@@ -92,8 +100,10 @@ def _coordinate_columns(columns, path):
         names = [f"{a}_{unit}" for a in "xyz"]
         if all(n in columns for n in names):
             return names, scale
-    raise InputError(f"{where(path)}no coordinate columns (has {list(columns)}); need x_m, y_m, z_m "
-                     "(or x_mm/x_cm with the unit in the name)")
+    raise InputError(
+        f"{where(path)}no coordinate columns (has {list(columns)}); need x_m, y_m, z_m "
+        "(or x_mm/x_cm with the unit in the name)"
+    )
 
 
 def read_points_csv(path) -> PointSeries:
@@ -118,29 +128,36 @@ def read_points_csv(path) -> PointSeries:
     except pd.errors.EmptyDataError:
         raise InputError(f"{where(path)}empty file; need columns t_s, point, x_m, y_m, z_m") from None
     except (pd.errors.ParserError, UnicodeDecodeError) as exc:
-        raise InputError(f"{where(path)}not a CSV table ({str(exc).splitlines()[0]}); "
-                         "export t_s, point, x_m, y_m, z_m") from None
+        raise InputError(
+            f"{where(path)}not a CSV table ({str(exc).splitlines()[0]}); export t_s, point, x_m, y_m, z_m"
+        ) from None
     df.columns = [str(c).strip() for c in df.columns]
     missing = [c for c in ("t_s", "point") if c not in df.columns]
     if missing:
-        raise InputError(f"{where(path)}missing column(s) {missing} (has {list(df.columns)}); "
-                         "need t_s, point, x_m, y_m, z_m (long format, one row per point per sample)")
+        raise InputError(
+            f"{where(path)}missing column(s) {missing} (has {list(df.columns)}); "
+            "need t_s, point, x_m, y_m, z_m (long format, one row per point per sample)"
+        )
     cols, scale = _coordinate_columns(df.columns, path)
     if df.empty:
         raise InputError(f"{where(path)}no data rows; need t_s, point, x_m, y_m, z_m rows")
     t = pd.to_numeric(df["t_s"], errors="coerce").to_numpy(float)
     bad = np.flatnonzero(~np.isfinite(t))
     if bad.size:
-        raise InputError(f"{where(path, int(bad[0]) + 2, 't_s')}not a number ({df['t_s'].iloc[bad[0]]!r}); "
-                         "every row needs its time in seconds")
+        raise InputError(
+            f"{where(path, int(bad[0]) + 2, 't_s')}not a number ({df['t_s'].iloc[bad[0]]!r}); "
+            "every row needs its time in seconds"
+        )
     xyz = np.empty((len(df), 3))
     for j, c in enumerate(cols):
         raw = df[c]
         val = pd.to_numeric(raw, errors="coerce").to_numpy(float)
         wrong = np.flatnonzero(np.isnan(val) & raw.notna().to_numpy() & (raw.astype(str).str.strip() != ""))
         if wrong.size:
-            raise InputError(f"{where(path, int(wrong[0]) + 2, c)}not a number ({raw.iloc[wrong[0]]!r}); "
-                             "leave the cell empty for a point not seen")
+            raise InputError(
+                f"{where(path, int(wrong[0]) + 2, c)}not a number ({raw.iloc[wrong[0]]!r}); "
+                "leave the cell empty for a point not seen"
+            )
         xyz[:, j] = val * scale
     names = df["point"].astype(str).str.strip().to_numpy()
     labels = tuple(dict.fromkeys(names))
@@ -152,8 +169,9 @@ def read_points_csv(path) -> PointSeries:
     _, first, counts = np.unique(key, return_index=True, return_counts=True)
     if (counts > 1).any():
         dup = int(np.sort(np.flatnonzero(np.isin(key, key[first[counts > 1]])))[1])
-        raise InputError(f"{where(path, dup + 2)}point {names[dup]!r} appears twice at t_s={t[dup]:.6g}; "
-                         "each point once per sample")
+        raise InputError(
+            f"{where(path, dup + 2)}point {names[dup]!r} appears twice at t_s={t[dup]:.6g}; each point once per sample"
+        )
     out = np.full((times.size, len(labels), 3), np.nan)
     out[ti, pi] = xyz
     notes = () if scale == 1.0 else (f"coordinates converted from {cols[0].split('_')[1]} to m",)
@@ -179,28 +197,33 @@ def read_c3d(path) -> PointSeries:
     try:
         c = ezc3d.c3d(str(path))
     except Exception as exc:  # ezc3d raises plain RuntimeError/IOError on a bad file
-        raise InputError(f"{where(path)}not a readable C3D file ({str(exc).splitlines()[0] if str(exc) else type(exc).__name__}); "
-                         "export the 3D points again as C3D, or as CSV t_s, point, x_m, y_m, z_m") from None
+        raise InputError(
+            f"{where(path)}not a readable C3D file ({str(exc).splitlines()[0] if str(exc) else type(exc).__name__}); "
+            "export the 3D points again as C3D, or as CSV t_s, point, x_m, y_m, z_m"
+        ) from None
     par = c["parameters"]["POINT"]
     labels = tuple(str(s).strip() for s in par["LABELS"]["value"])
-    pts = np.asarray(c["data"]["points"], dtype=float)          # (4, p, n)
+    pts = np.asarray(c["data"]["points"], dtype=float)  # (4, p, n)
     if pts.shape[1] == 0 or pts.shape[2] == 0 or not labels:
         raise InputError(f"{where(path)}no 3D points in the file (only analog data?); export the markers")
-    labels = labels[:pts.shape[1]]
+    labels = labels[: pts.shape[1]]
     units = [str(u).strip().lower() for u in np.atleast_1d(par.get("UNITS", {}).get("value", ["mm"]))] or ["mm"]
     if len(set(units)) > 1:
-        raise InputError(f"{where(path, key='POINT:UNITS')}mixed units {sorted(set(units))}; "
-                         "export all points in one unit")
+        raise InputError(
+            f"{where(path, key='POINT:UNITS')}mixed units {sorted(set(units))}; export all points in one unit"
+        )
     unit = units[0]
     if unit not in LENGTH_UNITS_M:
-        raise InputError(f"{where(path, key='POINT:UNITS')}unknown length unit {unit!r}; "
-                         "need m, cm or mm (re-export, or convert to CSV with x_m, y_m, z_m)")
+        raise InputError(
+            f"{where(path, key='POINT:UNITS')}unknown length unit {unit!r}; "
+            "need m, cm or mm (re-export, or convert to CSV with x_m, y_m, z_m)"
+        )
     rate = float(np.atleast_1d(par["RATE"]["value"])[0])
     if not np.isfinite(rate) or rate <= 0:
         raise InputError(f"{where(path, key='POINT:RATE')}rate {rate!r} is not positive; fix the file's point rate")
-    xyz = np.moveaxis(pts[:3], 0, 2).transpose(1, 0, 2) * LENGTH_UNITS_M[unit]     # (n, p, 3)
+    xyz = np.moveaxis(pts[:3], 0, 2).transpose(1, 0, 2) * LENGTH_UNITS_M[unit]  # (n, p, 3)
     xyz = np.ascontiguousarray(xyz)
-    resid = np.asarray(c["data"]["meta_points"]["residuals"], dtype=float)[0].T    # (n, p)
+    resid = np.asarray(c["data"]["meta_points"]["residuals"], dtype=float)[0].T  # (n, p)
     invalid = (resid < 0) | (np.abs(xyz) == 0).all(axis=2)
     n_invalid = int((invalid & np.isfinite(xyz).all(axis=2)).sum())
     xyz[invalid] = np.nan
@@ -231,8 +254,9 @@ def write_c3d(series: PointSeries, path, unit: str = "mm") -> Path:
     dt = np.diff(series.t_s)
     rate = 1.0 / float(np.median(dt))
     if np.abs(dt * rate - 1.0).max() > 1e-3:
-        raise InputError(f"{where(path)}C3D needs a uniform time base (steps vary by more than 0.1 %); "
-                         "write a CSV instead")
+        raise InputError(
+            f"{where(path)}C3D needs a uniform time base (steps vary by more than 0.1 %); write a CSV instead"
+        )
     c = ezc3d.c3d()
     c["parameters"]["POINT"]["RATE"]["value"] = [rate]
     c["parameters"]["POINT"]["LABELS"]["value"] = list(series.labels)
@@ -241,11 +265,13 @@ def write_c3d(series: PointSeries, path, unit: str = "mm") -> Path:
     n, p, _ = xyz.shape
     pts = np.ones((4, p, n))
     pts[:3] = np.transpose(xyz, (2, 1, 0))
-    seen = np.isfinite(xyz).all(axis=2).T                      # (p, n)
+    seen = np.isfinite(xyz).all(axis=2).T  # (p, n)
     pts[:3, ~seen] = 0.0
     c["data"]["points"] = pts
-    c["data"]["meta_points"] = {"residuals": np.where(seen, 0.0, -1.0)[None].astype(float),
-                                "camera_masks": np.zeros((7, p, n), dtype=bool)}
+    c["data"]["meta_points"] = {
+        "residuals": np.where(seen, 0.0, -1.0)[None].astype(float),
+        "camera_masks": np.zeros((7, p, n), dtype=bool),
+    }
     c["header"]["points"]["first_frame"] = int(round(series.t_s[0] * rate))
     path = Path(path)
     with atomic_path(path) as tmp:

@@ -27,8 +27,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["RockingGeometry", "rocking_axes", "split_rotation", "find_impacts", "fit_pivots", "pivot_motion",
-           "axis_vector"]
+__all__ = [
+    "RockingGeometry",
+    "rocking_axes",
+    "split_rotation",
+    "find_impacts",
+    "fit_pivots",
+    "pivot_motion",
+    "axis_vector",
+]
 
 
 def axis_vector(spec: str) -> np.ndarray:
@@ -174,10 +181,16 @@ class RockingGeometry:
 
     def to_dict(self) -> dict:
         """Plain-number dictionary (vectors as lists)."""
-        return {"up": self.up.tolist(), "axis": self.axis.tolist(), "e_r": self.e_r.tolist(),
-                "origin_m": self.origin_m.tolist(), "pivot_pos_m": self.pivot_pos_m.tolist(),
-                "pivot_neg_m": self.pivot_neg_m.tolist(), "base_width_m": self.base_width_m,
-                "pivot_height_gap_m": self.pivot_height_gap_m}
+        return {
+            "up": self.up.tolist(),
+            "axis": self.axis.tolist(),
+            "e_r": self.e_r.tolist(),
+            "origin_m": self.origin_m.tolist(),
+            "pivot_pos_m": self.pivot_pos_m.tolist(),
+            "pivot_neg_m": self.pivot_neg_m.tolist(),
+            "base_width_m": self.base_width_m,
+            "pivot_height_gap_m": self.pivot_height_gap_m,
+        }
 
 
 def _centred(R, t, origin):
@@ -217,7 +230,7 @@ def fit_pivots(R, t_m, theta_rad, seg, origin, min_theta_rad: float, axis=None):
         for r, (k, j) in enumerate(zip(idx, col)):
             rows = slice(d * r, d * r + d)
             A[rows, :d] = R[k]
-            A[rows, d + d * j: d + d * j + d] = -np.eye(d)
+            A[rows, d + d * j : d + d * j + d] = -np.eye(d)
             b[rows] = -tc[k]
         sol, *_ = np.linalg.lstsq(A, b, rcond=None)
         out.append(sol[:d])
@@ -244,7 +257,7 @@ def rotation_sigma(rms_m, n_points, ref_m, axis) -> np.ndarray:
     points' squared distances from the axis through their centroid.
     """
     q = ref_m - np.nanmean(ref_m, axis=0)
-    d2 = np.nansum(q ** 2, axis=1) - (q @ axis) ** 2
+    d2 = np.nansum(q**2, axis=1) - (q @ axis) ** 2
     spread = float(np.nansum(d2)) / max(len(d2), 1)
     n = np.asarray(n_points, float)
     dof = np.where(3 * n > 6, 3 * n / np.maximum(3 * n - 6, 1), np.nan)

@@ -11,12 +11,36 @@
 """
 
 from ._calib import DEFAULT_BOARD, StereoRig, calibrate_stereo, charuco_board, load_rig
-from ._dots import (DotTracks2D, StereoPoints, SyncOffset, detect_dots, match_tracks, sync_offset_stereo,
-                    track_dots_2d, track_dots_stereo, triangulate_tracks)
+from ._dots import (
+    DotTracks2D,
+    StereoPoints,
+    SyncOffset,
+    detect_dots,
+    match_tracks,
+    sync_offset_stereo,
+    track_dots_2d,
+    track_dots_stereo,
+    triangulate_tracks,
+)
 from ._markers import track_markers_2d, track_markers_stereo
 from ._world import stereo_point_series
 
-__all__ = ["StereoRig", "calibrate_stereo", "load_rig", "DEFAULT_BOARD", "charuco_board",
-           "detect_dots", "track_dots_2d", "DotTracks2D", "match_tracks", "sync_offset_stereo", "SyncOffset",
-           "triangulate_tracks", "StereoPoints", "track_dots_stereo", "stereo_point_series",
-           "track_markers_2d", "track_markers_stereo"]
+__all__ = [
+    "StereoRig",
+    "calibrate_stereo",
+    "load_rig",
+    "DEFAULT_BOARD",
+    "charuco_board",
+    "detect_dots",
+    "track_dots_2d",
+    "DotTracks2D",
+    "match_tracks",
+    "sync_offset_stereo",
+    "SyncOffset",
+    "triangulate_tracks",
+    "StereoPoints",
+    "track_dots_stereo",
+    "stereo_point_series",
+    "track_markers_2d",
+    "track_markers_stereo",
+]

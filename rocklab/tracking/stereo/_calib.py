@@ -73,10 +73,18 @@ class StereoRig:
 
     def to_dict(self) -> dict:
         """The ``stereo.json`` object (SI units, px)."""
-        return {"K1": self.K1.tolist(), "dist1": self.dist1.tolist(), "K2": self.K2.tolist(),
-                "dist2": self.dist2.tolist(), "R": self.R.tolist(), "T_m": self.T.tolist(),
-                "size_px": list(self.size), "rms_px": dict(self.rms_px), "n_frames": self.n_frames,
-                "baseline_m": self.baseline_m}
+        return {
+            "K1": self.K1.tolist(),
+            "dist1": self.dist1.tolist(),
+            "K2": self.K2.tolist(),
+            "dist2": self.dist2.tolist(),
+            "R": self.R.tolist(),
+            "T_m": self.T.tolist(),
+            "size_px": list(self.size),
+            "rms_px": dict(self.rms_px),
+            "n_frames": self.n_frames,
+            "baseline_m": self.baseline_m,
+        }
 
     def save(self, path) -> Path:
         """Write ``stereo.json`` atomically."""
@@ -90,14 +98,23 @@ def load_rig(path) -> StereoRig:
     path = Path(path)
     try:
         d = json.loads(path.read_text())
-        return StereoRig(np.array(d["K1"], float), np.array(d["dist1"], float), np.array(d["K2"], float),
-                         np.array(d["dist2"], float), np.array(d["R"], float), np.array(d["T_m"], float),
-                         tuple(d["size_px"]), dict(d.get("rms_px", {})), int(d.get("n_frames", 0)))
+        return StereoRig(
+            np.array(d["K1"], float),
+            np.array(d["dist1"], float),
+            np.array(d["K2"], float),
+            np.array(d["dist2"], float),
+            np.array(d["R"], float),
+            np.array(d["T_m"], float),
+            tuple(d["size_px"]),
+            dict(d.get("rms_px", {})),
+            int(d.get("n_frames", 0)),
+        )
     except FileNotFoundError:
         raise InputError(f"{where(path)}not found; make one with 'rocklab stereo calibrate'") from None
     except (ValueError, KeyError, TypeError) as e:
-        raise InputError(f"{where(path)}not a stereo calibration ({type(e).__name__}: {e}); make one with "
-                         "'rocklab stereo calibrate'") from None
+        raise InputError(
+            f"{where(path)}not a stereo calibration ({type(e).__name__}: {e}); make one with 'rocklab stereo calibrate'"
+        ) from None
 
 
 def charuco_board(spec: dict):
@@ -146,18 +163,24 @@ def calibrate_stereo(film1, film2, board: dict | None = None) -> StereoRig:
     det1, size1 = _detect(film1, b)
     det2, size2 = _detect(film2, b)
     if len(det1) != len(det2):
-        raise InputError(f"{where(film2)}{len(det2)} frames, but {Path(film1).name} has {len(det1)}; the two "
-                         "calibration films must show the same board poses frame by frame (trim them to match)")
+        raise InputError(
+            f"{where(film2)}{len(det2)} frames, but {Path(film1).name} has {len(det1)}; the two "
+            "calibration films must show the same board poses frame by frame (trim them to match)"
+        )
     if size1 != size2:
-        raise InputError(f"{where(film2)}frame size {size2} differs from {Path(film1).name}'s {size1}; "
-                         "calibrate cameras of one size (or give each its own calibration)")
+        raise InputError(
+            f"{where(film2)}frame size {size2} differs from {Path(film1).name}'s {size1}; "
+            "calibrate cameras of one size (or give each its own calibration)"
+        )
 
     def per_camera(dets, film):
         ok = [d for d in dets if len(d) >= MIN_CORNERS]
         if len(ok) < MIN_FRAMES:
-            raise InputError(f"{where(film)}the board is seen (>= {MIN_CORNERS} corners) in {len(ok)} of "
-                             f"{len(dets)} frames; need {MIN_FRAMES}: film more poses, closer, sharper, and check "
-                             f"the board ({spec['squares'][0]}x{spec['squares'][1]} squares, {spec['dictionary']})")
+            raise InputError(
+                f"{where(film)}the board is seen (>= {MIN_CORNERS} corners) in {len(ok)} of "
+                f"{len(dets)} frames; need {MIN_FRAMES}: film more poses, closer, sharper, and check "
+                f"the board ({spec['squares'][0]}x{spec['squares'][1]} squares, {spec['dictionary']})"
+            )
         obj = [obj_all[sorted(d)].astype(np.float32) for d in ok]
         img = [np.array([d[i] for i in sorted(d)], np.float32) for d in ok]
         rms, K, dist, _, _ = cv2.calibrateCamera(obj, img, size1, None, None, flags=cv2.CALIB_FIX_K3)
@@ -173,11 +196,22 @@ def calibrate_stereo(film1, film2, board: dict | None = None) -> StereoRig:
             img1.append(np.array([a[i] for i in common], np.float32))
             img2.append(np.array([c[i] for i in common], np.float32))
     if len(obj) < MIN_FRAMES:
-        raise InputError(f"{where(film1)}the board is seen by both cameras at once in {len(obj)} frames; need "
-                         f"{MIN_FRAMES}: hold it where both see it (check {Path(film2).name} too)")
+        raise InputError(
+            f"{where(film1)}the board is seen by both cameras at once in {len(obj)} frames; need "
+            f"{MIN_FRAMES}: hold it where both see it (check {Path(film2).name} too)"
+        )
     crit = (cv2.TERM_CRITERIA_COUNT + cv2.TERM_CRITERIA_EPS, 200, 1e-10)
     rms, K1, d1, K2, d2, R, T, _, _ = cv2.stereoCalibrate(
-        obj, img1, img2, K1, d1, K2, d2, size1, criteria=crit,
-        flags=cv2.CALIB_USE_INTRINSIC_GUESS | cv2.CALIB_FIX_K3)
-    return StereoRig(K1, np.asarray(d1, float).ravel(), K2, np.asarray(d2, float).ravel(), R, np.asarray(T).ravel(),
-                     tuple(size1), {"cam1": rms1, "cam2": rms2, "stereo": float(rms)}, len(obj))
+        obj, img1, img2, K1, d1, K2, d2, size1, criteria=crit, flags=cv2.CALIB_USE_INTRINSIC_GUESS | cv2.CALIB_FIX_K3
+    )
+    return StereoRig(
+        K1,
+        np.asarray(d1, float).ravel(),
+        K2,
+        np.asarray(d2, float).ravel(),
+        R,
+        np.asarray(T).ravel(),
+        tuple(size1),
+        {"cam1": rms1, "cam2": rms2, "stereo": float(rms)},
+        len(obj),
+    )

@@ -37,8 +37,10 @@ def track_markers_2d(frames, dictionary: str = "DICT_4X4_50", source: str = ""):
                     seen.setdefault(f"M{int(mid)}c{k}", {})[i] = c.reshape(4, 2)[k]
         n = i + 1
     if not seen:
-        raise InputError(f"{where(source)}no {dictionary} marker found in {n} frames; check the dictionary "
-                         "(--dictionary) and that the markers are in view and sharp")
+        raise InputError(
+            f"{where(source)}no {dictionary} marker found in {n} frames; check the dictionary "
+            "(--dictionary) and that the markers are in view and sharp"
+        )
     out = {}
     for lab, d in seen.items():
         a = np.full((n, 2), np.nan)
@@ -53,8 +55,9 @@ def _sort_key(label: str):
     return int(mid), int(k)
 
 
-def track_markers_stereo(film1, film2, rig: StereoRig, dictionary: str = "DICT_4X4_50", fps: float | None = None,
-                         sync: bool = True) -> StereoPoints:
+def track_markers_stereo(
+    film1, film2, rig: StereoRig, dictionary: str = "DICT_4X4_50", fps: float | None = None, sync: bool = True
+) -> StereoPoints:
     """ArUco corners of two films to 3D points in camera 1's axes (labels in ``StereoPoints.labels``)."""
     from ..video._video import iter_video_frames
 
@@ -62,13 +65,17 @@ def track_markers_stereo(film1, film2, rig: StereoRig, dictionary: str = "DICT_4
     from concurrent.futures import ThreadPoolExecutor
 
     with ThreadPoolExecutor(max_workers=2) as ex:
-        jobs = [ex.submit(track_markers_2d, (g for _, g in iter_video_frames(f)), dictionary, str(f))
-                for f in (film1, film2)]
+        jobs = [
+            ex.submit(track_markers_2d, (g for _, g in iter_video_frames(f)), dictionary, str(f))
+            for f in (film1, film2)
+        ]
         (m1, n1), (m2, n2) = (j.result() for j in jobs)
     labels = sorted(set(m1) & set(m2), key=_sort_key)
     if len(labels) < 3:
-        raise InputError(f"{where(film1)}{len(labels)} marker corner(s) seen by both cameras; need markers both "
-                         f"cameras see (camera 1: {len(m1) // 4} markers, camera 2: {len(m2) // 4})")
+        raise InputError(
+            f"{where(film1)}{len(labels)} marker corner(s) seen by both cameras; need markers both "
+            f"cameras see (camera 1: {len(m1) // 4} markers, camera 2: {len(m2) // 4})"
+        )
     t1 = DotTracks2D(np.stack([m1[lab] for lab in labels], axis=1), str(film1))
     t2 = DotTracks2D(np.stack([m2[lab] for lab in labels], axis=1), str(film2))
     pairs = np.column_stack([np.arange(len(labels)), np.arange(len(labels))])

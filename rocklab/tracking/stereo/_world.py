@@ -47,8 +47,8 @@ def stereo_point_series(sp: StereoPoints, source: str = ""):
     table = still[0] if still and len(still[0][0]) >= 3 else None
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)
-        rest = np.nanmedian(xyz, axis=0)                                    # (k, 3)
-    cam_up = np.array([0.0, -1.0, 0.0])                 # camera 1's image-up direction
+        rest = np.nanmedian(xyz, axis=0)  # (k, 3)
+    cam_up = np.array([0.0, -1.0, 0.0])  # camera 1's image-up direction
     if table is not None:
         bodies["table"] = tuple(table[0])
         q = rest[table[1]]
@@ -59,15 +59,17 @@ def stereo_point_series(sp: StereoPoints, source: str = ""):
             table = None
             notes.append("the still targets lie on a line: the vertical is camera 1's image-up direction")
         elif abs(normal @ cam_up) > math.cos(math.radians(45.0)):
-            up = normal                                 # targets on the table top
+            up = normal  # targets on the table top
         else:
             # targets on an upright plate (the table's edge): the vertical lies in its plane, and camera 1's
             # x axis is horizontal when the camera is not rolled, so the vertical is across both
             up = np.cross(normal, np.array([1.0, 0.0, 0.0]))
             up /= np.linalg.norm(up)
             up = up if up @ cam_up > 0 else -up
-            notes.append("the table's targets stand upright: the vertical is taken across their plane and "
-                         "camera 1's image rows (a camera roll stays in it; put three targets on the table top)")
+            notes.append(
+                "the table's targets stand upright: the vertical is taken across their plane and "
+                "camera 1's image rows (a camera roll stays in it; put three targets on the table top)"
+            )
     if table is None:
         up = cam_up
         origin = np.nanmean(rest, axis=0)

@@ -11,8 +11,16 @@
 - the target detectors in :mod:`.targets`.
 """
 
-from ._config import (BoardConfig, MotionConfig, ObjectConfig, ReferenceConfig, TargetsConfig, TrackConfig,
-                      VideoConfig, load_track_config)
+from ._config import (
+    BoardConfig,
+    MotionConfig,
+    ObjectConfig,
+    ReferenceConfig,
+    TargetsConfig,
+    TrackConfig,
+    VideoConfig,
+    load_track_config,
+)
 from ._geometry import PlaneMap, SimilarityFit, calibrate_camera, fit_similarity
 from ._init import find_markers, suggest_config
 from ._level import level_from_reference
@@ -20,9 +28,34 @@ from ._motion import TableMotion, choose_sg_window, estimate_noise, table_motion
 from ._track import TRACK_COLUMNS, ObjectTrack, Observation, TrackResult, assemble_tracks, track_frames, track_video
 from ._video import VideoInfo, iter_video_frames, probe_video
 
-__all__ = ["TrackConfig", "VideoConfig", "TargetsConfig", "ReferenceConfig", "BoardConfig", "MotionConfig",
-           "ObjectConfig", "load_track_config", "PlaneMap", "SimilarityFit", "fit_similarity", "calibrate_camera",
-           "track_video", "track_frames", "assemble_tracks", "TrackResult", "ObjectTrack", "Observation",
-           "TRACK_COLUMNS", "TableMotion", "table_motion", "choose_sg_window", "estimate_noise",
-           "level_from_reference", "VideoInfo", "probe_video", "iter_video_frames", "find_markers",
-           "suggest_config"]
+__all__ = [
+    "TrackConfig",
+    "VideoConfig",
+    "TargetsConfig",
+    "ReferenceConfig",
+    "BoardConfig",
+    "MotionConfig",
+    "ObjectConfig",
+    "load_track_config",
+    "PlaneMap",
+    "SimilarityFit",
+    "fit_similarity",
+    "calibrate_camera",
+    "track_video",
+    "track_frames",
+    "assemble_tracks",
+    "TrackResult",
+    "ObjectTrack",
+    "Observation",
+    "TRACK_COLUMNS",
+    "TableMotion",
+    "table_motion",
+    "choose_sg_window",
+    "estimate_noise",
+    "level_from_reference",
+    "VideoInfo",
+    "probe_video",
+    "iter_video_frames",
+    "find_markers",
+    "suggest_config",
+]

@@ -53,14 +53,20 @@ def _check_frames(res, expected: int, path) -> None:
     if expected > 0 and res.n_frames < 0.99 * expected:
         # a note, not suspect: every decoded frame is measured; some headers count frames the
         # stream does not hold (the real pendulum film: 2057 in the header, 1844 decodable)
-        warn("W-VIDEO-SHORT", f"{path}: the container's header counts {expected} frames but {res.n_frames} "
-                              "decoded (file cut, damaged, or a header that over-counts)")
+        warn(
+            "W-VIDEO-SHORT",
+            f"{path}: the container's header counts {expected} frames but {res.n_frames} "
+            "decoded (file cut, damaged, or a header that over-counts)",
+        )
     _check_latch(res, path)
     for t in res.tracks:
         lost = int(np.sum(~np.isin(t.status, ("ok", "interpolated"))))
         if lost > 0.01 * len(t.status):
-            warn("W-VIDEO-LOST", f"{path}: object {t.object!r} lost on {lost} of {len(t.status)} frames "
-                                 f"({100 * lost / len(t.status):.3g} %); see the status column")
+            warn(
+                "W-VIDEO-LOST",
+                f"{path}: object {t.object!r} lost on {lost} of {len(t.status)} frames "
+                f"({100 * lost / len(t.status):.3g} %); see the status column",
+            )
 
 
 #: A table turning by more than this (rad, 5th to 95th percentile) is following something else.
@@ -75,18 +81,24 @@ def _check_latch(res, path) -> None:
         if t.kind == "table" and th.size >= 5:
             turn = float(np.percentile(th, 95) - np.percentile(th, 5))
             if turn > TABLE_TURN_MAX_RAD:
-                warn("W-TRACK-LATCH", f"{path}: table {t.object!r} turns by {math.degrees(turn):.4g} deg over the video; "
-                                      "a table translates: its region or markers probably follow another object")
+                warn(
+                    "W-TRACK-LATCH",
+                    f"{path}: table {t.object!r} turns by {math.degrees(turn):.4g} deg over the video; "
+                    "a table translates: its region or markers probably follow another object",
+                )
     tr = [t for t in res.tracks if t.x_px is not None]
     for i, a in enumerate(tr):
-        for b in tr[i + 1:]:
+        for b in tr[i + 1 :]:
             both = a.ok & b.ok
             if both.sum() < 5:
                 continue
             d = np.hypot(a.x_px[both] - b.x_px[both], a.y_px[both] - b.y_px[both])
             if np.mean(d < 3.0) > 0.1:
-                warn("W-TRACK-LATCH", f"{path}: objects {a.object!r} and {b.object!r} sit on the same pixels on "
-                                      f"{100 * np.mean(d < 3.0):.3g} % of the frames; one follows the other's target")
+                warn(
+                    "W-TRACK-LATCH",
+                    f"{path}: objects {a.object!r} and {b.object!r} sit on the same pixels on "
+                    f"{100 * np.mean(d < 3.0):.3g} % of the frames; one follows the other's target",
+                )
 
 
 def _tee(frames, fn):

@@ -59,8 +59,16 @@ from pathlib import Path
 from ..._errors import InputError
 
 __all__ = [
-    "TrackConfig", "VideoConfig", "TargetsConfig", "ReferenceConfig", "BoardConfig",
-    "MotionConfig", "ObjectConfig", "load_track_config", "TARGET_STYLES", "OBJECT_KINDS",
+    "TrackConfig",
+    "VideoConfig",
+    "TargetsConfig",
+    "ReferenceConfig",
+    "BoardConfig",
+    "MotionConfig",
+    "ObjectConfig",
+    "load_track_config",
+    "TARGET_STYLES",
+    "OBJECT_KINDS",
 ]
 
 TARGET_STYLES = ("aruco", "apriltag", "dots", "edges", "region", "markerless")
@@ -316,14 +324,17 @@ class TrackConfig:
         for o in self.objects:
             if o.id == oid:
                 return o
-        raise InputError(f"no object '{oid}' in the tracking config; known: "
-                         f"{', '.join(o.id for o in self.objects)}")
+        raise InputError(f"no object '{oid}' in the tracking config; known: {', '.join(o.id for o in self.objects)}")
 
     def to_dict(self) -> dict:
         """Plain dict of the fields, JSON-ready (SI units in the keys)."""
-        d = {"video": _prune(asdict(self.video)), "targets": _prune(asdict(self.targets)),
-             "reference": _prune(asdict(self.reference)), "motion": _prune(asdict(self.motion)),
-             "objects": [_prune(asdict(o)) for o in self.objects]}
+        d = {
+            "video": _prune(asdict(self.video)),
+            "targets": _prune(asdict(self.targets)),
+            "reference": _prune(asdict(self.reference)),
+            "motion": _prune(asdict(self.motion)),
+            "objects": [_prune(asdict(o)) for o in self.objects],
+        }
         return d
 
     def to_toml(self) -> str:
@@ -365,15 +376,14 @@ def load_track_config(path) -> TrackConfig:
     v = cfg.video
     if v.calibration is not None and not Path(v.calibration).is_absolute():
         import dataclasses
-        cfg = dataclasses.replace(cfg, video=dataclasses.replace(
-            v, calibration=str(path.parent / v.calibration)))
+
+        cfg = dataclasses.replace(cfg, video=dataclasses.replace(v, calibration=str(path.parent / v.calibration)))
     return cfg
 
 
 # ------------------------------------------------------------------ internals
 def _prune(d: dict) -> dict:
-    return {k: (_prune(v) if isinstance(v, dict) else v) for k, v in d.items()
-            if v is not None and k != "source"}
+    return {k: (_prune(v) if isinstance(v, dict) else v) for k, v in d.items() if v is not None and k != "source"}
 
 
 def _toml_value(v) -> str:
@@ -413,9 +423,14 @@ def schema_markdown() -> str:
                     out[n].append(ln.strip())
         return {k: " ".join(v) for k, v in out.items()}
 
-    sections = [("[video]", VideoConfig), ("[targets]", TargetsConfig), ("[reference]", ReferenceConfig),
-                ("[reference.board]", BoardConfig), ("[motion]", MotionConfig), ("[[objects]] (one per object)",
-                                                                              ObjectConfig)]
+    sections = [
+        ("[video]", VideoConfig),
+        ("[targets]", TargetsConfig),
+        ("[reference]", ReferenceConfig),
+        ("[reference.board]", BoardConfig),
+        ("[motion]", MotionConfig),
+        ("[[objects]] (one per object)", ObjectConfig),
+    ]
     lines = []
     for title, cls in sections:
         first = (inspect.getdoc(cls) or "").splitlines()[0]

@@ -13,9 +13,19 @@ from dataclasses import fields
 import numpy as np
 
 from ..._errors import InputError, where
-from ._config import (CORNER_REFINEMENTS, LEVEL_MODES, OBJECT_KINDS, TARGET_STYLES, BoardConfig,
-                      MotionConfig, ObjectConfig, ReferenceConfig, TargetsConfig, TrackConfig,
-                      VideoConfig)
+from ._config import (
+    CORNER_REFINEMENTS,
+    LEVEL_MODES,
+    OBJECT_KINDS,
+    TARGET_STYLES,
+    BoardConfig,
+    MotionConfig,
+    ObjectConfig,
+    ReferenceConfig,
+    TargetsConfig,
+    TrackConfig,
+    VideoConfig,
+)
 
 __all__ = ["ConfigParser"]
 
@@ -33,8 +43,11 @@ class ConfigParser:
         lines = self.text.splitlines()
         start, count = 0, -1
         if section:
-            hdr = re.compile(r"^\s*\[\[\s*%s\s*\]\]" % re.escape(section) if index is not None
-                             else r"^\s*\[\s*%s\s*\]" % re.escape(section))
+            hdr = re.compile(
+                r"^\s*\[\[\s*%s\s*\]\]" % re.escape(section)
+                if index is not None
+                else r"^\s*\[\s*%s\s*\]" % re.escape(section)
+            )
             found = None
             for i, ln in enumerate(lines):
                 if hdr.match(ln):
@@ -74,8 +87,7 @@ class ConfigParser:
             return None
         ok = isinstance(v, int) if integer else isinstance(v, (int, float))
         if isinstance(v, bool) or not ok or not math.isfinite(v):
-            self.err(section, key, f"must be {'an integer' if integer else 'a finite number'}"
-                     f", got {v!r}", index)
+            self.err(section, key, f"must be {'an integer' if integer else 'a finite number'}, got {v!r}", index)
         if positive and v <= 0:
             self.err(section, key, f"must be > 0, got {v!r}", index)
         return int(v) if integer else float(v)
@@ -92,8 +104,11 @@ class ConfigParser:
             rows = tuple(tuple(float(x) for x in r) for r in v)
         except TypeError:
             rows = ()
-        if len(rows) != shape[0] or any(len(r) != shape[1] for r in rows) or not all(
-                math.isfinite(x) for r in rows for x in r):
+        if (
+            len(rows) != shape[0]
+            or any(len(r) != shape[1] for r in rows)
+            or not all(math.isfinite(x) for r in rows for x in r)
+        ):
             self.err(section, key, f"must be a {shape[0]}x{shape[1]} array of numbers", index)
         return rows
 
@@ -102,8 +117,12 @@ class ConfigParser:
         if H is not None:
             c = float(np.linalg.cond(np.asarray(H, float)))
             if not math.isfinite(c) or c > 1e12:
-                self.err(section, "homography", f"is singular (condition number {c:.3g}): it maps the image "
-                                                "to a line or a point; fix it or drop it")
+                self.err(
+                    section,
+                    "homography",
+                    f"is singular (condition number {c:.3g}): it maps the image "
+                    "to a line or a point; fix it or drop it",
+                )
         return H
 
     def vector(self, v, section, key, index=None, n=None, integer=False):
@@ -137,13 +156,23 @@ class ConfigParser:
             seen.add(o.id)
             for m in o.markers:
                 if m in seen_markers:
-                    self.err("objects", "markers", f"marker {m} already belongs to "
-                             f"{seen_markers[m]!r}; each marker id belongs to one object", i)
+                    self.err(
+                        "objects",
+                        "markers",
+                        f"marker {m} already belongs to {seen_markers[m]!r}; each marker id belongs to one object",
+                        i,
+                    )
                 seen_markers[m] = o.id
         # level = "table" without a table object stays as written: tracking then warns W-LEVEL-NONE.
         # Markers of unknown size are tracked in marker units: x_m, y_m stay empty (W-TRACK-NOSCALE).
-        return TrackConfig(objects=objects, video=video, targets=targets, reference=reference,
-                           motion=motion, source=None if self.source is None else str(self.source))
+        return TrackConfig(
+            objects=objects,
+            video=video,
+            targets=targets,
+            reference=reference,
+            motion=motion,
+            source=None if self.source is None else str(self.source),
+        )
 
     def video(self, d):
         s = "video"
@@ -152,14 +181,20 @@ class ConfigParser:
         start = self.num(d.get("start_frame", 0), s, "start_frame", integer=True, allow_none=False)
         stop = self.num(d.get("stop_frame"), s, "stop_frame", integer=True)
         if start < 0 or (stop is not None and stop <= start):
-            self.err(s, "stop_frame" if stop is not None and stop <= start else "start_frame",
-                     "need 0 <= start_frame < stop_frame")
+            self.err(
+                s,
+                "stop_frame" if stop is not None and stop <= start else "start_frame",
+                "need 0 <= start_frame < stop_frame",
+            )
         K = self.matrix(d.get("camera_matrix"), (3, 3), s, "camera_matrix")
         if K is not None:
             fx, fy, k22 = K[0][0], K[1][1], K[2][2]
             if not (fx > 0 and fy > 0 and abs(K[1][0]) + abs(K[2][0]) + abs(K[2][1]) == 0 and k22 == 1):
-                self.err(s, "camera_matrix", "must be [[fx, 0, cx], [0, fy, cy], [0, 0, 1]] with fx, fy > 0 "
-                                             "(pixels); fix it or drop it")
+                self.err(
+                    s,
+                    "camera_matrix",
+                    "must be [[fx, 0, cx], [0, fy, cy], [0, 0, 1]] with fx, fy > 0 (pixels); fix it or drop it",
+                )
         dist = self.vector(d.get("dist_coeffs"), s, "dist_coeffs")
         if dist is not None and len(dist) not in (4, 5, 8, 12, 14):
             self.err(s, "dist_coeffs", "must have 4, 5, 8, 12 or 14 coefficients")
@@ -178,15 +213,19 @@ class ConfigParser:
         dictionary = d.get("dictionary", default_dict)
         import cv2
 
-        if not isinstance(dictionary, str) or not dictionary.startswith("DICT_") or \
-                not hasattr(cv2.aruco, dictionary):
-            self.err(s, "dictionary", f"unknown dictionary {dictionary!r}; use an OpenCV name "
-                     "such as DICT_4X4_50 or DICT_APRILTAG_36h11")
+        if not isinstance(dictionary, str) or not dictionary.startswith("DICT_") or not hasattr(cv2.aruco, dictionary):
+            self.err(
+                s,
+                "dictionary",
+                f"unknown dictionary {dictionary!r}; use an OpenCV name such as DICT_4X4_50 or DICT_APRILTAG_36h11",
+            )
         return TargetsConfig(
-            style=style, dictionary=dictionary,
+            style=style,
+            dictionary=dictionary,
             marker_size_m=self.num(d.get("marker_size_m"), s, "marker_size_m", positive=True),
-            corner_refinement=self.choice(d.get("corner_refinement", "edges"), CORNER_REFINEMENTS,
-                                          s, "corner_refinement"),
+            corner_refinement=self.choice(
+                d.get("corner_refinement", "edges"), CORNER_REFINEMENTS, s, "corner_refinement"
+            ),
             search_margin=self.num(d.get("search_margin", 0.5), s, "search_margin", positive=True),
             dot_diameter_m=self.num(d.get("dot_diameter_m"), s, "dot_diameter_m", positive=True),
             dot_color=self.choice(d.get("dot_color", "dark"), ("dark", "light"), s, "dot_color"),
@@ -211,22 +250,29 @@ class ConfigParser:
                 square_m=self.num(b.get("square_m", 0.025), bs, "square_m", positive=True),
                 marker_m=self.num(b.get("marker_m"), bs, "marker_m", positive=True),
                 dictionary=str(b.get("dictionary", "DICT_4X4_50")),
-                frame=self.num(b.get("frame", 0), bs, "frame", integer=True, allow_none=False))
+                frame=self.num(b.get("frame", 0), bs, "frame", integer=True, allow_none=False),
+            )
         line = self.matrix(d.get("level_line_px"), (2, 2), s, "level_line_px")
         if level == "line" and (line is None or (line[0][0] - line[1][0]) ** 2 + (line[0][1] - line[1][1]) ** 2 < 400):
-            self.err(s, "level_line_px", "level = 'line' needs level_line_px = [[u0, v0], [u1, v1]] (px, first "
-                                         "frame), at least 20 px apart along a horizontal edge")
+            self.err(
+                s,
+                "level_line_px",
+                "level = 'line' needs level_line_px = [[u0, v0], [u1, v1]] (px, first "
+                "frame), at least 20 px apart along a horizontal edge",
+            )
         lobj = d.get("level_object")
         if lobj is not None and not isinstance(lobj, str):
             self.err(s, "level_object", "must be an object id (string)")
         return ReferenceConfig(
             level=level,
             level_rad=self.num(d.get("level_rad", 0.0), s, "level_rad", allow_none=False),
-            level_line_px=line, level_object=lobj,
+            level_line_px=line,
+            level_object=lobj,
             m_per_px=self.num(d.get("m_per_px"), s, "m_per_px", positive=True),
             homography=self._homography(d.get("homography"), s),
             board=board,
-            plane=self.choice(d.get("plane", "auto"), ("auto", "table", "image"), s, "plane"))
+            plane=self.choice(d.get("plane", "auto"), ("auto", "table", "image"), s, "plane"),
+        )
 
     def motion(self, d):
         s = "motion"
@@ -234,8 +280,9 @@ class ConfigParser:
         order = self.num(d.get("sg_polyorder"), s, "sg_polyorder", integer=True)
         if order is not None and order < 2:
             self.err(s, "sg_polyorder", "must be >= 2 so acceleration is defined")
-        gap = self.num(d.get("interpolate_max_gap_frames", 0), s, "interpolate_max_gap_frames",
-                       integer=True, allow_none=False)
+        gap = self.num(
+            d.get("interpolate_max_gap_frames", 0), s, "interpolate_max_gap_frames", integer=True, allow_none=False
+        )
         if gap < 0:
             self.err(s, "interpolate_max_gap_frames", "must be >= 0")
         return MotionConfig(self.num(d.get("sg_window_s"), s, "sg_window_s", positive=True), order, gap)
@@ -254,8 +301,7 @@ class ConfigParser:
         if mpos is not None:
             mpos = self.matrix(mpos, (len(markers), 2), s, "marker_positions_m", i)
         dots = d.get("dots", [])
-        dots = self.matrix(dots, (len(dots) if isinstance(dots, list) else -1, 2), s, "dots", i) \
-            if dots else ()
+        dots = self.matrix(dots, (len(dots) if isinstance(dots, list) else -1, 2), s, "dots", i) if dots else ()
         roi = self.vector(d.get("roi"), s, "roi", i, n=4)
         if roi is not None and (roi[2] <= 0 or roi[3] <= 0):
             self.err(s, "roi", "must be [u, v, width, height] with positive size (px)", i)
@@ -267,15 +313,20 @@ class ConfigParser:
             own = self.choice(own, TARGET_STYLES, s, "style", i)
         style = own or targets.style
         if style in ("aruco", "apriltag") and not markers:
-            self.err(s, "markers", f"style {style!r} needs the marker ids on this object, "
-                     "e.g. markers = [1]", i)
+            self.err(s, "markers", f"style {style!r} needs the marker ids on this object, e.g. markers = [1]", i)
         if style == "dots" and len(dots) < 2:
             self.err(s, "dots", "style 'dots' needs at least two dot centres [[x_m, y_m], ...]", i)
         if style in ("edges", "region", "markerless") and roi is None:
             self.err(s, "roi", f"style {style!r} needs roi = [u, v, width, height] (px, first frame)", i)
-        return ObjectConfig(id=oid, kind=kind, markers=markers, marker_positions_m=mpos, dots=dots,
-                            roi=roi, size_m=size,
-                            theta0_rad=self.num(d.get("theta0_rad"), s, "theta0_rad", i),
-                            marker_size_m=self.num(d.get("marker_size_m"), s, "marker_size_m", i,
-                                                   positive=True),
-                            style=own)
+        return ObjectConfig(
+            id=oid,
+            kind=kind,
+            markers=markers,
+            marker_positions_m=mpos,
+            dots=dots,
+            roi=roi,
+            size_m=size,
+            theta0_rad=self.num(d.get("theta0_rad"), s, "theta0_rad", i),
+            marker_size_m=self.num(d.get("marker_size_m"), s, "marker_size_m", i, positive=True),
+            style=own,
+        )

@@ -15,8 +15,15 @@ import numpy as np
 
 from ..._errors import InputError
 
-__all__ = ["PlaneMap", "SimilarityFit", "fit_similarity", "calibrate_camera",
-           "board_homography", "load_calibration", "plane_homography_from_points"]
+__all__ = [
+    "PlaneMap",
+    "SimilarityFit",
+    "fit_similarity",
+    "calibrate_camera",
+    "board_homography",
+    "load_calibration",
+    "plane_homography_from_points",
+]
 
 
 @dataclass(frozen=True)
@@ -175,8 +182,7 @@ def plane_homography_from_points(img_px, obj_m, plane_map: PlaneMap):
         ok, rvec, tvec = cv2.solvePnP(obj3, img, plane_map.K, dist, flags=cv2.SOLVEPNP_IPPE)
         if not ok:
             return None
-        ok, rvec, tvec = cv2.solvePnP(obj3, img, plane_map.K, dist, rvec, tvec, True,
-                                      flags=cv2.SOLVEPNP_ITERATIVE)
+        ok, rvec, tvec = cv2.solvePnP(obj3, img, plane_map.K, dist, rvec, tvec, True, flags=cv2.SOLVEPNP_ITERATIVE)
         R, _ = cv2.Rodrigues(rvec)
         G = plane_map.K @ np.column_stack((R[:, 0], R[:, 1], tvec.ravel()))
         H = np.linalg.inv(G)
@@ -192,8 +198,10 @@ def load_calibration(path):
             K = np.asarray(z["camera_matrix"], float).reshape(3, 3)
             d = np.asarray(z["dist_coeffs"], float).ravel()
     except (OSError, KeyError, ValueError) as e:
-        raise InputError(f"{path}: not a calibration .npz with camera_matrix and dist_coeffs "
-                         f"({e}); run rocklab.tracking.calibrate_camera") from None
+        raise InputError(
+            f"{path}: not a calibration .npz with camera_matrix and dist_coeffs "
+            f"({e}); run rocklab.tracking.calibrate_camera"
+        ) from None
     return K, d
 
 
@@ -209,9 +217,13 @@ def _find_board(gray, board):
         # The sector-based detector leaves ~0.2 px errors; cornerSubPix is exact on X-junctions.
         spacing = float(np.median(np.hypot(*np.diff(corners.reshape(-1, 2), axis=0).T)))
         win = int(np.clip(0.3 * spacing, 2, 10))
-        corners = cv2.cornerSubPix(gray, corners.astype(np.float32).reshape(-1, 1, 2), (win, win),
-                                   (-1, -1), (cv2.TERM_CRITERIA_EPS + cv2.TERM_CRITERIA_COUNT,
-                                              50, 0.001))
+        corners = cv2.cornerSubPix(
+            gray,
+            corners.astype(np.float32).reshape(-1, 1, 2),
+            (win, win),
+            (-1, -1),
+            (cv2.TERM_CRITERIA_EPS + cv2.TERM_CRITERIA_COUNT, 50, 0.001),
+        )
         pts = corners.reshape(pattern[1], pattern[0], 2).astype(float)
         # OpenCV may start from any corner of a symmetric board: make the origin the
         # top-left inner corner as seen in the image, x to the right (y up).
@@ -221,8 +233,9 @@ def _find_board(gray, board):
         obj = np.column_stack((ix.ravel(), -iy.ravel())) * board.square_m
         return pts.reshape(-1, 2), obj.astype(float)
     d = cv2.aruco.getPredefinedDictionary(getattr(cv2.aruco, board.dictionary))
-    b = cv2.aruco.CharucoBoard((board.squares_x, board.squares_y), board.square_m,
-                               board.marker_m or 0.7 * board.square_m, d)
+    b = cv2.aruco.CharucoBoard(
+        (board.squares_x, board.squares_y), board.square_m, board.marker_m or 0.7 * board.square_m, d
+    )
     det = cv2.aruco.CharucoDetector(b)
     ch_corners, ch_ids, _, _ = det.detectBoard(gray)
     if ch_ids is None or len(ch_ids) < 4:
@@ -242,8 +255,10 @@ def board_homography(gray, board, plane_map: PlaneMap | None = None):
 
     found = _find_board(gray, board)
     if found is None:
-        raise InputError(f"reference.board: no {board.kind} {board.squares_x}x{board.squares_y} "
-                         f"found in frame {board.frame}; check squares_x/squares_y or the frame")
+        raise InputError(
+            f"reference.board: no {board.kind} {board.squares_x}x{board.squares_y} "
+            f"found in frame {board.frame}; check squares_x/squares_y or the frame"
+        )
     img, obj = found
     return plane_homography_from_points(img, obj, plane_map or PlaneMap(*gray.shape[::-1]))
 
@@ -280,8 +295,10 @@ def calibrate_camera(frames, board, every: int = 10, out=None):
             img_pts.append(f[0].astype(np.float32).reshape(-1, 1, 2))
             obj_pts.append(np.c_[f[1], np.zeros(len(f[1]))].astype(np.float32))
     if len(img_pts) < 3:
-        raise InputError(f"calibration video: the board was found in {len(img_pts)} frames, "
-                         "need at least 3; film the board at several angles")
+        raise InputError(
+            f"calibration video: the board was found in {len(img_pts)} frames, "
+            "need at least 3; film the board at several angles"
+        )
     rms, K, dist, _, _ = cv2.calibrateCamera(obj_pts, img_pts, size, None, None)
     dist = dist.ravel()
     if out is not None:

@@ -17,8 +17,18 @@ from ._config import ObjectConfig, ReferenceConfig, TargetsConfig, TrackConfig, 
 __all__ = ["DICTIONARIES", "MarkerFinding", "find_markers", "suggest_config", "parse_region"]
 
 #: Dictionaries tried, most common first (ArUco 4x4..6x6, AprilTag 36h11, original ArUco).
-DICTIONARIES = ("DICT_4X4_50", "DICT_5X5_100", "DICT_6X6_250", "DICT_APRILTAG_36h11", "DICT_ARUCO_ORIGINAL",
-                "DICT_4X4_1000", "DICT_5X5_1000", "DICT_6X6_1000", "DICT_7X7_1000", "DICT_APRILTAG_25h9")
+DICTIONARIES = (
+    "DICT_4X4_50",
+    "DICT_5X5_100",
+    "DICT_6X6_250",
+    "DICT_APRILTAG_36h11",
+    "DICT_ARUCO_ORIGINAL",
+    "DICT_4X4_1000",
+    "DICT_5X5_1000",
+    "DICT_6X6_1000",
+    "DICT_7X7_1000",
+    "DICT_APRILTAG_25h9",
+)
 
 
 @dataclass(frozen=True)
@@ -100,8 +110,14 @@ def _group_markers(f: MarkerFinding):
     return table, blocks
 
 
-def suggest_config(first_gray, *, regions: dict | None = None, table_roi=None, fps: float | None = None,
-                   marker_size_m: float | None = None) -> tuple[TrackConfig, list[str], MarkerFinding | None]:
+def suggest_config(
+    first_gray,
+    *,
+    regions: dict | None = None,
+    table_roi=None,
+    fps: float | None = None,
+    marker_size_m: float | None = None,
+) -> tuple[TrackConfig, list[str], MarkerFinding | None]:
     """A tracking config for a video from its first frame.
 
     Parameters
@@ -138,18 +154,26 @@ def suggest_config(first_gray, *, regions: dict | None = None, table_roi=None, f
         _check_overlaps(objs)
         notes.append("objects followed markerless from the regions given (px, first frame)")
         if table_roi is None:
-            notes.append("no table: angles are not levelled (warning W-LEVEL-NONE when tracking); add "
-                         "--table x,y,w,h round the table's top edge or set reference.level")
+            notes.append(
+                "no table: angles are not levelled (warning W-LEVEL-NONE when tracking); add "
+                "--table x,y,w,h round the table's top edge or set reference.level"
+            )
         if marker_size_m is None:
             notes.append("no metric scale: x_m, y_m stay empty; set reference.m_per_px (m per pixel)")
-        cfg = TrackConfig(objects=tuple(objs), video=video, targets=TargetsConfig(style="markerless"),
-                          reference=ReferenceConfig(level="table"))
+        cfg = TrackConfig(
+            objects=tuple(objs),
+            video=video,
+            targets=TargetsConfig(style="markerless"),
+            reference=ReferenceConfig(level="table"),
+        )
         return cfg, notes, None
     found = find_markers(first_gray)
     if found is None:
-        raise InputError("no ArUco/AprilTag marker found in the first frame (tried "
-                         f"{', '.join(DICTIONARIES[:5])}, ...); give the objects as --object NAME=x,y,w,h "
-                         "(and --table x,y,w,h) to follow them markerless")
+        raise InputError(
+            "no ArUco/AprilTag marker found in the first frame (tried "
+            f"{', '.join(DICTIONARIES[:5])}, ...); give the objects as --object NAME=x,y,w,h "
+            "(and --table x,y,w,h) to follow them markerless"
+        )
     table, blocks = _group_markers(found)
     style = "apriltag" if "APRILTAG" in found.dictionary else "aruco"
     objs = []
@@ -158,16 +182,21 @@ def suggest_config(first_gray, *, regions: dict | None = None, table_roi=None, f
     for k, ms in enumerate(blocks, start=1):
         objs.append(ObjectConfig(id=f"block_{k}", kind="block", markers=tuple(ms)))
     notes.append(f"{len(found.ids)} markers found with {found.dictionary}: ids {sorted(found.ids)}")
-    notes.append(f"grouped as: table {table or '(none)'}; " + "; ".join(f"block_{k} {m}" for k, m in
-                                                                      enumerate(blocks, start=1)))
+    notes.append(
+        f"grouped as: table {table or '(none)'}; " + "; ".join(f"block_{k} {m}" for k, m in enumerate(blocks, start=1))
+    )
     if not table:
-        notes.append("no table found (markers spread along the lowest row): angles are not levelled "
-                     "(W-LEVEL-NONE when tracking)")
+        notes.append(
+            "no table found (markers spread along the lowest row): angles are not levelled (W-LEVEL-NONE when tracking)"
+        )
     if marker_size_m is None:
         notes.append("marker size unknown: x_m, y_m stay empty; set targets.marker_size_m (m)")
-    cfg = TrackConfig(objects=tuple(objs), video=video,
-                      targets=TargetsConfig(style=style, dictionary=found.dictionary, marker_size_m=marker_size_m),
-                      reference=ReferenceConfig(level="table"))
+    cfg = TrackConfig(
+        objects=tuple(objs),
+        video=video,
+        targets=TargetsConfig(style=style, dictionary=found.dictionary, marker_size_m=marker_size_m),
+        reference=ReferenceConfig(level="table"),
+    )
     return cfg, notes, found
 
 
@@ -175,11 +204,13 @@ def _check_overlaps(objs) -> None:
     """Two objects' regions may touch but not overlap by more than 20 % of the smaller: a tracker
     would latch onto the other object."""
     for i, a in enumerate(objs):
-        for b in objs[i + 1:]:
+        for b in objs[i + 1 :]:
             ax, ay, aw, ah = a.roi
             bx, by, bw, bh = b.roi
             ix = max(0.0, min(ax + aw, bx + bw) - max(ax, bx))
             iy = max(0.0, min(ay + ah, by + bh) - max(ay, by))
             if ix * iy > 0.2 * min(aw * ah, bw * bh):
-                raise InputError(f"objects {a.id!r} and {b.id!r}: their regions overlap by {ix * iy:.0f} px^2; "
-                                 "draw each round its own object only")
+                raise InputError(
+                    f"objects {a.id!r} and {b.id!r}: their regions overlap by {ix * iy:.0f} px^2; "
+                    "draw each round its own object only"
+                )

@@ -44,8 +44,10 @@ def level_from_reference(config, raw, fps, metric_plane, plane_map):
         return 0.0, "none (camera level)", math.nan
     if ref.level == "line":
         if plane_map is None:
-            raise InputError(f"{src}: level = 'line' needs the image -> plane mapping the frames were tracked "
-                             "with; pass plane_map to assemble_tracks")
+            raise InputError(
+                f"{src}: level = 'line' needs the image -> plane mapping the frames were tracked "
+                "with; pass plane_map to assemble_tracks"
+            )
         q = plane_map.to_plane(np.asarray(ref.level_line_px, float))
         d = q[1] - q[0]
         if d[0] < 0:
@@ -55,15 +57,21 @@ def level_from_reference(config, raw, fps, metric_plane, plane_map):
     if ref.level == "rest":
         oid = ref.level_object or next((o.id for o in config.objects if o.kind == "block"), None)
         if oid is None or oid not in raw:
-            warn("W-LEVEL-NONE", f"{src}: level = 'rest' but there is no block {oid or ''} to take the final rest "
-                                 "of; name one with reference.level_object")
+            warn(
+                "W-LEVEL-NONE",
+                f"{src}: level = 'rest' but there is no block {oid or ''} to take the final rest "
+                "of; name one with reference.level_object",
+            )
             return 0.0, "none", math.nan
         a, st, _ = raw[oid]
         th = np.where(st == "ok", a["th"], np.nan)
         rest = _final_rest(th, fps)
         if rest is None:
-            warn("W-LEVEL-NONE", f"{src}: level = 'rest' but {oid!r} does not come to rest at the end of the video "
-                                 "(1 s still needed); angles are not levelled")
+            warn(
+                "W-LEVEL-NONE",
+                f"{src}: level = 'rest' but {oid!r} does not come to rest at the end of the video "
+                "(1 s still needed); angles are not levelled",
+            )
             return 0.0, "none", math.nan
         # the frames' scatter understates a bias shared by all frames: one frame's σ is the floor
         sig = max(_robust_sem(th[rest]), float(np.nanmedian(a["sig"][rest])))
@@ -78,9 +86,12 @@ def level_from_reference(config, raw, fps, metric_plane, plane_map):
     if metric_plane:
         return 0.0, f"plane ({plane_map.source if plane_map is not None else 'homography'})", math.nan
     why = "no object of kind 'table'" if config.table is None else "the table was never seen"
-    warn("W-LEVEL-NONE", f"{src}: level = 'table' but {why}: angles are not levelled (camera roll stays in "
-                         "theta); add a table object, use level = 'rest' / 'line' / 'value', or 'none' if the "
-                         "camera is level")
+    warn(
+        "W-LEVEL-NONE",
+        f"{src}: level = 'table' but {why}: angles are not levelled (camera roll stays in "
+        "theta); add a table object, use level = 'rest' / 'line' / 'value', or 'none' if the "
+        "camera is level",
+    )
     return 0.0, "none", math.nan
 
 

@@ -50,23 +50,25 @@ class TableMotion:
         """The result as a pandas DataFrame (SI units in the column names)."""
         import pandas as pd
 
-        return pd.DataFrame({"t_s": self.t_s, "x_m": self.x_m, "vx_m_s": self.vx_m_s,
-                             "ax_m_s2": self.ax_m_s2})
+        return pd.DataFrame({"t_s": self.t_s, "x_m": self.x_m, "vx_m_s": self.vx_m_s, "ax_m_s2": self.ax_m_s2})
 
     def to_base_motion(self, name: str | None = None):
         """As a :class:`rocklab.models.BaseMotion` (gaps filled with 0 m/s²), to drive the simulator."""
         from ...models import BaseMotion
 
         a = np.where(np.isfinite(self.ax_m_s2), self.ax_m_s2, 0.0)
-        return BaseMotion.from_arrays(self.t_s - self.t_s[0], a, "m/s2",
-                                      name=name or f"{self.object} (video)")
+        return BaseMotion.from_arrays(self.t_s - self.t_s[0], a, "m/s2", name=name or f"{self.object} (video)")
 
     def to_dict(self) -> dict:
         """Plain dict of the fields, JSON-ready (SI units in the keys)."""
-        return {"object": self.object, "window": self.window, "window_s": self.window_s,
-                "polyorder": self.polyorder, "noise_m": self.noise_m,
-                "max_abs_ax_m_s2": float(np.nanmax(np.abs(self.ax_m_s2))) if np.any(
-                    np.isfinite(self.ax_m_s2)) else np.nan}
+        return {
+            "object": self.object,
+            "window": self.window,
+            "window_s": self.window_s,
+            "polyorder": self.polyorder,
+            "noise_m": self.noise_m,
+            "max_abs_ax_m_s2": float(np.nanmax(np.abs(self.ax_m_s2))) if np.any(np.isfinite(self.ax_m_s2)) else np.nan,
+        }
 
 
 def _segments(ok):
@@ -89,7 +91,7 @@ def _spectrum(x):
     k = np.arange(n)
     x = x - np.polyval(np.polyfit(k, x, 1), k)
     w = np.hanning(n)
-    return np.abs(np.fft.rfft(x * w)) ** 2 / np.sum(w ** 2)
+    return np.abs(np.fft.rfft(x * w)) ** 2 / np.sum(w**2)
 
 
 def estimate_noise(x) -> float:
@@ -103,12 +105,13 @@ def estimate_noise(x) -> float:
     if len(seg) < 16:
         return np.nan
     P = _spectrum(seg)
-    hi = P[int(0.6 * (len(P) - 1)):]
+    hi = P[int(0.6 * (len(P) - 1)) :]
     return float(np.sqrt(np.median(hi) / np.log(2.0)))
 
 
-def choose_sg_window(x, dt_s: float = 1.0, polyorder: int | None = None, noise=None,
-                     max_window: int = 61) -> tuple[int, int]:
+def choose_sg_window(
+    x, dt_s: float = 1.0, polyorder: int | None = None, noise=None, max_window: int = 61
+) -> tuple[int, int]:
     """Savitzky-Golay window and order that minimise the predicted acceleration error.
 
     From the record's periodogram ``P`` and noise floor ``σ²`` the signal
@@ -129,17 +132,18 @@ def choose_sg_window(x, dt_s: float = 1.0, polyorder: int | None = None, noise=N
     orders = [polyorder] if polyorder is not None else [2, 3, 4, 5, 6]
     lo = min(orders) + 1 + (min(orders) % 2)
     if len(seg) < max(lo, 16):
-        raise InputError(f"table displacement has at most {len(seg)} consecutive samples; need "
-                         f"{max(lo, 16)} to differentiate it")
+        raise InputError(
+            f"table displacement has at most {len(seg)} consecutive samples; need {max(lo, 16)} to differentiate it"
+        )
     sigma = estimate_noise(seg) if noise is None else float(noise)
     P = _spectrum(seg)
     n = len(seg)
     # Signal power only where it stands clearly above the noise floor: a noise bin taken
     # for signal at high frequency would be weighted by (2πf)^4 and force tiny windows.
     Ps = np.convolve(P, np.ones(5) / 5, mode="same")
-    S = np.where(Ps > 3.0 * sigma ** 2, np.maximum(P - sigma ** 2, 0.0), 0.0)
+    S = np.where(Ps > 3.0 * sigma**2, np.maximum(P - sigma**2, 0.0), 0.0)
     f = np.fft.rfftfreq(n, dt_s)
-    ideal = -(2 * np.pi * f) ** 2
+    ideal = -((2 * np.pi * f) ** 2)
     best, best_err = (lo, orders[0]), np.inf
     for p in orders:
         for N in range(p + 1 + (p % 2), min(max_window, n - (1 - n % 2)) + 1, 2):
@@ -147,14 +151,15 @@ def choose_sg_window(x, dt_s: float = 1.0, polyorder: int | None = None, noise=N
             k = np.arange(N) - N // 2
             H = np.exp(-2j * np.pi * np.outer(f, k) * dt_s) @ h
             # one-sided spectrum: factor 2 for the negative frequencies (Parseval)
-            err = 2 * np.sum(np.abs(H - ideal) ** 2 * S) / n + sigma ** 2 * np.sum(h ** 2)
+            err = 2 * np.sum(np.abs(H - ideal) ** 2 * S) / n + sigma**2 * np.sum(h**2)
             if err < best_err:
                 best, best_err = (N, p), err
     return best
 
 
-def table_motion(t_s, x_m, window_s: float | None = None, polyorder: int | None = None,
-                 object: str = "table") -> TableMotion:
+def table_motion(
+    t_s, x_m, window_s: float | None = None, polyorder: int | None = None, object: str = "table"
+) -> TableMotion:
     """Velocity and acceleration of a displacement record by Savitzky-Golay differentiation.
 
     Parameters

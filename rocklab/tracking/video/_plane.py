@@ -83,6 +83,7 @@ def _table_plane(config, pm, gray):
             return plane_homography_from_points(np.vstack(img), np.vstack(obj), pm)
         why = "not every table marker is visible in the first frame"
     if strict:
-        raise InputError(f"{config.source or 'config'}: 'reference.plane' = \"table\" {why}; "
-                         "fix it or use plane = \"image\"")
+        raise InputError(
+            f'{config.source or "config"}: \'reference.plane\' = "table" {why}; fix it or use plane = "image"'
+        )
     return None

@@ -72,9 +72,16 @@ class VideoInfo:
 
     def to_dict(self) -> dict:
         """Plain dict of the fields, JSON-ready (SI units in the keys)."""
-        return dict(path=self.path, n_frames=self.n_frames, fps=self.fps,
-                    width_px=self.width_px, height_px=self.height_px, pixel_aspect=self.pixel_aspect,
-                    variable_rate=self.variable_rate, field_order=self.field_order)
+        return dict(
+            path=self.path,
+            n_frames=self.n_frames,
+            fps=self.fps,
+            width_px=self.width_px,
+            height_px=self.height_px,
+            pixel_aspect=self.pixel_aspect,
+            variable_rate=self.variable_rate,
+            field_order=self.field_order,
+        )
 
 
 def _open(path):
@@ -88,8 +95,10 @@ def _open(path):
     cap = cv2.VideoCapture(str(p))
     if not cap.isOpened():
         cap.release()
-        raise InputError(f"{p}: cannot open as a video (unknown format or corrupt file); "
-                         "convert it to .mkv/.mp4 or an image sequence 'dir/%05d.png'")
+        raise InputError(
+            f"{p}: cannot open as a video (unknown format or corrupt file); "
+            "convert it to .mkv/.mp4 or an image sequence 'dir/%05d.png'"
+        )
     return cap
 
 
@@ -164,8 +173,7 @@ def probe_video(path) -> VideoInfo:
         fps = float(cap.get(cv2.CAP_PROP_FPS) or 0.0)
         ok, img = cap.read()
         if not ok or img is None:
-            raise InputError(f"{path}: the video has no decodable frame (empty or corrupt); "
-                             "check the file")
+            raise InputError(f"{path}: the video has no decodable frame (empty or corrupt); check the file")
         h, w = img.shape[:2]
     finally:
         cap.release()
@@ -180,8 +188,7 @@ def probe_video(path) -> VideoInfo:
         rate = 1.0 / float(np.median(np.diff(times)))
         if fps is None or abs(fps - rate) > 0.01 * rate:
             fps, n = rate, len(times)
-    return VideoInfo(str(path), max(n, 0), fps, _square_width(int(w), aspect), int(h), aspect, times,
-                     field_order(path))
+    return VideoInfo(str(path), max(n, 0), fps, _square_width(int(w), aspect), int(h), aspect, times, field_order(path))
 
 
 def _square_width(w: int, aspect: float) -> int:
@@ -232,18 +239,28 @@ def _fields(img, order: str):
 
     h, w = img.shape[:2]
     out = []
-    for first in ((True, False) if order == "tff" else (False, True)):
+    for first in (True, False) if order == "tff" else (False, True):
         off = 0 if first else 1
         field = img[off::2]
         # output row y lies at field row (y - off) / 2: the field's lines keep their height
         M = np.array([[1.0, 0.0, 0.0], [0.0, 0.5, -0.5 * off]], np.float32)
-        out.append(cv2.warpAffine(field, M, (w, h), flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP,
-                                  borderMode=cv2.BORDER_REPLICATE))
+        out.append(
+            cv2.warpAffine(
+                field, M, (w, h), flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP, borderMode=cv2.BORDER_REPLICATE
+            )
+        )
     return out
 
 
-def iter_video_frames(path, start: int = 0, stop: int | None = None, prefetch: int = 8,
-                      color: bool = False, pixel_aspect: float = 1.0, fields: str | None = None):
+def iter_video_frames(
+    path,
+    start: int = 0,
+    stop: int | None = None,
+    prefetch: int = 8,
+    color: bool = False,
+    pixel_aspect: float = 1.0,
+    fields: str | None = None,
+):
     """Yield ``(index, gray)`` (``(index, gray, image)`` with ``color``) for frames
     ``start <= index < stop``.
 

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 
-
 def register(sub):
     """Add this module's subcommand(s) to the ``rocklab`` parser ``sub``."""
     p = sub.add_parser("campaign", help="run every experiment.toml under DIR in parallel, then campaign fits")
@@ -21,8 +20,14 @@ def run(args) -> int:
     """Run ``rocklab campaign`` with parsed ``args``; returns the exit status (0 ok)."""
     from ...campaign._campaign import run_campaign
 
-    res = run_campaign(args.dir, args.out, workers=args.workers, scheduler=args.scheduler,
-                       force=args.force, progress=not args.no_progress)
+    res = run_campaign(
+        args.dir,
+        args.out,
+        workers=args.workers,
+        scheduler=args.scheduler,
+        force=args.force,
+        progress=not args.no_progress,
+    )
     if args.json:
         from .._cli_base import emit_json
 

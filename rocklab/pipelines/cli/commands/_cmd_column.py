@@ -24,32 +24,59 @@ _MAX_LINES = 40
 
 def register(sub):
     """Add this module's subcommand(s) to the ``rocklab`` parser ``sub``."""
-    p = sub.add_parser("column", help="simulate a multi-block column (opening and impact models)",
-                       description="Simulate a planar column of rigid blocks on a rigid base (SI units).")
-    p.add_argument("--blocks", default=None,
-                   help="blocks bottom to top as WIDTHxHEIGHT in m, comma separated (e.g. 0.1x0.2,0.1x0.2)")
+    p = sub.add_parser(
+        "column",
+        help="simulate a multi-block column (opening and impact models)",
+        description="Simulate a planar column of rigid blocks on a rigid base (SI units).",
+    )
+    p.add_argument(
+        "--blocks",
+        default=None,
+        help="blocks bottom to top as WIDTHxHEIGHT in m, comma separated (e.g. 0.1x0.2,0.1x0.2)",
+    )
     p.add_argument("--cut", default="0", help="cut edge size per joint, m (one value or one per joint)")
-    p.add_argument("--density", type=float, default=2700.0,
-                   help="block density, kg/m3 (sets the mass ratios; default 2700, granite)")
+    p.add_argument(
+        "--density",
+        type=float,
+        default=2700.0,
+        help="block density, kg/m3 (sets the mass ratios; default 2700, granite)",
+    )
     p.add_argument("--mu", type=float, default=math.inf, help="friction coefficient (default: no sliding check)")
     p.add_argument("--theta0", default=None, help="initial block angles, rad (comma separated, bottom first)")
     p.add_argument("--omega0", default=None, help="initial block rates, rad/s (comma separated)")
     p.add_argument("--duration", type=float, default=None, help="simulated time, s (default record end + 5 s)")
     p.add_argument("--dt", type=float, default=1e-4, help="time step, s (default 1e-4)")
-    p.add_argument("--impacts", type=int, default=1,
-                   help="consecutive impacts per closing: 1 Housner, 2 one mid-joint bump (thesis)")
+    p.add_argument(
+        "--impacts",
+        type=int,
+        default=1,
+        help="consecutive impacts per closing: 1 Housner, 2 one mid-joint bump (thesis)",
+    )
     add_base_motion_args(p)
-    p.add_argument("--thesis-form", action="store_true",
-                   help="drop the velocity terms of the App. C reduction (the thesis's M(phi) phi'' = p(phi))")
+    p.add_argument(
+        "--thesis-form",
+        action="store_true",
+        help="drop the velocity terms of the App. C reduction (the thesis's M(phi) phi'' = p(phi))",
+    )
     p.add_argument("-o", "--output", default=None, help="write the time history CSV here")
-    p.add_argument("--output-dt", type=float, default=None,
-                   help="spacing of the -o time history, s (a multiple of --dt; default every step); "
-                        "events and peaks always come from every step")
-    p.add_argument("--maps-png", default=None,
-                   help="also compute the thesis Fig. 40 overturning maps (H=12 m, B=1 m, 1-3 blocks) "
-                        "and write them to this PNG")
-    p.add_argument("--maps-grid", type=int, default=10,
-                   help="maps: grid points per axis over a_p 1-12 m/s2, t_p 0.3-2.4 s (default 10)")
+    p.add_argument(
+        "--output-dt",
+        type=float,
+        default=None,
+        help="spacing of the -o time history, s (a multiple of --dt; default every step); "
+        "events and peaks always come from every step",
+    )
+    p.add_argument(
+        "--maps-png",
+        default=None,
+        help="also compute the thesis Fig. 40 overturning maps (H=12 m, B=1 m, 1-3 blocks) and write them to this PNG",
+    )
+    p.add_argument(
+        "--maps-grid",
+        type=int,
+        default=10,
+        help="maps: grid points per axis over a_p 1-12 m/s2, t_p 0.3-2.4 s (default 10)",
+    )
     p.add_argument("--json", action="store_true", help="print one JSON summary object on stdout")
     p.set_defaults(func=run)
 
@@ -83,8 +110,6 @@ def _blocks(text, density):
     return tuple(out)
 
 
-
-
 def run(args) -> int:
     """Run ``rocklab column`` with parsed ``args``; returns the exit status (0 ok)."""
     from ...._errors import InputError
@@ -105,9 +130,17 @@ def run(args) -> int:
             raise InputError("nothing moves: give --base-motion FILE or a non-zero --theta0/--omega0")
         # without -o nothing reads the time history: keep only the end states
         odt = args.output_dt if args.output else math.inf
-        res = simulate_column(col, base, theta0_rad=th0, omega0_rad_s=om0, duration_s=args.duration,
-                              dt_s=args.dt, n_impacts=args.impacts, velocity_terms=not args.thesis_form,
-                              output_dt_s=odt)
+        res = simulate_column(
+            col,
+            base,
+            theta0_rad=th0,
+            omega0_rad_s=om0,
+            duration_s=args.duration,
+            dt_s=args.dt,
+            n_impacts=args.impacts,
+            velocity_terms=not args.thesis_form,
+            output_dt_s=odt,
+        )
         if args.output:
             write_frame_atomic(args.output, res.to_frame())
         out = res.to_dict()
@@ -124,17 +157,21 @@ def run(args) -> int:
             sys.stdout.write(f"wrote {args.output}\n")
     if args.maps_png is not None:
         fr = out["maps"]["overturned_fraction"]
-        sys.stdout.write("overturning maps (H=12 m, B=1 m, full-sine pulse): overturned share "
-                         + ", ".join(f"{k} block{'s' * (k > 1)} {f:.2f}" for k, f in zip((1, 2, 3), fr))
-                         + f"\nwrote {args.maps_png}\n")
+        sys.stdout.write(
+            "overturning maps (H=12 m, B=1 m, full-sine pulse): overturned share "
+            + ", ".join(f"{k} block{'s' * (k > 1)} {f:.2f}" for k, f in zip((1, 2, 3), fr))
+            + f"\nwrote {args.maps_png}\n"
+        )
     return 0
 
 
 def _print_summary(res, d):
     w = sys.stdout.write
     col = res.column
-    w(f"column of {col.n} block(s), height {col.height_m:g} m, cut {', '.join(f'{c:g}' for c in col.cut_m)} m; "
-      f"dt = {res.params['dt_s']:g} s, {res.params['n_impacts']} impact(s) per closing\n")
+    w(
+        f"column of {col.n} block(s), height {col.height_m:g} m, cut {', '.join(f'{c:g}' for c in col.cut_m)} m; "
+        f"dt = {res.params['dt_s']:g} s, {res.params['n_impacts']} impact(s) per closing\n"
+    )
     t_end = res.t_s[-1] if len(res.t_s) else 0.0
     when = f"at t = {res.t_status_s:.4f} s" if math.isfinite(res.t_status_s) else f"at t = {t_end:.4f} s"
     w(f"status {res.status} {when}, {len(res.impacts)} impacts{': ' + res.message if res.message else ''}\n")
@@ -159,7 +196,6 @@ def _maps(args):
     ap = np.linspace(1.0, 12.0, k)
     tp = np.linspace(0.3, 2.4, k)
     with tqdm(total=3 * k * k, file=sys.stderr, desc="maps", leave=False) as bar:
-        maps = column_overturning_maps(ap_m_s2=ap, tp_s=tp, n_impacts=args.impacts,
-                                       progress=lambda i: bar.update(1))
+        maps = column_overturning_maps(ap_m_s2=ap, tp_s=tp, n_impacts=args.impacts, progress=lambda i: bar.update(1))
     plot_column_maps(maps, args.maps_png)
     return maps.to_dict()

@@ -5,8 +5,11 @@ from __future__ import annotations
 
 def register(sub):
     """Add this module's subcommand(s) to the ``rocklab`` parser ``sub``."""
-    p = sub.add_parser("demo", help="render a small synthetic campaign (Čeh blocks, ArUco video, x-IMU logs, "
-                                    "an El Centro shake-table run) and run it end to end")
+    p = sub.add_parser(
+        "demo",
+        help="render a small synthetic campaign (Čeh blocks, ArUco video, x-IMU logs, "
+        "an El Centro shake-table run) and run it end to end",
+    )
     p.add_argument("--out", default="demo_out", help="output folder (default: demo_out)")
     p.add_argument("--workers", type=int, default=2, help="parallel processes (default 2)")
     p.add_argument("--no-progress", action="store_true", help="no progress bars")
@@ -20,6 +23,8 @@ def run(args) -> int:
     res, t = run_demo(args.out, workers=args.workers, progress=not args.no_progress)
     print(res.summary_text())
     print(f"(rendered sessions in {t['render_s']:.0f} s, campaign in {t['campaign_s']:.0f} s)")
-    print(f"look: {args.out}/results/campaign.csv, {args.out}/results/figures/, "
-          f"rerun {args.out}/results/campaign.rrd, rerun {args.out}/results/experiments/<run>/session.rrd")
+    print(
+        f"look: {args.out}/results/campaign.csv, {args.out}/results/figures/, "
+        f"rerun {args.out}/results/campaign.rrd, rerun {args.out}/results/experiments/<run>/session.rrd"
+    )
     return 0 if res.n_ok == len(res.runs) else 1

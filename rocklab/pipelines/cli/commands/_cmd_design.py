@@ -31,8 +31,12 @@ def register(sub):
 
     p = sub.add_parser("oas", help="Overturning Acceleration Spectrum and t_I of record(s)")
     p.add_argument("record", nargs="*", help="record files or folders of records (every visible file in them)")
-    p.add_argument("--list", default=None, metavar="FILE",
-                   help="a text file naming one record per line (relative to its folder; # comments)")
+    p.add_argument(
+        "--list",
+        default=None,
+        metavar="FILE",
+        help="a text file naming one record per line (relative to its folder; # comments)",
+    )
     p.add_argument("--units", default=None)
     p.add_argument("--slenderness", type=float, default=12.0, help="block h/b (default 12)")
     p.add_argument("--levels", type=int, default=80, help="a_p/a_p,min levels 1..level-max (80)")
@@ -43,13 +47,23 @@ def register(sub):
     p.add_argument("--free", default="energy", help="after the record: energy | none | SECONDS")
     p.add_argument("--search", choices=("scan", "contiguous"), default="scan")
     p.add_argument("--eta", type=float, default=None, help="restitution (default Housner)")
-    p.add_argument("-o", "--out", default=None,
-                   help="CSV: OAS boundary (one record) or the record table (several; also written as .parquet)")
-    p.add_argument("--plot", default=None,
-                   help="PNG: OAS, transformed OAS, 1/p view (one record), or t_I vs t_p with the thesis's values")
-    p.add_argument("--band", action="store_true",
-                   help="t_I, t'_I and beta over an ensemble of grid placements, densities, step, eta and search "
-                        "(median and 5-95 %% band; 8 OAS per record)")
+    p.add_argument(
+        "-o",
+        "--out",
+        default=None,
+        help="CSV: OAS boundary (one record) or the record table (several; also written as .parquet)",
+    )
+    p.add_argument(
+        "--plot",
+        default=None,
+        help="PNG: OAS, transformed OAS, 1/p view (one record), or t_I vs t_p with the thesis's values",
+    )
+    p.add_argument(
+        "--band",
+        action="store_true",
+        help="t_I, t'_I and beta over an ensemble of grid placements, densities, step, eta and search "
+        "(median and 5-95 %% band; 8 OAS per record)",
+    )
     p.add_argument("--workers", type=int, default=None, help="local processes for several records")
     p.add_argument("--scheduler", default=None, help="Dask distributed scheduler address")
     p.add_argument("--no-progress", action="store_true")
@@ -88,10 +102,10 @@ def register(sub):
 
 # -- handlers -------------------------------------------------------------------------
 
+
 def run(args) -> int:
     """Run ``rocklab design`` with parsed ``args``; returns the exit status (0 ok)."""
-    return {"pulse": run_pulse, "oas": run_oas, "design": run_design,
-            "equivalent": run_equivalent}[args.command](args)
+    return {"pulse": run_pulse, "oas": run_oas, "design": run_design, "equivalent": run_equivalent}[args.command](args)
 
 
 def run_pulse(args) -> int:
@@ -102,8 +116,10 @@ def run_pulse(args) -> int:
     if args.json:
         _emit(d)
     else:
-        print(f"{pp.name}: a_max = {pp.a_max_m_s2:.4f} m/s2, I_max = {pp.I_max_m_s:.4f} m/s, "
-              f"t_p = {pp.t_p_s:.4f} s (lobe {pp.lobe_start_s:.2f}-{pp.lobe_end_s:.2f} s)")
+        print(
+            f"{pp.name}: a_max = {pp.a_max_m_s2:.4f} m/s2, I_max = {pp.I_max_m_s:.4f} m/s, "
+            f"t_p = {pp.t_p_s:.4f} s (lobe {pp.lobe_start_s:.2f}-{pp.lobe_end_s:.2f} s)"
+        )
     return 0
 
 
@@ -119,8 +135,16 @@ def _free(v):
 def run_oas(args) -> int:
     from ...._io import write_frame_atomic
 
-    kw = dict(levels=args.levels, level_max=args.level_max, sizes=args.sizes, refine=args.refine,
-              criterion=args.criterion, free=_free(args.free), search=args.search, eta=args.eta)
+    kw = dict(
+        levels=args.levels,
+        level_max=args.level_max,
+        sizes=args.sizes,
+        refine=args.refine,
+        criterion=args.criterion,
+        free=_free(args.free),
+        search=args.search,
+        eta=args.eta,
+    )
     if args.slenderness is None or not (args.slenderness > 0):
         raise InputError(f"--slenderness {args.slenderness}: h/b must be > 0 (e.g. 12)")
     from pathlib import Path
@@ -145,9 +169,11 @@ def run_oas(args) -> int:
         _emit(d)
     else:
         lv, R = o.f_min_at
-        print(f"{rec.name}: t_I = {o.t_I_s:.4f} s, t'_I = {o.t_I_prime_s:.4f} s, beta = {o.beta:.3f}, "
-              f"f_min = {o.f_min_rad_s:.4f} 1/s at a_p/a_p,min = {lv:.3f}, R = {R:.3f} m "
-              f"(H/B = {args.slenderness:g})")
+        print(
+            f"{rec.name}: t_I = {o.t_I_s:.4f} s, t'_I = {o.t_I_prime_s:.4f} s, beta = {o.beta:.3f}, "
+            f"f_min = {o.f_min_rad_s:.4f} 1/s at a_p/a_p,min = {lv:.3f}, R = {R:.3f} m "
+            f"(H/B = {args.slenderness:g})"
+        )
     return 0
 
 
@@ -164,10 +190,18 @@ def _run_oas_batch(args, kw) -> int:
     for _, _, err in items:
         if err:
             sys.stderr.write(f"rocklab oas: error: {err}\n")
-    tab = oas_table(items, units=args.units, slenderness=args.slenderness, oas_kwargs=kw, workers=args.workers,
-                    scheduler=args.scheduler, progress=not args.no_progress, band=args.band)
-    for (_, _, err), row_err in zip(items, tab["error"]):     # the table keeps the items' order
-        if row_err and not err:                                  # the expansion's errors are printed above
+    tab = oas_table(
+        items,
+        units=args.units,
+        slenderness=args.slenderness,
+        oas_kwargs=kw,
+        workers=args.workers,
+        scheduler=args.scheduler,
+        progress=not args.no_progress,
+        band=args.band,
+    )
+    for (_, _, err), row_err in zip(items, tab["error"]):  # the table keeps the items' order
+        if row_err and not err:  # the expansion's errors are printed above
             sys.stderr.write(f"rocklab oas: error: {row_err}\n")
     if args.out:
         out = Path(args.out)
@@ -184,8 +218,11 @@ def _run_oas_batch(args, kw) -> int:
     if args.json:
         _emit({"records": tab.to_dict(orient="records"), "failed": n_bad})
     else:
-        cols = ["name", "t_p_s", "t_I_s"] + (["t_I_p05_s", "t_I_p95_s"] if args.band else []) + \
-            ["t_I_prime_s", "beta", "thesis_id", "thesis_t_I_s"]
+        cols = (
+            ["name", "t_p_s", "t_I_s"]
+            + (["t_I_p05_s", "t_I_p95_s"] if args.band else [])
+            + ["t_I_prime_s", "beta", "thesis_id", "thesis_t_I_s"]
+        )
         show = tab[cols]
         print(show.to_string(index=False, float_format=lambda v: f"{v:.4g}"))
         print(f"{len(tab) - n_bad}/{len(tab)} records done" + (f", {n_bad} failed (see above)" if n_bad else ""))
@@ -201,15 +238,22 @@ def run_design(args) -> int:
     aI = args.alpha_I if args.alpha_I is not None else (1.0 if args.mass_at_top else 4.0 / 3.0)
     ag = args.ag * g
     kw = dict(cm_height_ratio=c, alpha_I=aI, g=g)
-    d = dict(width_m=required_width(args.height, ag, args.tI, exact_icr=True, **kw),
-             width_eq31_m=required_width(args.height, ag, args.tI, exact_icr=False, **kw),
-             width_slender_m=required_width_slender(args.height, ag, args.tI, **kw),
-             width_no_uplift_m=2 * c * args.height * args.ag, cm_height_ratio=c, alpha_I=aI, g_m_s2=g)
+    d = dict(
+        width_m=required_width(args.height, ag, args.tI, exact_icr=True, **kw),
+        width_eq31_m=required_width(args.height, ag, args.tI, exact_icr=False, **kw),
+        width_slender_m=required_width_slender(args.height, ag, args.tI, **kw),
+        width_no_uplift_m=2 * c * args.height * args.ag,
+        cm_height_ratio=c,
+        alpha_I=aI,
+        g_m_s2=g,
+    )
     if args.json:
         _emit(d)
     else:
-        print(f"required width {d['width_m']:.4g} m (Eq. 21 exact; i_cr = 1: {d['width_eq31_m']:.4g} m, "
-              f"slender: {d['width_slender_m']:.4g} m, no uplift: {d['width_no_uplift_m']:.4g} m)")
+        print(
+            f"required width {d['width_m']:.4g} m (Eq. 21 exact; i_cr = 1: {d['width_eq31_m']:.4g} m, "
+            f"slender: {d['width_slender_m']:.4g} m, no uplift: {d['width_no_uplift_m']:.4g} m)"
+        )
     return 0
 
 
@@ -234,10 +278,12 @@ def run_equivalent(args) -> int:
     extra = {}
     if mech in ("block", "strut", "frame", "wall"):
         R, a = _R_alpha(args)
-        fp = {"block": lambda: m.block_parameters(R, a, args.alpha_I),
-              "strut": lambda: m.strut_parameters(R, a),
-              "frame": lambda: m.frame_parameters(R, a, args.gamma, args.alpha_I),
-              "wall": lambda: m.wall_parameters(R, a, args.alpha_I)}[mech]()
+        fp = {
+            "block": lambda: m.block_parameters(R, a, args.alpha_I),
+            "strut": lambda: m.strut_parameters(R, a),
+            "frame": lambda: m.frame_parameters(R, a, args.gamma, args.alpha_I),
+            "wall": lambda: m.wall_parameters(R, a, args.alpha_I),
+        }[mech]()
         out = fp.to_dict()
     elif mech == "asym-frame":
         _need(args, "b", "H", "H1", "L", "h")

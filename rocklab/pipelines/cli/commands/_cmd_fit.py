@@ -23,8 +23,11 @@ from ...._errors import InputError, where
 
 def register(sub):
     """Add this module's subcommand(s) to the ``rocklab`` parser ``sub``."""
-    p = sub.add_parser("fit", help="restitution calibration: eta_e, eta_mat, inverse k, k regression",
-                       description=__doc__.split("\n\n")[0])
+    p = sub.add_parser(
+        "fit",
+        help="restitution calibration: eta_e, eta_mat, inverse k, k regression",
+        description=__doc__.split("\n\n")[0],
+    )
     fs = p.add_subparsers(dest="fit_command", metavar="WHAT")
 
     r = fs.add_parser("restitution", help="fit a constant eta_e to a free-rocking record (t_s, theta_rad)")
@@ -34,10 +37,17 @@ def register(sub):
     r.add_argument("--object", default=None, help="object id in tracks.csv (default: the only block)")
     r.add_argument("--window", choices=("middle50", "all", "first"), default="middle50")
     r.add_argument("--objective", choices=("theta", "peaks"), default="theta")
-    r.add_argument("--fit-offset", action="store_true",
-                   help="also fit a constant level offset of theta (camera level error, IMU bias)")
-    r.add_argument("--nan", choices=("raise", "skip"), default="skip",
-                   help="rows with NaN/not-ok samples: skip them (counted) or stop with an error")
+    r.add_argument(
+        "--fit-offset",
+        action="store_true",
+        help="also fit a constant level offset of theta (camera level error, IMU bias)",
+    )
+    r.add_argument(
+        "--nan",
+        choices=("raise", "skip"),
+        default="skip",
+        help="rows with NaN/not-ok samples: skip them (counted) or stop with an error",
+    )
     _common(r)
 
     e = fs.add_parser("eta-mat", help="material restitution eta_mat from edge-contact results (Čeh Eq. 16)")
@@ -60,16 +70,15 @@ def register(sub):
     q = fs.add_parser("k-predict", help="predict k, eta_M and b_bar for a new block (Čeh Eq. 19 by default)")
     q.add_argument("--hb", type=float, required=True, help="aspect ratio h/b")
     q.add_argument("--b-cm", type=float, required=True, help="block width b, cm")
-    q.add_argument("--coefficients", default=None,
-                   help="JSON file: a 'k-table --json' output or a {hb2, hb, const, b_cm} object")
+    q.add_argument(
+        "--coefficients", default=None, help="JSON file: a 'k-table --json' output or a {hb2, hb, const, b_cm} object"
+    )
     _common(q)
     p.set_defaults(func=run, _fit_parser=p)
 
 
 def _common(p):
     p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
-
-
 
 
 def _emit(args, payload: dict, text: str) -> None:
@@ -87,8 +96,12 @@ def run(args) -> int:
     if cmd is None:
         args._fit_parser.print_help()
         return 2
-    return {"restitution": _run_restitution, "eta-mat": _run_eta_mat, "k-table": _run_k_table,
-            "k-predict": _run_k_predict}[cmd](args)
+    return {
+        "restitution": _run_restitution,
+        "eta-mat": _run_eta_mat,
+        "k-table": _run_k_table,
+        "k-predict": _run_k_predict,
+    }[cmd](args)
 
 
 def _read_track(path: Path, obj: str | None, nan: str):
@@ -123,8 +136,9 @@ def _read_track(path: Path, obj: str | None, nan: str):
         bad |= df["status"].astype(str).str.lower().ne("ok").to_numpy()
     if bad.any() and nan == "raise":
         line = int(df["_line"].to_numpy()[np.flatnonzero(bad)[0]])
-        raise InputError(f"{where(path, line)}NaN or not-ok sample ({int(bad.sum())} such rows); "
-                         "use --nan skip to drop them")
+        raise InputError(
+            f"{where(path, line)}NaN or not-ok sample ({int(bad.sum())} such rows); use --nan skip to drop them"
+        )
     return t[~bad], y[~bad], int(bad.sum())
 
 
@@ -136,15 +150,39 @@ def _run_restitution(args) -> int:
     t, y, n_skip = _read_track(Path(args.track), args.object, args.nan)
     if n_skip:
         sys.stderr.write(f"rocklab fit restitution: skipped {n_skip} NaN/not-ok row(s)\n")
-    fit = fit_restitution(t, y, block, window=args.window, objective=args.objective, nan="raise",
-                          fit_offset=args.fit_offset)
+    fit = fit_restitution(
+        t, y, block, window=args.window, objective=args.objective, nan="raise", fit_offset=args.fit_offset
+    )
     d = fit.to_dict()
     d["n_skipped"] = n_skip
-    keys = ("eta_e", "eta_e_first", "ci95_eta_e", "theta0_rad", "release_t_s", "rms_residual_rad",
-            "per_impact_eta", "status")
+    keys = (
+        "eta_e",
+        "eta_e_first",
+        "ci95_eta_e",
+        "theta0_rad",
+        "release_t_s",
+        "rms_residual_rad",
+        "per_impact_eta",
+        "status",
+    )
     payload = {k: d[k] for k in keys}
-    payload.update({k: d[k] for k in ("message", "suspicious", "flags", "n_impacts", "window", "objective",
-                                       "n_skipped", "theta_offset_rad", "sigma_theta_rad", "at_bound")})
+    payload.update(
+        {
+            k: d[k]
+            for k in (
+                "message",
+                "suspicious",
+                "flags",
+                "n_impacts",
+                "window",
+                "objective",
+                "n_skipped",
+                "theta_offset_rad",
+                "sigma_theta_rad",
+                "at_bound",
+            )
+        }
+    )
     _emit(args, payload, fit.report())
     return 0 if fit.ok else 1
 
@@ -155,8 +193,17 @@ def _run_eta_mat(args) -> int:
     table = read_block_table(Path(args.table), nan=args.nan)
     res = fit_eta_mat(table, l_c_m=args.lc_m, contact=args.contact, rule=args.rule, min_hb=args.min_hb)
     pb = res.per_block[["block", "b_m", "h_m", "h_over_b", "k", "eta_M", "eta_e", "ratio", "used", "above_one"]]
-    payload = dict(eta_mat=res.eta_mat, std=res.std, n=res.n, rule=res.rule, contact=res.contact,
-                   l_c_m=res.l_c_m, per_block=pb.to_dict(orient="records"), message=res.message, status=res.status)
+    payload = dict(
+        eta_mat=res.eta_mat,
+        std=res.std,
+        n=res.n,
+        rule=res.rule,
+        contact=res.contact,
+        l_c_m=res.l_c_m,
+        per_block=pb.to_dict(orient="records"),
+        message=res.message,
+        status=res.status,
+    )
     _emit(args, payload, res.report())
     return 0 if res.status != "failed" else 1
 
@@ -189,11 +236,15 @@ def _run_k_predict(args) -> int:
         coefs = obj.get("coefficients", obj)
         if not isinstance(coefs, dict):
             raise InputError(f"{where(path, key='coefficients')}must be an object of name: value")
-        reg = KRegression.from_coefficients(coefs, hb_range=obj.get("hb_range", (math.nan, math.nan)),
-                                            b_cm_range=obj.get("b_cm_range", (math.nan, math.nan)))
+        reg = KRegression.from_coefficients(
+            coefs,
+            hb_range=obj.get("hb_range", (math.nan, math.nan)),
+            b_cm_range=obj.get("b_cm_range", (math.nan, math.nan)),
+        )
     pred = reg.predict(args.hb, args.b_cm / 100.0)
     d = pred.to_dict()
-    text = (f"k = {pred.k:.4f}, eta_M = {pred.eta_M:.4f}, b_bar = {pred.b_bar_m * 1000:.2f} mm"
-            + (f"  [{pred.message}]" if pred.message else ""))
+    text = f"k = {pred.k:.4f}, eta_M = {pred.eta_M:.4f}, b_bar = {pred.b_bar_m * 1000:.2f} mm" + (
+        f"  [{pred.message}]" if pred.message else ""
+    )
     _emit(args, d, text)
     return 0

@@ -16,25 +16,39 @@ import sys
 
 def register(sub):
     """Add this module's subcommand(s) to the ``rocklab`` parser ``sub``."""
-    p = sub.add_parser("imu", help="IMU log -> block rotation / table acceleration",
-                       description="Read an IMU log (x-IMU GUI export, x-IMU3 folder, Fusion CSV) "
-                                   "and estimate the block rotation about the rocking axis "
-                                   "(or, with --table, the table acceleration).")
+    p = sub.add_parser(
+        "imu",
+        help="IMU log -> block rotation / table acceleration",
+        description="Read an IMU log (x-IMU GUI export, x-IMU3 folder, Fusion CSV) "
+        "and estimate the block rotation about the rocking axis "
+        "(or, with --table, the table acceleration).",
+    )
     p.add_argument("path", help="IMU CSV or log folder")
-    p.add_argument("--axis", default=None,
-                   help="rocking axis (block) / shaking axis (table) in the sensor frame: "
-                        "x, y, z with optional sign, e.g. -y; default: found from the data")
-    p.add_argument("--rate", type=float, default=None,
-                   help="sample rate, Hz (needed when the log has no rate register/time column)")
+    p.add_argument(
+        "--axis",
+        default=None,
+        help="rocking axis (block) / shaking axis (table) in the sensor frame: "
+        "x, y, z with optional sign, e.g. -y; default: found from the data",
+    )
+    p.add_argument(
+        "--rate",
+        type=float,
+        default=None,
+        help="sample rate, Hz (needed when the log has no rate register/time column)",
+    )
     p.add_argument("-o", "--out", default=None, help="write the time series to this CSV")
     p.add_argument("--json", action="store_true", help="print one JSON summary on stdout")
-    p.add_argument("--table", action="store_true",
-                   help="table IMU: base acceleration along the shaking axis, gravity removed")
-    p.add_argument("--release", default="auto", choices=("auto", "thread", "none"),
-                   help="thread: thread-burn release (rest tilted, then rocking); none: a block on a "
-                        "shake table that starts upright; auto (default): decide from the data")
-    p.add_argument("--ahrs", action="store_true",
-                   help="also run imufusion's AHRS and report its difference (slower)")
+    p.add_argument(
+        "--table", action="store_true", help="table IMU: base acceleration along the shaking axis, gravity removed"
+    )
+    p.add_argument(
+        "--release",
+        default="auto",
+        choices=("auto", "thread", "none"),
+        help="thread: thread-burn release (rest tilted, then rocking); none: a block on a "
+        "shake table that starts upright; auto (default): decide from the data",
+    )
+    p.add_argument("--ahrs", action="store_true", help="also run imufusion's AHRS and report its difference (slower)")
     p.set_defaults(func=run)
 
 
@@ -61,18 +75,25 @@ def run(args) -> int:
         emit_json(summary)
         return 0
     out = sys.stdout
-    out.write(f"{summary['source']}: {summary['format']}, {summary['n_samples']} samples at "
-              f"{summary['sample_rate_hz']:g} Hz, {summary['dropped_samples']} dropped\n")
+    out.write(
+        f"{summary['source']}: {summary['format']}, {summary['n_samples']} samples at "
+        f"{summary['sample_rate_hz']:g} Hz, {summary['dropped_samples']} dropped\n"
+    )
     if args.table:
-        out.write(f"table acceleration: peak {summary['pga_m_s2']:.3f} m/s2, sensor tilt "
-                  f"{math.degrees(summary['tilt_rad']):.2f} deg\n")
+        out.write(
+            f"table acceleration: peak {summary['pga_m_s2']:.3f} m/s2, sensor tilt "
+            f"{math.degrees(summary['tilt_rad']):.2f} deg\n"
+        )
     else:
         b = [f"{math.degrees(v):.3f}" for v in summary["gyro_bias_rad_s"]]
-        out.write(f"gyro bias [{', '.join(b)}] deg/s; release {summary['release_t_s']:.4f} s; "
-                  f"{len(summary['impact_t_s'])} impacts; status {summary['status']}\n")
+        out.write(
+            f"gyro bias [{', '.join(b)}] deg/s; release {summary['release_t_s']:.4f} s; "
+            f"{len(summary['impact_t_s'])} impacts; status {summary['status']}\n"
+        )
         if args.ahrs:
-            out.write(f"AHRS vs gyro integration: RMS difference "
-                      f"{math.degrees(summary['ahrs_rms_diff_rad']):.3f} deg\n")
+            out.write(
+                f"AHRS vs gyro integration: RMS difference {math.degrees(summary['ahrs_rms_diff_rad']):.3f} deg\n"
+            )
     if args.out:
         out.write(f"wrote {args.out}\n")
     return 0

@@ -23,8 +23,9 @@ def run(args) -> int:
     from ...._io import dumps_json
     from ...experiment._experiment import run_experiment
 
-    report, ran = run_experiment(args.config, args.out, force=args.force, spawn=args.spawn,
-                                 connect=args.connect, progress=args.progress)
+    report, ran = run_experiment(
+        args.config, args.out, force=args.force, spawn=args.spawn, connect=args.connect, progress=args.progress
+    )
     if args.json:
         keys = ("name", "status", "fit", "simulations", "sync", "video_vs_imu_rms_rad", "truth")
         out = {k: report.get(k) for k in keys}
@@ -36,6 +37,9 @@ def run(args) -> int:
         f = report.get("fit") or {}
         eta = f.get("eta_e")
         eta_s = f"{eta:.4g}" if isinstance(eta, (int, float)) else "not fitted"
-        print(f"{report['name']}: {report['status']}; eta_e = {eta_s}, "
-              f"outputs in {args.out} (summary.md, report.json, session.rrd)", file=sys.stdout)
+        print(
+            f"{report['name']}: {report['status']}; eta_e = {eta_s}, "
+            f"outputs in {args.out} (summary.md, report.json, session.rrd)",
+            file=sys.stdout,
+        )
     return 0 if report.get("status") != "failed" else 1

@@ -22,23 +22,39 @@ from ...._errors import InputError
 
 def register(sub):
     """Add ``stereo`` to the ``rocklab`` parser ``sub``."""
-    p = sub.add_parser("stereo", help="two-camera 3D dot tracking: calibrate a rig, track a test",
-                       description=__doc__)
+    p = sub.add_parser("stereo", help="two-camera 3D dot tracking: calibrate a rig, track a test", description=__doc__)
     p.add_argument("action", choices=("calibrate", "track"), help="calibrate | track")
     p.add_argument("film1", help="camera 1's film")
     p.add_argument("film2", help="camera 2's film")
-    p.add_argument("-o", "--out", default=None,
-                   help="calibrate: stereo.json (default next to FILM1); track: tracks.csv (default next to FILM1)")
-    p.add_argument("--board", default=None, metavar="CxR,SQUARE_M,MARKER_M,DICT",
-                   help="calibrate: ChArUco board (default 9x6,0.03,0.022,DICT_5X5_100)")
+    p.add_argument(
+        "-o",
+        "--out",
+        default=None,
+        help="calibrate: stereo.json (default next to FILM1); track: tracks.csv (default next to FILM1)",
+    )
+    p.add_argument(
+        "--board",
+        default=None,
+        metavar="CxR,SQUARE_M,MARKER_M,DICT",
+        help="calibrate: ChArUco board (default 9x6,0.03,0.022,DICT_5X5_100)",
+    )
     p.add_argument("--calib", default=None, help="track: stereo.json from 'rocklab stereo calibrate'")
     p.add_argument("--fps", type=float, default=None, help="track: frame rate, Hz (default: the containers')")
-    p.add_argument("--targets", choices=("dots", "aruco"), default="dots",
-                   help="track: bright dots (default) or ArUco markers (each corner a target named M<id>c<k>)")
+    p.add_argument(
+        "--targets",
+        choices=("dots", "aruco"),
+        default="dots",
+        help="track: bright dots (default) or ArUco markers (each corner a target named M<id>c<k>)",
+    )
     p.add_argument("--dictionary", default="DICT_4X4_50", help="track --targets aruco: ArUco dictionary")
     p.add_argument("--no-sync", action="store_true", help="track: the cameras share a trigger (no offset estimated)")
-    p.add_argument("--body", action="append", default=[], metavar="NAME=P1,P2,...",
-                   help="track: bodies by point label (default: still targets = table, moving = block)")
+    p.add_argument(
+        "--body",
+        action="append",
+        default=[],
+        metavar="NAME=P1,P2,...",
+        help="track: bodies by point label (default: still targets = table, moving = block)",
+    )
     p.add_argument("--rest", default="auto", metavar="auto|first|last|T0,T1", help="track: the upright rest")
     p.add_argument("--rrd", default=None, metavar="FILE", help="track: also write a Rerun review (see track3d)")
     p.add_argument("--json", action="store_true", help="print a JSON summary on stdout")
@@ -54,8 +70,9 @@ def _board(spec):
         c, r = (int(v) for v in squares.lower().split("x"))
         return {"squares": (c, r), "square_m": float(sq), "marker_m": float(mk), "dictionary": dic.strip()}
     except ValueError:
-        raise InputError(f"--board {spec!r}: give COLSxROWS,SQUARE_M,MARKER_M,DICT, e.g. "
-                         "9x6,0.03,0.022,DICT_5X5_100") from None
+        raise InputError(
+            f"--board {spec!r}: give COLSxROWS,SQUARE_M,MARKER_M,DICT, e.g. 9x6,0.03,0.022,DICT_5X5_100"
+        ) from None
 
 
 def run(args) -> int:
@@ -84,16 +101,23 @@ def _calibrate(args) -> int:
 
     board = _board(args.board)
     if board is not None and not hasattr(cv2.aruco, board["dictionary"]):
-        raise InputError(f"--board: unknown ArUco dictionary {board['dictionary']!r}; e.g. DICT_5X5_100, "
-                         "DICT_4X4_50, DICT_6X6_250")
+        raise InputError(
+            f"--board: unknown ArUco dictionary {board['dictionary']!r}; e.g. DICT_5X5_100, DICT_4X4_50, DICT_6X6_250"
+        )
     out = Path(args.out) if args.out else Path(args.film1).parent / "stereo.json"
     rig = calibrate_stereo(args.film1, args.film2, board)
     rig.save(out)
     d = dict(rig.to_dict(), stereo_json=str(out))
-    _emit(args, d, [f"calibrated from {rig.n_frames} board poses seen by both: reprojection RMS "
-                    f"{rig.rms_px['cam1']:.4g} / {rig.rms_px['cam2']:.4g} px (each camera), "
-                    f"{rig.rms_px['stereo']:.4g} px (stereo); baseline {rig.baseline_m:.4g} m",
-                    f"wrote {out}"])
+    _emit(
+        args,
+        d,
+        [
+            f"calibrated from {rig.n_frames} board poses seen by both: reprojection RMS "
+            f"{rig.rms_px['cam1']:.4g} / {rig.rms_px['cam2']:.4g} px (each camera), "
+            f"{rig.rms_px['stereo']:.4g} px (stereo); baseline {rig.baseline_m:.4g} m",
+            f"wrote {out}",
+        ],
+    )
     return 0
 
 
@@ -114,11 +138,11 @@ def _track(args) -> int:
     if args.targets == "aruco":
         from ....tracking.stereo import track_markers_stereo
 
-        sp = track_markers_stereo(args.film1, args.film2, rig, dictionary=args.dictionary, fps=args.fps,
-                                  sync=not args.no_sync)
+        sp = track_markers_stereo(
+            args.film1, args.film2, rig, dictionary=args.dictionary, fps=args.fps, sync=not args.no_sync
+        )
     else:
-        sp = track_dots_stereo(args.film1, args.film2, rig, fps=args.fps, sync=not args.no_sync,
-                               progress=args.progress)
+        sp = track_dots_stereo(args.film1, args.film2, rig, fps=args.fps, sync=not args.no_sync, progress=args.progress)
     series, bodies, notes = stereo_point_series(sp, str(args.film1))
     if args.body:
         bodies = parse_bodies(args.body, series.labels, series.source)
@@ -128,14 +152,22 @@ def _track(args) -> int:
     pts_path = out.with_name("points.csv")
     write_points_csv(series, pts_path)
     d = write_track3d_outputs(out, series, res, args.rrd)
-    d.update(points_csv=str(pts_path), sync=None if sp.sync is None else sp.sync.to_dict(),
-             bodies={k: list(v) for k, v in bodies.items()}, median_reprojection_px=float(np.nanmedian(sp.reproj_px)))
+    d.update(
+        points_csv=str(pts_path),
+        sync=None if sp.sync is None else sp.sync.to_dict(),
+        bodies={k: list(v) for k, v in bodies.items()},
+        median_reprojection_px=float(np.nanmedian(sp.reproj_px)),
+    )
     lines = [f"note: {n}" for n in notes]
     if sp.sync is not None:
-        lines.append(f"clock offset: camera 2 exposes {1e3 * sp.sync.offset_s:.4g} ms after camera 1 "
-                     f"(± {1e3 * sp.sync.sigma_s:.2g} ms)")
-    lines.append(f"{len(sp.pairs)} targets matched, median reprojection {d['median_reprojection_px']:.3g} px; "
-                 f"bodies: " + ", ".join(f"{k} ({len(v)} points)" for k, v in bodies.items()))
+        lines.append(
+            f"clock offset: camera 2 exposes {1e3 * sp.sync.offset_s:.4g} ms after camera 1 "
+            f"(± {1e3 * sp.sync.sigma_s:.2g} ms)"
+        )
+    lines.append(
+        f"{len(sp.pairs)} targets matched, median reprojection {d['median_reprojection_px']:.3g} px; "
+        f"bodies: " + ", ".join(f"{k} ({len(v)} points)" for k, v in bodies.items())
+    )
     for b in res.blocks:
         lines.append(b.audit.report())
     lines.append(f"wrote {pts_path}, {out} and {d['audit_json']} (verdict {d['verdict']})")

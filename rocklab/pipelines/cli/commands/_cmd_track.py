@@ -22,23 +22,34 @@ from ...._errors import InputError
 
 def register(sub):
     """Add this module's subcommand(s) to the ``rocklab`` parser ``sub``."""
-    p = sub.add_parser("track", help="track blocks and table in a video (ArUco, dots, edges, region)",
-                       description=__doc__)
-    p.add_argument("video", help="video file (.mkv/.mp4/...) or image sequence 'dir/%%05d.png'; or 'init' / "
-                                 "'preview' followed by the video")
+    p = sub.add_parser(
+        "track", help="track blocks and table in a video (ArUco, dots, edges, region)", description=__doc__
+    )
+    p.add_argument(
+        "video",
+        help="video file (.mkv/.mp4/...) or image sequence 'dir/%%05d.png'; or 'init' / "
+        "'preview' followed by the video",
+    )
     p.add_argument("video2", nargs="?", default=None, metavar="VIDEO", help=argparse.SUPPRESS)
-    p.add_argument("--object", action="append", default=[], metavar="NAME=x,y,w,h",
-                   help="init: an object's region in the first frame (px), followed markerless")
-    p.add_argument("--table", default=None, metavar="x,y,w,h",
-                   help="init: a markerless table's region (round its top edge: it levels the angles)")
+    p.add_argument(
+        "--object",
+        action="append",
+        default=[],
+        metavar="NAME=x,y,w,h",
+        help="init: an object's region in the first frame (px), followed markerless",
+    )
+    p.add_argument(
+        "--table",
+        default=None,
+        metavar="x,y,w,h",
+        help="init: a markerless table's region (round its top edge: it levels the angles)",
+    )
     p.add_argument("--marker-size", type=float, default=None, help="init: printed marker side, m")
     p.add_argument("--preview", default=None, help="init: preview PNG (default: <config stem>_init.png)")
     p.add_argument("--frames", type=int, default=6, help="preview: frames on the contact sheet (default 6)")
-    p.add_argument("--config", default=None,
-                   help="track.toml (default: track.toml next to the video)")
+    p.add_argument("--config", default=None, help="track.toml (default: track.toml next to the video)")
     p.add_argument("-o", "--out", default=None, help="output CSV (default: tracks.csv next to the video)")
-    p.add_argument("--fps", type=float, default=None,
-                   help="frame rate; required when the container has none")
+    p.add_argument("--fps", type=float, default=None, help="frame rate; required when the container has none")
     p.add_argument("--json", action="store_true", help="print a JSON summary on stdout")
     p.add_argument("--progress", action="store_true", help="progress bar on stderr")
     p.set_defaults(func=run)
@@ -51,8 +62,10 @@ def run(args) -> int:
     if args.video in ("init", "preview"):
         return _tools(args)
     if args.video2 is not None:
-        raise InputError(f"unexpected second argument {args.video2!r}; use 'rocklab track VIDEO', "
-                         "'rocklab track init VIDEO' or 'rocklab track preview VIDEO'")
+        raise InputError(
+            f"unexpected second argument {args.video2!r}; use 'rocklab track VIDEO', "
+            "'rocklab track init VIDEO' or 'rocklab track preview VIDEO'"
+        )
 
     from ...._io import write_frame_atomic
     from ....tracking import load_track_config, track_video
@@ -87,8 +100,9 @@ def run(args) -> int:
         emit_json(summary)
     else:
         for oid, d in summary["objects"].items():
-            print(f"{oid}: {d['n_ok']}/{res.n_frames} frames ok, "
-                  f"median sigma_theta {d['median_sigma_theta_rad']:.2e} rad")
+            print(
+                f"{oid}: {d['n_ok']}/{res.n_frames} frames ok, median sigma_theta {d['median_sigma_theta_rad']:.2e} rad"
+            )
         print(f"wrote {out}")
     return 0
 
@@ -104,18 +118,28 @@ def _tools(args) -> int:
         if out.suffix.lower() != ".toml":
             raise InputError(f"-o {out}: the config is a .toml file; give e.g. -o track.toml")
         preview = Path(args.preview) if args.preview else out.with_name(out.stem + "_init.png")
-        cfg, notes = track_init(video, out, objects=args.object, table=args.table,
-                                marker_size_m=args.marker_size, preview=preview)
+        cfg, notes = track_init(
+            video, out, objects=args.object, table=args.table, marker_size_m=args.marker_size, preview=preview
+        )
         if args.json:
             from .._cli_base import emit_json
 
-            emit_json({"config": str(out), "preview": str(preview), "objects": [o.id for o in cfg.objects],
-                       "style": cfg.targets.style, "notes": notes})
+            emit_json(
+                {
+                    "config": str(out),
+                    "preview": str(preview),
+                    "objects": [o.id for o in cfg.objects],
+                    "style": cfg.targets.style,
+                    "notes": notes,
+                }
+            )
         else:
             for n in notes:
                 print(f"note: {n}")
-            print(f"wrote {out} ({', '.join(o.id for o in cfg.objects)}) and {preview}; check the preview, then "
-                  f"'rocklab track {video} --config {out}'")
+            print(
+                f"wrote {out} ({', '.join(o.id for o in cfg.objects)}) and {preview}; check the preview, then "
+                f"'rocklab track {video} --config {out}'"
+            )
         return 0
     cfg_path = Path(args.config) if args.config else video.parent / "track.toml"
     if not cfg_path.exists():

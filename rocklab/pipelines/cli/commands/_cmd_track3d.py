@@ -25,24 +25,48 @@ from ...._errors import InputError
 
 def register(sub):
     """Add ``track3d`` to the ``rocklab`` parser ``sub``."""
-    p = sub.add_parser("track3d", help="rocking angle, twist, pivot sliding/uplift and the assumption audit "
-                                       "from 3D points (CSV or C3D)", description=__doc__)
+    p = sub.add_parser(
+        "track3d",
+        help="rocking angle, twist, pivot sliding/uplift and the assumption audit from 3D points (CSV or C3D)",
+        description=__doc__,
+    )
     p.add_argument("points", help="3D points: .c3d, or CSV with t_s, point, x_m, y_m, z_m (long format)")
-    p.add_argument("-o", "--out", default=None, help="output tracks.csv (default: tracks.csv next to POINTS); "
-                                                     "audit.json is written next to it")
-    p.add_argument("--body", action="append", default=[], metavar="NAME=P1,P2,...",
-                   help="a rigid body and its point labels (repeat; 'table' or 'base' names the table); "
-                        "default: all points are one block")
+    p.add_argument(
+        "-o",
+        "--out",
+        default=None,
+        help="output tracks.csv (default: tracks.csv next to POINTS); audit.json is written next to it",
+    )
+    p.add_argument(
+        "--body",
+        action="append",
+        default=[],
+        metavar="NAME=P1,P2,...",
+        help="a rigid body and its point labels (repeat; 'table' or 'base' names the table); "
+        "default: all points are one block",
+    )
     p.add_argument("--up", default="z", help="the rig's vertical axis: x, y or z, optionally signed (default z)")
-    p.add_argument("--rest", default="auto", metavar="auto|first|last|T0,T1",
-                   help="samples where the block stands upright at rest (default auto: the end, or the start "
-                        "if it overturned)")
+    p.add_argument(
+        "--rest",
+        default="auto",
+        metavar="auto|first|last|T0,T1",
+        help="samples where the block stands upright at rest (default auto: the end, or the start if it overturned)",
+    )
     p.add_argument("--slide-tol", type=float, default=0.5, metavar="MM", help="pivot sliding tolerance, mm (0.5)")
     p.add_argument("--jump-tol", type=float, default=1.0, metavar="MM", help="pivot uplift tolerance, mm (1.0)")
-    p.add_argument("--twist-tol", type=float, default=0.5, metavar="DEG",
-                   help="twist and out-of-plane rotation tolerance, deg (0.5)")
-    p.add_argument("--rrd", default=None, metavar="FILE",
-                   help="also write a Rerun review: the targets in 3D, the pivot path, the plots, the audit's flags")
+    p.add_argument(
+        "--twist-tol",
+        type=float,
+        default=0.5,
+        metavar="DEG",
+        help="twist and out-of-plane rotation tolerance, deg (0.5)",
+    )
+    p.add_argument(
+        "--rrd",
+        default=None,
+        metavar="FILE",
+        help="also write a Rerun review: the targets in 3D, the pivot path, the plots, the audit's flags",
+    )
     p.add_argument("--json", action="store_true", help="print a JSON summary on stdout")
     p.set_defaults(func=run)
 
@@ -85,10 +109,12 @@ def run(args) -> int:
     from ....tracking.rigid import AuditTolerances, parse_bodies, read_points, track_points3d
 
     src = Path(args.points)
-    tol = AuditTolerances(slide_m=positive("--slide-tol (mm)", args.slide_tol) * 1e-3,
-                          jump_m=positive("--jump-tol (mm)", args.jump_tol) * 1e-3,
-                          twist_rad=math.radians(positive("--twist-tol (deg)", args.twist_tol)),
-                          out_of_plane_rad=math.radians(args.twist_tol))
+    tol = AuditTolerances(
+        slide_m=positive("--slide-tol (mm)", args.slide_tol) * 1e-3,
+        jump_m=positive("--jump-tol (mm)", args.jump_tol) * 1e-3,
+        twist_rad=math.radians(positive("--twist-tol (deg)", args.twist_tol)),
+        out_of_plane_rad=math.radians(args.twist_tol),
+    )
     rest = _rest(args.rest)
     out = Path(args.out) if args.out else src.parent / "tracks.csv"
     audit_path = out.with_name("audit.json")
@@ -107,9 +133,11 @@ def run(args) -> int:
         print(f"note: {n}")
     for b in res.bodies:
         d = b.to_dict()
-        line = (f"{b.name}: {d['samples_ok']}/{d['samples']} samples, rest = {b.rest}, "
-                f"max |theta| {math.degrees(d['max_abs_theta_rad']):.4g} deg, "
-                f"median sigma_theta {math.degrees(d['median_sigma_theta_rad']):.4g} deg")
+        line = (
+            f"{b.name}: {d['samples_ok']}/{d['samples']} samples, rest = {b.rest}, "
+            f"max |theta| {math.degrees(d['max_abs_theta_rad']):.4g} deg, "
+            f"median sigma_theta {math.degrees(d['median_sigma_theta_rad']):.4g} deg"
+        )
         if not b.is_table:
             line += f", base width {b.geometry.base_width_m * 1e3:.4g} mm"
         print(line)

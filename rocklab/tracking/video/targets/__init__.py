@@ -15,5 +15,16 @@ from ._edges import EdgeDetector, refine_rectangle
 from ._markerless import MarkerlessDetector, MarkerlessTracker
 from ._region import RegionDetector, RegionTracker
 
-__all__ = ["Detection", "make_detector", "ArucoDetector", "DotDetector", "dot_centroid", "EdgeDetector",
-           "refine_rectangle", "RegionDetector", "RegionTracker", "MarkerlessDetector", "MarkerlessTracker"]
+__all__ = [
+    "Detection",
+    "make_detector",
+    "ArucoDetector",
+    "DotDetector",
+    "dot_centroid",
+    "EdgeDetector",
+    "refine_rectangle",
+    "RegionDetector",
+    "RegionTracker",
+    "MarkerlessDetector",
+    "MarkerlessTracker",
+]

@@ -16,9 +16,13 @@ from .._geometry import fit_similarity
 
 __all__ = ["ArucoDetector", "Detection"]
 
-_REFINE = {"none": "CORNER_REFINE_NONE", "subpix": "CORNER_REFINE_SUBPIX",
-           "contour": "CORNER_REFINE_CONTOUR", "apriltag": "CORNER_REFINE_APRILTAG",
-           "edges": "CORNER_REFINE_NONE"}
+_REFINE = {
+    "none": "CORNER_REFINE_NONE",
+    "subpix": "CORNER_REFINE_SUBPIX",
+    "contour": "CORNER_REFINE_CONTOUR",
+    "apriltag": "CORNER_REFINE_APRILTAG",
+    "edges": "CORNER_REFINE_NONE",
+}
 # Object-frame corner offsets (y up) in OpenCV's order TL, TR, BR, BL, unit side.
 _UNIT_CORNERS = np.array([[-0.5, 0.5], [0.5, 0.5], [0.5, -0.5], [-0.5, -0.5]])
 
@@ -57,13 +61,11 @@ def refine_marker_corners(gray, corners, cells=6):
         The marker's orientation uncertainty from the edge-line scatter.
     """
 
-
     side = float(np.mean(np.hypot(*(np.roll(corners, -1, axis=0) - corners).T)))
     half = float(np.clip(0.5 * side / cells, 1.5, 4.0))
     # One pass: a profile slightly off the normal still crosses the edge on the edge.
     # About 30 profiles per side: closer ones share their noise through the blur.
-    out, _, _, sig = refine_rectangle(gray, corners, half=half, step=max(1.5, side / 38),
-                                      trim=0.12)
+    out, _, _, sig = refine_rectangle(gray, corners, half=half, step=max(1.5, side / 38), trim=0.12)
     if out is None or np.max(np.abs(out - corners)) > 0.5 * half + 1.0:
         return corners, np.nan
     return out, sig
@@ -91,9 +93,11 @@ class ArucoDetector:
         for i, o in enumerate(config.objects):
             bad = [m for m in o.markers if m >= n_dict]
             if bad:
-                raise InputError(f"{config.source or 'config'}: 'objects[{i}].markers': id {bad[0]} "
-                                 f"is not in {config.targets.dictionary} (ids 0..{n_dict - 1}); "
-                                 "fix the id or the dictionary")
+                raise InputError(
+                    f"{config.source or 'config'}: 'objects[{i}].markers': id {bad[0]} "
+                    f"is not in {config.targets.dictionary} (ids 0..{n_dict - 1}); "
+                    "fix the id or the dictionary"
+                )
         self.size = {o.id: o.marker_size_m or config.targets.marker_size_m for o in config.objects}
         self.owner = {m: o.id for o in config.objects for m in o.markers}
         self.layout = {}
@@ -102,7 +106,7 @@ class ArucoDetector:
                 self.layout[o.id] = {m: np.asarray(c, float) for m, c in zip(o.markers, o.marker_positions_m)}
             elif len(o.markers) == 1:
                 self.layout[o.id] = {o.markers[0]: np.zeros(2)}
-        self.last = {}   # marker id -> (frame, corners (4,2))
+        self.last = {}  # marker id -> (frame, corners (4,2))
         self.prev = {}
         self.margin = config.targets.search_margin
         self.ever_seen = set()
@@ -151,8 +155,7 @@ class ArucoDetector:
         """
         H, W = gray.shape[:2]
         found = {}
-        need_full = frame % 25 == 0 and any(
-            m not in self.last or frame - self.last[m][0] > 2 for m in self.owner)
+        need_full = frame % 25 == 0 and any(m not in self.last or frame - self.last[m][0] > 2 for m in self.owner)
         for o in self.cfg.objects:
             ms = [m for m in o.markers if m in self.last and frame - self.last[m][0] <= 2]
             if not ms:
@@ -196,8 +199,9 @@ class ArucoDetector:
             q = self.pm.to_plane(found[m])
             fits[m] = fit_similarity(_UNIT_CORNERS * (self.size[o.id] or 1.0), q)
         f0 = fits[o.markers[0]]
-        rot = np.array([[np.cos(-f0.theta_rad), -np.sin(-f0.theta_rad)],
-                        [np.sin(-f0.theta_rad), np.cos(-f0.theta_rad)]])
+        rot = np.array(
+            [[np.cos(-f0.theta_rad), -np.sin(-f0.theta_rad)], [np.sin(-f0.theta_rad), np.cos(-f0.theta_rad)]]
+        )
         k = np.mean([f.scale for f in fits.values()])
         return {m: rot @ (fits[m].t - f0.t) / k for m in o.markers}
 
@@ -221,7 +225,6 @@ class ArucoDetector:
             obj = np.vstack([lay[m] + _UNIT_CORNERS * s for m in have])
             sig = np.array([self.sigma.get(m, np.nan) for m in have])
             # markers are independent: the mean orientation's sigma shrinks with their number
-            sig_mean = float(np.sqrt(np.nansum(sig ** 2)) / len(have)) if np.any(np.isfinite(sig)) else 0.0
-            out[o.id] = Detection(img, obj, self.size[o.id] is not None, 4 * len(o.markers), sig_mean,
-                                  len(have))
+            sig_mean = float(np.sqrt(np.nansum(sig**2)) / len(have)) if np.any(np.isfinite(sig)) else 0.0
+            out[o.id] = Detection(img, obj, self.size[o.id] is not None, 4 * len(o.markers), sig_mean, len(have))
         return out

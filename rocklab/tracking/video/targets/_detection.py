@@ -46,5 +46,5 @@ class Detection:
     def combined_sigma(self, sigma_fit):
         """The reported 1-σ of θ given the rigid fit's own σ (rad)."""
         if self.n_groups >= 2 and self.sigma_rad > 0 and sigma_fit > 0:
-            return float((sigma_fit ** -2 + self.sigma_rad ** -2) ** -0.5)
+            return float((sigma_fit**-2 + self.sigma_rad**-2) ** -0.5)
         return float(np.hypot(sigma_fit, self.sigma_rad))

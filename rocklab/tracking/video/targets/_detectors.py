@@ -23,13 +23,17 @@ class _MixedDetector:
 
 def make_detector(config, pm, first_gray):
     """The detector for ``config``'s objects: one per target style, merged when styles mix."""
+
     def style(o):
         return o.style or config.targets.style
 
     parts = []
     for st in sorted({style(o) for o in config.objects}):
-        sub = dataclasses.replace(config, objects=tuple(o for o in config.objects if style(o) == st),
-                                  targets=dataclasses.replace(config.targets, style=st))
+        sub = dataclasses.replace(
+            config,
+            objects=tuple(o for o in config.objects if style(o) == st),
+            targets=dataclasses.replace(config.targets, style=st),
+        )
         parts.append(_make_single(sub, pm, first_gray))
     return parts[0] if len(parts) == 1 else _MixedDetector(parts)
 

@@ -81,9 +81,9 @@ class DotDetector:
         self.pm = plane_map
         self.dark = config.targets.dot_color == "dark"
         self.layout = {o.id: np.asarray(o.dots, float) for o in config.objects}
-        self.last = {}   # object id -> (frame, pts (n,2) with NaN rows for missing dots)
+        self.last = {}  # object id -> (frame, pts (n,2) with NaN rows for missing dots)
         self.prev = {}
-        self.diam = {}   # object id -> dot diameter, px
+        self.diam = {}  # object id -> dot diameter, px
 
     # ------------------------------------------------------------ acquisition
     def _blobs(self, gray, roi=None):
@@ -97,8 +97,7 @@ class DotDetector:
         img = gray[y0:y1, x0:x1]
         block = int(max(51, min(img.shape) // 8)) | 1
         mode = cv2.THRESH_BINARY_INV if self.dark else cv2.THRESH_BINARY
-        binary = cv2.adaptiveThreshold(img, 255, cv2.ADAPTIVE_THRESH_MEAN_C, mode, block, -10 if
-                                       not self.dark else 10)
+        binary = cv2.adaptiveThreshold(img, 255, cv2.ADAPTIVE_THRESH_MEAN_C, mode, block, -10 if not self.dark else 10)
         n, lab, stats, cents = cv2.connectedComponentsWithStats(binary, connectivity=8)
         out = []
         for k in range(1, n):
@@ -112,8 +111,7 @@ class DotDetector:
         lay = self.layout[o.id]
         blobs = self._blobs(gray, o.roi)
         if len(blobs) and taken:
-            keep = [i for i, b in enumerate(blobs)
-                    if min(np.hypot(b[0] - t[0], b[1] - t[1]) for t in taken) > 1.0]
+            keep = [i for i, b in enumerate(blobs) if min(np.hypot(b[0] - t[0], b[1] - t[1]) for t in taken) > 1.0]
             blobs = blobs[keep]
         if len(blobs) < 2:
             return None
@@ -121,8 +119,7 @@ class DotDetector:
         qc = q[:, 0] + 1j * q[:, 1]
         # blob diameters in plane units (the plane may be metric, the blobs are in px)
         half = np.column_stack((blobs[:, 2] / 2, np.zeros(len(blobs))))
-        d_plane = np.hypot(*(self.pm.to_plane(blobs[:, :2] + half)
-                             - self.pm.to_plane(blobs[:, :2] - half)).T)
+        d_plane = np.hypot(*(self.pm.to_plane(blobs[:, :2] + half) - self.pm.to_plane(blobs[:, :2] - half)).T)
         pc = lay[:, 0] + 1j * lay[:, 1]
         j = int(np.argmax(np.abs(pc - pc[0])))
         dmed = np.median(blobs[:, 2])

@@ -74,8 +74,8 @@ def refine_rectangle(gray, corners, half=6.0, step=2.0, trim=0.15):
     m = max(5, int((1 - 2 * trim) * L.max() / step))
     frac = np.linspace(trim, 1 - trim, m)
     offs = np.arange(-half, half + 0.25, 0.5)
-    base = c[:, None, :] + (frac[None, :, None] * L[:, None, None]) * d[:, None, :]   # (4, m, 2)
-    pts = base[:, :, None, :] + offs[None, None, :, None] * nrm[:, None, None, :]    # (4, m, p, 2)
+    base = c[:, None, :] + (frac[None, :, None] * L[:, None, None]) * d[:, None, :]  # (4, m, 2)
+    pts = base[:, :, None, :] + offs[None, None, :, None] * nrm[:, None, None, :]  # (4, m, p, 2)
     # Work on a float crop: remap of uint8 would round the profiles to whole grey levels.
     H, W = gray.shape[:2]
     x0 = int(max(np.floor(pts[..., 0].min()) - 3, 0))
@@ -103,7 +103,7 @@ def refine_rectangle(gray, corners, half=6.0, step=2.0, trim=0.15):
     den = f1 - f0
     t = np.divide(0.5 - f0, den, out=np.full_like(den, 0.5), where=den != 0)
     off = (offs[j - 1] + t * 0.5).reshape(4, m)
-    edge = base + off[..., None] * nrm[:, None, :]                                  # (4, m, 2)
+    edge = base + off[..., None] * nrm[:, None, :]  # (4, m, 2)
     w = ok.reshape(4, m).astype(float)
     for it in range(2):
         sw = w.sum(1)
@@ -120,13 +120,13 @@ def refine_rectangle(gray, corners, half=6.0, step=2.0, trim=0.15):
         dist = np.einsum("kmi,ki->km", e, nv)
         if it == 0:
             # drop outliers (a notch, a neighbouring edge): beyond 3 rms of the first fit
-            rms_k = np.sqrt(np.einsum("km,km->k", w, dist ** 2) / sw)
+            rms_k = np.sqrt(np.einsum("km,km->k", w, dist**2) / sw)
             w = w * (np.abs(dist) <= np.maximum(3 * rms_k, 0.05)[:, None])
     sw = w.sum(1)
     along = np.einsum("kmi,ki->km", e, dv)
     a_mean = np.einsum("km,km->k", w, along) / sw
     s_along = np.einsum("km,km->k", w, (along - a_mean[:, None]) ** 2)
-    ss = np.einsum("km,km->k", w, dist ** 2)
+    ss = np.einsum("km,km->k", w, dist**2)
     # profiles closer than ~2 px share their noise through the blur: one sample per 2 px
     spacing = (1 - 2 * trim) * L / max(m - 1, 1)
     corr = np.maximum(1.0, 2.0 / spacing)
@@ -154,7 +154,7 @@ def horizontal_edge_angle(gray, roi, plane_map, topmost: bool = False):
     import cv2
 
     u, v, w, h = (int(round(x)) for x in roi)
-    crop = gray[max(v, 0):v + h, max(u, 0):u + w].astype(np.float32)
+    crop = gray[max(v, 0) : v + h, max(u, 0) : u + w].astype(np.float32)
     gy = np.abs(cv2.Sobel(crop, cv2.CV_32F, 0, 1, ksize=3))
     if topmost:
         # average along the (near-horizontal) edge: a textured face's grain averages out, the edge not
@@ -207,9 +207,9 @@ class EdgeDetector:
         for o in config.objects:
             if o.kind == "table" and o.size_m is not None:
                 u, v, w, h = (int(round(x)) for x in o.roi)
-                crop = first_gray[max(v, 0):v + h, max(u, 0):u + w]
+                crop = first_gray[max(v, 0) : v + h, max(u, 0) : u + w]
                 hh, ww = crop.shape
-                level = float(np.median(crop[hh // 3:2 * hh // 3, ww // 4:3 * ww // 4]))
+                level = float(np.median(crop[hh // 3 : 2 * hh // 3, ww // 4 : 3 * ww // 4]))
                 border = float(np.median(np.r_[crop[0], crop[-1]]))
                 self.band[o.id] = (level, max(0.5 * abs(level - border), 8.0))
             elif o.kind == "table":
@@ -217,8 +217,7 @@ class EdgeDetector:
                     import dataclasses
 
                     # The table top's image angle, so that levelling from the table works.
-                    o = dataclasses.replace(o, theta0_rad=horizontal_edge_angle(first_gray, o.roi,
-                                                                               plane_map))
+                    o = dataclasses.replace(o, theta0_rad=horizontal_edge_angle(first_gray, o.roi, plane_map))
                 self.regions[o.id] = RegionTracker(o, plane_map, first_gray)
         self.size = {o.id: o.size_m for o in config.objects}
         self.polarity = {}
@@ -229,8 +228,7 @@ class EdgeDetector:
         import cv2
 
         H, W = gray.shape
-        x0, y0, x1, y1 = (int(max(box[0], 0)), int(max(box[1], 0)), int(min(box[2], W)),
-                          int(min(box[3], H)))
+        x0, y0, x1, y1 = (int(max(box[0], 0)), int(max(box[1], 0)), int(min(box[2], W)), int(min(box[3], H)))
         if x1 - x0 < 8 or y1 - y0 < 8:
             return None
         crop = gray[y0:y1, x0:x1]
@@ -241,7 +239,7 @@ class EdgeDetector:
             return self._largest_rect(binary, x0, y0)
         if oid not in self.polarity:
             h, w = crop.shape
-            centre = np.median(crop[h // 3:2 * h // 3, w // 3:2 * w // 3])
+            centre = np.median(crop[h // 3 : 2 * h // 3, w // 3 : 2 * w // 3])
             border = np.median(np.r_[crop[0], crop[-1], crop[:, 0], crop[:, -1]])
             self.polarity[oid] = centre > border
         if self.thr is None:
@@ -320,8 +318,10 @@ class EdgeDetector:
                 metric = True
             else:
                 if o.id not in self.ref_px:
-                    self.ref_px[o.id] = (np.hypot(*(q[1] - q[0])) + np.hypot(*(q[2] - q[3]))) / 2, \
-                        (np.hypot(*(q[0] - q[3])) + np.hypot(*(q[1] - q[2]))) / 2
+                    self.ref_px[o.id] = (
+                        (np.hypot(*(q[1] - q[0])) + np.hypot(*(q[2] - q[3]))) / 2,
+                        (np.hypot(*(q[0] - q[3])) + np.hypot(*(q[1] - q[2]))) / 2,
+                    )
                 bw, bh = self.ref_px[o.id]
                 obj = _SIGNS * (bw / 2, bh / 2)
                 metric = False

@@ -44,14 +44,14 @@ class ICAffine:
         tn = (t - t.mean()) / (t.std() + 1e-9)
         gx = cv2.Sobel(tn, cv2.CV_32F, 1, 0, ksize=3) / 8.0
         gy = cv2.Sobel(tn, cv2.CV_32F, 0, 1, ksize=3) / 8.0
-        yy, xx = np.mgrid[0:self.h, 0:self.w].astype(np.float32)
+        yy, xx = np.mgrid[0 : self.h, 0 : self.w].astype(np.float32)
         # parameters about the template's centre: a well-conditioned Gauss-Newton matrix (about
         # pixel (0, 0) rotation and translation are nearly collinear on a wide template)
         self.cx, self.cy = (self.w - 1) / 2.0, (self.h - 1) / 2.0
         xx, yy = xx - self.cx, yy - self.cy
         inner = np.zeros((self.h, self.w), bool)
         b = BORDER_PX
-        inner[b:self.h - b, b:self.w - b] = True
+        inner[b : self.h - b, b : self.w - b] = True
         self.idx = np.flatnonzero(inner.ravel())
         sd = self._steepest_descent(xx, yy, gx, gy)
         self.sd_t = np.ascontiguousarray(sd[self.idx].T)  # (k, n) float32
@@ -101,8 +101,13 @@ class ICAffine:
         image = cv2.GaussianBlur(np.asarray(image, np.float32), (BLUR_PX, BLUR_PX), 0)
         vn = None
         for _ in range(max_iter):
-            warped = cv2.warpAffine(image, W.astype(np.float32), (self.w, self.h),
-                                    flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP, borderMode=cv2.BORDER_REPLICATE)
+            warped = cv2.warpAffine(
+                image,
+                W.astype(np.float32),
+                (self.w, self.h),
+                flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP,
+                borderMode=cv2.BORDER_REPLICATE,
+            )
             v = warped.ravel()[self.idx]
             sd = float(v.std())
             if not sd > 1e-6:
@@ -125,8 +130,13 @@ class ICAffine:
                 break
         # the correlation at the final warp (not the one before the last update), so that fits of
         # different motion models compare fairly
-        warped = cv2.warpAffine(image, W.astype(np.float32), (self.w, self.h),
-                                flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP, borderMode=cv2.BORDER_REPLICATE)
+        warped = cv2.warpAffine(
+            image,
+            W.astype(np.float32),
+            (self.w, self.h),
+            flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP,
+            borderMode=cv2.BORDER_REPLICATE,
+        )
         v = warped.ravel()[self.idx]
         v = v - float(v.mean())
         cc = float(np.dot(v, self.tn)) / (float(np.linalg.norm(self.tn)) * float(np.linalg.norm(v)) + 1e-12)

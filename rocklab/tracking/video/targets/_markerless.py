@@ -96,12 +96,16 @@ class MarkerlessTracker:
         u, v, w, h = (int(round(x)) for x in obj.roi)
         u0, v0, u1, v1 = max(u, 0), max(v, 0), min(u + w, W), min(v + h, H)
         if u1 - u0 < 8 or v1 - v0 < 8:
-            raise InputError(f"object {obj.id!r}: roi {list(obj.roi)} lies outside the {W}x{H} frame or is "
-                             "smaller than 8x8 px; give the object's region in the first frame")
+            raise InputError(
+                f"object {obj.id!r}: roi {list(obj.roi)} lies outside the {W}x{H} frame or is "
+                "smaller than 8x8 px; give the object's region in the first frame"
+            )
         tmpl = first_gray[v0:v1, u0:u1].astype(np.float32)
         if float(tmpl.std()) < MIN_TEXTURE_STD:
-            raise InputError(f"object {obj.id!r}: roi {list(obj.roi)} holds no texture (grey std "
-                             f"{float(tmpl.std()):.3g}); draw it round the object's edges or surface detail")
+            raise InputError(
+                f"object {obj.id!r}: roi {list(obj.roi)} holds no texture (grey std "
+                f"{float(tmpl.std()):.3g}); draw it round the object's edges or surface detail"
+            )
         self.origin = np.array([u0, v0], float)  # template pixel (0, 0) in the first frame
         self.tmpl0 = tmpl
         self.key = tmpl
@@ -122,8 +126,9 @@ class MarkerlessTracker:
     def _window(self, gray, W, margin):
         """The part of ``gray`` round the template's footprint under W (float32) and its offset (px)."""
         w, h = self.size
-        corners = (np.array([[0, 0], [w, 0], [0, h], [w, h]], float) + self.origin) @ W[:, :2].T.astype(float) \
-            + W[:, 2].astype(float)
+        corners = (np.array([[0, 0], [w, 0], [0, h], [w, h]], float) + self.origin) @ W[:, :2].T.astype(float) + W[
+            :, 2
+        ].astype(float)
         H, Wd = gray.shape[:2]
         x0 = int(max(np.floor(corners[:, 0].min() - margin), 0))
         y0 = int(max(np.floor(corners[:, 1].min() - margin), 0))
@@ -190,7 +195,7 @@ class MarkerlessTracker:
         cv2 = self._cv2
         W = self._to_tmpl(_rigid(W0))
         for lvl in range(levels - 1, 0, -1):
-            f = 0.5 ** lvl
+            f = 0.5**lvl
             t = cv2.resize(tmpl, None, fx=f, fy=f, interpolation=cv2.INTER_AREA)
             if min(t.shape) < 8:
                 continue
@@ -224,8 +229,7 @@ class MarkerlessTracker:
             # ECC from the rigid pose finds their optimum where the fast fit does not
             try:
                 cv2 = self._cv2
-                cc_a, Wa = cv2.findTransformECC(tmpl, gray_f, fit[0].copy(), cv2.MOTION_AFFINE, ECC_CRITERIA,
-                                                None, 5)
+                cc_a, Wa = cv2.findTransformECC(tmpl, gray_f, fit[0].copy(), cv2.MOTION_AFFINE, ECC_CRITERIA, None, 5)
                 aff = (Wa, float(cc_a))
             except cv2.error:
                 aff = None
@@ -254,8 +258,12 @@ class MarkerlessTracker:
         cv2 = self._cv2
         th, tx, ty = _params(W_pred)
         w, h = self.size
-        rot = cv2.warpAffine(tmpl, cv2.getRotationMatrix2D((w / 2, h / 2), -math.degrees(th), 1.0), (w, h),
-                             borderMode=cv2.BORDER_REPLICATE)
+        rot = cv2.warpAffine(
+            tmpl,
+            cv2.getRotationMatrix2D((w / 2, h / 2), -math.degrees(th), 1.0),
+            (w, h),
+            borderMode=cv2.BORDER_REPLICATE,
+        )
         ctr = self.origin + (w / 2, h / 2)
         cx, cy = W_pred[:, :2] @ ctr + W_pred[:, 2]
         H, Wd = gray.shape
@@ -310,8 +318,9 @@ class MarkerlessTracker:
         Wfull = W.copy()
         Wfull[:, 2] += (W[:, :2] @ self.origin).astype(np.float32) - off
         h, w = self.tmpl0.shape
-        return cv2.warpAffine(crop, Wfull, (w, h), flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP,
-                              borderMode=cv2.BORDER_REPLICATE)
+        return cv2.warpAffine(
+            crop, Wfull, (w, h), flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP, borderMode=cv2.BORDER_REPLICATE
+        )
 
     def detect(self, gray, frame):
         """The object's reference points in ``gray``: a :class:`Detection`, or None (lost)."""
@@ -360,8 +369,7 @@ class MarkerlessDetector:
         for o in config.objects:
             if o.kind == "table" and o.theta0_rad is None:
                 # the table top's angle in the first frame, so that levelling from the table works
-                o = dataclasses.replace(o, theta0_rad=horizontal_edge_angle(first_gray, o.roi, plane_map,
-                                                                           topmost=True))
+                o = dataclasses.replace(o, theta0_rad=horizontal_edge_angle(first_gray, o.roi, plane_map, topmost=True))
             self.trackers[o.id] = MarkerlessTracker(o, plane_map, first_gray)
 
     def detect(self, gray, frame):

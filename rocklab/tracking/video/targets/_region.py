@@ -38,14 +38,18 @@ class RegionTracker:
         self.pm = plane_map
         u, v, w, h = (int(round(x)) for x in obj.roi)
         mask = np.zeros_like(first_gray)
-        mask[max(v, 0):v + h, max(u, 0):u + w] = 255
+        mask[max(v, 0) : v + h, max(u, 0) : u + w] = 255
         f = cv2.goodFeaturesToTrack(first_gray, max_features, 0.01, 5, mask=mask, blockSize=7)
         self.ref = first_gray
         self.p_ref = np.zeros((0, 2), np.float32) if f is None else f.reshape(-1, 2).astype(np.float32)
         if len(self.p_ref):
-            self.p_ref = cv2.cornerSubPix(first_gray, self.p_ref.reshape(-1, 1, 2), (5, 5), (-1, -1),
-                                          (cv2.TERM_CRITERIA_EPS + cv2.TERM_CRITERIA_COUNT, 30, 0.01)
-                                          ).reshape(-1, 2)
+            self.p_ref = cv2.cornerSubPix(
+                first_gray,
+                self.p_ref.reshape(-1, 1, 2),
+                (5, 5),
+                (-1, -1),
+                (cv2.TERM_CRITERIA_EPS + cv2.TERM_CRITERIA_COUNT, 30, 0.01),
+            ).reshape(-1, 2)
         q = plane_map.to_plane(self.p_ref) if len(self.p_ref) else np.zeros((0, 2))
         cu, cv_ = obj.roi[0] + obj.roi[2] / 2, obj.roi[1] + obj.roi[3] / 2
         centre = plane_map.to_plane(np.array([[cu, cv_]]))[0]
@@ -58,9 +62,12 @@ class RegionTracker:
         H, W = first_gray.shape[:2]
         if len(self.p_ref):
             m = 24
-            self.box = (int(max(self.p_ref[:, 0].min() - m, 0)), int(max(self.p_ref[:, 1].min() - m, 0)),
-                        int(min(self.p_ref[:, 0].max() + m + 1, W)),
-                        int(min(self.p_ref[:, 1].max() + m + 1, H)))
+            self.box = (
+                int(max(self.p_ref[:, 0].min() - m, 0)),
+                int(max(self.p_ref[:, 1].min() - m, 0)),
+                int(min(self.p_ref[:, 0].max() + m + 1, W)),
+                int(min(self.p_ref[:, 1].max() + m + 1, H)),
+            )
             x0, y0, x1, y1 = self.box
             self.ref_crop = first_gray[y0:y1, x0:x1].copy()
 
@@ -79,22 +86,29 @@ class RegionTracker:
         x0, y0, x1, y1 = self.box
         T = np.array([[1.0, 0, x0], [0, 1.0, y0], [0, 0, 1.0]])
         M = A @ T
-        warped = cv2.warpAffine(gray, M, (x1 - x0, y1 - y0),
-                                flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP,
-                                borderMode=cv2.BORDER_REPLICATE)
+        warped = cv2.warpAffine(
+            gray, M, (x1 - x0, y1 - y0), flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP, borderMode=cv2.BORDER_REPLICATE
+        )
         p0 = (self.p_ref - (x0, y0)).astype(np.float32).reshape(-1, 1, 2)
         pw, st, err = cv2.calcOpticalFlowPyrLK(
-            self.ref_crop, warped, p0, p0.copy(), winSize=self.win, maxLevel=2,
+            self.ref_crop,
+            warped,
+            p0,
+            p0.copy(),
+            winSize=self.win,
+            maxLevel=2,
             flags=cv2.OPTFLOW_USE_INITIAL_FLOW,
-            criteria=(cv2.TERM_CRITERIA_EPS + cv2.TERM_CRITERIA_COUNT, 40, 0.005))
-        pr = pw.reshape(-1, 2).astype(float) + (x0, y0)   # in reference coordinates
-        p = pr @ A[:, :2].T + A[:, 2]                      # in the current frame
+            criteria=(cv2.TERM_CRITERIA_EPS + cv2.TERM_CRITERIA_COUNT, 40, 0.005),
+        )
+        pr = pw.reshape(-1, 2).astype(float) + (x0, y0)  # in reference coordinates
+        p = pr @ A[:, :2].T + A[:, 2]  # in the current frame
         ok = st.ravel() == 1
         if ok.sum() < 3:
             self.A_last = self.A_prev = None
             return None
-        A_new, inl = cv2.estimateAffinePartial2D(self.p_ref[ok], p[ok].astype(np.float32),
-                                                 method=cv2.RANSAC, ransacReprojThreshold=1.0)
+        A_new, inl = cv2.estimateAffinePartial2D(
+            self.p_ref[ok], p[ok].astype(np.float32), method=cv2.RANSAC, ransacReprojThreshold=1.0
+        )
         if A_new is None:
             return None
         idx = np.flatnonzero(ok)[inl.ravel() == 1]

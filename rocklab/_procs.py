@@ -73,3 +73,16 @@ def dask_client(address: str, timeout_s: float = 10.0):
             f"--scheduler {address}: no Dask scheduler answered ({msg[:120]}); start one "
             "with 'dask scheduler' and give its address, or drop --scheduler"
         ) from None
+
+
+def spawn_pool(workers: int):
+    """A ``ProcessPoolExecutor`` of ``workers`` fresh (spawned) processes that die with this one.
+
+    Spawned rather than forked: numba's OpenMP threads do not survive a fork.
+    """
+    import multiprocessing as mp
+    from concurrent.futures import ProcessPoolExecutor
+
+    return ProcessPoolExecutor(
+        max_workers=workers, mp_context=mp.get_context("spawn"), initializer=pool_initializer, initargs=(os.getpid(),)
+    )

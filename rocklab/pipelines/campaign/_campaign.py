@@ -9,18 +9,17 @@ spans enough blocks, ``campaign.csv``, figures and ``campaign.rrd``.
 
 from __future__ import annotations
 
-import os
 
 import json
 import traceback
-from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures import as_completed
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
 from ..._errors import InputError
-from ..._procs import dask_client, pool_initializer
+from ..._procs import dask_client, spawn_pool
 from ..._io import write_frame_atomic, write_json_atomic, write_text_atomic
 
 __all__ = ["CampaignResult", "run_campaign", "find_experiments"]
@@ -376,14 +375,7 @@ def run_campaign(
             runs.append(_one(*j))
             bar.update(1)
     else:
-        import multiprocessing as mp
-
-        with ProcessPoolExecutor(
-            max_workers=workers,
-            mp_context=mp.get_context("spawn"),
-            initializer=pool_initializer,
-            initargs=(os.getpid(),),
-        ) as ex:
+        with spawn_pool(workers) as ex:
             futs = [ex.submit(_one, *j) for j in jobs]
             for f in as_completed(futs):
                 runs.append(f.result())

@@ -23,12 +23,11 @@ block, η_H, η_e ± CI, η_M and the truth.
 
 from __future__ import annotations
 
-import os
 
 import time
 from pathlib import Path
 
-from ..._procs import pool_initializer
+from ..._procs import spawn_pool
 
 __all__ = ["DEMO_RUNS", "make_demo_campaign", "run_demo"]
 
@@ -148,8 +147,6 @@ def make_demo_campaign(
     root, *, size=(960, 540), fps: float = 50.0, progress: bool = True, runs=DEMO_RUNS, workers: int = 2
 ) -> list[Path]:
     """Render the demo sessions into ``root/<run>/`` (skips sessions already there), in parallel."""
-    import multiprocessing as mp
-    from concurrent.futures import ProcessPoolExecutor
 
     from tqdm import tqdm
 
@@ -162,12 +159,7 @@ def make_demo_campaign(
     ]
     bar = tqdm(total=len(todo), desc="demo: render sessions", unit="session", disable=not progress)
     if workers > 1 and len(todo) > 1:
-        with ProcessPoolExecutor(
-            max_workers=workers,
-            mp_context=mp.get_context("spawn"),
-            initializer=pool_initializer,
-            initargs=(os.getpid(),),
-        ) as ex:
+        with spawn_pool(workers) as ex:
             for f in [ex.submit(_render_one, *job) for job in todo]:
                 f.result()
                 bar.update(1)

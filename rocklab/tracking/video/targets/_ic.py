@@ -75,6 +75,19 @@ class ICAffine:
         """Largest displacement of a template pixel by the update, px."""
         return max(float(np.abs(dp[:4]).max()) * ext, float(np.abs(dp[4:]).max()))
 
+    def _patch(self, image, W):
+        """The template's pixels (less the border) sampled from ``image`` through ``W``, (n,) float32."""
+        import cv2
+
+        warped = cv2.warpAffine(
+            image,
+            np.asarray(W, np.float32),
+            (self.w, self.h),
+            flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP,
+            borderMode=cv2.BORDER_REPLICATE,
+        )
+        return warped.ravel()[self.idx]
+
     def refine(self, image: np.ndarray, W: np.ndarray, max_iter: int = 30, tol_px: float = 1e-3):
         """Refine the warp ``W`` (template px -> ``image`` px) by Gauss-Newton.
 
@@ -101,14 +114,7 @@ class ICAffine:
         image = cv2.GaussianBlur(np.asarray(image, np.float32), (BLUR_PX, BLUR_PX), 0)
         vn = None
         for _ in range(max_iter):
-            warped = cv2.warpAffine(
-                image,
-                W.astype(np.float32),
-                (self.w, self.h),
-                flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP,
-                borderMode=cv2.BORDER_REPLICATE,
-            )
-            v = warped.ravel()[self.idx]
+            v = self._patch(image, W)
             sd = float(v.std())
             if not sd > 1e-6:
                 return None
@@ -130,14 +136,7 @@ class ICAffine:
                 break
         # the correlation at the final warp (not the one before the last update), so that fits of
         # different motion models compare fairly
-        warped = cv2.warpAffine(
-            image,
-            W.astype(np.float32),
-            (self.w, self.h),
-            flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP,
-            borderMode=cv2.BORDER_REPLICATE,
-        )
-        v = warped.ravel()[self.idx]
+        v = self._patch(image, W)
         v = v - float(v.mean())
         cc = float(np.dot(v, self.tn)) / (float(np.linalg.norm(self.tn)) * float(np.linalg.norm(v)) + 1e-12)
         return W.astype(np.float32), cc

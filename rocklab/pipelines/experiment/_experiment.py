@@ -248,12 +248,9 @@ def analyse_experiment(
     sims: dict = {}
     status = "ok"
     column = None
-    if cfg.columns:
-        from ._column_run import analyse_column
 
-        t3 = time.perf_counter()
-        column = analyse_column(cfg, tr, table, cfg.truth)
-        timings["column_s"] = time.perf_counter() - t3
+    def result(**kw):
+        """The result with what every path shares (read when called: the stages fill them in)."""
         return ExperimentResult(
             name=cfg.name,
             config=cfg,
@@ -262,18 +259,22 @@ def analyse_experiment(
             primary=cfg.primary,
             sync=sync,
             video_imu_residual=residual,
-            fit=None,
             per_impact_eta=per_imp,
-            simulations={},
             table=table,
-            truth=None,
-            status=status,
             messages=msgs,
             timings_s=timings,
             frames=tr,
-            column=column,
             video=film,
+            **kw,
         )
+
+    if cfg.columns:
+        from ._column_run import analyse_column
+
+        t3 = time.perf_counter()
+        column = analyse_column(cfg, tr, table, cfg.truth)
+        timings["column_s"] = time.perf_counter() - t3
+        return result(fit=None, simulations={}, truth=None, status=status, column=column)
     from ._audit_stage import audit_experiment
 
     audit = audit_experiment(cfg, measured, tr, track_rows)
@@ -301,26 +302,7 @@ def analyse_experiment(
     truth = None
     if cfg.truth is not None:
         truth = _truth(cfg, prim, msgs)
-    return ExperimentResult(
-        name=cfg.name,
-        config=cfg,
-        block=block,
-        measured=measured,
-        primary=cfg.primary,
-        sync=sync,
-        video_imu_residual=residual,
-        fit=fit_d,
-        per_impact_eta=per_imp,
-        simulations=sims,
-        table=table,
-        truth=truth,
-        status=status,
-        messages=msgs,
-        timings_s=timings,
-        frames=tr,
-        video=film,
-        audit=audit,
-    )
+    return result(fit=fit_d, simulations=sims, truth=truth, status=status, audit=audit)
 
 
 def _eta_for_law(law, cfg, block, fit_d, msgs):

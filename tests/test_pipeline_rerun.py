@@ -35,8 +35,6 @@ def test_series_and_events_round_trip(tmp_path):
 
 
 def test_review_opens_on_the_impact_with_the_largest_residual(tmp_path):
-    from types import SimpleNamespace
-
     import pandas as pd
 
     from rocklab.pipelines.experiment._log_experiment import _focus
@@ -46,10 +44,10 @@ def test_review_opens_on_the_impact_with_the_largest_residual(tmp_path):
     impacts = pd.DataFrame({"t_s": [0.25, 0.77, 1.30, 1.82, 2.35]})
     measured = sim.copy()
     measured[(t > 1.75) & (t < 1.86)] += 0.004  # the model misses most around the 4th impact
-    res = SimpleNamespace(simulations={"eta_e": {"t_s": t, "theta_rad": sim, "impacts": impacts}})
-    t_imp, t0, t1 = _focus(res, t, measured)
+    ref = {"t_s": t, "theta_rad": sim, "impacts": impacts}
+    t_imp, t0, t1 = _focus(ref, t, measured - sim)
     assert t_imp == 1.82 and (t0, t1) == (0.77, 2.35)  # two half-cycles either side
-    assert _focus(SimpleNamespace(simulations={}), t, measured) is None
+    assert _focus(None, t, measured - sim) is None
     # the blueprint carries that window to the time panel and the plots
     path = tmp_path / "b.rrd"
     rec = open_recording("rocklab_test", path, recording_id="b")

@@ -114,6 +114,11 @@ class CampaignResult:
         return _ok_rows(self.table)
 
     @property
+    def n_suspect(self) -> int:
+        """Number of experiments that ran with a suspect status (see their warnings)."""
+        return sum(1 for r in self.runs if r["ok"] and (r.get("report") or {}).get("status") == "suspect")
+
+    @property
     def n_failed(self) -> int:
         """Number of experiments that failed (they are listed in ``campaign.csv`` with their error)."""
         return len(self.runs) - self.n_ok
@@ -135,15 +140,9 @@ class CampaignResult:
 
     def summary_md(self, figures: dict | None = None) -> str:
         """The campaign's one-page Markdown report: experiments, campaign fits, figures, failures."""
+        from ..reports import sig as g
 
-        def g(x):
-            try:
-                v = float(x)
-            except (TypeError, ValueError):
-                return "–"
-            return f"{v:.4g}" if np.isfinite(v) else "–"
-
-        n_sus = sum(1 for r in self.runs if r["ok"] and (r.get("report") or {}).get("status") == "suspect")
+        n_sus = self.n_suspect
         lines = [
             f"# Campaign {self.out_dir.name}",
             "",
@@ -201,7 +200,7 @@ class CampaignResult:
 
     def summary_text(self) -> str:
         """The table the CLI prints: per experiment η_H, η_e ± CI, η_M, truth; then the campaign fits."""
-        n_sus = sum(1 for r in self.runs if r["ok"] and (r.get("report") or {}).get("status") == "suspect")
+        n_sus = self.n_suspect
         sus = f" ({n_sus} suspect: see their warnings)" if n_sus else ""
         lines = [f"campaign: {self.n_ok}/{len(self.runs)} experiments ran{sus}; outputs in {self.out_dir}"]
         t = self.ok_table

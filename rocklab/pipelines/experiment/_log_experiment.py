@@ -53,17 +53,16 @@ def _theta(rec, bp: str, key: str, t, th, name: str, i: int = 0) -> int:
     return n
 
 
-def _focus(res, t_p, th_p):
-    """(t_impact_s, t0_s, t1_s): the impact nearest the largest |measured − simulated| and a
-    window of a few half-cycles around it, for the blueprint to open on; None without one."""
-    ref = res.simulations.get("eta_e") or next(iter(res.simulations.values()), None)
+def _focus(ref, t_s, residual_rad):
+    """(t_impact_s, t0_s, t1_s): the impact of the simulation ``ref`` nearest the largest
+    |measured − simulated| (``residual_rad`` at ``t_s``) and a window of a few half-cycles
+    around it, for the blueprint to open on; None without one."""
     if ref is None or ref.get("impacts") is None or not len(ref["impacts"]):
         return None
-    sim_on = np.interp(t_p, ref["t_s"], ref["theta_rad"], left=np.nan, right=np.nan)
-    r = np.abs(np.asarray(th_p, float) - sim_on)
+    r = np.abs(np.asarray(residual_rad, float))
     if not np.isfinite(r).any():
         return None
-    t_worst = float(np.asarray(t_p, float)[int(np.nanargmax(r))])
+    t_worst = float(np.asarray(t_s, float)[int(np.nanargmax(r))])
     ti = ref["impacts"]["t_s"].to_numpy(float)
     k = int(np.argmin(np.abs(ti - t_worst)))
     # two half-cycles either side (impacts k-2 .. k+2), never less than 0.15 s each way
@@ -146,18 +145,20 @@ def log_experiment(
             rec, f"{blk}/residual/video_minus_imu", *res.video_imu_residual
         )
     t_p, th_p = res.measured[res.primary]
+    residual = {}
     for i, (law, s) in enumerate(res.simulations.items()):
-        sim_on = np.interp(t_p, s["t_s"], s["theta_rad"], left=np.nan, right=np.nan)
+        residual[law] = th_p - np.interp(t_p, s["t_s"], s["theta_rad"], left=np.nan, right=np.nan)
         rows[f"{blk}/residual/measured_minus_sim_{law}"] = log_series(
             rec,
             f"{blk}/residual/measured_minus_sim_{law}",
             t_p,
-            th_p - sim_on,
+            residual[law],
             color=_style(f"sim_{law}", i)[0],
             name=f"measured − sim {law} (rad)",
         )
-    focus = _focus(res, t_p, th_p)
-    ref = res.simulations.get("eta_e") or next(iter(res.simulations.values()), None)
+    ref_law = "eta_e" if "eta_e" in res.simulations else next(iter(res.simulations), None)
+    ref = res.simulations.get(ref_law)
+    focus = _focus(ref, t_p, residual.get(ref_law))
     if ref is not None and len(ref["impacts"]):
         imp = ref["impacts"]
         txt = [

@@ -9,6 +9,8 @@ import numpy as np
 
 from ..._io import write_frame_atomic, write_json_atomic, write_text_atomic
 
+from ..reports import sig as _g
+
 __all__ = ["series_frame", "write_outputs"]
 
 
@@ -42,15 +44,6 @@ def series_frame(res):
                 tt, th = c["theta_truth_rad"]
                 cols[f"theta_{o}_truth_rad"] = np.interp(t, tt, th[:, i], left=np.nan, right=np.nan)
     return pd.DataFrame(cols)
-
-
-def _g(x, digits: int = 4) -> str:
-    """A number for people: ``digits`` significant digits, "–" when missing."""
-    try:
-        v = float(x)
-    except (TypeError, ValueError):
-        return "–"
-    return f"{v:.{digits}g}" if np.isfinite(v) else "–"
 
 
 def _summary_md(res, figs: dict, rrd: bool) -> str:

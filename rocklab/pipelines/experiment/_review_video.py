@@ -33,15 +33,18 @@ class ReviewVideo:
     kind : str
         ``"av1"`` (one MP4 in ``data``) or ``"jpeg"`` (stills in ``stills``).
     frame_index : tuple of int
-        Video frame index of each encoded frame (MP4 sample order, or the stills').
+        Video frame index of each encoded frame (MP4 sample order, or the stills'); the review
+        places each at the tracker's time for that frame.
     fps : float
-        Frame rate of the source, Hz; frame ``i`` is at ``t = i / fps`` s.
+        Nominal frame rate of the source, Hz (the MP4's own rate and key-frame interval).
     data : bytes
         The MP4 (``kind == "av1"``), else empty.
     stills : tuple of bytes
         JPEG bytes per frame (``kind == "jpeg"``), else empty.
     note : str
         How the film was made, for the report (the fallback and why).
+    size_px : (int, int)
+        Width and height of the frames as tracked, px (the film pads odd sizes by one pixel).
     """
 
     kind: str

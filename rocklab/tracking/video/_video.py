@@ -26,7 +26,7 @@ import numpy as np
 
 from ..._errors import InputError
 
-__all__ = ["VideoInfo", "probe_video", "iter_video_frames", "container_timing", "field_order"]
+__all__ = ["VideoInfo", "probe_video", "iter_video_frames", "container_info"]
 
 
 @dataclass(frozen=True)
@@ -102,59 +102,53 @@ def _open(path):
     return cap
 
 
-def container_timing(path) -> tuple[np.ndarray | None, float]:
-    """Per-frame presentation times (s, first frame at 0) and the pixel aspect ratio of a video.
+#: FFmpeg's AVFieldOrder: TT and TB code/show the top field first, BB and BT the bottom one.
+_FIELD_ORDER = {2: "tff", 4: "tff", 3: "bff", 5: "bff"}
 
-    Read with PyAV from the container's packets (no decoding). Returns ``(None, 1.0)`` where
-    PyAV is missing or cannot open the file (image sequences, exotic containers): the caller
-    then uses frame / fps and square pixels.
+
+def container_info(path) -> tuple[np.ndarray | None, float, str | None]:
+    """What the container says and OpenCV does not, read with PyAV in one pass over the packets.
+
+    Returns
+    -------
+    frame_times_s : ndarray (n,) or None
+        Each frame's presentation time, s, the first frame at 0.
+    pixel_aspect : float
+        Width / height of a stored pixel (the sample aspect ratio; 1 if none is given).
+    field_order : {"tff", "bff"} or None
+        Interlaced video: the stream's field order where the codec states it, else a first
+        frame flagged interlaced is taken as top field first (HD camcorders; PAL DV is bottom
+        first and says so); None for progressive.
+
+    ``(None, 1.0, None)`` where PyAV is missing or cannot open the file (image sequences, exotic
+    containers): the caller then uses frame / fps, square pixels and progressive frames.
     """
     if "%" in str(path):
-        return None, 1.0
+        return None, 1.0, None
     try:
         import av
     except ImportError:
-        return None, 1.0
+        return None, 1.0, None
     try:
         with av.open(str(path)) as c:
             s = c.streams.video[0]
             sar = s.sample_aspect_ratio or s.codec_context.sample_aspect_ratio
             tb = s.time_base
-            pts = [p.pts for p in c.demux(s) if p.pts is not None and p.size]
-    except Exception:  # noqa: BLE001 - PyAV raises many types; the frame rate stays the fallback
-        return None, 1.0
-    aspect = float(sar) if sar and float(sar) > 0 else 1.0
-    if not pts or tb is None:
-        return None, aspect
-    p = np.sort(np.asarray(pts, np.int64))
-    return (p - p[0]) * float(tb), aspect
-
-
-#: FFmpeg's AVFieldOrder: TT and TB code/show the top field first, BB and BT the bottom one.
-_FIELD_ORDER = {2: "tff", 4: "tff", 3: "bff", 5: "bff"}
-
-
-def field_order(path) -> str | None:
-    """``"tff"``/``"bff"`` for interlaced video, None for progressive or unknown (PyAV, first frame).
-
-    The stream's field order where the codec states it; else a first frame flagged interlaced is
-    taken as top field first (HD camcorders; PAL DV is bottom first and says so).
-    """
-    if "%" in str(path):
-        return None
-    try:
-        import av
-    except ImportError:
-        return None
-    try:
-        with av.open(str(path)) as c:
-            s = c.streams.video[0]
-            f = next(c.decode(s), None)
+            pts, first = [], None
+            for p in c.demux(s):
+                if p.pts is not None and p.size:
+                    pts.append(p.pts)
+                if first is None and p.size:  # decode only until the first picture appears
+                    first = next(iter(p.decode()), None)
             fo = int(s.codec_context.field_order or 0)
-            flagged = bool(f is not None and f.interlaced_frame)
-    except Exception:  # noqa: BLE001 - PyAV raises many types; progressive is the fallback
-        return None
-    return _FIELD_ORDER.get(fo, "tff" if flagged else None)
+    except Exception:  # noqa: BLE001 - PyAV raises many types; rate, square pixels stay the fallback
+        return None, 1.0, None
+    aspect = float(sar) if sar and float(sar) > 0 else 1.0
+    order = _FIELD_ORDER.get(fo, "tff" if first is not None and first.interlaced_frame else None)
+    if not pts or tb is None:
+        return None, aspect, order
+    q = np.sort(np.asarray(pts, np.int64))
+    return (q - q[0]) * float(tb), aspect, order
 
 
 def probe_video(path) -> VideoInfo:
@@ -180,7 +174,7 @@ def probe_video(path) -> VideoInfo:
     # Image sequences report a nominal rate (or none); only trust real containers.
     if not np.isfinite(fps) or fps <= 0 or fps > 1e5 or "%" in str(path):
         fps = None
-    times, aspect = container_timing(path)
+    times, aspect, order = container_info(path)
     if times is not None and len(times) > 1:
         # where OpenCV's nominal rate contradicts the packets (variable-rate files often report
         # the time base: 1000 fps and 681 "frames" for 24), count and rate come from the packets;
@@ -188,7 +182,7 @@ def probe_video(path) -> VideoInfo:
         rate = 1.0 / float(np.median(np.diff(times)))
         if fps is None or abs(fps - rate) > 0.01 * rate:
             fps, n = rate, len(times)
-    return VideoInfo(str(path), max(n, 0), fps, _square_width(int(w), aspect), int(h), aspect, times, field_order(path))
+    return VideoInfo(str(path), max(n, 0), fps, _square_width(int(w), aspect), int(h), aspect, times, order)
 
 
 def _square_width(w: int, aspect: float) -> int:

@@ -179,7 +179,7 @@ class MarkerlessTracker:
         return ic
 
     def _to_tmpl(self, W):
-        """First-frame px -> image px  into  template px -> image px (and back with ``sign=-1``)."""
+        """First-frame px -> image px  into  template px -> image px (:meth:`_from_tmpl` undoes it)."""
         W = W.copy()
         W[:, 2] += (W[:, :2] @ self.origin).astype(np.float32)
         return W
@@ -223,35 +223,39 @@ class MarkerlessTracker:
         fit = rigid.refine(gray_f, self._to_tmpl(W0))
         if fit is None or fit[1] < FAST_CC:
             return None
-        aff = affine.refine(gray_f, fit[0])
-        if aff is None or aff[1] < fit[1]:
-            # a thin template (a table edge) leaves the affine terms weakly determined; OpenCV's
-            # ECC from the rigid pose finds their optimum where the fast fit does not
-            try:
-                cv2 = self._cv2
-                cc_a, Wa = cv2.findTransformECC(tmpl, gray_f, fit[0].copy(), cv2.MOTION_AFFINE, ECC_CRITERIA, None, 5)
-                aff = (Wa, float(cc_a))
-            except cv2.error:
-                aff = None
-        if aff is not None and aff[1] >= fit[1] and _near_rigid(aff[0]):
-            fit = aff
-        return self._from_tmpl(fit[0]), float(fit[1])
+        W, cc = self._keep_affine(tmpl, gray_f, fit, affine.refine(gray_f, fit[0]))
+        return self._from_tmpl(W), cc
 
     def _ecc_fine(self, tmpl, gray_f, W0):
         """The same two steps with OpenCV's ECC (slower, wider basin): (W, cc) or None."""
-        W = self._to_tmpl(W0)
         cv2 = self._cv2
         try:
-            cc, W = cv2.findTransformECC(tmpl, gray_f, W.copy(), cv2.MOTION_EUCLIDEAN, ECC_CRITERIA, None, 5)
+            cc, W = cv2.findTransformECC(tmpl, gray_f, self._to_tmpl(W0), cv2.MOTION_EUCLIDEAN, ECC_CRITERIA, None, 5)
         except cv2.error:
             return None
-        try:
-            cc_a, Wa = cv2.findTransformECC(tmpl, gray_f, W.copy(), cv2.MOTION_AFFINE, ECC_CRITERIA, None, 5)
-            if cc_a >= cc and _near_rigid(Wa):
-                cc, W = cc_a, Wa
-        except cv2.error:
-            pass
-        return self._from_tmpl(W), float(cc)
+        W, cc = self._keep_affine(tmpl, gray_f, (W, float(cc)))
+        return self._from_tmpl(W), cc
+
+    def _keep_affine(self, tmpl, gray_f, rigid_fit, aff=None):
+        """The affine refinement of ``rigid_fit`` (template px -> ``gray_f`` px, cc) where it is
+        near-rigid and matches at least as well, else ``rigid_fit``.
+
+        ``aff``: an affine fit already made (the fast one); OpenCV's ECC from the rigid pose where
+        it is missing or worse, as a thin template (a table edge) leaves the affine terms weakly
+        determined for the fast fit.
+        """
+        cv2 = self._cv2
+        if aff is None or aff[1] < rigid_fit[1]:
+            try:
+                cc_a, Wa = cv2.findTransformECC(
+                    tmpl, gray_f, rigid_fit[0].copy(), cv2.MOTION_AFFINE, ECC_CRITERIA, None, 5
+                )
+                aff = (Wa, float(cc_a))
+            except cv2.error:
+                aff = None
+        if aff is not None and aff[1] >= rigid_fit[1] and _near_rigid(aff[0]):
+            return aff[0], float(aff[1])
+        return rigid_fit[0], float(rigid_fit[1])
 
     def _search(self, tmpl, gray, W_pred):
         """Re-acquire by normalised cross-correlation of the (rotated) template round the prediction."""

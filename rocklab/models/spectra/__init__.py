@@ -10,14 +10,13 @@ over the open choices (:func:`t_I_band`), and the design check and required pier
 from ._design import DesignCheck, design_check, required_width, required_width_slender
 from ._oas import (
     OASResult,
-    OverturningCurve,
     critical_impulse,
     fit_inclined_line,
     normalised_critical_impulse,
-    overturning_curve,
     overturning_spectrum,
     simplified_oas,
 )
+from ._oas_curve import OverturningCurve, overturning_curve
 from ._oas_band import BAND_ENSEMBLE, TIBand, t_I_band
 from ._pulses import (
     F_SINE,

@@ -59,10 +59,10 @@ import numpy as np
 from ..._errors import InputError
 from ...blocks import G
 from ..rocking._batch import free_rocking_overturns, simulate_batch
+from ._oas_grid import adaptive_verdicts
 from ._records import BaseMotion
 
-__all__ = ["OASResult", "overturning_spectrum", "OverturningCurve", "overturning_curve",
-           "normalised_critical_impulse", "critical_impulse",
+__all__ = ["OASResult", "overturning_spectrum", "normalised_critical_impulse", "critical_impulse",
            "fit_inclined_line", "simplified_oas", "OAS_DEFAULTS"]
 
 #: Defaults of :func:`overturning_spectrum` (thesis §5.3: 80 levels 1..10, 120 sizes 1000..0.1 m).
@@ -127,6 +127,9 @@ class OASResult:
         Record label.
     options : dict
         All definition options used.
+    evaluated : ndarray of bool, shape (n_l, n_s), optional
+        Grid points simulated; the others took the verdict of the uniform
+        cell around them (``grid="adaptive"``).
     """
 
     levels: np.ndarray
@@ -146,6 +149,12 @@ class OASResult:
     eta: float
     name: str = ""
     options: dict = field(default_factory=dict)
+    evaluated: np.ndarray | None = None
+
+    @property
+    def n_runs(self) -> int:
+        """Grid points simulated (the bisection's runs not counted)."""
+        return int(self.overturned.size if self.evaluated is None else np.count_nonzero(self.evaluated))
 
     def to_frame(self):
         """Boundary per level: ``level, p_min_rad_s, R_unsafe_max_m, f_rad_s``."""
@@ -198,7 +207,8 @@ def overturning_spectrum(base: BaseMotion, slenderness: float = 12.0, *, levels:
                          R_min_m: float = 0.1, refine: int = 10, criterion: str = "angle",
                          free="energy", search: str = "scan", alpha_I: float = 4.0 / 3.0,
                          eta: float | None = None, max_p_dt: float = 0.001, level_offset: float = 0.0,
-                         size_offset: float = 0.0) -> OASResult:
+                         size_offset: float = 0.0, grid: str = "adaptive",
+                         verdicts: OASResult | None = None) -> OASResult:
     """OAS, transformed OAS, t_I, t'_I and beta of a record for one block slenderness.
 
     Parameters
@@ -227,6 +237,14 @@ def overturning_spectrum(base: BaseMotion, slenderness: float = 12.0, *, levels:
         Shift of the level grid and of the (log) size grid by this fraction of one
         step, in [0, 1): the same resolution placed elsewhere, to see how much t_I
         owes to where the grid falls (:func:`t_I_band`).
+    grid : {"adaptive", "dense"}
+        ``"adaptive"`` simulates a coarse grid and refines only where verdicts
+        change (:func:`~rocklab.models.spectra._oas_grid.adaptive_verdicts`);
+        ``"dense"`` simulates every grid point.
+    verdicts : OASResult, optional
+        An earlier result on the same grid and runs (every option equal but
+        ``search`` and ``refine``): its verdicts are reused and only the
+        boundary is searched and bisected again.
 
     Returns
     -------
@@ -247,6 +265,8 @@ def overturning_spectrum(base: BaseMotion, slenderness: float = 12.0, *, levels:
         raise InputError(f"criterion={criterion!r}: use 'angle' (|theta|>=alpha) or 'fall' (|theta|>=pi/2)")
     if search not in ("scan", "contiguous"):
         raise InputError(f"search={search!r}: use 'scan' or 'contiguous'")
+    if grid not in ("adaptive", "dense"):
+        raise InputError(f"grid={grid!r}: use 'adaptive' (refined where verdicts change) or 'dense'")
     free_code, free_s = _free_code(free)
     alpha = math.atan(1.0 / sl)
     eta_v = 1.0 - 2.0 * math.sin(alpha) ** 2 / alpha_I if eta is None else float(eta)
@@ -261,8 +281,24 @@ def overturning_spectrum(base: BaseMotion, slenderness: float = 12.0, *, levels:
     if not (math.isfinite(max_p_dt) and 0 < max_p_dt <= 0.5):
         raise InputError(f"max_p_dt={max_p_dt!r}: step times p must be in (0, 0.5]")
     args = (alpha, eta_v, _CRIT[criterion], free_code, free_s, float(max_p_dt))
-    over = _runs(base, np.repeat(scales, p.size), np.tile(p, scales.size), args)
-    over = over.reshape(scales.size, p.size)
+    opts = dict(levels=int(levels), level_max=float(level_max), sizes=int(sizes), R_max_m=float(R_max_m),
+                R_min_m=float(R_min_m), refine=int(refine), criterion=criterion, free=free,
+                search=search, max_p_dt=float(max_p_dt), level_offset=float(level_offset),
+                size_offset=float(size_offset), grid=grid)
+    if verdicts is not None:
+        def grid_of(o):
+            return {k: v for k, v in o.items() if k not in ("search", "refine")}
+
+        if (grid_of(verdicts.options) != grid_of(opts) or (verdicts.eta, verdicts.alpha_rad, verdicts.alpha_I)
+                != (eta_v, alpha, float(alpha_I)) or verdicts.name != base.name):
+            raise InputError("verdicts: the earlier OAS differs in more than search/refine; compute this one anew")
+        over, evaluated = verdicts.overturned, verdicts.evaluated
+    elif grid == "dense":
+        over = _runs(base, np.repeat(scales, p.size), np.tile(p, scales.size), args)
+        over = over.reshape(scales.size, p.size)
+        evaluated = np.ones_like(over)
+    else:
+        over, evaluated = adaptive_verdicts(lambda i, j: _runs(base, scales[i], p[j], args), lv.size, p.size)
 
     # largest unsafe grid size per level
     k = np.full(lv.size, -1)
@@ -283,14 +319,10 @@ def overturning_spectrum(base: BaseMotion, slenderness: float = 12.0, *, levels:
     f_min = float(np.nanmin(f)) if np.isfinite(f).any() else float("nan")
     t_I = icr / f_min if math.isfinite(f_min) else float("nan")
     tIp, beta = fit_inclined_line(f, lv)
-    opts = dict(levels=int(levels), level_max=float(level_max), sizes=int(sizes), R_max_m=float(R_max_m),
-                R_min_m=float(R_min_m), refine=int(refine), criterion=criterion, free=free,
-                search=search, max_p_dt=float(max_p_dt), level_offset=float(level_offset),
-                size_offset=float(size_offset))
     return OASResult(levels=lv, R_m=R, p_rad_s=p, overturned=over, p_min_rad_s=p_hi,
                      R_unsafe_max_m=G / (alpha_I * p_hi ** 2), f_rad_s=f, f_min_rad_s=f_min,
                      t_I_s=t_I, t_I_prime_s=tIp, beta=beta, i_cr=icr, alpha_rad=alpha,
-                     alpha_I=float(alpha_I), eta=eta_v, name=base.name, options=opts)
+                     alpha_I=float(alpha_I), eta=eta_v, name=base.name, options=opts, evaluated=evaluated)
 
 
 def _runs(base, scale, p, args):
@@ -394,92 +426,3 @@ def simplified_oas(p_rad_s, t_I_s: float, t_I_prime_s: float | None = None, beta
     if kind == "eq30":
         return np.maximum(a21, a29)
     raise InputError(f"kind={kind!r}: use eq21, eq29 or eq30")
-
-
-@dataclass(frozen=True)
-class OverturningCurve:
-    """Normalised overturning curve of a simple pulse (thesis Fig. 33a, 34).
-
-    Attributes
-    ----------
-    kind : str
-        Pulse kind (see :func:`rocklab.models.pulse_shape`), ``n`` lobes for n-half-sines.
-    ptp : ndarray, shape (n_x,)
-        p t_p values (t_p = one lobe's duration).
-    levels : ndarray, shape (n_l,)
-        a_p/a_p,min grid.
-    overturned : ndarray of bool, shape (n_l, n_x)
-        Grid verdicts; bays and islands of multi-lobe pulses show here.
-    a_min_ratio : ndarray, shape (n_x,)
-        Refined lowest a_p/a_p,min that overturns (NaN if none on the grid).
-    impulse_ratio : ndarray, shape (n_x,)
-        Overturning impulse curve p I / a_p,min = F a_min_ratio p t_p (Fig. 34b).
-    i_cr : float
-        Its short-pulse limit for a single lobe (Eq. 18).
-    """
-
-    kind: str
-    n: int
-    alpha_rad: float
-    ptp: np.ndarray
-    levels: np.ndarray
-    overturned: np.ndarray
-    a_min_ratio: np.ndarray
-    impulse_ratio: np.ndarray
-    i_cr: float
-
-    def to_frame(self):
-        """The result as a pandas DataFrame (SI units in the column names)."""
-        import pandas as pd
-
-        return pd.DataFrame({"ptp": self.ptp, "a_min_ratio": self.a_min_ratio,
-                             "impulse_ratio": self.impulse_ratio})
-
-
-def overturning_curve(kind: str, slenderness: float, ptp, levels, *, n: int = 1, refine: int = 12,
-                      criterion: str = "angle", free="energy", alpha_I: float = 4.0 / 3.0,
-                      eta: float | None = None, samples_per_lobe: int = 200) -> OverturningCurve:
-    """Overturning curve a_p/a_p,min vs p t_p of a simple pulse, bays and islands resolved.
-
-    Every (level, p t_p) grid point is simulated (dimensionless: p = 1, t_p = p t_p);
-    the lowest overturning level is then refined by bisection against the safe
-    level below it. See :func:`overturning_spectrum` for ``criterion``, ``free``, ``eta``.
-    """
-    from ._pulses import pulse_duration, pulse_fullness, pulse_shape
-
-    alpha = math.atan(1.0 / _check_opts(slenderness, 2, 2, 2.0, 1.0, 2.0, alpha_I))
-    eta_v = 1.0 - 2.0 * math.sin(alpha) ** 2 / alpha_I if eta is None else float(eta)
-    if criterion not in _CRIT:
-        raise InputError(f"criterion={criterion!r}: use 'angle' or 'fall'")
-    fc, fs = _free_code(free)
-    x = np.atleast_1d(np.asarray(ptp, float))
-    lv = np.atleast_1d(np.asarray(levels, float))
-    if (x <= 0).any() or (lv <= 0).any():
-        raise InputError("ptp and levels must be positive")
-    over = np.zeros((lv.size, x.size), bool)
-    amin = np.full(x.size, np.nan)
-    args = (alpha, eta_v, _CRIT[criterion], fc, fs, OAS_DEFAULTS["max_p_dt"])
-    for j, tp in enumerate(x):
-        # dimensionless: p = 1 rad/s, the pulse in g (record in m/s^2 times level tan(alpha))
-        dt = tp / samples_per_lobe
-        t = np.arange(int(round(pulse_duration(kind, tp, n) / dt)) + 2) * dt
-        base = BaseMotion.from_samples(G * pulse_shape(kind, t, tp, n), dt, name=kind)
-        o = _runs(base, lv * math.tan(alpha), np.ones(lv.size), args)
-        over[:, j] = o
-        hit = np.flatnonzero(o)
-        if hit.size == 0:
-            continue
-        k = hit[0]
-        hi = lv[k]
-        lo = lv[k - 1] if k > 0 else 1.0
-        for _ in range(refine if lo < hi else 0):
-            mid = 0.5 * (lo + hi)
-            if _runs(base, np.array([mid * math.tan(alpha)]), np.ones(1), args)[0]:
-                hi = mid
-            else:
-                lo = mid
-        amin[j] = hi
-    F = pulse_fullness(kind)
-    return OverturningCurve(kind=kind, n=int(n), alpha_rad=alpha, ptp=x, levels=lv, overturned=over,
-                            a_min_ratio=amin, impulse_ratio=F * amin * x,
-                            i_cr=normalised_critical_impulse(alpha))

@@ -121,6 +121,7 @@ def t_I_band(base, slenderness: float = 12.0, ensemble: dict | None = None, **op
     TIBand
     """
     members = []
+    grids: dict[tuple, object] = {}  # members that differ only in search/refine share one grid's runs
     for name, change in (ensemble or BAND_ENSEMBLE).items():
         kw = dict(options)
         kw.update({k: v for k, v in change.items() if k != "eta_factor"})
@@ -129,7 +130,9 @@ def t_I_band(base, slenderness: float = 12.0, ensemble: dict | None = None, **op
             alpha = math.atan(1.0 / slenderness)
             eta0 = kw.get("eta") if kw.get("eta") is not None else 1.0 - 2.0 * math.sin(alpha) ** 2 / alpha_I
             kw["eta"] = eta0 * change["eta_factor"]
-        o = overturning_spectrum(base, slenderness, **kw)
+        key = tuple(sorted((k, repr(v)) for k, v in kw.items() if k not in ("search", "refine")))
+        o = overturning_spectrum(base, slenderness, verdicts=grids.get(key), **kw)
+        grids.setdefault(key, o)
         lv, R = o.f_min_at
         members.append(
             {

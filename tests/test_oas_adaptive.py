@@ -7,7 +7,7 @@ import pytest
 
 from rocklab._errors import InputError
 from rocklab.models import BaseMotion, load_base_motion, overturning_spectrum
-from rocklab.models.spectra._oas_grid import adaptive_verdicts
+from rocklab.models.spectra._oas_grid import adaptive_verdicts, boundary_verdicts
 
 FF1 = "records/fema-p695-far-field/SortedEQFile_120111.txt"
 
@@ -68,3 +68,37 @@ def test_oas_grid_option_is_checked():
     m = BaseMotion.from_samples(np.sin(np.arange(400) * 0.05), 0.01)
     with pytest.raises(InputError, match="grid='sparse'"):
         overturning_spectrum(m, 12, grid="sparse")
+
+
+def test_boundary_search_finds_each_rows_first_unsafe_point():
+    truth = _image()
+    first = truth.argmax(axis=1)
+    calls = []
+
+    def run(r, c):
+        calls.append(len(r))
+        return truth[r, c]
+
+    # a guess 3 columns off either way, as a neighbouring grid's boundary would be
+    guess = first + np.where(np.arange(truth.shape[0]) % 2, 3, -3)
+    over, known = boundary_verdicts(run, *truth.shape, guess)
+    assert np.array_equal(over.argmax(axis=1), first)
+    assert known[np.arange(truth.shape[0]), first].all()
+    assert sum(calls) == known.sum() < 0.2 * truth.size
+    # a guess of "no unsafe point" walks from the smallest blocks leftwards to the boundary;
+    # the island 18+ columns before it (rows 40-51) is out of the search's reach
+    over, _ = boundary_verdicts(run, *truth.shape, np.full(truth.shape[0], truth.shape[1]))
+    rows = np.r_[0:40, 52:80]
+    assert np.array_equal(over.argmax(axis=1)[rows], first[rows])
+    assert (over.argmax(axis=1)[40:52] > first[40:52] + 8).all()
+
+
+def test_boundary_grid_gives_the_adaptive_grids_t_I(shared_data):
+    r = load_base_motion(shared_data / FF1, units="g")
+    guide = overturning_spectrum(r, 12)
+    full = overturning_spectrum(r, 12, level_offset=0.5)
+    fast = overturning_spectrum(r, 12, level_offset=0.5, grid="boundary", guide=guide)
+    assert fast.t_I_s == full.t_I_s and fast.t_I_prime_s == full.t_I_prime_s and fast.beta == full.beta
+    assert fast.n_runs < 0.7 * full.n_runs
+    with pytest.raises(InputError, match="guide"):
+        overturning_spectrum(r, 12, grid="boundary")

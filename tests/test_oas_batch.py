@@ -26,6 +26,10 @@ def test_thesis_table4_transcription():
     ids = t.fema_id.astype(int).to_numpy()
     assert (np.diff(ids) > 0).all() and set(t.fema_id.str[-1]) == {"1", "2"}
     assert table4_row("SortedEQFile_(120821).txt", t).ff_id == "FF-19"
+    # Fig. 55 (the Northridge record of FF-1) prints t_I = 0.27, t'_I = 0.40, beta = 2.39 for the
+    # same record: t_I and t'_I round to Table 4's, beta does not (1.744) -- the thesis states no
+    # fitting rule for the inclined line, so neither beta can be checked against its equations
+    assert round(ff1.t_I_s, 2) == 0.27 and round(ff1.t_I_prime_s, 1) == 0.4 and abs(ff1.beta - 2.39) > 0.6
     assert table4_row("elcentro.AT2", t) is None
 
 
@@ -120,6 +124,16 @@ def test_t_I_band_members_and_consistency(tmp_path):
     # percentiles of the members
     ti = np.array([m["t_I_s"] for m in b.members])
     assert b.t_I_p05_s == pytest.approx(np.percentile(ti, 5)) and b.t_I_s == pytest.approx(np.median(ti))
+
+
+def test_band_statistics_with_infinite_members():
+    from rocklab.models.spectra._oas_band import _stats
+
+    # t'_I is inf where no inclined line fits: it counts as the largest, never as NaN
+    med, p05, p95 = _stats([0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0, math.inf])
+    assert med == pytest.approx(0.75) and p05 == pytest.approx(np.percentile([0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0, 2], 5))
+    assert p95 == math.inf
+    assert _stats([math.nan, 0.3])[0] == 0.3 and all(math.isnan(x) for x in _stats([math.nan]))
 
 
 def test_cli_band_columns(tmp_path, run_cli):

@@ -23,7 +23,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-__all__ = ["adaptive_verdicts", "ADAPTIVE_COARSE", "ADAPTIVE_DILATE", "ADAPTIVE_FRONTIER"]
+__all__ = ["adaptive_verdicts", "boundary_verdicts", "ADAPTIVE_COARSE", "ADAPTIVE_DILATE", "ADAPTIVE_FRONTIER"]
 
 #: Spacing (grid steps) of the first pass.
 ADAPTIVE_COARSE = 8
@@ -140,3 +140,67 @@ def _check_frontier(run, over, known, width):
         known[i, j] = True
         if not v.any():
             return
+
+
+def boundary_verdicts(
+    run: Callable[[np.ndarray, np.ndarray], np.ndarray],
+    n_rows: int,
+    n_cols: int,
+    first_guess: np.ndarray,
+    *,
+    frontier: int = ADAPTIVE_FRONTIER,
+    ahead: int = 2,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Each row's first unsafe point, searched near a guess (a neighbouring OAS's boundary).
+
+    Per row, the points from ``first_guess - frontier`` to ``first_guess + ahead``
+    are simulated; a row with no unsafe point there moves on to the right in
+    steps of ``frontier`` until one is found or the row ends; then the frontier
+    check of :func:`adaptive_verdicts` runs. Only the boundary (and hence t_I,
+    t'_I and beta) is resolved: the map elsewhere is filled, safe before each
+    row's first unsafe point and unsafe after the simulated window.
+
+    Parameters
+    ----------
+    run : callable
+        As in :func:`adaptive_verdicts`.
+    n_rows, n_cols : int
+        Grid shape.
+    first_guess : ndarray of int, shape (n_rows,)
+        Expected first unsafe column per row; ``n_cols`` or more for a row
+        expected to hold no unsafe point.
+    frontier, ahead : int
+        Columns simulated before and after the guess.
+
+    Returns
+    -------
+    over, evaluated : ndarray of bool, shape (n_rows, n_cols)
+    """
+    over = np.zeros((n_rows, n_cols), bool)
+    known = np.zeros_like(over)
+    g = np.clip(np.asarray(first_guess, int), 0, n_cols)
+    lo = np.clip(g - int(frontier), 0, n_cols)
+    hi = np.clip(g + int(ahead) + 1, 0, n_cols)
+    # rows expected to stay safe get their last `frontier` columns, the smallest blocks
+    none = g >= n_cols
+    lo[none] = max(0, n_cols - int(frontier))
+    hi[none] = n_cols
+    active = np.ones(n_rows, bool)
+    while active.any():
+        i = np.concatenate([np.full(hi[r] - lo[r], r) for r in np.flatnonzero(active)]).astype(int)
+        j = np.concatenate([np.arange(lo[r], hi[r]) for r in np.flatnonzero(active)]).astype(int)
+        todo = ~known[i, j]
+        if todo.any():
+            over[i[todo], j[todo]] = np.asarray(run(i[todo], j[todo]), bool)
+            known[i[todo], j[todo]] = True
+        # rows whose window held no unsafe point look further right (smaller blocks)
+        active = ~over.any(axis=1) & (hi < n_cols)
+        lo = np.where(active, hi, lo)
+        hi = np.where(active, np.minimum(hi + int(frontier), n_cols), hi)
+    if frontier > 0:
+        _check_frontier(run, over, known, int(frontier))
+    # fill: unsafe after each row's simulated window (rows with an unsafe point only)
+    for r in np.flatnonzero(over.any(axis=1)):
+        last = np.flatnonzero(known[r]).max()
+        over[r, last + 1 :] = True
+    return over, known

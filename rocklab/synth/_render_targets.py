@@ -138,6 +138,40 @@ def _speckle(p: _Painter, si, sj, rng, amp: float, grain_m: float):
     return amp * cv2.resize(noise, (w, h), interpolation=cv2.INTER_CUBIC)
 
 
+#: Photographs in rocklab/data/textures (see its PROVENANCE.md) and the width each covers, m.
+PHOTOS = {"gravel": 0.25, "brick": 1.5}
+
+
+def photo_texture(name: str) -> np.ndarray:
+    """Grey photograph ``name`` (:data:`PHOTOS`), float32, zero mean and unit standard deviation.
+
+    Returns
+    -------
+    ndarray, shape (512, 512)
+    """
+    from importlib.resources import files
+
+    import cv2
+
+    raw = (files("rocklab") / "data" / "textures" / f"{name}.png").read_bytes()
+    img = cv2.imdecode(np.frombuffer(raw, np.uint8), cv2.IMREAD_GRAYSCALE).astype(np.float32)
+    return (img - img.mean()) / img.std()
+
+
+def _photo(p: _Painter, si, sj, rng, name: str, amp: float):
+    """The photograph at its physical size over the painter's region, from a random offset (tiled)."""
+    import cv2
+
+    img = photo_texture(name)
+    h, w = p.L[si, sj].shape
+    pix_m = PHOTOS[name] / img.shape[1]
+    ny, nx = int(np.ceil(h * p.s / pix_m)) + 2, int(np.ceil(w * p.s / pix_m)) + 2
+    i0, j0 = (int(v) for v in rng.integers(0, img.shape[0], 2))
+    crop = np.take(np.take(img, np.arange(i0, i0 + ny) % img.shape[0], 0), np.arange(j0, j0 + nx) % img.shape[1], 1)
+    interp = cv2.INTER_AREA if p.s > pix_m else cv2.INTER_CUBIC
+    return amp * cv2.resize(crop, (w, h), interpolation=interp)
+
+
 def _marker_corners(x0, y0, size):
     # ArUco corner order as printed: top-left, top-right, bottom-right, bottom-left.
     return np.array([[x0, y0 + size], [x0 + size, y0 + size], [x0 + size, y0], [x0, y0]])
@@ -156,12 +190,15 @@ def block_texture(
     psf_px_m,
     rng,
     face_value=None,
+    texture: str = "procedural",
 ) -> Texture:
     """Front face of a block ``b_m`` x ``h_m`` (m) with its targets.
 
     ``style``: ``"aruco"`` (markers stacked on the centre line, each on a white
     quiet zone), ``"dots"`` (four black dots on white, an asymmetric layout so
-    the set has no symmetry), ``"edges"`` (plain light stone with faint speckle).
+    the set has no symmetry), ``"edges"`` (plain light stone with faint speckle),
+    ``"markerless"`` (granite-like stone: synthetic grains, or with
+    ``texture="photo"`` the gravel photograph of :data:`PHOTOS`).
     ``psf_px_m`` is the Gaussian prefilter sigma in metres on the face.
     """
     pad = 4 * psf_px_m + 2 * texel_m
@@ -176,7 +213,10 @@ def block_texture(
         # granite-like stone: grains at two scales over a mid-grey face, no targets at all
         p.rect(-b_m / 2, b_m / 2, 0, h_m, face_value or 150.0, opaque=True)
         si, sj = p._slices(-b_m / 2, b_m / 2, 0, h_m)
-        p.L[si, sj] += _speckle(p, si, sj, rng, 22.0, 0.0025) + _speckle(p, si, sj, rng, 14.0, 0.01)
+        if texture == "photo":
+            p.L[si, sj] += _photo(p, si, sj, rng, "gravel", 26.0)
+        else:
+            p.L[si, sj] += _speckle(p, si, sj, rng, 22.0, 0.0025) + _speckle(p, si, sj, rng, 14.0, 0.01)
     elif style == "aruco":
         p.rect(-b_m / 2, b_m / 2, 0, h_m, face_value or 196.0, opaque=True)
         n = len(marker_ids)

@@ -266,7 +266,7 @@ def _roi_box(px, margin_px: float = 0.0, size=None) -> list:
 
 def build_scene(*, seed, blocks, table, fps, size, targets, duration_s, occlusion, rolling_shutter,
                 block, restitution, eta, theta0_rad, record, table_amplitude_m, table_period_s,
-                table_stroke_m, exposure_s, noise_dn, distortion, layout=None) -> Scene:
+                table_stroke_m, exposure_s, noise_dn, distortion, layout=None, texture="procedural") -> Scene:
     from ._render import Occluder, RenderObject
     from ._render_targets import block_texture, table_texture
     from ._camera import make_camera
@@ -340,7 +340,7 @@ def build_scene(*, seed, blocks, table, fps, size, targets, duration_s, occlusio
                             marker_size_m=min(0.6 * blk.b_m, 0.3 * blk.h_m), dot_diameter_m=dot_dia,
                             texel_m=texel, psf_px_m=psf_m, rng=rng_t,
                             # stacked plain blocks alternate in shade so the joints are visible
-                            face_value=(212.0, 176.0)[k % 2] if targets == "edges" else None)
+                            face_value=(212.0, 176.0)[k % 2] if targets == "edges" else None, texture=texture)
         objects.append(RenderObject(bm.id, tex, bm.pose))
         f = dict(tex.features, size_m=[blk.b_m, blk.h_m], origin="centre of the front face")
         shift = np.array([0.0, blk.h_m / 2])         # body (bottom centre) -> face centre origin
@@ -349,7 +349,7 @@ def build_scene(*, seed, blocks, table, fps, size, targets, duration_s, occlusio
         if "dots" in f:
             f["dots"] = f["dots"] - shift
         feats[bm.id] = f
-    background, illum = _background(maps, size, targets, np.random.default_rng(s_bg))
+    background, illum = _background(maps, size, targets, np.random.default_rng(s_bg), texture)
     occl = []
     if occlusion is not None:
         if isinstance(occlusion, dict):
@@ -456,8 +456,8 @@ def _column_motions(blks, tbl, base, table, rest_s, sim_end_s, rng_m, phi0=None)
     return motions, sims, [tbl.end_s, float(t[-1])]
 
 
-def _background(maps, size, targets, rng):
-    """Wall (with faint blotches) above the table, the table's steel frame below; lighting field."""
+def _background(maps, size, targets, rng, texture="procedural"):
+    """Wall (faint blotches, or the brick photograph) above the table, the table's steel frame below; lighting."""
     import cv2
 
     W, H = size
@@ -465,6 +465,16 @@ def _background(maps, size, targets, rng):
     wall = 50.0 if targets == "edges" else 150.0
     blot = cv2.resize(rng.standard_normal((6, 10)).astype(np.float32), (W, H), interpolation=cv2.INTER_CUBIC)
     bg = wall + (3.0 if targets == "edges" else 6.0) * blot
+    if texture == "photo":
+        from ._render_targets import PHOTOS, photo_texture
+
+        img = np.ascontiguousarray(photo_texture("brick").T)  # the photograph's courses run vertically
+        k = img.shape[1] / PHOTOS["brick"]  # photo pixels per metre on the wall
+        # centred on the set-up: one photograph spans the view (it does not tile without a seam;
+        # mirrored beyond its edges for the widest framings)
+        u = ((X + 0.5 * PHOTOS["brick"]) * k).astype(np.float32)
+        v = ((0.6 - Y) * k).astype(np.float32)
+        bg = bg + 18.0 * cv2.remap(img, u, v, cv2.INTER_LINEAR, borderMode=cv2.BORDER_REFLECT_101)
     bg = np.where(Y < -TABLE_THICK_M - 0.004, np.float32(72.0), bg).astype(np.float32)
     u = (np.arange(W, dtype=np.float32) - W / 2) / (W / 2)
     v = (np.arange(H, dtype=np.float32) - H / 2) / (W / 2)

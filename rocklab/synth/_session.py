@@ -188,6 +188,7 @@ def synth_session(
     force: bool = False,
     progress: bool = False,
     flicker: float = 0.0,
+    texture: str = "procedural",
 ) -> SynthSession:
     """Render a synthetic lab session into ``out_dir`` (see the module doc for the layout).
 
@@ -240,6 +241,10 @@ def synth_session(
     flicker : float
         Exposure flicker, relative amplitude (0 to 0.5): a camcorder's automatic exposure
         hunting under mains light (``Renderer.exposure_gain``); the frames' brightness follows it.
+    texture : {"procedural", "photo"}
+        Surfaces from synthetic noise, or from photographs (CC0, shipped in
+        ``rocklab/data/textures``): the wall is a brick wall and a markerless block's
+        face is gravel-like stone.
     imu : bool
         Write IMU logs (one per block and one on the table), x-IMU GUI format. They
         start 0.5..1.5 s before the video and run on 0.5 s after its last frame (the
@@ -262,6 +267,8 @@ def synth_session(
     _check(seed, blocks, table, fps, targets, duration_s, exposure_s, noise_dn)
     if not (isinstance(flicker, (int, float)) and not isinstance(flicker, bool) and 0 <= flicker <= 0.5):
         raise InputError(f"flicker={flicker!r}: exposure flicker must be a relative amplitude from 0 to 0.5")
+    if texture not in ("procedural", "photo"):
+        raise InputError(f"texture={texture!r}: use 'procedural' (synthetic noise) or 'photo' (photographs)")
     out_dir = Path(out_dir)
     tmp = _prepare_out(out_dir, force)
     t_start = time.perf_counter()
@@ -288,11 +295,13 @@ def synth_session(
             noise_dn=noise_dn,
             distortion=distortion,
             layout=layout,
+            texture=texture,
         )
         scene.flicker = float(flicker)
         _render_video(scene, tmp, mp4, progress)
         meta = scene.write_files(tmp, imu=imu, imu_rate_hz=imu_rate_hz, calibrated=calibrated)
         meta["flicker"] = float(flicker)
+        meta["texture"] = texture
         render_s = time.perf_counter() - t_start
         meta["render_s"] = render_s
         from .._io import write_json_atomic

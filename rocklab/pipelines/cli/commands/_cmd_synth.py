@@ -73,6 +73,13 @@ def register(sub):
         metavar="A",
         help="exposure flicker, relative amplitude 0-0.5 (automatic exposure hunting under mains light; default 0)",
     )
+    p.add_argument(
+        "--texture",
+        choices=("procedural", "photo"),
+        default="procedural",
+        help="surfaces from synthetic noise (default) or photographs: a brick wall, gravel-like stone on "
+        "markerless blocks (CC0, shipped with rocklab)",
+    )
     p.add_argument("--no-imu", action="store_true", help="do not write IMU logs")
     p.add_argument(
         "--uncalibrated",
@@ -260,6 +267,7 @@ def run(args) -> int:
         exposure_s=args.exposure,
         noise_dn=args.noise,
         flicker=args.flicker,
+        texture=args.texture,
         progress=args.progress,
     )
     d = s.to_dict()

@@ -12,9 +12,20 @@ from rocklab.tracking import load_track_config, track_video
 av = pytest.importorskip("av")
 
 
+def _track_block(s):
+    """Track a session's lossy film with its own config: result, truth, block truth, block track, ok mask."""
+    import pandas as pd
+
+    tr = track_video(s.video_mp4, load_track_config(s.track_toml))
+    truth = pd.read_csv(s.truth_csv)
+    b = tr["block_1"]
+    ok = b.status == "ok"
+    assert ok.mean() >= 0.99
+    return tr, truth, truth[truth.object == "block_1"].sort_values("frame"), b, ok
+
+
 @pytest.mark.parametrize("targets", ["aruco", "markerless"])
 def test_tracking_survives_h264_and_exposure_flicker(tmp_path, targets):
-    import pandas as pd
 
     s = synth_session(tmp_path / "s", seed=2, size=(960, 540), duration_s=2.4, imu=False, targets=targets, flicker=0.12)
     meta = json.loads(s.session_json.read_text())
@@ -29,12 +40,7 @@ def test_tracking_survives_h264_and_exposure_flicker(tmp_path, targets):
     gain = np.array(meta["video"]["exposure_gain"], float)
     assert gain.max() - gain.min() > 0.1
     assert np.corrcoef(lum, gain[: lum.size])[0, 1] > 0.95
-    tr = track_video(s.video_mp4, load_track_config(s.track_toml))
-    truth = pd.read_csv(s.truth_csv)
-    tb = truth[truth.object == "block_1"].sort_values("frame")
-    b = tr["block_1"]
-    ok = b.status == "ok"
-    assert ok.mean() >= 0.99
+    tr, truth, tb, b, ok = _track_block(s)
     err = np.degrees(b.theta_rad[ok] - tb.theta_rad.to_numpy()[ok])
     # the motion: within 0.03 deg RMS of the truth once the level's constant offset is removed;
     # the level itself (markerless: the table's top edge at 960x540, 0.04 deg off even on the
@@ -48,7 +54,6 @@ def test_markerless_full_hd_camcorder_render_block_and_table(tmp_path):
     motion blur (half-frame shutter), a block faced with photographed stone in front of a
     photographed brick wall, rocking through its impacts on a table driven by a 45 mm / 0.6 s sine
     pulse, no markers anywhere; tracked from the lossy file."""
-    import pandas as pd
 
     s = synth_session(
         tmp_path / "s",
@@ -63,12 +68,7 @@ def test_markerless_full_hd_camcorder_render_block_and_table(tmp_path):
     )
     meta = json.loads(s.session_json.read_text())
     assert meta["video"]["lossy_codec"] == "h264" and meta["flicker"] == 0.12 and meta["texture"] == "photo"
-    tr = track_video(s.video_mp4, load_track_config(s.track_toml))
-    truth = pd.read_csv(s.truth_csv)
-    tb = truth[truth.object == "block_1"].sort_values("frame")
-    b = tr["block_1"]
-    ok = b.status == "ok"
-    assert ok.mean() >= 0.99
+    tr, truth, tb, b, ok = _track_block(s)
     # measured on 6 s of this render: 0.020 deg RMS (max 0.037; 0.020 of it the level from the table
     # edge in front of the brick wall), 300/300 frames
     err = np.degrees(b.theta_rad[ok] - tb.theta_rad.to_numpy()[ok])

@@ -11,7 +11,7 @@ from pathlib import Path
 __all__ = ["drop_stale_cache"]
 
 
-def drop_stale_cache(index_glob: str, sources) -> None:
+def drop_stale_cache(index_glob: str, sources, module_file: str) -> None:
     """Delete ``__pycache__/<index_glob>`` numba index files older than any of ``sources``.
 
     Parameters
@@ -19,9 +19,11 @@ def drop_stale_cache(index_glob: str, sources) -> None:
     index_glob : str
         Glob of the cache index files, e.g. ``"_newmark.*.nbi"``.
     sources : iterable of str
-        Module file names (in this package folder) the cached kernels depend on.
+        Module file names (in the caller's package folder) the cached kernels depend on.
+    module_file : str
+        The caller's ``__file__``: its folder holds ``sources`` and the ``__pycache__``.
     """
-    here = Path(__file__).resolve().parent
+    here = Path(module_file).resolve().parent
     try:
         newest = max((here / f).stat().st_mtime for f in sources)
         for idx in (here / "__pycache__").glob(index_glob):

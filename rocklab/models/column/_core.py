@@ -405,7 +405,5 @@ def run_core(
 
 
 # run_core inlines the kernels of these modules (see _numba_cache)
-drop_stale_cache(
-    "_column_core.run_core-*.nbi", ("_column_kernels.py", "_column_step.py", "_column_events.py", "_column_core.py")
-)
+drop_stale_cache("_core.run_core-*.nbi", ("_kernels.py", "_step.py", "_events.py", "_core.py"), __file__)
 run_core_jit = njit(cache=True)(run_core)

@@ -42,7 +42,7 @@ import numpy as np
 from numba import njit, prange
 
 from ...blocks import G
-from ._newmark_contact import contact_tau, cross_fraction
+from ._newmark_contact import contact_tau, cross_fraction, restitution_at, store_impact
 from ._newmark_forced import forced_steps
 from ._newmark_free import free_steps, sdcd
 from .._numba_cache import drop_stale_cache
@@ -50,7 +50,7 @@ from .._numba_cache import drop_stale_cache
 
 # run_block compiles in the kernels of _newmark_free, _newmark_forced and _newmark_contact (see _numba_cache)
 drop_stale_cache("_newmark.*.nbi", ("_newmark_free.py", "_newmark_forced.py", "_newmark_contact.py",
-                                    "_newmark.py"))
+                                    "_newmark.py"), __file__)
 
 #: Status codes returned by the kernel.
 ROCKING, REST, OVERTURNED, NO_UPLIFT = 0, 1, 2, 3
@@ -320,19 +320,9 @@ def run_block(p, alpha, theta0, omega0, h, n_steps, acc, acc_t0, acc_dt, scale,
                     w_m = -2.0 * th / tau - w  # Eq. 10
                 ti = tc + tau
                 u_i = u_c + (u1 - u_c) * (tau / rem)
-                if eta_mode == 1:
-                    e = eta_y[min(n_imp, eta_y.shape[0] - 1)]
-                elif eta_mode == 2:
-                    e = np.interp(abs(w_m), eta_x, eta_y)
-                else:
-                    e = eta_y[0]
+                e = restitution_at(eta_mode, eta_x, eta_y, n_imp, w_m)
                 w_p = e * w_m
-                if n_imp < imp_cap:
-                    imp[0, n_imp] = ti
-                    imp[1, n_imp] = w_m
-                    imp[2, n_imp] = w_p
-                    imp[3, n_imp] = e
-                n_imp += 1
+                n_imp = store_impact(imp, n_imp, ti, w_m, w_p, e)
                 th = 0.0
                 tc = ti
                 u_c = u_i

@@ -3,7 +3,8 @@
 :func:`contact_tau` is the length of the step that ends exactly at theta = 0
 (Čeh Eq. 8–9, a cubic when the base acceleration varies linearly over the
 step); :func:`cross_fraction` is where the cubic Hermite of a step reaches a
-given |theta| (overturning and fall times). Used by
+given |theta| (overturning and fall times); :func:`restitution_at` and
+:func:`store_impact` apply the restitution law and fill the impact table. Used by
 :func:`~rocklab.models.rocking._newmark.run_block`, which drops its on-disk numba cache
 when this file is newer (numba only tracks the caller's file).
 """
@@ -12,6 +13,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 from numba import njit
 
 
@@ -105,3 +107,28 @@ def contact_tau(th0, w0, a0, s, h, u0, u1, p2, alpha, lin):
             break
         t = tn
     return t
+
+
+@njit(cache=True, inline="always")
+def restitution_at(eta_mode, eta_x, eta_y, n_imp, w_m):
+    """eta of impact number ``n_imp`` (from 0) with pre-impact omega ``w_m`` (rad/s).
+
+    ``eta_mode`` 0: constant ``eta_y[0]``; 1: per-impact table ``eta_y`` (the last entry
+    repeats); 2: ``eta_y`` tabulated over |omega-| at ``eta_x``.
+    """
+    if eta_mode == 1:
+        return eta_y[min(n_imp, eta_y.shape[0] - 1)]
+    if eta_mode == 2:
+        return np.interp(abs(w_m), eta_x, eta_y)
+    return eta_y[0]
+
+
+@njit(cache=True, inline="always")
+def store_impact(imp, n_imp, t, w_m, w_p, e):
+    """Row ``n_imp`` of the impact table ``imp`` (4, cap): t_s, omega-, omega+, eta; returns n_imp + 1."""
+    if n_imp < imp.shape[1]:
+        imp[0, n_imp] = t
+        imp[1, n_imp] = w_m
+        imp[2, n_imp] = w_p
+        imp[3, n_imp] = e
+    return n_imp + 1

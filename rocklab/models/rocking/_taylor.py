@@ -29,6 +29,12 @@ import math
 import numpy as np
 from numba import njit
 
+from .._numba_cache import drop_stale_cache
+from ._newmark_contact import restitution_at, store_impact
+
+# run_taylor compiles in the impact helpers of _newmark_contact (see _numba_cache)
+drop_stale_cache("_taylor.*.nbi", ("_newmark_contact.py", "_taylor.py"), __file__)
+
 __all__ = ["run_taylor", "ORDER", "P_H"]
 
 #: Order of the Taylor series (terms up to tau^ORDER).
@@ -251,19 +257,9 @@ def run_taylor(
             break
         if event == 1:
             w_m = w
-            if eta_mode == 1:
-                e = eta_y[min(n_imp, eta_y.shape[0] - 1)]
-            elif eta_mode == 2:
-                e = np.interp(abs(w_m), eta_x, eta_y)
-            else:
-                e = eta_y[0]
+            e = restitution_at(eta_mode, eta_x, eta_y, n_imp, w_m)
             w_p = e * w_m
-            if n_imp < imp_cap:
-                imp[0, n_imp] = t
-                imp[1, n_imp] = w_m
-                imp[2, n_imp] = w_p
-                imp[3, n_imp] = e
-            n_imp += 1
+            n_imp = store_impact(imp, n_imp, t, w_m, w_p, e)
             th = 0.0
             w = w_p
             energy = 0.5 * w * w * e_scale

@@ -285,8 +285,27 @@ def test_occlusion_hides_the_block_only_in_its_interval(tmp_path):
     hidden = (t >= 0.3) & (t < 0.5)
     assert all({1, 2}.isdisjoint(k) and {0, 7} <= k for k, h in zip(seen, hidden) if h)
     assert all({0, 1, 2, 7} <= k for k, h in zip(seen, hidden) if not h)
-    assert s.meta["occlusions"] == [{"object": "block_1", "t0_s": 0.3, "t1_s": 0.5}]
+    assert s.meta["occlusions"] == [{"object": "block_1", "t0_s": 0.3, "t1_s": 0.5, "kind": "patch"}]
     assert len(s.truth[s.truth.object == "block_1"]) == s.n_frames  # truth is never hidden
+
+
+def test_hand_covers_the_top_of_the_block_while_it_reaches_in(tmp_path):
+    hand = {"object": "block_1", "t0_s": 0.2, "t1_s": 0.8, "kind": "hand"}
+    s = synth_session(tmp_path / "h", seed=1, size=(640, 360), duration_s=0.9, occlusion=hand, imu=False, mp4=False)
+    frames = _frames(s.video_mkv, s.n_frames)
+    seen = [set(_aruco_centres(f)) for f in frames]
+    t = np.arange(s.n_frames) / s.fps
+    # full reach in the middle 40 % of the interval: the upper marker (id 2) is under the fingers,
+    # the lower one (id 1) and the table's stay visible; before and after, every marker is seen
+    full = (t >= 0.2 + 0.3 * 0.6) & (t < 0.8 - 0.3 * 0.6)
+    assert full.sum() >= 5
+    assert all(2 not in k and {1, 0, 7} <= k for k, f in zip(seen, full) if f)
+    assert all({0, 1, 2, 7} <= k for k, tt in zip(seen, t) if tt < 0.2 or tt >= 0.8)
+    # the hand is lighter than the dark patch and reaches in from the top edge of the frame
+    mid = frames[int(np.flatnonzero(full)[0])]
+    col = int(np.argmax(np.abs(mid.astype(int) - frames[0].astype(int)).sum(axis=0)))
+    assert mid[:5, col].mean() > 120 and abs(int(mid[0, col]) - int(frames[0][0, col])) > 10
+    assert s.meta["occlusions"] == [hand]
 
 
 def test_full_hd_markers_give_theta_to_a_few_hundredths_of_a_degree():

@@ -50,11 +50,89 @@ class RenderObject:
 
 @dataclass(frozen=True)
 class Occluder:
-    """A dark patch in front of ``object`` during ``[t0_s, t1_s)`` (covers it entirely)."""
+    """Something in front of ``object`` during ``[t0_s, t1_s)``.
+
+    ``kind="patch"``: a dark patch covering the object entirely. ``kind="hand"``: a hand and
+    forearm reaching down from the top of the frame over the upper part of the object (fingers
+    to about 55 % of its height at full reach, in the middle 40 % of the interval) and back;
+    lighter than the stone, with soft edges.
+    """
 
     object: str
     t0_s: float
     t1_s: float
+    kind: str = "patch"
+
+
+def _hand_alpha(box, reach, H, W):
+    """Coverage (0..1) of a hand reaching down to ``reach`` (0..1) of the object box; its region.
+
+    Returns ``(alpha, (r0, r1, c0, c1))`` or None when the hand is out of the frame.
+    """
+    import cv2
+
+    r0, r1, c0, c1 = box
+    bw, bh = c1 - c0, r1 - r0
+    tip = r0 + reach * 0.55 * bh  # fingertips, px from the top
+    if tip <= 0:
+        return None
+    palm_w = 0.9 * bw
+    cx = 0.5 * (c0 + c1) + 0.15 * bw
+    finger_l = 0.45 * palm_w
+    palm_bot = tip - finger_l
+    palm_top = palm_bot - 0.9 * palm_w
+    R1 = int(min(H, np.ceil(tip + 4)))
+    C0 = int(max(0, np.floor(cx - 0.75 * palm_w)))
+    C1 = int(min(W, np.ceil(cx + 0.75 * palm_w)))
+    if R1 <= 0 or C1 <= C0:
+        return None
+    k = 4  # supersampling for soft edges
+    canvas = np.zeros((R1 * k, (C1 - C0) * k), np.uint8)
+
+    def P(x, y):
+        return (int(round((x - C0) * k)), int(round(y * k)))
+
+    # forearm from the top of the frame to the palm, the palm, four fingers and a thumb
+    fa = 0.4 * palm_w
+    cv2.fillConvexPoly(
+        canvas,
+        np.array(
+            [
+                P(cx - fa, -10),
+                P(cx + fa, -10),
+                P(cx + 0.45 * palm_w, palm_top + 0.3 * palm_w),
+                P(cx - 0.45 * palm_w, palm_top + 0.3 * palm_w),
+            ],
+            np.int32,
+        ),
+        255,
+    )
+    cv2.ellipse(
+        canvas,
+        P(cx, 0.5 * (palm_top + palm_bot)),
+        (int(0.5 * palm_w * k), int(0.5 * (palm_bot - palm_top) * k)),
+        0,
+        0,
+        360,
+        255,
+        -1,
+    )
+    fw = palm_w / 4.4
+    for i, lf in enumerate((0.85, 1.0, 0.95, 0.75)):
+        x = cx - 0.5 * palm_w + fw * (0.7 + 1.0 * i)
+        y1 = palm_bot + lf * finger_l - 0.5 * fw
+        cv2.line(canvas, P(x, palm_bot - fw), P(x, y1), 255, max(1, int(fw * k)))
+        cv2.circle(canvas, P(x, y1), int(0.5 * fw * k), 255, -1)
+    tx = cx + 0.5 * palm_w
+    cv2.line(
+        canvas,
+        P(tx, palm_bot - 0.6 * palm_w),
+        P(tx + 0.25 * palm_w, palm_bot - 0.1 * palm_w),
+        255,
+        max(1, int(1.1 * fw * k)),
+    )
+    alpha = cv2.resize(canvas, (C1 - C0, R1), interpolation=cv2.INTER_AREA).astype(np.float32) / 255.0
+    return alpha, (0, R1, C0, C1)
 
 
 def _to_world(outline: np.ndarray, ox, oy, phi):
@@ -212,7 +290,7 @@ class Renderer:
         boxes = {o.id: self._bbox(o, span) for o in self.moving}
         live = [b for b in boxes.values() if b is not None]
         occ = self._occluder_boxes(t_s)
-        live += occ
+        live += [o[0] for o in occ]
         if live:
             R0, R1 = min(b[0] for b in live), max(b[1] for b in live)
             C0, C1 = min(b[2] for b in live), max(b[3] for b in live)
@@ -237,8 +315,14 @@ class Renderer:
                     self._composite(canvas, o, (R0, R1, C0, C1), box, ox, oy, phi)
                 acc += canvas
             acc *= np.float32(1.0 / n)
-            for r0, r1, c0, c1 in occ:
-                acc[r0 - R0 : r1 - R0, c0 - C0 : c1 - C0] = 38.0  # a dark hand in front
+            for (r0, r1, c0, c1), alpha in occ:
+                region = acc[r0 - R0 : r1 - R0, c0 - C0 : c1 - C0]
+                if alpha is None:
+                    region[...] = 38.0  # a dark patch in front
+                else:
+                    # skin lighter than the stone, shaded across the hand
+                    shade = 172.0 + 14.0 * np.linspace(-1.0, 1.0, c1 - c0, dtype=np.float32)[None, :]
+                    region += alpha * (shade - region)
             acc *= self.illum[R0:R1, C0:C1]
             frame[R0:R1, C0:C1] = np.clip(np.rint(acc), 0, 255).astype(np.uint8)
         if self.flicker > 0:
@@ -257,7 +341,17 @@ class Renderer:
             if obj is None or not (oc.t0_s <= t_s < oc.t1_s):
                 continue
             box = self._bbox(obj, np.linspace(oc.t0_s, oc.t1_s, 25))
-            if box is not None:
-                r0, r1, c0, c1 = box
-                out.append((max(0, r0 - 6), min(self.H, r1 + 6), max(0, c0 - 6), min(self.W, c1 + 6)))
+            if box is None:
+                continue
+            r0, r1, c0, c1 = box
+            if oc.kind == "hand":
+                # in over the first 30 % of the interval, held, out over the last 30 %
+                u = (t_s - oc.t0_s) / (oc.t1_s - oc.t0_s)
+                reach = min(1.0, u / 0.3, (1.0 - u) / 0.3)
+                reach = reach * reach * (3.0 - 2.0 * reach)
+                hand = _hand_alpha(box, reach, self.H, self.W) if reach > 0 else None
+                if hand is not None:
+                    out.append((hand[1], hand[0]))
+            else:
+                out.append(((max(0, r0 - 6), min(self.H, r1 + 6), max(0, c0 - 6), min(self.W, c1 + 6)), None))
         return out

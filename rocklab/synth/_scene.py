@@ -354,14 +354,15 @@ def build_scene(*, seed, blocks, table, fps, size, targets, duration_s, occlusio
     if occlusion is not None:
         if isinstance(occlusion, dict):
             occl.append(Occluder(str(occlusion.get("object", "block_1")), float(occlusion["t0_s"]),
-                                 float(occlusion["t1_s"])))
+                                 float(occlusion["t1_s"]), str(occlusion.get("kind", "patch"))))
         else:
             t0, t1 = (float(v) for v in occlusion)
             occl.append(Occluder("block_1", t0, t1))
     ids = [o.id for o in objects]
     for oc in occl:
-        if oc.object not in ids or not oc.t1_s > oc.t0_s:
-            raise InputError(f"occlusion={occlusion!r}: needs an object among {', '.join(ids)} and t1_s > t0_s")
+        if oc.object not in ids or not oc.t1_s > oc.t0_s or oc.kind not in ("patch", "hand"):
+            raise InputError(f"occlusion={occlusion!r}: needs an object among {', '.join(ids)}, t1_s > t0_s "
+                             "and kind 'patch' or 'hand'")
     exposure = 0.5 / fps if exposure_s is None else float(exposure_s)
     params = {"blocks": blocks, "table": table, "fps": fps, "size": list(size), "targets": targets,
               "duration_s": duration_s, "rolling_shutter": rolling_shutter, "restitution": restitution,

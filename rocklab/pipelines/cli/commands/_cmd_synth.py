@@ -57,6 +57,9 @@ def register(sub):
     p.add_argument(
         "--occlusion", default=None, metavar="T0,T1", help="hide block_1 behind a dark patch from T0 to T1 s"
     )
+    p.add_argument(
+        "--hand", default=None, metavar="T0,T1", help="a hand reaches down over the top of block_1 from T0 to T1 s"
+    )
     p.add_argument("--rolling-shutter", action="store_true", help="rolling-shutter readout")
     p.add_argument(
         "--exposure",
@@ -238,14 +241,18 @@ def run(args) -> int:
 
     size = parse_size(args.size)
     occ = None
-    if args.occlusion:
+    if args.occlusion and args.hand:
+        raise InputError("--occlusion and --hand: give one of them (one occluder per session)")
+    for flag, text, kind in (("--occlusion", args.occlusion, "patch"), ("--hand", args.hand, "hand")):
+        if not text:
+            continue
         try:
-            t0, t1 = (float(v) for v in args.occlusion.split(","))
+            t0, t1 = (float(v) for v in text.split(","))
         except ValueError:
-            raise InputError(f"--occlusion={args.occlusion!r}: give T0,T1 in seconds, e.g. 1.0,2.0") from None
+            raise InputError(f"{flag}={text!r}: give T0,T1 in seconds, e.g. 1.0,2.0") from None
         if not t1 > t0:
-            raise InputError(f"--occlusion={args.occlusion!r}: T1 must be after T0")
-        occ = (t0, t1)
+            raise InputError(f"{flag}={text!r}: T1 must be after T0")
+        occ = {"object": "block_1", "t0_s": t0, "t1_s": t1, "kind": kind}
     if args.record is not None and args.table != "record":
         raise InputError("--record is only used with --table record; add --table record")
     s = synth_session(

@@ -10,8 +10,13 @@ never chained frame to frame, so the pose does not drift:
    the latest keyframe — a keyframe is the current frame warped back into the first
    template's coordinates, so both templates share one coordinate frame;
 3. if ECC fails (occlusion, a jump at an impact), re-acquire: normalised cross-
-   correlation of the template over a search window around the prediction, then ECC;
+   correlation of the template, turned by up to ±8°, over a search window around the
+   prediction (after lost frames: the first frame's place, then the last pose seen), then ECC;
 4. still nothing: the frame is lost (NaN, status ``lost``) and the next frame searches.
+
+A keyframe is not renewed from a frame in which part of the object is covered (most cells
+of a 4 x 4 grid match, one does not: a hand, the thread), so the keyframe never learns an
+occluder; the covered frames then fail and are lost, and the object is found again after.
 
 The per-frame orientation uncertainty is the Gauss-Newton covariance of the ECC fit,
 ``σ² (JᵀJ)⁻¹`` with σ the intensity residual, inflated by :data:`CORRELATION_INFLATION`
@@ -44,6 +49,16 @@ FINE_MARGIN_PX = 12
 #: Correlation the fast (inverse-compositional) fit must reach to be kept; below it, the frame is
 #: registered by OpenCV's ECC on the wide window (a spinning or changing object).
 FAST_CC = 0.97
+#: Occlusion check: the registered template is cut into OCC_GRID x OCC_GRID cells; when most
+#: cells still match (median correlation >= OCC_MEDIAN_CC) but one falls below OCC_CELL_CC,
+#: something covers part of the object (a hand, the thread) and the keyframe is not renewed
+#: from that frame: it would learn the occluder and follow it. An object whose look changes
+#: as a whole (a spinning ball, lighting) lowers every cell and renews as before.
+OCC_GRID = 4
+OCC_CELL_CC = 0.4
+OCC_MEDIAN_CC = 0.95
+#: Turns of the template tried round the predicted angle when re-acquiring, degrees.
+SEARCH_TURNS_DEG = (0.0, -2.0, 2.0, -4.0, 4.0, -6.0, 6.0, -8.0, 8.0)
 #: ECC stopping rule: 60 iterations or a correlation gain below 1e-5.
 ECC_CRITERIA = (3, 60, 1e-5)  # cv2.TERM_CRITERIA_EPS | cv2.TERM_CRITERIA_COUNT
 
@@ -112,6 +127,7 @@ class MarkerlessTracker:
         self._ic: list = []  # (template, ICAffine): the first template's, then the keyframe's
         self.size = (u1 - u0, v1 - v0)
         self.poses: list = []  # last two accepted (theta, tx, ty): first-frame px -> image px
+        self.last = None  # the last accepted pose before a run of lost frames
         # reference points: a 3x3 grid over the template, as plane points of the first frame
         gx, gy = np.meshgrid(np.linspace(0, self.size[0] - 1, 3), np.linspace(0, self.size[1] - 1, 3))
         self.grid = np.column_stack((gx.ravel(), gy.ravel()))
@@ -258,16 +274,14 @@ class MarkerlessTracker:
         return rigid_fit[0], float(rigid_fit[1])
 
     def _search(self, tmpl, gray, W_pred):
-        """Re-acquire by normalised cross-correlation of the (rotated) template round the prediction."""
+        """Re-acquire by normalised cross-correlation of the rotated template round the prediction.
+
+        The template is tried at the predicted angle and at SEARCH_TURNS_DEG from it (after lost
+        frames the object may have turned); the best match above MIN_CC wins.
+        """
         cv2 = self._cv2
-        th, tx, ty = _params(W_pred)
+        th_pred, tx, ty = _params(W_pred)
         w, h = self.size
-        rot = cv2.warpAffine(
-            tmpl,
-            cv2.getRotationMatrix2D((w / 2, h / 2), -math.degrees(th), 1.0),
-            (w, h),
-            borderMode=cv2.BORDER_REPLICATE,
-        )
         ctr = self.origin + (w / 2, h / 2)
         cx, cy = W_pred[:, :2] @ ctr + W_pred[:, 2]
         H, Wd = gray.shape
@@ -276,14 +290,43 @@ class MarkerlessTracker:
         x1, y1 = int(min(cx + w / 2 + m, Wd)), int(min(cy + h / 2 + m, H))
         if x1 - x0 <= w or y1 - y0 <= h:
             return None
-        res = cv2.matchTemplate(gray[y0:y1, x0:x1].astype(np.float32), rot, cv2.TM_CCOEFF_NORMED)
-        _, best, _, loc = cv2.minMaxLoc(res)
-        if best < MIN_CC:
+        window = gray[y0:y1, x0:x1].astype(np.float32)
+        found = None
+        for turn in SEARCH_TURNS_DEG:
+            th = th_pred + math.radians(turn)
+            rot = cv2.warpAffine(
+                tmpl,
+                cv2.getRotationMatrix2D((w / 2, h / 2), -math.degrees(th), 1.0),
+                (w, h),
+                borderMode=cv2.BORDER_REPLICATE,
+            )
+            res = cv2.matchTemplate(window, rot, cv2.TM_CCOEFF_NORMED)
+            _, best, _, loc = cv2.minMaxLoc(res)
+            if best >= MIN_CC and (found is None or best > found[0]):
+                found = (best, th, loc)
+        if found is None:
             return None
+        _, th, loc = found
         new_ctr = np.array([x0 + loc[0] + w / 2, y0 + loc[1] + h / 2])
         R = np.array([[math.cos(th), -math.sin(th)], [math.sin(th), math.cos(th)]])
         t = new_ctr - R @ ctr
         return _euclid(th, t[0], t[1])
+
+    def _partly_covered(self, tmpl, back) -> bool:
+        """Whether something covers part of the registered template (see :data:`OCC_GRID`)."""
+        h, w = tmpl.shape
+        ys = np.linspace(0, h, OCC_GRID + 1).astype(int)
+        xs = np.linspace(0, w, OCC_GRID + 1).astype(int)
+        ccs = np.ones(OCC_GRID * OCC_GRID)
+        for i in range(OCC_GRID):
+            for j in range(OCC_GRID):
+                a = tmpl[ys[i] : ys[i + 1], xs[j] : xs[j + 1]]
+                b = back[ys[i] : ys[i + 1], xs[j] : xs[j + 1]]
+                a = a - a.mean()
+                b = b - b.mean()
+                den = math.sqrt(float((a * a).sum()) * float((b * b).sum()))
+                ccs[i * OCC_GRID + j] = float((a * b).sum()) / den if den > 0 else 1.0
+        return bool(np.median(ccs) >= OCC_MEDIAN_CC and ccs.min() < OCC_CELL_CC)
 
     def _sigma_theta(self, tmpl, gray, W):
         """Gauss-Newton σ of θ (rad) from the residual of the registered template."""
@@ -342,18 +385,24 @@ class MarkerlessTracker:
             if alt is not None and (fit is None or alt[1] > fit[1]):
                 fit, tmpl = alt, self.key
         if fit is None or fit[1] < MIN_CC:
-            W_s = self._search(self.key, gray, W_pred)
-            if W_s is not None:
-                alt = self._ecc(self.key, gray, W_s)
-                if alt is not None and alt[1] >= MIN_CC:
-                    fit, tmpl = alt, self.key
+            # re-acquire round the prediction, then (after lost frames) round the last pose seen
+            starts = [W_pred] if self.last is None or self.poses else [W_pred, _euclid(*self.last)]
+            for W_start in starts:
+                W_s = self._search(self.key, gray, W_start)
+                if W_s is not None:
+                    alt = self._ecc(self.key, gray, W_s)
+                    if alt is not None and alt[1] >= MIN_CC:
+                        fit, tmpl = alt, self.key
+                        break
         if fit is None or fit[1] < MIN_CC:
-            self.poses = []  # the next frame searches from the last known place
+            if self.poses:
+                self.last = self.poses[-1]
+            self.poses = []  # the next frame searches from the first frame's place, then the last seen
             return None
         W, cc = fit
         if cc < REKEY_CC:  # appearance drifted from the first frame: renew the keyframe here
             key = self._warp_back(gray, W)
-            if key is not None:
+            if key is not None and not self._partly_covered(tmpl, key):
                 self.key = key
         self.poses = (self.poses + [_params(W)])[-2:]
         sig = self._sigma_theta(tmpl, gray, W)

@@ -34,6 +34,12 @@ def _line_ls(A, f):
     return c, s
 
 
+def _ls_p(A, f):
+    """Least squares in p = f/A against 1/A (p = 1/beta + (1/t'_I)/A): (1/t'_I, 1/beta)."""
+    s, c = _line_ls(1.0 / A, f / A)
+    return c, s
+
+
 def _envelope(A, f):
     o = np.argsort(A)
     return A[o], np.minimum.accumulate(f[o][::-1])[::-1]
@@ -64,9 +70,9 @@ def _lp(A, f):
 RULES = {
     "lower line, max. mean (rocklab)": _lp,
     "least squares in f, all points": _line_ls,
-    "least squares in p vs 1/A": lambda A, f: _line_ls(1.0 / A, f / A)[::-1],
+    "least squares in p vs 1/A": _ls_p,
     "least squares on the envelope": lambda A, f: _line_ls(*_envelope(A, f)),
-    "least squares in p, envelope": lambda A, f: _line_ls(*(lambda a, g: (1.0 / a, g / a))(*_envelope(A, f)))[::-1],
+    "least squares in p, envelope": lambda A, f: _ls_p(*_envelope(A, f)),
     "10 % quantile line in f": _quantile(0.10),
     "25 % quantile line in f": _quantile(0.25),
     "least squares in f, A <= 5": lambda A, f: _line_ls(A[A <= 5], f[A <= 5]),

@@ -343,7 +343,6 @@ class Renderer:
             box = self._bbox(obj, np.linspace(oc.t0_s, oc.t1_s, 25))
             if box is None:
                 continue
-            r0, r1, c0, c1 = box
             if oc.kind == "hand":
                 # in over the first 30 % of the interval, held, out over the last 30 %
                 u = (t_s - oc.t0_s) / (oc.t1_s - oc.t0_s)
@@ -353,5 +352,6 @@ class Renderer:
                 if hand is not None:
                     out.append((hand[1], hand[0]))
             else:
+                r0, r1, c0, c1 = box
                 out.append(((max(0, r0 - 6), min(self.H, r1 + 6), max(0, c0 - 6), min(self.W, c1 + 6)), None))
         return out

@@ -18,7 +18,8 @@ builds the Taylor series of theta about the step's start to order
 Steps are ``p h <= P_H`` (0.2) at order 12: on B6M (3.9 s of rocking, 90
 impacts) impact times agree with ``solve_ivp`` DOP853 at rtol 1e-13 within
 3.5e-11 s and theta within 3e-12 rad (the Newmark kernel at dt = 1e-4 s:
-2.2e-7 s, 1.2e-7 rad), at about the Newmark kernel's cost on a 1e-4 s output grid. Free rocking only: a base record makes the right-hand side a
+2.2e-7 s, 1.2e-7 rad), at about the Newmark kernel's cost on a 1e-4 s output
+grid. Free rocking only: a base record makes the right-hand side a
 piecewise-linear function of time, which the Newmark kernel handles.
 """
 

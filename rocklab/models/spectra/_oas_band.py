@@ -155,7 +155,8 @@ def t_I_band(base, slenderness: float = 12.0, ensemble: dict | None = None, **op
             o = overturning_spectrum(base, slenderness, grid="boundary", guide=guide, **kw)
         else:
             o = overturning_spectrum(base, slenderness, **kw)
-            guide = o if guide is None else guide
+            if guide is None:
+                guide = o
         grids.setdefault(key, o)
         lv, R = o.f_min_at
         members.append(

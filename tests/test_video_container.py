@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 from rocklab.tracking import TrackConfig, probe_video, track_video
+from rocklab.tracking.video._video import iter_video_frames
 
 av = pytest.importorskip("av")
 
@@ -153,3 +154,38 @@ def test_interlaced_camcorder_video_is_read_field_by_field(tmp_path):
     assert np.all(b.status == "ok")
     err = np.degrees(b.theta_rad - theta)
     assert np.sqrt(np.mean(err**2)) < 0.1, err  # each field its own instant
+
+
+@pytest.mark.parametrize("pix_fmt", ["yuv420p", "yuvj420p"])
+def test_grey_from_the_luma_plane_matches_opencv_and_a_seek_lands_on_its_frame(tmp_path, pix_fmt):
+    """Grey frames come from PyAV's luma plane (stretched from 16..235 unless full range), not
+    OpenCV's YUV -> BGR -> grey: the same picture to rounding. A start past 0 seeks to the key
+    frame before it (B-frames, 12-frame GOP) and must deliver exactly the frame a full read has
+    there."""
+    n, path = 60, tmp_path / f"{pix_fmt}.mp4"
+    rng = np.random.default_rng(3)
+    base = cv2.GaussianBlur((rng.random((H, W)) * 255).astype(np.uint8), (0, 0), 3)
+    with av.open(str(path), "w") as c:
+        s = c.add_stream("libx264", rate=25)
+        s.width, s.height, s.pix_fmt = W + 1, H + 1, pix_fmt  # x264 needs even sizes
+        s.options = {"g": "12", "bf": "2", "crf": "18"}
+        for k in range(n):
+            f = np.pad(base, ((0, 1), (0, 1)), mode="edge")
+            f[:, 5 * k : 5 * k + 4] = 250  # a bar that walks: every frame is told apart
+            for pkt in s.encode(av.VideoFrame.from_ndarray(f, format="gray")):
+                c.mux(pkt)
+        for pkt in s.encode():
+            c.mux(pkt)
+    ours = list(iter_video_frames(path))
+    cap, ref = cv2.VideoCapture(str(path)), []
+    while (got := cap.read())[0]:
+        ref.append(cv2.cvtColor(got[1], cv2.COLOR_BGR2GRAY))
+    cap.release()
+    assert len(ours) == len(ref) == n
+    diff = max(int(np.abs(g.astype(int) - r.astype(int)).max()) for (_, g), r in zip(ours, ref))
+    assert diff <= 3, f"luma vs OpenCV's grey differ by {diff} grey levels"
+    for start in (1, 13, 37, 59):
+        first = next(iter(iter_video_frames(path, start, prefetch=0)))
+        assert first[0] == start
+        assert np.array_equal(first[1], ours[start][1]), f"start {start}: not the frame a full read has there"
+    assert list(iter_video_frames(path, n)) == []

@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..._blas import one_blas_thread
 from ..._diagnostics import warn
 from ..._errors import InputError
 from ._checks import _check_frames, _look, _tee, _why_lost
@@ -107,7 +108,8 @@ def track_frames(frames, config: TrackConfig, plane_map: PlaneMap | None = None)
             if plane_map is None:
                 plane_map = make_plane_map(config, gray.shape[1], gray.shape[0], gray)
             det = make_detector(config, plane_map, gray)
-        dets = det.detect(gray, idx)
+        with one_blas_thread():
+            dets = det.detect(gray, idx)
         obs = []
         for o in config.objects:
             d = dets.get(o.id)

@@ -49,16 +49,16 @@ class ICAffine:
         # pixel (0, 0) rotation and translation are nearly collinear on a wide template)
         self.cx, self.cy = (self.w - 1) / 2.0, (self.h - 1) / 2.0
         xx, yy = xx - self.cx, yy - self.cy
-        inner = np.zeros((self.h, self.w), bool)
         b = BORDER_PX
-        inner[b : self.h - b, b : self.w - b] = True
-        self.idx = np.flatnonzero(inner.ravel())
-        sd = self._steepest_descent(xx, yy, gx, gy)
-        self.sd_t = np.ascontiguousarray(sd[self.idx].T)  # (k, n) float32
+        inner = (slice(b, self.h - b), slice(b, self.w - b))
+        sd = self._steepest_descent(xx[inner], yy[inner], gx[inner], gy[inner])
+        self.sd_t = np.ascontiguousarray(sd.T)  # (k, n) float32
         hess = self.sd_t.astype(float) @ self.sd_t.T.astype(float)
         self.hess_inv = np.linalg.inv(hess)
-        self.tn = tn.ravel()[self.idx]
-        self.n_px = int(self.idx.size)
+        self.tn = np.ascontiguousarray(tn[inner]).ravel()
+        self.n_px = int(self.tn.size)
+        # the inner pixels are sampled directly: template px (b, b) is the patch's (0, 0)
+        self._shift = np.array([[1.0, 0.0, b], [0.0, 1.0, b], [0.0, 0.0, 1.0]])
 
     @staticmethod
     def _steepest_descent(xx, yy, gx, gy):
@@ -79,16 +79,27 @@ class ICAffine:
         """The template's pixels (less the border) sampled from ``image`` through ``W``, (n,) float32."""
         import cv2
 
+        b = BORDER_PX
+        Wi = np.asarray(W, np.float64) @ self._shift
         warped = cv2.warpAffine(
             image,
-            np.asarray(W, np.float32),
-            (self.w, self.h),
+            Wi.astype(np.float32),
+            (self.w - 2 * b, self.h - 2 * b),
             flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP,
             borderMode=cv2.BORDER_REPLICATE,
         )
-        return warped.ravel()[self.idx]
+        return warped.ravel()
 
-    def refine(self, image: np.ndarray, W: np.ndarray, max_iter: int = 30, tol_px: float = 1e-3):
+    @staticmethod
+    def smooth(image: np.ndarray) -> np.ndarray:
+        """``image`` smoothed as :meth:`refine` needs it (float32), for several fits on one picture."""
+        import cv2
+
+        return cv2.GaussianBlur(np.asarray(image, np.float32), (BLUR_PX, BLUR_PX), 0)
+
+    def refine(
+        self, image: np.ndarray, W: np.ndarray, max_iter: int = 30, tol_px: float = 1e-3, smoothed: bool = False
+    ):
         """Refine the warp ``W`` (template px -> ``image`` px) by Gauss-Newton.
 
         Parameters
@@ -99,6 +110,8 @@ class ICAffine:
         max_iter : int
         tol_px : float
             Stop when the update moves no template pixel by more than this, px.
+        smoothed : bool
+            ``image`` is already :meth:`smooth`'s output.
 
         Returns
         -------
@@ -106,12 +119,11 @@ class ICAffine:
             The refined warp and the correlation coefficient of the normalised patches, or None
             when the patch has no contrast or the iteration diverged.
         """
-        import cv2
-
         W = np.asarray(W, np.float64)
         ext = float(max(self.w, self.h))
         # smoothed once, before warping, with the real picture round the object (as ECC does)
-        image = cv2.GaussianBlur(np.asarray(image, np.float32), (BLUR_PX, BLUR_PX), 0)
+        if not smoothed:
+            image = self.smooth(image)
         vn = None
         for _ in range(max_iter):
             v = self._patch(image, W)

@@ -57,6 +57,8 @@ FAST_CC = 0.97
 OCC_GRID = 4
 OCC_CELL_CC = 0.4
 OCC_MEDIAN_CC = 0.95
+#: Correlations closer than this are equal (float32 sums over the template).
+CC_ROUNDING = 1e-6
 #: Turns of the template tried round the predicted angle when re-acquiring, degrees.
 SEARCH_TURNS_DEG = (0.0, -2.0, 2.0, -4.0, 4.0, -6.0, 6.0, -8.0, 8.0)
 #: ECC stopping rule: 60 iterations or a correlation gain below 1e-5.
@@ -154,13 +156,23 @@ class MarkerlessTracker:
             return None, None
         return gray[y0:y1, x0:x1].astype(np.float32), np.array([x0, y0], np.float32)
 
-    def _ecc(self, tmpl, gray, W0, levels=3):
+    def _ecc(self, tmpl, gray, W0, levels=3, direct=False):
         """ECC of ``tmpl`` in ``gray`` from the warp W0 (first-frame px -> image px); (W, cc) or None.
 
         The reduced levels run on a window wide enough for the prediction's error; the full-
         resolution pass on a window a few pixels round the coarse footprint (ECC takes the
         gradient of its whole input image, so the window's size is its cost).
         """
+        if direct:
+            # a prediction from smooth motion is good to a pixel: the fine fit alone, from it
+            fine, off2 = self._window(gray, W0, FINE_MARGIN_PX)
+            if fine is not None:
+                Wg = W0.copy()
+                Wg[:, 2] -= off2
+                r = self._ic_fine(tmpl, fine, Wg)
+                if r is not None:
+                    r[0][:, 2] += off2
+                    return r
         crop, off = self._window(gray, W0, 0.5 * max(self.size) + 16)
         if crop is None:
             return None
@@ -236,10 +248,11 @@ class MarkerlessTracker:
         and the rigid pose comes from the warped points in the plane afterwards.
         """
         rigid, affine = self._ic_for(tmpl)
-        fit = rigid.refine(gray_f, self._to_tmpl(W0))
+        smooth = rigid.smooth(gray_f)
+        fit = rigid.refine(smooth, self._to_tmpl(W0), smoothed=True)
         if fit is None or fit[1] < FAST_CC:
             return None
-        W, cc = self._keep_affine(tmpl, gray_f, fit, affine.refine(gray_f, fit[0]))
+        W, cc = self._keep_affine(tmpl, gray_f, fit, affine.refine(smooth, fit[0], smoothed=True))
         return self._from_tmpl(W), cc
 
     def _ecc_fine(self, tmpl, gray_f, W0):
@@ -261,7 +274,8 @@ class MarkerlessTracker:
         determined for the fast fit.
         """
         cv2 = self._cv2
-        if aff is None or aff[1] < rigid_fit[1]:
+        # "at least as well" up to float32 rounding of the correlation (1e-7 on a 2e5 px template)
+        if aff is None or aff[1] < rigid_fit[1] - CC_ROUNDING:
             try:
                 cc_a, Wa = cv2.findTransformECC(
                     tmpl, gray_f, rigid_fit[0].copy(), cv2.MOTION_AFFINE, ECC_CRITERIA, None, 5
@@ -269,7 +283,7 @@ class MarkerlessTracker:
                 aff = (Wa, float(cc_a))
             except cv2.error:
                 aff = None
-        if aff is not None and aff[1] >= rigid_fit[1] and _near_rigid(aff[0]):
+        if aff is not None and aff[1] >= rigid_fit[1] - CC_ROUNDING and _near_rigid(aff[0]):
             return aff[0], float(aff[1])
         return rigid_fit[0], float(rigid_fit[1])
 
@@ -378,7 +392,7 @@ class MarkerlessTracker:
             W_pred = _euclid(*self.poses[-1])
         else:
             W_pred = _euclid(0.0, 0.0, 0.0)
-        fit = self._ecc(self.tmpl0, gray, W_pred)
+        fit = self._ecc(self.tmpl0, gray, W_pred, direct=len(self.poses) >= 2)
         tmpl = self.tmpl0
         if (fit is None or fit[1] < REKEY_CC) and self.key is not self.tmpl0:
             alt = self._ecc(self.key, gray, W_pred if fit is None else fit[0])

@@ -42,11 +42,11 @@ def test_tracking_survives_h264_and_exposure_flicker(tmp_path, targets):
     assert np.corrcoef(lum, gain[: lum.size])[0, 1] > 0.95
     tr, truth, tb, b, ok = _track_block(s)
     err = np.degrees(b.theta_rad[ok] - tb.theta_rad.to_numpy()[ok])
-    # the motion: within 0.03 deg RMS of the truth once the level's constant offset is removed;
-    # the level itself (markerless: the table's top edge at 960x540, 0.04 deg off even on the
-    # lossless film without flicker) within 0.1 deg
+    # the motion: within 0.03 deg RMS of the truth once the constant offset is removed; the offset
+    # (the level, and the block's own bias) within 0.03 deg (markerless measured 0.010 deg: the
+    # table's top edge followed along its whole length)
     assert np.sqrt(np.mean((err - err.mean()) ** 2)) <= 0.03
-    assert abs(err.mean()) <= 0.1
+    assert abs(err.mean()) <= 0.03
 
 
 def test_markerless_full_hd_camcorder_render_block_and_table(tmp_path):

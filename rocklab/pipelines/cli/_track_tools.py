@@ -109,9 +109,34 @@ def draw_init_preview(img, cfg, found):
             col = _COLOURS[k % len(_COLOURS)]
             cv2.rectangle(out, (x, y), (x + w, y + h), col, 2)
             cv2.putText(out, o.id, (x, max(y - 6, 10)), cv2.FONT_HERSHEY_SIMPLEX, 0.5, col, 1, cv2.LINE_AA)
-            if o.kind == "table":
-                cv2.line(out, (x, y + 1), (x + w, y + 1), (0, 255, 255), 1, cv2.LINE_AA)
+            if o.kind == "table" and not o.markers:
+                _draw_top_edge(out, img, cfg, o)
     return out
+
+
+def _draw_top_edge(out, img, cfg, table) -> None:
+    """Draw on ``out`` a markerless table's top edge in ``img`` (the undrawn frame) as the level will
+    use it: the line over the span followed, and its angle (or a note that the region holds no edge)."""
+    import cv2
+
+    from ...tracking.video._plane import make_plane_map
+    from ...tracking.video.targets._table_edge import table_top_edge
+
+    gray = img if img.ndim == 2 else cv2.cvtColor(img, cv2.COLOR_BGR2GRAY)
+    x, y = (int(round(v)) for v in table.roi[:2])
+    try:
+        edge = table_top_edge(gray, table.roi, make_plane_map(cfg, gray.shape[1], gray.shape[0], gray))
+    except InputError:  # a board or table-marker plane that this frame cannot give: the pixels' own
+        from ...tracking.video._geometry import PlaneMap
+
+        edge = table_top_edge(gray, table.roi, PlaneMap(gray.shape[1], gray.shape[0]))
+    if edge is None:
+        cv2.putText(out, "no top edge: cannot level", (x, y + 16), cv2.FONT_HERSHEY_SIMPLEX, 0.5, (0, 0, 255), 1)
+        return
+    a, b = (tuple(int(round(v)) for v in p) for p in edge.ends_px)
+    cv2.line(out, a, b, (0, 255, 255), 1, cv2.LINE_AA)
+    text = f"level {math.degrees(edge.angle_rad):+.3f} +- {math.degrees(edge.sigma_rad):.3f} deg"
+    cv2.putText(out, text, (a[0], a[1] + 16), cv2.FONT_HERSHEY_SIMPLEX, 0.5, (0, 255, 255), 1, cv2.LINE_AA)
 
 
 def track_preview(video, config, out, *, n_frames: int = 6, progress: bool = False):

@@ -130,6 +130,8 @@ class MarkerlessTracker:
         self.size = (u1 - u0, v1 - v0)
         self.poses: list = []  # last two accepted (theta, tx, ty): first-frame px -> image px
         self.last = None  # the last accepted pose before a run of lost frames
+        #: 1-sigma of the object's first-frame angle (a table's top edge), rad: a floor of every frame's
+        self.theta0_sigma_rad = 0.0
         # reference points: a 3x3 grid over the template, as plane points of the first frame
         gx, gy = np.meshgrid(np.linspace(0, self.size[0] - 1, 3), np.linspace(0, self.size[1] - 1, 3))
         self.grid = np.column_stack((gx.ravel(), gy.ravel()))
@@ -419,7 +421,7 @@ class MarkerlessTracker:
             if key is not None and not self._partly_covered(tmpl, key):
                 self.key = key
         self.poses = (self.poses + [_params(W)])[-2:]
-        sig = self._sigma_theta(tmpl, gray, W)
+        sig = math.hypot(self._sigma_theta(tmpl, gray, W), self.theta0_sigma_rad)
         pts = (self.grid + self.origin) @ W[:, :2].T.astype(float) + W[:, 2]
         return Detection(pts, self.obj_pts, False, len(self.grid), sigma_rad=sig, n_groups=1)
 
@@ -430,14 +432,28 @@ class MarkerlessDetector:
     def __init__(self, config, plane_map, first_gray):
         import dataclasses
 
-        from ._edges import horizontal_edge_angle
+        from ._table_edge import table_top_edge
 
         self.trackers = {}
+        #: the table top edges found in the first frame (levelling), by object id
+        self.top_edges = {}
         for o in config.objects:
+            edge = None
             if o.kind == "table" and o.theta0_rad is None:
                 # the table top's angle in the first frame, so that levelling from the table works
-                o = dataclasses.replace(o, theta0_rad=horizontal_edge_angle(first_gray, o.roi, plane_map, topmost=True))
-            self.trackers[o.id] = MarkerlessTracker(o, plane_map, first_gray)
+                edge = table_top_edge(first_gray, o.roi, plane_map)
+                if edge is None and config.reference.level == "table":
+                    raise InputError(
+                        f"object {o.id!r}: roi {list(o.roi)} holds no horizontal top edge to level "
+                        "from; draw the roi round the table's top edge (the edge crossing it from side "
+                        "to side), or set reference.level to 'rest', 'line', 'value' or 'none'"
+                    )
+                o = dataclasses.replace(o, theta0_rad=edge.angle_rad if edge is not None else 0.0)
+                self.top_edges[o.id] = edge
+            t = MarkerlessTracker(o, plane_map, first_gray)
+            # the table's angle is measured from its top edge: that edge's uncertainty is in every frame
+            t.theta0_sigma_rad = edge.sigma_rad if edge is not None else 0.0
+            self.trackers[o.id] = t
 
     def detect(self, gray, frame):
         return {oid: t.detect(gray, frame) for oid, t in self.trackers.items()}

@@ -97,8 +97,28 @@ class ICAffine:
 
         return cv2.GaussianBlur(np.asarray(image, np.float32), (BLUR_PX, BLUR_PX), 0)
 
+    def _masked(self, mask):
+        """(steepest-descent images, normalised template, inverse Gauss-Newton matrix, pixel
+        selector) over the pixels ``mask`` keeps (all without one)."""
+        if mask is None:
+            return self.sd_t, self.tn, self.hess_inv, slice(None)
+        m = np.asarray(mask, bool)[BORDER_PX : self.h - BORDER_PX, BORDER_PX : self.w - BORDER_PX].ravel()
+        t = self.tn[m]
+        sd_t = self.sd_t[:, m]
+        # the kept part normalised on its own, as the patch will be: the gradients scale with it
+        sd_ = float(t.std()) + 1e-9
+        t = (t - float(t.mean())) / sd_
+        sd_t = np.ascontiguousarray(sd_t / sd_)
+        return sd_t, t, np.linalg.inv(sd_t.astype(float) @ sd_t.T.astype(float)), m
+
     def refine(
-        self, image: np.ndarray, W: np.ndarray, max_iter: int = 30, tol_px: float = 1e-3, smoothed: bool = False
+        self,
+        image: np.ndarray,
+        W: np.ndarray,
+        max_iter: int = 30,
+        tol_px: float = 1e-3,
+        smoothed: bool = False,
+        mask: np.ndarray | None = None,
     ):
         """Refine the warp ``W`` (template px -> ``image`` px) by Gauss-Newton.
 
@@ -112,6 +132,9 @@ class ICAffine:
             Stop when the update moves no template pixel by more than this, px.
         smoothed : bool
             ``image`` is already :meth:`smooth`'s output.
+        mask : ndarray (h, w) of bool, optional
+            Template pixels to use (the rest covered by something): the fit and the correlation
+            are made on these alone.
 
         Returns
         -------
@@ -124,17 +147,20 @@ class ICAffine:
         # smoothed once, before warping, with the real picture round the object (as ECC does)
         if not smoothed:
             image = self.smooth(image)
+        sd_t, tn, hess_inv, keep = self._masked(mask)
+        if tn.size < 16:
+            return None
         vn = None
         for _ in range(max_iter):
-            v = self._patch(image, W)
+            v = self._patch(image, W)[keep]
             sd = float(v.std())
             if not sd > 1e-6:
                 return None
             vn = (v - float(v.mean())) / sd
             # residual of the best gain: its fixed point is ECC's optimum (the correlation's
             # stationary point), not that of a plain difference of normalised patches
-            rho = float(np.dot(vn, self.tn)) / float(np.dot(vn, vn))
-            dp = self.hess_inv @ (self.sd_t @ (rho * vn - self.tn)).astype(float)
+            rho = float(np.dot(vn, tn)) / float(np.dot(vn, vn))
+            dp = hess_inv @ (sd_t @ (rho * vn - tn)).astype(float)
             if not np.all(np.isfinite(dp)):
                 return None
             inc = self._increment(dp)
@@ -148,9 +174,9 @@ class ICAffine:
                 break
         # the correlation at the final warp (not the one before the last update), so that fits of
         # different motion models compare fairly
-        v = self._patch(image, W)
+        v = self._patch(image, W)[keep]
         v = v - float(v.mean())
-        cc = float(np.dot(v, self.tn)) / (float(np.linalg.norm(self.tn)) * float(np.linalg.norm(v)) + 1e-12)
+        cc = float(np.dot(v, tn)) / (float(np.linalg.norm(tn)) * float(np.linalg.norm(v)) + 1e-12)
         return W.astype(np.float32), cc
 
 

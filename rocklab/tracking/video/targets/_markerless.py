@@ -32,6 +32,7 @@ import numpy as np
 from ...._errors import InputError
 from ._detection import Detection
 from ._ic import ICAffine, ICRigid
+from ._occlusion import cell_correlations, masked_fit, partly_covered
 
 __all__ = ["MarkerlessTracker", "MarkerlessDetector", "MIN_CC", "REKEY_CC"]
 
@@ -49,14 +50,6 @@ FINE_MARGIN_PX = 12
 #: Correlation the fast (inverse-compositional) fit must reach to be kept; below it, the frame is
 #: registered by OpenCV's ECC on the wide window (a spinning or changing object).
 FAST_CC = 0.97
-#: Occlusion check: the registered template is cut into OCC_GRID x OCC_GRID cells; when most
-#: cells still match (median correlation >= OCC_MEDIAN_CC) but one falls below OCC_CELL_CC,
-#: something covers part of the object (a hand, the thread) and the keyframe is not renewed
-#: from that frame: it would learn the occluder and follow it. An object whose look changes
-#: as a whole (a spinning ball, lighting) lowers every cell and renews as before.
-OCC_GRID = 4
-OCC_CELL_CC = 0.4
-OCC_MEDIAN_CC = 0.95
 #: Correlations closer than this are equal (float32 sums over the template).
 CC_ROUNDING = 1e-6
 #: Turns of the template tried round the predicted angle when re-acquiring, degrees.
@@ -328,44 +321,33 @@ class MarkerlessTracker:
         t = new_ctr - R @ ctr
         return _euclid(th, t[0], t[1])
 
-    def _partly_covered(self, tmpl, back) -> bool:
-        """Whether something covers part of the registered template (see :data:`OCC_GRID`)."""
-        h, w = tmpl.shape
-        ys = np.linspace(0, h, OCC_GRID + 1).astype(int)
-        xs = np.linspace(0, w, OCC_GRID + 1).astype(int)
-        ccs = np.ones(OCC_GRID * OCC_GRID)
-        for i in range(OCC_GRID):
-            for j in range(OCC_GRID):
-                a = tmpl[ys[i] : ys[i + 1], xs[j] : xs[j + 1]]
-                b = back[ys[i] : ys[i + 1], xs[j] : xs[j + 1]]
-                a = a - a.mean()
-                b = b - b.mean()
-                den = math.sqrt(float((a * a).sum()) * float((b * b).sum()))
-                ccs[i * OCC_GRID + j] = float((a * b).sum()) / den if den > 0 else 1.0
-        return bool(np.median(ccs) >= OCC_MEDIAN_CC and ccs.min() < OCC_CELL_CC)
-
-    def _sigma_theta(self, tmpl, gray, W):
-        """Gauss-Newton σ of θ (rad) from the residual of the registered template."""
+    def _sigma_theta(self, tmpl, gray, W, mask=None):
+        """Gauss-Newton σ of θ (rad) from the residual of the registered template (on the pixels
+        ``mask`` keeps, when part of the object is covered)."""
         cv2 = self._cv2
         h, w = tmpl.shape
         warped = self._warp_back(gray, W)
         if warped is None:
             return math.inf
         # ECC matches up to gain and offset: compare zero-mean, unit-variance patches
-        a = (tmpl - tmpl.mean()) / (tmpl.std() + 1e-9)
-        b = (warped - warped.mean()) / (warped.std() + 1e-9)
+        sel = np.ones((h, w), bool) if mask is None else mask
+        a = (tmpl - tmpl[sel].mean()) / (tmpl[sel].std() + 1e-9)
+        b = (warped - warped[sel].mean()) / (warped[sel].std() + 1e-9)
         r = a - b
         gx = cv2.Sobel(b, cv2.CV_32F, 1, 0, ksize=3) / 8.0
         gy = cv2.Sobel(b, cv2.CV_32F, 0, 1, ksize=3) / 8.0
+        if mask is not None:  # covered pixels contribute neither residual nor gradient
+            r, gx, gy = r * mask, gx * mask, gy * mask
         # every 2nd pixel each way: JᵀJ of the full grid is 4 times the subsample's to well under
         # a percent on any textured region, at a quarter of the cost
         k = 2 if min(h, w) >= 32 else 1
+        n_used = int(sel[::k, ::k].sum())
         gx, gy, r = gx[::k, ::k], gy[::k, ::k], r[::k, ::k]
         yy, xx = np.mgrid[0:h:k, 0:w:k].astype(np.float32)
         xc, yc = xx - w / 2, yy - h / 2
         J = np.column_stack(((-yc * gx + xc * gy).ravel(), gx.ravel(), gy.ravel())).astype(float)
         JTJ = (k * k) * (J.T @ J)
-        s2 = float(np.sum(r.astype(float) ** 2)) / max(r.size - 3, 1)
+        s2 = float(np.sum(r.astype(float) ** 2)) / max(n_used - 3, 1)
         try:
             cov = s2 * np.linalg.inv(JTJ)
         except np.linalg.LinAlgError:
@@ -410,20 +392,35 @@ class MarkerlessTracker:
                     if alt is not None and alt[1] >= MIN_CC:
                         fit, tmpl = alt, self.key
                         break
+        mask, visible = None, 1.0
+        if (fit is None or fit[1] < MIN_CC) and self.poses:
+            # part of the object may be covered (a hand): fit the part still in view
+            part = masked_fit(self, self.key, gray, W_pred, FINE_MARGIN_PX)
+            if part is not None:
+                fit, tmpl, mask, visible = part[:2], self.key, part[2], part[3]
         if fit is None or fit[1] < MIN_CC:
             if self.poses:
                 self.last = self.poses[-1]
             self.poses = []  # the next frame searches from the first frame's place, then the last seen
             return None
         W, cc = fit
-        if cc < REKEY_CC:  # appearance drifted from the first frame: renew the keyframe here
-            key = self._warp_back(gray, W)
-            if key is not None and not self._partly_covered(tmpl, key):
-                self.key = key
+        if cc < REKEY_CC and mask is None:
+            back = self._warp_back(gray, W)
+            if back is not None and partly_covered(cell_correlations(tmpl, back)):
+                # covered in part: no new keyframe from here (it would learn the occluder), and
+                # the pose from the cells still in view
+                part = masked_fit(self, tmpl, gray, W, FINE_MARGIN_PX)
+                if part is not None:
+                    (W, cc), mask, visible = part[:2], part[2], part[3]
+            elif back is not None:  # appearance drifted from the first frame: renew the keyframe here
+                self.key = back
         self.poses = (self.poses + [_params(W)])[-2:]
-        sig = math.hypot(self._sigma_theta(tmpl, gray, W), self.theta0_sigma_rad)
+        sig = math.hypot(self._sigma_theta(tmpl, gray, W, mask), self.theta0_sigma_rad)
         pts = (self.grid + self.origin) @ W[:, :2].T.astype(float) + W[:, 2]
-        return Detection(pts, self.obj_pts, False, len(self.grid), sigma_rad=sig, n_groups=1)
+        # a partial view: fewer points than a whole one would give (its quality says so, and the
+        # rigid fit keeps the object's known scale)
+        n_expected = len(self.grid) if mask is None else int(math.ceil(len(self.grid) / max(visible, 1e-3)))
+        return Detection(pts, self.obj_pts, False, n_expected, sigma_rad=sig, n_groups=1)
 
 
 class MarkerlessDetector:

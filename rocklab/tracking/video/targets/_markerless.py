@@ -330,9 +330,12 @@ class MarkerlessTracker:
         if warped is None:
             return math.inf
         # ECC matches up to gain and offset: compare zero-mean, unit-variance patches
-        sel = np.ones((h, w), bool) if mask is None else mask
-        a = (tmpl - tmpl[sel].mean()) / (tmpl[sel].std() + 1e-9)
-        b = (warped - warped[sel].mean()) / (warped[sel].std() + 1e-9)
+        if mask is None:
+            a = (tmpl - tmpl.mean()) / (tmpl.std() + 1e-9)
+            b = (warped - warped.mean()) / (warped.std() + 1e-9)
+        else:
+            a = (tmpl - tmpl[mask].mean()) / (tmpl[mask].std() + 1e-9)
+            b = (warped - warped[mask].mean()) / (warped[mask].std() + 1e-9)
         r = a - b
         gx = cv2.Sobel(b, cv2.CV_32F, 1, 0, ksize=3) / 8.0
         gy = cv2.Sobel(b, cv2.CV_32F, 0, 1, ksize=3) / 8.0
@@ -341,13 +344,19 @@ class MarkerlessTracker:
         # every 2nd pixel each way: JᵀJ of the full grid is 4 times the subsample's to well under
         # a percent on any textured region, at a quarter of the cost
         k = 2 if min(h, w) >= 32 else 1
-        n_used = int(sel[::k, ::k].sum())
+        n_used = r[::k, ::k].size if mask is None else int(mask[::k, ::k].sum())
         gx, gy, r = gx[::k, ::k], gy[::k, ::k], r[::k, ::k]
-        yy, xx = np.mgrid[0:h:k, 0:w:k].astype(np.float32)
-        xc, yc = xx - w / 2, yy - h / 2
-        J = np.column_stack(((-yc * gx + xc * gy).ravel(), gx.ravel(), gy.ravel())).astype(float)
-        JTJ = (k * k) * (J.T @ J)
-        s2 = float(np.sum(r.astype(float) ** 2)) / max(n_used - 3, 1)
+        xc = (np.arange(0, w, k, dtype=np.float32) - w / 2)[None, :]
+        yc = (np.arange(0, h, k, dtype=np.float32) - h / 2)[:, None]
+        cols = [(-yc * gx + xc * gy).ravel(), np.ascontiguousarray(gx).ravel(), np.ascontiguousarray(gy).ravel()]
+        # JᵀJ from the six distinct dot products (float64 sums of float32 columns)
+        JTJ = np.empty((3, 3))
+        for i in range(3):
+            for j in range(i, 3):
+                JTJ[i, j] = JTJ[j, i] = float(np.dot(cols[i].astype(float), cols[j].astype(float)))
+        JTJ *= k * k
+        rr = r.ravel().astype(float)
+        s2 = float(np.dot(rr, rr)) / max(n_used - 3, 1)
         try:
             cov = s2 * np.linalg.inv(JTJ)
         except np.linalg.LinAlgError:

@@ -153,6 +153,10 @@ def suggest_config(
             objs.append(ObjectConfig(id="table", kind="table", roi=inside("table", table_roi)))
         _check_overlaps(objs)
         notes.append("objects followed markerless from the regions given (px, first frame)")
+        notes.append(
+            "a block's theta starts at its theta0_rad (default 0: upright in the first frame); "
+            "set theta0_rad (rad, ccw) for a block released from a tilt"
+        )
         if table_roi is None:
             notes.append(
                 "no table: angles are not levelled (warning W-LEVEL-NONE when tracking); add "

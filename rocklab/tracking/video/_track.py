@@ -323,6 +323,12 @@ def _interpolate(arrs, status, max_gap):
             status[a + 1:b] = "interpolated"
 
 
+def _anchored(o, config) -> bool:
+    """Whether object ``o``'s angle is its rotation since the first frame plus ``theta0_rad`` (a
+    block followed by its texture) rather than measured against the image (markers, outlines)."""
+    return o.kind != "table" and (o.style or config.targets.style) in ("region", "markerless")
+
+
 def assemble_tracks(observations, config: TrackConfig, fps: float, width_px: int, height_px: int,
                     plane_map: PlaneMap | None = None, source=None, frame_times_s=None) -> TrackResult:
     """Convert per-frame observations (plane units) into a :class:`TrackResult` (m, levelled rad).
@@ -403,7 +409,9 @@ def assemble_tracks(observations, config: TrackConfig, fps: float, width_px: int
         a, st, _ = raw[o.id]
         x = (c * a["X"] - s * a["Y"]) * m_per[o.id]
         y = (s * a["X"] + c * a["Y"]) * m_per[o.id]
-        th = a["th"] - level
+        # a region or markerless object's angle is anchored by theta0_rad, an angle in the levelled
+        # (world) frame: its rotation since the first frame carries no camera roll to take out
+        th = a["th"] if _anchored(o, config) else a["th"] - level
         sig = a["sig"].copy()
         q = np.where(st == "ok", a["q"], np.nan)
         if pm_px is not None:

@@ -174,3 +174,22 @@ def checker_texture(squares_x, squares_y, square_m, margin_m=0.01):
     ox, oy = _origin(tex, (0.0, 0.0))
     # first inner corner: one square in from the top-left board corner
     return tex, (m + s - 0.5, m + s - 0.5)
+
+
+def realistic_session(path, size=(1920, 1080), seed=3, duration_s=2.4):
+    """Issue 13's realistic render with ``rocklab synth``: photographed stone and bricks, H.264 at
+    a camcorder's bit rate, exposure flicker 0.12, half-frame motion blur, no markers anywhere, a
+    block rocking on a table driven by a 45 mm / 0.6 s sine pulse. Returns the session."""
+    from rocklab.synth import synth_session
+
+    return synth_session(
+        path,
+        seed=seed,
+        size=size,
+        duration_s=duration_s,
+        imu=False,
+        targets="markerless",
+        table="sine",
+        flicker=0.12,
+        texture="photo",
+    )

@@ -6,6 +6,7 @@ import json
 import numpy as np
 import pytest
 
+from _render import realistic_session
 from rocklab.synth import synth_session
 from rocklab.tracking import load_track_config, track_video
 
@@ -55,17 +56,7 @@ def test_markerless_full_hd_camcorder_render_block_and_table(tmp_path):
     photographed brick wall, rocking through its impacts on a table driven by a 45 mm / 0.6 s sine
     pulse, no markers anywhere; tracked from the lossy file."""
 
-    s = synth_session(
-        tmp_path / "s",
-        seed=3,
-        size=(1920, 1080),
-        duration_s=2.4,
-        imu=False,
-        targets="markerless",
-        table="sine",
-        flicker=0.12,
-        texture="photo",
-    )
+    s = realistic_session(tmp_path / "s")
     meta = json.loads(s.session_json.read_text())
     assert meta["video"]["lossy_codec"] == "h264" and meta["flicker"] == 0.12 and meta["texture"] == "photo"
     tr, truth, tb, b, ok = _track_block(s)

@@ -107,20 +107,10 @@ def test_init_markerless_on_a_realistic_render_tracks_unedited(tmp_path, run_cli
     its default theta0 = 0 holds, and the table's top edge takes out the camera's roll (about
     1.2 deg): theta within 0.05 deg RMS (measured 0.015), the table's pixel track a straight-line
     image of its true displacement to 0.1 px (measured 0.04)."""
-    from rocklab.synth import synth_session
+    from _render import realistic_session
     from rocklab.tracking import load_track_config
 
-    s = synth_session(
-        tmp_path / "s",
-        seed=3,
-        size=(960, 540),
-        duration_s=2.4,
-        imu=False,
-        targets="markerless",
-        table="sine",
-        flicker=0.12,
-        texture="photo",
-    )
+    s = realistic_session(tmp_path / "s", size=(960, 540))
     rois = {o.id: o.roi for o in load_track_config(s.track_toml).objects}
     box = lambda r: ",".join(str(int(round(v))) for v in r)  # noqa: E731
     cfg = tmp_path / "init.toml"

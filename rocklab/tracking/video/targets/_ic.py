@@ -12,6 +12,8 @@ warp, as ECC smooths them.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 __all__ = ["ICAffine", "ICRigid"]
@@ -150,22 +152,26 @@ class ICAffine:
         sd_t, tn, hess_inv, keep = self._masked(mask)
         if tn.size < 16:
             return None
-        vn = None
+        n = tn.size
+        g_t = (sd_t @ tn).astype(float)
+        T = np.array([[1.0, 0.0, self.cx], [0.0, 1.0, self.cy], [0.0, 0.0, 1.0]])
+        Ti = np.array([[1.0, 0.0, -self.cx], [0.0, 1.0, -self.cy], [0.0, 0.0, 1.0]])
         for _ in range(max_iter):
             v = self._patch(image, W)[keep]
-            sd = float(v.std())
-            if not sd > 1e-6:
+            d = v - float(v.mean())
+            ss = float(np.dot(d, d))
+            if not ss > 1e-12 * n:  # no contrast (sigma below 1e-6 grey levels)
                 return None
-            vn = (v - float(v.mean())) / sd
-            # residual of the best gain: its fixed point is ECC's optimum (the correlation's
-            # stationary point), not that of a plain difference of normalised patches
-            rho = float(np.dot(vn, tn)) / float(np.dot(vn, vn))
-            dp = hess_inv @ (sd_t @ (rho * vn - tn)).astype(float)
+            sd = math.sqrt(ss / n)
+            # with vn = d / sd the patch normalised like the template (vn . vn = n): the residual
+            # of the best gain, rho vn - tn, whose fixed point is ECC's optimum (the correlation's
+            # stationary point), not that of a plain difference of normalised patches; its
+            # projection sd_t (rho vn - tn) taken without forming vn
+            rho = float(np.dot(d, tn)) / (sd * n)
+            dp = hess_inv @ ((rho / sd) * (sd_t @ d).astype(float) - g_t)
             if not np.all(np.isfinite(dp)):
                 return None
             inc = self._increment(dp)
-            T = np.array([[1.0, 0.0, self.cx], [0.0, 1.0, self.cy], [0.0, 0.0, 1.0]])
-            Ti = np.array([[1.0, 0.0, -self.cx], [0.0, 1.0, -self.cy], [0.0, 0.0, 1.0]])
             W = (np.vstack((W, (0.0, 0.0, 1.0))) @ np.linalg.inv(T @ inc @ Ti))[:2]
             step = self._step_px(dp, ext)
             if step > ext:  # a jump larger than the template: diverged

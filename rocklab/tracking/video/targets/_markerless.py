@@ -123,6 +123,7 @@ class MarkerlessTracker:
         self.size = (u1 - u0, v1 - v0)
         self.poses: list = []  # last two accepted (theta, tx, ty): first-frame px -> image px
         self.last = None  # the last accepted pose before a run of lost frames
+        self._norm = None  # (template, its normalised copy) for the uncertainty
         #: 1-sigma of the object's first-frame angle (a table's top edge), rad: a floor of every frame's
         self.theta0_sigma_rad = 0.0
         # reference points: a 3x3 grid over the template, as plane points of the first frame
@@ -331,8 +332,9 @@ class MarkerlessTracker:
             return math.inf
         # ECC matches up to gain and offset: compare zero-mean, unit-variance patches
         if mask is None:
-            a = (tmpl - tmpl.mean()) / (tmpl.std() + 1e-9)
-            b = (warped - warped.mean()) / (warped.std() + 1e-9)
+            a = self._normalised(tmpl)
+            b = warped - float(warped.mean())
+            b /= math.sqrt(float(np.dot(b.ravel(), b.ravel())) / b.size) + 1e-9
         else:
             a = (tmpl - tmpl[mask].mean()) / (tmpl[mask].std() + 1e-9)
             b = (warped - warped[mask].mean()) / (warped[mask].std() + 1e-9)
@@ -362,6 +364,13 @@ class MarkerlessTracker:
         except np.linalg.LinAlgError:
             return math.inf
         return CORRELATION_INFLATION * math.sqrt(max(cov[0, 0], 0.0))
+
+    def _normalised(self, tmpl):
+        """``tmpl`` at zero mean and unit variance (kept for the first template and the keyframe)."""
+        hit = self._norm if self._norm is not None and self._norm[0] is tmpl else None
+        if hit is None:
+            self._norm = hit = (tmpl, (tmpl - tmpl.mean()) / (tmpl.std() + 1e-9))
+        return hit[1]
 
     def _warp_back(self, gray, W):
         """The current image resampled onto the template grid by the pose W (float32), or None."""

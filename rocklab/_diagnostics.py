@@ -118,6 +118,12 @@ WARNING_CODES: dict[str, tuple[str, str]] = {
         "levelling asked for a table that is missing or never seen: the camera's roll "
         "stays in every angle; add a level reference or say the camera is level",
     ),
+    "W-THETA0-REST": (
+        "note",
+        "a markerless block without theta0_rad came to rest away from upright: its starting "
+        "angle was taken from the final rest (free rocking ends upright); set theta0_rad if "
+        "the block really rests tilted",
+    ),
     "W-TABLE-MOTION": (
         "suspect",
         "the table's displacement could not be differentiated into velocity and "

@@ -275,8 +275,9 @@ class ObjectConfig:
         Block outline width and height (m), for ``edges`` (gives the scale).
     theta0_rad : float or None
         ``region`` and ``markerless`` blocks: the object's angle at the first frame, rad,
-        counter-clockwise, in the levelled frame (default 0: upright; give it for a release from
-        a tilt): these trackers measure the rotation since the first frame and add it;
+        counter-clockwise, in the levelled frame: these trackers measure the rotation since the
+        first frame and add it. Not given: upright, unless the block ends at rest away from
+        upright, when that rest sets it (free rocking ends upright; warning W-THETA0-REST);
         ``edges``: a hint (default 0) to tell the outline's top from its side.
     marker_size_m : float or None
         This object's marker side (m) when it differs from ``targets.marker_size_m``.

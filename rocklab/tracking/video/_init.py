@@ -154,8 +154,9 @@ def suggest_config(
         _check_overlaps(objs)
         notes.append("objects followed markerless from the regions given (px, first frame)")
         notes.append(
-            "a block's theta starts at its theta0_rad (default 0: upright in the first frame); "
-            "set theta0_rad (rad, ccw) for a block released from a tilt"
+            "a block's theta starts at its theta0_rad (not given: upright in the first frame, or "
+            "from its final rest when it ends at rest tilted); set theta0_rad (rad, ccw) for a "
+            "release from a tilt"
         )
         if table_roi is None:
             notes.append(

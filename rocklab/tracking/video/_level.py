@@ -15,7 +15,7 @@ import numpy as np
 from ..._diagnostics import warn
 from ..._errors import InputError
 
-__all__ = ["level_from_reference"]
+__all__ = ["level_from_reference", "anchored", "world_angle"]
 
 
 def _robust_sem(x) -> float:
@@ -108,3 +108,49 @@ def _final_rest(th, fps, min_s=1.0):
         k -= 1
     idx = ok[k:]
     return idx if idx.size >= max(10, int(min_s * fps)) else None
+
+
+def anchored(o, config) -> bool:
+    """Whether object ``o``'s angle is its rotation since the first frame plus ``theta0_rad`` (a
+    block followed by its texture) rather than measured against the image (markers, outlines)."""
+    return o.kind != "table" and (o.style or config.targets.style) in ("region", "markerless")
+
+
+#: A final rest further from upright than this is not taken as upright (an overturned block).
+MAX_REST_OFFSET_RAD = math.radians(45.0)
+
+
+def world_angle(o, config, th, sig, fps, level, level_src, src="config"):
+    """Object ``o``'s levelled angle (rad) from its plane angles ``th`` (n,) and their 1-sigma ``sig``.
+
+    Measured objects lose the camera's roll (``level``). An anchored object (:func:`anchored`)
+    carries none: its angle is its rotation plus ``theta0_rad``, an angle in the levelled frame.
+    Without ``theta0_rad`` it is assumed upright at the first frame, unless it ends at rest
+    (its last 0.5 s within 10 per-frame sigmas) at an angle that differs from upright by more than 3 sigma and less than 45 deg:
+    free rocking ends upright, so the rest sets the starting angle (warning W-THETA0-REST). With
+    ``level = "rest"`` of the object itself, that rest is the level and is taken off as before.
+    """
+    if not anchored(o, config) or level_src == f"rest of {o.id}":
+        return th - level
+    if o.theta0_rad is not None:
+        return th
+    # still at the end: the last 0.5 s within 10 per-frame sigmas (a block still rocking by a
+    # tenth of a degree is not at rest)
+    n = max(int(round(0.5 * fps)), 5)
+    rest = np.arange(max(th.size - n, 0), th.size)
+    tail = th[rest]
+    if rest.size < n or np.isfinite(tail).mean() < 0.8:
+        return th
+    if not np.nanmax(tail) - np.nanmin(tail) <= 10.0 * float(np.nanmedian(sig[rest])):
+        return th
+    off = float(np.nanmedian(th[rest]))
+    unc = max(_robust_sem(th[rest]), float(np.nanmedian(sig[rest])))
+    if not 3.0 * unc < abs(off) < MAX_REST_OFFSET_RAD:
+        return th
+    warn(
+        "W-THETA0-REST",
+        f"{src}: object {o.id!r} has no theta0_rad and comes to rest at {math.degrees(off):.4g} deg: "
+        f"its starting angle is taken as {-math.degrees(off):.4g} deg from the final rest (free "
+        "rocking ends upright); set theta0_rad if it really rests tilted",
+    )
+    return th - off

@@ -323,12 +323,6 @@ def _interpolate(arrs, status, max_gap):
             status[a + 1:b] = "interpolated"
 
 
-def _anchored(o, config) -> bool:
-    """Whether object ``o``'s angle is its rotation since the first frame plus ``theta0_rad`` (a
-    block followed by its texture) rather than measured against the image (markers, outlines)."""
-    return o.kind != "table" and (o.style or config.targets.style) in ("region", "markerless")
-
-
 def assemble_tracks(observations, config: TrackConfig, fps: float, width_px: int, height_px: int,
                     plane_map: PlaneMap | None = None, source=None, frame_times_s=None) -> TrackResult:
     """Convert per-frame observations (plane units) into a :class:`TrackResult` (m, levelled rad).
@@ -397,7 +391,7 @@ def assemble_tracks(observations, config: TrackConfig, fps: float, width_px: int
             warn("W-TRACK-NOSCALE", f"{config.source or 'config'}: no metric scale for object {o.id!r}: x_m, y_m "
                                     "left empty (x_px, y_px and theta_rad are measured); give "
                                     "targets.marker_size_m, objects.size_m or reference.m_per_px")
-    from ._level import level_from_reference
+    from ._level import level_from_reference, world_angle
 
     pm_px = plane_map
     if pm_px is None and plane == "image":  # observations in centred pixels: invert that
@@ -409,9 +403,7 @@ def assemble_tracks(observations, config: TrackConfig, fps: float, width_px: int
         a, st, _ = raw[o.id]
         x = (c * a["X"] - s * a["Y"]) * m_per[o.id]
         y = (s * a["X"] + c * a["Y"]) * m_per[o.id]
-        # a region or markerless object's angle is anchored by theta0_rad, an angle in the levelled
-        # (world) frame: its rotation since the first frame carries no camera roll to take out
-        th = a["th"] if _anchored(o, config) else a["th"] - level
+        th = world_angle(o, config, a["th"], a["sig"], fps, level, level_src, config.source or "config")
         sig = a["sig"].copy()
         q = np.where(st == "ok", a["q"], np.nan)
         if pm_px is not None:

@@ -143,33 +143,19 @@ def refine_rectangle(gray, corners, half=6.0, step=2.0, trim=0.15):
     return out, float(np.sqrt(ss.sum() / n_pts)), n_pts, float(np.sqrt(var_phi.sum()) / 4)
 
 
-def horizontal_edge_angle(gray, roi, plane_map, topmost: bool = False):
+def horizontal_edge_angle(gray, roi, plane_map):
     """Plane angle (rad, ccw) of the strongest near-horizontal edge in ``roi`` (u, v, w, h px).
 
     Per column, the sub-pixel row of the largest vertical grey gradient
-    (parabola through the peak), then a Huber line fit. ``topmost``: per column the
-    first row whose gradient reaches half the column's largest (a table's top edge,
-    not the stronger edges of markers or of its bottom further down).
+    (parabola through the peak), then a Huber line fit. (A markerless table's top edge,
+    followed beyond its region, is :func:`._table_edge.table_top_edge`.)
     """
     import cv2
 
     u, v, w, h = (int(round(x)) for x in roi)
     crop = gray[max(v, 0) : v + h, max(u, 0) : u + w].astype(np.float32)
     gy = np.abs(cv2.Sobel(crop, cv2.CV_32F, 0, 1, ksize=3))
-    if topmost:
-        # average along the (near-horizontal) edge: a textured face's grain averages out, the edge not
-        gy = cv2.blur(gy, (15, 1))
-        inner = gy[1:-1]
-        first = inner >= 0.5 * inner.max(axis=0, keepdims=True)
-        rows = np.argmax(first, axis=0)
-        # climb to the local peak of that edge
-        for _ in range(3):
-            nxt = np.minimum(rows + 1, inner.shape[0] - 1)
-            up = inner[nxt, np.arange(inner.shape[1])] > inner[rows, np.arange(inner.shape[1])]
-            rows = np.where(up, nxt, rows)
-        rows = rows + 1
-    else:
-        rows = np.argmax(gy[1:-1], axis=0) + 1
+    rows = np.argmax(gy[1:-1], axis=0) + 1
     cols = np.arange(gy.shape[1])
     g0, g1, g2 = gy[rows - 1, cols], gy[rows, cols], gy[rows + 1, cols]
     den = g0 - 2 * g1 + g2

@@ -159,16 +159,15 @@ class MarkerlessTracker:
         resolution pass on a window a few pixels round the coarse footprint (ECC takes the
         gradient of its whole input image, so the window's size is its cost).
         """
+
+        def ic_fine(window, W):
+            return self._ic_fine(tmpl, window, W)
+
         if direct:
             # a prediction from smooth motion is good to a pixel: the fine fit alone, from it
-            fine, off2 = self._window(gray, W0, FINE_MARGIN_PX)
-            if fine is not None:
-                Wg = W0.copy()
-                Wg[:, 2] -= off2
-                r = self._ic_fine(tmpl, fine, Wg)
-                if r is not None:
-                    r[0][:, 2] += off2
-                    return r
+            r = self.fit_near(gray, W0, ic_fine)
+            if r is not None:
+                return r
         crop, off = self._window(gray, W0, 0.5 * max(self.size) + 16)
         if crop is None:
             return None
@@ -179,17 +178,27 @@ class MarkerlessTracker:
             return None
         Wg = W.copy()
         Wg[:, 2] += off
-        fine, off2 = self._window(gray, Wg, FINE_MARGIN_PX)
-        if fine is not None:
-            Wg[:, 2] -= off2
-            r = self._ic_fine(tmpl, fine, Wg)
-            if r is not None:
-                r[0][:, 2] += off2
-                return r
+        r = self.fit_near(gray, Wg, ic_fine)
+        if r is not None:
+            return r
         r = self._ecc_fine(tmpl, crop, W)  # the robust path, on the wide window
         if r is None:
             return None
         r[0][:, 2] += off
+        return r
+
+    def fit_near(self, gray, W, fit, margin_px=FINE_MARGIN_PX):
+        """``fit(window, W_window)`` on the part of ``gray`` ``margin_px`` round the template's
+        footprint under the pose ``W`` (first-frame px -> image px); its pose ``(W, cc, ...)`` with
+        the window's offset put back, or None (the footprint off the frame, or the fit failing)."""
+        window, off = self._window(gray, W, margin_px)
+        if window is None:
+            return None
+        Ww = W.copy()
+        Ww[:, 2] -= off
+        r = fit(window, Ww)
+        if r is not None:
+            r[0][:, 2] += off
         return r
 
     def _ic_for(self, tmpl):
@@ -413,7 +422,7 @@ class MarkerlessTracker:
         mask, visible = None, 1.0
         if (fit is None or fit[1] < MIN_CC) and self.poses:
             # part of the object may be covered (a hand): fit the part still in view
-            part = masked_fit(self, self.key, gray, W_pred, FINE_MARGIN_PX)
+            part = masked_fit(self, self.key, gray, W_pred)
             if part is not None:
                 fit, tmpl, mask, visible = part[:2], self.key, part[2], part[3]
         if fit is None or fit[1] < MIN_CC:
@@ -427,7 +436,7 @@ class MarkerlessTracker:
             if back is not None and partly_covered(cell_correlations(tmpl, back)):
                 # covered in part: no new keyframe from here (it would learn the occluder), and
                 # the pose from the cells still in view
-                part = masked_fit(self, tmpl, gray, W, FINE_MARGIN_PX)
+                part = masked_fit(self, tmpl, gray, W)
                 if part is not None:
                     (W, cc), mask, visible = part[:2], part[2], part[3]
             elif back is not None:  # appearance drifted from the first frame: renew the keyframe here
@@ -450,8 +459,6 @@ class MarkerlessDetector:
         from ._table_edge import table_top_edge
 
         self.trackers = {}
-        #: the table top edges found in the first frame (levelling), by object id
-        self.top_edges = {}
         for o in config.objects:
             edge = None
             if o.kind == "table" and o.theta0_rad is None:
@@ -464,7 +471,6 @@ class MarkerlessDetector:
                         "to side), or set reference.level to 'rest', 'line', 'value' or 'none'"
                     )
                 o = dataclasses.replace(o, theta0_rad=edge.angle_rad if edge is not None else 0.0)
-                self.top_edges[o.id] = edge
             t = MarkerlessTracker(o, plane_map, first_gray)
             # the table's angle is measured from its top edge: that edge's uncertainty is in every frame
             t.theta0_sigma_rad = edge.sigma_rad if edge is not None else 0.0

@@ -62,7 +62,7 @@ def cell_pixels(shape, cells: np.ndarray) -> np.ndarray:
     return cells[rows[:, None], cols[None, :]]
 
 
-def masked_fit(tracker, tmpl, gray, W0, margin_px: int = 12):
+def masked_fit(tracker, tmpl, gray, W0):
     """The pose fitted on the cells of ``tmpl`` still in view, from the pose ``W0``.
 
     Twice: cells matching loosely at ``W0`` (it may be a pixel off), then cells matching at
@@ -76,8 +76,6 @@ def masked_fit(tracker, tmpl, gray, W0, margin_px: int = 12):
     gray : ndarray (H, W), uint8
     W0 : ndarray (2, 3)
         Starting pose, first-frame px -> image px.
-    margin_px : int
-        Margin of the window round the template's footprint, px.
 
     Returns
     -------
@@ -101,16 +99,15 @@ def masked_fit(tracker, tmpl, gray, W0, margin_px: int = 12):
         if int(cells.sum()) < MIN_VISIBLE:
             return None
         mask = cell_pixels(tmpl.shape, cells)
-        fine, off = tracker._window(gray, W, margin_px)
-        if fine is None:
-            return None
-        Wf = W.copy()
-        Wf[:, 2] -= off
-        r = rigid.refine(fine, tracker._to_tmpl(Wf), mask=mask)
+
+        def fit(window, Ww, mask=mask):
+            got = rigid.refine(window, tracker._to_tmpl(Ww), mask=mask)
+            return None if got is None else (tracker._from_tmpl(got[0]), got[1])
+
+        r = tracker.fit_near(gray, W, fit)
         if r is None:
             return None
-        W = tracker._from_tmpl(r[0])
-        W[:, 2] += off
+        W = r[0]
     if r is None or r[1] < MASKED_CC:
         return None
     return W, float(r[1]), mask, float(cells.mean())

@@ -69,7 +69,7 @@ def _sub_row(g, rows, cols):
     return rows + np.divide(0.5 * (g0 - g2), den, out=np.zeros_like(den), where=den < 0), g1
 
 
-def _robust_line(u, v, w=None):
+def _robust_line(u, v):
     """(a, b) of v = a + b u by least squares with points beyond 3 robust sigma left out (twice)."""
     keep = np.ones(u.size, bool)
     a = b = 0.0
@@ -135,9 +135,8 @@ def table_top_edge(gray, roi, plane_map, follow: bool = True) -> TopEdge | None:
     u_pts, v_pts = u_pts[keep], v_pts[keep]
     strength = float(np.median(peak[strong][keep]))
     if follow:
-        more = [_follow(g, a, b, u, step, strength, r0, W) for u, step in ((u0 - 1, -1), (u1, 1))]
-        u_pts = np.concatenate([m[0] for m in more[:1]] + [u_pts] + [m[0] for m in more[1:]])
-        v_pts = np.concatenate([m[1] for m in more[:1]] + [v_pts] + [m[1] for m in more[1:]])
+        (ul, vl), (ur, vr) = (_follow(g, a, b, u, step, strength, r0, W) for u, step in ((u0 - 1, -1), (u1, 1)))
+        u_pts, v_pts = np.concatenate((ul, u_pts, ur)), np.concatenate((vl, v_pts, vr))
     # the line in the plane, from the undistorted points
     q = plane_map.to_plane(np.column_stack((u_pts, v_pts)))
     x, y = q[:, 0], q[:, 1]
@@ -157,8 +156,6 @@ def _follow(g, a, b, u_start, step, strength, r0, W):
     """Columns beyond the region that continue the edge v = a + b u: (u, v) arrays, px."""
     us, vs = [], []
     u, gap = u_start, 0
-    # the line is refitted as points come in: a lens bends a long straight edge by a pixel or two
-    ua, va = [], []
     while 0 <= u < W and gap < MAX_GAP_PX:
         pred = a + b * u - r0
         lo, hi = int(math.floor(pred)) - BAND_PX, int(math.ceil(pred)) + BAND_PX + 1
@@ -179,15 +176,12 @@ def _follow(g, a, b, u_start, step, strength, r0, W):
                 if abs(v - (a + b * u)) <= MAX_OFF_PX:
                     us.append(float(u))
                     vs.append(v)
-                    ua.append(float(u))
-                    va.append(v)
                     ok = True
         gap = 0 if ok else gap + 1
-        if len(ua) >= 4 * BLUR_PX:
-            # blend the new stretch into the line (keeps the slope local where the lens bends it)
-            bb, aa = np.polyfit(np.array(ua), np.array(va), 1)
-            a, b = aa, bb
-            ua, va = ua[-2 * BLUR_PX :], va[-2 * BLUR_PX :]
+        # the line refitted to the last 4 BLUR_PX points every 2 BLUR_PX new ones: a lens bends a
+        # long straight edge by a pixel or two, so the slope is kept local
+        if ok and len(us) >= 4 * BLUR_PX and (len(us) - 4 * BLUR_PX) % (2 * BLUR_PX) == 0:
+            b, a = np.polyfit(np.array(us[-4 * BLUR_PX :]), np.array(vs[-4 * BLUR_PX :]), 1)
         u += step
     if step < 0:
         us.reverse()

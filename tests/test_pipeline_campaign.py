@@ -1,6 +1,7 @@
 """``rocklab campaign``: parallel experiments, a failing one reported, campaign fits with known truth."""
 
 import json
+import re
 
 import numpy as np
 import pandas as pd
@@ -108,3 +109,52 @@ def test_campaign_on_a_dask_cluster_matches_local(tmp_path):
     assert remote.n_ok == local.n_ok == 2
     assert remote.table["eta_e"].tolist() == pytest.approx(local.table["eta_e"].tolist(), abs=1e-12)
     assert remote.table["eta_e"].tolist() == pytest.approx([0.882, 0.941], abs=0.002)
+
+
+def _track_experiment(folder, name, eta, b_m=0.045, h_m=0.2025):
+    """A track-only experiment (free rocking with noise) under ``folder``, named ``name``."""
+    import pandas as pd
+
+    from rocklab import Block
+    from rocklab.models import simulate
+
+    blk = Block(b_m, h_m)
+    sim = simulate(blk, theta0_rad=0.8 * blk.alpha_rad, duration_s=3.0, restitution="constant", eta=eta)
+    t = np.arange(0, 3.0, 1 / 100)
+    th = np.where(t < 0.3, sim.theta_rad[0], np.interp(t - 0.3, sim.t_s, sim.theta_rad))
+    th = th + np.random.default_rng(0).normal(0, 3e-4, t.size)
+    folder.mkdir(parents=True)
+    pd.DataFrame({"t_s": t, "theta_rad": th}).to_csv(folder / "tracks.csv", index=False)
+    (folder / "experiment.toml").write_text(
+        f'name = "{name}"\n[block]\nb_m = {b_m}\nh_m = {h_m}\n[sources.track]\npath = "tracks.csv"\n'
+        "[output]\nrrd = false\nfigures = false\n"
+    )
+
+
+def test_campaign_refuses_two_experiments_of_one_name(tmp_path, run_cli):
+    # two blocks of different size under one name would be one "block" in the k fit and one
+    # entity in campaign.rrd: refused before any work, naming both configs
+    root = tmp_path / "lab"
+    _track_experiment(root / "mon", "take", 0.9)
+    _track_experiment(root / "tue", "take", 0.8, b_m=0.06, h_m=0.3)
+    out = tmp_path / "out"
+    rc, _, err = run_cli("campaign", root, "--out", out, "--workers", "1", "--no-progress")
+    assert rc == 2 and len(err.strip().splitlines()) == 1
+    assert "'take'" in err and "mon/experiment.toml" in err and "tue/experiment.toml" in err
+    assert not out.exists()
+
+
+def test_campaign_links_follow_the_output_folder_not_the_name(tmp_path, run_cli):
+    root = tmp_path / "lab"
+    _track_experiment(root / "mon", "granite_a", 0.9)
+    _track_experiment(root / "tue", "granite_b", 0.85)
+    out = tmp_path / "out"
+    rc, _, err = run_cli("campaign", root, "--out", out, "--workers", "1", "--no-progress")
+    assert rc == 0, err
+    md = (out / "summary.md").read_text()
+    links = re.findall(r"\]\((experiments/[^)]+/report\.html)\)", md)
+    assert len(links) == 2 and all((out / link).is_file() for link in links)
+    # each link leads to its own experiment's report (its η_e, not the other's)
+    for link, name in zip(sorted(links), ("granite_a", "granite_b")):
+        rep = json.loads((out / link).parent.joinpath("report.json").read_text())
+        assert rep["name"] == name

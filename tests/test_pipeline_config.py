@@ -64,3 +64,24 @@ def test_config_errors_name_key_and_line(tmp_path, text, match):
     with pytest.raises(InputError, match=match) as e:
         load_experiment(p)
     assert "\n" not in str(e.value) and str(p) in str(e.value)
+
+
+def test_fingerprint_follows_the_calibration_a_track_config_names(tmp_path):
+    # a run is skipped when its fingerprint is unchanged: a new lens calibration named by
+    # track.toml (not by experiment.toml) must change it, or a resume reuses a stale result
+    from rocklab.pipelines.experiment._experiment import fingerprint
+
+    (tmp_path / "v.mp4").write_bytes(b"\0" * 64)
+    (tmp_path / "cal.npz").write_bytes(b"first")
+    (tmp_path / "track.toml").write_text(
+        '[video]\ncalibration = "cal.npz"\n[[objects]]\nid = "block_1"\nkind = "block"\nmarkers = [1]\n'
+    )
+    (tmp_path / "experiment.toml").write_text(
+        'name = "x"\n[block]\nb_m = 0.045\nh_m = 0.2\n[sources.video]\npath = "v.mp4"\ntrack_config = "track.toml"\n'
+    )
+    cfg = load_experiment(tmp_path / "experiment.toml")
+    assert (tmp_path / "cal.npz").resolve() in [p.resolve() for p in cfg.input_files()]
+    before = fingerprint(cfg)
+    assert fingerprint(cfg) == before
+    (tmp_path / "cal.npz").write_bytes(b"second")
+    assert fingerprint(cfg) != before

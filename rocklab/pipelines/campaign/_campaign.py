@@ -48,6 +48,29 @@ def find_experiments(root) -> list[Path]:
     return found
 
 
+def _check_unique_names(configs, root: Path) -> None:
+    """Experiment names label a campaign's rows, blocks, links and Rerun entities, so two
+    experiments of one name would be merged in its fits and figures: refused before any work.
+    A config that cannot be read is left to its own run, which reports it as failed."""
+    import tomllib
+
+    seen: dict[str, Path] = {}
+    for c in configs:
+        try:
+            name = tomllib.loads(c.read_text(encoding="utf-8")).get("name", c.parent.name)
+        except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError):
+            continue
+        if not isinstance(name, str):
+            continue
+        if name in seen:
+            raise InputError(
+                f"{c.relative_to(root)}: experiment name {name!r} is also used by {seen[name].relative_to(root)}; "
+                "names must be unique in a campaign (they label its rows, blocks and figures): "
+                'set a different name = "..." in one of them'
+            )
+        seen[name] = c
+
+
 def _one(config: str, out: str, force: bool) -> dict:
     """Worker: run one experiment; never raises (the failure is the result)."""
     from ..._errors import InputError as _IE
@@ -160,10 +183,11 @@ class CampaignResult:
             ]
             for _, r in t.iterrows():
                 name = str(r["experiment"])
+                folder = Path(str(r["out"])).name
                 ci = f"{g(r.get('ci_lo'))} – {g(r.get('ci_hi'))}" if np.isfinite(r.get("ci_lo", np.nan)) else "–"
                 eta_e = g(r["eta_e"]) if np.isfinite(r["eta_e"]) else "(forced)"
                 lines.append(
-                    f"| [{name}](experiments/{name}/report.html) | {r['block']} | {r['contact']} | "
+                    f"| [{name}](experiments/{folder}/report.html) | {r['block']} | {r['contact']} | "
                     f"{g(r.get('hb'))} | {g(r['eta_H'])} | {eta_e} | {ci} | {g(r.get('eta_M'))} | "
                     f"{g(r.get('eta_true'))} | {r.get('status', '')} |"
                 )
@@ -352,6 +376,7 @@ def run_campaign(
 
     root = Path(root).resolve()
     configs = find_experiments(root)
+    _check_unique_names(configs, root)
     out_dir = check_output_dir(out_dir, force=force, need_bytes=len(configs) * 30 * 1024 * 1024)
     claim_dir(out_dir, CAMPAIGN_ENTRIES, command="campaign")
     jobs = []
@@ -410,69 +435,12 @@ def _write_campaign(res: CampaignResult) -> None:
         if res.k_table and res.k_table.get("coefficients"):
             reg = KRegression.from_coefficients(res.k_table["coefficients"])
         figs = campaign_figures(res.ok_table, out / "figures", regression=reg) if len(res.ok_table) else {}
-        _campaign_rrd(res, out / "campaign.rrd")
+        from ._campaign_rrd import campaign_rrd
+
+        campaign_rrd(res, out / "campaign.rrd")
     else:
         figs = {}
     write_json_atomic(out / "campaign.json", json.loads(json.dumps(res.to_dict(), default=str)))
     md = res.summary_md(figs if isinstance(figs, dict) else {})
     write_text_atomic(out / "summary.md", md)
     write_html_report(md, out / "report.html", out, title=f"rocklab campaign: {out.name}")
-
-
-def _campaign_rrd(res: CampaignResult, path: Path) -> None:
-    import rerun as rr
-
-    from ..._io import atomic_path
-    from ..experiment._rerun import campaign_blueprint, close_recording, open_recording
-
-    with atomic_path(path, suffix=".rrd") as tmp:
-        rec = open_recording("rocklab", tmp, recording_id="campaign")
-        t = res.ok_table
-        for _, r in t.iterrows():
-            # h/b on a sequence timeline so the viewer plots η against slenderness
-            rec.set_time("h_over_b_x1000", sequence=int(round(1000 * r["hb"])))
-            base = f"campaign/eta/{r['contact']}/b_{int(round(1000 * r['b_m']))}mm"
-            rec.log(f"{base}/eta_e", rr.Scalars(float(r["eta_e"])))
-            rec.log(f"{base}/eta_H", rr.Scalars(float(r["eta_H"])))
-            if np.isfinite(r.get("eta_true", np.nan)):
-                rec.log(f"{base}/eta_true", rr.Scalars(float(r["eta_true"])))
-            rec.log(
-                "campaign/experiments",
-                rr.TextLog(
-                    f"{r['experiment']}: block {r['block']} ({r['contact']}), η_e = {r['eta_e']:.4f}, "
-                    f"η_H = {r['eta_H']:.4f}"
-                ),
-            )
-        rec.reset_time()
-        # η_e against h/b as labelled points, one entity per experiment: clicking a point selects
-        # that experiment and shows where its own report and recording are
-        for _, r in t.iterrows():
-            if not np.isfinite(r["eta_e"]):
-                continue
-            name = str(r["experiment"])
-            ent = f"campaign/eta_vs_hb/{r['contact']}/{name}"
-            colour = [0, 114, 178] if r["contact"] == "full" else [213, 94, 0]
-            rec.log(
-                ent,
-                rr.Points2D(
-                    [[float(r["hb"]), -float(r["eta_e"])]],
-                    labels=[name],
-                    colors=[colour],
-                    radii=[0.06],
-                    show_labels=False,
-                ),
-                static=True,
-            )
-            rec.log(
-                ent,
-                rr.TextDocument(
-                    f"**{name}**: block {r['block']} ({r['contact']} contact), h/b = {r['hb']:.4g}, "
-                    f"η_e = {r['eta_e']:.4g}, η_H = {r['eta_H']:.4g}\n\n"
-                    f"report: [experiments/{name}/report.html](experiments/{name}/report.html); "
-                    f"review: `rerun experiments/{name}/session.rrd`",
-                    media_type="text/markdown",
-                ),
-                static=True,
-            )
-        rec.send_blueprint(campaign_blueprint())
-        close_recording(rec, tmp)

@@ -173,6 +173,7 @@ class ExperimentConfig:
             tc = getattr(src, "track_config", None)
             if tc:
                 out.append(tc)
+                out.extend(_track_config_files(tc))
         for p in (self.table.imu, self.table.record, self.truth):
             if p:
                 out.append(p)
@@ -185,6 +186,19 @@ class ExperimentConfig:
         """Plain dict of the fields, JSON-ready (SI units in the keys)."""
         d = asdict(self)
         return _paths_to_str(d)
+
+
+def _track_config_files(path: Path) -> list[Path]:
+    """Files a ``track.toml`` names (its lens calibration): a run reads them, so a changed
+    calibration must change the fingerprint. Unreadable configs add nothing here; the
+    tracking stage reports them with their line."""
+    from ...tracking import load_track_config
+
+    try:
+        cal = load_track_config(path).video.calibration
+    except InputError:
+        return []
+    return [Path(cal)] if cal is not None and Path(cal).is_file() else []
 
 
 def _paths_to_str(obj):

@@ -18,7 +18,6 @@ relative to it, so a shake table's motion is not read as sliding.
 from __future__ import annotations
 
 import math
-import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -28,6 +27,7 @@ from ..._errors import InputError, where
 from ._audit import AuditResult, AuditTolerances, audit_rocking
 from ._pose import MIN_POINTS, BodyPoses, body_poses, kabsch, reference_shape
 from ._read import PointSeries
+from ._rigidity import check_bodies_disjoint, check_rigid_body
 from ._rocking import (RockingGeometry, axis_vector, find_impacts, fit_pivots, pivot_motion, rocking_axes,
                        rotation_sigma, segment_ids, split_rotation)
 
@@ -283,58 +283,6 @@ def _in_frame(R_T, t_T, xyz):
     return np.einsum("nji,npj->npi", R_T, xyz - t_T[:, None, :])
 
 
-def rigid_groups(xyz, labels, tol_m: float = 1e-3) -> list:
-    """Groups of points whose mutual distances stay within ``tol_m`` (5th-95th percentile) over the record.
-
-    Parameters
-    ----------
-    xyz : ndarray, shape (n, p, 3)
-    labels : sequence of str, length p
-
-    Returns
-    -------
-    list of tuple of str
-        Connected groups, largest first (single points left out).
-    """
-    from scipy.sparse.csgraph import connected_components
-
-    p = xyz.shape[1]
-    step = max(1, xyz.shape[0] // 2000)
-    sub = xyz[::step]
-    d = np.linalg.norm(sub[:, :, None, :] - sub[:, None, :, :], axis=3)          # (m, p, p)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", RuntimeWarning)     # pairs never seen together stay NaN: no link
-        lo, hi = np.nanpercentile(d, [5, 95], axis=0)
-    link = np.isfinite(hi) & ((hi - lo) < tol_m)
-    np.fill_diagonal(link, False)
-    _, comp = connected_components(link, directed=False)
-    groups = [tuple(labels[i] for i in range(p) if comp[i] == c) for c in np.unique(comp)]
-    return sorted((g for g in groups if len(g) > 1), key=len, reverse=True)
-
-
-def _check_rigid(name, labels, xyz, poses, source) -> None:
-    """:class:`InputError` when a body's points do not move as one rigid body (with the groups that do)."""
-    rest_rms = float(np.nanmedian(poses.rms_m[:max(5, poses.rms_m.size // 20)])) if np.isfinite(poses.rms_m).any() \
-        else float("nan")
-    with np.errstate(all="ignore"):
-        run_rms = float(np.nanpercentile(poses.rms_m, 95)) if np.isfinite(poses.rms_m).any() else float("nan")
-    typical = float(np.nanmin([rest_rms, np.nanmedian(poses.rms_m)]))
-    if not (np.isfinite(run_rms) and run_rms > max(10.0 * typical, 1e-3)):
-        return
-    groups = rigid_groups(xyz, list(labels))
-    names = []
-    for g in groups[:4]:
-        cen = np.nanmean(xyz[:, [list(labels).index(lab) for lab in g]], axis=1)
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", RuntimeWarning)
-            still = float(np.nanmax(np.nanpercentile(cen, 95, axis=0) - np.nanpercentile(cen, 5, axis=0))) < 2e-3
-        names.append("table" if still and "table" not in names else f"block{len(names) + 1}")
-    hint = " ".join(f"--body {n}={','.join(g)}" for n, g in zip(names, groups))
-    raise InputError(f"{where(source)}the points of body {name!r} do not move as one rigid body (pose residual "
-                     f"{run_rms * 1e3:.4g} mm at the 95th percentile, {typical * 1e3:.4g} mm typical): some belong "
-                     f"to another body; list each body's points, e.g. {hint or '--body NAME=P1,P2,P3'}")
-
-
 def _fit_body(name, labels, t, xyz, rest, source):
     """``(reference shape, rest used, notes, BodyPoses)`` of one body: its rest, then its pose in every sample."""
     ref, rest_used, notes = _choose_rest(t, xyz, rest, name, source)
@@ -342,7 +290,7 @@ def _fit_body(name, labels, t, xyz, rest, source):
         raise InputError(f"{where(source)}body {name!r}: fewer than {MIN_POINTS} of its points are placed at rest; "
                          "give --rest T0,T1 where the points are seen, or fix the --body list")
     poses = body_poses(xyz, ref)
-    _check_rigid(name, labels, xyz, poses, source)
+    check_rigid_body(name, labels, xyz, poses, source)
     return ref, rest_used, notes, poses
 
 
@@ -432,6 +380,7 @@ def track_points3d(series: PointSeries, bodies: dict | None = None, up: str = "z
     if series.t_s.size < 10:
         raise InputError(f"{where(series.source)}{series.t_s.size} samples; a rocking record needs at least 10")
     bodies = bodies or parse_bodies(None, series.labels)
+    check_bodies_disjoint(bodies, series.source)
     tables = [n for n in bodies if n.lower() in TABLE_NAMES]
     if len(tables) > 1:
         raise InputError(f"--body: two tables {tables}; name one body table")

@@ -17,7 +17,7 @@ import warnings
 import numpy as np
 
 from ..rigid import PointSeries
-from ..rigid._track3d import rigid_groups
+from ..rigid._rigidity import rigid_groups
 from ._dots import StereoPoints
 
 __all__ = ["stereo_point_series"]

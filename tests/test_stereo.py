@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import shutil
 import math
 
 import numpy as np
@@ -135,6 +136,14 @@ def test_stereo_bad_input(session, tmp_path, run_cli):
     # a calibration film against a test film: different lengths
     with pytest.raises(InputError, match=r"cam2.mkv: 356 frames, but calib_cam1.mkv has 20; .*trim them"):
         calibrate_stereo(d / "calib_cam1.mkv", d / "cam2.mkv")
+    # one calibration film given twice (also as a copy under another name) calibrated to a
+    # 5.5e-11 m baseline: refused, naming the cause
+    shutil.copy(d / "calib_cam1.mkv", tmp_path / "copy.mkv")
+    for second in (d / "calib_cam1.mkv", tmp_path / "copy.mkv"):
+        with pytest.raises(
+            InputError, match=r"sit where they sit in calib_cam1.mkv \(median 0 px apart\): the same film"
+        ):
+            calibrate_stereo(d / "calib_cam1.mkv", second)
     with pytest.raises(InputError, match=r"the films must cover the same test"):
         track_dots_stereo(d / "cam1.mkv", d / "calib_cam2.mkv", rig)
     rc, _, err = run_cli("stereo", "track", d / "cam1.mkv", d / "cam2.mkv", "--calib", tmp_path / "none.json")

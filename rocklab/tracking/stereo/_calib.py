@@ -26,6 +26,10 @@ DEFAULT_BOARD = {"squares": (9, 6), "square_m": 0.03, "marker_m": 0.022, "dictio
 #: Fewest ChArUco corners for a frame to count, and fewest frames for a calibration.
 MIN_CORNERS = 8
 MIN_FRAMES = 6
+#: Median corner distance between the two films below which they are one film, px.
+SAME_FILM_PX = 0.05
+#: Smallest camera separation that triangulates a lab scene (a few cm at 1-3 m), m.
+MIN_BASELINE_M = 0.01
 
 
 @dataclass(frozen=True)
@@ -200,10 +204,24 @@ def calibrate_stereo(film1, film2, board: dict | None = None) -> StereoRig:
             f"{where(film1)}the board is seen by both cameras at once in {len(obj)} frames; need "
             f"{MIN_FRAMES}: hold it where both see it (check {Path(film2).name} too)"
         )
+    # one film given twice (or two copies of one camera) calibrates to a zero baseline that
+    # triangulates nothing: the corners then agree to the detector's rounding in every frame
+    gap_px = float(np.median([np.median(np.linalg.norm(a - c, axis=1)) for a, c in zip(img1, img2)]))
+    if gap_px < SAME_FILM_PX:
+        raise InputError(
+            f"{where(film2)}the board's corners sit where they sit in {Path(film1).name} (median "
+            f"{gap_px:.2g} px apart): the same film twice, or one camera's; give the second camera's film"
+        )
     crit = (cv2.TERM_CRITERIA_COUNT + cv2.TERM_CRITERIA_EPS, 200, 1e-10)
     rms, K1, d1, K2, d2, R, T, _, _ = cv2.stereoCalibrate(
         obj, img1, img2, K1, d1, K2, d2, size1, criteria=crit, flags=cv2.CALIB_USE_INTRINSIC_GUESS | cv2.CALIB_FIX_K3
     )
+    baseline_m = float(np.linalg.norm(T))
+    if baseline_m < MIN_BASELINE_M:
+        raise InputError(
+            f"{where(film2)}the two cameras are {baseline_m:.3g} m apart after calibration: no depth can be "
+            f"triangulated; film the board with two cameras at least {MIN_BASELINE_M:g} m apart"
+        )
     return StereoRig(
         K1,
         np.asarray(d1, float).ravel(),

@@ -214,3 +214,18 @@ def test_cli_text_on_clean_simulated_log(run_cli, tmp_path):
     assert "rocking axis ~+y" in out and "status ok: rests found" in out
     rot = block_rotation(log)
     assert f"{len(rot.impact_t_s)} impacts" in out and len(rot.impact_t_s) >= 5
+
+
+@pytest.mark.parametrize("seed", [1, 2])
+def test_table_rest_ends_where_the_shaking_starts(seed):
+    # a 1 m/s2 horizontal shaking changes |acc| by only a^2 / 2g = 0.005 g (below the 0.03 g
+    # motion threshold): the rest that gives gravity used to run to the end of the log
+    # (0 - 13.95 s) and left a -0.0101 m/s2 offset; it now ends before the shaking at 3 s
+    t = np.arange(0.0, 14.0, 1e-3)
+    a = np.where(t > 3, 1.0 * np.sin(2 * np.pi * 1.0 * (t - 3)) * np.exp(-0.2 * (t - 3)), 0.0)
+    log = simulate_imu_log(t, np.zeros_like(t), None, base=(t, a), seed=seed)
+    ta = table_acceleration(log, "x")
+    assert 2.5 < ta.rest_s[1] <= 3.0
+    err = ta.acc_m_s2 - np.interp(ta.t_s, t, a)
+    assert abs(float(np.mean(err))) < 0.003
+    assert np.rad2deg(ta.tilt_rad) < 0.03

@@ -107,6 +107,19 @@ WARNING_CODES: dict[str, tuple[str, str]] = {
         "sample rate disagrees between the option, the log's register and its timestamps; the timestamps were trusted",
     ),
     "W-IMU-TRUNCATED": ("note", "an incomplete final line (logger stopped mid-write) was dropped"),
+    "W-IMU-NOT-ROCKING": (
+        "suspect",
+        "the log is not a rocking block: its rotation axis is far from horizontal (a spin "
+        "about the vertical), the rotation is spread over several axes (a hand-held sensor), "
+        "it turns through more than a half turn, or holding the rests needs a large gyro "
+        "drift; theta, release and impacts mean nothing. Check the file and the mounting",
+    ),
+    "W-IMU-TABLE": (
+        "suspect",
+        "the table sensor turned during the log (gyro or the gravity of its first and last "
+        "rests): gravity, removed in the orientation at the first rest, leaks into the table "
+        "acceleration by 2 g sin(turn/2); check that the sensor is fixed to the table",
+    ),
     # video tracking
     "W-TRACK-NOSCALE": (
         "note",

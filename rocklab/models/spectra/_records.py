@@ -11,6 +11,10 @@ Formats
 - CSV with a header ``t_s,acc_m_s2`` (or ``acc_g`` / ``acc_cm_s2``).
 - Two-column whitespace text ``t a`` without header; ``units`` is required
   (``g``, ``m/s2``, ``cm/s2``).
+
+Units are never guessed or overridden: a unit the file states (an AT2 units
+field, a CSV column name) is used; ``units`` (``--units``) applies only to a
+file that states none, and one that disagrees with the file's is an error.
 """
 
 from __future__ import annotations
@@ -24,6 +28,7 @@ import numpy as np
 
 from ..._errors import InputError
 from ...blocks import G
+from ._record_units import UNITS_TO_M_S2, _at2_units, _stated_wins, _unit_factor
 
 __all__ = [
     "BaseMotion",
@@ -35,29 +40,7 @@ __all__ = [
     "BUNDLED_RECORDS",
 ]
 
-#: Factors from accepted acceleration units to m/s^2.
-UNITS_TO_M_S2 = {
-    "g": G,
-    "m/s2": 1.0,
-    "m/s^2": 1.0,
-    "m_s2": 1.0,
-    "cm/s2": 0.01,
-    "cm/s^2": 0.01,
-    "cm_s2": 0.01,
-    "gal": 0.01,
-    "mm/s2": 0.001,
-}
-
 _NUM = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eEdD][-+]?\d+)?")
-
-
-def _unit_factor(units: str, source: str = "") -> float:
-    key = str(units).strip().lower().replace(" ", "")
-    if key not in UNITS_TO_M_S2:
-        raise InputError(
-            f"{source}units={units!r}: unknown acceleration unit; use one of {', '.join(sorted(set(UNITS_TO_M_S2)))}"
-        )
-    return UNITS_TO_M_S2[key]
 
 
 @dataclass(frozen=True)
@@ -179,7 +162,9 @@ class BaseMotion:
 # -- readers ------------------------------------------------------------------
 
 
-def load_base_motion(path, units: str | None = None, dt_s: float | None = None, name: str | None = None) -> BaseMotion:
+def load_base_motion(
+    path, units: str | None = None, dt_s: float | None = None, name: str | None = None, default_units: str | None = None
+) -> BaseMotion:
     """Read a base-motion record file into SI units.
 
     Parameters
@@ -187,8 +172,12 @@ def load_base_motion(path, units: str | None = None, dt_s: float | None = None, 
     path : str or Path
         ``.AT2`` (PEER), ``.csv`` with header, or two-column text ``t a``.
     units : str, optional
-        Acceleration units of the file (``g``, ``m/s2``, ``cm/s2``). Required for
-        headerless text; for ``.AT2`` overrides the header's units.
+        Acceleration units the user states (``g``, ``m/s2``, ``cm/s2``; ``--units``):
+        used for a file that states none (headerless text, an AT2 without a units
+        field); a file that states other units is an error (never overridden).
+    default_units : str, optional
+        A documented default (a config's) for a file that states none when ``units``
+        is None; it never conflicts with a file's own units.
     dt_s : float, optional
         Only for single-column text files: the sample spacing, s.
     name : str, optional
@@ -198,11 +187,12 @@ def load_base_motion(path, units: str | None = None, dt_s: float | None = None, 
     ------
     InputError
         Unreadable file, NPTS disagreeing with the data, NaN, non-monotonic or
-        non-uniform time, unknown units.
+        non-uniform time, unknown units, ``units`` disagreeing with the file's.
     """
     path = Path(path)
-    if units is not None:
-        _unit_factor(units, f"{path}: ")  # fail on a bad option before reading anything
+    for u in (units, default_units):
+        if u is not None:
+            _unit_factor(u, f"{path}: ")  # fail on a bad option before reading anything
     if path.is_dir():
         raise InputError(f"{path}: is a folder; give the record file (.AT2, .csv or two-column text)")
     if not path.is_file():
@@ -217,15 +207,15 @@ def load_base_motion(path, units: str | None = None, dt_s: float | None = None, 
     if "\x00" in text[:4096]:
         raise InputError(f"{path}: binary file, not a record; give an .AT2, CSV or two-column text file")
     if re.search(r"NPTS\s*=", text[:4000], re.I):
-        bm = _read_at2(path, text, units, nm)
+        bm = _read_at2(path, text, units, nm, default_units)
     elif path.suffix.lower() == ".csv" or re.match(r"\s*[A-Za-z_]", text):
         bm = _read_csv(path, units, nm)
     else:
-        bm = _read_columns(path, text, units, dt_s, nm)
+        bm = _read_columns(path, text, units or default_units, dt_s, nm)
     return check_plausible(bm)
 
 
-def _read_at2(path: Path, text: str, units: str | None, name: str) -> BaseMotion:
+def _read_at2(path: Path, text: str, units: str | None, name: str, default_units: str | None = None) -> BaseMotion:
     lines = text.splitlines()
     hdr_i = next(i for i, ln in enumerate(lines) if re.search(r"NPTS\s*=", ln, re.I))
     hdr = lines[hdr_i]
@@ -236,10 +226,13 @@ def _read_at2(path: Path, text: str, units: str | None, name: str) -> BaseMotion
     npts, dt = int(m_n.group(1)), float(m_dt.group(1))
     if dt <= 0:
         raise InputError(f"{path}, line {hdr_i + 1}: DT={dt} must be positive")
-    file_units = _at2_units(path, lines[:hdr_i], given=units)
-    units_from = "option" if units is not None else ("header" if file_units else "PEER convention (g)")
-    if units is None:
-        units = file_units or "g"  # PEER's documented convention when the file names no units
+    file_units, line = _at2_units(path, lines[:hdr_i], given=units)
+    if file_units is not None:
+        units, units_from = _stated_wins(path, file_units, f"the header (line {line})", units), "header"
+    elif units is not None:
+        units_from = "option"
+    else:  # PEER's documented convention when the file names no units
+        units, units_from = default_units or "g", "default" if default_units else "PEER convention (g)"
     f = _unit_factor(units, f"{path}: ")
     vals: list[float] = []
     for j, ln in enumerate(lines[hdr_i + 1 :], start=hdr_i + 2):
@@ -268,82 +261,6 @@ def _read_at2(path: Path, text: str, units: str | None, name: str) -> BaseMotion
         meta={"format": "AT2", "units_in_file": units, "header": lines[: hdr_i + 1], "units_from": units_from},
     )
     return bm
-
-
-# units named in an AT2 header ("IN UNITS OF G", "The units are (g)", "UNITS: CM/S/S")
-_UNITS_FIELD = re.compile(
-    r"\bUNITS?\b\s*(?:(?:OF|ARE|IN)\b\s*[(\[]?|[:=(\[])\s*[(\[]?\s*([A-Z][A-Z0-9/*^.\-]*(?:\s*/\s*[A-Z0-9*^]+)*)", re.I
-)
-_ACC_UNITS = {
-    "G": "g",
-    "GS": "g",
-    "CM/S/S": "cm/s2",
-    "CM/S2": "cm/s2",
-    "CM/S**2": "cm/s2",
-    "CM/S^2": "cm/s2",
-    "CM/SEC/SEC": "cm/s2",
-    "CM/SEC2": "cm/s2",
-    "CM/SEC**2": "cm/s2",
-    "CM/SEC^2": "cm/s2",
-    "GAL": "cm/s2",
-    "M/S/S": "m/s2",
-    "M/S2": "m/s2",
-    "M/S**2": "m/s2",
-    "M/S^2": "m/s2",
-    "M/SEC/SEC": "m/s2",
-    "M/SEC2": "m/s2",
-    "M/SEC**2": "m/s2",
-    "MM/S/S": "mm/s2",
-    "MM/S2": "mm/s2",
-}
-_OTHER_QUANTITY = {
-    "CM/S": "velocity",
-    "CM/SEC": "velocity",
-    "M/S": "velocity",
-    "M/SEC": "velocity",
-    "IN/S": "velocity",
-    "IN/SEC": "velocity",
-    "CM": "displacement",
-    "M": "displacement",
-    "MM": "displacement",
-    "IN": "displacement",
-}
-
-
-def _at2_units(path: Path, header: list[str], given: str | None = None) -> str | None:
-    """The acceleration units an AT2 header names in a units field, or None when it names none.
-
-    Free text (a station called "Galway" or "Portugal") is never read as a unit; a
-    velocity or displacement series is an error; so are unknown or two different units,
-    unless the user ``given`` the units (``--units``), which then decide.
-    """
-    found = {}
-    for i, ln in enumerate(header, start=1):
-        if re.search(r"\b(VELOCITY|DISPLACEMENT)\s+TIME\s+SERIES\b", ln, re.I):
-            kind = re.search(r"VELOCITY|DISPLACEMENT", ln, re.I).group(0).lower()  # type: ignore[union-attr]
-            raise InputError(
-                f"{path}, line {i}: this is a {kind} time series, not acceleration; give the "
-                "matching .AT2 acceleration file"
-            )
-        for m in _UNITS_FIELD.finditer(ln):
-            tok = re.sub(r"\s+", "", m.group(1)).upper().rstrip(".,;)]")
-            if tok in _ACC_UNITS:
-                found[_ACC_UNITS[tok]] = i
-            elif tok in _OTHER_QUANTITY:
-                raise InputError(
-                    f"{path}, line {i}: units {m.group(1)!r} are {_OTHER_QUANTITY[tok]}, not "
-                    "acceleration; give the acceleration record"
-                )
-            elif given is None:
-                raise InputError(
-                    f"{path}, line {i}: unknown units {m.group(1)!r} in the header; give --units "
-                    "g|m/s2|cm/s2 to say what the file holds"
-                )
-    if len(found) > 1 and given is None:
-        raise InputError(
-            f"{path}: header names two units ({', '.join(sorted(found))}); give --units to say which is right"
-        )
-    return next(iter(found), None)
 
 
 def _token_shape(tok: str) -> tuple:
@@ -423,8 +340,10 @@ def _read_csv(path: Path, units: str | None, name: str) -> BaseMotion:
         i = int(np.flatnonzero(bad)[0])
         raise InputError(f"{path}, line {i + 2}: NaN or non-numeric value; clean the record")
     _check_time(path, t, first_line=2)
-    f = _unit_factor(units or str(file_units), f"{path}: ")
-    return BaseMotion(t, a * f, name=name, source=str(path), meta={"format": "csv"})
+    file_units = _stated_wins(path, str(file_units), f"its column {acc_col.strip()!r}", units)
+    f = _unit_factor(file_units, f"{path}: ")
+    meta = {"format": "csv", "units_in_file": file_units, "units_from": "column name"}
+    return BaseMotion(t, a * f, name=name, source=str(path), meta=meta)
 
 
 def _read_columns(path: Path, text: str, units: str | None, dt_s: float | None, name: str) -> BaseMotion:

@@ -12,7 +12,12 @@ def add_base_motion_args(p) -> None:
     p.add_argument(
         "--base-motion", default=None, help="base acceleration record (.AT2, CSV t_s,acc_m_s2, 2-column text)"
     )
-    p.add_argument("--units", default=None, help="record units: g, m/s2, cm/s2 (2-column text needs it)")
+    p.add_argument(
+        "--units",
+        default=None,
+        help="units of a record that states none: g, m/s2, cm/s2 (2-column text needs it); "
+        "a file's own units win, a conflict is an error",
+    )
     p.add_argument("--scale-pga", type=float, default=None, help="scale the record to this PGA (in --units, default g)")
 
 

@@ -121,7 +121,7 @@ class SourceTable:
     object: str = "table"
     imu: Path | None = None
     record: Path | None = None
-    units: str = "g"
+    units: str | None = None  # a record's units when it states none (None: g); never overrides the file's
 
 
 @dataclass(frozen=True)
@@ -397,7 +397,7 @@ def load_experiment(path) -> ExperimentConfig:
         object=r.get("sources.table.object", "table", kind=str),
         imu=r.file("sources.table.imu", required=tsrc == "imu", allow_dir=True),
         record=r.file("sources.table.record", required=tsrc == "record"),
-        units=r.get("sources.table.units", "g", kind=str),
+        units=r.get("sources.table.units", None, kind=str),
     )
     if tsrc == "video" and video is None:
         r.fail("sources.table.from", "= 'video' needs a [sources.video] section")

@@ -221,7 +221,7 @@ def analyse_experiment(
     elif cfg.table.source == "record":
         from ...models import load_base_motion
 
-        bm = load_base_motion(cfg.table.record, units=cfg.table.units)
+        bm = load_base_motion(cfg.table.record, units=cfg.table.units, default_units="g")
         table = {"t_s": bm.t_s, "acc_m_s2": bm.acc_m_s2}
 
     sync = None

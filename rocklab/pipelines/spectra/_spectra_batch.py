@@ -131,7 +131,7 @@ def oas_summary_row(
         error="",
     )
     try:
-        rec = load_base_motion(path, units=units)
+        rec = load_base_motion(path, default_units=units)  # a file's own units are kept
         row["t_p_s"] = pulse_parameters(rec).t_p_s
         if band:
             b = t_I_band(rec, slenderness, **(oas_kwargs or {}))
@@ -186,7 +186,8 @@ def oas_many(
     paths : sequence of str or Path
         Record files (any format :func:`rocklab.models.load_base_motion` reads).
     units : str, optional
-        Units of headerless files (``g`` for the FEMA two-column set).
+        Units of the files that state none (``g`` for the FEMA two-column set); a
+        file's own units (AT2 units field, CSV column) are kept.
     slenderness : float
         Block h/b.
     oas_kwargs : dict, optional

@@ -57,6 +57,7 @@ from ._motion import (axis_vector, cumtrapz, first_motion, forced_run, last_moti
                           motion_mask, moving_average, quat_mul, rownorm, still_acc_start,
                           tilt_about, twist_angle)
 from ._read import ImuLog
+from ._validity import RockingCheck, check_rocking, warn_not_rocking
 
 __all__ = ["ImuRotation", "block_rotation", "ahrs_rotation", "ahrs_quaternions"]
 
@@ -107,6 +108,9 @@ class ImuRotation:
     run_kind : str
         ``"thread"`` (released from a tilt; upright = end rest) or ``"forced"``
         (shake table; upright = initial rest, ``theta0_rad`` = 0, no release).
+    rocking : RockingCheck or None
+        The evidence that the log is a rocking block (axis angle to the horizontal,
+        share of the rotation about the axis, turn range; ``_validity``).
     """
 
     t_s: np.ndarray
@@ -129,6 +133,7 @@ class ImuRotation:
     status: str = "ok"
     message: str = ""
     run_kind: str = "thread"
+    rocking: RockingCheck | None = field(default=None, repr=False)
 
     def to_frame(self):
         """``t_s, theta_rad, omega_rad_s, acc_{x,y,z}_m_s2`` (+ ``theta_ahrs_rad``)."""
@@ -153,6 +158,8 @@ class ImuRotation:
                 "rest_t_s": float(self.rest_t_s),
                 "ahrs_rms_diff_rad": float(self.ahrs_rms_diff_rad),
                 "status": self.status, "message": self.message, "run_kind": self.run_kind,
+                "axis_tilt_rad": float(self.rocking.axis_tilt_rad) if self.rocking else float("nan"),
+                "axis_share": float(self.rocking.axis_share) if self.rocking else float("nan"),
                 "source": self.source}
 
 
@@ -302,6 +309,10 @@ def block_rotation(log: ImuLog, axis: str | None = None, *, release: str = "auto
     planar = float(np.sum(omega[moving] ** 2)) >= 0.9 * float(np.sum(w[moving] ** 2)) if moving.any() else False
     if has_end and planar and float(np.max(np.abs(theta))) < 0.5 * np.pi:
         status, msg = _check_gyro_vs_tilt(log.source, ie_mean - is_mean, th_end - th_start, status, msg)
+    rocking = check_rocking(t, w, u, f_start, fs, drift) if status != "no_motion" else None
+    if rocking is not None and rocking.reasons:
+        # a spinning or hand-held sensor: worse than any rest-window status
+        status, msg = "suspect", warn_not_rocking(log.source, rocking) + ("; " + msg if msg else "")
     if axis is None:
         ref = th_start if abs(th_start) > np.deg2rad(1.0) else theta[np.argmax(np.abs(theta))]
         if ref < 0:
@@ -320,7 +331,7 @@ def block_rotation(log: ImuLog, axis: str | None = None, *, release: str = "auto
         ahrs_rms = float(np.sqrt(np.mean(diff ** 2)))
     return ImuRotation(t, theta, omega, acc, u, bias, th_start, float(drift), release_t,
                        impacts, rest_t, fs, log.dropped_samples, log.format, log.source,
-                       ahrs_theta, ahrs_rms, status, msg, "forced" if forced else "thread")
+                       ahrs_theta, ahrs_rms, status, msg, "forced" if forced else "thread", rocking)
 
 
 def _strict_rest_start(omega, e0, e1, sigma, fs, min_rest) -> int:

@@ -25,7 +25,11 @@ def register(sub):
     """Add this module's subcommand(s) to the ``rocklab`` parser ``sub``."""
     p = sub.add_parser("pulse", help="pulse parameters of a record (a_max, I_max, t_p)")
     p.add_argument("record")
-    p.add_argument("--units", default=None, help="units of a headerless record (g, m/s2, cm/s2)")
+    p.add_argument(
+        "--units",
+        default=None,
+        help="units of a record that states none (g, m/s2, cm/s2); a file's own units win, a conflict is an error",
+    )
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.set_defaults(func=run)
 
@@ -37,7 +41,12 @@ def register(sub):
         metavar="FILE",
         help="a text file naming one record per line (relative to its folder; # comments)",
     )
-    p.add_argument("--units", default=None)
+    p.add_argument(
+        "--units",
+        default=None,
+        help="units of records that state none (g, m/s2, cm/s2); a file's own units are kept, "
+        "and one record stating other units is an error",
+    )
     p.add_argument("--slenderness", type=float, default=12.0, help="block h/b (default 12)")
     p.add_argument("--levels", type=int, default=80, help="a_p/a_p,min levels 1..level-max (80)")
     p.add_argument("--level-max", type=float, default=10.0)

@@ -1,12 +1,14 @@
 """``rocklab imu``: an IMU log to block rotation (or table acceleration).
 
-``rocklab imu PATH [--axis y] [--rate 256] [-o imu.csv] [--json] [--table] [--ahrs]``
+``rocklab imu PATH [--axis y] [--rate 256] [-o imu.csv] [--json] [--table] [--ahrs] [--plot imu.png]``
 
 PATH is an IMU CSV or a log folder (x-IMU GUI export, x-IMU3 device folder,
 Fusion-style CSV).  The output CSV has ``t_s, theta_rad, omega_rad_s,
 acc_x_m_s2, acc_y_m_s2, acc_z_m_s2`` (``--table``: ``t_s, acc_m_s2``).
 ``--json`` prints one object: ``format, sample_rate_hz, n_samples,
 dropped_samples, gyro_bias_rad_s, release_t_s, impact_t_s`` and more.
+``--plot`` draws theta (or the table acceleration) with the release, the
+impacts and the rests, over the three gyro axes.
 """
 
 from __future__ import annotations
@@ -49,6 +51,9 @@ def register(sub):
         "shake table that starts upright; auto (default): decide from the data",
     )
     p.add_argument("--ahrs", action="store_true", help="also run imufusion's AHRS and report its difference (slower)")
+    p.add_argument(
+        "--plot", default=None, help="PNG: theta (table: acceleration), release, impacts, rests and the gyro axes"
+    )
     p.set_defaults(func=run)
 
 
@@ -69,6 +74,11 @@ def run(args) -> int:
     if args.out:
         write_frame_atomic(args.out, res.to_frame())
         summary["output"] = str(args.out)
+    if args.plot:
+        from .._imu_plot import imu_figure
+
+        imu_figure(log, res, args.plot, title=str(args.path))
+        summary["plot"] = str(args.plot)
     if args.json:
         from .._cli_base import emit_json
 
@@ -79,21 +89,69 @@ def run(args) -> int:
         f"{summary['source']}: {summary['format']}, {summary['n_samples']} samples at "
         f"{summary['sample_rate_hz']:g} Hz, {summary['dropped_samples']} dropped\n"
     )
+    from ...._diagnostics import collected, worst_status
+
+    status = worst_status(res.status, collected())
     if args.table:
+        d = summary["direction"]
         out.write(
-            f"table acceleration: peak {summary['pga_m_s2']:.3f} m/s2, sensor tilt "
-            f"{math.degrees(summary['tilt_rad']):.2f} deg\n"
+            f"table acceleration along sensor ({d[0]:+.3f}, {d[1]:+.3f}, {d[2]:+.3f}): peak "
+            f"{summary['pga_m_s2']:.3f} m/s2, gravity removed in the orientation of the rest "
+            f"{summary['rest_s'][0]:.3f}-{summary['rest_s'][1]:.3f} s (sensor tilt "
+            f"{math.degrees(summary['tilt_rad']):.2f} deg); the sensor turned by "
+            f"{math.degrees(summary['turn_rad']):.3g} deg\n"
         )
     else:
-        b = [f"{math.degrees(v):.3f}" for v in summary["gyro_bias_rad_s"]]
-        out.write(
-            f"gyro bias [{', '.join(b)}] deg/s; release {summary['release_t_s']:.4f} s; "
-            f"{len(summary['impact_t_s'])} impacts; status {summary['status']}\n"
-        )
-        if args.ahrs:
-            out.write(
-                f"AHRS vs gyro integration: RMS difference {math.degrees(summary['ahrs_rms_diff_rad']):.3f} deg\n"
-            )
-    if args.out:
-        out.write(f"wrote {args.out}\n")
+        out.write(_block_text(res))
+    out.write(f"status {status}: {_STATUS_MEANING.get(status, '')}\n")
+    if res.message:
+        out.write(f"  {res.message}\n")
+    if args.ahrs and not args.table:
+        out.write(f"AHRS vs gyro integration: RMS difference {math.degrees(summary['ahrs_rms_diff_rad']):.3f} deg\n")
+    for k in ("output", "plot"):
+        if k in summary:
+            out.write(f"wrote {summary[k]}\n")
     return 0
+
+
+_STATUS_MEANING = {
+    "ok": "rests found before and after, gyro and accelerometer agree, no warning",
+    "suspect": "a warning above: the numbers may be wrong; check before using them",
+    "no_rest_before": "no rest before the first motion: the gyro bias came from the first 0.5 s",
+    "no_rest_after": "still moving at the end: the gyro drift is not held by a final rest",
+    "no_motion": "nothing moved above the stillness thresholds",
+}
+
+
+def _block_text(res) -> str:
+    import math
+
+    import numpy as np
+
+    a = res.axis
+    k = int(np.argmax(np.abs(a)))
+    name = ("+" if a[k] > 0 else "-") + "xyz"[k]
+    line = f"rocking axis ~{name} ({a[0]:+.3f}, {a[1]:+.3f}, {a[2]:+.3f}) in the sensor frame"
+    rk = res.rocking
+    if rk is not None and math.isfinite(rk.axis_tilt_rad):
+        line += (
+            f", {math.degrees(rk.axis_tilt_rad):.3g} deg above the horizontal, "
+            f"{100 * rk.axis_share:.3g} % of the rotation about it"
+        )
+    b = ", ".join(f"{math.degrees(v):.3f}" for v in res.gyro_bias_rad_s)
+    line += f"\ngyro bias [{b}] deg/s, residual drift {math.degrees(res.drift_rad_s):.3g} deg/s\n"
+    th = np.rad2deg(res.theta_rad)
+    if res.run_kind == "forced":
+        line += "forced run (table moved before the block turned): upright = the rest at the start"
+    elif math.isfinite(res.release_t_s):
+        line += f"release at {res.release_t_s:.4f} s from theta0 {math.degrees(res.theta0_rad):.3f} deg"
+    else:
+        line += "no release found"
+    line += f"; theta from {th.min():.3g} to {th.max():.3g} deg"
+    line += f"; final rest from {res.rest_t_s:.3f} s\n" if math.isfinite(res.rest_t_s) else "; no final rest\n"
+    imp = res.impact_t_s
+    if len(imp):
+        line += f"{len(imp)} impacts, first {imp[0]:.4f} s, last {imp[-1]:.4f} s\n"
+    else:
+        line += "no impacts\n"
+    return line

@@ -1,0 +1,137 @@
+"""Is this IMU log a rocking block (or a still-mounted table sensor)?
+
+A rocking block turns about one edge of its base: a horizontal axis, fixed in
+the block (and so in the sensor frame), whatever the sensor's mis-mount.  Its
+gyro rate therefore lies along one sensor-frame direction perpendicular to the
+gravity reading at rest, and the angle about that axis stays within a half
+turn (a block that overturns lies on a side, ~90 deg).  A sensor turned about
+its vertical, moved by hand or spun shows none of this; integrating it about
+its principal axis gives angles that mean nothing (``W-IMU-NOT-ROCKING``).
+
+A table sensor is meant not to turn at all: gravity is removed in the
+orientation measured at the rest before shaking, so any later turn of the
+sensor leaks ``2 g sin(turn / 2)`` into the "table acceleration"
+(``W-IMU-TABLE``).
+
+The bounds are module constants so tests can perturb them.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..._diagnostics import warn
+from ._motion import cumtrapz, moving_average, rownorm
+
+__all__ = []
+
+#: Largest angle of the rocking axis above the horizontal at the rest before release, rad.
+#: A level table tilts the axis by its slope (< 2 deg in a lab); a vertical spin is 90 deg.
+AXIS_TILT_MAX_RAD = np.deg2rad(20.0)
+#: Smallest share of the mean-square rate (while rotating) about the rocking axis.
+#: Planar rocking with 0.1 deg/s of gyro noise gives > 0.99.
+AXIS_SHARE_MIN = 0.8
+#: Largest range (max - min) of the gyro angle about the axis, rad: a rocking or
+#: overturning block stays within a half turn.
+TURN_RANGE_MAX_RAD = np.pi
+#: Largest residual gyro bias the two-rest anchoring may remove, rad/s (a still MEMS
+#: gyro's bias wanders by hundredths of a deg/s over a test).
+DRIFT_MAX_RAD_S = np.deg2rad(1.0)
+#: Largest turn of a table sensor over the log, rad.
+TABLE_TURN_MAX_RAD = np.deg2rad(3.0)
+#: Rate above which a sample counts as rotating (50 ms means), rad/s.
+_ROT_THR_RAD_S = np.deg2rad(2.0)
+
+
+@dataclass(frozen=True)
+class RockingCheck:
+    """Measured evidence that a log is a rocking block.
+
+    Attributes
+    ----------
+    axis_tilt_rad : float
+        Angle of the rocking axis above the horizontal plane at the rest before
+        the motion, rad (NaN when the log never rotates).
+    axis_share : float
+        Share of the mean-square bias-free rate about the axis over the rotating
+        samples, 0..1 (NaN when fewer than 0.1 s rotate).
+    turn_range_rad : float
+        Range of the bias-free gyro angle about the axis, rad.
+    reasons : tuple of str
+        The bounds broken (empty: a rocking block).
+    """
+
+    axis_tilt_rad: float
+    axis_share: float
+    turn_range_rad: float
+    reasons: tuple = ()
+
+
+def check_rocking(t, w, u, f_rest, fs, drift_rad_s) -> RockingCheck:
+    """Measure the rocking evidence (module doc) of bias-free rates ``w`` (n, 3) rad/s about ``u``.
+
+    ``f_rest`` is the accelerometer mean over the rest before the motion (m/s^2,
+    sensor frame); ``drift_rad_s`` the residual bias the anchoring removed.
+    """
+    w_avg = max(1, int(round(0.05 * fs)))
+    rot = moving_average(rownorm(w), w_avg) > _ROT_THR_RAD_S
+    if int(rot.sum()) < max(2, int(round(0.1 * fs))):
+        return RockingCheck(float("nan"), float("nan"), 0.0)
+    g_hat = f_rest / (np.linalg.norm(f_rest) + 1e-300)
+    tilt = float(np.arcsin(min(1.0, abs(float(u @ g_hat)))))
+    wr = w[rot]
+    share = float(np.sum((wr @ u) ** 2) / max(float(np.sum(wr * wr)), 1e-300))
+    ang = cumtrapz(t, w @ u)
+    turn = float(np.max(ang) - np.min(ang))
+    reasons = []
+    if tilt > AXIS_TILT_MAX_RAD:
+        reasons.append(
+            f"the rotation axis is {np.rad2deg(tilt):.3g} deg above the horizontal "
+            f"(a rocking edge is horizontal; bound {np.rad2deg(AXIS_TILT_MAX_RAD):.3g} deg)"
+        )
+    if share < AXIS_SHARE_MIN:
+        reasons.append(
+            f"only {100 * share:.3g} % of the rotation is about that axis (rocking: > {100 * AXIS_SHARE_MIN:.3g} %)"
+        )
+    if turn > TURN_RANGE_MAX_RAD:
+        reasons.append(
+            f"the gyro turns through {np.rad2deg(turn):.4g} deg about it "
+            f"(rocking stays within {np.rad2deg(TURN_RANGE_MAX_RAD):.3g} deg)"
+        )
+    if abs(drift_rad_s) > DRIFT_MAX_RAD_S:
+        reasons.append(
+            f"holding the rests needs a {np.rad2deg(drift_rad_s):.3g} deg/s gyro drift "
+            f"(a still gyro drifts < {np.rad2deg(DRIFT_MAX_RAD_S):.3g} deg/s)"
+        )
+    return RockingCheck(tilt, share, turn, tuple(reasons))
+
+
+def warn_not_rocking(source: str, chk: RockingCheck) -> str:
+    """Emit ``W-IMU-NOT-ROCKING`` for a failed :class:`RockingCheck`; returns its message."""
+    d = warn(
+        "W-IMU-NOT-ROCKING",
+        f"{source}: not a rocking block: "
+        + "; ".join(chk.reasons)
+        + "; theta, release and impacts are meaningless (check the log and the sensor's mounting)",
+    )
+    return d.message
+
+
+def table_turn(t, gyro, bias, acc, f_rest, fs, min_rest) -> float:
+    """Largest turn of a table sensor over the log, rad.
+
+    The larger of the bias-free gyro's small-angle rotation vector norm and, when the
+    log ends still, the angle between the gravity readings of the first and last rests.
+    """
+    w = gyro - bias
+    phi = np.concatenate([np.zeros((1, 3)), np.cumsum(0.5 * (w[1:] + w[:-1]) * np.diff(t)[:, None], axis=0)])
+    turn = float(np.max(rownorm(phi))) if len(t) else 0.0
+    k = min(len(t), max(3, int(min_rest)))
+    tail = acc[-k:]
+    if float(np.max(rownorm(tail - tail.mean(axis=0)))) < 0.05 * np.linalg.norm(f_rest):
+        f1 = tail.mean(axis=0)
+        c = float(f1 @ f_rest) / (np.linalg.norm(f1) * np.linalg.norm(f_rest) + 1e-300)
+        turn = max(turn, float(np.arccos(np.clip(c, -1.0, 1.0))))
+    return turn

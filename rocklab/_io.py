@@ -16,13 +16,16 @@ __all__ = ["atomic_path", "write_text_atomic", "write_json_atomic", "write_frame
 
 
 @contextlib.contextmanager
-def atomic_path(path, suffix: str | None = None):
+def atomic_path(path, suffix: str | None = None, *, side: bool = False):
     """Yield a temporary path next to ``path``; rename it onto ``path`` on success.
 
-    On an exception the temporary file is removed and ``path`` is untouched.
+    On an exception the temporary file is removed and ``path`` is untouched. A ``side``
+    file (one the user did not name: ``<stem>_table.csv``, ``audit.json``, a default
+    output name) never replaces a user's file: one rocklab did not write is kept as
+    ``NAME.user-<time>`` (:func:`rocklab._outdir.set_aside_user_file`).
     """
     from ._errors import InputError
-    from ._outdir import clean_stale, stale_prefix
+    from ._outdir import claim_side_file, clean_stale, set_aside_user_file, stale_prefix
 
     path = Path(path)
     if path.is_dir():
@@ -39,23 +42,30 @@ def atomic_path(path, suffix: str | None = None):
         umask = os.umask(0)
         os.umask(umask)
         os.chmod(tmp, 0o666 & ~umask)
+        kept = set_aside_user_file(path) if side else None
         os.replace(tmp, path)
+        if kept is not None:
+            import sys
+
+            sys.stderr.write(f"rocklab: kept your {path} as {kept.name} (rocklab did not write it) and wrote {path}\n")
+        if side:
+            claim_side_file(path)
     except BaseException:
         with contextlib.suppress(FileNotFoundError):
             os.unlink(tmp)
         raise
 
 
-def write_text_atomic(path, text: str) -> Path:
-    """Write ``text`` (UTF-8) to ``path`` atomically and return the path."""
-    with atomic_path(path) as tmp:
+def write_text_atomic(path, text: str, *, side: bool = False) -> Path:
+    """Write ``text`` (UTF-8) to ``path`` atomically and return the path (``side``: see :func:`atomic_path`)."""
+    with atomic_path(path, side=side) as tmp:
         Path(tmp).write_text(text, encoding="utf-8")
     return Path(path)
 
 
-def write_json_atomic(path, obj, indent: int = 2) -> Path:
-    """Write ``obj`` as JSON to ``path`` atomically (NaN written as null)."""
-    return write_text_atomic(path, dumps_json(obj, indent=indent) + "\n")
+def write_json_atomic(path, obj, indent: int = 2, *, side: bool = False) -> Path:
+    """Write ``obj`` as JSON to ``path`` atomically (NaN written as null; ``side``: see :func:`atomic_path`)."""
+    return write_text_atomic(path, dumps_json(obj, indent=indent) + "\n", side=side)
 
 
 def dumps_json(obj, indent: int | None = None) -> str:
@@ -64,10 +74,11 @@ def dumps_json(obj, indent: int | None = None) -> str:
     return json.dumps(json_safe(obj), indent=indent, allow_nan=False, default=str)
 
 
-def write_frame_atomic(path, frame, **kwargs) -> Path:
-    """Write a pandas DataFrame to CSV atomically (``index=False`` by default)."""
+def write_frame_atomic(path, frame, *, side: bool = False, **kwargs) -> Path:
+    """Write a pandas DataFrame to CSV atomically (``index=False`` by default; ``side``: see
+    :func:`atomic_path`)."""
     kwargs.setdefault("index", False)
-    with atomic_path(path) as tmp:
+    with atomic_path(path, side=side) as tmp:
         frame.to_csv(tmp, **kwargs)
     return Path(path)
 

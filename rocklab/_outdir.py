@@ -41,6 +41,8 @@ __all__ = [
     "foreign_entries",
     "pid_alive",
     "stale_prefix",
+    "set_aside_user_file",
+    "claim_side_file",
 ]
 
 #: Name of the marker file in every folder rocklab writes.
@@ -225,6 +227,43 @@ def claim_dir(path, entries, command: str = "") -> Path:
     path.mkdir(parents=True, exist_ok=True)
     _write_marker(path, command, owned_entries(path) | set(entries))
     return path
+
+
+def _user_copy_name(path: Path, stamp: str, k: int) -> Path:
+    return path.with_name(f"{path.name}.user-{stamp}" + (f"-{k}" if k else ""))
+
+
+def set_aside_user_file(path) -> Path | None:
+    """Keep a user's file at ``path`` as ``NAME.user-<time>`` before rocklab writes a side file there.
+
+    Side files (``<stem>_table.csv``, ``audit.json``, ``points.csv``, ``<stem>.parquet``,
+    default output names) follow the rule of folder outputs: a file rocklab wrote there
+    before (recorded in the folder's :data:`MARKER`) is replaced; anything else is the
+    user's and is kept under a new name, never overwritten. Returns the new name, or
+    None when there was nothing of the user's to keep.
+    """
+    path = Path(path)
+    if not (path.exists() or path.is_symlink()) or path.name in owned_entries(path.parent):
+        return None
+    stamp = time.strftime("%Y%m%dT%H%M%S")
+    for k in range(1000):
+        dest = _user_copy_name(path, stamp, k)
+        try:  # a hard link cannot replace an existing name: two runs in one second keep both copies
+            os.link(path, dest, follow_symlinks=False)
+        except FileExistsError:
+            continue
+        except OSError:  # no hard links on this file system: a rename onto a name checked free
+            if dest.exists() or dest.is_symlink():
+                continue
+            os.rename(path, dest)
+        return dest
+    raise InputError(f"{path}: too many kept copies ({path.name}.user-*); tidy the folder")
+
+
+def claim_side_file(path, command: str = "") -> None:
+    """Record the side file ``path`` as rocklab's in its folder's marker (replaced freely next time)."""
+    path = Path(path)
+    claim_dir(path.parent, [path.name], command=command)
 
 
 def _swap(src: Path, dest: Path) -> None:

@@ -662,6 +662,252 @@ def _broken_campaign(tmp):
     return ["campaign", root, "--out", tmp / "out", "--workers", 1, "--no-progress"]
 
 
+# -- inputs are sacred: an output naming an input is refused before any work ----------------------
+SACRED = "would overwrite the input|are the same file"
+
+
+def _film(p: Path, n: int = 6, size=(64, 48)) -> Path:
+    """A short real film (PyAV, MPEG-4 part 2): the trackers can decode it."""
+    av = pytest.importorskip("av")
+    w, h = size
+    with av.open(str(p), "w") as c:
+        s = c.add_stream("mpeg4", rate=25)
+        s.width, s.height, s.pix_fmt = w, h, "yuv420p"
+        for i in range(n):
+            img = np.full((h, w, 3), 30 + 20 * i, np.uint8)
+            for pkt in s.encode(av.VideoFrame.from_ndarray(img, format="rgb24")):
+                c.mux(pkt)
+        for pkt in s.encode():
+            c.mux(pkt)
+    return p
+
+
+def _points_csv(p: Path) -> Path:
+    """Four targets of a block rocking about a base edge (long CSV, metres)."""
+    t = np.arange(0, 2, 0.01)
+    th = 0.05 * np.exp(-t) * np.cos(8 * t)
+    rows = []
+    for name, (x, z) in {"a": (0.0, 0.2), "b": (0.045, 0.2), "c": (0.0, 0.0), "d": (0.045, 0.0)}.items():
+        X, Z = x * np.cos(th) + z * np.sin(th), -x * np.sin(th) + z * np.cos(th)
+        rows += [f"{ti:.3f},{name},{xi:.6f},0,{zi:.6f}" for ti, xi, zi in zip(t, X, Z)]
+    p.write_text("t_s,point,x_m,y_m,z_m\n" + "\n".join(rows) + "\n")
+    return p
+
+
+def _c3d(tmp: Path) -> Path:
+    src = Path(__file__).parent / "data" / "c3d" / "Qualisys.c3d"
+    p = tmp / "p.c3d"
+    p.write_bytes(src.read_bytes())
+    return p
+
+
+def _imu_folder(tmp: Path, high_g: bool = False) -> Path:
+    d = tmp / "log"
+    d.mkdir()
+    (d / "Inertial.csv").write_text(IMU_HEAD + "\n" + "\n".join(ROWS) + "\n")
+    if high_g:
+        (d / "HighGAccelerometer.csv").write_text("Timestamp (us),X (g),Y (g),Z (g)\n19150794,0,0,1\n")
+    return d
+
+
+def _trk_real(tmp: Path, toml: str = OBJ):
+    return _film(tmp / "v.mp4"), _write(tmp / "t.toml", toml)
+
+
+def _stereo_in(tmp: Path):
+    return _film(tmp / "c1.mkv"), _film(tmp / "c2.mkv"), _write(tmp / "c.json", '{"K1": 1}')
+
+
+def _symlink(target: Path, link: Path) -> Path:
+    link.symlink_to(target.name)
+    return link
+
+
+def _hardlink(target: Path, link: Path) -> Path:
+    import os
+
+    os.link(target, link)
+    return link
+
+
+def _frames(tmp: Path) -> Path:
+    import cv2
+
+    d = tmp / "seq"
+    d.mkdir()
+    for i in range(1, 4):
+        cv2.imwrite(str(d / f"{i:03d}.png"), np.full((48, 64, 3), 60 * i, np.uint8))
+    return d
+
+
+many(
+    "sacred",
+    [
+        ("track-o-video", lambda tmp: ["track", *_trk_cmd(tmp), "-o", tmp / "v.mp4"], "error", SACRED),
+        ("track-o-config", lambda tmp: ["track", *_trk_cmd(tmp), "-o", tmp / "t.toml"], "error", SACRED),
+        (
+            "track-o-calibration",
+            lambda tmp: [
+                "track",
+                _film(tmp / "v.mp4"),
+                "--config",
+                _write(tmp / "t.toml", '[video]\ncalibration = "cam.json"\n' + OBJ),
+                "-o",
+                _write(tmp / "cam.json", "{}"),
+            ],
+            "error",
+            SACRED,
+        ),
+        (
+            "track-o-frame",
+            lambda tmp: [
+                "track",
+                _frames(tmp) / "%03d.png",
+                "--config",
+                _write(tmp / "t.toml", OBJ),
+                "-o",
+                tmp / "seq" / "002.png",
+            ],
+            "error",
+            SACRED,
+        ),
+        (
+            "track-init-preview-video",
+            lambda tmp: ["track", "init", _film(tmp / "v.mp4"), "-o", tmp / "n.toml", "--preview", tmp / "v.mp4"],
+            "error",
+            SACRED,
+        ),
+        (
+            "track-init-o-preview",
+            lambda tmp: ["track", "init", _film(tmp / "v.mp4"), "-o", tmp / "n.toml", "--preview", tmp / "n.toml"],
+            "error",
+            SACRED,
+        ),
+        (
+            "track-preview-o-video",
+            lambda tmp: ["track", "preview", *_trk_cmd(tmp), "-o", tmp / "v.mp4"],
+            "error",
+            SACRED,
+        ),
+        ("track3d-o-csv", lambda tmp: ["track3d", _points_csv(tmp / "p.csv"), "-o", tmp / "p.csv"], "error", SACRED),
+        (
+            "track3d-rrd-csv",
+            lambda tmp: ["track3d", _points_csv(tmp / "p.csv"), "-o", tmp / "o.csv", "--rrd", tmp / "p.csv"],
+            "error",
+            SACRED,
+        ),
+        ("track3d-o-c3d", lambda tmp: ["track3d", _c3d(tmp), "-o", tmp / "p.c3d"], "error", SACRED),
+        (
+            "track3d-audit-is-input",
+            lambda tmp: ["track3d", _points_csv(tmp / "audit.json"), "-o", tmp / "o.csv"],
+            "error",
+            SACRED,
+        ),
+        (
+            "track3d-o-audit",
+            lambda tmp: ["track3d", _points_csv(tmp / "p.csv"), "-o", tmp / "audit.json"],
+            "error",
+            SACRED,
+        ),
+        (
+            "track3d-o-symlink",
+            lambda tmp: ["track3d", _points_csv(tmp / "p.csv"), "-o", _symlink(tmp / "p.csv", tmp / "link.csv")],
+            "error",
+            SACRED,
+        ),
+        ("imu-o-log", lambda tmp: ["imu", _imu_folder(tmp), "-o", tmp / "log" / "Inertial.csv"], "error", SACRED),
+        (
+            "imu-o-companion",
+            lambda tmp: ["imu", _imu_folder(tmp, True), "-o", tmp / "log" / "HighGAccelerometer.csv"],
+            "error",
+            SACRED,
+        ),
+        ("oas-o-record", lambda tmp: ["oas", _good_record(tmp), "-o", tmp / "r.AT2"], "error", SACRED),
+        ("oas-plot-record", lambda tmp: ["oas", _good_record(tmp), "--plot", tmp / "r.AT2"], "error", SACRED),
+        (
+            "oas-list-o-list",
+            lambda tmp: ["oas", "--list", _write(tmp / "t.csv", f"{_good_record(tmp).name}\n"), "-o", tmp / "t.csv"],
+            "error",
+            SACRED,
+        ),
+        (
+            "oas-folder-o-record",
+            lambda tmp: ["oas", _good_record(tmp).parent, "-o", tmp / "r.AT2", "--no-progress"],
+            "error",
+            SACRED,
+        ),
+        (
+            "simulate-o-base",
+            lambda tmp: [*_sim()(tmp), "--base-motion", _good_record(tmp), "-o", tmp / "r.AT2"],
+            "error",
+            SACRED,
+        ),
+        (
+            "simulate-o-hardlink",
+            lambda tmp: [
+                *_sim()(tmp),
+                "--base-motion",
+                _good_record(tmp),
+                "-o",
+                _hardlink(tmp / "r.AT2", tmp / "h.AT2"),
+            ],
+            "error",
+            SACRED,
+        ),
+        (
+            "column-o-base",
+            lambda tmp: ["column", "--blocks", "0.3x1.5", "--base-motion", _good_record(tmp), "-o", tmp / "r.AT2"],
+            "error",
+            SACRED,
+        ),
+        (
+            "column-maps-base",
+            lambda tmp: [
+                "column",
+                "--blocks",
+                "0.3x1.5",
+                "--base-motion",
+                _good_record(tmp),
+                "--maps-png",
+                tmp / "r.AT2",
+            ],
+            "error",
+            SACRED,
+        ),
+        (
+            "stereo-track-o-calib",
+            lambda tmp: ["stereo", "track", *_stereo_in(tmp)[:2], "--calib", tmp / "c.json", "-o", tmp / "c.json"],
+            "error",
+            SACRED,
+        ),
+        (
+            "stereo-track-points-side",
+            lambda tmp: ["stereo", "track", *_stereo_in(tmp)[:2], "--calib", tmp / "c.json", "-o", tmp / "points.csv"],
+            "error",
+            SACRED,
+        ),
+        (
+            "stereo-track-o-film2",
+            lambda tmp: ["stereo", "track", *_stereo_in(tmp)[:2], "--calib", tmp / "c.json", "-o", tmp / "c2.mkv"],
+            "error",
+            SACRED,
+        ),
+        (
+            "stereo-calibrate-o-film",
+            lambda tmp: ["stereo", "calibrate", *_stereo_in(tmp)[:2], "-o", tmp / "c1.mkv"],
+            "error",
+            SACRED,
+        ),
+    ],
+    None,
+)
+
+
+def _trk_cmd(tmp):
+    v, c = _trk_real(tmp)
+    return [v, "--config", c]
+
+
 # -- the runner --------------------------------------------------------------------------------------------
 def test_corpus_size():
     assert len(CASES) >= 150, len(CASES)
@@ -675,6 +921,8 @@ def test_corpus_case(tmp_path, run_cli, capsys, name, build, expect):
     before = set()
     argv = build(tmp_path)
     before = {p for p in tmp_path.rglob("*")}
+    # inputs are sacred: every file the case made keeps its bytes, whatever the outcome
+    kept = {p: p.read_bytes() for p in before if p.is_file()}
     try:
         rc, out, err = run_cli(*argv)
     except SystemExit as e:  # argparse's own usage errors (one line, status 2)
@@ -700,3 +948,5 @@ def test_corpus_case(tmp_path, run_cli, capsys, name, build, expect):
         assert rc == 1, (rc, err)
         assert re.search(words, err + out), (err, out)
     assert not [p for p in tmp_path.rglob(".*.tmp-*")], "staging leftovers"
+    changed = [str(p) for p, b in kept.items() if not p.is_file() or p.read_bytes() != b]
+    assert not changed, f"inputs changed: {changed}"

@@ -136,3 +136,63 @@ def test_unreachable_scheduler_is_one_line(tmp_path, run_cli):
         "campaign", cfg.parent, "--out", tmp_path / "c", "--scheduler", "tcp://127.0.0.1:9", "--no-progress"
     )
     assert rc == 2 and err.count("\n") == 1 and "no Dask scheduler answered" in err
+
+
+def _points(p):
+    t = np.arange(0, 2, 0.01)
+    th = 0.05 * np.exp(-t) * np.cos(8 * t)
+    rows = []
+    for name, (x, z) in {"a": (0.0, 0.2), "b": (0.045, 0.2), "c": (0.0, 0.0), "d": (0.045, 0.0)}.items():
+        X, Z = x * np.cos(th) + z * np.sin(th), -x * np.sin(th) + z * np.cos(th)
+        rows += [f"{ti:.3f},{name},{xi:.6f},0,{zi:.6f}" for ti, xi, zi in zip(t, X, Z)]
+    p.write_text("t_s,point,x_m,y_m,z_m\n" + "\n".join(rows) + "\n")
+    return p
+
+
+def test_side_files_keep_a_users_file_and_replace_their_own(tmp_path, run_cli):
+    src = _points(tmp_path / "p.csv")
+    (tmp_path / "audit.json").write_text("my audit")
+    (tmp_path / "tracks.csv").write_text("my tracks")  # the default -o is a side file too
+    for k in range(2):
+        rc, out, err = run_cli("track3d", src)
+        assert rc == 0, err
+        kept = sorted(p.name for p in tmp_path.iterdir() if ".user-" in p.name)
+        # the first run keeps both of the user's files; the second replaces only rocklab's own
+        assert len(kept) == 2, kept
+        assert {(tmp_path / n).read_text() for n in kept} == {"my audit", "my tracks"}
+        assert json.loads((tmp_path / "audit.json").read_text())["verdict"] in ("valid", "suspect", "invalid")
+        assert pd.read_csv(tmp_path / "tracks.csv")["theta_rad"].abs().max() == pytest.approx(0.05, rel=0.2)
+        assert err.count("rocklab: kept your") == (2 if k == 0 else 0), err
+    assert src.read_text().startswith("t_s,point")
+    # an explicit -o is the user's choice: replaced, but audit.json beside it is still a side file
+    (tmp_path / "sub").mkdir()
+    (tmp_path / "sub" / "mine.csv").write_text("replace me")
+    (tmp_path / "sub" / "audit.json").write_text("keep me")
+    assert run_cli("track3d", src, "-o", tmp_path / "sub" / "mine.csv")[0] == 0
+    assert "theta_rad" in (tmp_path / "sub" / "mine.csv").read_text().splitlines()[0]
+    assert [p.read_text() for p in (tmp_path / "sub").glob("audit.json.user-*")] == ["keep me"]
+
+
+def test_user_copies_in_one_second_do_not_collide(tmp_path):
+    from rocklab._io import write_text_atomic
+
+    p = tmp_path / "audit.json"
+    for k in range(3):
+        p.write_text(f"user {k}")  # the user writes it again: not rocklab's any more
+        marker = tmp_path / MARKER
+        if marker.exists():
+            marker.unlink()
+        write_text_atomic(p, "rocklab", side=True)
+    kept = sorted(q.read_text() for q in tmp_path.glob("audit.json.user-*"))
+    assert kept == ["user 0", "user 1", "user 2"] and p.read_text() == "rocklab"
+
+
+def test_oas_parquet_side_file_keeps_a_users_file(tmp_path, run_cli, shared_data):
+    recs = sorted((shared_data / "records").glob("*.AT2"))[:2]
+    (tmp_path / "tab.parquet").write_text("my parquet")
+    rc, out, err = run_cli(
+        "oas", *recs, "-o", tmp_path / "tab.csv", "--levels", 6, "--sizes", 6, "--refine", 2, "--no-progress"
+    )
+    assert rc == 0, err
+    assert [p.read_text() for p in tmp_path.glob("tab.parquet.user-*")] == ["my parquet"]
+    assert len(pd.read_parquet(tmp_path / "tab.parquet")) == 2

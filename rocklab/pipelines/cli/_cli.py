@@ -11,7 +11,8 @@ Exit status (the policy scripts rely on):
   JSON output's ``warnings`` list); with ``--strict`` a suspect result exits 4;
 - 1: the command ran but (part of) its result failed: a failed fit, a campaign
   with a failed experiment (the others are still reported);
-- 2: bad input, or an output that cannot be written: one line on stderr naming
+- 2: bad input, or an output that cannot be written or is one of the command's
+  inputs (checked before any work, :mod:`._io_plan`): one line on stderr naming
   the file/line or parameter, the rule and the fix; nothing is written;
 - 3: an internal error (a bug): one line, ``--debug`` shows the traceback;
 - 4: ``--strict`` and a warning of severity ``suspect``;
@@ -68,8 +69,10 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def _check_file_outputs(args) -> None:
-    """Output files named on the command line are checked before any work starts."""
+    """Output files are checked before any work starts: writable, and none of them an input."""
+    from ..._inputs import check_outputs_not_inputs
     from ..._outdir import check_output_file
+    from ._io_plan import io_plan
 
     for attr, opt in (("output", "-o"), ("plot", "--plot"), ("maps_png", "--maps-png"), ("rrd", "--rrd")):
         v = getattr(args, attr, None)
@@ -77,6 +80,7 @@ def _check_file_outputs(args) -> None:
             check_output_file(v, opt)
     if args.command not in FOLDER_COMMANDS and getattr(args, "out", None):
         check_output_file(args.out, "-o/--out")
+    check_outputs_not_inputs(*io_plan(args))
 
 
 #: Commands whose ``--out`` is a folder (checked by :func:`rocklab._outdir.check_output_dir`).

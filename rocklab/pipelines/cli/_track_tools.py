@@ -28,7 +28,7 @@ def _first_frame(video: Path):
     raise InputError(f"{video}: no frame could be decoded; check the file")
 
 
-def track_init(video, out, *, objects=(), table=None, marker_size_m=None, preview=None):
+def track_init(video, out, *, objects=(), table=None, marker_size_m=None, preview=None, side=(False, False)):
     """Write a commented ``track.toml`` for ``video`` (and a preview PNG); returns (config, notes).
 
     Parameters
@@ -69,11 +69,11 @@ def track_init(video, out, *, objects=(), table=None, marker_size_m=None, previe
         "# Schema: docs/track-toml.md",
     ]
     head += [f"# {n}" for n in notes]
-    write_text_atomic(out, "\n".join(head) + "\n\n" + cfg.to_toml())
+    write_text_atomic(out, "\n".join(head) + "\n\n" + cfg.to_toml(), side=side[0])
     if preview is not None:
         from ..experiment._figures import save_bgr_png
 
-        save_bgr_png(Path(preview), draw_init_preview(img, cfg, found))
+        save_bgr_png(Path(preview), draw_init_preview(img, cfg, found), side=side[1])
     return cfg, notes
 
 
@@ -139,7 +139,7 @@ def _draw_top_edge(out, img, cfg, table) -> None:
     cv2.putText(out, text, (a[0], a[1] + 16), cv2.FONT_HERSHEY_SIMPLEX, 0.5, (0, 255, 255), 1, cv2.LINE_AA)
 
 
-def track_preview(video, config, out, *, n_frames: int = 6, progress: bool = False):
+def track_preview(video, config, out, *, n_frames: int = 6, progress: bool = False, side: bool = False):
     """Track ``video`` and write a contact sheet of ``n_frames`` frames spread over it (PNG)."""
     from ...tracking import load_track_config, track_video
 
@@ -161,7 +161,7 @@ def track_preview(video, config, out, *, n_frames: int = 6, progress: bool = Fal
             tiles.append(_draw_pose(img, res, i))
     from ..experiment._figures import save_bgr_png
 
-    save_bgr_png(Path(out), contact_sheet(tiles))
+    save_bgr_png(Path(out), contact_sheet(tiles), side=side)
     return res, [int(f) for f in pick]
 
 

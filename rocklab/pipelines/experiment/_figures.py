@@ -29,14 +29,15 @@ def save_png(fig, path, dpi: int = 110, tight: bool = True):
     return path
 
 
-def save_bgr_png(path, image):
-    """Write a BGR (or grey) uint8 image to ``path`` as a PNG atomically; returns ``path``."""
+def save_bgr_png(path, image, *, side: bool = False):
+    """Write a BGR (or grey) uint8 image to ``path`` as a PNG atomically; returns ``path``
+    (``side``: a user's file there is kept, see :func:`rocklab._io.atomic_path`)."""
     import cv2
 
     ok, buf = cv2.imencode(".png", image)
     if not ok:
         raise OSError(f"{path}: PNG encoding failed")
-    with atomic_path(path, suffix=".png") as tmp:
+    with atomic_path(path, suffix=".png", side=side) as tmp:
         Path(tmp).write_bytes(buf.tobytes())
     return path
 

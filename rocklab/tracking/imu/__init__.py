@@ -8,13 +8,14 @@
 - a table's horizontal acceleration (:func:`table_acceleration`).
 """
 
-from ._read import ImuLog, read_imu, read_ximu_registers, ximu_rate_from_registers
+from ._read import ImuLog, imu_log_files, read_imu, read_ximu_registers, ximu_rate_from_registers
 from ._rotation import ImuRotation, ahrs_quaternions, ahrs_rotation, block_rotation
 from ._table import TableAcceleration, table_acceleration
 
 __all__ = [
     "ImuLog",
     "read_imu",
+    "imu_log_files",
     "read_ximu_registers",
     "ximu_rate_from_registers",
     "ImuRotation",

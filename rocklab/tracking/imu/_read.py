@@ -60,7 +60,7 @@ from ._csv import (
 from ._log import ImuLog
 from ._ximu import _read_ximu_gui, read_ximu_registers, ximu_rate_from_registers
 
-__all__ = ["ImuLog", "read_imu", "read_ximu_registers", "ximu_rate_from_registers"]
+__all__ = ["ImuLog", "read_imu", "imu_log_files", "read_ximu_registers", "ximu_rate_from_registers"]
 
 
 # --------------------------------------------------------------------------- x-IMU3
@@ -190,6 +190,19 @@ def _resolve(path: Path) -> Path:
         if cand.is_file():
             return cand
     raise FileNotFoundError(2, "no such file or folder", str(path))
+
+
+def imu_log_files(path) -> list[Path]:
+    """The files :func:`read_imu` reads for ``path`` (the log, and the companions next to it that exist).
+
+    Raises the same errors as :func:`read_imu` for a folder without one log, or a missing path.
+    """
+    p = _resolve(Path(path))
+    companions = [p.with_name("HighGAccelerometer.csv")]
+    for suffix in ("_CalInertialAndMag.csv", "_CalInertialMagnetic.csv"):
+        if p.name.endswith(suffix):
+            companions.append(p.with_name(p.name[: -len(suffix)] + "_Registers.csv"))
+    return [p] + [c for c in companions if c.is_file()]
 
 
 def read_imu(

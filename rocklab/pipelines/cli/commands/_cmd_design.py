@@ -217,7 +217,7 @@ def _run_oas_batch(args, kw) -> int:
         write_frame_atomic(out, tab, float_format="%.6g")
         from ...._io import atomic_path
 
-        with atomic_path(out.with_suffix(".parquet")) as tmp:
+        with atomic_path(out.with_suffix(".parquet"), side=True) as tmp:
             tab.to_parquet(tmp, index=False)
     if args.plot:
         from ...spectra._plots_spectra import plot_tI_vs_tp

@@ -104,9 +104,11 @@ def _calibrate(args) -> int:
         raise InputError(
             f"--board: unknown ArUco dictionary {board['dictionary']!r}; e.g. DICT_5X5_100, DICT_4X4_50, DICT_6X6_250"
         )
+    from ...._io import write_json_atomic
+
     out = Path(args.out) if args.out else Path(args.film1).parent / "stereo.json"
     rig = calibrate_stereo(args.film1, args.film2, board)
-    rig.save(out)
+    write_json_atomic(out, rig.to_dict(), side=not args.out)  # StereoRig.save's file; a default name keeps a user's
     d = dict(rig.to_dict(), stereo_json=str(out))
     _emit(
         args,
@@ -124,8 +126,10 @@ def _calibrate(args) -> int:
 def _track(args) -> int:
     import numpy as np
 
-    from ....tracking.rigid import parse_bodies, track_points3d, write_points_csv
+    from ...._io import write_frame_atomic
+    from ....tracking.rigid import parse_bodies, track_points3d
     from ....tracking.stereo import load_rig, stereo_point_series, track_dots_stereo
+    from .._io_plan import POINTS, stereo_track_outputs
     from ._cmd_track3d import _rest, write_track3d_outputs
 
     if not args.calib:
@@ -149,9 +153,9 @@ def _track(args) -> int:
     if not bodies:
         raise InputError(f"{args.film1}: no moving group of targets found; name the block's points with --body")
     res = track_points3d(series, bodies, up="z", rest=rest)
-    pts_path = out.with_name("points.csv")
-    write_points_csv(series, pts_path)
-    d = write_track3d_outputs(out, series, res, args.rrd)
+    pts_path = stereo_track_outputs(out)[POINTS]
+    write_frame_atomic(pts_path, series.to_frame(), float_format="%.9g", side=True)  # as write_points_csv
+    d = write_track3d_outputs(out, series, res, args.rrd, out_side=not args.out)
     d.update(
         points_csv=str(pts_path),
         sync=None if sp.sync is None else sp.sync.to_dict(),

@@ -69,6 +69,7 @@ def run(args) -> int:
 
     from ...._io import write_frame_atomic
     from ....tracking import load_track_config, track_video
+    from .._io_plan import TABLE, track_outputs
 
     video = Path(args.video)
     cfg_path = Path(args.config) if args.config else video.parent / "track.toml"
@@ -79,7 +80,7 @@ def run(args) -> int:
     cfg = load_track_config(cfg_path)
     res = track_video(video, cfg, fps=args.fps, progress=args.progress)
     out = Path(args.out) if args.out else video.parent / "tracks.csv"
-    write_frame_atomic(out, res.to_frame(), float_format="%.9g")
+    write_frame_atomic(out, res.to_frame(), float_format="%.9g", side=not args.out)
     summary = res.to_dict()
     summary["tracks_csv"] = str(out)
     if cfg.table is not None and any(res[cfg.table.id].ok):
@@ -91,8 +92,8 @@ def run(args) -> int:
             summary["table_motion"] = {"error": str(e)}
             warn("W-TABLE-MOTION", f"{video}: no table motion for {cfg.table.id!r}: {e}")
         else:
-            tpath = out.with_name(out.stem + "_table.csv")
-            write_frame_atomic(tpath, tm.to_frame(), float_format="%.9g")
+            tpath = track_outputs(out)[TABLE]
+            write_frame_atomic(tpath, tm.to_frame(), float_format="%.9g", side=True)
             summary["table_motion"] = {**tm.to_dict(), "csv": str(tpath)}
     if args.json:
         from .._cli_base import emit_json
@@ -119,7 +120,13 @@ def _tools(args) -> int:
             raise InputError(f"-o {out}: the config is a .toml file; give e.g. -o track.toml")
         preview = Path(args.preview) if args.preview else out.with_name(out.stem + "_init.png")
         cfg, notes = track_init(
-            video, out, objects=args.object, table=args.table, marker_size_m=args.marker_size, preview=preview
+            video,
+            out,
+            objects=args.object,
+            table=args.table,
+            marker_size_m=args.marker_size,
+            preview=preview,
+            side=(not args.out, not args.preview),
         )
         if args.json:
             from .._cli_base import emit_json
@@ -145,6 +152,6 @@ def _tools(args) -> int:
     if not cfg_path.exists():
         raise InputError(f"{cfg_path}: tracking config not found; pass --config track.toml")
     out = Path(args.out) if args.out else video.parent / "track_preview.png"
-    res, frames = track_preview(video, cfg_path, out, n_frames=args.frames, progress=args.progress)
+    res, frames = track_preview(video, cfg_path, out, n_frames=args.frames, progress=args.progress, side=not args.out)
     print(f"wrote {out}: frames {', '.join(map(str, frames))}")
     return 0

@@ -84,15 +84,19 @@ def _rest(spec: str):
     return (t0, t1)
 
 
-def write_track3d_outputs(out: Path, series, res, rrd=None) -> dict:
+def write_track3d_outputs(out: Path, series, res, rrd=None, out_side: bool = False) -> dict:
     """Write ``tracks.csv`` at ``out``, ``audit.json`` beside it and the Rerun review at ``rrd`` (if given);
-    returns the summary (:meth:`Track3DResult.to_dict` with the paths and the verdict)."""
-    from ...._io import write_frame_atomic, write_json_atomic
+    returns the summary (:meth:`Track3DResult.to_dict` with the paths and the verdict).
 
-    write_frame_atomic(out, res.to_frame(), float_format="%.9g")
+    ``audit.json`` (and ``out`` when ``out_side``: a default name) never replaces a user's file
+    (kept as ``NAME.user-<time>``)."""
+    from ...._io import write_frame_atomic, write_json_atomic
+    from .._io_plan import AUDIT, track3d_outputs
+
+    write_frame_atomic(out, res.to_frame(), float_format="%.9g", side=out_side)
     audit = res.audit_dict()
-    audit_path = out.with_name("audit.json")
-    write_json_atomic(audit_path, audit)
+    audit_path = track3d_outputs(out)[AUDIT]
+    write_json_atomic(audit_path, audit, side=True)
     summary = res.to_dict()
     summary.update(tracks_csv=str(out), audit_json=str(audit_path), verdict=audit["verdict"])
     if rrd:
@@ -117,13 +121,10 @@ def run(args) -> int:
     )
     rest = _rest(args.rest)
     out = Path(args.out) if args.out else src.parent / "tracks.csv"
-    audit_path = out.with_name("audit.json")
-    if audit_path.resolve() == src.resolve():
-        raise InputError(f"-o {out}: audit.json would replace the input; write to another folder")
     series = read_points(src)
     bodies = parse_bodies(args.body, series.labels, series.source)
     res = track_points3d(series, bodies, up=args.up, rest=rest, tolerances=tol)
-    summary = write_track3d_outputs(out, series, res, args.rrd)
+    summary = write_track3d_outputs(out, series, res, args.rrd, out_side=not args.out)
     if args.json:
         from .._cli_base import emit_json
 
@@ -143,5 +144,5 @@ def run(args) -> int:
         print(line)
         if b.audit is not None:
             print(b.audit.report())
-    print(f"wrote {out} and {audit_path} (verdict {summary['verdict']})")
+    print(f"wrote {out} and {summary['audit_json']} (verdict {summary['verdict']})")
     return 0

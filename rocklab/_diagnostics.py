@@ -150,8 +150,23 @@ WARNING_CODES: dict[str, tuple[str, str]] = {
     ),
     "W-VIDEO-SHORT": (
         "note",
-        "fewer frames decoded than the container's header counts: the file was cut or "
-        "damaged, or its header over-counts; the frames there are measured",
+        "the container's header counts more frames than the file holds: the file was cut, or its "
+        "header over-counts; the frames there are measured",
+    ),
+    "W-VIDEO-DROPPED": (
+        "note",
+        "the camera dropped frames: slots of the container's constant clock hold no frame; every "
+        "frame keeps its own time, the gaps are in t_s",
+    ),
+    "W-VIDEO-DAMAGED": (
+        "suspect",
+        "frames the container holds did not decode (damaged packets): the frames around them are "
+        "measured at their own times, the gaps are in t_s; check the copy of the file",
+    ),
+    "W-VIDEO-FPS": (
+        "suspect",
+        "a frame rate given in the config or with --fps contradicts the container's own clock: "
+        "t_s follows the given rate; remove it unless the film's clock is known wrong",
     ),
     "W-VIDEO-LOST": ("suspect", "an object was lost on more than 1 % of the frames (see the status column)"),
     # 3D points and the assumption audit

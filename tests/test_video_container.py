@@ -10,6 +10,7 @@ import cv2
 import numpy as np
 import pytest
 
+from rocklab._diagnostics import RocklabWarning
 from rocklab.tracking import TrackConfig, probe_video, track_video
 from rocklab.tracking.video._video import iter_video_frames
 
@@ -70,8 +71,9 @@ def test_variable_frame_rate_times_come_from_the_container(tmp_path):
     np.testing.assert_allclose(b.t_s, pts_ms / 1000.0, atol=1e-9)
     # θ lines up with the truth at those times (at a constant 1/fps the phase would drift)
     assert np.nanmax(np.abs(b.theta_rad - theta)) < math.radians(0.3)
-    # --fps still overrides the container (a file whose clock is known to be wrong)
-    tr30 = track_video(path, TrackConfig.from_dict(CFG), fps=30.0)
+    # --fps still overrides the container (a file whose clock is known to be wrong), and says so
+    with pytest.warns(RocklabWarning, match="W-VIDEO-FPS"):
+        tr30 = track_video(path, TrackConfig.from_dict(CFG), fps=30.0)
     np.testing.assert_allclose(tr30["block_1"].t_s, np.arange(n) / 30.0, atol=1e-12)
 
 

@@ -400,6 +400,15 @@ def check_films(film1, film2, rig: StereoRig, fps: float | None = None) -> float
         if (info.width_px, info.height_px) != tuple(rig.size):
             raise InputError(f"{where(film)}frame size {info.width_px}x{info.height_px} differs from the "
                              f"calibration's {rig.size[0]}x{rig.size[1]}; calibrate with films of this camera mode")
+        if fps is None and info.frame_times_s is not None and (info.n_dropped or info.variable_rate):
+            # frames are paired by index at one rate: a dropped frame would pair every later one
+            # with its neighbour's time in the other film
+            d = np.diff(info.frame_times_s)
+            at = float(info.frame_times_s[int(np.argmax(np.abs(d - np.median(d))))])
+            what = f"drops {info.n_dropped} frame(s)" if info.n_dropped else "has a variable frame rate"
+            raise InputError(f"{where(film)}the camera {what} (first irregular interval after t = {at:.4f} s); "
+                             "stereo pairs the two films frame by frame at one rate: cut both films to a "
+                             "stretch without the gap, or give --fps if the container's times are wrong")
     rate1 = fps or i1.fps
     rate2 = fps or i2.fps
     if not rate1:

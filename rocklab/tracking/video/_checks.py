@@ -2,7 +2,8 @@
 for: frames the container promised but did not give, objects lost on more than 1 % of the frames,
 a tracker that follows another object.
 
-Each finding is a named warning (``W-VIDEO-SHORT``, ``W-VIDEO-LOST``, ``W-TRACK-LATCH``).
+Each finding is a named warning (``W-VIDEO-SHORT``, ``W-VIDEO-DROPPED``, ``W-VIDEO-DAMAGED``,
+``W-VIDEO-FPS``, ``W-VIDEO-LOST``, ``W-TRACK-LATCH``).
 """
 
 from __future__ import annotations
@@ -47,16 +48,36 @@ def _why_lost(now, ref):
     return "lost"
 
 
-def _check_frames(res, expected: int, path) -> None:
-    """W-VIDEO-SHORT (a note) when fewer frames decode than the container's header counts;
-    W-VIDEO-LOST when an object is lost on more than 1 % of the frames."""
-    if expected > 0 and res.n_frames < 0.99 * expected:
-        # a note, not suspect: every decoded frame is measured; some headers count frames the
-        # stream does not hold (the real pendulum film: 2057 in the header, 1844 decodable)
+def _check_frames(res, expected: int, path, info=None) -> None:
+    """Frames lost, counted per cause: W-VIDEO-SHORT (a note) when the header counts frames the
+    file does not hold; W-VIDEO-DROPPED (a note) for slots of the container's clock without a
+    frame (the camera dropped them; the times stay true); W-VIDEO-DAMAGED when frames the
+    container holds do not decode; W-VIDEO-LOST when an object is lost on more than 1 % of the
+    frames."""
+    n_header = getattr(info, "n_header", 0)
+    n_held = getattr(info, "n_frames", expected)
+    if n_header and n_held < 0.99 * n_header:
+        # a note, not suspect: every frame the file holds is measured
         warn(
             "W-VIDEO-SHORT",
-            f"{path}: the container's header counts {expected} frames but {res.n_frames} "
-            "decoded (file cut, damaged, or a header that over-counts)",
+            f"{path}: the container's header counts {n_header} frames but the file holds "
+            f"{n_held} (file cut, or a header that over-counts)",
+        )
+    if getattr(info, "n_dropped", 0):
+        t = info.frame_times_s
+        at = np.flatnonzero(np.diff(t) > 1.5 / info.fps)[:3] if t is not None and info.fps else []
+        warn(
+            "W-VIDEO-DROPPED",
+            f"{path}: the camera dropped {info.n_dropped} frame(s) (gaps in the container's "
+            f"{info.fps:.6g} frames/s clock, first after t = "
+            f"{', '.join(f'{t[i]:.4f}' for i in at)} s); each frame keeps its own time",
+        )
+    if expected > 0 and res.n_frames < expected:
+        warn(
+            "W-VIDEO-DAMAGED",
+            f"{path}: {expected - res.n_frames} of the {expected} frames the container holds "
+            "did not decode (damaged packets); the frames around them keep their times, "
+            "the gaps are in t_s",
         )
     _check_latch(res, path)
     for t in res.tracks:
@@ -67,6 +88,17 @@ def _check_frames(res, expected: int, path) -> None:
                 f"{path}: object {t.object!r} lost on {lost} of {len(t.status)} frames "
                 f"({100 * lost / len(t.status):.3g} %); see the status column",
             )
+
+
+def _check_rate(given: float, info, path, where: str) -> None:
+    """W-VIDEO-FPS when a frame rate given by the user contradicts the container's own clock."""
+    kind = "mean" if info.variable_rate and not info.n_dropped else "constant"
+    warn(
+        "W-VIDEO-FPS",
+        f"{where} = {given:.6g} frames/s, but {path} holds its frames at a {kind} "
+        f"{info.fps:.6g} frames/s: t_s follows the given rate; remove it to use the "
+        "container's times (keep it only for a film whose clock is known wrong)",
+    )
 
 
 #: A table turning by more than this (rad, 5th to 95th percentile) is following something else.

@@ -19,7 +19,7 @@ import numpy as np
 from ..._blas import one_blas_thread
 from ..._diagnostics import warn
 from ..._errors import InputError
-from ._checks import _check_frames, _look, _tee, _why_lost
+from ._checks import _check_frames, _check_rate, _look, _tee, _why_lost
 from ._config import TrackConfig
 from ._geometry import PlaneMap, fit_similarity
 from .targets._detectors import make_detector
@@ -449,15 +449,18 @@ def track_video(path, config: TrackConfig, fps: float | None = None, progress: b
 
     info = probe_video(path)
     fields = info.field_order
-    rate = fps or config.video.fps or info.fps
+    given = fps or config.video.fps
+    rate = given or info.fps
     # the container's own frame times, unless the user overrides the rate (a clock known wrong)
-    times = info.frame_times_s if not (fps or config.video.fps) and info.variable_rate else None
+    times = None if given else info.frame_times_s
+    if given and info.frame_times_s is not None and info.fps and abs(given - info.fps) > 1e-3 * info.fps:
+        _check_rate(given, info, path, "--fps" if fps else f"{config.source or 'config'}: [video] fps")
     n_expected = info.n_frames
     if fields is not None:  # deinterlaced: two fields per frame, half a frame apart
-        if rate is not None and not (fps or config.video.fps):
+        if rate is not None and not given:
             rate = 2.0 * rate
         if times is not None:
-            half = 0.5 * float(np.median(np.diff(times)))
+            half = 0.5 / info.fps if info.fps else 0.5 * float(np.median(np.diff(times)))
             times = np.column_stack((times, times + half)).ravel()
         n_expected = 2 * info.n_frames
     if rate is None:
@@ -485,8 +488,7 @@ def track_video(path, config: TrackConfig, fps: float | None = None, progress: b
         frames = tqdm(frames, total=total if total > 0 else None, unit="frame", desc="track",
                       leave=False)
     obs = track_frames(frames, config, pm)
-    res = assemble_tracks(obs, config, rate, info.width_px, info.height_px, pm, path,
-                          frame_times_s=times if times is not None and len(times) >= n_expected else None)
+    res = assemble_tracks(obs, config, rate, info.width_px, info.height_px, pm, path, frame_times_s=times)
     expected = (min(stop, n_expected) if stop else n_expected) - start
-    _check_frames(res, expected, path)
+    _check_frames(res, expected, path, info)
     return res

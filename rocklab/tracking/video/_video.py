@@ -1,16 +1,20 @@
 """Video input: probe a file and stream grey frames (OpenCV ``VideoCapture``), optionally
 with the decoded colour picture alongside.
 
-What OpenCV does not give is read from the container with PyAV (demuxing only, no decoding):
-each frame's presentation time (phones record at a variable frame rate) and the pixel aspect
-ratio (SD camcorders store 4:3 and 16:9 pictures with non-square pixels, PAL 16:15 or 64:45,
+What OpenCV does not give is read from the container with PyAV (:mod:`._container`): each
+frame's presentation time (exact on a constant clock, the container's own at a variable rate, a
+dropped frame a missing slot), the display rotation (phones film sideways and say so) and the
+pixel aspect ratio (SD camcorders store 4:3 and 16:9 pictures with non-square pixels, PAL 16:15 or 64:45,
 NTSC 8:9 or 32:27). Frames with non-square pixels are resampled to square pixels as they are
 read, so every angle and distance downstream is measured on the true picture. Interlaced video
 (camcorders' 1080i50: each frame two fields exposed 20 ms apart) is deinterlaced on read by
 splitting the fields ("bob"): twice the frame rate, each field brought to full height on its own
 rows, so a rocking block is sampled at 50 Hz without combing.
 
-Decoding runs in a background thread (OpenCV releases the GIL) so it overlaps
+Frames are decoded with PyAV (OpenCV only where PyAV cannot open the file, e.g. image
+sequences), turned upright by the display matrix as OpenCV would, each frame indexed by its
+packet: a packet that does not decode is skipped and counted, the frames after it keep their
+places and times. Decoding runs in a background thread (FFmpeg releases the GIL) so it overlaps
 with detection on a second core.
 """
 
@@ -25,6 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from ..._errors import InputError
+from ._container import container_info
 
 __all__ = ["VideoInfo", "probe_video", "iter_video_frames", "container_info"]
 
@@ -37,9 +42,10 @@ class VideoInfo:
     ----------
     path : str
     n_frames : int
-        Frame count from the container (0 if it does not say; then the frames are counted).
+        Frames the container holds (its packets; OpenCV's count where PyAV cannot read it).
     fps : float or None
-        Frames per second (None when the container has no rate).
+        Frames per second: the exact rate of the container's clock, the mean rate of a
+        variable-rate film (None when the container has no rate).
     width_px, height_px : int
         Size of the frames as yielded: square pixels (the stored width times ``pixel_aspect``).
     pixel_aspect : float
@@ -49,6 +55,12 @@ class VideoInfo:
         PyAV cannot read the container, e.g. an image sequence).
     field_order : {"tff", "bff"} or None
         Interlaced video: which field is exposed first (top or bottom); None for progressive.
+    rotation_deg : int
+        Display rotation applied on read (counter-clockwise, 0/90/180/270); sizes are upright.
+    n_dropped : int
+        Slots of the container's constant clock with no frame (frames the camera dropped).
+    n_header : int
+        Frame count the container's header states (0 where it states none).
     """
 
     path: str
@@ -59,6 +71,9 @@ class VideoInfo:
     pixel_aspect: float = 1.0
     frame_times_s: np.ndarray | None = None
     field_order: str | None = None
+    rotation_deg: int = 0
+    n_dropped: int = 0
+    n_header: int = 0
 
     @property
     def variable_rate(self) -> bool:
@@ -81,6 +96,9 @@ class VideoInfo:
             pixel_aspect=self.pixel_aspect,
             variable_rate=self.variable_rate,
             field_order=self.field_order,
+            rotation_deg=self.rotation_deg,
+            n_dropped=self.n_dropped,
+            n_header=self.n_header,
         )
 
 
@@ -107,55 +125,6 @@ def _open(path):
     return cap
 
 
-#: FFmpeg's AVFieldOrder: TT and TB code/show the top field first, BB and BT the bottom one.
-_FIELD_ORDER = {2: "tff", 4: "tff", 3: "bff", 5: "bff"}
-
-
-def container_info(path) -> tuple[np.ndarray | None, float, str | None]:
-    """What the container says and OpenCV does not, read with PyAV in one pass over the packets.
-
-    Returns
-    -------
-    frame_times_s : ndarray (n,) or None
-        Each frame's presentation time, s, the first frame at 0.
-    pixel_aspect : float
-        Width / height of a stored pixel (the sample aspect ratio; 1 if none is given).
-    field_order : {"tff", "bff"} or None
-        Interlaced video: the stream's field order where the codec states it, else a first
-        frame flagged interlaced is taken as top field first (HD camcorders; PAL DV is bottom
-        first and says so); None for progressive.
-
-    ``(None, 1.0, None)`` where PyAV is missing or cannot open the file (image sequences, exotic
-    containers): the caller then uses frame / fps, square pixels and progressive frames.
-    """
-    if "%" in str(path):
-        return None, 1.0, None
-    try:
-        import av
-    except ImportError:
-        return None, 1.0, None
-    try:
-        with av.open(str(path)) as c:
-            s = c.streams.video[0]
-            sar = s.sample_aspect_ratio or s.codec_context.sample_aspect_ratio
-            tb = s.time_base
-            pts, first = [], None
-            for p in c.demux(s):
-                if p.pts is not None and p.size:
-                    pts.append(p.pts)
-                if first is None and p.size:  # decode only until the first picture appears
-                    first = next(iter(p.decode()), None)
-            fo = int(s.codec_context.field_order or 0)
-    except Exception:  # noqa: BLE001 - PyAV raises many types; rate, square pixels stay the fallback
-        return None, 1.0, None
-    aspect = float(sar) if sar and float(sar) > 0 else 1.0
-    order = _FIELD_ORDER.get(fo, "tff" if first is not None and first.interlaced_frame else None)
-    if not pts or tb is None:
-        return None, aspect, order
-    q = np.sort(np.asarray(pts, np.int64))
-    return (q - q[0]) * float(tb), aspect, order
-
-
 def probe_video(path) -> VideoInfo:
     """Open ``path`` and read its frame count, rate, size, pixel aspect and frame times.
 
@@ -179,15 +148,26 @@ def probe_video(path) -> VideoInfo:
     # Image sequences report a nominal rate (or none); only trust real containers.
     if not np.isfinite(fps) or fps <= 0 or fps > 1e5 or "%" in str(path):
         fps = None
-    times, aspect, order = container_info(path)
+    ci = container_info(path)
+    times = ci.frame_times_s
     if times is not None and len(times) > 1:
-        # where OpenCV's nominal rate contradicts the packets (variable-rate files often report
-        # the time base: 1000 fps and 681 "frames" for 24), count and rate come from the packets;
-        # otherwise the header's count stays, so a cut file is still noticed (W-VIDEO-SHORT)
-        rate = 1.0 / float(np.median(np.diff(times)))
-        if fps is None or abs(fps - rate) > 0.01 * rate:
-            fps, n = rate, len(times)
-    return VideoInfo(str(path), max(n, 0), fps, _square_width(int(w), aspect), int(h), aspect, times, order)
+        # count and rate from the packets: OpenCV's are estimates (a Matroska film's duration x a
+        # rate rounded from its 1 ms ticks; a variable-rate phone film reports its time base)
+        n = len(times)
+        fps = ci.rate_hz or (n - 1) / float(times[-1] - times[0])
+    return VideoInfo(
+        str(path),
+        max(n, 0),
+        fps,
+        _square_width(int(w), ci.pixel_aspect),
+        int(h),
+        ci.pixel_aspect,
+        times,
+        ci.field_order,
+        ci.rotation_deg,
+        ci.n_dropped,
+        ci.n_header,
+    )
 
 
 def _square_width(w: int, aspect: float) -> int:
@@ -239,8 +219,11 @@ class _PyAVReader:
     """``cv2.VideoCapture``'s ``read``/``release`` over PyAV's decoder, from frame ``first``.
 
     Pictures are BGR, or grey straight from the luma plane with ``gray`` (no colour conversion:
-    a third of OpenCV's decoding time at 1080p). A start past frame 0 seeks to the key frame
-    before it and decodes forward, frames being placed by their presentation times.
+    a third of OpenCV's decoding time at 1080p), turned upright by the frame's display matrix
+    (as OpenCV does). Every frame is placed by its presentation time among the packets':
+    ``index`` is the last frame's place, so a packet that fails to decode (counted in
+    ``n_broken``) leaves a gap instead of shifting the frames after it. A start past frame 0
+    seeks to the key frame before it and decodes forward.
     """
 
     def __init__(self, path, first: int = 0, gray: bool = False):
@@ -248,59 +231,92 @@ class _PyAVReader:
 
         self._c = av.open(str(path))
         self._gray = gray
+        self.n_broken = 0
+        self.index = int(first) - 1
         # four frame threads: decoding keeps pace beside the tracker, the frames in flight hiding
         # the moments the tracker holds a core (1080p H.264 at 17 Mbit/s on 2 cores, markerless,
         # decode included, six runs of 480 frames each: 106-138 frames/s; FFmpeg's automatic
         # frame + slice threads 100-126, slices alone 86-101)
         s = self._c.streams.video[0]
+        self._pts = np.sort([p.pts for p in self._c.demux(s) if p.pts is not None and p.size])
+        self._c.seek(0, stream=s)
         s.thread_type, s.thread_count = "FRAME", 4
         self._it = self._decode(int(first))
+
+    def _frames(self):
+        """Decoded frames from the current position on, packet by packet: a broken packet is
+        counted and skipped (FFmpeg's decoder resumes at the next one it can read)."""
+        import av
+
+        s = self._c.streams.video[0]
+        packets = self._c.demux(s)
+        while True:
+            try:
+                p = next(packets)
+            except StopIteration:
+                return
+            except av.error.FFmpegError:  # the container itself breaks off: what was read stands
+                self.n_broken += 1
+                return
+            try:
+                yield from p.decode()
+            except av.error.FFmpegError:
+                self.n_broken += 1
 
     def _decode(self, first: int):
         c = self._c
         s = c.streams.video[0]
+        pts = self._pts
         if first > 0:
-            pts = np.sort([p.pts for p in c.demux(s) if p.pts is not None and p.size])
             if first >= len(pts):
                 return
             c.seek(int(pts[first]), stream=s, backward=True, any_frame=False)
-            for f in c.decode(s):
+            frames = self._frames()
+            for f in frames:
                 if f.pts is None:  # cannot place frames by time: decode from the start instead
                     break
                 if int(np.searchsorted(pts, f.pts)) >= first:
                     yield f
-                    yield from c.decode(s)
+                    yield from frames
                     return
             c.seek(0, stream=s)
-            frames = c.decode(s)
+            frames = self._frames()
+            self.index = -1
             for _ in range(first):
                 if next(frames, None) is None:
                     return
+                self.index += 1
             yield from frames
             return
-        yield from c.decode(s)
+        yield from self._frames()
+
+    def _place(self, f) -> int:
+        """The frame's index: its packet's place by presentation time, else the next one."""
+        nxt = self.index + 1
+        if f.pts is None or not len(self._pts):
+            return nxt
+        k = int(np.searchsorted(self._pts, f.pts))
+        return k if k >= nxt and k < len(self._pts) and self._pts[k] == f.pts else nxt
 
     def read(self):
-        import av
-
-        try:
-            f = next(self._it, None)
-        except av.error.FFmpegError:  # a broken packet ends the read, as in OpenCV; the frame count is checked
-            f = None
+        f = next(self._it, None)
         if f is None:
             return False, None
-        return True, (_luma(f) if self._gray else f.to_ndarray(format="bgr24"))
+        self.index = self._place(f)
+        img = _luma(f) if self._gray else f.to_ndarray(format="bgr24")
+        k = int(round((f.rotation or 0) / 90.0)) % 4
+        return True, (np.ascontiguousarray(np.rot90(img, k)) if k else img)
 
     def release(self):
         self._c.close()
 
 
-def _pyav_reader(path, first: int):
-    """A grey PyAV reader for a video file, or None where PyAV cannot decode it (OpenCV then does)."""
+def _pyav_reader(path, first: int, gray: bool = True):
+    """A PyAV reader for a video file, or None where PyAV cannot decode it (OpenCV then does)."""
     if "%" in str(path):
         return None
     try:
-        r = _PyAVReader(path, first, gray=True)
+        r = _PyAVReader(path, first, gray=gray)
     except Exception:  # noqa: BLE001 - PyAV raises many types; OpenCV's reader is the fallback
         return None
     return r
@@ -358,6 +374,7 @@ def iter_video_frames(
     Yields
     ------
     index : int
+        The frame's place in the container (a packet that did not decode leaves a gap).
     gray : ndarray, shape (height, width), uint8
     image : ndarray, shape (height, width, 3), uint8, BGR
         Only with ``color``: the frame as decoded (a grey source decodes to three equal
@@ -371,8 +388,9 @@ def iter_video_frames(
         # progressive frames") and returns the previous picture again, silently: decode with PyAV
         cap = _PyAVReader(path, first, gray=not color)
     else:
-        # grey frames come from PyAV's luma plane (no YUV -> BGR -> grey); colour from OpenCV
-        cap = None if color else _pyav_reader(_open_checked(path), first)
+        # PyAV for every film it opens (grey from the luma plane: no YUV -> BGR -> grey), so grey
+        # and colour frames are the same frames, upright and at the same indices
+        cap = _pyav_reader(_open_checked(path), first, gray=not color)
         if cap is None:
             cap = _open(path)
             if first:
@@ -384,6 +402,9 @@ def iter_video_frames(
             while stop is None or (2 * i if fields else i) < stop:
                 ok, img = cap.read()
                 if not ok or img is None:
+                    return
+                i = getattr(cap, "index", i)  # PyAV places each frame by its time
+                if stop is not None and (2 * i if fields else i) >= stop:
                     return
                 img = _squared(img, pixel_aspect)
                 if fields:

@@ -1,0 +1,161 @@
+"""What the container says and OpenCV does not, read with PyAV from the packets (no decoding but
+the first picture): each frame's presentation time, the pixel aspect ratio, the field order and
+the display rotation.
+
+Frame times are the container's, never a rate rounded from them. A container stores times in
+its own ticks (Matroska: 1 ms), so a constant 150 fps is stored as steps of 7, 7 and 6 ms; the
+packets are then laid on the constant-rate clock that explains every one of them within half a
+tick (the stream's declared rate, else one fitted to the packets), which restores the exact
+times and shows a frame the camera dropped as a missing slot. Packets that fit no constant clock
+(phones record at a variable rate) keep their own times, true to half a tick.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from fractions import Fraction
+
+import numpy as np
+
+__all__ = ["ContainerInfo", "container_info", "frame_clock"]
+
+#: FFmpeg's AVFieldOrder: TT and TB code/show the top field first, BB and BT the bottom one.
+_FIELD_ORDER = {2: "tff", 4: "tff", 3: "bff", 5: "bff"}
+#: A constant clock must place at least this share of the intervals in one slot each; a file
+#: whose frames skip slots more often is variable-rate, not a constant rate with dropped frames.
+MIN_SINGLE_STEPS = 0.9
+
+
+@dataclass(frozen=True)
+class ContainerInfo:
+    """The container's own account of a video stream.
+
+    Attributes
+    ----------
+    frame_times_s : ndarray (n,) or None
+        Each frame's presentation time, s, the first frame at 0, in presentation order.
+    pixel_aspect : float
+        Width / height of a stored pixel (the sample aspect ratio; 1 if none is given).
+    field_order : {"tff", "bff"} or None
+        Interlaced video: the field exposed first; None for progressive.
+    rotation_deg : int
+        Counter-clockwise turn that shows the stored picture upright (phones' display matrix):
+        0, 90, 180 or 270.
+    rate_hz : float or None
+        The constant clock the frames sit on (None: variable rate).
+    n_dropped : int
+        Slots of that clock with no frame (frames the camera dropped); 0 at a variable rate.
+    n_header : int
+        Frame count the container's header states (0 where it states none, e.g. Matroska).
+    pts : ndarray (n,) of int64 or None
+        The packets' presentation times in stream ticks, sorted: a decoded frame's index is its
+        place here.
+    """
+
+    frame_times_s: np.ndarray | None = None
+    pixel_aspect: float = 1.0
+    field_order: str | None = None
+    rotation_deg: int = 0
+    rate_hz: float | None = None
+    n_dropped: int = 0
+    n_header: int = 0
+    pts: np.ndarray | None = None
+
+
+def frame_clock(t_s: np.ndarray, tick_s: float, rates=()) -> tuple[np.ndarray, float | None, int]:
+    """Lay packet times on the constant-rate clock that explains them to half a tick.
+
+    Parameters
+    ----------
+    t_s : ndarray (n,)
+        Sorted packet times, s, the first at 0, each rounded to the container's tick.
+    tick_s : float
+        The container's tick (time base), s.
+    rates : iterable of float or Fraction
+        Rates the stream declares, Hz, tried first; a rate fitted to the packets is tried last.
+
+    Returns
+    -------
+    times_s : ndarray (n,)
+        Each frame's time: its slot over the rate (exact) where a clock fits, else ``t_s``.
+    rate_hz : float or None
+        The clock's rate (None: no constant clock fits, the rate is variable).
+    n_dropped : int
+        Empty slots between the first and the last frame.
+    """
+    t = np.asarray(t_s, float)
+    if len(t) < 3:
+        return t, (1.0 / float(t[1] - t[0]) if len(t) == 2 and t[1] > t[0] else None), 0
+    tol = 0.5 * tick_s * (1 + 1e-6) + 1e-9
+    d = np.diff(t)
+    single = d[d <= 1.5 * np.median(d)]
+    cands = [Fraction(r) if isinstance(r, Fraction) else Fraction(float(r)).limit_denominator(1001) for r in rates if r]
+    if len(single) and np.mean(single) > 0:
+        # the mean of the single steps: the ticks' rounding cancels along a run of frames
+        r0 = 1.0 / float(np.mean(single))
+        k = np.rint(t * r0)
+        if np.all(np.diff(k) >= 1) and k[-1] > 0:
+            r1 = 1.0 / float(np.polyfit(k, t, 1)[0])  # refined over the whole film
+            cands += [Fraction(r1).limit_denominator(1001), Fraction(r1)]
+    for r in cands:
+        if not 0 < r < 1e5:
+            continue
+        rf = float(r)
+        k = np.rint(t * rf)
+        steps = np.diff(k)
+        if np.all(steps >= 1) and np.mean(steps == 1) >= MIN_SINGLE_STEPS and np.all(np.abs(t - k / rf) <= tol):
+            return k / rf, rf, int(k[-1]) + 1 - len(t)
+    return t, None, 0
+
+
+def _rotation(frame) -> int:
+    """The counter-clockwise turn (0, 90, 180, 270 deg) the frame's display matrix asks for."""
+    try:
+        r = frame.rotation
+    except Exception:  # noqa: BLE001 - no display matrix readable: shown as stored
+        return 0
+    return int(round((r or 0) / 90.0)) % 4 * 90
+
+
+def container_info(path) -> ContainerInfo:
+    """What the container says and OpenCV does not, read with PyAV in one pass over the packets.
+
+    ``ContainerInfo()`` (no times, square pixels, progressive, upright) where PyAV is missing or
+    cannot open the file (image sequences, exotic containers): the caller then uses frame / fps.
+    """
+    if "%" in str(path):
+        return ContainerInfo()
+    try:
+        import av
+    except ImportError:
+        return ContainerInfo()
+    try:
+        with av.open(str(path)) as c:
+            s = c.streams.video[0]
+            sar = s.sample_aspect_ratio or s.codec_context.sample_aspect_ratio
+            tb = s.time_base
+            rates = [s.average_rate, s.guessed_rate]
+            n_header = int(s.frames or 0)
+            pts, first = [], None
+            try:
+                for p in c.demux(s):
+                    if p.pts is not None and p.size:
+                        pts.append(p.pts)
+                    if first is None and p.size:  # decode only until the first picture appears
+                        try:
+                            first = next(iter(p.decode()), None)
+                        except av.error.FFmpegError:
+                            pass
+            except av.error.FFmpegError:  # damaged tail: the packets read so far stand
+                pass
+            fo = int(s.codec_context.field_order or 0)
+    except Exception:  # noqa: BLE001 - PyAV raises many types; rate, square pixels stay the fallback
+        return ContainerInfo()
+    aspect = float(sar) if sar and float(sar) > 0 else 1.0
+    order = _FIELD_ORDER.get(fo, "tff" if first is not None and first.interlaced_frame else None)
+    rot = _rotation(first) if first is not None else 0
+    if not pts or tb is None:
+        return ContainerInfo(None, aspect, order, rot, n_header=n_header)
+    q = np.sort(np.asarray(pts, np.int64))
+    times, rate, dropped = frame_clock((q - q[0]) * float(tb), float(tb), rates)
+    return ContainerInfo(times, aspect, order, rot, rate, dropped, n_header, q)

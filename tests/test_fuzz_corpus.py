@@ -658,7 +658,8 @@ def _broken_campaign(tmp):
         d = root / name
         d.mkdir(parents=True)
         _track_csv(d)
-        (d / "experiment.toml").write_text(toml)
+        # names must be unique in a campaign (a duplicate is refused before any work)
+        (d / "experiment.toml").write_text(toml.replace('name = "e"', f'name = "{name}"'))
     return ["campaign", root, "--out", tmp / "out", "--workers", 1, "--no-progress"]
 
 

@@ -199,3 +199,18 @@ def test_aruco_corners_in_stereo(tmp_path, run_cli):
     # twist is seen over a 6 cm marker pair only: 0.1 deg here, against 0.02 deg with dots across the face
     assert np.sqrt(np.nanmean(b.twist_rad**2)) < math.radians(0.3)
     del r
+
+
+def test_setup_errors_are_named_before_the_audit(session, tmp_path):
+    # the same film twice triangulated to infinity and swapped films to a mirrored scene
+    # behind the cameras; the audit then read them as slides and jumps
+    d, _, rig, sp = session
+    assert float(np.nanmedian(sp.xyz_m[..., 2])) > 0.3  # the right order: the scene in front
+    shutil.copy(d / "cam1.mkv", tmp_path / "copy.mkv")
+    with pytest.raises(InputError, match=r"copy.mkv: every target sits where it sits in .*cam1.mkv .*the same film"):
+        track_dots_stereo(d / "cam1.mkv", tmp_path / "copy.mkv", rig, sync=False)
+    # swapped films: 1.9 px off their epipolar lines in the order given, 0.014 px in the other
+    with pytest.raises(
+        InputError, match=r"cam2.mkv: the targets miss their epipolar lines by 1.* px in this order and by 0.0.*wrong order"
+    ):
+        track_dots_stereo(d / "cam2.mkv", d / "cam1.mkv", rig)

@@ -26,7 +26,9 @@ DEFAULT_BOARD = {"squares": (9, 6), "square_m": 0.03, "marker_m": 0.022, "dictio
 #: Fewest ChArUco corners for a frame to count, and fewest frames for a calibration.
 MIN_CORNERS = 8
 MIN_FRAMES = 6
-#: Median corner distance between the two films below which they are one film, px.
+#: Median distance between two films' image points below which they are one film, px
+#: (detector rounding on identical pixels is far below this; two cameras a few cm apart
+#: see a lab scene with tens of pixels of disparity).
 SAME_FILM_PX = 0.05
 #: Smallest camera separation that triangulates a lab scene (a few cm at 1-3 m), m.
 MIN_BASELINE_M = 0.01

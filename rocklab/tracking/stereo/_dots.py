@@ -28,6 +28,8 @@ import numpy as np
 
 from ..._errors import InputError, where
 from ._calib import StereoRig
+from ._epipolar import epi_distance, fundamental, undistorted
+from ._setup import check_depth_in_front, check_film_order
 
 __all__ = ["detect_dots", "track_dots_2d", "DotTracks2D", "sync_offset_stereo", "SyncOffset", "match_tracks",
            "triangulate_tracks", "StereoPoints", "track_dots_stereo", "check_films"]
@@ -165,35 +167,6 @@ def track_dots_2d(frames, source: str = "", gate_px: float = 25.0, progress=None
     return DotTracks2D(np.stack(rows), source)
 
 
-def _undistorted(rig: StereoRig, cam: int, uv):
-    """Undistorted pixel positions (same K) of ``uv`` (n, 2) seen by camera ``cam`` (NaN kept)."""
-    import cv2
-
-    K, dist = (rig.K1, rig.dist1) if cam == 1 else (rig.K2, rig.dist2)
-    uv = np.asarray(uv, float).reshape(-1, 2)
-    out = np.full_like(uv, np.nan)
-    ok = np.isfinite(uv).all(axis=1)
-    if ok.any():
-        out[ok] = cv2.undistortPoints(uv[ok].reshape(-1, 1, 2), K, dist, P=K).reshape(-1, 2)
-    return out
-
-
-def _fundamental(rig: StereoRig) -> np.ndarray:
-    t = rig.T
-    tx = np.array([[0, -t[2], t[1]], [t[2], 0, -t[0]], [-t[1], t[0], 0]])
-    return np.linalg.inv(rig.K2).T @ tx @ rig.R @ np.linalg.inv(rig.K1)
-
-
-def _epi_distance(F, p1, p2):
-    """Symmetric epipolar distance, px, for every pair: p1 (..., 2), p2 (..., 2) broadcast."""
-    h1 = np.concatenate([p1, np.ones(p1.shape[:-1] + (1,))], axis=-1)
-    h2 = np.concatenate([p2, np.ones(p2.shape[:-1] + (1,))], axis=-1)
-    l2 = h1 @ F.T                 # lines in image 2
-    l1 = h2 @ F                   # lines in image 1
-    num = np.abs((h2 * l2).sum(axis=-1))
-    return 0.5 * (num / np.hypot(l2[..., 0], l2[..., 1]) + num / np.hypot(l1[..., 0], l1[..., 1]))
-
-
 def _shift(uv, lag):
     """Tracks (n, k, 2) read ``lag`` frames later (sub-frame, linear; NaN outside)."""
     n = uv.shape[0]
@@ -261,13 +234,13 @@ def sync_offset_stereo(rig: StereoRig, tracks1: DotTracks2D, tracks2: DotTracks2
     cc = [np.dot(a[max(0, -k):n - max(0, k)], b[max(0, k):n - max(0, -k)]) for k in lags]
     coarse = int(lags[int(np.argmax(cc))])
     i1, i2 = np.asarray(pairs, int).T
-    F = _fundamental(rig)
-    u1 = _undistorted(rig, 1, tracks1.uv_px[:, i1].reshape(-1, 2)).reshape(-1, len(i1), 2)
-    u2 = _undistorted(rig, 2, tracks2.uv_px[:, i2].reshape(-1, 2)).reshape(-1, len(i2), 2)
+    F = fundamental(rig)
+    u1 = undistorted(rig, 1, tracks1.uv_px[:, i1].reshape(-1, 2)).reshape(-1, len(i1), 2)
+    u2 = undistorted(rig, 2, tracks2.uv_px[:, i2].reshape(-1, 2)).reshape(-1, len(i2), 2)
     moving = np.r_[_speed(tracks1.uv_px[:, i1]) > 0.05, False]
 
     def misfit(lag):
-        d = _epi_distance(F, u1[moving], _shift(u2, lag)[moving])
+        d = epi_distance(F, u1[moving], _shift(u2, lag)[moving])
         return float(np.sqrt(np.nanmean(d ** 2)))
 
     r = minimize_scalar(misfit, bounds=(coarse - 1.5, coarse + 1.5), method="bounded",
@@ -293,13 +266,13 @@ def match_tracks(rig: StereoRig, tracks1: DotTracks2D, tracks2: DotTracks2D, lag
     """
     from scipy.optimize import linear_sum_assignment
 
-    F = _fundamental(rig)
+    F = fundamental(rig)
     n1, n2 = tracks1.uv_px.shape[1], tracks2.uv_px.shape[1]
-    u1 = _undistorted(rig, 1, tracks1.uv_px.reshape(-1, 2)).reshape(-1, n1, 2)
-    u2 = _undistorted(rig, 2, _shift(tracks2.uv_px, lag).reshape(-1, 2)).reshape(-1, n2, 2)
+    u1 = undistorted(rig, 1, tracks1.uv_px.reshape(-1, 2)).reshape(-1, n1, 2)
+    u2 = undistorted(rig, 2, _shift(tracks2.uv_px, lag).reshape(-1, 2)).reshape(-1, n2, 2)
     n = min(u1.shape[0], u2.shape[0])
     step = max(1, n // 200)
-    d = _epi_distance(F, u1[:n:step, :, None, :], u2[:n:step, None, :, :])      # (frames, n1, n2)
+    d = epi_distance(F, u1[:n:step, :, None, :], u2[:n:step, None, :, :])      # (frames, n1, n2)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)
         cost = np.nanmedian(d, axis=0)
@@ -368,8 +341,8 @@ def triangulate_tracks(rig: StereoRig, tracks1: DotTracks2D, tracks2: DotTracks2
 
     i1, i2 = np.asarray(pairs, int).T
     n = tracks1.n_frames
-    a = _undistorted(rig, 1, tracks1.uv_px[:, i1].reshape(-1, 2))
-    b = _undistorted(rig, 2, _shift(tracks2.uv_px[:, i2], lag)[:n].reshape(-1, 2))
+    a = undistorted(rig, 1, tracks1.uv_px[:, i1].reshape(-1, 2))
+    b = undistorted(rig, 2, _shift(tracks2.uv_px[:, i2], lag)[:n].reshape(-1, 2))
     if b.shape[0] < a.shape[0]:
         b = np.vstack([b, np.full((a.shape[0] - b.shape[0], 2), np.nan)])
     P1, P2 = rig.projection_matrices()
@@ -463,6 +436,7 @@ def track_dots_stereo(film1, film2, rig: StereoRig, fps: float | None = None, sy
     if len(pairs) < 3:
         raise InputError(f"{where(film1)}only {len(pairs)} dot(s) match along epipolar lines with {film2}; check that "
                          "the calibration belongs to these cameras and both see the targets")
+    check_film_order(rig, t1.uv_px[:, pairs[:, 0]], t2.uv_px[:, pairs[:, 1]], film1, film2)
     so = None
     lag = 0.0
     if sync:
@@ -470,4 +444,5 @@ def track_dots_stereo(film1, film2, rig: StereoRig, fps: float | None = None, sy
         lag = so.offset_frames
         pairs, _ = match_tracks(rig, t1, t2, lag)
     pts = triangulate_tracks(rig, t1, t2, pairs, lag, rate1)
+    check_depth_in_front(pts.xyz_m, film1, film2)
     return StereoPoints(pts.t_s, pts.xyz_m, pts.reproj_px, pts.pairs, so, pts.notes, None)

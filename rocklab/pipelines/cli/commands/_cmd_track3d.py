@@ -88,8 +88,9 @@ def write_track3d_outputs(out: Path, series, res, rrd=None) -> dict:
     """Write ``tracks.csv`` at ``out``, ``audit.json`` beside it and the Rerun review at ``rrd`` (if given);
     returns the summary (:meth:`Track3DResult.to_dict` with the paths and the verdict)."""
     from ...._io import write_frame_atomic, write_json_atomic
+    from ....tracking.rigid._read import exact_times
 
-    write_frame_atomic(out, res.to_frame(), float_format="%.9g")
+    write_frame_atomic(out, exact_times(res.to_frame()), float_format="%.9g")
     audit = res.audit_dict()
     audit_path = out.with_name("audit.json")
     write_json_atomic(audit_path, audit)

@@ -179,6 +179,22 @@ WARNING_CODES: dict[str, tuple[str, str]] = {
         "no upright rest found at the end of the 3D record: theta is measured from another "
         "pose and may carry a constant tilt; give --rest T0,T1",
     ),
+    "W-3D-RATE": (
+        "suspect",
+        "the 3D record's median time step is outside 10 Hz - 20 kHz: t_s is probably not in "
+        "seconds (ms gives 1000x fewer Hz); every rate, impact time and velocity is off",
+    ),
+    "W-3D-SIZE": (
+        "suspect",
+        "a body's targets span less than 2 mm or more than 20 m: the coordinates are "
+        "probably not in metres (mm under x_m); name the columns x_mm, y_mm, z_mm",
+    ),
+    "W-3D-UP": (
+        "suspect",
+        "--up is not the rig's vertical: the block's rotation axis is far from horizontal, or "
+        "its centroid falls (reversed axis) or sways with the sign of theta (a horizontal axis) "
+        "when it tilts; theta, pivots and uplift are measured in the wrong frame",
+    ),
     "W-AUDIT": (
         "suspect",
         "the test broke the planar-rocking assumptions (sliding, jumping, twist, out-of-plane "

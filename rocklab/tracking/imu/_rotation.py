@@ -309,7 +309,9 @@ def block_rotation(log: ImuLog, axis: str | None = None, *, release: str = "auto
     planar = float(np.sum(omega[moving] ** 2)) >= 0.9 * float(np.sum(w[moving] ** 2)) if moving.any() else False
     if has_end and planar and float(np.max(np.abs(theta))) < 0.5 * np.pi:
         status, msg = _check_gyro_vs_tilt(log.source, ie_mean - is_mean, th_end - th_start, status, msg)
-    rocking = check_rocking(t, w, u, f_start, fs, drift) if status != "no_motion" else None
+    # without a rest before, the bias came from moving samples: the drift then corrects it
+    judge = status != "no_rest_before"
+    rocking = check_rocking(t, w, u, f_start, fs, drift, judge) if status != "no_motion" else None
     if rocking is not None and rocking.reasons:
         # a spinning or hand-held sensor: worse than any rest-window status
         status, msg = "suspect", warn_not_rocking(log.source, rocking) + ("; " + msg if msg else "")

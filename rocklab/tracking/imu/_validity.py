@@ -58,7 +58,7 @@ class RockingCheck:
         Share of the mean-square bias-free rate about the axis over the rotating
         samples, 0..1 (NaN when fewer than 0.1 s rotate).
     turn_range_rad : float
-        Range of the bias-free gyro angle about the axis, rad.
+        Range of the gyro angle about the axis (bias and anchoring drift removed), rad.
     reasons : tuple of str
         The bounds broken (empty: a rocking block).
     """
@@ -69,11 +69,13 @@ class RockingCheck:
     reasons: tuple = ()
 
 
-def check_rocking(t, w, u, f_rest, fs, drift_rad_s) -> RockingCheck:
+def check_rocking(t, w, u, f_rest, fs, drift_rad_s, judge_drift=True) -> RockingCheck:
     """Measure the rocking evidence (module doc) of bias-free rates ``w`` (n, 3) rad/s about ``u``.
 
     ``f_rest`` is the accelerometer mean over the rest before the motion (m/s^2,
-    sensor frame); ``drift_rad_s`` the residual bias the anchoring removed.
+    sensor frame); ``drift_rad_s`` the residual bias the anchoring removed (also
+    removed before the turn range is taken); ``judge_drift`` False when the bias
+    came from moving samples (no rest before), which the drift then rightly corrects.
     """
     w_avg = max(1, int(round(0.05 * fs)))
     rot = moving_average(rownorm(w), w_avg) > _ROT_THR_RAD_S
@@ -83,7 +85,7 @@ def check_rocking(t, w, u, f_rest, fs, drift_rad_s) -> RockingCheck:
     tilt = float(np.arcsin(min(1.0, abs(float(u @ g_hat)))))
     wr = w[rot]
     share = float(np.sum((wr @ u) ** 2) / max(float(np.sum(wr * wr)), 1e-300))
-    ang = cumtrapz(t, w @ u)
+    ang = cumtrapz(t, w @ u - drift_rad_s)
     turn = float(np.max(ang) - np.min(ang))
     reasons = []
     if tilt > AXIS_TILT_MAX_RAD:
@@ -100,7 +102,7 @@ def check_rocking(t, w, u, f_rest, fs, drift_rad_s) -> RockingCheck:
             f"the gyro turns through {np.rad2deg(turn):.4g} deg about it "
             f"(rocking stays within {np.rad2deg(TURN_RANGE_MAX_RAD):.3g} deg)"
         )
-    if abs(drift_rad_s) > DRIFT_MAX_RAD_S:
+    if judge_drift and abs(drift_rad_s) > DRIFT_MAX_RAD_S:
         reasons.append(
             f"holding the rests needs a {np.rad2deg(drift_rad_s):.3g} deg/s gyro drift "
             f"(a still gyro drifts < {np.rad2deg(DRIFT_MAX_RAD_S):.3g} deg/s)"

@@ -235,11 +235,22 @@ def read_c3d(path) -> PointSeries:
     return PointSeries(t, labels, xyz, str(path), tuple(notes))
 
 
+def exact_times(frame):
+    """``frame`` with its ``t_s`` column as the shortest text that reads back to the same float.
+
+    Coordinates are written to 9 digits (0.1 um at 100 m), but times may be absolute (epoch
+    seconds, ~1.7e9): 9 digits would round them to 10 s and collapse every sample to one time.
+    """
+    out = frame.copy()
+    out["t_s"] = [repr(float(v)) for v in out["t_s"].to_numpy(float)]
+    return out
+
+
 def write_points_csv(series: PointSeries, path) -> Path:
-    """Write ``series`` as the long CSV :func:`read_points_csv` reads (atomically)."""
+    """Write ``series`` as the long CSV :func:`read_points_csv` reads (atomically; times exact)."""
     from ..._io import write_frame_atomic
 
-    return write_frame_atomic(path, series.to_frame(), float_format="%.9g")
+    return write_frame_atomic(path, exact_times(series.to_frame()), float_format="%.9g")
 
 
 def write_c3d(series: PointSeries, path, unit: str = "mm") -> Path:

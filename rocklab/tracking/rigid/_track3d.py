@@ -26,6 +26,7 @@ from ..._diagnostics import warn
 from ..._errors import InputError, where
 from ._audit import AuditResult, AuditTolerances, audit_rocking
 from ._pose import MIN_POINTS, BodyPoses, body_poses, kabsch, reference_shape
+from ._plausible import check_rate, check_span, check_up, up_evidence
 from ._read import PointSeries
 from ._rigidity import check_bodies_disjoint, check_rigid_body
 from ._rocking import (RockingGeometry, axis_vector, find_impacts, fit_pivots, pivot_motion, rocking_axes,
@@ -418,6 +419,11 @@ def track_points3d(series: PointSeries, bodies: dict | None = None, up: str = "z
                       axes=(geo.axis, geo.e_r))
         out.append(tb)
     out += blocks
+    check_rate(series)
+    for b in out:
+        check_span(series.source, b.name, b.poses.ref_m)
+        if not b.is_table:
+            check_up(series.source, b.name, up_evidence(b.theta_rad, b.y_m, b.poses.R, u), up)
     for b in out:
         lost = int((b.status != "ok").sum())
         if lost > 0.01 * b.t_s.size:

@@ -211,6 +211,7 @@ def test_setup_errors_are_named_before_the_audit(session, tmp_path):
         track_dots_stereo(d / "cam1.mkv", tmp_path / "copy.mkv", rig, sync=False)
     # swapped films: 1.9 px off their epipolar lines in the order given, 0.014 px in the other
     with pytest.raises(
-        InputError, match=r"cam2.mkv: the targets miss their epipolar lines by 1.* px in this order and by 0.0.*wrong order"
+        InputError,
+        match=r"cam2.mkv: the targets miss their epipolar lines by 1.* px in this order and by 0.0.*wrong order",
     ):
         track_dots_stereo(d / "cam2.mkv", d / "cam1.mkv", rig)

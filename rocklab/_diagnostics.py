@@ -201,6 +201,12 @@ WARNING_CODES: dict[str, tuple[str, str]] = {
         "rotation or a double impact beyond tolerance): see audit.json for the impacts "
         "affected; fits through them are not trustworthy",
     ),
+    "W-STEREO-NOSYNC": (
+        "suspect",
+        "the films were taken as triggered together (--no-sync), but a clock offset between them "
+        "fits the targets' epipolar lines far better: the 3D points of moving targets are skewed; "
+        "run without --no-sync",
+    ),
 }
 
 

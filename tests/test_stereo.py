@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import shutil
 import math
+import re
 
 import numpy as np
 import pandas as pd
@@ -211,6 +212,31 @@ def test_setup_errors_are_named_before_the_audit(session, tmp_path):
         track_dots_stereo(d / "cam1.mkv", tmp_path / "copy.mkv", rig, sync=False)
     # swapped films: 1.9 px off their epipolar lines in the order given, 0.014 px in the other
     with pytest.raises(
-        InputError, match=r"cam2.mkv: the targets miss their epipolar lines by 1.* px in this order and by 0.0.*wrong order"
+        InputError,
+        match=r"cam2.mkv: the targets miss their epipolar lines by 1.* px in this order and by 0.0.*wrong order",
     ):
         track_dots_stereo(d / "cam2.mkv", d / "cam1.mkv", rig)
+
+
+def test_no_sync_on_lagged_films_is_a_warning_and_silent_once_aligned(session):
+    # --no-sync on films 2.7 ms (0.4 frame) apart skewed every moving target; the offset is
+    # measured anyway and reported, and films aligned by that offset raise nothing
+    from rocklab.tracking.stereo._dots import _shift, match_tracks, sync_offset_stereo, track_dots_2d
+    from rocklab.tracking.stereo._setup import check_unsynchronised
+    from rocklab.tracking.video._video import iter_video_frames
+
+    d, _, rig, _ = session
+    with collecting() as diags:
+        sp = track_dots_stereo(d / "cam1.mkv", d / "cam2.mkv", rig, sync=False)
+    assert sp.sync is None
+    nosync = [x for x in diags if x.code == "W-STEREO-NOSYNC"]
+    assert len(nosync) == 1 and re.search(r"runs 2\.[5-9]\d* ms", nosync[0].message), nosync
+    t1, t2 = (track_dots_2d((g for _, g in iter_video_frames(d / f)), f) for f in ("cam1.mkv", "cam2.mkv"))
+    pairs, _ = match_tracks(rig, t1, t2, 0.0, max_px=5.0)
+    found = sync_offset_stereo(rig, t1, t2, pairs, 150.0)
+    aligned = type(t2)(_shift(t2.uv_px, found.offset_frames), t2.source)
+    again = sync_offset_stereo(rig, t1, aligned, pairs, 150.0)
+    assert abs(again.offset_s) < 0.2e-3
+    with collecting() as diags:
+        check_unsynchronised(again, "cam1.mkv", "aligned")
+    assert not diags

@@ -29,7 +29,7 @@ import numpy as np
 from ..._errors import InputError, where
 from ._calib import StereoRig
 from ._epipolar import epi_distance, fundamental, undistorted
-from ._setup import check_depth_in_front, check_film_order
+from ._setup import check_depth_in_front, check_film_order, check_unsynchronised
 
 __all__ = ["detect_dots", "track_dots_2d", "DotTracks2D", "sync_offset_stereo", "SyncOffset", "match_tracks",
            "triangulate_tracks", "StereoPoints", "track_dots_stereo", "check_films"]
@@ -214,7 +214,8 @@ class SyncOffset:
 def _speed(uv):
     """Mean image speed over the tracks, px/frame (NaN-safe), shape (n,)."""
     v = np.linalg.norm(np.diff(uv, axis=0), axis=2)
-    with np.errstate(all="ignore"):
+    with np.errstate(all="ignore"), warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # a frame with no target seen: speed 0
         s = np.nanmean(np.where(np.isfinite(v), v, np.nan), axis=1)
     return np.nan_to_num(s)
 
@@ -443,6 +444,8 @@ def track_dots_stereo(film1, film2, rig: StereoRig, fps: float | None = None, sy
         so = sync_offset_stereo(rig, t1, t2, pairs, rate1)
         lag = so.offset_frames
         pairs, _ = match_tracks(rig, t1, t2, lag)
+    else:
+        check_unsynchronised(sync_offset_stereo(rig, t1, t2, pairs, rate1), film1, film2)
     pts = triangulate_tracks(rig, t1, t2, pairs, lag, rate1)
     check_depth_in_front(pts.xyz_m, film1, film2)
     return StereoPoints(pts.t_s, pts.xyz_m, pts.reproj_px, pts.pairs, so, pts.notes, None)

@@ -13,7 +13,7 @@ import numpy as np
 
 from ..._errors import InputError, where
 from ._calib import StereoRig
-from ._setup import check_depth_in_front, check_film_order
+from ._setup import check_depth_in_front, check_film_order, check_unsynchronised
 from ._dots import DotTracks2D, StereoPoints, check_films, sync_offset_stereo, triangulate_tracks
 
 __all__ = ["track_markers_2d", "track_markers_stereo"]
@@ -81,7 +81,10 @@ def track_markers_stereo(
     t2 = DotTracks2D(np.stack([m2[lab] for lab in labels], axis=1), str(film2))
     pairs = np.column_stack([np.arange(len(labels)), np.arange(len(labels))])
     check_film_order(rig, t1.uv_px, t2.uv_px, film1, film2)
-    so = sync_offset_stereo(rig, t1, t2, pairs, rate) if sync else None
+    so = sync_offset_stereo(rig, t1, t2, pairs, rate)
+    if not sync:
+        check_unsynchronised(so, film1, film2)
+        so = None
     lag = so.offset_frames if so is not None else 0.0
     pts = triangulate_tracks(rig, t1, t2, pairs, lag, rate)
     check_depth_in_front(pts.xyz_m, film1, film2)

@@ -12,11 +12,12 @@ import warnings
 
 import numpy as np
 
+from ..._diagnostics import warn
 from ..._errors import InputError, where
 from ._calib import SAME_FILM_PX
 from ._epipolar import epipolar_misfit_px
 
-__all__ = ["check_distinct_films", "check_film_order", "check_depth_in_front"]
+__all__ = ["check_distinct_films", "check_film_order", "check_depth_in_front", "check_unsynchronised"]
 
 #: Median epipolar misfit of the matched targets above which the other film order is tried, px
 #: (a calibrated rig fits its own order to a few tenths of a pixel, with up to a frame of
@@ -25,6 +26,10 @@ ORDER_MISFIT_PX = 1.0
 #: The other order is the right one when it fits this much better (swapped films of the
 #: default rig: 1.9 px against 0.014 px, medians over frames and targets).
 ORDER_RATIO = 0.25
+#: A clock offset found on films given as synchronised is reported when it exceeds this
+#: share of a frame and this many of its own standard deviations.
+NOSYNC_MIN_FRAMES = 0.1
+NOSYNC_MIN_SIGMAS = 5.0
 
 
 def check_distinct_films(uv1, uv2, film1, film2) -> None:
@@ -88,3 +93,24 @@ def check_film_order(rig, uv1, uv2, film1, film2) -> None:
                 f"by {other:.3g} px in the other: the films are in the wrong order (give camera 1's film "
                 f"({film2}) first, then {film1}) or the calibration's cameras are swapped"
             )
+
+
+def check_unsynchronised(found, film1, film2) -> None:
+    """``W-STEREO-NOSYNC`` when films given as triggered together show a clock offset.
+
+    Parameters
+    ----------
+    found : SyncOffset
+        The offset estimated from the films although the user asked for none.
+    film1, film2 : path-like
+        The films (for the message).
+    """
+    off_s, sig_s = abs(found.offset_s), found.sigma_s
+    fps = abs(found.offset_frames / found.offset_s) if found.offset_s else float("inf")
+    if abs(found.offset_frames) > NOSYNC_MIN_FRAMES and np.isfinite(sig_s) and off_s > NOSYNC_MIN_SIGMAS * sig_s:
+        warn(
+            "W-STEREO-NOSYNC",
+            f"{film2} runs {found.offset_s * 1e3:.4g} ms (+/- {sig_s * 1e3:.2g} ms, {found.offset_frames:+.3g} frames at "
+            f"{fps:.4g} fps) off {film1}, measured from the targets although --no-sync takes them as one clock: "
+            "moving targets are triangulated from different instants; run without --no-sync",
+        )

@@ -7,7 +7,10 @@ The CLI turns it into one line on stderr and exit status 2.
 
 from __future__ import annotations
 
-__all__ = ["InputError", "where", "positive", "check_memory", "available_memory_bytes"]
+__all__ = ["InputError", "where", "positive", "check_memory", "check_time", "available_memory_bytes"]
+
+#: Longest computation a single command starts without being asked to split it, s.
+MAX_RUN_S = 3600.0
 
 
 class InputError(ValueError):
@@ -62,3 +65,13 @@ def check_memory(nbytes: float, what: str, fix: str) -> None:
         raise InputError(
             f"{what} would need about {nbytes / 1024**3:.4g} GiB of memory ({avail / 1024**3:.4g} GiB available); {fix}"
         )
+
+
+def check_time(seconds: float, what: str, fix: str) -> None:
+    """:class:`InputError` when ``what`` would run longer than :data:`MAX_RUN_S` (an estimate made before starting).
+
+    ``seconds`` is a lower-bound estimate from the loop's measured speed; ``fix`` says which option to change.
+    """
+    if not seconds <= MAX_RUN_S:
+        shown = f"{seconds / 3600:.3g} hours" if seconds < 1e7 * 3600 else "forever"
+        raise InputError(f"{what} would take about {shown} (at most {MAX_RUN_S / 3600:g} h is started); {fix}")

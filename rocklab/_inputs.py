@@ -15,7 +15,7 @@ from pathlib import Path
 
 from ._errors import InputError
 
-__all__ = ["check_outputs_not_inputs", "sequence_files"]
+__all__ = ["check_outputs_not_inputs", "check_folder_keeps_inputs", "sequence_files"]
 
 
 def _file_id(path) -> tuple[int, int] | None:
@@ -83,3 +83,30 @@ def check_outputs_not_inputs(inputs, outputs) -> None:
                 "choose another output name"
             )
         seen[key] = (label, o)
+
+
+def check_folder_keeps_inputs(out_dir, inputs, option: str = "--out") -> None:
+    """Refuse an output folder that holds one of the inputs among the entries rocklab would replace.
+
+    A folder rocklab wrote is replaced whole, and its own entries one by one when the user's
+    files sit beside them (:func:`rocklab._outdir.publish_dir`): an input inside one of those
+    entries (a ``tracks.csv`` of an earlier run used as a source) would be destroyed.
+    """
+    from ._outdir import MARKER, owned_entries
+
+    out_dir = Path(out_dir)
+    if not out_dir.is_dir():
+        return
+    root = Path(os.path.realpath(out_dir))
+    owned = owned_entries(out_dir) | {MARKER}
+    for label, p in inputs:
+        rp = Path(os.path.realpath(p))
+        try:
+            top = rp.relative_to(root).parts[0]
+        except (ValueError, IndexError):
+            continue
+        if top in owned:
+            raise InputError(
+                f"{option} {out_dir}: holds the input {label} {p}, written there by an earlier rocklab run "
+                "and replaced by this one; copy the input elsewhere or choose another output folder"
+            )

@@ -904,6 +904,184 @@ many(
 )
 
 
+# -- limits and exits: bad input is exit 2 (never 3), physical ranges, time and memory estimates -------
+RIG = {
+    "K1": [[800, 0, 320], [0, 800, 240], [0, 0, 1]],
+    "dist1": [0, 0, 0, 0, 0],
+    "K2": [[800, 0, 320], [0, 800, 240], [0, 0, 1]],
+    "dist2": [0, 0, 0, 0, 0],
+    "R": [[1, 0, 0], [0, 1, 0], [0, 0, 1]],
+    "T_m": [0.2, 0, 0],
+    "size_px": [64, 48],
+}
+
+
+def _rig(tmp, **change):
+    import json
+
+    return [
+        "stereo",
+        "track",
+        _film(tmp / "c1.mkv"),
+        _film(tmp / "c2.mkv"),
+        "--calib",
+        _write(tmp / "rig.json", json.dumps({**RIG, **change})),
+        "-o",
+        tmp / "t.csv",
+    ]
+
+
+def _two_records(tmp):
+    return [_write(tmp / "a.AT2", at2()), _write(tmp / "b.AT2", at2(values=SINE[::-1]))]
+
+
+def _small_oas(tmp, *extra):
+    return ["oas", _good_record(tmp), "--levels", 4, "--sizes", 4, "--refine", 1, *extra]
+
+
+many(
+    "limits",
+    [
+        ("oas-workers-0", lambda tmp: ["oas", *_two_records(tmp), "--workers", 0], "error", "workers"),
+        ("oas-refine-neg", lambda tmp: _small_oas(tmp, "--refine=-1"), "error", "refine"),
+        ("campaign-workers-neg", lambda tmp: ["campaign", tmp, "--out", tmp / "o", "--workers=-1"], "error", "workers"),
+        ("demo-workers-0", lambda tmp: ["demo", "--out", tmp / "d", "--workers", 0], "error", "workers"),
+        (
+            "equivalent-alpha-I-neg",
+            lambda tmp: ["equivalent", "block", "--b", 1, "--h", 2, "--alpha-I=-1"],
+            "error",
+            "alpha_I",
+        ),
+        (
+            "equivalent-alpha-I-0",
+            lambda tmp: ["equivalent", "block", "--R", 1, "--alpha", 0.2, "--alpha-I", 0],
+            "error",
+            "alpha_I",
+        ),
+        (
+            "equivalent-alpha-I-half",
+            lambda tmp: ["equivalent", "frame", "--b", 1, "--h", 2, "--alpha-I", 0.5],
+            "error",
+            "parallel-axis",
+        ),
+        (
+            "equivalent-asym-huge",
+            lambda tmp: ["equivalent", "asym-frame", "--b", 0.2, "--H", 1e300, "--H1", 1.2, "--L", 3, "--h", 0.1],
+            "error",
+            "times",
+        ),
+        (
+            "equivalent-arch-thin",
+            lambda tmp: ["equivalent", "arch", "--beta", 1, "--thickness", 1e-300, "--radius", 1],
+            "error",
+            "times",
+        ),
+        ("oas-housner-squat", lambda tmp: _small_oas(tmp, "--slenderness", 0.5), "error", "Housner"),
+        ("oas-housner-0.9", lambda tmp: _small_oas(tmp, "--slenderness", 0.9), "error", "Housner"),
+        ("oas-squat-given-eta", lambda tmp: _small_oas(tmp, "--slenderness", 0.5, "--eta", 0.5, "--json"), "ok", None),
+        ("oas-slender-1", lambda tmp: _small_oas(tmp, "--slenderness", 1, "--json"), "ok", None),
+        ("oas-eta-neg", lambda tmp: _small_oas(tmp, "--eta=-0.5"), "error", "eta"),
+        ("oas-eta-above-1", lambda tmp: _small_oas(tmp, "--eta", 1.01), "error", "eta"),
+        ("oas-slender-1e300", lambda tmp: _small_oas(tmp, "--slenderness", 1e300), "error", "needle"),
+        ("oas-level-max-1e300", lambda tmp: _small_oas(tmp, "--level-max", 1e300), "error", "level_max"),
+        ("stereo-K1-2x2", lambda tmp: _rig(tmp, K1=[[1, 0], [0, 1]]), "error", "'K1' must be 3 x 3"),
+        ("stereo-R-vector", lambda tmp: _rig(tmp, R=[1, 0]), "error", "'R' must be 3 x 3"),
+        ("stereo-T-short", lambda tmp: _rig(tmp, T_m=[0.2, 0]), "error", "'T_m' must be 3"),
+        ("stereo-dist-3", lambda tmp: _rig(tmp, dist2=[0, 0, 0]), "error", "'dist2'"),
+        ("stereo-size-1", lambda tmp: _rig(tmp, size_px=[64]), "error", "size_px"),
+        (
+            "stereo-board-0x0",
+            lambda tmp: [
+                "stereo",
+                "calibrate",
+                *_stereo_in(tmp)[:2],
+                "-o",
+                tmp / "s.json",
+                "--board",
+                "0x0,0.03,0.022,DICT_5X5_100",
+            ],
+            "error",
+            "3x3",
+        ),
+        (
+            "stereo-board-marker-big",
+            lambda tmp: [
+                "stereo",
+                "calibrate",
+                *_stereo_in(tmp)[:2],
+                "-o",
+                tmp / "s.json",
+                "--board",
+                "9x6,0.03,0.05,DICT_5X5_100",
+            ],
+            "error",
+            "marker side",
+        ),
+        (
+            "stereo-board-square-neg",
+            lambda tmp: [
+                "stereo",
+                "calibrate",
+                *_stereo_in(tmp)[:2],
+                "-o",
+                tmp / "s.json",
+                "--board",
+                "9x6,-0.03,0.022,DICT_5X5_100",
+            ],
+            "error",
+            "marker side",
+        ),
+        ("column-dt-1e-12", _col("--blocks", "0.1x0.2", "--theta0", 0.05, "--dt", 1e-12), "error", "would take about"),
+        (
+            "column-duration-1e300",
+            _col("--blocks", "0.1x0.2", "--theta0", 0.05, "--duration", 1e300),
+            "error",
+            "would take about",
+        ),
+        (
+            "column-dt-1e-300",
+            _col("--blocks", "0.1x0.2,0.1x0.2", "--theta0", "0.02,0.02", "--dt", 1e-300),
+            "error",
+            "would take about",
+        ),
+        ("simulate-dt-1e-12", _sim("--theta0", 0.05, "--dt", 1e-12, "--output-dt", 1), "error", "would take about"),
+        ("simulate-output-dt-huge", _sim("--theta0", 0.05, "--output-dt", 1e300), "error", "output_dt"),
+        ("simulate-width-1e300", _sim("--theta0", 0.05, width=1e300), "error", "too large or too small"),
+        (
+            "design-tI-tiny",
+            lambda tmp: ["design", "--height", 12, "--ag", 0.14, "--tI", 1e-300],
+            "error",
+            "no pier width",
+        ),
+        (
+            "design-ag-huge",
+            lambda tmp: ["design", "--height", 12, "--ag", 1e300, "--tI", 0.7],
+            "error",
+            "no pier width",
+        ),
+        (
+            "design-cm-ratio-2",
+            lambda tmp: ["design", "--height", 12, "--ag", 0.14, "--tI", 0.7, "--cm-ratio", 2],
+            "error",
+            "cm_height_ratio",
+        ),
+        (
+            "design-alpha-I-nan",
+            lambda tmp: ["design", "--height", 12, "--ag", 0.14, "--tI", 0.7, "--alpha-I", "nan"],
+            "error",
+            "alpha_I",
+        ),
+        (
+            "design-g-tiny",
+            lambda tmp: ["design", "--height", 12, "--ag", 0.14, "--tI", 0.7, "--g", 1e-300],
+            "error",
+            "no pier width",
+        ),
+    ],
+    None,
+)
+
+
 def _trk_cmd(tmp):
     v, c = _trk_real(tmp)
     return [v, "--config", c]

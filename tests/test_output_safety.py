@@ -196,3 +196,42 @@ def test_oas_parquet_side_file_keeps_a_users_file(tmp_path, run_cli, shared_data
     assert rc == 0, err
     assert [p.read_text() for p in tmp_path.glob("tab.parquet.user-*")] == ["my parquet"]
     assert len(pd.read_parquet(tmp_path / "tab.parquet")) == 2
+
+
+def test_a_closed_pipe_is_not_an_error(tmp_path):
+    """`rocklab ... | head` closing the pipe early: exit 0, nothing on stderr (was exit 2, "Broken pipe")."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    env = {**os.environ, "PYTHONPATH": str(root)}
+    argv = [sys.executable, "-m", "rocklab", "column", "--blocks", "0.1x0.2,0.1x0.2", "--theta0", "0.02,0.02"]
+    p = subprocess.Popen([*argv, "--duration", "3", "--json"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, env=env)
+    p.stdout.close()  # the reader is gone before the first byte is written
+    with p.stderr:
+        err = p.stderr.read().decode()
+    assert p.wait(timeout=120) == 0 and err == "", err
+    # the same output to a reader that stays reads as one JSON object with the column's status
+    done = subprocess.run([*argv, "--duration", "3", "--json"], capture_output=True, env=env, timeout=120)
+    assert done.returncode == 0 and json.loads(done.stdout)["status"] in ("rest", "rocking", "overturned")
+
+
+@pytest.mark.parametrize("force", [False, True])
+def test_run_refuses_an_out_folder_that_holds_its_inputs(tmp_path, run_cli, force):
+    """`run S/experiment.toml --out S` on a folder rocklab wrote (a synth session) replaced the session."""
+    from rocklab._outdir import claim_dir
+
+    cfg = _experiment(tmp_path)
+    session = cfg.parent
+    claim_dir(session, ["experiment.toml", "tracks.csv"], command="synth")  # as `rocklab synth` leaves it
+    before = {p.name: p.read_bytes() for p in session.iterdir()}
+    rc, out, err = run_cli("run", cfg, "--out", session, *(["--force"] if force else []))
+    assert rc == 2 and err.count("\n") == 1 and "holds the input" in err, err
+    assert {p.name: p.read_bytes() for p in session.iterdir()} == before
+    # the user's own folder (no marker entry for the inputs) with --force: outputs beside the inputs
+    (session / MARKER).unlink()
+    rc, out, err = run_cli("run", cfg, "--out", session, "--force")
+    assert rc == 0, err
+    assert (session / "tracks.csv").read_bytes() == before["tracks.csv"]
+    assert json.loads((session / "report.json").read_text())["status"] == "ok"

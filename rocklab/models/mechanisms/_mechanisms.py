@@ -121,6 +121,20 @@ def four_bar_mechanism(A, B, C, D, bodies, name: str = "four-bar") -> Mechanism:
     return Mechanism(M=M, V=V, B=Bf, phi_max=phi_max, name=name, eom=eom)
 
 
+#: Largest ratio between two lengths of one mechanism (beyond it the geometry is degenerate in floats).
+MAX_LENGTH_RATIO = 1e6
+
+
+def _comparable(what: str, **lengths) -> None:
+    """:class:`InputError` unless the mechanism's lengths are within :data:`MAX_LENGTH_RATIO` of each other."""
+    lo, hi = min(lengths, key=lengths.get), max(lengths, key=lengths.get)
+    if lengths[hi] > MAX_LENGTH_RATIO * lengths[lo]:
+        raise InputError(
+            f"{what}: {hi}={lengths[hi]:g} is more than {MAX_LENGTH_RATIO:g} times {lo}={lengths[lo]:g}; "
+            "give the mechanism's lengths in one unit (m)"
+        )
+
+
 def asymmetric_frame(
     b_m: float, H_m: float, H1_m: float, L_m: float, h_m: float, m_AB: float, m_BC: float, m_CD: float
 ):
@@ -142,6 +156,7 @@ def asymmetric_frame(
     b, H, H1, L, h = (_pos(n, v) for n, v in (("b_m", b_m), ("H_m", H_m), ("H1_m", H1_m), ("L_m", L_m), ("h_m", h_m)))
     if L <= 2 * b:
         raise InputError(f"L_m={L}: columns overlap; the left-face distance L must exceed the width 2b")
+    _comparable("asymmetric frame", b_m=b, H_m=H, H1_m=H1, L_m=L, h_m=h)
     mA, mB, mC = (_pos(n, v) for n, v in (("m_AB", m_AB), ("m_BC", m_BC), ("m_CD", m_CD)))
     yD = 2 * H - 2 * H1
     wbeam = L + 2 * b
@@ -237,6 +252,7 @@ def arch_mechanism(inclusion_angle_rad: float, thickness_m: float, radius_m: flo
     t, r = _pos("thickness_m", thickness_m), _pos("radius_m", radius_m)
     if beta > 2 * math.pi * 0.95 or t >= r:
         raise InputError(f"arch: need inclusion angle < 1.9 pi and thickness < radius (got {beta}, {t}, {r})")
+    _comparable("arch", thickness_m=t, radius_m=r)
     faces, mirror = (True, False, True, False), False
     if hinges is None:
         best: tuple[float, tuple | None] = (math.inf, None)

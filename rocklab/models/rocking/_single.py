@@ -30,7 +30,7 @@ import math
 
 import numpy as np
 
-from ..._errors import InputError, check_memory
+from ..._errors import InputError, check_memory, check_time
 from ...blocks import G
 from ._newmark import STATUS_NAMES, run_single
 from ..spectra._records import BaseMotion
@@ -103,6 +103,8 @@ def _last_uplift_t(base, alpha, scale=1.0):
 #: (about 1/p long) and the result is meaningless; between P_DT_WARN and it, amplitudes and impact
 #: times are not converged (W-SIM-DT).
 P_DT_MAX = 0.1
+#: Speed of the compiled single-block loop used for the time estimate, steps/s (measured on one core).
+SINGLE_STEPS_PER_S = 3e7
 P_DT_WARN = 0.01
 
 
@@ -230,6 +232,8 @@ def simulate(
         odt = _finite("output_dt_s", output_dt_s, positive=True)
         if odt < dt:
             raise InputError(f"output_dt_s={odt}: must be >= dt_s={dt}")
+        if odt > T:
+            raise InputError(f"output_dt_s={odt}: longer than duration_s={T}; give a spacing <= the duration")
         k = int(round(odt / dt))
         if abs(k * dt - odt) <= 1e-9 * odt:
             every = k
@@ -245,6 +249,11 @@ def simulate(
         40.0 * n_steps / every,
         f"{T:g} s at dt = {dt:g} s ({n_steps} steps stored every {every})",
         "shorten duration_s or give a coarser output_dt_s",
+    )
+    check_time(
+        T / dt / SINGLE_STEPS_PER_S,
+        f"{T:g} s at dt = {dt:g} s ({T / dt:.3g} steps)",
+        "give a coarser dt_s (e.g. 1e-4 s) or a shorter duration_s",
     )
     t_last = _last_uplift_t(base, alpha)
     if meth == "newmark":

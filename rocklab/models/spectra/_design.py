@@ -126,8 +126,11 @@ def required_width(
     ag = _pos("a_g_m_s2", a_g_m_s2)
     tI = _pos("t_I_s", t_I_s)
     c = _pos("cm_height_ratio", cm_height_ratio)
-    if alpha_I < 1:
+    g = _pos("g (gravity, m/s^2)", g)
+    if not (math.isfinite(alpha_I) and alpha_I >= 1):
         raise InputError(f"alpha_I={alpha_I}: must be >= 1 (parallel-axis theorem)")
+    if c > 1:
+        raise InputError(f"cm_height_ratio={c}: the centre of mass is in the pier; give a height ratio in (0, 1]")
     b_uplift = 2 * c * H * ag / g  # width at which a_g = a_p,min
 
     def excess(B):
@@ -139,7 +142,13 @@ def required_width(
 
     if excess(b_uplift) >= 0:
         return b_uplift  # i_cr/(t_I p) <= 1 at B0: only "no uplift" is safe (Eq. 21's max with 1)
-    return brentq(excess, 1e-9 * H, b_uplift, xtol=1e-12, rtol=1e-14)
+    try:
+        return brentq(excess, 1e-9 * H, b_uplift, xtol=1e-12, rtol=1e-14)
+    except (ValueError, RuntimeError, OverflowError):  # no sign change, or no convergence, in floats
+        raise InputError(
+            f"height {H:g} m, a_g {ag:g} m/s2, t_I {tI:g} s, g {g:g} m/s2: no pier width between 1e-9 H and "
+            f"{b_uplift:g} m solves Eq. 21; check the values and their units (m, m/s2, s)"
+        ) from None
 
 
 def required_width_slender(

@@ -185,6 +185,10 @@ class OASResult:
                     options=dict(self.options))
 
 
+#: Largest h/b the OAS accepts: alpha = atan(b/h) >= 1 mrad.
+MAX_SLENDERNESS = 1000.0
+
+
 def _check_opts(slenderness, levels, sizes, R_max_m, R_min_m, level_max, alpha_I):
     try:
         sl = float(slenderness)
@@ -192,12 +196,16 @@ def _check_opts(slenderness, levels, sizes, R_max_m, R_min_m, level_max, alpha_I
         raise InputError(f"slenderness={slenderness!r}: must be a number h/b > 0") from None
     if not (math.isfinite(sl) and sl > 0):
         raise InputError(f"slenderness={slenderness!r}: h/b must be a positive number (e.g. 12)")
+    if sl > MAX_SLENDERNESS:
+        raise InputError(f"slenderness={sl:g}: h/b above {MAX_SLENDERNESS:g} (alpha below 1 mrad) is a needle that "
+                         "any imperfection topples, not a rocking block; give the block's h/b (e.g. 12)")
     if int(levels) < 2 or int(sizes) < 2:
         raise InputError(f"levels={levels}, sizes={sizes}: need at least 2 of each")
     if not (R_max_m > R_min_m > 0):
         raise InputError(f"R_max_m={R_max_m}, R_min_m={R_min_m}: need R_max > R_min > 0 (m)")
-    if not level_max > 1:
-        raise InputError(f"level_max={level_max}: a_p/a_p,min range must go above 1")
+    if not 1 < level_max <= 1000:
+        raise InputError(f"level_max={level_max}: the a_p/a_p,min range must go above 1 and up to at most 1000 "
+                         "(default 10)")
     if not alpha_I >= 1:
         raise InputError(f"alpha_I={alpha_I}: inertia coefficient must be >= 1")
     return sl
@@ -283,6 +291,11 @@ def overturning_spectrum(base: BaseMotion, slenderness: float = 12.0, *, levels:
     free_code, free_s = _free_code(free)
     alpha = math.atan(1.0 / sl)
     eta_v = 1.0 - 2.0 * math.sin(alpha) ** 2 / alpha_I if eta is None else float(eta)
+    if eta is not None and not (0.0 <= eta_v <= 1.0):
+        raise InputError(f"eta={eta!r}: restitution omega+/omega- must be in [0, 1] (1: no energy lost); fix it")
+    if eta is None and sl < 1.0:
+        raise InputError(f"slenderness={sl:g}: Housner's restitution 1 - 2 sin^2(alpha)/alpha_I = {eta_v:.3g} "
+                         "holds for slender blocks (h/b >= 1); give h/b >= 1, or the block's restitution eta")
     if not (0.0 <= float(level_offset) < 1.0 and 0.0 <= float(size_offset) < 1.0):
         raise InputError(f"level_offset={level_offset!r}, size_offset={size_offset!r}: fractions of a step in [0, 1)")
     step = (float(level_max) - 1.0) / (int(levels) - 1)

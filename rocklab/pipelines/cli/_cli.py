@@ -17,6 +17,9 @@ Exit status (the policy scripts rely on):
 - 3: an internal error (a bug): one line, ``--debug`` shows the traceback;
 - 4: ``--strict`` and a warning of severity ``suspect``;
 - 130/143: interrupted (Ctrl-C / SIGTERM); staged outputs are removed.
+
+A closed output pipe (``rocklab ... --json | head -1``) is not an error: the
+command stops writing to it and exits 0.
 """
 
 from __future__ import annotations
@@ -103,8 +106,41 @@ def _os_error_line(e: OSError) -> str:
     return f"{name}: {fix}" if name else fix
 
 
+def _silence_stdout() -> None:
+    """Point stdout at /dev/null so the interpreter's final flush into a closed pipe says nothing."""
+    import os
+
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+    except (OSError, ValueError, AttributeError):  # stdout replaced by an object without a descriptor
+        pass
+
+
+class _Terminated(SystemExit):
+    """SIGTERM: unwinds the stack (staged outputs are removed on the way out), then exits 143."""
+
+
 def _on_sigterm(signum, frame):  # a killed run removes its staged outputs on the way out
-    raise SystemExit(143)
+    raise _Terminated(143)
+
+
+def _exit_now(code: int, line: str) -> None:
+    """One line on stderr, then leave without the interpreter's teardown.
+
+    The teardown would free native encoders (SVT-AV1 of the review film) in the middle of a
+    film, which abort the process (status 134/139, "deinit called without sending EOS!");
+    the stack has already unwound, so every staged output is gone and nothing is lost.
+    """
+    import os
+
+    sys.stderr.write(line)
+    for f in (sys.stdout, sys.stderr):
+        try:
+            f.flush()
+        except (OSError, ValueError):
+            pass
+    os._exit(code)
 
 
 def main(argv=None) -> int:
@@ -114,6 +150,7 @@ def main(argv=None) -> int:
 
     from ..._diagnostics import collecting, stderr_echo
 
+    from_command_line = argv is None
     parser = build_parser()
     args = parser.parse_args(argv)
     if not getattr(args, "func", None):
@@ -135,8 +172,22 @@ def main(argv=None) -> int:
     except KeyboardInterrupt:
         sys.stderr.write(f"rocklab {cmd}: interrupted; staged outputs removed\n")
         return 130
+    except _Terminated:
+        line = f"rocklab {cmd}: terminated (SIGTERM); staged outputs removed\n"
+        if from_command_line:  # the process ends here; in-process callers get the status back
+            _exit_now(143, line)
+        sys.stderr.write(line)
+        return 143
     except SystemExit:
         raise
+    except OverflowError as e:  # a number given beyond what floats hold (1e300 m, a step of 1e-300 s)
+        if args.debug:
+            raise
+        sys.stderr.write(
+            f"rocklab {cmd}: error: a value given is too large or too small to compute with ({e}); "
+            "check the numbers and their units\n"
+        )
+        return 2
     except MemoryError:
         sys.stderr.write(
             f"rocklab {cmd}: error: not enough memory for this request; reduce its size (duration, grid, frames)\n"
@@ -148,6 +199,9 @@ def main(argv=None) -> int:
             "give the CSV/text file the option expects\n"
         )
         return 2
+    except BrokenPipeError:  # the reader stopped early (`rocklab ... --json | head`): not an error
+        _silence_stdout()
+        return 0
     except OSError as e:
         if args.debug:
             raise

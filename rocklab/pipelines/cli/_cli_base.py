@@ -4,7 +4,24 @@ from __future__ import annotations
 
 from ..._errors import InputError
 
-__all__ = ["add_base_motion_args", "base_motion_from_args", "emit_json"]
+__all__ = ["add_base_motion_args", "base_motion_from_args", "emit_json", "count"]
+
+
+def count(minimum: int):
+    """An argparse ``type``: an integer >= ``minimum`` (a usage error, exit 2, otherwise)."""
+    import argparse
+
+    def parse(text):
+        try:
+            v = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{text!r} is not a whole number") from None
+        if v < minimum:
+            raise argparse.ArgumentTypeError(f"{v}: must be >= {minimum}")
+        return v
+
+    parse.__name__ = "count"
+    return parse
 
 
 def add_base_motion_args(p) -> None:

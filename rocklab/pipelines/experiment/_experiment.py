@@ -434,8 +434,11 @@ def run_experiment(
     """
     from ..._outdir import check_output_dir, publish_dir, stage_dir
 
+    from ..._inputs import check_folder_keeps_inputs
+
     cfg = load_experiment(config_path)
     out_dir = check_output_dir(out_dir, force=force, need_bytes=_space_needed(cfg))
+    check_folder_keeps_inputs(out_dir, [("source", p) for p in cfg.input_files()])
     fp = fingerprint(cfg)
     rep_path = out_dir / "report.json"
     if not force and rep_path.is_file():

@@ -2,13 +2,15 @@
 
 from __future__ import annotations
 
+from .._cli_base import count
+
 
 def register(sub):
     """Add this module's subcommand(s) to the ``rocklab`` parser ``sub``."""
     p = sub.add_parser("campaign", help="run every experiment.toml under DIR in parallel, then campaign fits")
     p.add_argument("dir", help="folder searched recursively for experiment*.toml")
     p.add_argument("--out", required=True, help="output folder")
-    p.add_argument("--workers", type=int, default=2, help="local processes (default 2)")
+    p.add_argument("--workers", type=count(1), default=2, help="local processes (default 2)")
     p.add_argument("--scheduler", metavar="ADDR", help="run the experiments on a Dask distributed cluster")
     p.add_argument("--force", action="store_true", help="re-run unchanged experiments too")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")

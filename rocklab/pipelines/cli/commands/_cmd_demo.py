@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from .._cli_base import count
+
 
 def register(sub):
     """Add this module's subcommand(s) to the ``rocklab`` parser ``sub``."""
@@ -11,7 +13,7 @@ def register(sub):
         "an El Centro shake-table run) and run it end to end",
     )
     p.add_argument("--out", default="demo_out", help="output folder (default: demo_out)")
-    p.add_argument("--workers", type=int, default=2, help="parallel processes (default 2)")
+    p.add_argument("--workers", type=count(1), default=2, help="parallel processes (default 2)")
     p.add_argument("--no-progress", action="store_true", help="no progress bars")
     p.set_defaults(func=run)
 

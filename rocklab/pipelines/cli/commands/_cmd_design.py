@@ -18,6 +18,7 @@ import sys
 from ...._errors import InputError
 
 
+from .._cli_base import count
 from .._cli_base import emit_json as _emit
 
 
@@ -51,7 +52,7 @@ def register(sub):
     p.add_argument("--levels", type=int, default=80, help="a_p/a_p,min levels 1..level-max (80)")
     p.add_argument("--level-max", type=float, default=10.0)
     p.add_argument("--sizes", type=int, default=120, help="log-spaced R from 1000 m to 0.1 m (120)")
-    p.add_argument("--refine", type=int, default=10, help="bisection steps on the boundary (10)")
+    p.add_argument("--refine", type=count(0), default=10, help="bisection steps on the boundary (10)")
     p.add_argument("--criterion", choices=("angle", "fall"), default="angle")
     p.add_argument("--free", default="energy", help="after the record: energy | none | SECONDS")
     p.add_argument("--search", choices=("scan", "contiguous"), default="scan")
@@ -73,7 +74,7 @@ def register(sub):
         help="t_I, t'_I and beta over an ensemble of grid placements, densities, step, eta and search "
         "(median and 5-95 %% band; 8 OAS per record)",
     )
-    p.add_argument("--workers", type=int, default=None, help="local processes for several records")
+    p.add_argument("--workers", type=count(1), default=None, help="local processes for several records")
     p.add_argument("--scheduler", default=None, help="Dask distributed scheduler address")
     p.add_argument("--no-progress", action="store_true")
     p.add_argument("--json", action="store_true")

@@ -68,11 +68,47 @@ def _board(spec):
     try:
         squares, sq, mk, dic = spec.split(",")
         c, r = (int(v) for v in squares.lower().split("x"))
-        return {"squares": (c, r), "square_m": float(sq), "marker_m": float(mk), "dictionary": dic.strip()}
+        board = {"squares": (c, r), "square_m": float(sq), "marker_m": float(mk), "dictionary": dic.strip()}
     except ValueError:
         raise InputError(
             f"--board {spec!r}: give COLSxROWS,SQUARE_M,MARKER_M,DICT, e.g. 9x6,0.03,0.022,DICT_5X5_100"
         ) from None
+    if min(c, r) < 3:
+        raise InputError(f"--board {spec!r}: a ChArUco board has at least 3x3 squares (e.g. 9x6)")
+    if not (math.isfinite(board["square_m"]) and 0 < board["marker_m"] < board["square_m"]):
+        raise InputError(
+            f"--board {spec!r}: the marker side ({mk.strip()} m) must be positive and smaller than the "
+            f"square side ({sq.strip()} m), e.g. 0.03,0.022"
+        )
+    return board
+
+
+#: Shapes of a ``stereo.json``'s arrays (StereoRig's fields).
+_RIG_SHAPES = {"K1": (3, 3), "K2": (3, 3), "R": (3, 3), "T": (3,)}
+
+
+def _check_rig(rig, path) -> None:
+    """A ``stereo.json`` whose arrays have the shapes the triangulation needs (one line otherwise)."""
+    import numpy as np
+
+    for name, shape in _RIG_SHAPES.items():
+        v = np.asarray(getattr(rig, name))
+        if v.shape != shape or not np.all(np.isfinite(v)):
+            key = "T_m" if name == "T" else name
+            raise InputError(
+                f"{path}: '{key}' must be {' x '.join(map(str, shape))} finite numbers (has shape {v.shape}); "
+                "make the file with 'rocklab stereo calibrate'"
+            )
+    for name in ("dist1", "dist2"):
+        v = np.asarray(getattr(rig, name)).ravel()
+        if v.size not in (4, 5, 8, 12, 14) or not np.all(np.isfinite(v)):
+            raise InputError(
+                f"{path}: '{name}' must be 4, 5, 8, 12 or 14 finite distortion coefficients (has {v.size}); "
+                "make the file with 'rocklab stereo calibrate'"
+            )
+    size = tuple(rig.size)
+    if len(size) != 2 or not all(float(s) > 0 for s in size):
+        raise InputError(f"{path}: 'size_px' must be [width, height] in pixels (has {list(size)})")
 
 
 def run(args) -> int:
@@ -137,6 +173,7 @@ def _track(args) -> int:
     if args.fps is not None and not (math.isfinite(args.fps) and args.fps > 0):
         raise InputError(f"--fps {args.fps}: must be a positive number of frames per second")
     rig = load_rig(args.calib)
+    _check_rig(rig, args.calib)
     rest = _rest(args.rest)
     out = Path(args.out) if args.out else Path(args.film1).parent / "tracks.csv"
     if args.targets == "aruco":

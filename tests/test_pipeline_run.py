@@ -164,3 +164,17 @@ def test_summary_numbers_for_people(tmp_path, run_cli):
 
     long_numbers = [x for x in re.findall(r"\d+\.\d+", text) if significant(x) > 4]
     assert long_numbers == [], long_numbers
+
+
+@pytest.mark.parametrize("status, code", [("ok", 0), ("suspect", 0), ("partial", 1), ("failed", 1)])
+def test_run_exit_status_follows_the_report(monkeypatch, tmp_path, run_cli, status, code):
+    """A run whose restitution fit failed reports "partial": exit 1, as the README documents
+    (it exited 0)."""
+    import rocklab.pipelines.experiment._experiment as exp
+
+    cfg = tmp_path / "experiment.toml"
+    cfg.write_text("")
+    report = {"name": "t", "status": status, "fit": {"eta_e": None}}
+    monkeypatch.setattr(exp, "run_experiment", lambda *a, **k: (report, True))
+    rc, out, _ = run_cli("run", cfg, "--out", tmp_path / "out")
+    assert rc == code and f"t: {status}" in out

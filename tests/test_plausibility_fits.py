@@ -25,6 +25,40 @@ def _track(eta=0.75, fps=50.0, seed=0, gap=None):
     return t, th
 
 
+@pytest.mark.parametrize("drop", [None, 29, 30, 31, 100])
+def test_a_dropped_frame_or_a_variable_rate_is_no_gap(drop):
+    """One missing sample (a dropped video frame, here at and after the release at 0.6 s) cannot
+    hide two impacts the sampling would resolve; nor can a phone's 14-26 ms frame intervals.
+    The fit was cut there against "the shortest half-cycle (0 s)" and failed."""
+    th0 = 0.8 * BLK.alpha_rad
+    r = simulate(BLK, th0, 0.0, 6.0, 1e-4, restitution="constant", eta=0.8)
+    if drop is None:
+        steps = np.random.default_rng(1).integers(14, 27, 400) / 1000.0
+        t = np.concatenate(([0.0], np.cumsum(steps)))
+    else:
+        t = np.delete(np.arange(0, 6.0, 1 / 50), drop)
+    th = np.interp(t - 0.6, r.t_s, r.theta_rad, left=th0, right=0.0)
+    th += np.random.default_rng(0).normal(0, math.radians(0.02), t.size)
+    with collecting() as found:
+        f = fit_restitution(t, th, BLK)
+    assert found == [] and f.status == "ok" and f.eta_e == pytest.approx(0.8, abs=0.003)
+
+
+def test_a_gap_before_the_second_impact_is_judged_by_the_half_cycle_after_it():
+    t, th = _track(eta=0.8)
+    # 4 samples lost right after the release: the first half-cycles last 0.26 s
+    keep = (t < 0.62) | (t >= 0.7)
+    with collecting() as found:
+        f = fit_restitution(t[keep], th[keep], BLK)
+    assert found == [] and f.eta_e == pytest.approx(0.8, abs=0.003)
+    # 14 lost there could hide two impacts: cut, and too few impacts are left
+    keep = (t < 0.62) | (t >= 0.9)
+    with collecting() as found:
+        f = fit_restitution(t[keep], th[keep], BLK)
+    assert [d.code for d in found] == ["W-FIT-GAP"] and "half-cycle after it" in found[0].message
+    assert f.status == "failed"
+
+
 def test_occlusion_is_cut_not_miscounted():
     t, th = _track(eta=0.9)
     clean = fit_restitution(t, th, BLK)

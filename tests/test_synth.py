@@ -196,6 +196,13 @@ def test_configs_load_with_their_readers(free_session):
     assert [o.id for o in cfg.objects] == ["table", "block_1"]
     assert cfg.object("block_1").marker_positions_m == ((0.0, -0.05), (0.0, 0.05))
     np.testing.assert_allclose(cfg.video.camera_matrix, s.meta["camera"]["camera_matrix"])
+    # no frame rate: the film's container times it, and a rate here would re-time any other film
+    assert cfg.video.fps is None
+    from rocklab.tracking import probe_video
+
+    info = probe_video(s.video_mkv)
+    assert info.n_frames == s.n_frames and info.fps == s.fps
+    np.testing.assert_allclose(info.frame_times_s, np.unique(s.truth.t_s)[: s.n_frames], rtol=0, atol=1e-9)
     exp = load_experiment(s.experiment_toml)
     assert (exp.b_m, exp.h_m) == (0.1, 0.2) and exp.video.object == "block_1"
     assert load_synth_session(s.out_dir).truth.equals(s.truth)

@@ -29,12 +29,16 @@ def _cut_at_gap(t, y, t_release_s, sigma_rad):
 
     Impacts inside a gap cannot be seen, so counting half-cycles across it makes every
     later impact one off (a 0.4 s occlusion turned eta_e 0.75 into 0.53). A gap is
-    dangerous when it lasts more than half of the shortest half-cycle seen before it;
-    the fit then uses the data before the gap and says so (``W-FIT-GAP``).
+    dangerous when it lasts more than half of the shortest half-cycle seen before it (or
+    the first one after it, where fewer than two impacts precede it: half-cycles only
+    shorten as the rocking decays); the fit then uses the data before the gap and says so
+    (``W-FIT-GAP``). Half-cycles are those resolved by the sampling (over two steps), and a
+    gap of one missing sample is no gap: two impacts hidden in it would be as unresolved
+    without it (a dropped video frame, a variable frame rate).
     """
     d = np.diff(t)
     med = float(np.median(d))
-    cand = np.flatnonzero((d > 1.5 * med) & (t[:-1] >= t_release_s))
+    cand = np.flatnonzero((d > 2.5 * med) & (t[:-1] >= t_release_s))
     if not cand.size:
         return t, y, None
     # sign changes of theta away from the noise band: the impacts seen so far
@@ -42,16 +46,24 @@ def _cut_at_gap(t, y, t_release_s, sigma_rad):
     idx = np.flatnonzero(big & (t >= t_release_s))
     sgn = np.sign(y[idx])
     t_cross = t[idx[1:][sgn[1:] != sgn[:-1]]]
+    halves = np.diff(t_cross)
+    resolved = halves > 2.0 * med
     for i in cand:
-        before = t_cross[t_cross <= t[i]]
-        half = float(np.min(np.diff(before))) if before.size >= 2 else float(t[i] - t_release_s)
+        before = resolved & (t_cross[1:] <= t[i])
+        after = np.flatnonzero(resolved & (t_cross[:-1] >= t[i + 1]))
+        if np.count_nonzero(before):
+            half = float(np.min(halves[before]))
+        elif after.size:  # half-cycles shorten as the rocking decays: the next one bounds those in the gap
+            half = float(halves[after[0]])
+        else:  # fewer than two impacts in the whole record: the fit fails on its own
+            continue
         if d[i] > 0.5 * half:
             n_lost = int(round(d[i] / med)) - 1
             diag = warn(
                 "W-FIT-GAP",
                 f"theta(t) has a {d[i]:.4g} s gap ({n_lost} samples) at t = {t[i]:.4g} s, "
-                f"longer than half the shortest half-cycle before it ({half:.4g} s); the "
-                f"fit uses the {i + 1} samples before the gap",
+                f"longer than half the {'shortest half-cycle before it' if np.count_nonzero(before) else 'half-cycle after it'} "
+                f"({half:.4g} s); the fit uses the {i + 1} samples before the gap",
             )
             return t[: i + 1], y[: i + 1], diag
     return t, y, None

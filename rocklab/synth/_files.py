@@ -127,8 +127,11 @@ class VideoPair:
             raise self._err[0]
 
 
-def write_track_toml(path: Path, *, style, fps, camera, objects, marker_size_m, dot_diameter_m, calibrated=True) -> str:
+def write_track_toml(path: Path, *, style, camera, objects, marker_size_m, dot_diameter_m, calibrated=True) -> str:
     """``track.toml`` through the tracker's own schema (:class:`TrackConfig`).
+
+    No frame rate: the film's container has each frame's time, and a rate written here would
+    re-time any other film the config is reused on.
 
     ``calibrated``: write the camera matrix, distortion and plane homography
     (else the tracker works from the marker size / dot layout alone).
@@ -139,7 +142,7 @@ def write_track_toml(path: Path, *, style, fps, camera, objects, marker_size_m, 
     from .._io import write_text_atomic
     from ..tracking.video._config import TrackConfig, load_track_config
 
-    d = {"video": {"fps": float(fps)}, "targets": {"style": style}, "reference": {"level": "table"}, "objects": []}
+    d = {"video": {}, "targets": {"style": style}, "reference": {"level": "table"}, "objects": []}
     if calibrated:
         # A calibrated lab: lens model plus the plane homography (undistorted px -> m), so
         # tracked positions are absolute in the session's world frame and perspective does

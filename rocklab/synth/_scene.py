@@ -186,7 +186,7 @@ class Scene:
 
         write_frame_atomic(folder / "truth.csv", self.truth_frame())
         f1 = self.features[self.block_motions[0].id]
-        write_track_toml(folder / "track.toml", style=self.targets, fps=self.fps, camera=self.camera,
+        write_track_toml(folder / "track.toml", style=self.targets, camera=self.camera,
                          objects=self._track_objects(), marker_size_m=f1.get("marker_size_m"),
                          dot_diameter_m=f1.get("dot_diameter_m"), calibrated=calibrated)
         b0 = self.sims[0]["block"]

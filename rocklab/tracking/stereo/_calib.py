@@ -131,16 +131,67 @@ def charuco_board(spec: dict):
     return cv2.aruco.CharucoBoard(tuple(spec["squares"]), float(spec["square_m"]), float(spec["marker_m"]), d)
 
 
-def _detect(path, board):
+def frames_by_index(path, lost: list | None = None):
+    """Grey frames of the film at ``path``, one per slot of its container's clock.
+
+    A frame the camera dropped or a damaged packet lost is a black picture (nothing is detected
+    in it), so frame ``i`` of one camera stays frame ``i`` of the other. ``(path, n_undecoded,
+    n_dropped, n_slots)`` is appended to ``lost`` at the end, for the caller to warn from its own
+    thread (:func:`warn_lost`).
+    """
+    from ..video._video import iter_video_frames, probe_video
+
+    info = probe_video(path)
+    slot = np.arange(info.n_frames)
+    if info.n_dropped and info.frame_times_s is not None and info.fps:
+        slot = np.rint(info.frame_times_s * info.fps).astype(int)
+    n = int(slot[-1]) + 1 if len(slot) else 0
+    nxt, n_undecoded, blank = 0, 0, None
+    for i, gray in iter_video_frames(path):
+        k = int(slot[i]) if i < len(slot) else i
+        blank = np.zeros_like(gray) if blank is None else blank
+        for _ in range(nxt, k):
+            yield blank
+        n_undecoded += max(k - nxt, 0)
+        yield gray
+        nxt = k + 1
+    if blank is not None:
+        for _ in range(nxt, n):
+            yield blank
+        n_undecoded += max(n - nxt, 0)
+    if lost is not None:
+        lost.append((str(path), n_undecoded - info.n_dropped, info.n_dropped, max(n, nxt)))
+
+
+def warn_lost(lost) -> None:
+    """W-VIDEO-DROPPED and W-VIDEO-DAMAGED for each film of :func:`frames_by_index` that lost frames."""
+    from ..._diagnostics import warn
+
+    for path, n_bad, n_dropped, n in lost:
+        if n_dropped:
+            warn(
+                "W-VIDEO-DROPPED",
+                f"{path}: the camera dropped {n_dropped} of {n} frames (gaps in the container's clock); "
+                "they count as frames without targets, so the two films stay paired frame by frame",
+            )
+        if n_bad > 0:
+            warn(
+                "W-VIDEO-DAMAGED",
+                f"{path}: {n_bad} of the {n} frames the container holds did not decode (damaged "
+                "packets); they count as frames without targets, so the two films stay paired frame by frame",
+            )
+
+
+def _detect(path, board, lost=None):
     """Per frame ``{corner id: (u, v)}`` of the ChArUco corners in the film at ``path``."""
     import cv2
 
-    from ..video._video import iter_video_frames, probe_video
+    from ..video._video import probe_video
 
     info = probe_video(path)
     det = cv2.aruco.CharucoDetector(board)
     out = []
-    for _, gray in iter_video_frames(path):
+    for gray in frames_by_index(path, lost):
         cc, ci, _, _ = det.detectBoard(gray)
         out.append({} if ci is None else {int(i): c for i, c in zip(ci.ravel(), cc.reshape(-1, 2))})
     return out, (info.width_px, info.height_px)
@@ -166,8 +217,10 @@ def calibrate_stereo(film1, film2, board: dict | None = None) -> StereoRig:
     spec = dict(DEFAULT_BOARD, **(board or {}))
     b = charuco_board(spec)
     obj_all = b.getChessboardCorners()
-    det1, size1 = _detect(film1, b)
-    det2, size2 = _detect(film2, b)
+    lost: list = []
+    det1, size1 = _detect(film1, b, lost)
+    det2, size2 = _detect(film2, b, lost)
+    warn_lost(lost)
     if len(det1) != len(det2):
         raise InputError(
             f"{where(film2)}{len(det2)} frames, but {Path(film1).name} has {len(det1)}; the two "

@@ -135,6 +135,7 @@ def track_dots_2d(frames, source: str = "", gate_px: float = 25.0, progress=None
 
     rows = []
     last = vel = area = None
+    blank = 0
     for i, gray in enumerate(frames):
         det, det_area = detect_dots(gray, with_area=True)
         if last is None:
@@ -145,13 +146,20 @@ def track_dots_2d(frames, source: str = "", gate_px: float = 25.0, progress=None
             vel = np.zeros_like(det)
             rows.append(det.copy())
             continue
-        pred = last + vel
         cur = np.full_like(last, np.nan)
+        if not det.shape[0]:  # a frame without any dot (lost to a damaged packet): the tracks wait
+            blank += 1
+            rows.append(cur)
+            if progress is not None:
+                progress(1)
+            continue
+        # after blank frames the dots moved for that long: predict and search as far
+        pred = last + vel * (1 + blank)
         if det.shape[0]:
             d = np.linalg.norm(pred[:, None, :] - det[None, :, :], axis=2)
             d = np.where(np.isfinite(d), d, 1e9)
             r, c = linear_sum_assignment(d)
-            ok = d[r, c] < gate_px
+            ok = d[r, c] < gate_px * (1 + blank)
             # a blob grown by half, or one that a second track could equally claim, is a merge: nobody's
             merged = det_area[c] > 1.5 * area[r]
             radius = np.sqrt(area[r] / np.pi)
@@ -159,8 +167,9 @@ def track_dots_2d(frames, source: str = "", gate_px: float = 25.0, progress=None
             ok &= ~merged & ~near
             cur[r[ok]] = det[c[ok]]
         seen = np.isfinite(cur).all(axis=1)
-        vel = np.where(seen[:, None], cur - last, vel)
+        vel = np.where(seen[:, None], (cur - last) / (1 + blank), vel)
         last = np.where(seen[:, None], cur, pred)
+        blank = 0
         rows.append(cur)
         if progress is not None:
             progress(1)
@@ -215,7 +224,7 @@ def _speed(uv):
     """Mean image speed over the tracks, px/frame (NaN-safe), shape (n,)."""
     v = np.linalg.norm(np.diff(uv, axis=0), axis=2)
     with np.errstate(all="ignore"), warnings.catch_warnings():
-        warnings.simplefilter("ignore", RuntimeWarning)  # a frame with no target seen: speed 0
+        warnings.simplefilter("ignore", RuntimeWarning)  # a frame without targets (lost): speed 0
         s = np.nanmean(np.where(np.isfinite(v), v, np.nan), axis=1)
     return np.nan_to_num(s)
 
@@ -374,15 +383,14 @@ def check_films(film1, film2, rig: StereoRig, fps: float | None = None) -> float
         if (info.width_px, info.height_px) != tuple(rig.size):
             raise InputError(f"{where(film)}frame size {info.width_px}x{info.height_px} differs from the "
                              f"calibration's {rig.size[0]}x{rig.size[1]}; calibrate with films of this camera mode")
-        if fps is None and info.frame_times_s is not None and (info.n_dropped or info.variable_rate):
-            # frames are paired by index at one rate: a dropped frame would pair every later one
-            # with its neighbour's time in the other film
+        if fps is None and info.frame_times_s is not None and info.variable_rate and not info.n_dropped:
+            # frames are paired by their slot on one constant clock (a dropped frame is an empty
+            # slot); a variable rate has no slots
             d = np.diff(info.frame_times_s)
             at = float(info.frame_times_s[int(np.argmax(np.abs(d - np.median(d))))])
-            what = f"drops {info.n_dropped} frame(s)" if info.n_dropped else "has a variable frame rate"
-            raise InputError(f"{where(film)}the camera {what} (first irregular interval after t = {at:.4f} s); "
-                             "stereo pairs the two films frame by frame at one rate: cut both films to a "
-                             "stretch without the gap, or give --fps if the container's times are wrong")
+            raise InputError(f"{where(film)}the camera has a variable frame rate (first irregular interval after "
+                             f"t = {at:.4f} s); stereo pairs the two films frame by frame at one rate: film at a "
+                             "fixed rate, or give --fps if the container's times are wrong")
     rate1 = fps or i1.fps
     rate2 = fps or i2.fps
     if not rate1:
@@ -416,9 +424,11 @@ def track_dots_stereo(film1, film2, rig: StereoRig, fps: float | None = None, sy
     -------
     StereoPoints
     """
-    from ..video._video import iter_video_frames, probe_video
+    from ..video._video import probe_video
+    from ._calib import frames_by_index, warn_lost
 
     rate1 = check_films(film1, film2, rig, fps)
+    lost: list = []
     bar = None
     if progress:
         from tqdm import tqdm
@@ -428,9 +438,10 @@ def track_dots_stereo(film1, film2, rig: StereoRig, fps: float | None = None, sy
 
     # one film per thread: decoding and the detector's OpenCV calls release the GIL, so two cores work
     with ThreadPoolExecutor(max_workers=2) as ex:
-        jobs = [ex.submit(track_dots_2d, (g for _, g in iter_video_frames(f)), str(f),
+        jobs = [ex.submit(track_dots_2d, frames_by_index(f, lost), str(f),
                           progress=bar.update if bar else None) for f in (film1, film2)]
         t1, t2 = (j.result() for j in jobs)
+    warn_lost(lost)
     if bar:
         bar.close()
     pairs, _ = match_tracks(rig, t1, t2, 0.0, max_px=5.0)

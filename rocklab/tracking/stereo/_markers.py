@@ -60,17 +60,16 @@ def track_markers_stereo(
     film1, film2, rig: StereoRig, dictionary: str = "DICT_4X4_50", fps: float | None = None, sync: bool = True
 ) -> StereoPoints:
     """ArUco corners of two films to 3D points in camera 1's axes (labels in ``StereoPoints.labels``)."""
-    from ..video._video import iter_video_frames
+    from ._calib import frames_by_index, warn_lost
 
     rate = check_films(film1, film2, rig, fps)
+    lost: list = []
     from concurrent.futures import ThreadPoolExecutor
 
     with ThreadPoolExecutor(max_workers=2) as ex:
-        jobs = [
-            ex.submit(track_markers_2d, (g for _, g in iter_video_frames(f)), dictionary, str(f))
-            for f in (film1, film2)
-        ]
+        jobs = [ex.submit(track_markers_2d, frames_by_index(f, lost), dictionary, str(f)) for f in (film1, film2)]
         (m1, n1), (m2, n2) = (j.result() for j in jobs)
+    warn_lost(lost)
     labels = sorted(set(m1) & set(m2), key=_sort_key)
     if len(labels) < 3:
         raise InputError(

@@ -84,8 +84,9 @@ class VideoConfig:
     Attributes
     ----------
     fps : float or None
-        Frames per second; overrides the container's rate. Required when the
-        container has none (else the CLI asks for ``--fps``).
+        Frames per second; overrides the container's own frame times (t_s = frame / fps;
+        W-VIDEO-FPS when they disagree). Required when the container has none (else the CLI
+        asks for ``--fps``).
     start_frame, stop_frame : int, int or None
         Half-open range of frames to track (``stop_frame=None``: to the end).
     camera_matrix : tuple of 3 tuples of 3 floats, or None

@@ -17,7 +17,7 @@ from fractions import Fraction
 
 import numpy as np
 
-__all__ = ["ContainerInfo", "container_info", "frame_clock"]
+__all__ = ["ContainerInfo", "container_info", "frame_clock", "shown_pts"]
 
 #: FFmpeg's AVFieldOrder: TT and TB code/show the top field first, BB and BT the bottom one.
 _FIELD_ORDER = {2: "tff", 4: "tff", 3: "bff", 5: "bff"}
@@ -96,6 +96,8 @@ def frame_clock(t_s: np.ndarray, tick_s: float, rates=()) -> tuple[np.ndarray, f
         k = np.rint(t * r0)
         if np.all(np.diff(k) >= 1) and k[-1] > 0:
             r1 = 1.0 / float(np.polyfit(k, t, 1)[0])  # refined over the whole film
+            # the plainest rate first: whole frames per second, NTSC's n / 1.001, then any fraction
+            cands += [Fraction(round(r1)), Fraction(round(r1 * 1.001) * 1000, 1001)]
             cands += [Fraction(r1).limit_denominator(1001), Fraction(r1)]
     for r in cands:
         if not 0 < r < 1e5:
@@ -106,6 +108,18 @@ def frame_clock(t_s: np.ndarray, tick_s: float, rates=()) -> tuple[np.ndarray, f
         if np.all(steps >= 1) and np.mean(steps == 1) >= MIN_SINGLE_STEPS and np.all(np.abs(t - k / rf) <= tol):
             return k / rf, rf, int(k[-1]) + 1 - len(t)
     return t, None, 0
+
+
+def _shown(packet) -> bool:
+    """Whether a packet is a frame of the film: timed, not empty, and not cut by an edit list
+    (an MP4 trimmed in a phone's editor keeps the cut frames, flagged discard; no decoder shows
+    them)."""
+    return packet.pts is not None and bool(packet.size) and not getattr(packet, "is_discard", False)
+
+
+def shown_pts(container, stream) -> np.ndarray:
+    """The presentation times (stream ticks, sorted) of the frames a film shows, from its packets."""
+    return np.sort(np.asarray([p.pts for p in container.demux(stream) if _shown(p)], np.int64))
 
 
 def _rotation(frame) -> int:
@@ -139,7 +153,7 @@ def container_info(path) -> ContainerInfo:
             pts, first = [], None
             try:
                 for p in c.demux(s):
-                    if p.pts is not None and p.size:
+                    if _shown(p):
                         pts.append(p.pts)
                     if first is None and p.size:  # decode only until the first picture appears
                         try:

@@ -454,7 +454,7 @@ def track_video(path, config: TrackConfig, fps: float | None = None, progress: b
     # the container's own frame times, unless the user overrides the rate (a clock known wrong)
     times = None if given else info.frame_times_s
     if given and info.frame_times_s is not None and info.fps and abs(given - info.fps) > 1e-3 * info.fps:
-        _check_rate(given, info, path, "--fps" if fps else f"{config.source or 'config'}: [video] fps")
+        _check_rate(given, info, path, "the given fps" if fps else f"{config.source or 'config'}: [video] fps")
     n_expected = info.n_frames
     if fields is not None:  # deinterlaced: two fields per frame, half a frame apart
         if rate is not None and not given:

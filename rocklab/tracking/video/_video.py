@@ -20,6 +20,7 @@ with detection on a second core.
 
 from __future__ import annotations
 
+import collections
 import os
 import queue
 import threading
@@ -29,7 +30,7 @@ from pathlib import Path
 import numpy as np
 
 from ..._errors import InputError
-from ._container import container_info
+from ._container import container_info, shown_pts
 
 __all__ = ["VideoInfo", "probe_video", "iter_video_frames", "container_info"]
 
@@ -222,7 +223,8 @@ class _PyAVReader:
     a third of OpenCV's decoding time at 1080p), turned upright by the frame's display matrix
     (as OpenCV does). Every frame is placed by its presentation time among the packets':
     ``index`` is the last frame's place, so a packet that fails to decode (counted in
-    ``n_broken``) leaves a gap instead of shifting the frames after it. A start past frame 0
+    ``n_broken``) leaves a gap instead of shifting the frames after it, and so does every frame
+    predicted from it up to the next key frame. A start past frame 0
     seeks to the key frame before it and decodes forward.
     """
 
@@ -232,13 +234,15 @@ class _PyAVReader:
         self._c = av.open(str(path))
         self._gray = gray
         self.n_broken = 0
+        # the first and the last place lost to damage, until a key frame after it
+        self._tainted, self._damage_end = None, -1
         self.index = int(first) - 1
         # four frame threads: decoding keeps pace beside the tracker, the frames in flight hiding
         # the moments the tracker holds a core (1080p H.264 at 17 Mbit/s on 2 cores, markerless,
         # decode included, six runs of 480 frames each: 106-138 frames/s; FFmpeg's automatic
         # frame + slice threads 100-126, slices alone 86-101)
         s = self._c.streams.video[0]
-        self._pts = np.sort([p.pts for p in self._c.demux(s) if p.pts is not None and p.size])
+        self._pts = shown_pts(self._c, s)
         self._c.seek(0, stream=s)
         s.thread_type, s.thread_count = "FRAME", 4
         self._it = self._decode(int(first))
@@ -250,6 +254,7 @@ class _PyAVReader:
 
         s = self._c.streams.video[0]
         packets = self._c.demux(s)
+        recent = collections.deque(maxlen=s.thread_count + 2)  # the packets in flight
         while True:
             try:
                 p = next(packets)
@@ -259,9 +264,29 @@ class _PyAVReader:
                 self.n_broken += 1
                 return
             try:
-                yield from p.decode()
+                frames = p.decode()
             except av.error.FFmpegError:
                 self.n_broken += 1
+                # the damage may begin inside a packet before, which decoded without complaint
+                # (concealed); with frame threads the error surfaces a few packets late
+                at = [int(np.searchsorted(self._pts, q)) for q in (p.pts, *recent) if q is not None]
+                if at:
+                    self._tainted = min(at + ([self._tainted] if self._tainted is not None else []))
+                    self._damage_end = max(at[0], self._damage_end)
+                continue
+            if p.size:
+                recent.append(p.pts)
+            for f in frames:
+                if self._tainted is not None and f.pts is not None:
+                    at = int(np.searchsorted(self._pts, f.pts))
+                    if f.key_frame and at > self._damage_end:  # a fresh start after the damage
+                        self._tainted = None
+                    elif at >= self._tainted:
+                        # predicted from a picture lost to the damage: FFmpeg conceals it without
+                        # a flag (a marker 10 deg off), so it is dropped until the next key frame
+                        self.n_broken += 1
+                        continue
+                yield f
 
     def _decode(self, first: int):
         c = self._c

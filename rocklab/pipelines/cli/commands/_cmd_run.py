@@ -42,4 +42,5 @@ def run(args) -> int:
             f"outputs in {args.out} (summary.md, report.json, session.rrd)",
             file=sys.stdout,
         )
-    return 0 if report.get("status") != "failed" else 1
+    # "partial": the run finished but a part of it failed (the restitution fit): exit 1, as documented
+    return 1 if report.get("status") in ("failed", "partial") else 0

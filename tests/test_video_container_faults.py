@@ -1,0 +1,140 @@
+"""The container is believed: frame times on its exact clock (coarse ticks, dropped frames,
+variable rate), its display rotation, and the frames after a damaged packet. Films are written
+with PyAV from a marker turned by a known angle at a known time."""
+
+from __future__ import annotations
+
+import math
+from fractions import Fraction
+
+import cv2
+import numpy as np
+import pytest
+
+from rocklab._diagnostics import RocklabWarning, collecting
+from rocklab.tracking import TrackConfig, probe_video, track_video
+from rocklab.tracking.video._video import iter_video_frames
+
+from test_video_container import CFG, _marker_frame, _write
+
+av = pytest.importorskip("av")
+
+
+def _theta(t_s):
+    return 0.2 * np.sin(2 * np.pi * np.asarray(t_s) / 0.4)
+
+
+def test_coarse_ticks_and_a_dropped_frame_keep_the_exact_clock(tmp_path):
+    """150 fps in Matroska's 1 ms ticks (steps of 7, 7, 6 ms) with frame 25 dropped: the rate is
+    150 exactly (a median step would say 142.857), every time is its slot / 150, and the gap is a
+    dropped frame (a note), not a stretch of the test."""
+    slots = np.delete(np.arange(61), 25)
+    t_true = slots / 150.0
+    path = tmp_path / "drop.mkv"
+    _write(path, [_marker_frame(t) for t in _theta(t_true)], np.rint(t_true * 1000), Fraction(1, 1000))
+    info = probe_video(path)
+    assert info.fps == 150.0 and info.n_frames == 60 and info.n_dropped == 1
+    np.testing.assert_allclose(info.frame_times_s, t_true, rtol=0, atol=1e-12)
+    with collecting() as diags:
+        b = track_video(path, TrackConfig.from_dict(CFG))["block_1"]
+    assert [d.code for d in diags] == ["W-VIDEO-DROPPED"] and diags[0].severity == "note"
+    assert "dropped 1 frame" in diags[0].message and "t = 0.1600" in diags[0].message
+    np.testing.assert_allclose(b.t_s, t_true, rtol=0, atol=1e-12)
+    assert np.nanmax(np.abs(b.theta_rad - _theta(b.t_s))) < math.radians(0.3)
+
+
+def test_variable_rate_matroska_keeps_its_packet_times(tmp_path):
+    """A phone's variable rate (31-36 ms steps) in Matroska: OpenCV's duration x rate estimate is
+    no frame count; t_s is each packet's time and θ lines up with the truth there."""
+    rng = np.random.default_rng(5)
+    pts_ms = np.concatenate(([0], np.cumsum(rng.integers(31, 37, 79))))
+    path = tmp_path / "phone.mkv"
+    _write(path, [_marker_frame(t) for t in _theta(pts_ms / 1000.0)], pts_ms, Fraction(1, 1000))
+    info = probe_video(path)
+    assert info.n_frames == 80 and info.n_dropped == 0 and info.variable_rate
+    with collecting() as diags:
+        b = track_video(path, TrackConfig.from_dict(CFG))["block_1"]
+    assert [d.code for d in diags] == []
+    np.testing.assert_allclose(b.t_s, pts_ms / 1000.0, rtol=0, atol=1e-9)
+    assert np.nanmax(np.abs(b.theta_rad - _theta(b.t_s))) < math.radians(0.3)
+    # the same frames at frame / mean rate would be over a degree off somewhere
+    t_even = np.arange(80) * pts_ms[-1] / 79 / 1000.0
+    assert np.nanmax(np.abs(b.theta_rad - _theta(t_even))) > math.radians(1.0)
+
+
+def test_display_rotation_is_applied_for_every_reader(tmp_path):
+    """A phone films sideways and stores a display matrix (+90 deg): grey (PyAV luma), colour
+    (PyAV) and OpenCV frames are one upright picture, and θ is the upright marker's."""
+    n = 12
+    t = np.arange(n) / 25.0
+    path = tmp_path / "phone.mp4"
+    with av.open(str(path), "w") as c:
+        s = c.add_stream("libx264", rate=25)
+        s.width, s.height, s.pix_fmt = 302, 402, "yuv420p"
+        s.options = {"crf": "0"}
+        s.set_display_rotation(90)
+        for th in _theta(t):
+            up = np.pad(_marker_frame(th), ((0, 1), (0, 1)), mode="edge")  # 302 rows x 402 columns
+            stored = np.ascontiguousarray(np.rot90(up, -1))  # turned clockwise, shown upright by +90
+            for pkt in s.encode(av.VideoFrame.from_ndarray(stored, format="gray")):
+                c.mux(pkt)
+        for pkt in s.encode():
+            c.mux(pkt)
+    info = probe_video(path)
+    assert (info.width_px, info.height_px, info.rotation_deg) == (402, 302, 90)
+    grey = next(iter(iter_video_frames(path, prefetch=0)))[1]
+    _, grey_c, colour = next(iter(iter_video_frames(path, prefetch=0, color=True)))
+    ok, ref = cv2.VideoCapture(str(path)).read()
+    assert ok and grey.shape == grey_c.shape == ref.shape[:2] == (302, 402)
+    assert np.array_equal(grey, grey_c)
+    assert np.abs(grey.astype(int) - cv2.cvtColor(ref, cv2.COLOR_BGR2GRAY)).max() <= 3
+    b = track_video(path, TrackConfig.from_dict(CFG))["block_1"]
+    assert np.all(b.status == "ok")
+    assert np.nanmax(np.abs(b.theta_rad - _theta(t))) < math.radians(0.3)
+
+
+def test_a_damaged_packet_loses_only_its_frames_and_says_so(tmp_path):
+    """20 kB of garbage in the middle of an H.264 film: the reading goes on past it, the frames
+    after keep their times, frames predicted from a lost picture are dropped to the next key frame
+    (they decode concealed, 10 deg off), and the loss is W-VIDEO-DAMAGED (suspect)."""
+    n, fps = 200, 50
+    t = np.arange(n) / fps
+    path = tmp_path / "clean.mp4"
+    with av.open(str(path), "w") as c:
+        s = c.add_stream("libx264", rate=fps)
+        s.width, s.height, s.pix_fmt = 402, 302, "yuv420p"
+        s.options = {"g": "25", "crf": "18"}
+        for th in _theta(t):
+            f = np.pad(_marker_frame(th), ((0, 1), (0, 1)), mode="edge")
+            for pkt in s.encode(av.VideoFrame.from_ndarray(f, format="gray")):
+                c.mux(pkt)
+        for pkt in s.encode():
+            c.mux(pkt)
+    data = bytearray(path.read_bytes())
+    mid = len(data) // 2
+    data[mid : mid + 20000] = np.random.default_rng(1).integers(0, 256, 20000, dtype=np.uint8).tobytes()
+    bad = tmp_path / "damaged.mp4"
+    bad.write_bytes(bytes(data))
+    with collecting() as diags:
+        b = track_video(bad, TrackConfig.from_dict(CFG))["block_1"]
+    m = len(b.t_s)
+    assert 100 < m < n and b.t_s[-1] == pytest.approx((n - 1) / fps)  # the film's end is read
+    assert set(np.round(b.t_s * fps).astype(int)) < set(range(n))
+    assert [d.code for d in diags] == ["W-VIDEO-DAMAGED"] and diags[0].severity == "suspect"
+    assert f"{n - m} of the {n} frames" in diags[0].message
+    assert np.all(b.status == "ok")
+
+    assert np.nanmax(np.abs(b.theta_rad - _theta(b.t_s))) < math.radians(0.3)
+
+
+def test_a_given_rate_that_contradicts_the_container_is_a_warning(tmp_path):
+    path = tmp_path / "cfr.mkv"
+    _write(path, [_marker_frame(0.1)] * 6, np.arange(6) * 40, Fraction(1, 1000))
+    cfg = TrackConfig.from_dict(dict(CFG, video={"fps": 50.0}))
+    with pytest.warns(RocklabWarning, match=r"W-VIDEO-FPS.*50 frames/s.*constant 25 frames/s"):
+        tr = track_video(path, cfg)
+    np.testing.assert_allclose(tr["block_1"].t_s, np.arange(6) / 50.0)  # the given rate, as asked
+    # the same rate as the container's: no warning
+    with collecting() as diags:
+        track_video(path, TrackConfig.from_dict(dict(CFG, video={"fps": 25.0})))
+    assert diags == []

@@ -124,7 +124,8 @@ def track_frames(frames, config: TrackConfig, plane_map: PlaneMap | None = None)
                 if fixed is None and len(q) == d.n_expected:
                     scales.setdefault(o.id, collections.deque(maxlen=51)).append(f.scale)
                 spread = math.sqrt(np.sum((q - q.mean(0)) ** 2) / len(q))
-                qual = (len(q) / d.n_expected) / (1.0 + f.rms / (0.002 * spread + 1e-12))
+                qual = (len(q) / d.n_expected) / (1.0 + f.rms / (0.002 * spread + 1e-12) if d.score is None
+                                                  else 1.0 / max(d.score, 1e-12))
                 if qual < min_q:
                     obs.append(Observation(idx, o.id, *(np.nan,) * 4, f.scale, f.rms, qual,
                                            "low_quality", d.metric, plane_map.source))
@@ -140,7 +141,10 @@ def track_frames(frames, config: TrackConfig, plane_map: PlaneMap | None = None)
                     sharp_ref[o.id] = _look(gray, box)
             else:
                 status = "lost"
-                if o.id in boxes:
+                why = det.lost_reason(o.id) if hasattr(det, "lost_reason") else None
+                if why is not None:
+                    status = why  # the pose was fitted but does not re-explain the image
+                elif o.id in boxes:
                     status = _why_lost(_look(gray, boxes[o.id]), sharp_ref.get(o.id))
                 obs.append(Observation(idx, o.id, *(np.nan,) * 7, status,
                                        getattr(d, "metric", True), plane_map.source))

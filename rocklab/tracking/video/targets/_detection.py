@@ -31,17 +31,22 @@ class Detection:
         reported σ is ``hypot(σ_fit, sigma_rad)``; with several, the corner fit
         also carries their relative positions and the two are combined as
         independent estimates, ``(σ_fit⁻² + sigma_rad⁻²)^-1/2``.
+    score : float or None
+        How well the pose re-explains the image, 0..1 (a markerless object: the correlation of
+        the frame, warped back, with its template); when given, it is the frame's quality
+        (times the fraction of points found) instead of the fit residual's.
     """
 
-    __slots__ = ("img_pts", "obj_pts", "metric", "n_expected", "sigma_rad", "n_groups")
+    __slots__ = ("img_pts", "obj_pts", "metric", "n_expected", "sigma_rad", "n_groups", "score")
 
-    def __init__(self, img_pts, obj_pts, metric, n_expected, sigma_rad=0.0, n_groups=1):
+    def __init__(self, img_pts, obj_pts, metric, n_expected, sigma_rad=0.0, n_groups=1, score=None):
         self.img_pts = np.asarray(img_pts, float).reshape(-1, 2)
         self.obj_pts = np.asarray(obj_pts, float).reshape(-1, 2)
         self.metric = bool(metric)
         self.n_expected = int(n_expected)
         self.sigma_rad = float(sigma_rad) if np.isfinite(sigma_rad) else 0.0
         self.n_groups = int(n_groups)
+        self.score = None if score is None else float(score)
 
     def combined_sigma(self, sigma_fit):
         """The reported 1-σ of θ given the rigid fit's own σ (rad)."""

@@ -12,7 +12,10 @@ never chained frame to frame, so the pose does not drift:
 3. if ECC fails (occlusion, a jump at an impact), re-acquire: normalised cross-
    correlation of the template, turned by up to ±8°, over a search window around the
    prediction (after lost frames: the first frame's place, then the last pose seen), then ECC;
-4. still nothing: the frame is lost (NaN, status ``lost``) and the next frame searches.
+4. verify the pose (:mod:`._verify`: appearance, motion, background, limits learned from the
+   object's own verified frames); a pose that fails, or no pose, sends the template over the
+   whole frame; still nothing verified: the frame is lost (NaN, status ``lost`` or the failed
+   check's name) and the next frame searches. Only verified frames renew the keyframe.
 
 A keyframe is not renewed from a frame in which part of the object is covered (most cells
 of a 4 x 4 grid match, one does not: a hand, the thread), so the keyframe never learns an
@@ -33,6 +36,7 @@ from ...._errors import InputError
 from ._detection import Detection
 from ._ic import ICAffine, ICRigid
 from ._occlusion import cell_correlations, masked_fit, partly_covered
+from ._verify import PoseVerifier
 
 __all__ = ["MarkerlessTracker", "MarkerlessDetector", "MIN_CC", "REKEY_CC"]
 
@@ -71,8 +75,7 @@ def _params(W):
 
 def _rigid(W):
     """The rigid warp nearest to ``W`` (same translation, the polar rotation)."""
-    th, tx, ty = _params(W)
-    return _euclid(th, tx, ty)
+    return _euclid(*_params(W))
 
 
 def _near_rigid(W, tol=0.05):
@@ -105,10 +108,10 @@ class MarkerlessTracker:
         H, W = first_gray.shape[:2]
         u, v, w, h = (int(round(x)) for x in obj.roi)
         u0, v0, u1, v1 = max(u, 0), max(v, 0), min(u + w, W), min(v + h, H)
-        if u1 - u0 < 8 or v1 - v0 < 8:
+        if u1 - u0 < 8 or v1 - v0 < 8 or w > W or h > H:
             raise InputError(
-                f"object {obj.id!r}: roi {list(obj.roi)} lies outside the {W}x{H} frame or is "
-                "smaller than 8x8 px; give the object's region in the first frame"
+                f"object {obj.id!r}: roi {list(obj.roi)} lies outside the {W}x{H} frame, is larger "
+                "than it, or is smaller than 8x8 px; draw the region round the object in the first frame"
             )
         tmpl = first_gray[v0:v1, u0:u1].astype(np.float32)
         if float(tmpl.std()) < MIN_TEXTURE_STD:
@@ -135,6 +138,9 @@ class MarkerlessTracker:
         c, s = math.cos(-th0), math.sin(-th0)
         self.obj_pts = (q - centre) @ np.array([[c, -s], [s, c]]).T
         self._cv2 = cv2
+        self.centre0 = self.origin + np.array(self.size, float) / 2  # template centre, first-frame px
+        self.verifier = PoseVerifier(first_gray, (u0, v0, u1, v1), self.size)
+        self.reason = None  # why the last frame was lost ("mismatch", "jump", "background", "lost")
 
     # -- registration -------------------------------------------------------------
     def _window(self, gray, W, margin):
@@ -144,10 +150,8 @@ class MarkerlessTracker:
             :, 2
         ].astype(float)
         H, Wd = gray.shape[:2]
-        x0 = int(max(np.floor(corners[:, 0].min() - margin), 0))
-        y0 = int(max(np.floor(corners[:, 1].min() - margin), 0))
-        x1 = int(min(np.ceil(corners[:, 0].max() + margin), Wd))
-        y1 = int(min(np.ceil(corners[:, 1].max() + margin), H))
+        x0, y0 = (int(max(np.floor(corners[:, i].min() - margin), 0)) for i in (0, 1))
+        x1, y1 = int(min(np.ceil(corners[:, 0].max() + margin), Wd)), int(min(np.ceil(corners[:, 1].max() + margin), H))
         if x1 - x0 < 8 or y1 - y0 < 8:
             return None, None
         return gray[y0:y1, x0:x1].astype(np.float32), np.array([x0, y0], np.float32)
@@ -425,11 +429,22 @@ class MarkerlessTracker:
             part = masked_fit(self, self.key, gray, W_pred)
             if part is not None:
                 fit, tmpl, mask, visible = part[:2], self.key, part[2], part[3]
-        if fit is None or fit[1] < MIN_CC:
+        self.reason = None
+        if fit is not None and fit[1] >= MIN_CC:
+            self.reason = self.verifier.verify(self, gray, fit[0], frame, fit[1])
+        if fit is None or fit[1] < MIN_CC or self.reason is not None:
+            # converged on something else, or nowhere: the template anywhere in the frame
+            alt = self.verifier.reacquire(self, gray, frame, MIN_CC)
+            if alt is not None:
+                fit, tmpl, mask, visible, self.reason = alt[:2], self.key, None, 1.0, None
+            self.reason = self.reason or (None if fit is not None and fit[1] >= MIN_CC else "lost")
+        if self.reason is not None:
+            self.key = self.tmpl0 if self.reason == "drift" else self.key  # the keyframe learned the slide
             if self.poses:
                 self.last = self.poses[-1]
             self.poses = []  # the next frame searches from the first frame's place, then the last seen
             return None
+        self.verifier.confirm(gray, self.size)
         W, cc = fit
         if cc < REKEY_CC and mask is None:
             back = self._warp_back(gray, W)
@@ -447,7 +462,7 @@ class MarkerlessTracker:
         # a partial view: fewer points than a whole one would give (its quality says so, and the
         # rigid fit keeps the object's known scale)
         n_expected = len(self.grid) if mask is None else int(math.ceil(len(self.grid) / max(visible, 1e-3)))
-        return Detection(pts, self.obj_pts, False, n_expected, sigma_rad=sig, n_groups=1)
+        return Detection(pts, self.obj_pts, False, n_expected, sigma_rad=sig, n_groups=1, score=cc)
 
 
 class MarkerlessDetector:
@@ -478,3 +493,8 @@ class MarkerlessDetector:
 
     def detect(self, gray, frame):
         return {oid: t.detect(gray, frame) for oid, t in self.trackers.items()}
+
+    def lost_reason(self, oid):
+        """Why object ``oid`` was lost in the last frame (a status word), or None."""
+        t = self.trackers.get(oid)
+        return None if t is None or t.reason in (None, "lost") else t.reason

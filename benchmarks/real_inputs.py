@@ -1,0 +1,96 @@
+"""Real films, checked against an independent reference: frames ok, frames ok but wrong, boxes.
+
+For each real film: the markerless tracker (``track_video``) from a box drawn round the ball and
+from boxes perturbed round it (each side +-20 %, the centre +-10 %, seeded), against a colour
+script that knows nothing of the tracker (``tests/_blob.py``: the ball's blue half by an HSV
+threshold). Printed per film and box: frames, frames ok, frames ok but wrong (the tracked point
+more than 1 % of the frame width off the reference, after the median offset), the status counts,
+and the swing period from x_px against the reference's.
+
+Development film (tune on it): ``../shared/data/video/pendulum_film2_vga.mp4``.
+Validation films (never tuned on): the other take of the same scene at four resolutions,
+``film1_{vga,sd,hd,fhd}.mp4`` of the public repository bartekpacia/pendulum (no licence stated,
+so not shipped: put them in ``$ROCKLAB_FILMS``, default ``/tmp/verify-films``; skipped when absent).
+
+Run: ``python benchmarks/real_inputs.py [n_boxes [part of a file name]]``.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+
+from _blob import blob_track, perturbed_boxes, swing_period_s, wrong_ok  # noqa: E402
+
+from rocklab._diagnostics import collecting  # noqa: E402
+from rocklab.tracking import TrackConfig, track_video  # noqa: E402
+from rocklab.tracking.video._video import probe_video  # noqa: E402
+
+ROOT = Path(__file__).resolve().parents[1]
+FILMS_DIR = Path(os.environ.get("ROCKLAB_FILMS", "/tmp/verify-films"))
+#: (set, path, box drawn round the ball in the first frame, x, y, w, h px)
+FILMS = [
+    ("development", ROOT.parent / "shared" / "data" / "video" / "pendulum_film2_vga.mp4", (310, 66, 70, 74)),
+    *[
+        ("validation", FILMS_DIR / f"film1_{r}.mp4", tuple(round(v * s) for v in (650, 290, 205, 220)))
+        for r, s in (("vga", 310 / 1080), ("sd", 480 / 1080), ("hd", 720 / 1080), ("fhd", 1.0))
+    ],
+]
+
+
+def run(path, box, ref, ref_scale):
+    cfg = TrackConfig.from_dict(
+        {
+            "targets": {"style": "markerless"},
+            "reference": {"level": "none"},
+            "objects": [{"id": "ball", "roi": list(box)}],
+        }
+    )
+    t0 = time.perf_counter()
+    with collecting():
+        res = track_video(path, cfg)
+    dt = time.perf_counter() - t0
+    tr = res["ball"]
+    r = ref * ref_scale
+    wrong, _ = wrong_ok(tr.x_px, tr.y_px, tr.ok, r, res.width_px)
+    st, cnt = np.unique(tr.status, return_counts=True)
+    x = np.where(tr.ok, tr.x_px, np.nan)
+    try:
+        T = swing_period_s(tr.t_s, x)
+    except Exception:  # a track too broken to fit is reported as such
+        T = np.nan
+    return len(tr.status), int(tr.ok.sum()), int(wrong.sum()), dict(zip(st.tolist(), cnt.tolist())), T, dt
+
+
+def main(n_boxes=5, only=""):
+    for kind, path, box in FILMS:
+        if only not in path.name:
+            continue
+        if not path.exists():
+            print(f"{kind:11s} {path.name}: absent, skipped")
+            continue
+        info = probe_video(path)
+        ref, fps, w_cv = blob_track(path)
+        scale = np.array([info.width_px / w_cv, 1.0])  # non-square pixels: the tracker resamples
+        T_ref = swing_period_s(np.arange(len(ref)) / fps, ref[:, 0])
+        print(f"{kind} {path.name} ({info.width_px}x{info.height_px}): reference period {T_ref:.5f} s")
+        periods = []
+        for i, b in enumerate([box, *perturbed_boxes(box, n_boxes, seed=1)]):
+            n, ok, bad, st, T, dt = run(path, b, ref, scale)
+            periods.append(T)
+            print(
+                f"  box {i:2d} {b}: frames {n}, ok {ok} ({100 * ok / n:.2f} %), ok but wrong {bad}, "
+                f"period {T:.5f} s ({1e2 * (T / T_ref - 1):+.3f} %), {n / dt:.0f} frames/s, {st}"
+            )
+        p = np.array(periods)
+        print(f"  period spread over boxes: {1e2 * (np.nanmax(p) - np.nanmin(p)) / np.nanmedian(p):.4f} %")
+
+
+if __name__ == "__main__":
+    main(int(sys.argv[1]) if len(sys.argv) > 1 else 5, sys.argv[2] if len(sys.argv) > 2 else "")

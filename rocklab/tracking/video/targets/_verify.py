@@ -1,0 +1,301 @@
+"""Does a fitted markerless pose re-explain the image? Checks after every fit, learned per object.
+
+A registration converges somewhere; it does not say whether that is the object. After the fit
+the frame, warped back onto the template's grid by the pose, is checked three ways, each against
+limits learned from the object's own verified frames (robust statistics, not global constants)
+and, for the outline, its own first frame:
+
+* **appearance** (``mismatch``): its correlation with the first template or the last verified
+  keyframe must reach the median of the verified frames' correlations less
+  :data:`APPEARANCE_MADS` robust deviations (at least :data:`MIN_DEVIATION`; never below
+  :data:`MIN_SCORE`);
+* **motion** (``jump``): the pose may leave the constant-velocity prediction by no more than
+  the verified frames' residuals allow (:data:`MOTION_FACTOR` times their 99th percentile, at
+  least :data:`MIN_RESIDUAL_FRAC` of the template), nor turn by more than
+  :data:`MAX_STEP_RAD` a frame since the last verified pose;
+* **background** (``background``): the warped patch must not match the still background
+  (the first frame, with the object's first region filled in once the object has left it)
+  on nearly all of its pixels: a pose frozen on a patch of wall is a lost lock;
+* **outline** (``drift``): once the background behind the object's first region is known, the
+  centroid of the pixels that differ from the background must stay where it was in the user's
+  region, within :data:`DRIFT_FRAC` of the template: a keyframe renewed over a still edge of
+  the wall lets the pose slide off a spinning object while every correlation stays high.
+
+A frame that fails is lost with that reason; only verified frames renew the keyframe and teach
+the limits, so a wrong lock cannot teach the tracker to accept itself.
+"""
+
+from __future__ import annotations
+
+import collections
+import math
+
+import numpy as np
+
+__all__ = ["PoseVerifier", "search_whole_frame", "MIN_SCORE", "MAX_STEP_RAD"]
+
+#: Lowest correlation of the warped frame with the template that can ever count as the object.
+MIN_SCORE = 0.2
+#: Robust standard deviations below the verified median correlation still accepted.
+APPEARANCE_MADS = 6.0
+#: Smallest robust deviation of the correlation assumed: a rendered object matches its template
+#: to 0.99 on every frame, and a 0.97 is not a different object.
+MIN_DEVIATION = 0.05
+#: Verified frames before the learned appearance limit is used (the floor applies until then).
+WARMUP_FRAMES = 15
+#: Verified frames between two updates of the learned limits (sorting 300 values every frame
+#: would cost a few percent of the tracker's time).
+RELEARN_FRAMES = 10
+#: Prediction residual allowed, in multiples of the verified frames' 99th percentile.
+MOTION_FACTOR = 4.0
+#: Smallest residual limit, as a fraction of the template's larger side (a frame's impact or a
+#: change of swing direction moves the object off the constant-velocity line by a few pixels).
+MIN_RESIDUAL_FRAC = 0.08
+#: Largest turn between consecutive frames, rad (as the track's outlier rule), and the largest
+#: turn since the last verified pose whatever the gap.
+MAX_STEP_RAD = 0.35
+MAX_TURN_RAD = 1.0
+#: Background check: a grey difference below this is "unchanged"; a patch unchanged on this
+#: fraction of the pixels whose background is known is background.
+BG_TOL = 10.0
+BG_FRACTION = 0.9
+#: Least fraction of a patch standing out of the background (and left as background) for its
+#: outline to be placed.
+MIN_FG = 0.05
+#: Largest move of the object's outline inside the template, as a fraction of its larger side.
+DRIFT_FRAC = 0.1
+#: Fraction of the patch whose background must be known for the background check to apply.
+BG_KNOWN = 0.5
+
+
+class PoseVerifier:
+    """One markerless object's checks (see the module's description).
+
+    Parameters
+    ----------
+    first_gray : ndarray (H, W) uint8
+        The first frame: the background everywhere but the object's region.
+    box : tuple of int
+        The object's region in the first frame, (u0, v0, u1, v1) px.
+    size : tuple of int
+        The template's (width, height), px.
+    """
+
+    def __init__(self, first_gray, box, size):
+        self.bg = first_gray.astype(np.float32)
+        self.box = box
+        self.filled = False  # the first region's background seen (the object has left it)
+        self.tmpl0 = first_gray[box[1] : box[3], box[0] : box[2]].astype(np.float32)
+        #: where the object stands out of the background in the user's region: its changed pixels'
+        #: centroid from the region's centre (template px), once that background is known
+        self.offset0 = None
+        self.size = size
+        self.scores = collections.deque(maxlen=300)
+        self.residuals = collections.deque(maxlen=300)
+        self.speeds = collections.deque(maxlen=300)
+        self.n_verified = 0
+        self._limits, self._learned_at = None, 0
+        #: (centre (2,), theta, frame) of the last two verified poses
+        self.recent: list = []
+
+    # -- learned limits ------------------------------------------------------------
+    def score_limit(self) -> float:
+        """The lowest correlation accepted now."""
+        if len(self.scores) < WARMUP_FRAMES:
+            return MIN_SCORE
+        s = np.asarray(self.scores)
+        med = float(np.median(s))
+        dev = max(1.4826 * float(np.median(np.abs(s - med))), MIN_DEVIATION)
+        return max(MIN_SCORE, med - APPEARANCE_MADS * dev)
+
+    def residual_limit(self) -> float:
+        """Largest distance from the constant-velocity prediction accepted for one frame, px."""
+        floor = MIN_RESIDUAL_FRAC * max(self.size) + 1.0
+        if len(self.residuals) < WARMUP_FRAMES:
+            return max(floor, 0.25 * max(self.size))
+        return max(floor, MOTION_FACTOR * float(np.percentile(self.residuals, 99)))
+
+    # -- the checks ------------------------------------------------------------------
+    def limits(self):
+        """(score, residual, speed) limits, learned again every :data:`RELEARN_FRAMES` verified frames."""
+        if (
+            self._limits is None
+            or self.n_verified >= self._learned_at + RELEARN_FRAMES
+            or self.n_verified < WARMUP_FRAMES
+        ):
+            self._limits = (self.score_limit(), self.residual_limit(), self.speed_limit())
+            self._learned_at = self.n_verified
+        return self._limits
+
+    def check(self, score, centre, theta, pred, last, gap, bg_back=None, back=None, known_back=None):
+        """The reason the pose fails, or None when it is verified.
+
+        Parameters
+        ----------
+        score : float
+            Correlation of the warped frame with the better of the two templates.
+        centre : ndarray (2,)
+            The template's centre under the pose, image px.
+        theta : float
+            The pose's angle, rad.
+        pred : tuple or None
+            (centre (2,), theta) predicted from the last two verified frames; None without them.
+        last : tuple or None
+            (centre (2,), theta) of the last verified pose; None before any.
+        gap : int
+            Frames since the last verified one (1: the previous frame).
+        bg_back, back, known_back : ndarray (h, w), optional
+            The background, the frame and the background's known mask, warped onto the template.
+        """
+        score_lim, lim, speed_lim = self.limits()
+        if score < score_lim:
+            return "mismatch"
+        if last is not None:
+            turn = abs(math.remainder(theta - last[1], 2 * math.pi))
+            if turn > min(MAX_STEP_RAD * gap, MAX_TURN_RAD):
+                return "jump"
+            ref = pred if pred is not None and gap == 1 else None
+            if ref is not None:
+                if float(np.hypot(*(centre - ref[0]))) > lim:
+                    return "jump"
+            else:  # after lost frames: no farther than the fastest verified motion allows
+                if float(np.hypot(*(centre - last[0]))) > (lim + speed_lim) * gap:
+                    return "jump"
+        if bg_back is not None and known_back is not None:
+            k = known_back > 0.5
+            if k.mean() >= BG_KNOWN and float(np.mean(np.abs(back[k] - bg_back[k]) < BG_TOL)) >= BG_FRACTION:
+                return "background"
+        return None
+
+    def speed_limit(self) -> float:
+        """Largest believable motion per frame, px: three times the fastest verified one, at
+        least a tenth of the template."""
+        top = float(np.percentile(self.speeds, 99)) if self.speeds else 0.0
+        return max(3.0 * top, 0.1 * max(self.size))
+
+    def accept(self, score, centre, pred, last, gap, gray=None, footprint=None):
+        """Learn from a verified frame: its correlation, its residual, its speed, and (once the
+        object has left its first region) the background there."""
+        self.n_verified += 1
+        self.scores.append(float(score))
+        if pred is not None and gap == 1:
+            self.residuals.append(float(np.hypot(*(centre - pred[0]))))
+        if last is not None and gap == 1:
+            self.speeds.append(float(np.hypot(*(centre - last[0]))))
+        if gray is not None and footprint is not None and not self.filled:
+            x0, y0, x1, y1 = footprint
+            u0, v0, u1, v1 = self.box
+            if x1 < u0 or x0 > u1 or y1 < v0 or y0 > v1:  # the first region is uncovered now
+                self.bg[v0:v1, u0:u1] = gray[v0:v1, u0:u1]
+                self.filled = True
+                self.offset0 = self._fg_offset(self.tmpl0, self.bg[v0:v1, u0:u1])
+
+    def _fg_offset(self, patch, bg):
+        """Centroid of the pixels of ``patch`` that differ from ``bg`` from the patch's centre
+        (template px, (2,)), or None when too few or nearly all differ (no outline to place)."""
+        fg = np.abs(patch - bg) >= BG_TOL
+        if not MIN_FG <= fg.mean() <= 1.0 - MIN_FG:
+            return None
+        ys, xs = np.nonzero(fg)
+        h, w = fg.shape
+        return np.array([xs.mean() - (w - 1) / 2, ys.mean() - (h - 1) / 2])
+
+    # -- with a tracker ----------------------------------------------------------------
+    def verify(self, tr, gray, W, frame, score):
+        """Check the pose ``W`` (first-frame px -> image px) of the tracker ``tr`` in ``gray``.
+
+        Parameters
+        ----------
+        score : float
+            The fit's correlation of the template with the frame warped back by ``W``.
+
+        Returns
+        -------
+        reason : str or None
+            None when verified (then :meth:`confirm` learns from it).
+        """
+        Wd = np.asarray(W, float)
+        centre = Wd[:, :2] @ tr.centre0 + Wd[:, 2]
+        theta = math.atan2(Wd[1, 0] - Wd[0, 1], Wd[0, 0] + Wd[1, 1])
+        last = self.recent[-1] if self.recent else None
+        gap = frame - last[2] if last is not None else 1
+        pred = None
+        if len(self.recent) == 2 and self.recent[1][2] - self.recent[0][2] == 1:
+            (c0, t0, _), (c1, t1, _) = self.recent
+            pred = (2 * c1 - c0, 2 * t1 - t0)
+        bg = back = known = None
+        # the background is known where the first frame did not show the object, and everywhere
+        # once the object has left its first region: only then is the check worth its two warps
+        if self.filled or self._clear(centre):
+            bg, back = tr._warp_back(self.bg, W), tr._warp_back(gray, W)
+            known = None if bg is None or back is None else np.ones_like(bg)
+        last2 = None if last is None else last[:2]
+        reason = self.check(float(score), centre, theta, pred, last2, gap, bg, back, known)
+        if reason is None and self.offset0 is not None and back is not None and bg is not None:
+            # the object's outline against the background has moved inside the template: the
+            # pose slid off the object (a keyframe that learned a still edge of the wall)
+            o = self._fg_offset(back, bg)
+            if o is not None and float(np.hypot(*(o - self.offset0))) > DRIFT_FRAC * max(self.size):
+                reason = "drift"
+        self._pending = (float(score), centre, theta, pred, last2, gap, frame)
+        return reason
+
+    def _clear(self, centre):
+        """Whether a pose centred at ``centre`` (px) keeps the template off the first region."""
+        half = 0.5 * math.hypot(*self.size)
+        u0, v0, u1, v1 = self.box
+        return centre[0] + half < u0 or centre[0] - half > u1 or centre[1] + half < v0 or centre[1] - half > v1
+
+    def reacquire(self, tr, gray, frame, min_cc):
+        """The object anywhere in ``gray`` (:func:`search_whole_frame` from the last verified angle,
+        then the tracker's fit from there), verified: (W, cc, score), or None."""
+        th = self.recent[-1][1] if self.recent else 0.0
+        W_s = search_whole_frame(tr, tr.key, gray, th)
+        alt = tr._ecc(tr.key, gray, W_s) if W_s is not None else None
+        if alt is None or alt[1] < min_cc:
+            return None
+        return None if self.verify(tr, gray, alt[0], frame, alt[1]) is not None else (alt[0], alt[1], alt[1])
+
+    def confirm(self, gray, size):
+        """Learn from the pose just verified (its correlation, motion and the background it uncovers)."""
+        score, centre, theta, pred, last, gap, frame = self._pending
+        w, h = size
+        half = 0.5 * math.hypot(w, h)
+        footprint = (centre[0] - half, centre[1] - half, centre[0] + half, centre[1] + half)
+        self.accept(score, centre, pred, last, gap, gray, footprint)
+        self.recent = (self.recent + [(centre, theta, frame)])[-2:]
+
+
+def search_whole_frame(tr, tmpl, gray, theta, turns_deg=(0.0, -5.0, 5.0, -10.0, 10.0), min_cc=0.5):
+    """Re-acquire anywhere in the frame: the template, turned round ``theta`` (rad) by ``turns_deg``,
+    matched by normalised cross-correlation on a copy reduced until the template is about 40 px
+    across; the best match's pose (first-frame px -> image px), or None below ``min_cc``."""
+    import cv2
+
+    h, w = tmpl.shape
+    f = min(1.0, 40.0 / max(w, h))
+    small = cv2.resize(gray, None, fx=f, fy=f, interpolation=cv2.INTER_AREA).astype(np.float32)
+    t_small = cv2.resize(tmpl, None, fx=f, fy=f, interpolation=cv2.INTER_AREA)
+    hs, ws = t_small.shape
+    if small.shape[0] <= hs or small.shape[1] <= ws:
+        return None
+    best = None
+    for turn in turns_deg:
+        th = theta + math.radians(turn)
+        rot = cv2.warpAffine(
+            t_small,
+            cv2.getRotationMatrix2D((ws / 2, hs / 2), -math.degrees(th), 1.0),
+            (ws, hs),
+            borderMode=cv2.BORDER_REPLICATE,
+        )
+        res = cv2.matchTemplate(small, rot, cv2.TM_CCOEFF_NORMED)
+        _, val, _, loc = cv2.minMaxLoc(res)
+        if val >= min_cc and (best is None or val > best[0]):
+            best = (val, th, loc)
+    if best is None:
+        return None
+    _, th, loc = best
+    new_ctr = np.array([(loc[0] + ws / 2) / f, (loc[1] + hs / 2) / f])
+    c, s = math.cos(th), math.sin(th)
+    t = new_ctr - np.array([[c, -s], [s, c]]) @ tr.centre0
+    return np.array([[c, -s, t[0]], [s, c, t[1]]], np.float32)

@@ -40,7 +40,13 @@ def die_with_parent(parent_pid: int | None = None) -> bool:
 
 
 def pool_initializer(parent_pid: int, then=None, *args) -> None:
-    """ProcessPoolExecutor ``initializer``: :func:`die_with_parent`, then ``then(*args)``."""
+    """ProcessPoolExecutor ``initializer``: :func:`die_with_parent`, then ``then(*args)``.
+
+    The CLI's SIGTERM handler raises to unwind the command's staged outputs; a worker has none
+    (a forked one would inherit the handler, and the executor ends the workers of a broken pool
+    with SIGTERM): it dies as by default.
+    """
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
     die_with_parent(parent_pid)
     if then is not None:
         then(*args)

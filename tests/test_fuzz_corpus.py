@@ -824,6 +824,32 @@ many(
             "error",
             SACRED,
         ),
+        # a new user's findings: --plot naming the log or its rate register, and -o naming a file
+        # of the log's folder that the reader does not open (the export's other tables)
+        (
+            "imu-plot-log",
+            lambda tmp: ["imu", _imu_folder(tmp), "--plot", tmp / "log" / "Inertial.csv"],
+            "error",
+            SACRED,
+        ),
+        (
+            "imu-plot-companion",
+            lambda tmp: ["imu", _imu_folder(tmp, True), "--plot", tmp / "log" / "HighGAccelerometer.csv"],
+            "error",
+            SACRED,
+        ),
+        (
+            "imu-o-folder-file",
+            lambda tmp: ["imu", _imu_folder(tmp), "-o", _write(tmp / "log" / "Notes.csv", "my notes\n")],
+            "error",
+            SACRED,
+        ),
+        (
+            "imu-o-plot-same",
+            lambda tmp: ["imu", _imu_folder(tmp), "-o", tmp / "r.csv", "--plot", tmp / "r.csv"],
+            "error",
+            SACRED,
+        ),
         ("oas-o-record", lambda tmp: ["oas", _good_record(tmp), "-o", tmp / "r.AT2"], "error", SACRED),
         ("oas-plot-record", lambda tmp: ["oas", _good_record(tmp), "--plot", tmp / "r.AT2"], "error", SACRED),
         (

@@ -135,3 +135,17 @@ def test_real_logs_raise_only_not_rocking(shared_data):
         with collecting() as found:
             block_rotation(read_imu(p))
         assert [d.code for d in found] == ["W-IMU-NOT-ROCKING"]
+
+
+@pytest.mark.parametrize("given_hz", [240.0, 280.0, 512.0])
+def test_a_rate_option_against_the_rate_register_warns_and_the_register_wins(shared_data, given_hz):
+    # x-IMU GUI times come from packet numbers and the rate: --rate 280 on a 256 Hz export moved
+    # the release and every impact by 9 % with status ok and no warning
+    folder = shared_data / "imu/x-imu-matlab-library-example"
+    with collecting() as diags:
+        log = read_imu(folder, rate_hz=given_hz)
+    assert log.rate_hz == 256.0
+    assert [d.code for d in diags if d.code == "W-IMU-RATE"] == ["W-IMU-RATE"]
+    with collecting() as diags:
+        assert read_imu(folder, rate_hz=257.0).rate_hz == 257.0  # within 2 %: the option stands
+    assert not [d for d in diags if d.code == "W-IMU-RATE"]

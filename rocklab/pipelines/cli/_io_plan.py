@@ -100,9 +100,19 @@ def _stereo(args):
 def _imu(args):
     from ...tracking.imu import imu_log_files
 
-    if not args.out:
+    outs = [("-o", _opt(args.out)), ("--plot", _opt(getattr(args, "plot", None)))]
+    if not any(p for _, p in outs):
         return [], []
-    return [("IMU log", p) for p in imu_log_files(args.path)], [("-o", Path(args.out))]
+    ins = [("IMU log", p) for p in imu_log_files(args.path)]
+    # the rest of a log's export (a folder given, or the x-IMU GUI's <base>_*.csv family) is the
+    # user's data too, read or not
+    given = Path(args.path)
+    if given.is_dir():
+        ins += [("file of the IMU log folder", p) for p in given.iterdir() if p.is_file()]
+    elif ins and "_" in ins[0][1].name:
+        base = ins[0][1].name.rsplit("_", 1)[0]
+        ins += [("file of the IMU log's export", p) for p in ins[0][1].parent.glob(base + "_*") if p.is_file()]
+    return ins, outs
 
 
 def _base_motion(args) -> list:

@@ -222,10 +222,16 @@ def oas_many(
                 rows[i] = oas_summary_row(p, *args)
                 bar.update()
         else:
+            import multiprocessing as mp
             from concurrent.futures import ProcessPoolExecutor, as_completed
 
+            # spawned, not forked: a process that already ran numba's threaded kernels forks
+            # children that crash in them (the pool then breaks and the record batch fails)
             with ProcessPoolExecutor(
-                max_workers=workers, initializer=pool_initializer, initargs=(os.getpid(), _one_numba_thread)
+                max_workers=workers,
+                mp_context=mp.get_context("spawn"),
+                initializer=pool_initializer,
+                initargs=(os.getpid(), _one_numba_thread),
             ) as ex:
                 futs = {ex.submit(oas_summary_row, p, *args): i for i, p in enumerate(paths)}
                 for f in as_completed(futs):

@@ -105,6 +105,22 @@ def _read_ximu_gui(path: Path, rate_hz: float | None, full_scale_g: float | None
                 "rate from; give the rate with --rate / rate_hz="
             )
         rate_hz = ximu_rate_from_registers(regs, legacy=legacy)
+    elif regs is not None and regs.is_file():
+        # the device's own rate register states the rate: it wins over the option, which would
+        # stretch every time (release, impacts) by their ratio
+        try:
+            stated = ximu_rate_from_registers(regs, legacy=legacy)
+        except InputError:  # no usable register: the option is the rate
+            stated = None
+        if stated is not None and abs(float(rate_hz) / stated - 1) > 0.02:
+            from ..._diagnostics import warn
+
+            warn(
+                "W-IMU-RATE",
+                f"{path}: --rate {float(rate_hz):g} Hz but the log's rate register ({regs.name}) says "
+                f"{stated:g} Hz; the register is used (drop --rate)",
+            )
+            rate_hz = stated
     df = _read_csv(path)
     if "Packet number" not in df.columns:
         raise InputError(f"{where(path, 1)}missing column 'Packet number'; not an x-IMU GUI export")

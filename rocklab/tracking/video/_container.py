@@ -150,6 +150,7 @@ def container_info(path) -> ContainerInfo:
             tb = s.time_base
             rates = [s.average_rate, s.guessed_rate]
             n_header = int(s.frames or 0)
+            duration_s = float(c.duration) / 1e6 if c.duration else 0.0
             pts, first = [], None
             try:
                 for p in c.demux(s):
@@ -172,4 +173,8 @@ def container_info(path) -> ContainerInfo:
         return ContainerInfo(None, aspect, order, rot, n_header=n_header)
     q = np.sort(np.asarray(pts, np.int64))
     times, rate, dropped = frame_clock((q - q[0]) * float(tb), float(tb), rates)
+    if not n_header and duration_s and rate:
+        # Matroska and WebM count no frames but state the duration at the file's start: a file
+        # cut short still claims its whole length
+        n_header = int(round(duration_s * rate))
     return ContainerInfo(times, aspect, order, rot, rate, dropped, n_header, q)

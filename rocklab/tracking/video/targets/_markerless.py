@@ -36,7 +36,7 @@ from ...._errors import InputError
 from ._detection import Detection
 from ._ic import ICAffine, ICRigid
 from ._occlusion import cell_correlations, masked_fit, partly_covered
-from ._verify import PoseVerifier
+from ._verify import PoseVerifier, best_turned_match
 
 __all__ = ["MarkerlessTracker", "MarkerlessDetector", "MIN_CC", "REKEY_CC"]
 
@@ -302,7 +302,6 @@ class MarkerlessTracker:
         The template is tried at the predicted angle and at SEARCH_TURNS_DEG from it (after lost
         frames the object may have turned); the best match above MIN_CC wins.
         """
-        cv2 = self._cv2
         th_pred, tx, ty = _params(W_pred)
         w, h = self.size
         ctr = self.origin + (w / 2, h / 2)
@@ -314,19 +313,7 @@ class MarkerlessTracker:
         if x1 - x0 <= w or y1 - y0 <= h:
             return None
         window = gray[y0:y1, x0:x1].astype(np.float32)
-        found = None
-        for turn in SEARCH_TURNS_DEG:
-            th = th_pred + math.radians(turn)
-            rot = cv2.warpAffine(
-                tmpl,
-                cv2.getRotationMatrix2D((w / 2, h / 2), -math.degrees(th), 1.0),
-                (w, h),
-                borderMode=cv2.BORDER_REPLICATE,
-            )
-            res = cv2.matchTemplate(window, rot, cv2.TM_CCOEFF_NORMED)
-            _, best, _, loc = cv2.minMaxLoc(res)
-            if best >= MIN_CC and (found is None or best > found[0]):
-                found = (best, th, loc)
+        found = best_turned_match(window, tmpl, th_pred, SEARCH_TURNS_DEG, MIN_CC)
         if found is None:
             return None
         _, th, loc = found

@@ -266,6 +266,44 @@ class PoseVerifier:
         self.recent = (self.recent + [(centre, theta, frame)])[-2:]
 
 
+def best_turned_match(image, tmpl, theta, turns_deg, min_cc):
+    """The template turned to ``theta + turn`` (rad; ``turns_deg`` in degrees) that matches
+    ``image`` best by normalised cross-correlation.
+
+    Parameters
+    ----------
+    image : ndarray, shape (H, W), float32
+    tmpl : ndarray, shape (h, w), float32
+        Smaller than ``image``.
+    theta : float
+        Angle the template is turned to before the trial turns, rad.
+    turns_deg : sequence of float
+    min_cc : float
+        Correlations below this are no match.
+
+    Returns
+    -------
+    (correlation, angle_rad, (x, y)) or None
+        The best match and its top-left corner in ``image``, px; None when none reaches ``min_cc``.
+    """
+    import cv2
+
+    h, w = tmpl.shape
+    best = None
+    for turn in turns_deg:
+        th = theta + math.radians(turn)
+        rot = cv2.warpAffine(
+            tmpl,
+            cv2.getRotationMatrix2D((w / 2, h / 2), -math.degrees(th), 1.0),
+            (w, h),
+            borderMode=cv2.BORDER_REPLICATE,
+        )
+        _, val, _, loc = cv2.minMaxLoc(cv2.matchTemplate(image, rot, cv2.TM_CCOEFF_NORMED))
+        if val >= min_cc and (best is None or val > best[0]):
+            best = (val, th, loc)
+    return best
+
+
 def search_whole_frame(tr, tmpl, gray, theta, turns_deg=(0.0, -5.0, 5.0, -10.0, 10.0), min_cc=0.5):
     """Re-acquire anywhere in the frame: the template, turned round ``theta`` (rad) by ``turns_deg``,
     matched by normalised cross-correlation on a copy reduced until the template is about 40 px
@@ -279,19 +317,7 @@ def search_whole_frame(tr, tmpl, gray, theta, turns_deg=(0.0, -5.0, 5.0, -10.0, 
     hs, ws = t_small.shape
     if small.shape[0] <= hs or small.shape[1] <= ws:
         return None
-    best = None
-    for turn in turns_deg:
-        th = theta + math.radians(turn)
-        rot = cv2.warpAffine(
-            t_small,
-            cv2.getRotationMatrix2D((ws / 2, hs / 2), -math.degrees(th), 1.0),
-            (ws, hs),
-            borderMode=cv2.BORDER_REPLICATE,
-        )
-        res = cv2.matchTemplate(small, rot, cv2.TM_CCOEFF_NORMED)
-        _, val, _, loc = cv2.minMaxLoc(res)
-        if val >= min_cc and (best is None or val > best[0]):
-            best = (val, th, loc)
+    best = best_turned_match(small, t_small, theta, turns_deg, min_cc)
     if best is None:
         return None
     _, th, loc = best

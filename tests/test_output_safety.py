@@ -11,6 +11,7 @@ import pytest
 from rocklab import Block
 from rocklab._outdir import MARKER, check_output_dir, clean_stale
 from rocklab.models import simulate
+from test_fuzz_corpus import _points_csv
 
 
 def _experiment(tmp_path, rrd="false"):
@@ -138,19 +139,8 @@ def test_unreachable_scheduler_is_one_line(tmp_path, run_cli):
     assert rc == 2 and err.count("\n") == 1 and "no Dask scheduler answered" in err
 
 
-def _points(p):
-    t = np.arange(0, 2, 0.01)
-    th = 0.05 * np.exp(-t) * np.cos(8 * t)
-    rows = []
-    for name, (x, z) in {"a": (0.0, 0.2), "b": (0.045, 0.2), "c": (0.0, 0.0), "d": (0.045, 0.0)}.items():
-        X, Z = x * np.cos(th) + z * np.sin(th), -x * np.sin(th) + z * np.cos(th)
-        rows += [f"{ti:.3f},{name},{xi:.6f},0,{zi:.6f}" for ti, xi, zi in zip(t, X, Z)]
-    p.write_text("t_s,point,x_m,y_m,z_m\n" + "\n".join(rows) + "\n")
-    return p
-
-
 def test_side_files_keep_a_users_file_and_replace_their_own(tmp_path, run_cli):
-    src = _points(tmp_path / "p.csv")
+    src = _points_csv(tmp_path / "p.csv")
     (tmp_path / "audit.json").write_text("my audit")
     (tmp_path / "tracks.csv").write_text("my tracks")  # the default -o is a side file too
     for k in range(2):

@@ -127,7 +127,7 @@ MAX_LENGTH_RATIO = 1e6
 
 def _comparable(what: str, **lengths) -> None:
     """:class:`InputError` unless the mechanism's lengths are within :data:`MAX_LENGTH_RATIO` of each other."""
-    lo, hi = min(lengths, key=lengths.get), max(lengths, key=lengths.get)
+    lo, hi = min(lengths, key=lambda k: lengths[k]), max(lengths, key=lambda k: lengths[k])
     if lengths[hi] > MAX_LENGTH_RATIO * lengths[lo]:
         raise InputError(
             f"{what}: {hi}={lengths[hi]:g} is more than {MAX_LENGTH_RATIO:g} times {lo}={lengths[lo]:g}; "

@@ -15,7 +15,7 @@ from dataclasses import asdict, dataclass
 from ._errors import InputError
 from ._errors import positive as _positive
 
-__all__ = ["Block", "G", "is_lab_size"]
+__all__ = ["Block", "G", "is_lab_size", "inertia_coefficient"]
 
 #: Standard gravity, m/s^2.
 G = 9.80665
@@ -155,6 +155,29 @@ class Block:
             uplift_acc_m_s2=self.uplift_acc_m_s2,
         )
         return d
+
+
+def inertia_coefficient(alpha_I, name: str = "alpha_I") -> float:
+    """The corner inertia coefficient ``alpha_I = I_O / (m R^2)`` (dimensionless), validated.
+
+    ``I_O = I_C + m R^2 >= m R^2`` (parallel-axis theorem), so ``alpha_I >= 1``; 4/3 is a
+    uniform rectangular block.
+
+    Raises
+    ------
+    InputError
+        ``alpha_I`` is not a finite number >= 1.
+    """
+    try:
+        v = float(alpha_I)
+    except (TypeError, ValueError):
+        v = math.nan
+    if not (math.isfinite(v) and v >= 1.0):
+        raise InputError(
+            f"{name}={alpha_I!r}: corner inertia coefficient I_O/(m R^2) must be >= 1 (parallel-axis theorem); "
+            "4/3 is a uniform block"
+        )
+    return v
 
 
 def is_lab_size(b_m, h_m):

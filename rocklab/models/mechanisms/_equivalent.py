@@ -27,7 +27,7 @@ import numpy as np
 
 from ..._errors import InputError
 from ..._errors import positive as _pos
-from ...blocks import G
+from ...blocks import G, inertia_coefficient
 
 __all__ = [
     "FundamentalParameters",
@@ -43,16 +43,6 @@ __all__ = [
     "linear_sine_pulse_response",
     "equivalence_errors",
 ]
-
-
-def _alpha_I(v):
-    aI = _pos("alpha_I (corner inertia coefficient)", v)
-    if aI < 1.0:  # I_O = I_C + m R^2 >= m R^2
-        raise InputError(
-            f"alpha_I={aI}: corner inertia coefficient I_O/(m R^2) must be >= 1 (parallel-axis theorem); "
-            "4/3 is a uniform block"
-        )
-    return aI
 
 
 def _slender(name, a):
@@ -129,7 +119,7 @@ def _fp(p, phi_cr, lam, lam_lin, eta, name):
 def block_parameters(R_m: float, alpha_rad: float, alpha_I: float = 4.0 / 3.0) -> FundamentalParameters:
     """Rocking block (Table I): p = sqrt(g/(alpha_I R)), theta_cr = alpha, lambda = tan(alpha),
     lambda_lin = alpha, eta = 1 - 2 sin^2(alpha)/alpha_I (Housner)."""
-    R, a, alpha_I = _pos("R_m", R_m), _slender("alpha_rad", alpha_rad), _alpha_I(alpha_I)
+    R, a, alpha_I = _pos("R_m", R_m), _slender("alpha_rad", alpha_rad), inertia_coefficient(alpha_I)
     return _fp(math.sqrt(G / (alpha_I * R)), a, math.tan(a), a, 1 - 2 * math.sin(a) ** 2 / alpha_I, "block")
 
 
@@ -149,7 +139,7 @@ def frame_parameters(R_m: float, alpha_rad: float, gamma: float, alpha_I: float 
     eta = (alpha_I - 2 sin^2 alpha + 4 gamma cos 2 alpha) / (alpha_I + 4 gamma)
     (angular momentum; Makris & Vassiliou 2013 for alpha_I = 4/3).
     """
-    R, a, alpha_I = _pos("R_m", R_m), _slender("alpha_rad", alpha_rad), _alpha_I(alpha_I)
+    R, a, alpha_I = _pos("R_m", R_m), _slender("alpha_rad", alpha_rad), inertia_coefficient(alpha_I)
     gmm = float(gamma)
     if not (math.isfinite(gmm) and gmm >= 0):
         raise InputError(f"gamma={gamma!r}: beam/columns mass ratio must be >= 0")
@@ -165,7 +155,7 @@ def wall_parameters(R_m: float, alpha_rad: float, alpha_I: float = 4.0 / 3.0) ->
     lambda_lin = 2 alpha, kappa1 = 1/2, kappa2 = alpha/(2 tan alpha), theta_cr = 2 alpha.
     The paper gives no restitution for the wall: eta is NaN.
     """
-    R, a, alpha_I = _pos("R_m", R_m), _slender("alpha_rad", alpha_rad), _alpha_I(alpha_I)
+    R, a, alpha_I = _pos("R_m", R_m), _slender("alpha_rad", alpha_rad), inertia_coefficient(alpha_I)
     return _fp(math.sqrt(2 * G / (alpha_I * R)), a, 2 * math.tan(a), 2 * a, float("nan"), "wall")
 
 
@@ -282,7 +272,7 @@ def wall_mechanism(R_m: float, alpha_rad: float, mass_kg: float = 1.0, alpha_I: 
     Lagrange gives ``-(R/g) sin(2(alpha-phi)) phi'^2`` (the sin^2 is a typesetting error).
     """
     R, a, m = _pos("R_m", R_m), _slender("alpha_rad", alpha_rad), _pos("mass_kg", mass_kg)
-    IO = _alpha_I(alpha_I) * m * R * R
+    IO = inertia_coefficient(alpha_I) * m * R * R
     return Mechanism(
         M=lambda f: 2 * IO + 8 * m * R * R * math.sin(a - f) ** 2,
         V=lambda f: 4 * m * G * R * math.cos(a - f),

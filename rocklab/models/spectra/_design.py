@@ -20,7 +20,7 @@ from dataclasses import asdict, dataclass
 
 from ..._errors import InputError
 from ..._errors import positive as _pos
-from ...blocks import G, Block
+from ...blocks import G, Block, inertia_coefficient
 
 __all__ = ["DesignCheck", "design_check", "required_width", "required_width_slender"]
 
@@ -127,8 +127,7 @@ def required_width(
     tI = _pos("t_I_s", t_I_s)
     c = _pos("cm_height_ratio", cm_height_ratio)
     g = _pos("g (gravity, m/s^2)", g)
-    if not (math.isfinite(alpha_I) and alpha_I >= 1):
-        raise InputError(f"alpha_I={alpha_I}: must be >= 1 (parallel-axis theorem)")
+    alpha_I = inertia_coefficient(alpha_I)
     if c > 1:
         raise InputError(f"cm_height_ratio={c}: the centre of mass is in the pier; give a height ratio in (0, 1]")
     b_uplift = 2 * c * H * ag / g  # width at which a_g = a_p,min

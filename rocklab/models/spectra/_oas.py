@@ -57,7 +57,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..._errors import InputError
-from ...blocks import G
+from ...blocks import G, inertia_coefficient
 from ..rocking._batch import free_rocking_overturns, simulate_batch
 from ._oas_grid import adaptive_verdicts, boundary_verdicts
 from ._records import BaseMotion
@@ -206,8 +206,7 @@ def _check_opts(slenderness, levels, sizes, R_max_m, R_min_m, level_max, alpha_I
     if not 1 < level_max <= 1000:
         raise InputError(f"level_max={level_max}: the a_p/a_p,min range must go above 1 and up to at most 1000 "
                          "(default 10)")
-    if not alpha_I >= 1:
-        raise InputError(f"alpha_I={alpha_I}: inertia coefficient must be >= 1")
+    inertia_coefficient(alpha_I)
     return sl
 
 

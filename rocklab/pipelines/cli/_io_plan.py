@@ -54,10 +54,7 @@ def _track_config_inputs(cfg_path: Path) -> tuple[list, object]:
     from ...tracking import load_track_config
 
     cfg = load_track_config(cfg_path)
-    ins = [("config", cfg_path)]
-    if cfg.video.calibration:
-        ins.append(("[video] calibration of the config", Path(cfg.video.calibration)))
-    return ins, cfg
+    return [("config", cfg_path)] + [("[video] calibration of the config", p) for p in cfg.named_files], cfg
 
 
 def _track(args):

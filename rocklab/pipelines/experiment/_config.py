@@ -195,10 +195,10 @@ def _track_config_files(path: Path) -> list[Path]:
     from ...tracking import load_track_config
 
     try:
-        cal = load_track_config(path).video.calibration
+        named = load_track_config(path).named_files
     except InputError:
         return []
-    return [Path(cal)] if cal is not None and Path(cal).is_file() else []
+    return [p for p in named if p.is_file()]
 
 
 def _paths_to_str(obj):

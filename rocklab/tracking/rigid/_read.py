@@ -246,11 +246,12 @@ def exact_times(frame):
     return out
 
 
-def write_points_csv(series: PointSeries, path) -> Path:
-    """Write ``series`` as the long CSV :func:`read_points_csv` reads (atomically; times exact)."""
+def write_points_csv(series: PointSeries, path, *, side: bool = False) -> Path:
+    """Write ``series`` as the long CSV :func:`read_points_csv` reads (atomically; times exact;
+    ``side``: a user's file there is kept, see :func:`rocklab._io.atomic_path`)."""
     from ..._io import write_frame_atomic
 
-    return write_frame_atomic(path, exact_times(series.to_frame()), float_format="%.9g")
+    return write_frame_atomic(path, exact_times(series.to_frame()), float_format="%.9g", side=side)
 
 
 def write_c3d(series: PointSeries, path, unit: str = "mm") -> Path:

@@ -324,6 +324,11 @@ class TrackConfig:
         """The first object of kind ``"table"`` (or None)."""
         return next((o for o in self.objects if o.kind == "table"), None)
 
+    @property
+    def named_files(self) -> tuple[Path, ...]:
+        """The files the config names, which a tracking run reads (its lens calibration)."""
+        return () if self.video.calibration is None else (Path(self.video.calibration),)
+
     def object(self, oid: str) -> ObjectConfig:
         for o in self.objects:
             if o.id == oid:

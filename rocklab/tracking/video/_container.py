@@ -17,7 +17,7 @@ from fractions import Fraction
 
 import numpy as np
 
-__all__ = ["ContainerInfo", "container_info", "frame_clock", "shown_pts"]
+__all__ = ["ContainerInfo", "container_info", "frame_clock", "shown_pts", "frame_rotation_deg"]
 
 #: FFmpeg's AVFieldOrder: TT and TB code/show the top field first, BB and BT the bottom one.
 _FIELD_ORDER = {2: "tff", 4: "tff", 3: "bff", 5: "bff"}
@@ -122,7 +122,7 @@ def shown_pts(container, stream) -> np.ndarray:
     return np.sort(np.asarray([p.pts for p in container.demux(stream) if _shown(p)], np.int64))
 
 
-def _rotation(frame) -> int:
+def frame_rotation_deg(frame) -> int:
     """The counter-clockwise turn (0, 90, 180, 270 deg) the frame's display matrix asks for."""
     try:
         r = frame.rotation
@@ -168,7 +168,7 @@ def container_info(path) -> ContainerInfo:
         return ContainerInfo()
     aspect = float(sar) if sar and float(sar) > 0 else 1.0
     order = _FIELD_ORDER.get(fo, "tff" if first is not None and first.interlaced_frame else None)
-    rot = _rotation(first) if first is not None else 0
+    rot = frame_rotation_deg(first) if first is not None else 0
     if not pts or tb is None:
         return ContainerInfo(None, aspect, order, rot, n_header=n_header)
     q = np.sort(np.asarray(pts, np.int64))

@@ -30,7 +30,7 @@ from pathlib import Path
 import numpy as np
 
 from ..._errors import InputError
-from ._container import container_info, shown_pts
+from ._container import container_info, frame_rotation_deg, shown_pts
 
 __all__ = ["VideoInfo", "probe_video", "iter_video_frames", "container_info"]
 
@@ -329,7 +329,7 @@ class _PyAVReader:
             return False, None
         self.index = self._place(f)
         img = _luma(f) if self._gray else f.to_ndarray(format="bgr24")
-        k = int(round((f.rotation or 0) / 90.0)) % 4
+        k = frame_rotation_deg(f) // 90
         return True, (np.ascontiguousarray(np.rot90(img, k)) if k else img)
 
     def release(self):

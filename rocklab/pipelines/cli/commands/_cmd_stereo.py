@@ -162,8 +162,7 @@ def _calibrate(args) -> int:
 def _track(args) -> int:
     import numpy as np
 
-    from ...._io import write_frame_atomic
-    from ....tracking.rigid import parse_bodies, track_points3d
+    from ....tracking.rigid import parse_bodies, track_points3d, write_points_csv
     from ....tracking.stereo import load_rig, stereo_point_series, track_dots_stereo
     from .._io_plan import POINTS, stereo_track_outputs
     from ._cmd_track3d import _rest, write_track3d_outputs
@@ -191,7 +190,7 @@ def _track(args) -> int:
         raise InputError(f"{args.film1}: no moving group of targets found; name the block's points with --body")
     res = track_points3d(series, bodies, up="z", rest=rest)
     pts_path = stereo_track_outputs(out)[POINTS]
-    write_frame_atomic(pts_path, series.to_frame(), float_format="%.9g", side=True)  # as write_points_csv
+    write_points_csv(series, pts_path, side=True)
     d = write_track3d_outputs(out, series, res, args.rrd, out_side=not args.out)
     d.update(
         points_csv=str(pts_path),

@@ -9,6 +9,11 @@ textured wall, sensor noise), so decoding is not timed; both are timed with Open
 Then, decoding counted: the same frames played 4 times (a 9.6 s clip) as an H.264 file at a
 camcorder's 17 Mbit/s, tracked by ``track_video`` (probe, decoding thread, tracking) against the
 plain script reading the file with ``cv2.VideoCapture``.
+
+Last, the cost of verifying every pose (issue 25: at most 15 % of the markerless speed): the
+same tracker on the same frames with :class:`~rocklab.tracking.video.targets._verify.PoseVerifier`
+accepting every pose unchecked, 1 thread; on the rendered frames and, when it is there, on the
+real pendulum film of ``../shared`` (decoded to memory first).
 """
 
 from __future__ import annotations
@@ -97,6 +102,7 @@ def main() -> None:
             )
     cv2.setNumThreads(nt)
     decode_included(frames, theta, roi)
+    verification_cost(frames, roi)
 
 
 #: Times the rendered frames are played in the file: 480 frames, a 9.6 s clip (a free-rocking
@@ -155,6 +161,63 @@ def decode_included(frames, theta, roi) -> None:
             dt = time.perf_counter() - t0
             err = np.degrees(th - theta[: th.size])
             print(f"  {name:>20}: {th.size / dt:7.1f} frames/s, theta RMS error {np.sqrt(np.nanmean(err**2)):.4f} deg")
+
+
+def _unverified():
+    """A context in which every pose is accepted unchecked (the tracker without verification)."""
+    from contextlib import ExitStack
+    from unittest import mock
+
+    from rocklab.tracking.video.targets import _verify
+
+    stack = ExitStack()
+    stack.enter_context(mock.patch.object(_verify.PoseVerifier, "verify", lambda *a, **k: None))
+    stack.enter_context(mock.patch.object(_verify.PoseVerifier, "confirm", lambda *a, **k: None))
+    return stack
+
+
+def verification_cost(frames, roi, repeats: int = 3) -> None:
+    """Frames/s with and without pose verification, same process, same frames, 1 thread (best of
+    ``repeats``, alternating so that drift in the machine's load hits both)."""
+    from pathlib import Path
+
+    films = [("rendered 1920x1080", frames, roi)]
+    real = Path(__file__).resolve().parents[2] / "shared" / "data" / "video" / "pendulum_film2_vga.mp4"
+    if real.exists():
+        cap = cv2.VideoCapture(str(real))
+        got = []
+        while True:
+            ok, img = cap.read()
+            if not ok:
+                break
+            got.append(cv2.cvtColor(img, cv2.COLOR_BGR2GRAY))
+        films.append((f"real pendulum film {got[0].shape[1]}x{got[0].shape[0]}", got, (310, 66, 70, 74)))
+    else:
+        print(f"  (real film not found at {real}: rendered frames only)")
+    print("verification cost: the same tracker with every pose accepted unchecked, 1 thread, best of 3")
+    cv2.setNumThreads(1)
+    for name, fr, r in films:
+        best = {"verified": np.inf, "unverified": np.inf}
+        with threadpool_limits(1):
+            ours(fr[:3], r)  # warm-up
+            for _ in range(repeats):
+                for label in best:
+                    with _unverified() if label == "unverified" else _nullcontext():
+                        t0 = time.perf_counter()
+                        ours(fr, r)
+                        best[label] = min(best[label], time.perf_counter() - t0)
+        n = len(fr)
+        v, u = n / best["verified"], n / best["unverified"]
+        print(
+            f"  {name} ({n} frames): verified {v:7.1f} frames/s, unverified {u:7.1f} frames/s, "
+            f"verification costs {100 * (1 - v / u):.1f} % of the speed"
+        )
+
+
+def _nullcontext():
+    from contextlib import nullcontext
+
+    return nullcontext()
 
 
 if __name__ == "__main__":

@@ -143,6 +143,12 @@ WARNING_CODES: dict[str, tuple[str, str]] = {
         "acceleration (too few consecutive samples, or no metric scale); no "
         "<stem>_table.csv was written",
     ),
+    "W-TRACK-THETA": (
+        "suspect",
+        "a block's appearance does not change when it turns (a disk, a plain ball, a region with "
+        "no edge or mark off its centre): its angle is not measured; theta_rad is NaN and x, y "
+        'are tracked. Set kind = "point" for a position only, or redraw the region',
+    ),
     "W-TRACK-LATCH": (
         "suspect",
         "a tracker follows another object: a table that turns, or two objects on the "

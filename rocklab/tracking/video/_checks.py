@@ -1,6 +1,6 @@
 """Why a target was lost in a frame (occluded or blurred), and what a finished video track is checked
 for: frames the container promised but did not give, objects lost on more than 1 % of the frames,
-a tracker that follows another object.
+a tracker that follows another object; and short gaps filled when the config asks.
 
 Each finding is a named warning (``W-VIDEO-SHORT``, ``W-VIDEO-DROPPED``, ``W-VIDEO-DAMAGED``,
 ``W-VIDEO-FPS``, ``W-VIDEO-LOST``, ``W-TRACK-LATCH``).
@@ -137,3 +137,17 @@ def _tee(frames, fn):
     for i, g, img in frames:
         fn(i, g, img)
         yield i, g
+
+
+def _interpolate(arrs, status, max_gap):
+    """Fill runs of at most ``max_gap`` frames between two ``ok`` frames linearly, in place (each
+    array of ``arrs``, shape (n,)); their ``status`` becomes ``"interpolated"``."""
+    ok = status == "ok"
+    idx = np.flatnonzero(ok)
+    if len(idx) < 2:
+        return
+    for a, b in zip(idx[:-1], idx[1:]):
+        if 1 < b - a <= max_gap + 1:
+            for arr in arrs:
+                arr[a + 1 : b] = np.interp(np.arange(a + 1, b), [a, b], [arr[a], arr[b]])
+            status[a + 1 : b] = "interpolated"

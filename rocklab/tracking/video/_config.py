@@ -14,7 +14,7 @@ dataclass below. Lengths are metres, angles radians, image coordinates pixels
     level = "table"              # "table" | "none" | "value" (then level_rad = ...)
     [[objects]]
     id = "block_1"
-    kind = "block"               # block | table
+    kind = "block"               # block | table | point (a position only: theta_rad NaN)
     markers = [1]                # aruco ids; for dots: dots = [[x_m, y_m], ...]
     [[objects]]
     id = "table"
@@ -72,7 +72,7 @@ __all__ = [
 ]
 
 TARGET_STYLES = ("aruco", "apriltag", "dots", "edges", "region", "markerless")
-OBJECT_KINDS = ("block", "table")
+OBJECT_KINDS = ("block", "table", "point")
 LEVEL_MODES = ("table", "none", "value", "rest", "line")
 CORNER_REFINEMENTS = ("edges", "subpix", "contour", "apriltag", "none")
 
@@ -261,7 +261,11 @@ class ObjectConfig:
     ----------
     id : str
         Name used in ``tracks.csv``'s ``object`` column.
-    kind : {"block", "table"}
+    kind : {"block", "table", "point"}
+        ``"point"``: a position only (a ball, a target on a string): ``theta_rad`` is NaN with
+        the reason in the track, ``x``/``y`` are measured. A markerless block whose appearance
+        does not tell its angle (a disk, a plain ball) is tracked the same way, with warning
+        W-TRACK-THETA.
     markers : tuple of int
         ArUco/AprilTag ids on this object.
     marker_positions_m : tuple of (x, y) or None

@@ -19,10 +19,11 @@ import numpy as np
 from ..._blas import one_blas_thread
 from ..._diagnostics import warn
 from ..._errors import InputError
-from ._checks import _check_frames, _check_rate, _look, _tee, _why_lost
+from ._checks import _check_frames, _check_rate, _interpolate, _look, _tee, _why_lost
 from ._config import TrackConfig
 from ._geometry import PlaneMap, fit_similarity
 from .targets._detectors import make_detector
+from .targets._observability import angle_free_objects, angle_note
 from ._plane import make_plane_map
 from ._motion import TableMotion, table_motion
 
@@ -108,6 +109,7 @@ def track_frames(frames, config: TrackConfig, plane_map: PlaneMap | None = None)
             if plane_map is None:
                 plane_map = make_plane_map(config, gray.shape[1], gray.shape[0], gray)
             det = make_detector(config, plane_map, gray)
+            free = angle_free_objects(config, det)
         with one_blas_thread():
             dets = det.detect(gray, idx)
         obs = []
@@ -130,10 +132,9 @@ def track_frames(frames, config: TrackConfig, plane_map: PlaneMap | None = None)
                     obs.append(Observation(idx, o.id, *(np.nan,) * 4, f.scale, f.rms, qual,
                                            "low_quality", d.metric, plane_map.source))
                     continue
-                sig = d.combined_sigma(f.sigma_theta_rad)
-                obs.append(Observation(idx, o.id, float(f.t[0]), float(f.t[1]), f.theta_rad,
-                                       sig, f.scale, f.rms, qual, "ok", d.metric,
-                                       plane_map.source))
+                th, sig = (np.nan, np.nan) if o.id in free else (f.theta_rad, d.combined_sigma(f.sigma_theta_rad))
+                obs.append(Observation(idx, o.id, float(f.t[0]), float(f.t[1]), th, sig, f.scale, f.rms, qual,
+                                       "ok", d.metric, plane_map.source))
                 u, v = d.img_pts[:, 0], d.img_pts[:, 1]
                 box = (int(max(u.min(), 0)), int(max(v.min(), 0)), int(u.max()) + 1, int(v.max()) + 1)
                 boxes[o.id] = box
@@ -171,6 +172,9 @@ class ObjectTrack:
         (then ``x_m, y_m`` are NaN: never a made-up scale).
     x_px, y_px : ndarray (n,)
         The object's reference point in the image (px, as in the video: u right, v down).
+    theta_note : str
+        Why ``theta_rad`` is NaN on every frame (kind ``"point"``, or an appearance that tells
+        no angle: W-TRACK-THETA); empty when the angle is measured.
     """
 
     object: str
@@ -186,6 +190,7 @@ class ObjectTrack:
     m_per_unit: float
     x_px: np.ndarray | None = None
     y_px: np.ndarray | None = None
+    theta_note: str = ""
 
     @property
     def ok(self) -> np.ndarray:
@@ -308,23 +313,11 @@ class TrackResult:
             per[t.object] = {"kind": t.kind, "n_ok": int(np.sum(t.ok)), "m_per_unit": t.m_per_unit,
                              "status_counts": {str(a): int(b) for a, b in zip(st, cnt)},
                              "median_sigma_theta_rad": float(np.nanmedian(t.sigma_theta_rad))
-                             if np.any(t.ok) else np.nan}
+                             if np.any(np.isfinite(t.sigma_theta_rad)) else np.nan, "theta_note": t.theta_note}
         return {"source": self.source, "fps": self.fps, "n_frames": self.n_frames,
                 "width_px": self.width_px, "height_px": self.height_px, "plane": self.plane,
                 "level_rad": self.level_rad, "level_source": self.level_source,
                 "level_sigma_rad": self.level_sigma_rad, "objects": per}
-
-
-def _interpolate(arrs, status, max_gap):
-    ok = status == "ok"
-    idx = np.flatnonzero(ok)
-    if len(idx) < 2:
-        return
-    for a, b in zip(idx[:-1], idx[1:]):
-        if 1 < b - a <= max_gap + 1:
-            for arr in arrs:
-                arr[a + 1:b] = np.interp(np.arange(a + 1, b), [a, b], [arr[a], arr[b]])
-            status[a + 1:b] = "interpolated"
 
 
 def assemble_tracks(observations, config: TrackConfig, fps: float, width_px: int, height_px: int,
@@ -420,7 +413,7 @@ def assemble_tracks(observations, config: TrackConfig, fps: float, width_px: int
         t_s = (np.asarray(frame_times_s, float)[frames] if frame_times_s is not None
                else frames / float(fps))
         tracks.append(ObjectTrack(o.id, o.kind, frames.copy(), t_s, x, y, th, sig,
-                                  q, st.astype(str), m_per[o.id], u, v))
+                                  q, st.astype(str), m_per[o.id], u, v, angle_note(o, st, th)))
     return TrackResult(tuple(tracks), float(fps), level, n, int(width_px), int(height_px),
                        None if source is None else str(source), config, plane, plane_map, level_src, level_sig)
 

@@ -101,9 +101,12 @@ def run(args) -> int:
         emit_json(summary)
     else:
         for oid, d in summary["objects"].items():
-            print(
-                f"{oid}: {d['n_ok']}/{res.n_frames} frames ok, median sigma_theta {d['median_sigma_theta_rad']:.2e} rad"
+            angle = (
+                f"theta not measured: {d['theta_note']}"
+                if d.get("theta_note")
+                else f"median sigma_theta {d['median_sigma_theta_rad']:.4g} rad"
             )
+            print(f"{oid}: {d['n_ok']}/{res.n_frames} frames ok, {angle}")
         print(f"wrote {out}")
     return 0
 

@@ -20,6 +20,20 @@ class _MixedDetector:
             out.update(d.detect(gray, frame))
         return out
 
+    def _ask(self, method, oid):
+        for d in self.parts:
+            if hasattr(d, method) and oid in getattr(d, "trackers", {oid: None}):
+                return getattr(d, method)(oid)
+        return None
+
+    def lost_reason(self, oid):
+        """Why object ``oid`` was lost in the last frame, from its own style's detector."""
+        return self._ask("lost_reason", oid)
+
+    def theta_note(self, oid):
+        """Why object ``oid``'s angle cannot be measured, from its own style's detector, or None."""
+        return self._ask("theta_note", oid)
+
 
 def make_detector(config, pm, first_gray):
     """The detector for ``config``'s objects: one per target style, merged when styles mix."""

@@ -21,9 +21,9 @@ A keyframe is not renewed from a frame in which part of the object is covered (m
 of a 4 x 4 grid match, one does not: a hand, the thread), so the keyframe never learns an
 occluder; the covered frames then fail and are lost, and the object is found again after.
 
-The per-frame orientation uncertainty is the Gauss-Newton covariance of the ECC fit,
-``σ² (JᵀJ)⁻¹`` with σ the intensity residual, inflated by :data:`CORRELATION_INFLATION`
-because neighbouring pixels are not independent (optics, codec, the ECC smoothing).
+The per-frame orientation uncertainty is the Gauss-Newton covariance of the fit
+(:func:`._observability.sigma_theta`). An object whose appearance tells no angle (a disk) is
+held upright about its centre of symmetry and reports no angle (:mod:`._observability`).
 """
 
 from __future__ import annotations
@@ -35,6 +35,7 @@ import numpy as np
 from ...._errors import InputError
 from ._detection import Detection
 from ._ic import ICAffine, ICRigid
+from ._observability import sigma_theta, theta_unobservable
 from ._occlusion import cell_correlations, masked_fit, partly_covered
 from ._verify import PoseVerifier, best_turned_match
 
@@ -44,8 +45,6 @@ __all__ = ["MarkerlessTracker", "MarkerlessDetector", "MIN_CC", "REKEY_CC"]
 MIN_CC = 0.6
 #: Correlation with the first template below which the latest keyframe is used (and renewed).
 REKEY_CC = 0.9
-#: Pixels are correlated over about a 3 x 3 neighbourhood: the covariance's σ is scaled by 3.
-CORRELATION_INFLATION = 3.0
 #: Smallest grey-level standard deviation of a region worth tracking.
 MIN_TEXTURE_STD = 3.0
 #: Margin of the full-resolution ECC window round the coarse footprint, px (the half-resolution
@@ -140,6 +139,11 @@ class MarkerlessTracker:
         self._cv2 = cv2
         self.centre0 = self.origin + np.array(self.size, float) / 2  # template centre, first-frame px
         self.verifier = PoseVerifier(first_gray, (u0, v0, u1, v1), self.size)
+        #: why this object's angle cannot be measured (its appearance does not change when it
+        #: turns), or None: then every pose is held upright about the template's centre
+        self.theta_note, sym = (None, None) if obj.kind == "table" else theta_unobservable(tmpl)
+        self.sym0 = None if sym is None else self.origin + sym  # the centre of symmetry, first-frame px
+        self.verifier.check_turn = self.theta_note is None
         self.reason = None  # why the last frame was lost ("mismatch", "jump", "background", "lost")
 
     # -- registration -------------------------------------------------------------
@@ -322,48 +326,19 @@ class MarkerlessTracker:
         t = new_ctr - R @ ctr
         return _euclid(th, t[0], t[1])
 
+    def _held(self, W):
+        """``W`` turned back upright about the object's centre of symmetry when its angle is not
+        observable (there the fitted angle is noise, and it would swing the template's centre)."""
+        if self.theta_note is None:
+            return W
+        return _euclid(0.0, *(W[:, :2].astype(float) @ self.sym0 + W[:, 2] - self.sym0))
+
     def _sigma_theta(self, tmpl, gray, W, mask=None):
-        """Gauss-Newton σ of θ (rad) from the residual of the registered template (on the pixels
-        ``mask`` keeps, when part of the object is covered)."""
-        cv2 = self._cv2
-        h, w = tmpl.shape
+        """Gauss-Newton σ of θ (rad) of ``tmpl`` registered by ``W`` (:func:`._observability.sigma_theta`)."""
         warped = self._warp_back(gray, W)
         if warped is None:
             return math.inf
-        # ECC matches up to gain and offset: compare zero-mean, unit-variance patches
-        if mask is None:
-            a = self._normalised(tmpl)
-            b = warped - float(warped.mean())
-            b /= math.sqrt(float(np.dot(b.ravel(), b.ravel())) / b.size) + 1e-9
-        else:
-            a = (tmpl - tmpl[mask].mean()) / (tmpl[mask].std() + 1e-9)
-            b = (warped - warped[mask].mean()) / (warped[mask].std() + 1e-9)
-        r = a - b
-        gx = cv2.Sobel(b, cv2.CV_32F, 1, 0, ksize=3) / 8.0
-        gy = cv2.Sobel(b, cv2.CV_32F, 0, 1, ksize=3) / 8.0
-        if mask is not None:  # covered pixels contribute neither residual nor gradient
-            r, gx, gy = r * mask, gx * mask, gy * mask
-        # every 2nd pixel each way: JᵀJ of the full grid is 4 times the subsample's to well under
-        # a percent on any textured region, at a quarter of the cost
-        k = 2 if min(h, w) >= 32 else 1
-        n_used = r[::k, ::k].size if mask is None else int(mask[::k, ::k].sum())
-        gx, gy, r = gx[::k, ::k], gy[::k, ::k], r[::k, ::k]
-        xc = (np.arange(0, w, k, dtype=np.float32) - w / 2)[None, :]
-        yc = (np.arange(0, h, k, dtype=np.float32) - h / 2)[:, None]
-        cols = [(-yc * gx + xc * gy).ravel(), np.ascontiguousarray(gx).ravel(), np.ascontiguousarray(gy).ravel()]
-        # JᵀJ from the six distinct dot products (float64 sums of float32 columns)
-        JTJ = np.empty((3, 3))
-        for i in range(3):
-            for j in range(i, 3):
-                JTJ[i, j] = JTJ[j, i] = float(np.dot(cols[i].astype(float), cols[j].astype(float)))
-        JTJ *= k * k
-        rr = r.ravel().astype(float)
-        s2 = float(np.dot(rr, rr)) / max(n_used - 3, 1)
-        try:
-            cov = s2 * np.linalg.inv(JTJ)
-        except np.linalg.LinAlgError:
-            return math.inf
-        return CORRELATION_INFLATION * math.sqrt(max(cov[0, 0], 0.0))
+        return sigma_theta(tmpl, warped, mask, None if mask is not None else self._normalised(tmpl))
 
     def _normalised(self, tmpl):
         """``tmpl`` at zero mean and unit variance (kept for the first template and the keyframe)."""
@@ -418,12 +393,13 @@ class MarkerlessTracker:
                 fit, tmpl, mask, visible = part[:2], self.key, part[2], part[3]
         self.reason = None
         if fit is not None and fit[1] >= MIN_CC:
+            fit = (self._held(fit[0]), fit[1])
             self.reason = self.verifier.verify(self, gray, fit[0], frame, fit[1])
         if fit is None or fit[1] < MIN_CC or self.reason is not None:
             # converged on something else, or nowhere: the template anywhere in the frame
             alt = self.verifier.reacquire(self, gray, frame, MIN_CC)
             if alt is not None:
-                fit, tmpl, mask, visible, self.reason = alt[:2], self.key, None, 1.0, None
+                fit, tmpl, mask, visible, self.reason = (self._held(alt[0]), alt[1]), self.key, None, 1.0, None
             self.reason = self.reason or (None if fit is not None and fit[1] >= MIN_CC else "lost")
         if self.reason is not None:
             self.key = self.tmpl0 if self.reason == "drift" else self.key  # the keyframe learned the slide
@@ -480,6 +456,11 @@ class MarkerlessDetector:
 
     def detect(self, gray, frame):
         return {oid: t.detect(gray, frame) for oid, t in self.trackers.items()}
+
+    def theta_note(self, oid):
+        """Why object ``oid``'s angle cannot be measured from its appearance, or None."""
+        t = self.trackers.get(oid)
+        return None if t is None else t.theta_note
 
     def lost_reason(self, oid):
         """Why object ``oid`` was lost in the last frame (a status word), or None."""

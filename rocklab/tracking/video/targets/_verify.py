@@ -97,6 +97,8 @@ class PoseVerifier:
         self._limits, self._learned_at = None, 0
         #: (centre (2,), theta, frame) of the last two verified poses
         self.recent: list = []
+        #: whether the angle is checked (False for an object whose appearance tells no angle)
+        self.check_turn = True
 
     # -- learned limits ------------------------------------------------------------
     def score_limit(self) -> float:
@@ -152,7 +154,7 @@ class PoseVerifier:
             return "mismatch"
         if last is not None:
             turn = abs(math.remainder(theta - last[1], 2 * math.pi))
-            if turn > min(MAX_STEP_RAD * gap, MAX_TURN_RAD):
+            if self.check_turn and turn > min(MAX_STEP_RAD * gap, MAX_TURN_RAD):
                 return "jump"
             ref = pred if pred is not None and gap == 1 else None
             if ref is not None:

@@ -1,0 +1,161 @@
+"""Angles that cannot be measured are not reported: kind = "point" and symmetric objects.
+
+A disk on a wall looks the same at every angle: a registration's angle there is noise, so the
+track gives theta NaN with the reason and x, y still measured (issue 25, item 2).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from rocklab._diagnostics import collecting
+from rocklab.tracking import TrackConfig, track_frames
+from rocklab.tracking.video._track import assemble_tracks
+from rocklab.tracking.video.targets._observability import MIN_TURN_SHARE, turn_share
+
+W, H, N, R = 320, 240, 90, 22.0
+PIVOT, LENGTH = (160.0, -300.0), 380.0  # pendulum pivot above the frame, px (u, v), length px
+
+
+def _wall(rng):
+    import cv2
+
+    # a faint texture: a template's margin of wall that moves off with the ball biases any
+    # registration by a pixel or two on a strong one, which is not the subject here
+    wall = cv2.GaussianBlur((rng.random((H, W)) * 255).astype(np.float32), (0, 0), 8)
+    return cv2.normalize(wall, None, 140, 160, cv2.NORM_MINMAX)
+
+
+def _swing(n=N, amp_rad=0.15, period_frames=40.0):
+    phi = amp_rad * np.cos(2 * np.pi * np.arange(n) / period_frames)
+    return PIVOT[0] + LENGTH * np.sin(phi), PIVOT[1] + LENGTH * np.cos(phi), phi
+
+
+def _disk_film(seed=0, mark=False):
+    """A plain dark disk (anti-aliased) swinging on a pendulum arc over a textured wall; with
+    ``mark``, a bright bar across its upper half turns with the swing (an angle to see)."""
+    rng = np.random.default_rng(seed)
+    wall = _wall(rng)
+    u, v, phi = _swing()
+    yy, xx = np.mgrid[0:H, 0:W].astype(float)
+    frames = []
+    for uc, vc, p in zip(u, v, phi):
+        d = np.hypot(xx - uc, yy - vc)
+        alpha = np.clip(R + 0.5 - d, 0.0, 1.0)
+        ball = np.full((H, W), 60.0)
+        if mark:  # a bar from the centre towards the pivot, turning with the string
+            along = (xx - uc) * math.sin(p) - (yy - vc) * math.cos(p)
+            across = (xx - uc) * math.cos(p) + (yy - vc) * math.sin(p)
+            ball = np.where((np.abs(across) < 3) & (along > 0), 230.0, ball)
+        f = wall * (1 - alpha) + ball * alpha + rng.normal(0, 1.5, (H, W))
+        frames.append(np.clip(f, 0, 255).astype(np.uint8))
+    return frames, np.column_stack((u, v)), phi
+
+
+def _track(frames, kind="block", box=None):
+    u0, v0 = _swing(1)[:2]
+    box = box or (u0[0] - R - 8, v0[0] - R - 8, 2 * R + 16, 2 * R + 16)
+    cfg = TrackConfig.from_dict(
+        {
+            "targets": {"style": "markerless"},
+            "reference": {"level": "none"},
+            "objects": [{"id": "ball", "kind": kind, "roi": [round(x) for x in box]}],
+        }
+    )
+    with collecting() as found:
+        res = assemble_tracks(track_frames(frames, cfg), cfg, 50.0, W, H)
+    return res, {d.code for d in found}
+
+
+def test_turn_share_closed_forms():
+    """Isotropic texture 1/2, a plain square's outline about 1/4 (its corners), a disk 0."""
+    rng = np.random.default_rng(1)
+    assert turn_share(rng.random((81, 81)) * 255) == pytest.approx(0.5, abs=0.06)
+    yy, xx = np.mgrid[-40:41, -40:41]
+    square = np.where((abs(xx) < 20) & (abs(yy) < 20), 200.0, 100.0)
+    assert 0.15 < turn_share(square) < 0.3
+    for r in (12, 25, 35):  # any radius, centred or a pixel off
+        for dx in (0, 1):
+            disk = np.where((xx - dx) ** 2 + yy**2 < r**2, 200.0, 100.0)
+            assert turn_share(disk) < 0.2 * MIN_TURN_SHARE
+    assert np.isnan(turn_share(np.full((20, 20), 7.0)))
+
+
+@pytest.mark.parametrize("grow", [0.0, 0.15, -0.1])
+def test_a_disk_has_no_angle_and_its_position_is_tracked(grow):
+    """A block whose appearance tells no angle: W-TRACK-THETA, theta NaN on every frame with the
+    reason in the track, and the centre within 0.5 px of the truth on >= 95 % of frames ok."""
+    frames, truth, _ = _disk_film()
+    u0, v0 = truth[0]
+    half = (R + 8) * (1 + grow)
+    res, codes = _track(frames, box=(u0 - half + 2, v0 - half - 1, 2 * half, 2 * half))
+    tr = res["ball"]
+    assert "W-TRACK-THETA" in codes
+    assert "W-TRACK-THETA" in tr.theta_note or "tells no angle" in tr.theta_note
+    assert np.all(np.isnan(tr.theta_rad)) and np.all(np.isnan(tr.sigma_theta_rad))
+    assert tr.ok.mean() >= 0.95
+    # the tracked point is the box's centre: compare displacements from the first frame
+    d = np.column_stack((tr.x_px, tr.y_px)) - truth
+    d -= d[0]
+    assert np.nanmax(np.hypot(*d[tr.ok].T)) < 0.5
+    assert res.to_dict()["objects"]["ball"]["theta_note"] == tr.theta_note
+
+
+def test_kind_point_reports_a_position_only():
+    """kind = "point": no warning (the user said so), theta NaN, the same positions as a block."""
+    frames, truth, _ = _disk_film(seed=2)
+    res, codes = _track(frames, kind="point")
+    tr = res["ball"]
+    assert "W-TRACK-THETA" not in codes
+    assert tr.theta_note.startswith('kind = "point"')
+    assert np.all(np.isnan(tr.theta_rad))
+    d = np.column_stack((tr.x_px, tr.y_px)) - truth
+    d -= d[0]
+    assert tr.ok.mean() >= 0.95 and np.nanmax(np.hypot(*d[tr.ok].T)) < 0.5
+    df = res.to_frame()
+    assert df["theta_rad"].isna().all() and df["x_px"].notna().mean() >= 0.95
+
+
+def test_a_mark_off_the_centre_gives_the_angle_back():
+    """The same disk with a bar towards its string: the angle is measured (no W-TRACK-THETA) and
+    follows the swing within 2 degrees."""
+    frames, _, phi = _disk_film(seed=3, mark=True)
+    res, codes = _track(frames)
+    tr = res["ball"]
+    assert "W-TRACK-THETA" not in codes and tr.theta_note == ""
+    # the bar points along (sin phi, -cos phi) in the image (v down): in the plane (y up) it
+    # turns clockwise as phi grows, theta = -(phi - phi0)
+    err = np.degrees(np.abs(tr.theta_rad + (phi - phi[0])))
+    assert tr.ok.mean() >= 0.95 and np.nanmax(err[tr.ok]) < 2.0
+
+
+def test_the_real_ball_shows_its_angle(shared_data):
+    """The development film's ball (a band round it, beads on top) is not taken for a disk,
+    from any box round it within the tolerance of item 3 (so its angle is still reported)."""
+    import cv2
+
+    import sys
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).parent))
+    from _blob import perturbed_boxes
+
+    cap = cv2.VideoCapture(str(shared_data / "video" / "pendulum_film2_vga.mp4"))
+    ok, img = cap.read()
+    cap.release()
+    assert ok
+    g = cv2.cvtColor(img, cv2.COLOR_BGR2GRAY)
+    for x, y, w, h in [(310, 66, 70, 74), *perturbed_boxes((310, 66, 70, 74), 8, seed=3)]:
+        assert turn_share(g[y : y + h, x : x + w]) > 2 * MIN_TURN_SHARE
+
+
+def test_kind_is_checked():
+    from rocklab import InputError
+
+    with pytest.raises(InputError, match="point"):
+        TrackConfig.from_dict(
+            {"targets": {"style": "markerless"}, "objects": [{"id": "b", "kind": "pont", "roi": [0, 0, 9, 9]}]}
+        )

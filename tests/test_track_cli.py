@@ -81,6 +81,23 @@ def test_cli_writes_tracks_and_table_motion(session, run_cli, tmp_path):
     assert rc == 0 and stdout.count("frames ok") == 2
 
 
+def test_plot_draws_every_object_and_never_replaces_an_input(session, run_cli, tmp_path):
+    """--plot: one column of panels per object (two here: the PNG is wider than tall); a plot named
+    as the film or the config is refused, exit 2, and the file keeps its bytes."""
+    d, frames, th, x = session
+    png = tmp_path / "tracks.png"
+    rc, stdout, err = run_cli("track", d / "video.mkv", "-o", tmp_path / "t.csv", "--plot", png, "--json")
+    assert rc == 0, err
+    assert json.loads(stdout)["plot"] == str(png)
+    img = cv2.imread(str(png))
+    assert img is not None and img.shape[1] > 1.3 * img.shape[0]
+    for victim in (d / "video.mkv", d / "track.toml"):
+        before = victim.read_bytes()
+        rc, _, err = run_cli("track", d / "video.mkv", "-o", tmp_path / "t3.csv", "--plot", victim)
+        assert rc == 2 and len(err.strip().splitlines()) == 1 and "--plot" in err, err
+        assert victim.read_bytes() == before
+
+
 def _one_line_error(run_cli, *argv, match):
     rc, out, err = run_cli("track", *argv)
     assert rc == 2

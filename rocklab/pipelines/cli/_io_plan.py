@@ -74,7 +74,7 @@ def _track(args):
     outs = track_outputs(_opt(args.out) or video.parent / "tracks.csv")
     if cfg is None or cfg.table is None:
         outs.pop(TABLE)
-    return _video("video", video) + cfg_ins, list(outs.items())
+    return _video("video", video) + cfg_ins, [*outs.items(), ("--plot", _opt(getattr(args, "plot", None)))]
 
 
 def _track3d(args):

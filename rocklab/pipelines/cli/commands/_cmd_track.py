@@ -1,9 +1,11 @@
 """``rocklab track``: per-object θ, x, y (and table motion) from a video.
 
-- ``rocklab track VIDEO [--config track.toml] [-o tracks.csv]`` writes ``tracks.csv``
+- ``rocklab track VIDEO [--config track.toml] [-o tracks.csv] [--plot tracks.png]`` writes ``tracks.csv``
   (columns ``frame, t_s, object, x_px, y_px, x_m, y_m, theta_rad, sigma_theta_rad,
   quality, status``; ``x_m, y_m`` empty without a metric scale) and, when the config
-  has a table, ``<stem>_table.csv`` (``t_s, x_m, vx_m_s, ax_m_s2``).
+  has a table, ``<stem>_table.csv`` (``t_s, x_m, vx_m_s, ax_m_s2``); ``--plot`` draws each
+  object's theta (with its 1-sigma band), image position and quality, every frame that is not
+  ``ok`` marked by its status.
 - ``rocklab track init VIDEO [--object NAME=x,y,w,h ...] [--table x,y,w,h]
   [--marker-size M] -o track.toml``: a config from the first frame (markers found by
   trying the common dictionaries, or the named regions followed markerless), commented,
@@ -50,6 +52,12 @@ def register(sub):
     p.add_argument("--config", default=None, help="track.toml (default: track.toml next to the video)")
     p.add_argument("-o", "--out", default=None, help="output CSV (default: tracks.csv next to the video)")
     p.add_argument("--fps", type=float, default=None, help="frame rate; required when the container has none")
+    p.add_argument(
+        "--plot",
+        default=None,
+        metavar="PNG",
+        help="track: theta, position and quality per object, every failed frame marked",
+    )
     p.add_argument("--json", action="store_true", help="print a JSON summary on stdout")
     p.add_argument("--progress", action="store_true", help="progress bar on stderr")
     p.set_defaults(func=run)
@@ -83,6 +91,11 @@ def run(args) -> int:
     write_frame_atomic(out, res.to_frame(), float_format="%.9g", side=not args.out)
     summary = res.to_dict()
     summary["tracks_csv"] = str(out)
+    if args.plot:
+        from .._track_plot import track_figure
+
+        track_figure(res, args.plot, title=str(video))
+        summary["plot"] = str(args.plot)
     if cfg.table is not None and any(res[cfg.table.id].ok):
         try:
             tm = res.table_motion()

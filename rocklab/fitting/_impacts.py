@@ -1,9 +1,9 @@
 """Model-free analysis of a measured free-rocking record θ(t).
 
-Release detection (thread-burn: block at rest at θ0, then let go), zero crossings
-(impacts), arch peaks, per-impact restitution from local fits on each side of each
-crossing, and the energy loss per rocking from successive amplitude peaks (Ther
-thesis Eq. 12). Times in s, angles in rad; arrays have shape (n,).
+Zero crossings (impacts) after the release (found by :mod:`._release`), arch peaks,
+per-impact restitution from local fits on each side of each crossing, and the energy loss
+per rocking from successive amplitude peaks (Ther thesis Eq. 12). Times in s, angles in
+rad; arrays have shape (n,).
 """
 
 from __future__ import annotations
@@ -15,6 +15,8 @@ import pandas as pd
 from scipy.optimize import minimize_scalar
 
 from .._errors import InputError
+from .._diagnostics import warn
+from ._release import ReleaseInfo, detect_release, settle_release
 
 __all__ = ["ReleaseInfo", "detect_release", "find_crossings", "arch_peaks", "per_impact_eta",
            "EnergyLoss", "energy_loss_from_peaks", "check_record"]
@@ -44,116 +46,6 @@ def check_record(t_s, theta_rad, nan: str = "raise", name: str = "theta_rad"):
         i = int(np.flatnonzero(np.diff(t) <= 0)[0])
         raise InputError(f"t_s at sample {i + 1}: times must increase strictly; sort or de-duplicate the record")
     return t, y, n_skip
-
-
-@dataclass(frozen=True)
-class ReleaseInfo:
-    """Where a thread-burn release happens in a record.
-
-    Attributes
-    ----------
-    found : bool
-    t_s : float
-        Estimated release time (last sample at rest), s.
-    index : int
-        Index of the first sample that has moved.
-    theta0_rad : float
-        Median angle of the initial plateau, rad.
-    sigma_rad : float
-        Noise σ of θ estimated on the plateau (second differences), rad.
-    n_plateau : int
-        Number of plateau samples.
-    message : str
-    """
-
-    found: bool
-    t_s: float
-    index: int
-    theta0_rad: float
-    sigma_rad: float
-    n_plateau: int
-    message: str = ""
-
-
-def _held_scale(dev) -> float:
-    """Scatter of a held block's angle about its level, rad: the 90th percentile of |dev| / 1.645.
-
-    For white noise this is σ. Compressed video repeats a still block's angle for many frames
-    and then steps (a median absolute deviation or a difference-based σ would be ~0 there);
-    the percentile keeps those steps, and a few isolated glitches do not inflate it.
-    """
-    dev = np.abs(np.asarray(dev, float))
-    return float(np.percentile(dev, 90) / 1.6449) if dev.size else 0.0
-
-
-def detect_release(t_s, theta_rad, min_plateau: int = 3) -> ReleaseInfo:
-    """Find the initial rest plateau at θ0 and the moment the block starts to move.
-
-    Every threshold comes from the record itself, so compressed or interlaced video and
-    flicker, which make a held block's angle step, drift or alternate, are judged on their
-    own scatter. The block is under way once it has come half-way down to upright for three
-    consecutive samples; the departure is followed back while it keeps shrinking (a released
-    block accelerates away monotonically), and the samples before are the plateau. Its
-    scatter σ (90th percentile of the deviations, see :func:`_held_scale`) fixes where the
-    motion is clearly under way (6 σ from the plateau's last level); from there the release
-    is placed where the departure came within 1.5× the RMS scatter of the samples before,
-    measured from their last level (the level of a compressed film can step while the block
-    is held). θ0 is the median of the plateau.
-
-    A record has no release (``found=False`` with the reason) when the plateau is shorter
-    than half of ``max(min(20, n // 3), min_plateau)`` samples or not still compared with
-    the release (its fitted acceleration above 5 % of the release's: the record starts in
-    motion), when the block never comes half-way down, or when θ0 is within 10 σ of 0.
-    """
-    t = np.asarray(t_s, float)
-    y = np.asarray(theta_rad, float)
-    n = y.size
-    m0 = max(min(20, n // 3), min_plateau)
-    lvl = float(np.median(y[:m0]))
-    s = 1.0 if lvl >= 0 else -1.0
-    far = s * (lvl - y) > 0.5 * abs(lvl)
-    run3 = far[:-2] & far[1:-1] & far[2:]
-    if not run3.any():
-        sig = _held_scale(y - float(np.median(y)))
-        if abs(lvl) < 10 * max(sig, 1e-9):
-            return ReleaseInfo(False, float("nan"), n, lvl, sig, n, f"initial angle {lvl:.3g} rad is within "
-                               "noise of 0: no tilted start (thread-burn release) found")
-        return ReleaseInfo(False, float("nan"), n, lvl, sig, n, "block never moves: no release in the record")
-    g = int(np.argmax(run3))
-    i = g
-    while i > 0 and y[i - 1] * s > y[i] * s:
-        i -= 1
-    pl = y[:max(i - 1, 0)]
-    if pl.size >= m0 // 2:
-        # under way: beyond 6 σ of the plateau's last level; then back to where the departure was
-        # within the scatter of the samples before
-        sig = _held_scale(pl - np.median(pl))
-        last = float(np.median(pl[-m0:]))
-        i = g
-        while i > 0 and s * (last - y[i - 1]) > 6.0 * max(sig, 1e-12):
-            i -= 1
-        pl = y[:max(i - 1, 1)]
-        med = float(np.median(pl))
-        tol = 1.5 * max(float(np.sqrt(np.mean((pl - med) ** 2))), 1e-12)
-        # within the scatter of the plateau's level, or of its last level: a compressed film's level
-        # can step while the block is held, and a slow start drags the last samples towards upright
-        last = float(np.median(pl[-max(3, m0 // 4):]))
-        while i > 0 and s * (med - y[i - 1]) > tol and s * (last - y[i - 1]) > tol:
-            i -= 1
-    n_pl = max(i - 1, 2)
-    med = float(np.median(y[:n_pl]))  # plateau only: early-motion samples would bias θ0 towards 0
-    sig = _held_scale(y[:n_pl] - med)
-    # a held block does not accelerate: compare the plateau's fitted acceleration with the release's
-    a_pl = 2.0 * abs(np.polynomial.polynomial.polyfit(t[:n_pl] - t[0], y[:n_pl], 2)[2]) if n_pl >= 3 else np.inf
-    a_rel = 2.0 * abs(y[g] - med) / max(t[g] - t[n_pl], 1e-12) ** 2
-    if n_pl < m0 // 2 or a_pl > 0.05 * a_rel:
-        return ReleaseInfo(False, float("nan"), 0, med, sig, 0, "record starts in motion: no rest plateau before "
-                           "release; keep ~0.1 s of the block at rest before the thread burns")
-    if abs(med) < 10 * max(sig, 1e-9):
-        return ReleaseInfo(False, float("nan"), i, med, sig, n_pl, f"initial angle {med:.3g} rad is within noise "
-                           "of 0: no tilted start (thread-burn release) found")
-    moved = np.flatnonzero(s * (med - y[i:g + 1]) > 6.0 * sig)  # first sample clearly under way
-    return ReleaseInfo(True, float(t[max(i - 1, 0)]), i + int(moved[0]) if moved.size else g, med, sig, n_pl)
 
 
 def find_crossings(t_s, theta_rad, start: int = 0, threshold: float = 0.0) -> np.ndarray:
@@ -343,6 +235,16 @@ def _rel_se_u(theta, se, alpha):
     return np.sin(alpha - th) / _u_rise(th, alpha) * se
 
 
+def _release_for(t, y, block):
+    """The release; placed by the block's release quarter-cycle when the block is known."""
+    if block is None:
+        return detect_release(t, y)
+    rel, undecided = settle_release(t, y, block, min(2e-4, 2e-3 / block.p_rad_s))
+    if undecided is not None:
+        warn("W-FIT-RELEASE", undecided)
+    return rel
+
+
 def _crossings(t, y, rel):
     sig = max(rel.sigma_rad, 1e-9)
     ic = find_crossings(t, y, start=rel.index if rel.found else 0, threshold=max(4.0 * sig, 1e-6))
@@ -371,7 +273,8 @@ def per_impact_eta(t_s, theta_rad, block=None, release: ReleaseInfo | None = Non
     t_s, theta_rad : array (n,)
     block : Block, optional
     release : ReleaseInfo, optional
-        From :func:`detect_release` (computed when None).
+        Computed when None: by :func:`~rocklab.fitting._release.settle_release` when ``block``
+        is given, else by :func:`detect_release`.
     powers : tuple of int
         Powers of u in the arch polynomial q.
     max_se : float
@@ -386,7 +289,7 @@ def per_impact_eta(t_s, theta_rad, block=None, release: ReleaseInfo | None = Non
     n_before, n_after, ok``.
     """
     t, y, _ = check_record(t_s, theta_rad)
-    rel = release if release is not None else detect_release(t, y)
+    rel = release if release is not None else _release_for(t, y, block)
     cols = ["impact", "t_s", "omega_before_rad_s", "omega_after_rad_s", "eta_velocity",
             "theta_peak_before_rad", "theta_peak_after_rad", "eta_peaks", "eta_peaks_se", "n_before", "n_after",
             "ok"]
@@ -471,14 +374,15 @@ def energy_loss_from_peaks(t_s, theta_rad, block=None, start: int = 0, n_avg: in
     ----------
     t_s, theta_rad : array (n,)
     block : Block, optional
-        Gives the exact rise u = R[cos(α − |θ|) − cos α] (m); without it u = |θ|.
+        Gives the exact rise u = R[cos(α − |θ|) − cos α] (m), without it u = |θ|; and the
+        release from the block's release quarter-cycle (see :func:`per_impact_eta`).
     start : int
         Index of the first loss averaged (0: the first rocking after release).
     n_avg : int
         Number of consecutive losses averaged (the thesis uses four).
     """
     t, y, _ = check_record(t_s, theta_rad)
-    rel = detect_release(t, y)
+    rel = _release_for(t, y, block)
     tc = _crossings(t, y, rel)
     if tc.size < 2:
         raise InputError(f"record has {tc.size} impact(s): need at least 2 for peak-to-peak energy loss")

@@ -87,8 +87,9 @@ WARNING_CODES: dict[str, tuple[str, str]] = {
     ),
     "W-FIT-RELEASE": (
         "suspect",
-        "the release time is not decided: two release times fit the record's plateau and first "
-        "quarter-cycle equally well, and eta depends on which is right; check the record's start",
+        "the release time is not decided: release times more than 3 samples apart fit the plateau "
+        "and the first quarter-cycle alike, and eta depends on which is right; check the record's "
+        "start and the block's dimensions",
     ),
     "W-FIT-BOUND": ("suspect", "the fitted parameter sits at a bound of its search range"),
     "W-FIT-UNITS": (

@@ -248,11 +248,11 @@ def _release_at(t, y, t_r, s):
 def settle_release(t, y, block, dt_s: float, max_nodes: int = 400, p_ambiguous: float = 0.999):
     """Release time where the release quarter-cycle of ``block`` fits the record best.
 
-    The start comes from :func:`detect_release`.
-    Every sample before the first pass through upright is then compared with the block
-    released from rest at each candidate time (every sample of the record up to there, at
-    most ``max_nodes`` of them; θ0 profiled by least squares); the best is refined by Brent's
-    method between its neighbours. Before the first impact the motion does not depend on η,
+    The start comes from :func:`detect_release`. Every sample before the first pass through
+    upright is then compared with the block released from rest at each candidate time (every
+    sample up to two after the first one the detector saw clearly moved, at most ``max_nodes``
+    of them; θ0 profiled by least squares); the best is refined by Brent's method between its
+    neighbours. Before the first impact the motion does not depend on η,
     so one simulation serves every candidate. A second, separate minimum (more than 3 samples
     away) whose misfit is within the ``p_ambiguous`` χ²₁ quantile of the noise (scaled by the
     residuals' lag-one autocorrelation), or a best candidate at the edge of the record, leaves
@@ -269,9 +269,11 @@ def settle_release(t, y, block, dt_s: float, max_nodes: int = 400, p_ambiguous: 
     Returns
     -------
     (ReleaseInfo, str or None)
-        The release, and why it is not decided (None when it is).
-        The detector's answer is returned unchanged when it finds no release or the record never passes
-        upright after it, or θ0 is not below α (the fit fails on those itself).
+        The release, and why it is not decided (None when it is). The detector's answer is
+        returned unchanged when it finds no release, the record never passes upright after it
+        or θ0 is not below α (the fit fails on those itself), and when the block's release
+        would come after the data show it moving (the block's dimensions do not describe the
+        record: the fit's residual says so).
     """
     rel = detect_release(t, y)
     if not rel.found:
@@ -303,7 +305,7 @@ def settle_release(t, y, block, dt_s: float, max_nodes: int = 400, p_ambiguous: 
             options=dict(xatol=1e-6 * (t[1] - t[0])),
         )
         f_hat, th_hat, _ = prob.at_release(0.5, idx, float(res.x))
-        if abs(th_hat - th0) < 1e-3 * (block.alpha_rad - th0):
+        if abs(th_hat - th0) < 1e-3 * (block.alpha_rad - th0) or th_hat >= block.alpha_rad:
             break
         th0 = th_hat
     t_r = float(res.x)

@@ -54,6 +54,7 @@ def test_still_and_moving_starts_are_not_releases():
     assert "never moves" in detect_release(t, still).message
 
 
+@pytest.mark.slow
 def test_h264_sessions_fit_like_the_lossless_film(tmp_path):
     # the camcorder-like video.mp4 of default free-rocking sessions: these seeds failed ("record starts
     # in motion", seed 1) or fitted a drift step as the release (seed 18: eta_e 0.662) before
@@ -134,15 +135,22 @@ def test_a_slow_start_from_near_alpha_gives_the_true_eta(frac, fps, noise_rad):
         assert abs(f.release_t_s - t_rel) < 2.0 / fps
 
 
-def test_slow_start_per_impact_and_detector():
-    t, y, t_rel = _slow_start(1, 0.9, 500.0, 5e-4)
-    rel = detect_release(t, y)
-    assert rel.found and 0 <= rel.t_s - t_rel < 0.1  # model-free: late, but found
-    settled, undecided = settle_release(t, y, B6M, 2e-4)
-    assert undecided is None and abs(settled.t_s - t_rel) < 2e-3
-    assert abs(settled.theta0_rad - 0.9 * B6M.alpha_rad) < 2e-4
-    pie = per_impact_eta(t, y, B6M)
-    assert len(pie) >= 12 and np.all(np.abs(pie["eta_peaks"].to_numpy()[:6] - 0.9) < 0.005)
+@pytest.mark.parametrize(("fps", "noise_rad"), [(500.0, 1e-4), (500.0, 5e-4), (300.0, 2.5e-4)])
+def test_slow_start_model_free_and_per_impact(fps, noise_rad):
+    # model-free, the release comes late (0.02-0.19 s) but theta0 and the noise are the held
+    # block's: the noise-judged plateau alone read 1e-4 rad noise as 8e-3 rad (6 of 29
+    # impacts found) and 5e-4 rad as "within noise of 0" (per_impact_eta raised IndexError)
+    for seed in range(3):
+        t, y, t_rel = _slow_start(seed, 0.9, fps, noise_rad)
+        rel = detect_release(t, y)
+        assert rel.found and 0 <= rel.t_s - t_rel < 0.25
+        assert abs(rel.theta0_rad - 0.9 * B6M.alpha_rad) < 0.5 * noise_rad
+        assert 0.8 < rel.sigma_rad / noise_rad < 1.2
+        settled, undecided = settle_release(t, y, B6M, 2e-4)
+        assert undecided is None and abs(settled.t_s - t_rel) < 2.0 / fps
+        pie = per_impact_eta(t, y, B6M)
+        assert len(pie) >= 14 and len(per_impact_eta(t, y)) == len(pie)
+        assert np.all(np.abs(pie["eta_peaks"].to_numpy()[:6] - 0.9) < 0.005)
 
 
 def test_an_undecided_release_is_not_ok():

@@ -81,13 +81,20 @@ def detect_release(t_s, theta_rad, min_plateau: int = 3) -> ReleaseInfo:
     motion), when the block never comes half-way down, or when θ0 is within 10 σ of 0 — unless
     a noise level from the first samples finds one (:func:`_threshold_release`): a slow start
     (θ0 near α) creeps away under the noise, so the departure followed back leaves part of the
-    motion in the plateau and its scatter hides θ0.
+    motion in the plateau and its scatter hides θ0. When that finds the block moving earlier,
+    θ0 and σ come from the samples before its release (the release time stays).
     """
     rel = _noise_release(t_s, theta_rad, min_plateau)
-    if rel.found:
-        return rel
     alt = _threshold_release(t_s, theta_rad, min_plateau)
-    return alt if alt.found else rel
+    if not rel.found:
+        return alt if alt.found else rel
+    if alt.found and alt.n_plateau < rel.n_plateau - 3:
+        # the first samples' noise saw the block move earlier: a slow start's creep (or a compressed
+        # film's step) follows, so θ0 and the scatter come from the samples before it
+        pl = np.asarray(theta_rad, float)[: max(alt.n_plateau, 3)]
+        med = float(np.median(pl))
+        return ReleaseInfo(True, rel.t_s, rel.index, med, _held_scale(pl - med), rel.n_plateau)
+    return rel
 
 
 def _noise_release(t_s, theta_rad, min_plateau: int = 3) -> ReleaseInfo:

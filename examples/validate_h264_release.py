@@ -2,7 +2,7 @@
 
 Renders ``rocklab synth --seed S --size 640x360 --duration 3`` for S = 1..20 (free rocking,
 eta = 0.75), tracks video.mp4 and video.mkv with the session's track.toml, fits eta_e and
-prints, per film, how many fits are ok and within 0.005 of the truth. About 10 s per seed on
+prints, per film, how many fits are ok and within 0.005 of the truth. About 7 s per seed on
 2 cores. Usage: ``python examples/validate_h264_release.py [N_SEEDS] [WORK_DIR]``.
 """
 

@@ -85,6 +85,12 @@ WARNING_CODES: dict[str, tuple[str, str]] = {
         "the fitted simulation misses the measurement by more than 20x the noise (at least "
         "1e-3 rad): the model or the block's dimensions do not describe this test",
     ),
+    "W-FIT-RELEASE": (
+        "suspect",
+        "the release time is not decided: release times more than 3 samples apart fit the plateau "
+        "and the first quarter-cycle alike, and eta depends on which is right; check the record's "
+        "start and the block's dimensions",
+    ),
     "W-FIT-BOUND": ("suspect", "the fitted parameter sits at a bound of its search range"),
     "W-FIT-UNITS": (
         "suspect",

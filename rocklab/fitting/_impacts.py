@@ -1,9 +1,9 @@
 """Model-free analysis of a measured free-rocking record θ(t).
 
-Release detection (thread-burn: block at rest at θ0, then let go), zero crossings
-(impacts), arch peaks, per-impact restitution from local fits on each side of each
-crossing, and the energy loss per rocking from successive amplitude peaks (Ther
-thesis Eq. 12). Times in s, angles in rad; arrays have shape (n,).
+Zero crossings (impacts) after the release (found by :mod:`._release`), arch peaks,
+per-impact restitution from local fits on each side of each crossing, and the energy loss
+per rocking from successive amplitude peaks (Ther thesis Eq. 12). Times in s, angles in
+rad; arrays have shape (n,).
 """
 
 from __future__ import annotations
@@ -15,6 +15,8 @@ import pandas as pd
 from scipy.optimize import minimize_scalar
 
 from .._errors import InputError
+from .._diagnostics import warn
+from ._release import ReleaseInfo, detect_release, settle_release
 
 __all__ = ["ReleaseInfo", "detect_release", "find_crossings", "arch_peaks", "per_impact_eta",
            "EnergyLoss", "energy_loss_from_peaks", "check_record"]
@@ -44,90 +46,6 @@ def check_record(t_s, theta_rad, nan: str = "raise", name: str = "theta_rad"):
         i = int(np.flatnonzero(np.diff(t) <= 0)[0])
         raise InputError(f"t_s at sample {i + 1}: times must increase strictly; sort or de-duplicate the record")
     return t, y, n_skip
-
-
-@dataclass(frozen=True)
-class ReleaseInfo:
-    """Where a thread-burn release happens in a record.
-
-    Attributes
-    ----------
-    found : bool
-    t_s : float
-        Estimated release time (last sample at rest), s.
-    index : int
-        Index of the first sample that has moved.
-    theta0_rad : float
-        Median angle of the initial plateau, rad.
-    sigma_rad : float
-        Noise σ of θ estimated on the plateau (second differences), rad.
-    n_plateau : int
-        Number of plateau samples.
-    message : str
-    """
-
-    found: bool
-    t_s: float
-    index: int
-    theta0_rad: float
-    sigma_rad: float
-    n_plateau: int
-    message: str = ""
-
-
-def detect_release(t_s, theta_rad, min_plateau: int = 3) -> ReleaseInfo:
-    """Find the initial rest plateau at θ0 and the moment the block starts to move.
-
-    The first samples must be flat (a quadratic fitted to them varies by less than 4 σ).
-    The block is at rest until three consecutive samples lie beyond ``max(6 σ, 1e-3 |θ0|)``
-    on the same side of the running plateau median (σ: standard deviation on the plateau); the release is placed where the departure was ~1 σ and θ0 is the median of
-    the samples before it. A record that starts in motion, never moves, or whose plateau
-    is at θ ≈ 0 has no release (``found=False`` with the reason).
-    """
-    t = np.asarray(t_s, float)
-    y = np.asarray(theta_rad, float)
-    n = y.size
-    m0 = max(min(20, n // 3), min_plateau)
-    # start: quadratic fit to the first samples; at rest the fitted curve stays within noise
-    x = (t[:m0] - t[0]) / max(t[m0 - 1] - t[0], 1e-12)
-    c = np.polynomial.polynomial.polyfit(x, y[:m0], 2)
-    fit0 = np.polynomial.polynomial.polyval(x, c)
-    sig = float(np.std(y[:m0] - fit0, ddof=3)) if m0 > 3 else 0.0
-    med = float(np.median(y[:m0]))
-    floor = max(1e-3 * abs(med), 1e-7)
-    if np.ptp(fit0) > max(4.0 * sig, floor) or np.any(np.abs(y[:m0] - med) > max(8.0 * sig, floor)):
-        return ReleaseInfo(False, float("nan"), 0, med, sig, 0, "record starts in motion: no rest plateau before "
-                           "release; keep ~0.1 s of the block at rest before the thread burns")
-    # grow the plateau until the departure: 3 consecutive samples beyond tolerance on the same
-    # side (a released block accelerates away; an isolated noise spike does not persist)
-    i = m0
-    tol = max(6.0 * sig, floor)
-    while i < n:
-        d = y[i:i + 3] - med
-        if d.size == 3 and np.all(np.abs(d) > tol) and abs(np.sum(np.sign(d))) == 3:
-            break
-        if d.size < 3:
-            i = n
-            break
-        i += 1
-        if i % 16 == 0:
-            med = float(np.median(y[:i]))
-            sig = float(np.std(y[:i], ddof=1))
-            tol = max(6.0 * sig, floor)
-    if i >= n:
-        return ReleaseInfo(False, float("nan"), n, med, sig, n, "block never moves: no release in the record")
-    # the departure is quadratic in time: step back to where |θ − θ0| was ~1 σ
-    sig = float(np.std(y[:i], ddof=1))
-    j = i
-    while j > 0 and abs(y[j - 1] - med) > 1.0 * sig:
-        j -= 1
-    n_pl = max(j - 1, 2)
-    med = float(np.median(y[:n_pl]))  # plateau only: early-motion samples would bias θ0 towards 0
-    sig = float(np.std(y[:n_pl], ddof=1))
-    if abs(med) < 10 * max(sig, 1e-6):
-        return ReleaseInfo(False, float("nan"), i, med, sig, n_pl, f"initial angle {med:.3g} rad is within noise "
-                           "of 0: no tilted start (thread-burn release) found")
-    return ReleaseInfo(True, float(t[max(j - 1, 0)]), i, med, sig, n_pl)
 
 
 def find_crossings(t_s, theta_rad, start: int = 0, threshold: float = 0.0) -> np.ndarray:
@@ -317,6 +235,16 @@ def _rel_se_u(theta, se, alpha):
     return np.sin(alpha - th) / _u_rise(th, alpha) * se
 
 
+def _release_for(t, y, block):
+    """The release; placed by the block's release quarter-cycle when the block is known."""
+    if block is None:
+        return detect_release(t, y)
+    rel, undecided = settle_release(t, y, block, min(2e-4, 2e-3 / block.p_rad_s))
+    if undecided is not None:
+        warn("W-FIT-RELEASE", undecided)
+    return rel
+
+
 def _crossings(t, y, rel):
     sig = max(rel.sigma_rad, 1e-9)
     ic = find_crossings(t, y, start=rel.index if rel.found else 0, threshold=max(4.0 * sig, 1e-6))
@@ -345,7 +273,8 @@ def per_impact_eta(t_s, theta_rad, block=None, release: ReleaseInfo | None = Non
     t_s, theta_rad : array (n,)
     block : Block, optional
     release : ReleaseInfo, optional
-        From :func:`detect_release` (computed when None).
+        Computed when None: by :func:`~rocklab.fitting._release.settle_release` when ``block``
+        is given, else by :func:`detect_release`.
     powers : tuple of int
         Powers of u in the arch polynomial q.
     max_se : float
@@ -360,7 +289,7 @@ def per_impact_eta(t_s, theta_rad, block=None, release: ReleaseInfo | None = Non
     n_before, n_after, ok``.
     """
     t, y, _ = check_record(t_s, theta_rad)
-    rel = release if release is not None else detect_release(t, y)
+    rel = release if release is not None else _release_for(t, y, block)
     cols = ["impact", "t_s", "omega_before_rad_s", "omega_after_rad_s", "eta_velocity",
             "theta_peak_before_rad", "theta_peak_after_rad", "eta_peaks", "eta_peaks_se", "n_before", "n_after",
             "ok"]
@@ -445,14 +374,15 @@ def energy_loss_from_peaks(t_s, theta_rad, block=None, start: int = 0, n_avg: in
     ----------
     t_s, theta_rad : array (n,)
     block : Block, optional
-        Gives the exact rise u = R[cos(α − |θ|) − cos α] (m); without it u = |θ|.
+        Gives the exact rise u = R[cos(α − |θ|) − cos α] (m), without it u = |θ|; and the
+        release from the block's release quarter-cycle (see :func:`per_impact_eta`).
     start : int
         Index of the first loss averaged (0: the first rocking after release).
     n_avg : int
         Number of consecutive losses averaged (the thesis uses four).
     """
     t, y, _ = check_record(t_s, theta_rad)
-    rel = detect_release(t, y)
+    rel = _release_for(t, y, block)
     tc = _crossings(t, y, rel)
     if tc.size < 2:
         raise InputError(f"record has {tc.size} impact(s): need at least 2 for peak-to-peak energy loss")

@@ -32,7 +32,8 @@ from scipy.stats import chi2
 from .._diagnostics import warn
 from .._errors import InputError
 from ..blocks import is_lab_size
-from ._impacts import _crossings, arch_peaks, check_record, detect_release, per_impact_eta
+from ._impacts import _crossings, arch_peaks, check_record, per_impact_eta
+from ._release import settle_release
 from ._fit_checks import RESIDUAL_FACTOR, RESIDUAL_FLOOR_RAD, _cut_at_gap, _suspicion
 from ._simfit import _ac_factor, _grid_then_brent, _Problem, _profile_ci
 
@@ -241,7 +242,9 @@ def fit_restitution(t_s, theta_rad, block, window: str = "middle50", objective: 
         raise InputError(f"eta_bounds={eta_bounds}: need 0 < lo < hi < 1 (a restitution >= 1 gains energy)")
     t, y, n_skip = check_record(t_s, theta_rad, nan=nan)
     name = getattr(block, "name", "")
-    rel = detect_release(t, y)
+    p = block.p_rad_s
+    dt_sim = float(dt_s) if dt_s is not None else min(2e-4, 2e-3 / p)
+    rel, undecided = settle_release(t, y, block, dt_sim)
     fail = dict(window=window, objective=objective, bounds=(lo_b, hi_b), n_skip=n_skip, name=name)
     if not rel.found:
         return _failed(f"no release found: {rel.message}", theta0=rel.theta0_rad, sigma=rel.sigma_rad, **fail)
@@ -250,7 +253,8 @@ def fit_restitution(t_s, theta_rad, block, window: str = "middle50", objective: 
         diags.append(warn("W-FIT-UNITS", f"{name or 'block'}: b = {block.b_m:.4g} m, h = {block.h_m:.4g} m "
                                          f"(h/b = {block.h_m / block.b_m:.4g}) is not a rocking block in metres; "
                                          "check units and order"))
-    t, y, gap_diag = _cut_at_gap(t, y, rel.t_s, rel.sigma_rad)
+    # from the last sample at rest: a gap that swallows the release (placed between samples) still counts
+    t, y, gap_diag = _cut_at_gap(t, y, min(rel.t_s, t[max(rel.n_plateau - 1, 0)]), rel.sigma_rad)
     if gap_diag is not None:
         diags.append(gap_diag)
     s0 = 1.0 if rel.theta0_rad > 0 else -1.0
@@ -265,6 +269,8 @@ def fit_restitution(t_s, theta_rad, block, window: str = "middle50", objective: 
         diags.append(warn("W-FIT-THETA0", f"{name or 'block'}: measured theta0 = {theta0:.4g} rad is "
                                           f"{theta0 / alpha:.3f} alpha (alpha = {alpha:.4g} rad from b = "
                                           f"{block.b_m:.4g} m, h = {block.h_m:.4g} m); check b and h"))
+    if undecided is not None:
+        diags.append(warn("W-FIT-RELEASE", f"{name or 'block'}: {undecided}"))
     tc = _crossings(t, y, rel)
     n_imp = int(tc.size)
     if n_imp < 3:
@@ -272,8 +278,6 @@ def fit_restitution(t_s, theta_rad, block, window: str = "middle50", objective: 
                        theta0=rel.theta0_rad, sigma=rel.sigma_rad, n_imp=n_imp, **fail)
     sigma = max(rel.sigma_rad, 1e-12)
     dt_data = float(np.median(np.diff(t)))
-    p = block.p_rad_s
-    dt_sim = float(dt_s) if dt_s is not None else min(2e-4, 2e-3 / p)
     rel_info = rel.__class__(**{**rel.__dict__, "theta0_rad": theta0})
     pie = per_impact_eta(t, y, block, release=rel_info, crossings_t_s=tc)
     half_last = tc[-1] - tc[-2]

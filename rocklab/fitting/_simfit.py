@@ -92,16 +92,21 @@ class _Problem:
         """min over release time (θ0 if sens, level offset if enabled) of Σ (y − θ_sim)².
 
         Returns (sse, t_r, θ0, offset)."""
-        tt, yy = self.t[idx], self.y[idx]
+        res = minimize_scalar(
+            lambda tr: self.at_release(eta, idx, tr, sens)[0],
+            bounds=t_r_bounds,
+            method="bounded",
+            options=dict(xatol=1e-7),
+        )
+        sse, th0, c = self.at_release(eta, idx, float(res.x), sens)
+        return sse, float(res.x), th0, c
 
-        def inner(tr):
-            m0, S = self.model(eta, tt, tr, sens)
-            d, dl, c = self._linear(yy - m0, S, yy.size)
-            return float(d @ d), dl, c
-
-        res = minimize_scalar(lambda tr: inner(tr)[0], bounds=t_r_bounds, method="bounded", options=dict(xatol=1e-7))
-        sse, dl, c = inner(float(res.x))
-        return sse, float(res.x), self.theta0 + dl, c
+    def at_release(self, eta, idx, t_r, sens=True):
+        """(Σ (y − θ_sim)², θ0, offset) at samples idx for release time t_r, θ0 and offset profiled."""
+        yy = self.y[idx]
+        m0, S = self.model(eta, self.t[idx], t_r, sens)
+        d, dl, c = self._linear(yy - m0, S, yy.size)
+        return float(d @ d), self.theta0 + dl, c
 
     def residual(self, eta, idx, t_r, theta0, offset=0.0, sens=True):
         """y − offset − θ_sim at samples idx; θ0 enters linearly (sens) or exactly via a fresh run."""

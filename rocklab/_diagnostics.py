@@ -168,6 +168,11 @@ WARNING_CODES: dict[str, tuple[str, str]] = {
         "a frame rate given in the config or with --fps contradicts the container's own clock: "
         "t_s follows the given rate; remove it unless the film's clock is known wrong",
     ),
+    "W-VIDEO-MIRRORED": (
+        "suspect",
+        "the film's display matrix mirrors the picture: it is tracked as shown, so theta's sign is "
+        "the mirrored picture's; check it against the lab, or re-mux the film without the mirror",
+    ),
     "W-VIDEO-LOST": ("suspect", "an object was lost on more than 1 % of the frames (see the status column)"),
     # 3D points and the assumption audit
     "W-3D-LOST": (

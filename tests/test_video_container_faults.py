@@ -219,3 +219,52 @@ def test_a_mirroring_display_matrix_is_shown_as_players_show_it_and_warned(tmp_p
         assert diags[0].severity == "suspect" and f"-display_rotation {info.rotation_deg}" in diags[0].message
     assert np.all(b.status == "ok")
     assert np.nanmax(np.abs(b.theta_rad - _theta(t + 0.05))) < math.radians(0.3)
+
+
+def _av1_encoder():
+    for name in ("libsvtav1", "libaom-av1", "librav1e"):
+        try:
+            av.codec.Codec(name, "w")
+            return name
+        except Exception:  # noqa: BLE001 - not built into this FFmpeg
+            continue
+    return None
+
+
+@pytest.mark.parametrize("ext", ["mp4", "mkv", "webm"])
+def test_an_av1_film_is_read_by_pyav_where_opencv_cannot(tmp_path, run_cli, ext):
+    """An AV1 film (phones and screen recorders write them): OpenCV's FFmpeg here has no AV1
+    decoder, so the probe refused it ("no decodable frame") though PyAV decodes it. `rocklab
+    track` reads it with the container's times and the true angle."""
+    enc = _av1_encoder()
+    if enc is None:
+        pytest.skip("this PyAV's FFmpeg has no AV1 encoder (libsvtav1, libaom-av1, librav1e)")
+    n, fps = 30, 30
+    t = np.arange(n) / fps
+    path = tmp_path / f"film.{ext}"
+    with av.open(str(path), "w") as c:
+        s = c.add_stream(enc, rate=fps)
+        s.width, s.height, s.pix_fmt = 320, 240, "yuv420p"
+        s.options = {"crf": "20", "preset": "10"} if enc == "libsvtav1" else {"crf": "20"}
+        for th in _theta(t + 0.05):
+            for pkt in s.encode(av.VideoFrame.from_ndarray(_marker_frame(th, 320, 240), format="gray")):
+                c.mux(pkt)
+        for pkt in s.encode():
+            c.mux(pkt)
+    with av.open(str(path)) as c:
+        assert c.streams.video[0].codec_context.name in ("av1", "libdav1d", "libaom-av1")
+    info = probe_video(path)
+    assert (info.n_frames, info.fps, info.width_px, info.height_px) == (n, fps, 320, 240)
+    cfg = tmp_path / "t.toml"
+    cfg.write_text(
+        '[targets]\nstyle = "aruco"\nmarker_size_m = 0.05\n[reference]\nlevel = "none"\n'
+        '[[objects]]\nid = "block_1"\nmarkers = [3]\n'
+    )
+    rc, out, err = run_cli("track", path, "--config", cfg, "-o", tmp_path / "tracks.csv")
+    assert rc == 0 and "W-" not in err, err
+    import pandas as pd
+
+    tr = pd.read_csv(tmp_path / "tracks.csv")
+    np.testing.assert_allclose(tr["t_s"], t, rtol=0, atol=1e-9)
+    assert (tr["status"] == "ok").all()
+    assert np.max(np.abs(tr["theta_rad"] - _theta(t + 0.05))) < math.radians(0.3)

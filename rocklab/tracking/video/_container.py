@@ -1,6 +1,6 @@
 """What the container says and OpenCV does not, read with PyAV from the packets (no decoding but
 the first picture): each frame's presentation time, the pixel aspect ratio, the field order and
-the display matrix (a right-angle turn, possibly mirrored).
+the display matrix (a right-angle turn, possibly mirrored); and the grey picture of a decoded frame.
 
 Frame times are the container's, never a rate rounded from them. A container stores times in
 its own ticks (Matroska: 1 ms), so a constant 150 fps is stored as steps of 7, 7 and 6 ms; the
@@ -187,6 +187,29 @@ def rotation_deg(orientation) -> int:
     if a * d - b * c < 0:  # mirrored left-right after the turn: undo the mirror of the x' column
         a, c = -a, -c
     return {(1, 0): 0, (0, -1): 90, (-1, 0): 180, (0, 1): 270}[(a, b)]
+
+
+#: 8-bit pixel formats whose first plane is the luma picture itself (grey needs no conversion)
+_LUMA_FORMATS = frozenset(
+    "yuv420p yuvj420p yuv422p yuvj422p yuv444p yuvj444p yuv411p yuvj411p yuv440p yuvj440p nv12 nv21 nv16 gray".split()
+)
+#: limited-range luma (16..235) stretched to 0..255, as OpenCV's YUV -> BGR -> grey path does
+_STRETCH = np.clip(np.round((np.arange(256) - 16.0) * 255.0 / 219.0), 0, 255).astype(np.uint8)
+
+
+def luma(frame) -> np.ndarray:
+    """The grey picture of a decoded PyAV frame: its luma plane, full range, shape (height, width)."""
+    name = frame.format.name
+    if name not in _LUMA_FORMATS:
+        return frame.to_ndarray(format="gray")
+    p = frame.planes[0]
+    y = np.frombuffer(p, np.uint8).reshape(-1, p.line_size)[: frame.height, : frame.width]
+    # full range where the pixel format or the frame's own tag says so (phones tag yuv420p "pc")
+    if name.startswith("yuvj") or name == "gray" or int(frame.color_range or 0) == 2:
+        return np.array(y)
+    import cv2
+
+    return cv2.LUT(y, _STRETCH)
 
 
 def container_info(path) -> ContainerInfo:

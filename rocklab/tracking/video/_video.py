@@ -30,7 +30,7 @@ from pathlib import Path
 import numpy as np
 
 from ..._errors import InputError
-from ._container import UPRIGHT, container_info, frame_orientation, orient, shown_pts
+from ._container import UPRIGHT, container_info, frame_orientation, luma, orient, shown_pts
 
 __all__ = ["VideoInfo", "probe_video", "iter_video_frames", "container_info"]
 
@@ -141,27 +141,33 @@ def probe_video(path) -> VideoInfo:
     """
     import cv2
 
-    cap = _open(path)
-    try:
-        n = int(cap.get(cv2.CAP_PROP_FRAME_COUNT) or 0)
-        fps = float(cap.get(cv2.CAP_PROP_FPS) or 0.0)
-        ok, img = cap.read()
-        if not ok or img is None:
-            raise InputError(f"{path}: the video has no decodable frame (empty or corrupt); check the file")
-        h, w = img.shape[:2]  # as OpenCV shows it: turned (not mirrored) by the display matrix
-    finally:
-        cap.release()
+    ci = container_info(path)
+    n, fps, size = 0, 0.0, None
+    try:  # OpenCV: count and rate where the packets have no times; image sequences
+        cap = _open(path)
+    except InputError:
+        if ci.stored_size_px is None:
+            raise
+        cap = None  # PyAV decodes what this OpenCV cannot (its FFmpeg may lack a decoder: AV1)
+    if cap is not None:
+        try:
+            n, fps = int(cap.get(cv2.CAP_PROP_FRAME_COUNT) or 0), float(cap.get(cv2.CAP_PROP_FPS) or 0.0)
+            ok, img = cap.read()
+            size = (img.shape[1], img.shape[0]) if ok and img is not None else None  # turned by OpenCV
+        finally:
+            cap.release()
+    if size is None and ci.stored_size_px is None:
+        raise InputError(f"{path}: the video has no decodable frame (empty or corrupt); check the file")
     # Image sequences report a nominal rate (or none); only trust real containers.
     if not np.isfinite(fps) or fps <= 0 or fps > 1e5 or "%" in str(path):
         fps = None
-    ci = container_info(path)
     times = ci.frame_times_s
     if times is not None and len(times) > 1:
         # count and rate from the packets: OpenCV's are estimates (a Matroska film's duration x a
         # rate rounded from its 1 ms ticks; a variable-rate phone film reports its time base)
         n = len(times)
         fps = ci.rate_hz or (n - 1) / float(times[-1] - times[0])
-    w, h = ci.shown_size_px or (_square_width(int(w), ci.pixel_aspect), h)
+    w, h = ci.shown_size_px or (_square_width(size[0], ci.pixel_aspect), size[1])
     return VideoInfo(
         str(path),
         max(n, 0),
@@ -198,29 +204,6 @@ def _to_gray(img):
     if img.ndim == 2:
         return img
     return cv2.cvtColor(img, cv2.COLOR_BGR2GRAY)
-
-
-#: 8-bit pixel formats whose first plane is the luma picture itself (grey needs no conversion)
-_LUMA_FORMATS = frozenset(
-    "yuv420p yuvj420p yuv422p yuvj422p yuv444p yuvj444p yuv411p yuvj411p yuv440p yuvj440p nv12 nv21 nv16 gray".split()
-)
-#: limited-range luma (16..235) stretched to 0..255, as OpenCV's YUV -> BGR -> grey path does
-_STRETCH = np.clip(np.round((np.arange(256) - 16.0) * 255.0 / 219.0), 0, 255).astype(np.uint8)
-
-
-def _luma(frame) -> np.ndarray:
-    """The grey picture of a decoded PyAV frame: its luma plane, full range, shape (height, width)."""
-    name = frame.format.name
-    if name not in _LUMA_FORMATS:
-        return frame.to_ndarray(format="gray")
-    p = frame.planes[0]
-    y = np.frombuffer(p, np.uint8).reshape(-1, p.line_size)[: frame.height, : frame.width]
-    # full range where the pixel format or the frame's own tag says so (phones tag yuv420p "pc")
-    if name.startswith("yuvj") or name == "gray" or int(frame.color_range or 0) == 2:
-        return np.array(y)
-    import cv2
-
-    return cv2.LUT(y, _STRETCH)
 
 
 class _PyAVReader:
@@ -338,7 +321,7 @@ class _PyAVReader:
             return False, None
         self.index = self._place(f)
         self.orientation = frame_orientation(f)
-        return True, (_luma(f) if self._gray else f.to_ndarray(format="bgr24"))
+        return True, (luma(f) if self._gray else f.to_ndarray(format="bgr24"))
 
     def release(self):
         self._c.close()

@@ -114,6 +114,12 @@ WARNING_CODES: dict[str, tuple[str, str]] = {
         "it turns through more than a half turn, or holding the rests needs a large gyro "
         "drift; theta, release and impacts mean nothing. Check the file and the mounting",
     ),
+    "W-IMU-NO-REST": (
+        "suspect",
+        "the IMU log does not start (or end) at rest: the gyro bias and the starting tilt come from moving "
+        "samples (or the drift is not held by a final rest), so theta drifts; log from before the release "
+        "until the block has rested",
+    ),
     "W-IMU-TABLE": (
         "suspect",
         "the table sensor turned during the log (gyro or the gravity of its first and last "

@@ -261,3 +261,28 @@ def test_named_vertical_axis_flagged():
     # 90 deg less the release tilt (up to 0.9 alpha) and the mis-mount
     assert np.rad2deg(rot.rocking.axis_tilt_rad) > 60.0 and rot.rocking.axis_share < 0.01
     assert block_rotation(log, "y").status == "ok"  # the right axis, named: clean
+
+
+def test_a_log_without_a_rest_at_either_end_is_a_coded_warning():
+    """A log cut while the block still rocks, or started after the release: theta is not anchored
+    (drift unheld; bias and theta0 from moving samples). The status said so, but `run` keeps only
+    warnings, so its result stayed ok: now W-IMU-NO-REST (suspect) with the drift's toll."""
+    log = _rocking_log(3)
+    with collecting() as found:
+        full = block_rotation(log)
+    assert full.status == "ok" and found == []
+    t = log.t_s
+    moving = np.flatnonzero(np.abs(np.rad2deg(full.omega_rad_s)) > 5.0)
+    t_move, t_last = t[moving[0]], t[moving[-1]]
+    end_cut = log.slice(0, int(np.searchsorted(t, 0.5 * (t_move + t_last))))
+    with collecting() as found:
+        rot = block_rotation(end_cut)
+    assert rot.status == "no_rest_after" and [d.code for d in found] == ["W-IMU-NO-REST"]
+    span = float(end_cut.t_s[-1] - end_cut.t_s[0])
+    toll = float(re.search(r"puts it ([\d.]+) deg off by the end", found[0].message).group(1))
+    assert toll == pytest.approx(0.1 * span, rel=0.01)
+    start_cut = log.slice(int(np.searchsorted(t, t_move + 0.3)), log.n)
+    with collecting() as found:
+        rot = block_rotation(start_cut)
+    assert rot.status == "no_rest_before" and [d.code for d in found] == ["W-IMU-NO-REST"]
+    assert "motion starts 0 s into the log" in found[0].message

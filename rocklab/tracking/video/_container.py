@@ -17,7 +17,16 @@ from fractions import Fraction
 
 import numpy as np
 
-__all__ = ["ContainerInfo", "container_info", "frame_clock", "shown_pts", "frame_orientation", "orient", "UPRIGHT"]
+__all__ = [
+    "ContainerInfo",
+    "container_info",
+    "frame_clock",
+    "shown_pts",
+    "frame_orientation",
+    "orient",
+    "UPRIGHT",
+    "luma",
+]
 
 #: The display matrix of a picture shown as stored (see :func:`frame_orientation`).
 UPRIGHT = (1, 0, 0, 1)

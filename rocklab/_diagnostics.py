@@ -120,6 +120,12 @@ WARNING_CODES: dict[str, tuple[str, str]] = {
         "it turns through more than a half turn, or holding the rests needs a large gyro "
         "drift; theta, release and impacts mean nothing. Check the file and the mounting",
     ),
+    "W-IMU-NO-REST": (
+        "suspect",
+        "the IMU log does not start (or end) at rest: the gyro bias and the starting tilt come from moving "
+        "samples (or the drift is not held by a final rest), so theta drifts; log from before the release "
+        "until the block has rested",
+    ),
     "W-IMU-TABLE": (
         "suspect",
         "the table sensor turned during the log (gyro or the gravity of its first and last "
@@ -179,6 +185,11 @@ WARNING_CODES: dict[str, tuple[str, str]] = {
         "suspect",
         "a frame rate given in the config or with --fps contradicts the container's own clock: "
         "t_s follows the given rate; remove it unless the film's clock is known wrong",
+    ),
+    "W-VIDEO-MIRRORED": (
+        "suspect",
+        "the film's display matrix mirrors the picture: it is tracked as shown, so theta's sign is "
+        "the mirrored picture's; check it against the lab, or re-mux the film without the mirror",
     ),
     "W-VIDEO-LOST": ("suspect", "an object was lost on more than 1 % of the frames (see the status column)"),
     # 3D points and the assumption audit

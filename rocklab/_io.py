@@ -16,16 +16,19 @@ __all__ = ["atomic_path", "write_text_atomic", "write_json_atomic", "write_frame
 
 
 @contextlib.contextmanager
-def atomic_path(path, suffix: str | None = None, *, side: bool = False):
+def atomic_path(path, suffix: str | None = None, *, side: bool = False, stamp: bool = True):
     """Yield a temporary path next to ``path``; rename it onto ``path`` on success.
 
     On an exception the temporary file is removed and ``path`` is untouched. A ``side``
     file (one the user did not name: ``<stem>_table.csv``, ``audit.json``, a default
     output name) never replaces a user's file: one rocklab did not write is kept as
-    ``NAME.user-<time>`` (:func:`rocklab._outdir.set_aside_user_file`).
+    ``NAME.user-<time>`` (:func:`rocklab._outdir.set_aside_user_file`). The file is stamped as
+    rocklab's (:func:`rocklab._outdir.stamp_output`: a later run replaces it and never reads it
+    back from a folder of inputs) unless ``stamp`` is False (data made to be read as an input:
+    ``rocklab synth``).
     """
     from ._errors import InputError
-    from ._outdir import claim_side_file, clean_stale, set_aside_user_file, stale_prefix
+    from ._outdir import claim_side_file, clean_stale, set_aside_user_file, stale_prefix, stamp_output
 
     path = Path(path)
     if path.is_dir():
@@ -42,6 +45,8 @@ def atomic_path(path, suffix: str | None = None, *, side: bool = False):
         umask = os.umask(0)
         os.umask(umask)
         os.chmod(tmp, 0o666 & ~umask)
+        if stamp:
+            stamp_output(tmp)
         kept = set_aside_user_file(path) if side else None
         os.replace(tmp, path)
         if kept is not None:
@@ -56,9 +61,10 @@ def atomic_path(path, suffix: str | None = None, *, side: bool = False):
         raise
 
 
-def write_text_atomic(path, text: str, *, side: bool = False) -> Path:
-    """Write ``text`` (UTF-8) to ``path`` atomically and return the path (``side``: see :func:`atomic_path`)."""
-    with atomic_path(path, side=side) as tmp:
+def write_text_atomic(path, text: str, *, side: bool = False, stamp: bool = True) -> Path:
+    """Write ``text`` (UTF-8) to ``path`` atomically and return the path (``side``, ``stamp``: see
+    :func:`atomic_path`)."""
+    with atomic_path(path, side=side, stamp=stamp) as tmp:
         Path(tmp).write_text(text, encoding="utf-8")
     return Path(path)
 

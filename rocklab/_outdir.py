@@ -43,10 +43,15 @@ __all__ = [
     "stale_prefix",
     "set_aside_user_file",
     "claim_side_file",
+    "stamp_output",
+    "rocklab_wrote",
 ]
 
 #: Name of the marker file in every folder rocklab writes.
 MARKER = ".rocklab-output"
+
+#: Extended attribute that marks a single output file as rocklab's (the BLAKE2b digest of its content).
+STAMP_XATTR = "user.rocklab.output"
 
 _MB = 1024 * 1024
 
@@ -111,6 +116,44 @@ def foreign_entries(path) -> list[str]:
     """Entries of folder ``path`` that rocklab did not write (sorted names)."""
     owned = owned_entries(path) | {MARKER}
     return sorted(p.name for p in Path(path).iterdir() if p.name not in owned)
+
+
+def _digest(path) -> bytes:
+    import hashlib
+
+    h = hashlib.blake2b(digest_size=16)
+    with open(path, "rb") as f:
+        for chunk in iter(lambda: f.read(1 << 20), b""):
+            h.update(chunk)
+    return h.hexdigest().encode()
+
+
+def stamp_output(path) -> None:
+    """Mark the file ``path`` as rocklab's output: its content digest in the extended attribute
+    :data:`STAMP_XATTR`.
+
+    A file rocklab writes beside the user's files (``-o`` into a folder of inputs, side files) is
+    known as rocklab's by this stamp rather than by a marker file, so nothing but the outputs asked
+    for is written into the user's folders. Where the file system keeps no extended attributes the
+    file stays unmarked and later counts as the user's (kept, never overwritten).
+    """
+    try:
+        os.setxattr(path, STAMP_XATTR, _digest(path))
+    except (AttributeError, OSError):  # no extended attributes on this system or file system
+        pass
+
+
+def rocklab_wrote(path) -> bool:
+    """Whether the file ``path`` is an output rocklab wrote and nobody changed since (its stamp,
+    :func:`stamp_output`, matches its content). A symlink is never rocklab's."""
+    try:
+        stamp = os.getxattr(path, STAMP_XATTR, follow_symlinks=False)
+    except (AttributeError, OSError):
+        return False
+    try:
+        return stamp == _digest(path)
+    except OSError:
+        return False
 
 
 def _check_parent(path: Path, option: str, need_bytes: int) -> None:
@@ -238,12 +281,12 @@ def set_aside_user_file(path) -> Path | None:
 
     Side files (``<stem>_table.csv``, ``audit.json``, ``points.csv``, ``<stem>.parquet``,
     default output names) follow the rule of folder outputs: a file rocklab wrote there
-    before (recorded in the folder's :data:`MARKER`) is replaced; anything else is the
-    user's and is kept under a new name, never overwritten. Returns the new name, or
-    None when there was nothing of the user's to keep.
+    before (stamped, :func:`rocklab_wrote`, or recorded in the folder's :data:`MARKER`) and
+    unchanged since is replaced; anything else is the user's and is kept under a new name,
+    never overwritten. Returns the new name, or None when there was nothing of the user's to keep.
     """
     path = Path(path)
-    if not (path.exists() or path.is_symlink()) or path.name in owned_entries(path.parent):
+    if not (path.exists() or path.is_symlink()) or path.name in owned_entries(path.parent) or rocklab_wrote(path):
         return None
     stamp = time.strftime("%Y%m%dT%H%M%S")
     for k in range(1000):
@@ -261,9 +304,11 @@ def set_aside_user_file(path) -> Path | None:
 
 
 def claim_side_file(path, command: str = "") -> None:
-    """Record the side file ``path`` as rocklab's in its folder's marker (replaced freely next time)."""
+    """Record the side file ``path`` as rocklab's in its folder's marker when the folder is rocklab's
+    (it has a :data:`MARKER`); a user's folder gets no marker (the file's stamp says it is rocklab's)."""
     path = Path(path)
-    claim_dir(path.parent, [path.name], command=command)
+    if (path.parent / MARKER).is_file():
+        claim_dir(path.parent, [path.name], command=command)
 
 
 def _swap(src: Path, dest: Path) -> None:

@@ -328,13 +328,33 @@ many(
             "W-IMU-CLOCK",
         ),
         ("rate-zero", _imu(IMU_HEAD + "\n" + "\n".join(ROWS) + "\n", extra=("--rate", 0)), "error", "rate"),
-        ("binary", _imu(b"\x00\xff" * 400), "error", "not a text file|not a number|missing columns"),
+        ("binary", _imu(b"\x00\xff" * 400), "error", "log/Inertial.csv: binary data, not a text file"),
+        # a picture or a film given for a log: refused by name before any reading (a PNG had been
+        # read as a log cut short, W-IMU-TRUNCATED, then an error naming no file)
+        ("png", lambda tmp: ["imu", _image(tmp / "photo.png")], "error", r"photo\.png: a PNG image, not a text file"),
+        ("jpeg-as-csv", lambda tmp: ["imu", _image(tmp / "log.csv", ".jpg")], "error", r"log\.csv: a JPEG image"),
+        ("film", lambda tmp: ["imu", _film(tmp / "v.mp4")], "error", r"v\.mp4: an MP4/MOV film"),
+        ("utf16", _imu((IMU_HEAD + "\n" + "\n".join(ROWS) + "\n").encode("utf-16")), "error", "UTF-16 text"),
+        (
+            "latin1",
+            _imu((IMU_HEAD.replace("deg/s", "°/s") + "\n" + "\n".join(ROWS) + "\n").encode("latin-1")),
+            "error",
+            r"Inertial\.csv: not UTF-8 text \(byte 0xb0",
+        ),
         ("still", _imu(IMU_HEAD + "\n" + "\n".join(ROWS) + "\n"), "ok", None),
         ("missing", lambda tmp: ["imu", tmp / "nope"], "error", "not found"),
         ("two-csv", lambda tmp: ["imu", _two_csv(tmp)], "error", "no IMU log found"),
     ],
     None,
 )
+
+
+def _image(p: Path, ext: str = ".png") -> Path:
+    import cv2
+
+    img = np.random.default_rng(0).integers(0, 256, (64, 64), dtype=np.uint8)
+    p.write_bytes(cv2.imencode(ext, img)[1].tobytes())
+    return p
 
 
 def _two_csv(tmp):
@@ -1142,6 +1162,8 @@ def test_corpus_case(tmp_path, run_cli, capsys, name, build, expect):
     if kind == "error":
         assert rc == 2, (rc, err)
         assert len(errors) == 1 and (not words or re.search(words, errors[0])), err
+        # a refused log: the one error line, no warning about reading it (a PNG warned W-IMU-TRUNCATED)
+        assert not (name.startswith("imu-") and warns), err
         # no partial output: nothing new but what the case itself built
         new = {p for p in tmp_path.rglob("*")} - before
         assert not new, sorted(map(str, new))

@@ -23,6 +23,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from rocklab._diagnostics import collecting
+
 from rocklab import Block
 from rocklab.models import BaseMotion, simulate
 from rocklab.tracking import block_rotation
@@ -117,8 +119,10 @@ def test_forced_log_ends_moving(forced):
     # No end rest: drift not anchored, but the 1 s initial rest still gives bias and upright.
     _, _, res = forced
     log = _log(forced, t_end_s=4.0, rest_after_s=0.0)
-    rot = block_rotation(log, "y", release="none")
+    with collecting() as found:  # said with a code (`run` keeps no status of its IMU, only warnings)
+        rot = block_rotation(log, "y", release="none")
     assert rot.status == "no_rest_after" and rot.run_kind == "forced"
+    assert [d.code for d in found] == ["W-IMU-NO-REST"] and "0.5 deg off by the end (5 s" in found[0].message
     rms, peak, rest0 = _errors(rot, res, 4.0)
     # Measured: 0.015 deg RMS.
     assert rms <= min(np.deg2rad(0.2), 0.02 * peak), np.rad2deg(rms)

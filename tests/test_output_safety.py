@@ -153,6 +153,7 @@ def test_side_files_keep_a_users_file_and_replace_their_own(tmp_path, run_cli):
         assert json.loads((tmp_path / "audit.json").read_text())["verdict"] in ("valid", "suspect", "invalid")
         assert pd.read_csv(tmp_path / "tracks.csv")["theta_rad"].abs().max() == pytest.approx(0.05, rel=0.2)
         assert err.count("rocklab: kept your") == (2 if k == 0 else 0), err
+        assert not (tmp_path / MARKER).exists()  # the user's folder gets the outputs, nothing else
     assert src.read_text().startswith("t_s,point")
     # an explicit -o is the user's choice: replaced, but audit.json beside it is still a side file
     (tmp_path / "sub").mkdir()
@@ -225,3 +226,55 @@ def test_run_refuses_an_out_folder_that_holds_its_inputs(tmp_path, run_cli, forc
     assert rc == 0, err
     assert (session / "tracks.csv").read_bytes() == before["tracks.csv"]
     assert json.loads((session / "report.json").read_text())["status"] == "ok"
+
+
+def _listing(folder):
+    return {p.name: p.read_bytes() for p in folder.iterdir()}
+
+
+def test_oas_output_in_its_record_folder_is_not_read_back(tmp_path, run_cli):
+    """`oas recs/ -o recs/tI.csv` twice: the second run read tI.csv (and tI.parquet) as records;
+    the first left a .rocklab-output marker in the user's record folder."""
+    import shutil
+
+    from test_fuzz_corpus import _two_records
+
+    recs = tmp_path / "recs"
+    recs.mkdir()
+    _two_records(recs)
+    inputs = _listing(recs)
+    argv = ("oas", recs, "-o", recs / "tI.csv", "--levels", 4, "--sizes", 4, "--refine", 1, "--no-progress")
+    tables = []
+    for k in range(2):
+        rc, out, err = run_cli(*argv)
+        assert rc == 0, err
+        assert err.count("not reading") == 2 * k, err  # tI.csv and tI.parquet, from the second run on
+        tables.append(pd.read_csv(recs / "tI.csv"))
+        # only the outputs asked for are written in the user's folder: no marker, no kept copies
+        assert sorted(_listing(recs)) == sorted([*inputs, "tI.csv", "tI.parquet"])
+        assert {n: b for n, b in _listing(recs).items() if n in inputs} == inputs
+    assert len(tables[1]) == 2 and tables[1]["t_p_s"].tolist() == tables[0]["t_p_s"].tolist()
+    assert len(pd.read_parquet(recs / "tI.parquet")) == 2
+    # a copy (made by the user, not stamped) is the user's file: it is read, and fails as a record
+    shutil.copyfile(recs / "tI.csv", recs / "mine.csv")
+    rc, out, err = run_cli(*argv)
+    assert rc == 1 and "mine.csv" in err and "2/3 records done" in out, (out, err)
+    # a stamped output the user changed afterwards is theirs again: read, so never overwritten
+    with open(recs / "tI.csv", "a") as f:
+        f.write("# checked\n")
+    rc, out, err = run_cli(*argv)
+    assert rc == 2 and "would overwrite the input record" in err, err
+
+
+def test_imu_output_in_its_log_folder_is_not_read_back(tmp_path, run_cli):
+    """`imu LOG/ -o LOG/theta.csv` twice: the second run took theta.csv for a second log (or refused)."""
+    from test_fuzz_corpus import _imu_folder
+
+    log = _imu_folder(tmp_path)
+    (log / "Inertial.csv").rename(log / "mylog.csv")  # found as the folder's single CSV
+    inputs = _listing(log)
+    for _ in range(2):
+        rc, out, err = run_cli("imu", log, "-o", log / "theta.csv")
+        assert rc == 0, err
+        assert sorted(_listing(log)) == ["mylog.csv", "theta.csv"] and _listing(log)["mylog.csv"] == inputs["mylog.csv"]
+        assert pd.read_csv(log / "theta.csv")["t_s"].size > 100

@@ -166,7 +166,7 @@ def write_track_toml(path: Path, *, style, camera, objects, marker_size_m, dot_d
         "# Tracking config written by 'rocklab synth' (schema: rocklab/tracking/video/_config.py).\n"
         "# Object origins: block = centre of its front face, table = top centre of its front face.\n" + cfg.to_toml()
     )
-    write_text_atomic(path, text)
+    write_text_atomic(path, text, stamp=False)  # an input of `rocklab run`, not an output
     load_track_config(path)  # round-trip check: the tracker can read what we wrote
     return text
 
@@ -213,5 +213,5 @@ def write_experiment_toml(path: Path, *, name, block, table_kind, imu_objects, c
         "# Experiment config written by 'rocklab synth' (schema: rocklab/pipelines/experiment/_config.py).\n"
         + "\n".join(lines)
     )
-    write_text_atomic(path, text)
+    write_text_atomic(path, text, stamp=False)  # an input of `rocklab run`, not an output
     return text

@@ -265,7 +265,7 @@ def write_ximu_csv(
     text = "Packet number,Address,Value,Fixed-point value,Name\n" + "".join(
         f"{i + 1},{a},{v},NaN,{nm}\n" for i, (a, v, nm) in enumerate(rows)
     )
-    with atomic_path(regs) as tmp:
+    with atomic_path(regs, stamp=False) as tmp:  # a log to read, not an output
         Path(tmp).write_text(text, encoding="utf-8")
     return inertial, regs
 
@@ -315,7 +315,7 @@ def _write_lines(path: Path, head: str, cols: list[np.ndarray]) -> None:
     body = cols[0].astype(object)
     for c in cols[1:]:
         body = body + "," + c.astype(object)
-    with atomic_path(path) as tmp:
+    with atomic_path(path, stamp=False) as tmp:
         with open(tmp, "w", encoding="utf-8", newline="\n") as fh:
             fh.write(head + "\n")
             fh.write("\n".join(body.tolist()))

@@ -122,7 +122,31 @@ class _Terminated(SystemExit):
 
 
 def _on_sigterm(signum, frame):  # a killed run removes its staged outputs on the way out
+    if _inside_numba(frame):
+        # A compiled loop cannot be interrupted; Python runs this handler when numba boxes the
+        # loop's results, inside numba's own callback (it unpickles types). An exception raised
+        # there leaves a NULL in the returned tuple and the interpreter crashes (exit 139), so
+        # the signal is sent again a moment later, once the call has returned.
+        import os
+
+        again = threading.Timer(0.05, os.kill, (os.getpid(), signum))
+        again.daemon = True
+        again.start()
+        return
     raise _Terminated(143)
+
+
+def _inside_numba(frame) -> bool:
+    """Whether the Python stack at ``frame`` runs numba's own code (compiling, boxing results)."""
+    import os
+
+    nb = sys.modules.get("numba")
+    root = os.path.dirname(getattr(nb, "__file__", "") or "")
+    while root and frame is not None:
+        if frame.f_code.co_filename.startswith(root + os.sep):
+            return True
+        frame = frame.f_back
+    return False
 
 
 def _exit_now(code: int, line: str) -> None:

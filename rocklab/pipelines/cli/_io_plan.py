@@ -95,6 +95,7 @@ def _stereo(args):
 
 
 def _imu(args):
+    from ..._outdir import rocklab_wrote
     from ...tracking.imu import imu_log_files
 
     outs = [("-o", _opt(args.out)), ("--plot", _opt(getattr(args, "plot", None)))]
@@ -102,13 +103,17 @@ def _imu(args):
         return [], []
     ins = [("IMU log", p) for p in imu_log_files(args.path)]
     # the rest of a log's export (a folder given, or the x-IMU GUI's <base>_*.csv family) is the
-    # user's data too, read or not
+    # user's data too, read or not; an earlier output of rocklab's there is not
     given = Path(args.path)
     if given.is_dir():
-        ins += [("file of the IMU log folder", p) for p in given.iterdir() if p.is_file()]
+        ins += [("file of the IMU log folder", p) for p in given.iterdir() if p.is_file() and not rocklab_wrote(p)]
     elif ins and "_" in ins[0][1].name:
         base = ins[0][1].name.rsplit("_", 1)[0]
-        ins += [("file of the IMU log's export", p) for p in ins[0][1].parent.glob(base + "_*") if p.is_file()]
+        ins += [
+            ("file of the IMU log's export", p)
+            for p in ins[0][1].parent.glob(base + "_*")
+            if p.is_file() and not rocklab_wrote(p)
+        ]
     return ins, outs
 
 

@@ -8,9 +8,10 @@ __all__ = ["sig"]
 
 
 def sig(x, digits: int = 4) -> str:
-    """``x`` to ``digits`` significant digits; "–" when it is missing, not a number or not finite."""
+    """``x`` to ``digits`` significant digits (zero as "0", never "-0"); "–" when it is missing, not a
+    number or not finite."""
     try:
         v = float(x)
     except (TypeError, ValueError):
         return "–"
-    return f"{v:.{digits}g}" if np.isfinite(v) else "–"
+    return f"{v + 0.0:.{digits}g}" if np.isfinite(v) else "–"  # + 0.0: -0.0 becomes 0.0

@@ -62,21 +62,29 @@ def table4_row(name: str, table=None):
     return None
 
 
-def expand_records(paths, list_file=None) -> list:
+def expand_records(paths, list_file=None, skipped: list | None = None) -> list:
     """``[(name, path, error)]`` of the records named on the command line.
 
-    A folder stands for every visible file in it (sorted); ``list_file`` holds one
-    path per line (relative to the list's folder; ``#`` starts a comment). A missing
-    file and a second record of the same name get an ``error`` (one line), so the
+    A folder stands for every visible file in it (sorted) except the outputs rocklab
+    wrote there (:func:`rocklab._outdir.rocklab_wrote`: a table of an earlier ``oas -o``
+    into the folder is not a record; appended to ``skipped`` when given); ``list_file``
+    holds one path per line (relative to the list's folder; ``#`` starts a comment). A
+    missing file and a second record of the same name get an ``error`` (one line), so the
     rest of the batch still runs and the table says what happened to each.
     """
     from pathlib import Path
+
+    from ..._outdir import rocklab_wrote
 
     items = []
     for p in paths:
         p = Path(p)
         if p.is_dir():
-            items += [(f, "") for f in sorted(p.iterdir()) if f.is_file() and not f.name.startswith(".")]
+            files = [f for f in sorted(p.iterdir()) if f.is_file() and not f.name.startswith(".")]
+            ours = [f for f in files if rocklab_wrote(f)]
+            if skipped is not None:
+                skipped += ours
+            items += [(f, "") for f in files if f not in ours]
         else:
             items.append((p, "" if p.is_file() else f"{p}: not found; check the path"))
     if list_file is not None:

@@ -30,17 +30,64 @@ def _skip_mag(col: str) -> bool:
     return not str(col).strip().lower().startswith("magnetometer")
 
 
+#: First bytes of the files an IMU log is most often mistaken for (named in the error).
+_MAGIC = (
+    (b"\x89PNG", "a PNG image"),
+    (b"\xff\xd8\xff", "a JPEG image"),
+    (b"GIF8", "a GIF image"),
+    (b"%PDF", "a PDF document"),
+    (b"PK\x03\x04", "a ZIP archive (or an .xlsx workbook)"),
+    (b"\x1f\x8b", "a gzip archive"),
+    (b"\x1a\x45\xdf\xa3", "a Matroska/WebM film"),
+    (b"RIFF", "a RIFF file (AVI, WAV)"),
+)
+
+
+def _require_text(path: Path) -> None:
+    """:class:`InputError` naming ``path`` unless it starts as UTF-8 text (its first 64 kB): a
+    picture or a film given for a log is refused before any reading (a missing final newline
+    in an image is no truncated log)."""
+    import codecs
+
+    try:
+        with open(path, "rb") as fh:
+            head = fh.read(1 << 16)
+    except OSError:
+        return  # the reader reports a missing or unreadable file itself
+    if head.startswith((b"\xff\xfe", b"\xfe\xff")):
+        raise InputError(f'{where(path)}UTF-16 text; an IMU log is read as UTF-8: save it as UTF-8 ("CSV UTF-8")')
+    kind = next((k for magic, k in _MAGIC if head.startswith(magic)), None)
+    if kind is None and head[4:8] == b"ftyp":
+        kind = "an MP4/MOV film"
+    if kind is None and b"\x00" in head:
+        kind = "binary data"
+    if kind is None:
+        try:
+            codecs.getincrementaldecoder("utf-8")().decode(head, final=False)
+            return
+        except UnicodeDecodeError as e:
+            raise InputError(
+                f"{where(path)}not UTF-8 text (byte 0x{head[e.start]:02x} at offset {e.start}); an IMU log is "
+                "a CSV text file: save it as UTF-8"
+            ) from None
+    raise InputError(
+        f"{where(path)}{kind}, not a text file; an IMU log is a CSV text file (x-io exports: "
+        "<base>_CalInertialAndMag.csv, Inertial.csv, sensor_data.csv): give the log"
+    )
+
+
 def _read_csv(path: Path):
     """Parse a CSV with pandas' C parser; numeric errors name the first bad line.
 
     All-numeric files go through the numba scanner (``_imu_fastcsv``); the
     rest (text, NaN, malformed rows) through pandas.  Magnetometer columns
-    are dropped (unused).
+    are dropped (unused). A file that is not text is refused first (:func:`_require_text`).
     """
     import pandas as pd
 
     from ._fastcsv import parse_numeric_csv
 
+    _require_text(path)
     nrows = _complete_rows(path)
     fast = parse_numeric_csv(path) if path.is_file() and nrows is None else None
     if fast is not None:

@@ -178,7 +178,10 @@ def _resolve(path: Path) -> Path:
                 raise InputError(
                     f"{where(path)}{len(hits)} logs match {pat} ({hits[0].name}, {hits[1].name}, ...); give one file"
                 )
-        csvs = sorted(path.glob("*.csv"))
+        from ..._outdir import rocklab_wrote
+
+        # an output of an earlier `imu FOLDER -o FOLDER/theta.csv` is not a second log
+        csvs = [c for c in sorted(path.glob("*.csv")) if not rocklab_wrote(c)]
         if len(csvs) == 1:
             return csvs[0]
         raise InputError(

@@ -57,7 +57,7 @@ from ._motion import (axis_vector, cumtrapz, first_motion, forced_run, last_moti
                           motion_mask, moving_average, quat_mul, rownorm, still_acc_start,
                           tilt_about, twist_angle)
 from ._read import ImuLog
-from ._validity import RockingCheck, check_rocking, warn_not_rocking
+from ._validity import RockingCheck, check_rocking, warn_no_rest, warn_not_rocking
 
 __all__ = ["ImuRotation", "block_rotation", "ahrs_rotation", "ahrs_quaternions"]
 
@@ -315,6 +315,8 @@ def block_rotation(log: ImuLog, axis: str | None = None, *, release: str = "auto
     if rocking is not None and rocking.reasons:
         # a spinning or hand-held sensor: worse than any rest-window status
         status, msg = "suspect", warn_not_rocking(log.source, rocking) + ("; " + msg if msg else "")
+    elif status in ("no_rest_before", "no_rest_after"):  # theta unanchored: a coded warning (run shows it)
+        msg = warn_no_rest(log.source, status, t, i_move, i_end, min_rest_s)
     if axis is None:
         ref = th_start if abs(th_start) > np.deg2rad(1.0) else theta[np.argmax(np.abs(theta))]
         if ref < 0:

@@ -13,6 +13,10 @@ orientation measured at the rest before shaking, so any later turn of the
 sensor leaks ``2 g sin(turn / 2)`` into the "table acceleration"
 (``W-IMU-TABLE``).
 
+A log that does not start or end at rest leaves theta unanchored: the gyro bias
+and the starting tilt come from moving samples, or the drift is not held by a
+final rest (``W-IMU-NO-REST``).
+
 The bounds are module constants so tests can perturb them.
 """
 
@@ -137,3 +141,29 @@ def table_turn(t, gyro, bias, acc, f_rest, fs, min_rest) -> float:
         c = float(f1 @ f_rest) / (np.linalg.norm(f1) * np.linalg.norm(f_rest) + 1e-300)
         turn = max(turn, float(np.arccos(np.clip(c, -1.0, 1.0))))
     return turn
+
+
+#: A residual gyro drift (after the start rest's bias) that the W-IMU-NO-REST message converts
+#: into the angle it adds by the end of the log, rad/s.
+NO_REST_DRIFT_RAD_S = np.deg2rad(0.1)
+
+
+def warn_no_rest(source: str, status: str, t, i_move: int, i_end: int, min_rest_s: float) -> str:
+    """Emit ``W-IMU-NO-REST`` for a log without a rest before its first motion (``status``
+    ``"no_rest_before"``) or after its last (``"no_rest_after"``); returns its message."""
+    if status == "no_rest_before":
+        what = (
+            f"motion starts {t[min(i_move, len(t) - 1)] - t[0]:.3g} s into the log, before a {min_rest_s:g} s "
+            "rest: the gyro bias and the starting tilt come from the first 0.5 s, which move; theta0 and the "
+            "release are not measured (start the logger before the release)"
+        )
+    else:
+        span = float(t[-1] - t[0])
+        what = (
+            f"the log ends {t[-1] - t[min(i_end, len(t) - 1)]:.3g} s after the last motion, short of a "
+            f"{min_rest_s:g} s rest: the gyro drift is not held by a final rest, so theta is integrated "
+            f"from the start alone; a drift of {np.rad2deg(NO_REST_DRIFT_RAD_S):.2g} deg/s puts it "
+            f"{np.rad2deg(NO_REST_DRIFT_RAD_S) * span:.3g} deg off by the end ({span:.4g} s; keep logging "
+            "until the block has rested)"
+        )
+    return warn("W-IMU-NO-REST", f"{source}: {what}").message

@@ -221,6 +221,11 @@ def calibrate_stereo(film1, film2, board: dict | None = None) -> StereoRig:
     det1, size1 = _detect(film1, b, lost)
     det2, size2 = _detect(film2, b, lost)
     warn_lost(lost)
+    from ..video._checks import check_mirrored
+    from ..video._video import probe_video
+
+    for film in (film1, film2):
+        check_mirrored(probe_video(film), film)
     if len(det1) != len(det2):
         raise InputError(
             f"{where(film2)}{len(det2)} frames, but {Path(film1).name} has {len(det1)}; the two "

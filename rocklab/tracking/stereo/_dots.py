@@ -378,8 +378,11 @@ def check_films(film1, film2, rig: StereoRig, fps: float | None = None) -> float
     """The common frame rate of two films, or :class:`InputError` when they cannot be one test of ``rig``."""
     from ..video._video import probe_video
 
+    from ..video._checks import check_mirrored
+
     i1, i2 = probe_video(film1), probe_video(film2)
     for info, film in ((i1, film1), (i2, film2)):
+        check_mirrored(info, film)
         if (info.width_px, info.height_px) != tuple(rig.size):
             raise InputError(f"{where(film)}frame size {info.width_px}x{info.height_px} differs from the "
                              f"calibration's {rig.size[0]}x{rig.size[1]}; calibrate with films of this camera mode")

@@ -3,7 +3,7 @@ for: frames the container promised but did not give, objects lost on more than 1
 a tracker that follows another object; and short gaps filled when the config asks.
 
 Each finding is a named warning (``W-VIDEO-SHORT``, ``W-VIDEO-DROPPED``, ``W-VIDEO-DAMAGED``,
-``W-VIDEO-FPS``, ``W-VIDEO-LOST``, ``W-TRACK-LATCH``).
+``W-VIDEO-FPS``, ``W-VIDEO-LOST``, ``W-VIDEO-MIRRORED``, ``W-TRACK-LATCH``).
 """
 
 from __future__ import annotations
@@ -14,7 +14,7 @@ import numpy as np
 
 from ..._diagnostics import warn
 
-__all__ = ["TABLE_TURN_MAX_RAD", "BLUR_RATIO"]
+__all__ = ["TABLE_TURN_MAX_RAD", "BLUR_RATIO", "check_mirrored"]
 
 #: A lost target whose window's sharpness fell below this fraction of the last good one is "blur".
 BLUR_RATIO = 0.35
@@ -79,6 +79,7 @@ def _check_frames(res, expected: int, path, info=None) -> None:
             "did not decode (damaged packets); the frames around them keep their times, "
             "the gaps are in t_s",
         )
+    check_mirrored(info, path)
     _check_latch(res, path)
     for t in res.tracks:
         lost = int(np.sum(~np.isin(t.status, ("ok", "interpolated"))))
@@ -88,6 +89,23 @@ def _check_frames(res, expected: int, path, info=None) -> None:
                 f"{path}: object {t.object!r} lost on {lost} of {len(t.status)} frames "
                 f"({100 * lost / len(t.status):.3g} %); see the status column",
             )
+
+
+def check_mirrored(info, path) -> None:
+    """W-VIDEO-MIRRORED when the film's display matrix mirrors the picture: it is read as shown,
+    and whether the mirror undoes one (a camera that stores its picture mirrored) or adds one (a
+    front camera's selfie view, an editor's flip) only the lab knows; the sign of every angle
+    depends on it."""
+    if getattr(info, "mirrored", False):
+        r = info.rotation_deg
+        warn(
+            "W-VIDEO-MIRRORED",
+            f"{path}: the container's display matrix mirrors the picture (turn {r} deg, then a mirror); "
+            "the frames are tracked as shown, so theta has the sign of the mirrored picture; if the "
+            "mirror was added for display (front camera, an editor's flip), theta's sign is reversed: "
+            f"check it against the lab, or re-mux the film without the mirror (ffmpeg -display_rotation {r} "
+            "-i FILM -c copy OUT)",
+        )
 
 
 def _check_rate(given: float, info, path, where: str) -> None:

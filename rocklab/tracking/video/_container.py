@@ -1,6 +1,6 @@
 """What the container says and OpenCV does not, read with PyAV from the packets (no decoding but
 the first picture): each frame's presentation time, the pixel aspect ratio, the field order and
-the display rotation.
+the display matrix (a right-angle turn, possibly mirrored); and the grey picture of a decoded frame.
 
 Frame times are the container's, never a rate rounded from them. A container stores times in
 its own ticks (Matroska: 1 ms), so a constant 150 fps is stored as steps of 7, 7 and 6 ms; the
@@ -17,7 +17,19 @@ from fractions import Fraction
 
 import numpy as np
 
-__all__ = ["ContainerInfo", "container_info", "frame_clock", "shown_pts", "frame_rotation_deg"]
+__all__ = [
+    "ContainerInfo",
+    "container_info",
+    "frame_clock",
+    "shown_pts",
+    "frame_orientation",
+    "orient",
+    "UPRIGHT",
+    "luma",
+]
+
+#: The display matrix of a picture shown as stored (see :func:`frame_orientation`).
+UPRIGHT = (1, 0, 0, 1)
 
 #: FFmpeg's AVFieldOrder: TT and TB code/show the top field first, BB and BT the bottom one.
 _FIELD_ORDER = {2: "tff", 4: "tff", 3: "bff", 5: "bff"}
@@ -40,7 +52,7 @@ class ContainerInfo:
         Interlaced video: the field exposed first; None for progressive.
     rotation_deg : int
         Counter-clockwise turn that shows the stored picture upright (phones' display matrix):
-        0, 90, 180 or 270.
+        0, 90, 180 or 270 (before the mirroring, when ``mirrored``).
     rate_hz : float or None
         The constant clock the frames sit on (None: variable rate).
     n_dropped : int
@@ -50,6 +62,10 @@ class ContainerInfo:
     pts : ndarray (n,) of int64 or None
         The packets' presentation times in stream ticks, sorted: a decoded frame's index is its
         place here.
+    orientation : tuple of 4 int
+        The first frame's display matrix as a signed permutation (:func:`frame_orientation`).
+    stored_size_px : tuple (width, height) or None
+        Size of the pictures as coded (before the pixel aspect and the display matrix).
     """
 
     frame_times_s: np.ndarray | None = None
@@ -60,6 +76,24 @@ class ContainerInfo:
     n_dropped: int = 0
     n_header: int = 0
     pts: np.ndarray | None = None
+    orientation: tuple = UPRIGHT
+    stored_size_px: tuple | None = None
+
+    @property
+    def shown_size_px(self) -> tuple[int, int] | None:
+        """(width, height) of the pictures as read: square pixels along the stored rows, then the
+        display matrix's turn (a film turned by 90 deg has its non-square pixels tall upright)."""
+        if self.stored_size_px is None:
+            return None
+        w, h = self.stored_size_px
+        w = int(round(w * self.pixel_aspect)) if abs(self.pixel_aspect - 1.0) > 1e-6 else w
+        return (h, w) if self.orientation[0] == 0 else (w, h)
+
+    @property
+    def mirrored(self) -> bool:
+        """Whether the display matrix mirrors the picture (its determinant is negative)."""
+        a, b, c, d = self.orientation
+        return a * d - b * c < 0
 
 
 def frame_clock(t_s: np.ndarray, tick_s: float, rates=()) -> tuple[np.ndarray, float | None, int]:
@@ -122,13 +156,69 @@ def shown_pts(container, stream) -> np.ndarray:
     return np.sort(np.asarray([p.pts for p in container.demux(stream) if _shown(p)], np.int64))
 
 
-def frame_rotation_deg(frame) -> int:
-    """The counter-clockwise turn (0, 90, 180, 270 deg) the frame's display matrix asks for."""
+def frame_orientation(frame) -> tuple[int, int, int, int]:
+    """The frame's display matrix as a signed permutation ``(a, b, c, d)``.
+
+    A stored pixel ``(p, q)`` (x right, y down) is shown at ``x' = a p + c q``, ``y' = b p + d q``
+    (FFmpeg's convention, translation aside): a right-angle turn, possibly mirrored, as phones and
+    editors write them. :data:`UPRIGHT` when the frame carries none; a matrix that is not a
+    right-angle turn is taken as the nearest one.
+    """
     try:
-        r = frame.rotation
+        sd = frame.side_data.get("DISPLAYMATRIX")
+        if sd is None:
+            return UPRIGHT
+        m = np.frombuffer(bytes(sd), np.int32)[[0, 1, 3, 4]].astype(float)
     except Exception:  # noqa: BLE001 - no display matrix readable: shown as stored
-        return 0
-    return int(round((r or 0) / 90.0)) % 4 * 90
+        return UPRIGHT
+    a, b, c, d = (int(np.sign(v)) for v in m)
+    if abs(m[0]) + abs(m[3]) >= abs(m[1]) + abs(m[2]):
+        return (a or 1, 0, 0, d or 1)
+    return (0, b or 1, c or 1, 0)
+
+
+def orient(img: np.ndarray, orientation) -> np.ndarray:
+    """The stored picture ``img`` (rows, columns[, channels]) as its display matrix shows it."""
+    a, b, c, d = orientation
+    if (a, b, c, d) == UPRIGHT:
+        return img
+    if a == 0:  # the turn swaps the axes: shown row = b p, shown column = c q
+        img = np.swapaxes(img, 0, 1)
+        rows, cols = b, c
+    else:
+        rows, cols = d, a
+    return np.ascontiguousarray(img[:: -1 if rows < 0 else 1, :: -1 if cols < 0 else 1])
+
+
+def rotation_deg(orientation) -> int:
+    """The counter-clockwise turn (0, 90, 180, 270 deg) of a display matrix (before its mirroring)."""
+    a, b, c, d = orientation
+    if a * d - b * c < 0:  # mirrored left-right after the turn: undo the mirror of the x' column
+        a, c = -a, -c
+    return {(1, 0): 0, (0, -1): 90, (-1, 0): 180, (0, 1): 270}[(a, b)]
+
+
+#: 8-bit pixel formats whose first plane is the luma picture itself (grey needs no conversion)
+_LUMA_FORMATS = frozenset(
+    "yuv420p yuvj420p yuv422p yuvj422p yuv444p yuvj444p yuv411p yuvj411p yuv440p yuvj440p nv12 nv21 nv16 gray".split()
+)
+#: limited-range luma (16..235) stretched to 0..255, as OpenCV's YUV -> BGR -> grey path does
+_STRETCH = np.clip(np.round((np.arange(256) - 16.0) * 255.0 / 219.0), 0, 255).astype(np.uint8)
+
+
+def luma(frame) -> np.ndarray:
+    """The grey picture of a decoded PyAV frame: its luma plane, full range, shape (height, width)."""
+    name = frame.format.name
+    if name not in _LUMA_FORMATS:
+        return frame.to_ndarray(format="gray")
+    p = frame.planes[0]
+    y = np.frombuffer(p, np.uint8).reshape(-1, p.line_size)[: frame.height, : frame.width]
+    # full range where the pixel format or the frame's own tag says so (phones tag yuv420p "pc")
+    if name.startswith("yuvj") or name == "gray" or int(frame.color_range or 0) == 2:
+        return np.array(y)
+    import cv2
+
+    return cv2.LUT(y, _STRETCH)
 
 
 def container_info(path) -> ContainerInfo:
@@ -168,13 +258,15 @@ def container_info(path) -> ContainerInfo:
         return ContainerInfo()
     aspect = float(sar) if sar and float(sar) > 0 else 1.0
     order = _FIELD_ORDER.get(fo, "tff" if first is not None and first.interlaced_frame else None)
-    rot = frame_rotation_deg(first) if first is not None else 0
+    ori = frame_orientation(first) if first is not None else UPRIGHT
+    rot = rotation_deg(ori)
+    size = (int(first.width), int(first.height)) if first is not None else None
     if not pts or tb is None:
-        return ContainerInfo(None, aspect, order, rot, n_header=n_header)
+        return ContainerInfo(None, aspect, order, rot, n_header=n_header, orientation=ori, stored_size_px=size)
     q = np.sort(np.asarray(pts, np.int64))
     times, rate, dropped = frame_clock((q - q[0]) * float(tb), float(tb), rates)
     if not n_header and duration_s and rate:
         # Matroska and WebM count no frames but state the duration at the file's start: a file
         # cut short still claims its whole length
         n_header = int(round(duration_s * rate))
-    return ContainerInfo(times, aspect, order, rot, rate, dropped, n_header, q)
+    return ContainerInfo(times, aspect, order, rot, rate, dropped, n_header, q, ori, size)

@@ -12,7 +12,7 @@ splitting the fields ("bob"): twice the frame rate, each field brought to full h
 rows, so a rocking block is sampled at 50 Hz without combing.
 
 Frames are decoded with PyAV (OpenCV only where PyAV cannot open the file, e.g. image
-sequences), turned upright by the display matrix as OpenCV would, each frame indexed by its
+sequences), shown as the display matrix says (turned, and mirrored), each frame indexed by its
 packet: a packet that does not decode is skipped and counted, the frames after it keep their
 places and times. Decoding runs in a background thread (FFmpeg releases the GIL) so it overlaps
 with detection on a second core.
@@ -30,7 +30,7 @@ from pathlib import Path
 import numpy as np
 
 from ..._errors import InputError
-from ._container import container_info, frame_rotation_deg, shown_pts
+from ._container import UPRIGHT, container_info, frame_orientation, luma, orient, shown_pts
 
 __all__ = ["VideoInfo", "probe_video", "iter_video_frames", "container_info"]
 
@@ -62,6 +62,9 @@ class VideoInfo:
         Slots of the container's constant clock with no frame (frames the camera dropped).
     n_header : int
         Frame count the container's header states (0 where it states none).
+    mirrored : bool
+        The display matrix mirrors the picture (after ``rotation_deg``): the frames are read as
+        shown, mirrored, so every angle has the sign of the mirrored picture (W-VIDEO-MIRRORED).
     """
 
     path: str
@@ -75,6 +78,7 @@ class VideoInfo:
     rotation_deg: int = 0
     n_dropped: int = 0
     n_header: int = 0
+    mirrored: bool = False
 
     @property
     def variable_rate(self) -> bool:
@@ -100,6 +104,7 @@ class VideoInfo:
             rotation_deg=self.rotation_deg,
             n_dropped=self.n_dropped,
             n_header=self.n_header,
+            mirrored=self.mirrored,
         )
 
 
@@ -136,31 +141,38 @@ def probe_video(path) -> VideoInfo:
     """
     import cv2
 
-    cap = _open(path)
-    try:
-        n = int(cap.get(cv2.CAP_PROP_FRAME_COUNT) or 0)
-        fps = float(cap.get(cv2.CAP_PROP_FPS) or 0.0)
-        ok, img = cap.read()
-        if not ok or img is None:
-            raise InputError(f"{path}: the video has no decodable frame (empty or corrupt); check the file")
-        h, w = img.shape[:2]
-    finally:
-        cap.release()
+    ci = container_info(path)
+    n, fps, size = 0, 0.0, None
+    try:  # OpenCV: count and rate where the packets have no times; image sequences
+        cap = _open(path)
+    except InputError:
+        if ci.stored_size_px is None:
+            raise
+        cap = None  # PyAV decodes what this OpenCV cannot (its FFmpeg may lack a decoder: AV1)
+    if cap is not None:
+        try:
+            n, fps = int(cap.get(cv2.CAP_PROP_FRAME_COUNT) or 0), float(cap.get(cv2.CAP_PROP_FPS) or 0.0)
+            ok, img = cap.read()
+            size = (img.shape[1], img.shape[0]) if ok and img is not None else None  # turned by OpenCV
+        finally:
+            cap.release()
+    if size is None and ci.stored_size_px is None:
+        raise InputError(f"{path}: the video has no decodable frame (empty or corrupt); check the file")
     # Image sequences report a nominal rate (or none); only trust real containers.
     if not np.isfinite(fps) or fps <= 0 or fps > 1e5 or "%" in str(path):
         fps = None
-    ci = container_info(path)
     times = ci.frame_times_s
     if times is not None and len(times) > 1:
         # count and rate from the packets: OpenCV's are estimates (a Matroska film's duration x a
         # rate rounded from its 1 ms ticks; a variable-rate phone film reports its time base)
         n = len(times)
         fps = ci.rate_hz or (n - 1) / float(times[-1] - times[0])
+    w, h = ci.shown_size_px or (_square_width(size[0], ci.pixel_aspect), size[1])
     return VideoInfo(
         str(path),
         max(n, 0),
         fps,
-        _square_width(int(w), ci.pixel_aspect),
+        int(w),
         int(h),
         ci.pixel_aspect,
         times,
@@ -168,6 +180,7 @@ def probe_video(path) -> VideoInfo:
         ci.rotation_deg,
         ci.n_dropped,
         ci.n_header,
+        ci.mirrored,
     )
 
 
@@ -193,35 +206,13 @@ def _to_gray(img):
     return cv2.cvtColor(img, cv2.COLOR_BGR2GRAY)
 
 
-#: 8-bit pixel formats whose first plane is the luma picture itself (grey needs no conversion)
-_LUMA_FORMATS = frozenset(
-    "yuv420p yuvj420p yuv422p yuvj422p yuv444p yuvj444p yuv411p yuvj411p yuv440p yuvj440p nv12 nv21 nv16 gray".split()
-)
-#: limited-range luma (16..235) stretched to 0..255, as OpenCV's YUV -> BGR -> grey path does
-_STRETCH = np.clip(np.round((np.arange(256) - 16.0) * 255.0 / 219.0), 0, 255).astype(np.uint8)
-
-
-def _luma(frame) -> np.ndarray:
-    """The grey picture of a decoded PyAV frame: its luma plane, full range, shape (height, width)."""
-    name = frame.format.name
-    if name not in _LUMA_FORMATS:
-        return frame.to_ndarray(format="gray")
-    p = frame.planes[0]
-    y = np.frombuffer(p, np.uint8).reshape(-1, p.line_size)[: frame.height, : frame.width]
-    # full range where the pixel format or the frame's own tag says so (phones tag yuv420p "pc")
-    if name.startswith("yuvj") or name == "gray" or int(frame.color_range or 0) == 2:
-        return np.array(y)
-    import cv2
-
-    return cv2.LUT(y, _STRETCH)
-
-
 class _PyAVReader:
     """``cv2.VideoCapture``'s ``read``/``release`` over PyAV's decoder, from frame ``first``.
 
     Pictures are BGR, or grey straight from the luma plane with ``gray`` (no colour conversion:
-    a third of OpenCV's decoding time at 1080p), turned upright by the frame's display matrix
-    (as OpenCV does). Every frame is placed by its presentation time among the packets':
+    a third of OpenCV's decoding time at 1080p), as stored: ``orientation`` is the last frame's
+    display matrix (:func:`._container.orient` shows it upright, after the pixels are made square).
+    Every frame is placed by its presentation time among the packets':
     ``index`` is the last frame's place, so a packet that fails to decode (counted in
     ``n_broken``) leaves a gap instead of shifting the frames after it, and so does every frame
     predicted from it up to the next key frame. A start past frame 0
@@ -234,6 +225,7 @@ class _PyAVReader:
         self._c = av.open(str(path))
         self._gray = gray
         self.n_broken = 0
+        self.orientation = UPRIGHT
         # the first and the last place lost to damage, until a key frame after it
         self._tainted, self._damage_end = None, -1
         self.index = int(first) - 1
@@ -328,9 +320,8 @@ class _PyAVReader:
         if f is None:
             return False, None
         self.index = self._place(f)
-        img = _luma(f) if self._gray else f.to_ndarray(format="bgr24")
-        k = frame_rotation_deg(f) // 90
-        return True, (np.ascontiguousarray(np.rot90(img, k)) if k else img)
+        self.orientation = frame_orientation(f)
+        return True, (luma(f) if self._gray else f.to_ndarray(format="bgr24"))
 
     def release(self):
         self._c.close()
@@ -431,13 +422,17 @@ def iter_video_frames(
                 i = getattr(cap, "index", i)  # PyAV places each frame by its time
                 if stop is not None and (2 * i if fields else i) >= stop:
                     return
+                # pixels made square and fields split on the stored rows, then the display matrix
                 img = _squared(img, pixel_aspect)
+                turn = getattr(cap, "orientation", UPRIGHT)
                 if fields:
                     for k, f in enumerate(_fields(img, fields)):
+                        f = orient(f, turn)
                         j = 2 * i + k
                         if j >= start and (stop is None or j < stop):
                             yield (j, _to_gray(f), f) if color else (j, _to_gray(f))
                 else:
+                    img = orient(img, turn)
                     yield (i, _to_gray(img), img) if color else (i, _to_gray(img))
                 i += 1
         finally:

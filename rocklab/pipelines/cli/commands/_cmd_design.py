@@ -194,7 +194,10 @@ def _run_oas_batch(args, kw) -> int:
     from ...._io import write_frame_atomic
     from ...spectra._spectra_batch import expand_records, oas_table
 
-    items = expand_records(args.record, args.list)
+    skipped: list = []
+    items = expand_records(args.record, args.list, skipped)
+    for f in skipped:
+        sys.stderr.write(f"rocklab oas: not reading {f}: an output rocklab wrote (name it to read it as a record)\n")
     if not items:
         raise InputError(f"rocklab oas: no records in {', '.join(args.record) or args.list}; give record files")
     for _, _, err in items:

@@ -15,6 +15,8 @@ from __future__ import annotations
 
 import sys
 
+from ...reports._format import sig
+
 
 def register(sub):
     """Add this module's subcommand(s) to the ``rocklab`` parser ``sub``."""
@@ -87,27 +89,30 @@ def run(args) -> int:
     out = sys.stdout
     out.write(
         f"{summary['source']}: {summary['format']}, {summary['n_samples']} samples at "
-        f"{summary['sample_rate_hz']:g} Hz, {summary['dropped_samples']} dropped\n"
+        f"{sig(summary['sample_rate_hz'], 6)} Hz, {summary['dropped_samples']} dropped\n"
     )
     from ...._diagnostics import collected, worst_status
 
-    status = worst_status(res.status, collected())
+    diags = collected()
+    status = worst_status(res.status, diags)
     if args.table:
-        d = summary["direction"]
         out.write(
-            f"table acceleration along sensor ({d[0]:+.3f}, {d[1]:+.3f}, {d[2]:+.3f}): peak "
-            f"{summary['pga_m_s2']:.3f} m/s2, gravity removed in the orientation of the rest "
+            f"table acceleration along sensor {_vec(summary['direction'])}: peak "
+            f"{sig(summary['pga_m_s2'])} m/s2, gravity removed in the orientation of the rest "
             f"{summary['rest_s'][0]:.3f}-{summary['rest_s'][1]:.3f} s (sensor tilt "
-            f"{math.degrees(summary['tilt_rad']):.2f} deg); the sensor turned by "
-            f"{math.degrees(summary['turn_rad']):.3g} deg\n"
+            f"{sig(math.degrees(summary['tilt_rad']))} deg); the sensor turned by "
+            f"{sig(math.degrees(summary['turn_rad']))} deg\n"
         )
     else:
         out.write(_block_text(res))
     out.write(f"status {status}: {_STATUS_MEANING.get(status, '')}\n")
-    if res.message:
-        out.write(f"  {res.message}\n")
+    msg = res.message
+    for d in diags:  # a warning's text is on stderr with its code: named here, not repeated
+        msg = msg.replace(d.message, f"{d.code} (above)")
+    if msg:
+        out.write(f"  {msg}\n")
     if args.ahrs and not args.table:
-        out.write(f"AHRS vs gyro integration: RMS difference {math.degrees(summary['ahrs_rms_diff_rad']):.3f} deg\n")
+        out.write(f"AHRS vs gyro integration: RMS difference {sig(math.degrees(summary['ahrs_rms_diff_rad']))} deg\n")
     for k in ("output", "plot"):
         if k in summary:
             out.write(f"wrote {summary[k]}\n")
@@ -123,6 +128,11 @@ _STATUS_MEANING = {
 }
 
 
+def _vec(v) -> str:
+    """A unit vector as ``(+0.2012, -0.3614, 0)`` (4 significant digits, signed, never -0)."""
+    return "(" + ", ".join(("+" if float(sig(x)) > 0 else "") + sig(x) for x in v) + ")"
+
+
 def _block_text(res) -> str:
     import math
 
@@ -131,23 +141,29 @@ def _block_text(res) -> str:
     a = res.axis
     k = int(np.argmax(np.abs(a)))
     name = ("+" if a[k] > 0 else "-") + "xyz"[k]
-    line = f"rocking axis ~{name} ({a[0]:+.3f}, {a[1]:+.3f}, {a[2]:+.3f}) in the sensor frame"
+    line = f"rocking axis ~{name} {_vec(a)} in the sensor frame"
     rk = res.rocking
     if rk is not None and math.isfinite(rk.axis_tilt_rad):
         line += (
-            f", {math.degrees(rk.axis_tilt_rad):.3g} deg above the horizontal, "
-            f"{100 * rk.axis_share:.3g} % of the rotation about it"
+            f", {sig(math.degrees(rk.axis_tilt_rad))} deg above the horizontal, "
+            f"{sig(100 * rk.axis_share)} % of the rotation about it"
         )
-    b = ", ".join(f"{math.degrees(v):.3f}" for v in res.gyro_bias_rad_s)
-    line += f"\ngyro bias [{b}] deg/s, residual drift {math.degrees(res.drift_rad_s):.3g} deg/s\n"
+    b = ", ".join(sig(math.degrees(v)) for v in res.gyro_bias_rad_s)
+    # the drift is anchored by the final rest; without one none is estimated (not a drift of 0)
+    drift = (
+        f"{sig(math.degrees(res.drift_rad_s))} deg/s"
+        if math.isfinite(res.rest_t_s)
+        else "not estimated (no final rest)"
+    )
+    line += f"\ngyro bias [{b}] deg/s, residual drift {drift}\n"
     th = np.rad2deg(res.theta_rad)
     if res.run_kind == "forced":
         line += "forced run (table moved before the block turned): upright = the rest at the start"
     elif math.isfinite(res.release_t_s):
-        line += f"release at {res.release_t_s:.4f} s from theta0 {math.degrees(res.theta0_rad):.3f} deg"
+        line += f"release at {res.release_t_s:.4f} s from theta0 {sig(math.degrees(res.theta0_rad))} deg"
     else:
         line += "no release found"
-    line += f"; theta from {th.min():.3g} to {th.max():.3g} deg"
+    line += f"; theta from {sig(th.min())} to {sig(th.max())} deg"
     line += f"; final rest from {res.rest_t_s:.3f} s\n" if math.isfinite(res.rest_t_s) else "; no final rest\n"
     imp = res.impact_t_s
     if len(imp):

@@ -45,10 +45,13 @@ def atomic_path(path, suffix: str | None = None, *, side: bool = False, stamp: b
         umask = os.umask(0)
         os.umask(umask)
         os.chmod(tmp, 0o666 & ~umask)
-        if stamp:
-            stamp_output(tmp)
+        # the extended attribute moves with the file; a stamp kept in the cache folder is named by
+        # the final path, and made only once the file it replaces has been judged
+        stamped = stamp and stamp_output(tmp, registry=False)
         kept = set_aside_user_file(path) if side else None
         os.replace(tmp, path)
+        if stamp and not stamped:
+            stamp_output(path)
         if kept is not None:
             import sys
 

@@ -128,28 +128,68 @@ def _digest(path) -> bytes:
     return h.hexdigest().encode()
 
 
-def stamp_output(path) -> None:
+def _stamp_entry(path) -> Path:
+    """Where the stamp of ``path`` is kept when its file system holds no extended attributes: one
+    small file per output under the user's cache folder (``$XDG_CACHE_HOME`` or ``~/.cache``),
+    named by a digest of the output's real path, so nothing is written beside the user's files."""
+    import hashlib
+
+    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    key = hashlib.blake2b(os.fsencode(os.path.realpath(path)), digest_size=16).hexdigest()
+    return Path(base) / "rocklab" / "output-stamps" / key
+
+
+def stamp_output(path, registry: bool = True) -> bool:
     """Mark the file ``path`` as rocklab's output: its content digest in the extended attribute
     :data:`STAMP_XATTR`.
 
     A file rocklab writes beside the user's files (``-o`` into a folder of inputs, side files) is
     known as rocklab's by this stamp rather than by a marker file, so nothing but the outputs asked
     for is written into the user's folders. Where the file system keeps no extended attributes the
-    file stays unmarked and later counts as the user's (kept, never overwritten).
+    digest goes to :func:`_stamp_entry` in the user's cache folder; where that cannot be written
+    either, the file stays unmarked and later counts as the user's (kept, never overwritten).
+
+    Parameters
+    ----------
+    registry : bool
+        Whether to fall back on the cache folder (False for a temporary file about to be renamed:
+        the entry is named by the path, which the extended attribute is not).
+
+    Returns
+    -------
+    bool
+        Whether the stamp was made.
     """
+    digest = _digest(path)
     try:
-        os.setxattr(path, STAMP_XATTR, _digest(path))
+        os.setxattr(path, STAMP_XATTR, digest)
+        return True
     except (AttributeError, OSError):  # no extended attributes on this system or file system
-        pass
+        if not registry:
+            return False
+    entry = _stamp_entry(path)
+    try:
+        entry.parent.mkdir(parents=True, exist_ok=True)
+        tmp = entry.with_name(f".{entry.name}.{os.getpid()}")
+        tmp.write_bytes(digest)
+        os.replace(tmp, entry)
+    except OSError:
+        return False
+    return True
 
 
 def rocklab_wrote(path) -> bool:
     """Whether the file ``path`` is an output rocklab wrote and nobody changed since (its stamp,
     :func:`stamp_output`, matches its content). A symlink is never rocklab's."""
+    if os.path.islink(path):
+        return False
     try:
         stamp = os.getxattr(path, STAMP_XATTR, follow_symlinks=False)
     except (AttributeError, OSError):
-        return False
+        try:
+            stamp = _stamp_entry(path).read_bytes()
+        except OSError:
+            return False
     try:
         return stamp == _digest(path)
     except OSError:

@@ -295,3 +295,33 @@ def test_imu_output_in_its_log_folder_is_not_read_back(tmp_path, run_cli):
         assert rc == 0, err
         assert sorted(_listing(log)) == ["mylog.csv", "theta.csv"] and _listing(log)["mylog.csv"] == inputs["mylog.csv"]
         assert pd.read_csv(log / "theta.csv")["t_s"].size > 100
+
+
+def test_stamps_live_in_the_cache_folder_where_files_hold_no_extended_attributes(tmp_path, monkeypatch):
+    """Without user extended attributes (tmpfs on older kernels, some network shares) a side file
+    rocklab wrote is still known as its own: replaced by the next run with no .user- copy, and
+    nothing written beside it; an edited one is the user's again."""
+    from rocklab._io import write_text_atomic
+    from rocklab._outdir import rocklab_wrote
+
+    def unsupported(*a, **k):
+        raise OSError(95, "Operation not supported")
+
+    monkeypatch.setattr(os, "setxattr", unsupported)
+    monkeypatch.setattr(os, "getxattr", unsupported)
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+    folder = tmp_path / "data"
+    folder.mkdir()
+    out = folder / "audit.json"
+    for k in range(3):
+        write_text_atomic(out, f'{{"run": {k}}}', side=True)
+        assert rocklab_wrote(out)
+        assert sorted(p.name for p in folder.iterdir()) == ["audit.json"]
+    out.write_text('{"run": "mine"}')
+    assert not rocklab_wrote(out)
+    write_text_atomic(out, '{"run": 3}', side=True)
+    kept = [p for p in folder.iterdir() if ".user-" in p.name]
+    assert [p.read_text() for p in kept] == ['{"run": "mine"}'] and out.read_text() == '{"run": 3}'
+    link = folder / "link.json"
+    link.symlink_to(out)
+    assert not rocklab_wrote(link)

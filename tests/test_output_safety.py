@@ -232,25 +232,9 @@ def _listing(folder):
     return {p.name: p.read_bytes() for p in folder.iterdir()}
 
 
-def _needs_stamps(folder):
-    """Skip unless files in ``folder`` can carry rocklab's output stamp (a user extended attribute:
-    without one a file rocklab wrote counts as the user's and is kept beside the new one)."""
-    import os
-
-    probe = folder / ".xattr-probe"
-    probe.write_bytes(b"")
-    try:
-        os.setxattr(probe, "user.rocklab.probe", b"1")
-    except (AttributeError, OSError) as e:
-        pytest.skip(f"this file system cannot hold user extended attributes ({e}); the stamp needs them")
-    finally:
-        probe.unlink()
-
-
 def test_oas_output_in_its_record_folder_is_not_read_back(tmp_path, run_cli):
     """`oas recs/ -o recs/tI.csv` twice: the second run read tI.csv (and tI.parquet) as records;
     the first left a .rocklab-output marker in the user's record folder."""
-    _needs_stamps(tmp_path)
     import shutil
 
     from test_fuzz_corpus import _two_records
@@ -284,7 +268,6 @@ def test_oas_output_in_its_record_folder_is_not_read_back(tmp_path, run_cli):
 
 def test_imu_output_in_its_log_folder_is_not_read_back(tmp_path, run_cli):
     """`imu LOG/ -o LOG/theta.csv` twice: the second run took theta.csv for a second log (or refused)."""
-    _needs_stamps(tmp_path)
     from test_fuzz_corpus import _imu_folder
 
     log = _imu_folder(tmp_path)

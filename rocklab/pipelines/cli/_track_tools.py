@@ -166,7 +166,8 @@ def _proposal_notes(props, window_s) -> list:
     if props.table_edge is not None:
         e = props.table_edge
         what = (
-            'it moves: the table is an object, its top edge levels the angles (level = "table")'
+            'it moves: the table is an object, its top edge levels the angles (level = "table"); its '
+            "velocity and acceleration need a metric scale: set reference.m_per_px (W-TABLE-MOTION otherwise)"
             if props.table_moves
             else 'it stays still: level = "line" through it (a shake table: add --table x,y,w,h)'
         )
@@ -234,8 +235,11 @@ def draw_init_preview(img, cfg, found, grid: bool = False):
         if o.roi is not None:
             x, y, w, h = (int(round(v)) for v in o.roi)
             col = _COLOURS[k % len(_COLOURS)]
-            cv2.rectangle(out, (x, y), (x + w, y + h), col, 2)
-            cv2.putText(out, o.id, (x, max(y - 6, 10)), cv2.FONT_HERSHEY_SIMPLEX, 0.5, col, 1, cv2.LINE_AA)
+            s = max(1.0, out.shape[1] / 960)  # readable on a 1080p frame too
+            cv2.rectangle(out, (x, y), (x + w, y + h), col, int(round(2 * s)))
+            cv2.putText(
+                out, o.id, (x, max(y - int(6 * s), 10)), cv2.FONT_HERSHEY_SIMPLEX, 0.5 * s, col, int(s), cv2.LINE_AA
+            )
             if o.kind == "table" and not o.markers:
                 _draw_top_edge(out, img, cfg, o)
     return out

@@ -44,6 +44,11 @@ MAX_FRACTION = 0.5
 #: inside its region is at least this many times the frame's median gradient (a soft shadow
 #: sweeping the wall changes as much as an object but has neither).
 MIN_STRUCTURE = 10.0
+#: A table's top edge: its mean vertical gradient (Sobel, smoothed along the rows) at least this
+#: many times the frame's median and at least ``MIN_EDGE`` (a 4 grey-level step); rendered tables
+#: give 72-168, a lighting gradient on a plain wall 1.2.
+EDGE_CONTRAST = 20.0
+MIN_EDGE = 16.0
 #: Gaps closed inside a region, and regions merged, within this fraction of the frame's short side.
 CLOSE_FRACTION = 0.02
 
@@ -59,7 +64,7 @@ class Proposals:
     table : (x, y, w, h) or None
         A region round the table's top edge (for a markerless ``table`` object), px.
     table_moves : bool
-        More than a fifth of the table's region moves (a shake table): the table is an object
+        More than a fifth of the table's region changes in some sample (a shake table): the table is an object
         to track, not only a level line.
     table_edge : TopEdge or None
         The edge found there (angle, 1-sigma, the span followed).
@@ -108,7 +113,7 @@ def _merge(boxes, gap):
     return boxes
 
 
-def moving_boxes(first_gray, samples, full_mask: bool = False) -> tuple[list, int]:
+def moving_boxes(first_gray, samples, masks: bool = False) -> tuple[list, int]:
     """Boxes round what moves, where it is in the first frame.
 
     Parameters
@@ -117,9 +122,9 @@ def moving_boxes(first_gray, samples, full_mask: bool = False) -> tuple[list, in
     samples : sequence of ndarray (H, W) uint8
         Later frames (a few dozen spread over the first seconds).
 
-    full_mask : bool
-        Return ``(mask, scale, n_moving)`` instead: the moving pixels of the first frame (uint8
-        0/1) at ``scale`` times the frame's size.
+    masks : bool
+        Return ``(changed, scale)`` instead: per sample in which something moves, the pixels that
+        differ from the first frame (bool), at ``scale`` times the frame's size.
 
     Returns
     -------
@@ -137,20 +142,18 @@ def moving_boxes(first_gray, samples, full_mask: bool = False) -> tuple[list, in
         d = _prepare(s, scale) - f0
         diffs.append(np.abs(d - float(np.median(d))))
     if not diffs:
-        return (None, scale, 0) if full_mask else ([], 0)
+        return ([], scale) if masks else ([], 0)
     # static pixels dominate every difference: their median is the noise (|N(0, s sqrt 2)| median
     # = 0.954 s)
     sigma = float(np.median([np.median(d) for d in diffs])) / 0.954
     thr = max(DIFF_SIGMAS * sigma, MIN_DIFF_DN)
     n_px = f0.size
-    masks = [d > thr for d in diffs]
-    moving = [m for m in masks if m.sum() >= MIN_FRACTION * n_px]
+    moving = [m for m in (d > thr for d in diffs) if m.sum() >= MIN_FRACTION * n_px]
+    if masks:
+        return moving, scale
     if not moving:
-        return (None, scale, 0) if full_mask else ([], 0)
-    frac = np.mean(moving, axis=0)
-    mask = (frac >= MOVING_FRACTION).astype(np.uint8)
-    if full_mask:
-        return mask, scale, len(moving)
+        return [], 0
+    mask = (np.mean(moving, axis=0) >= MOVING_FRACTION).astype(np.uint8)
     k = max(3, int(round(CLOSE_FRACTION * min(f0.shape))) | 1)
     mask = cv2.morphologyEx(mask, cv2.MORPH_OPEN, np.ones((3, 3), np.uint8))
     mask = cv2.morphologyEx(mask, cv2.MORPH_CLOSE, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (k, k)))
@@ -179,7 +182,8 @@ def find_table_below(first_gray, box):
 
     The edge is searched in rows within 15 % of the block's height of its bottom, beside the block
     (the wider side), the topmost row at least half as strong as the strongest; accepted when followed over at least twice the block's
-    width, at less than 10 degrees, with a contrast at least 4 times the frame's median gradient.
+    width, at less than 10 degrees, with a contrast of at least :data:`EDGE_CONTRAST` times the
+    frame's median vertical gradient and :data:`MIN_EDGE`.
     """
     import cv2
 
@@ -199,7 +203,7 @@ def find_table_below(first_gray, box):
         return None
     prof = np.abs(gy[v_lo:v_hi, u0:u1]).mean(axis=1)
     v_edge = v_lo + int(np.argmax(prof >= 0.5 * prof.max()))
-    if prof.max() < 4.0 * noise:
+    if prof.max() < max(EDGE_CONTRAST * noise, MIN_EDGE):
         return None
     pad = max(4, int(round(0.05 * h)))
     depth = max(2 * pad, int(round(0.3 * h)))
@@ -246,7 +250,8 @@ def propose_objects(first_gray, samples) -> Proposals:
                 continue
             kept.append((x, y, w, float(min(y + h, math.ceil(v_top + 2)) - y)))
         boxes = kept
-        mask, scale, _ = moving_boxes(first_gray, samples, full_mask=True)
+        # a shake table moves and comes back: changed in any sample, not in most
+        changed, scale = moving_boxes(first_gray, samples, masks=True)
         x, y, w, h = (int(round(v * scale)) for v in table)
-        moves = mask is not None and float(mask[y : y + max(h, 1), x : x + max(w, 1)].mean()) > 0.2
+        moves = any(float(m[y : y + max(h, 1), x : x + max(w, 1)].mean()) > 0.2 for m in changed)
     return Proposals(tuple(boxes), table, edge, moves, len(samples), n_moving)

@@ -38,8 +38,9 @@ def _samples(video, info, window_s):
     """Grey frames spread over the first ``window_s`` seconds after the first (decoded in one pass)."""
     from ...tracking.video._video import iter_video_frames
 
-    n = info.n_frames or 0
-    stop = int(round(window_s * (info.fps or 50.0)))
+    per = 2 if info.field_order is not None else 1  # a deinterlaced film yields two fields a frame
+    n = per * (info.n_frames or 0)
+    stop = int(round(window_s * per * (info.fps or 50.0)))
     stop = min(stop, n) if n else stop
     step = max(1, (stop - 1) // PROPOSE_SAMPLES)
     return [

@@ -96,14 +96,14 @@ def test_regions_without_a_table_level_by_the_final_rest(free, tmp_path, run_cli
     assert _theta_rms_deg(tmp_path / "r.csv", free) <= 0.6
 
 
-def _scene(n=30, size=(240, 320), shadow=False, square=True, flicker=0.0, seed=0):
-    """A smooth wall with sensor noise; a textured 40x40 square moving right from (100, 60) after
-    frame 5; optionally a soft dark blob sweeping the wall and a frame-wide exposure flicker."""
+def _scene(n=30, size=(240, 320), shadow=False, square=True, flicker=0.0, seed=0, side=40, speed=4):
+    """A smooth wall with sensor noise; a textured ``side`` px square moving right from (100, 60)
+    at ``speed`` px a frame after frame 5; optionally a soft dark blob sweeping the wall and a frame-wide exposure flicker."""
     rng = np.random.default_rng(seed)
     H, W = size
     yy, xx = np.mgrid[0:H, 0:W]
     wall = 110 + 30 * xx / W + 10 * yy / H
-    tex = rng.uniform(40, 220, (40, 40))
+    tex = rng.uniform(40, 220, (side, side))
     frames = []
     for k in range(n):
         f = wall.copy()
@@ -111,8 +111,8 @@ def _scene(n=30, size=(240, 320), shadow=False, square=True, flicker=0.0, seed=0
             cx = 40 + 6 * k
             f -= 25 * np.exp(-((xx - cx) ** 2 + (yy - 150) ** 2) / (2 * 30.0**2))
         if square:
-            x0 = 100 + 4 * max(k - 5, 0)
-            f[60:100, x0 : x0 + 40] = tex
+            x0 = 100 + speed * max(k - 5, 0)
+            f[60 : 60 + side, x0 : x0 + side] = tex
         f = f * (1 + flicker * np.sin(k)) + rng.normal(0, 1.5, f.shape)
         frames.append(np.clip(f, 0, 255).astype(np.uint8))
     return frames
@@ -153,6 +153,25 @@ def test_nothing_moves_is_one_line_and_writes_the_grid(tmp_path, run_cli):
     img = cv2.imread(str(tmp_path / "t_init.png"), cv2.IMREAD_GRAYSCALE)
     # grid lines every 50 px (white), none between them
     assert np.mean(img[30:, 50] > 240) > 0.9 and np.mean(img[30:, 75] > 240) < 0.1
+
+
+@pytest.mark.parametrize("side, speed, width, large", [(40, 4, 320, False), (130, 12, 560, True)])
+def test_a_large_proposal_is_said(tmp_path, run_cli, side, speed, width, large):
+    """A moving square of 2 % of the frame is proposed plainly; one of 12.6 % is proposed with a
+    note that it is likely several things merged (a hand and its shadow)."""
+    import cv2
+
+    v = tmp_path / "sq.avi"
+    w = cv2.VideoWriter(str(v), cv2.VideoWriter_fourcc(*"FFV1"), 25.0, (width, 240))
+    for f in _scene(n=30, size=(240, width), side=side, speed=speed):
+        w.write(cv2.cvtColor(f, cv2.COLOR_GRAY2BGR))
+    w.release()
+    rc, out, err = run_cli("track", "init", v, "-o", tmp_path / "t.toml", "--json")
+    assert rc == 0, err
+    d = json.loads(out)
+    box = [float(x) for x in d["proposed"][0].split("=")[1].split(",")]
+    assert len(d["proposed"]) == 1 and np.allclose(box, (100, 60, side, side), atol=3)
+    assert any("of the frame: likely several things" in n for n in d["notes"]) == large
 
 
 def test_preview_tracks_only_its_span(free, tmp_path, run_cli, monkeypatch):

@@ -129,7 +129,7 @@ def track_init(video, out, *, objects=(), table=None, marker_size_m=None, previe
             proposed = tuple(f"--object {n}={_box_text(b)}" for n, b in regions.items())
             if troi is not None:
                 proposed += (f"--table {_box_text(troi)}",)
-            pnotes = _proposal_notes(props, window)
+            pnotes = _proposal_notes(props, window, gray.size)
     cfg, notes, found = suggest_config(
         gray,
         regions=regions or None,
@@ -158,12 +158,23 @@ def _box_text(b) -> str:
     return ",".join(f"{v:.0f}" for v in b)
 
 
-def _proposal_notes(props, window_s) -> list:
+#: A proposal larger than this share of the frame is likely several things merged.
+LARGE_PROPOSAL = 0.1
+
+
+def _proposal_notes(props, window_s, frame_px) -> list:
     notes = [
         f"PROPOSED, check before tracking: no marker found, so the objects are what moves in the first "
         f"{window_s:.3g} s ({props.n_moving} of {props.n_samples} frames compared with the first moved); "
         "see the preview, and re-run with --object NAME=x,y,w,h (and --table x,y,w,h) to correct them"
     ]
+    for k, (x, y, w, h) in enumerate(props.blocks, start=1):
+        if w * h > LARGE_PROPOSAL * frame_px:
+            notes.append(
+                f"PROPOSED block_{k} covers {100 * w * h / frame_px:.0f} % of the frame: likely several things that "
+                "move together (a hand, its shadow); draw the object's own box with --object block_"
+                f"{k}=x,y,w,h (a large region also tracks slowly)"
+            )
     if props.table_edge is not None:
         e = props.table_edge
         what = (

@@ -125,3 +125,18 @@ def test_markerless_table_edge_levels_a_camcorder_render_at_960x540(tmp_path, se
     assert edge.u_span_px[1] - edge.u_span_px[0] >= 3 * roi[2]
     assert abs(edge.angle_rad) <= math.radians(0.01) and abs(edge.angle_rad) <= 3 * edge.sigma_rad
     assert edge.sigma_rad < 0.5 * inside.sigma_rad
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_final_rest_in_tracking_noise(seed):
+    """A decaying rocking then 1.5 s of rest with white tracking noise (0.002 deg, a markerless
+    block's) is a rest of at least 1.4 s; the same film still rocking at the end has none."""
+    from rocklab.tracking.video._level import _final_rest
+
+    rng = np.random.default_rng(seed)
+    t = np.arange(150) / FPS
+    rocking = 0.2 * np.exp(-t) * np.cos(2 * np.pi * t / 0.4)
+    noise = rng.normal(0.0, math.radians(0.002), t.size)
+    rest = _final_rest(np.where(t < 1.5, rocking, 0.0) + noise, FPS)
+    assert rest is not None and rest.size >= 0.9 * 75 and rest[-1] == t.size - 1
+    assert _final_rest(rocking + noise, FPS) is None

@@ -28,8 +28,46 @@ def _first_frame(video: Path):
     raise InputError(f"{video}: no frame could be decoded; check the file")
 
 
+#: ``track init`` without markers compares frames over the first seconds (then, when nothing moves
+#: there, over a longer stretch), this many frames spread over each.
+PROPOSE_WINDOWS_S = (3.0, 12.0)
+PROPOSE_SAMPLES = 30
+
+
+def _samples(video, info, window_s):
+    """Grey frames spread over the first ``window_s`` seconds after the first (decoded in one pass)."""
+    from ...tracking.video._video import iter_video_frames
+
+    per = 2 if info.field_order is not None else 1  # a deinterlaced film yields two fields a frame
+    n = per * (info.n_frames or 0)
+    stop = int(round(window_s * per * (info.fps or 50.0)))
+    stop = min(stop, n) if n else stop
+    step = max(1, (stop - 1) // PROPOSE_SAMPLES)
+    return [
+        g
+        for i, g in iter_video_frames(video, 1, stop, pixel_aspect=info.pixel_aspect, fields=info.field_order)
+        if i % step == 0
+    ]
+
+
+def _propose(video, info, gray):
+    """Objects proposed from what moves; (Proposals, window s)."""
+    from ...tracking.video._propose import propose_objects
+
+    duration = (info.n_frames or 0) / (info.fps or 50.0)
+    for window in PROPOSE_WINDOWS_S:
+        props = propose_objects(gray, _samples(video, info, window))
+        if props.blocks or duration <= window:
+            break
+    return props, min(window, duration) if duration else window
+
+
 def track_init(video, out, *, objects=(), table=None, marker_size_m=None, preview=None, side=(False, False)):
     """Write a commented ``track.toml`` for ``video`` (and a preview PNG); returns (config, notes).
+
+    Without markers and without ``objects``, the objects that move in the first seconds and the
+    table they stand on are proposed (:mod:`rocklab.tracking.video._propose`), written as
+    markerless objects and drawn on the preview with a pixel grid.
 
     Parameters
     ----------
@@ -41,9 +79,22 @@ def track_init(video, out, *, objects=(), table=None, marker_size_m=None, previe
         Printed marker side, m, when markers are used.
     preview : path or None
         PNG with every detection, region and the level line drawn on the first frame.
+
+    Returns
+    -------
+    (TrackConfig, list of str, tuple)
+        The config, its notes, and the proposed objects as options (``--object NAME=x,y,w,h``,
+        ``--table x,y,w,h``; empty when nothing was proposed).
+
+    Raises
+    ------
+    InputError
+        Bad regions; no marker and nothing moving (the preview, a pixel grid on the first
+        frame, is written first so the regions can be read off it).
     """
     from ..._io import write_text_atomic
-    from ...tracking.video._init import parse_region, suggest_config
+    from ...tracking.video._init import find_markers, parse_region, suggest_config
+    from ..experiment._figures import save_bgr_png
 
     video, out = Path(video), Path(out)
     info, gray, img = _first_frame(video)
@@ -58,9 +109,37 @@ def track_init(video, out, *, objects=(), table=None, marker_size_m=None, previe
     troi = parse_region(table, "--table") if table is not None else None
     if marker_size_m is not None and not (math.isfinite(marker_size_m) and marker_size_m > 0):
         raise InputError(f"--marker-size {marker_size_m}: give the printed marker side in metres (> 0)")
+    found, proposed, pnotes, line = None, (), [], None
+    if not regions and troi is None:
+        found = find_markers(gray)
+        if found is None:
+            props, window = _propose(video, info, gray)
+            if not props.blocks:
+                if preview is not None:
+                    save_bgr_png(Path(preview), draw_grid(img), side=side[1])
+                raise InputError(
+                    f"{video}: no ArUco/AprilTag marker in the first frame and nothing moves in its first "
+                    f"{window:.3g} s; give the objects as --object NAME=x,y,w,h (and --table x,y,w,h)"
+                    + (f", read off the pixel grid in {preview}" if preview is not None else "")
+                )
+            regions = {f"block_{k}": b for k, b in enumerate(props.blocks, start=1)}
+            troi = props.table if props.table_moves else None
+            if props.table_edge is not None and not props.table_moves:
+                line = tuple(tuple(round(float(v), 1) for v in p) for p in props.table_edge.ends_px)
+            proposed = tuple(f"--object {n}={_box_text(b)}" for n, b in regions.items())
+            if troi is not None:
+                proposed += (f"--table {_box_text(troi)}",)
+            pnotes = _proposal_notes(props, window, gray.size)
     cfg, notes, found = suggest_config(
-        gray, regions=regions or None, table_roi=troi, fps=None if info.fps else 50.0, marker_size_m=marker_size_m
+        gray,
+        regions=regions or None,
+        table_roi=troi,
+        fps=None if info.fps else 50.0,
+        marker_size_m=marker_size_m,
+        found=found,
+        level_line_px=line,
     )
+    notes = pnotes + notes
     if not info.fps:
         notes.append("the container has no frame rate: fps = 50 written; correct it")
     head = [
@@ -71,17 +150,73 @@ def track_init(video, out, *, objects=(), table=None, marker_size_m=None, previe
     head += [f"# {n}" for n in notes]
     write_text_atomic(out, "\n".join(head) + "\n\n" + cfg.to_toml(), side=side[0])
     if preview is not None:
-        from ..experiment._figures import save_bgr_png
-
-        save_bgr_png(Path(preview), draw_init_preview(img, cfg, found), side=side[1])
-    return cfg, notes
+        save_bgr_png(Path(preview), draw_init_preview(img, cfg, found, grid=found is None), side=side[1])
+    return cfg, notes, proposed
 
 
-def draw_init_preview(img, cfg, found):
-    """The first frame (BGR) with markers (id, outline), regions and the level line drawn."""
+def _box_text(b) -> str:
+    return ",".join(f"{v:.0f}" for v in b)
+
+
+#: A proposal larger than this share of the frame is likely several things merged.
+LARGE_PROPOSAL = 0.1
+
+
+def _proposal_notes(props, window_s, frame_px) -> list:
+    notes = [
+        f"PROPOSED, check before tracking: no marker found, so the objects are what moves in the first "
+        f"{window_s:.3g} s ({props.n_moving} of {props.n_samples} frames compared with the first moved); "
+        "see the preview, and re-run with --object NAME=x,y,w,h (and --table x,y,w,h) to correct them"
+    ]
+    for k, (x, y, w, h) in enumerate(props.blocks, start=1):
+        if w * h > LARGE_PROPOSAL * frame_px:
+            notes.append(
+                f"PROPOSED block_{k} covers {100 * w * h / frame_px:.0f} % of the frame: likely several things that "
+                "move together (a hand, its shadow); draw the object's own box with --object block_"
+                f"{k}=x,y,w,h (a large region also tracks slowly)"
+            )
+    if props.table_edge is not None:
+        e = props.table_edge
+        what = (
+            'it moves: the table is an object, its top edge levels the angles (level = "table"); its '
+            "velocity and acceleration need a metric scale: set reference.m_per_px (W-TABLE-MOTION otherwise)"
+            if props.table_moves
+            else 'it stays still: level = "line" through it (a shake table: add --table x,y,w,h)'
+        )
+        notes.append(
+            f"PROPOSED table: a straight edge below the first block over columns {e.u_span_px[0]:.0f}-"
+            f"{e.u_span_px[1]:.0f} px at {math.degrees(e.angle_rad):+.2f} deg; {what}"
+        )
+    else:
+        notes.append("no table edge found below the moving objects")
+    return notes
+
+
+def draw_grid(img, step_px: int | None = None):
+    """``img`` (BGR or grey) with a pixel grid, lines every ``step_px`` (default 50 px, 100 px on
+    frames wider than 1000 px) labelled with their pixel coordinate, to read regions off."""
     import cv2
 
     out = img.copy() if img.ndim == 3 else cv2.cvtColor(img, cv2.COLOR_GRAY2BGR)
+    H, W = out.shape[:2]
+    step = int(step_px or (100 if W > 1000 else 50))
+    scale = max(0.35, W / 1800)
+    for k, n in ((0, W), (1, H)):
+        for p in range(step, n, step):
+            a, b = ((p, 0), (p, H - 1)) if k == 0 else ((0, p), (W - 1, p))
+            cv2.line(out, a, b, (255, 255, 255), 1, cv2.LINE_4)
+            at = (p + 2, int(14 * scale / 0.35)) if k == 0 else (2, p - 3)
+            for col, th in (((0, 0, 0), 3), ((255, 255, 255), 1)):  # white on a dark halo: readable anywhere
+                cv2.putText(out, str(p), at, cv2.FONT_HERSHEY_SIMPLEX, scale, col, th, cv2.LINE_AA)
+    return out
+
+
+def draw_init_preview(img, cfg, found, grid: bool = False):
+    """The first frame (BGR) with markers (id, outline), regions and the level line drawn (over a
+    pixel grid with ``grid``)."""
+    import cv2
+
+    out = draw_grid(img) if grid else img.copy() if img.ndim == 3 else cv2.cvtColor(img, cv2.COLOR_GRAY2BGR)
     owner = {m: (k, o) for k, o in enumerate(cfg.objects) for m in o.markers}
     if found is not None:
         for mid, c in zip(found.ids, found.corners_px):
@@ -103,12 +238,20 @@ def draw_init_preview(img, cfg, found):
             cs = found.centres_px[[found.ids.index(m) for m in tab.markers]]
             a, b = cs[np.argmin(cs[:, 0])], cs[np.argmax(cs[:, 0])]
             cv2.line(out, tuple(int(x) for x in a), tuple(int(x) for x in b), (0, 255, 255), 1, cv2.LINE_AA)
+    line = cfg.reference.level_line_px if cfg.reference.level == "line" else None
+    if line is not None:
+        a, b = (tuple(int(round(v)) for v in p) for p in line)
+        cv2.line(out, a, b, (0, 255, 255), 1, cv2.LINE_AA)
+        cv2.putText(out, "level line", (a[0], a[1] + 16), cv2.FONT_HERSHEY_SIMPLEX, 0.5, (0, 255, 255), 1, cv2.LINE_AA)
     for k, o in enumerate(cfg.objects):
         if o.roi is not None:
             x, y, w, h = (int(round(v)) for v in o.roi)
             col = _COLOURS[k % len(_COLOURS)]
-            cv2.rectangle(out, (x, y), (x + w, y + h), col, 2)
-            cv2.putText(out, o.id, (x, max(y - 6, 10)), cv2.FONT_HERSHEY_SIMPLEX, 0.5, col, 1, cv2.LINE_AA)
+            s = max(1.0, out.shape[1] / 960)  # readable on a 1080p frame too
+            cv2.rectangle(out, (x, y), (x + w, y + h), col, int(round(2 * s)))
+            cv2.putText(
+                out, o.id, (x, max(y - int(6 * s), 10)), cv2.FONT_HERSHEY_SIMPLEX, 0.5 * s, col, int(s), cv2.LINE_AA
+            )
             if o.kind == "table" and not o.markers:
                 _draw_top_edge(out, img, cfg, o)
     return out
@@ -139,8 +282,15 @@ def _draw_top_edge(out, img, cfg, table) -> None:
     cv2.putText(out, text, (a[0], a[1] + 16), cv2.FONT_HERSHEY_SIMPLEX, 0.5, (0, 255, 255), 1, cv2.LINE_AA)
 
 
+#: ``track preview`` tracks at most this much of the film (s from its start frame): a quick check.
+PREVIEW_SPAN_S = 10.0
+
+
 def track_preview(video, config, out, *, n_frames: int = 6, progress: bool = False, side: bool = False):
-    """Track ``video`` and write a contact sheet of ``n_frames`` frames spread over it (PNG)."""
+    """Track the first :data:`PREVIEW_SPAN_S` seconds of ``video`` (all of a shorter film) and write
+    a contact sheet of ``n_frames`` frames spread over them (PNG); returns (result, frames drawn)."""
+    from dataclasses import replace
+
     from ...tracking import load_track_config, track_video
 
     video = Path(video)
@@ -150,6 +300,11 @@ def track_preview(video, config, out, *, n_frames: int = 6, progress: bool = Fal
 
     vinfo = probe_video(video)  # the sheet shows the frames (fields) as tracked: square pixels
     cfg = load_track_config(config)
+    # frames (fields) in the span: the container's rate, or the config's when it has none
+    rate = (vinfo.fps or cfg.video.fps or 50.0) * (2 if vinfo.field_order is not None else 1)
+    stop = cfg.video.start_frame + max(int(round(PREVIEW_SPAN_S * rate)), 1)
+    if cfg.video.stop_frame is None or stop < cfg.video.stop_frame:
+        cfg = replace(cfg, video=replace(cfg.video, stop_frame=stop))
     res = track_video(video, cfg, progress=progress)
     frames = np.asarray(res.tracks[0].frame)
     pick = frames[np.unique(np.round(np.linspace(0, frames.size - 1, int(n_frames))).astype(int))]

@@ -117,6 +117,8 @@ def suggest_config(
     table_roi=None,
     fps: float | None = None,
     marker_size_m: float | None = None,
+    found: MarkerFinding | None = None,
+    level_line_px=None,
 ) -> tuple[TrackConfig, list[str], MarkerFinding | None]:
     """A tracking config for a video from its first frame.
 
@@ -131,6 +133,10 @@ def suggest_config(
         Written when the container has no frame rate.
     marker_size_m : float, optional
         Marker side, m (gives the metric scale of marker targets).
+    found : MarkerFinding, optional
+        The markers already found in ``first_gray`` (the search is not repeated).
+    level_line_px : ((u0, v0), (u1, v1)), optional
+        Without a table: a horizontal line of the first frame (px) that levels the angles.
 
     Returns
     -------
@@ -158,21 +164,26 @@ def suggest_config(
             "from its final rest when it ends at rest tilted); set theta0_rad (rad, ccw) for a "
             "release from a tilt"
         )
-        if table_roi is None:
-            notes.append(
-                "no table: angles are not levelled (warning W-LEVEL-NONE when tracking); add "
-                "--table x,y,w,h round the table's top edge or set reference.level"
-            )
+        if level_line_px is not None and table_roi is None:
+            level = "line"
+        elif table_roi is None:
+            level = "rest"
+            notes.append(_REST_NOTE + "; a table levels instead: add --table x,y,w,h round its top edge")
+        else:
+            level = "table"
         if marker_size_m is None:
             notes.append("no metric scale: x_m, y_m stay empty; set reference.m_per_px (m per pixel)")
         cfg = TrackConfig(
             objects=tuple(objs),
             video=video,
             targets=TargetsConfig(style="markerless"),
-            reference=ReferenceConfig(level="table"),
+            reference=ReferenceConfig(
+                level=level,
+                level_line_px=None if level != "line" else tuple(tuple(float(v) for v in p) for p in level_line_px),
+            ),
         )
         return cfg, notes, None
-    found = find_markers(first_gray)
+    found = found if found is not None else find_markers(first_gray)
     if found is None:
         raise InputError(
             "no ArUco/AprilTag marker found in the first frame (tried "
@@ -191,18 +202,24 @@ def suggest_config(
         f"grouped as: table {table or '(none)'}; " + "; ".join(f"block_{k} {m}" for k, m in enumerate(blocks, start=1))
     )
     if not table:
-        notes.append(
-            "no table found (markers spread along the lowest row): angles are not levelled (W-LEVEL-NONE when tracking)"
-        )
+        notes.append("no table found (markers spread along the lowest row): " + _REST_NOTE)
     if marker_size_m is None:
         notes.append("marker size unknown: x_m, y_m stay empty; set targets.marker_size_m (m)")
     cfg = TrackConfig(
         objects=tuple(objs),
         video=video,
         targets=TargetsConfig(style=style, dictionary=found.dictionary, marker_size_m=marker_size_m),
-        reference=ReferenceConfig(level="table"),
+        reference=ReferenceConfig(level="table" if table else "rest"),
     )
     return cfg, notes, found
+
+
+#: What ``level = "rest"`` assumes, and what to do when it does not hold.
+_REST_NOTE = (
+    "level = \"rest\": the camera's roll is taken from the first block's final rest (free rocking "
+    "ends upright; W-LEVEL-NONE when it does not come to rest in the film: then set reference.level "
+    '= "line", "value" or "none")'
+)
 
 
 def _check_overlaps(objs) -> None:

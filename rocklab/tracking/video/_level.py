@@ -97,16 +97,24 @@ def level_from_reference(config, raw, fps, metric_plane, plane_map):
 
 def _final_rest(th, fps, min_s=1.0):
     """Indices of the last still stretch of ``th`` (>= ``min_s`` long, ending at the last sample
-    seen), or None. Still: frame-to-frame steps within 5x the smallest steps' scale."""
+    seen), or None. Still: frame-to-frame steps within 4 sigma of the measurement noise, its scale
+    from the smallest fifth of the steps (the 20 % quantile of |N(0, s)| is 0.253 s), and a spread
+    within 5 % of the whole track's."""
     ok = np.flatnonzero(np.isfinite(th))
     if ok.size < 10:
         return None
     steps = np.abs(np.diff(th[ok]))
-    still_rad = max(5.0 * float(np.quantile(steps, 0.2)), 1e-5)
+    # 4 / 0.253 = 16: a still step beyond it is one in 16 000 (at 5 quantiles, one in five, which
+    # broke every tracked rest of more than a few frames)
+    still_rad = max(16.0 * float(np.quantile(steps, 0.2)), 1e-5)
     k = ok.size - 1
     while k > 0 and steps[k - 1] <= still_rad:
         k -= 1
     idx = ok[k:]
+    # still against the motion before it: the noise scale above holds only when a fifth of the
+    # steps are still, and a film that rocks to its end has no such fifth
+    if np.ptp(th[idx]) > 0.05 * np.ptp(th[ok]):
+        return None
     return idx if idx.size >= max(10, int(min_s * fps)) else None
 
 

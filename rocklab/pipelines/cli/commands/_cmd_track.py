@@ -11,7 +11,11 @@
   trying the common dictionaries, or the named regions followed markerless), commented,
   plus ``track_init.png`` with every detection, region and the level line drawn.
 - ``rocklab track preview VIDEO --config track.toml [-o sheet.png] [--frames 6]``: a
-  contact sheet of frames spread over the video with each object's pose and θ drawn.
+  contact sheet of frames spread over the first 10 s (the span tracked: a quick check) with
+  each object's pose and θ drawn.
+- ``track init`` on a film without markers and without ``--object`` proposes the objects that
+  move in the first seconds and the table edge they stand on, draws them over a pixel grid and
+  prints each as the option to re-run with.
 """
 
 from __future__ import annotations
@@ -125,7 +129,7 @@ def run(args) -> int:
 
 
 def _tools(args) -> int:
-    from .._track_tools import track_init, track_preview
+    from .._track_tools import PREVIEW_SPAN_S, track_init, track_preview
 
     if args.video2 is None:
         raise InputError(f"rocklab track {args.video}: give the video, e.g. 'rocklab track {args.video} film.mp4'")
@@ -135,7 +139,7 @@ def _tools(args) -> int:
         if out.suffix.lower() != ".toml":
             raise InputError(f"-o {out}: the config is a .toml file; give e.g. -o track.toml")
         preview = Path(args.preview) if args.preview else out.with_name(out.stem + "_init.png")
-        cfg, notes = track_init(
+        cfg, notes, proposed = track_init(
             video,
             out,
             objects=args.object,
@@ -153,12 +157,18 @@ def _tools(args) -> int:
                     "preview": str(preview),
                     "objects": [o.id for o in cfg.objects],
                     "style": cfg.targets.style,
+                    "level": cfg.reference.level,
+                    "proposed": list(proposed),
                     "notes": notes,
                 }
             )
         else:
             for n in notes:
                 print(f"note: {n}")
+            for p in proposed:
+                print(f"proposed: {p}")
+            if proposed:
+                print(f"to correct them: rocklab track init {video} {' '.join(proposed)} -o {out}")
             print(
                 f"wrote {out} ({', '.join(o.id for o in cfg.objects)}) and {preview}; check the preview, then "
                 f"'rocklab track {video} --config {out}'"
@@ -169,5 +179,7 @@ def _tools(args) -> int:
         raise InputError(f"{cfg_path}: tracking config not found; pass --config track.toml")
     out = Path(args.out) if args.out else video.parent / "track_preview.png"
     res, frames = track_preview(video, cfg_path, out, n_frames=args.frames, progress=args.progress, side=not args.out)
-    print(f"wrote {out}: frames {', '.join(map(str, frames))}")
+    print(
+        f"wrote {out}: frames {', '.join(map(str, frames))} (of the first {PREVIEW_SPAN_S:g} s, tracked for the check)"
+    )
     return 0

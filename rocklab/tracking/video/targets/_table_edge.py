@@ -77,7 +77,10 @@ def _robust_line(u, v):
         b, a = np.polyfit(u[keep], v[keep], 1)
         r = v - (a + b * u)
         s = 1.4826 * float(np.median(np.abs(r[keep] - np.median(r[keep])))) + 1e-3
-        keep = np.abs(r) <= 3 * s
+        nxt = np.abs(r) <= 3 * s
+        if nxt.sum() < 2:  # points on no line at all: keep the last fit rather than none
+            break
+        keep = nxt
     return a, b, keep
 
 

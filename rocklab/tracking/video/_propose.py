@@ -1,0 +1,257 @@
+"""Objects to track proposed from a film without markers: what moves, and the table under it.
+
+A film of rocking blocks without fiducials still says where the blocks are: they move and the
+wall behind them does not. Frames sampled over the first seconds are compared with the first
+frame; a pixel belongs to a moving object in the first frame when it differs from the first
+frame in at least half of the samples in which anything moves (the object has left it, or its
+texture has turned over it). The frames' common brightness change is taken out first, so
+exposure hunting does not count as motion. Connected regions of that mask, closed over the
+texture's gaps and merged when they touch, are the proposals: boxes in first-frame pixels.
+
+The table is the long straight horizontal edge a block stands on: searched just below each
+proposal's bottom, on either side of it, and accepted only when
+:func:`~rocklab.tracking.video.targets._table_edge.table_top_edge` follows it over at least
+twice the block's width, with a contrast well above the frame's own gradients and a small
+angle. A proposal that lies below the table's top edge (the table itself moving on a shake
+table) is not a block.
+
+Pure functions on images; ``rocklab track init`` decodes the frames and writes the result.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["Proposals", "propose_objects", "moving_boxes", "find_table_below", "WORK_WIDTH_PX"]
+
+#: Frames are compared at this width at most (px): enough for boxes to a couple of pixels of the
+#: full frame, and a 1080p film costs no more than a VGA one.
+WORK_WIDTH_PX = 640
+#: A pixel moves when it differs from the first frame by this many noise sigmas (and at least
+#: ``MIN_DIFF_DN`` grey levels: compression blocks and sensor noise stay below it).
+DIFF_SIGMAS = 6.0
+MIN_DIFF_DN = 6.0
+#: ... in at least this fraction of the samples in which something moves.
+MOVING_FRACTION = 0.5
+#: A region smaller than this fraction of the frame is noise, one larger than ``MAX_FRACTION``
+#: is the whole scene changing (camera moved, light switched), not an object.
+MIN_FRACTION = 4e-4
+MAX_FRACTION = 0.5
+#: An object shows an outline or texture in the first frame: the 95th percentile of the gradient
+#: inside its region is at least this many times the frame's median gradient (a soft shadow
+#: sweeping the wall changes as much as an object but has neither).
+MIN_STRUCTURE = 10.0
+#: A table's top edge: its mean vertical gradient (Sobel, smoothed along the rows) at least this
+#: many times the frame's median and at least ``MIN_EDGE`` (a 4 grey-level step); rendered tables
+#: give 72-168, a lighting gradient on a plain wall 1.2.
+EDGE_CONTRAST = 20.0
+MIN_EDGE = 16.0
+#: Gaps closed inside a region, and regions merged, within this fraction of the frame's short side.
+CLOSE_FRACTION = 0.02
+
+
+@dataclass(frozen=True)
+class Proposals:
+    """What :func:`propose_objects` found.
+
+    Attributes
+    ----------
+    blocks : tuple of (x, y, w, h)
+        Boxes round the moving objects in the first frame, px (full frame), left to right.
+    table : (x, y, w, h) or None
+        A region round the table's top edge (for a markerless ``table`` object), px.
+    table_moves : bool
+        More than a fifth of the table's region changes in some sample (a shake table): the table is an object
+        to track, not only a level line.
+    table_edge : TopEdge or None
+        The edge found there (angle, 1-sigma, the span followed).
+    n_samples, n_moving : int
+        Frames compared with the first, and those in which something moved.
+    """
+
+    blocks: tuple
+    table: tuple | None
+    table_edge: object | None
+    table_moves: bool
+    n_samples: int
+    n_moving: int
+
+
+def _prepare(gray, scale):
+    import cv2
+
+    g = gray if scale == 1.0 else cv2.resize(gray, None, fx=scale, fy=scale, interpolation=cv2.INTER_AREA)
+    return cv2.GaussianBlur(g.astype(np.float32), (0, 0), 1.0)
+
+
+def _box_gap(a, b) -> float:
+    """Distance between two boxes (x, y, w, h), px; 0 when they touch or overlap."""
+    dx = max(a[0] - (b[0] + b[2]), b[0] - (a[0] + a[2]), 0.0)
+    dy = max(a[1] - (b[1] + b[3]), b[1] - (a[1] + a[3]), 0.0)
+    return math.hypot(dx, dy)
+
+
+def _merge(boxes, gap):
+    boxes = [tuple(float(v) for v in b) for b in boxes]
+    merged = True
+    while merged:
+        merged = False
+        for i in range(len(boxes)):
+            for j in range(i + 1, len(boxes)):
+                if _box_gap(boxes[i], boxes[j]) <= gap:
+                    a, b = boxes[i], boxes.pop(j)
+                    x0, y0 = min(a[0], b[0]), min(a[1], b[1])
+                    x1, y1 = max(a[0] + a[2], b[0] + b[2]), max(a[1] + a[3], b[1] + b[3])
+                    boxes[i] = (x0, y0, x1 - x0, y1 - y0)
+                    merged = True
+                    break
+            if merged:
+                break
+    return boxes
+
+
+def moving_boxes(first_gray, samples, masks: bool = False) -> tuple[list, int]:
+    """Boxes round what moves, where it is in the first frame.
+
+    Parameters
+    ----------
+    first_gray : ndarray (H, W) uint8
+    samples : sequence of ndarray (H, W) uint8
+        Later frames (a few dozen spread over the first seconds).
+
+    masks : bool
+        Return ``(changed, scale)`` instead: per sample in which something moves, the pixels that
+        differ from the first frame (bool), at ``scale`` times the frame's size.
+
+    Returns
+    -------
+    (boxes, n_moving)
+        ``boxes``: (x, y, w, h) px of the full frame, left to right; ``n_moving``: samples in
+        which something moved.
+    """
+    import cv2
+
+    H, W = first_gray.shape[:2]
+    scale = min(1.0, WORK_WIDTH_PX / W)
+    f0 = _prepare(first_gray, scale)
+    diffs = []
+    for s in samples:
+        d = _prepare(s, scale) - f0
+        diffs.append(np.abs(d - float(np.median(d))))
+    if not diffs:
+        return ([], scale) if masks else ([], 0)
+    # static pixels dominate every difference: their median is the noise (|N(0, s sqrt 2)| median
+    # = 0.954 s)
+    sigma = float(np.median([np.median(d) for d in diffs])) / 0.954
+    thr = max(DIFF_SIGMAS * sigma, MIN_DIFF_DN)
+    n_px = f0.size
+    moving = [m for m in (d > thr for d in diffs) if m.sum() >= MIN_FRACTION * n_px]
+    if masks:
+        return moving, scale
+    if not moving:
+        return [], 0
+    mask = (np.mean(moving, axis=0) >= MOVING_FRACTION).astype(np.uint8)
+    k = max(3, int(round(CLOSE_FRACTION * min(f0.shape))) | 1)
+    mask = cv2.morphologyEx(mask, cv2.MORPH_OPEN, np.ones((3, 3), np.uint8))
+    mask = cv2.morphologyEx(mask, cv2.MORPH_CLOSE, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (k, k)))
+    n, labels, stats, _ = cv2.connectedComponentsWithStats(mask, connectivity=8)
+    grad = cv2.magnitude(cv2.Sobel(f0, cv2.CV_32F, 1, 0), cv2.Sobel(f0, cv2.CV_32F, 0, 1))
+    floor = MIN_STRUCTURE * (float(np.median(grad)) + 1e-3)
+    boxes = [
+        tuple(stats[i, :4])
+        for i in range(1, n)
+        if stats[i, 4] >= MIN_FRACTION * n_px and np.percentile(grad[labels == i], 95) >= floor
+    ]
+    boxes = _merge(boxes, gap=k)
+    out = []
+    for x, y, w, h in boxes:
+        if w * h > MAX_FRACTION * n_px:
+            continue
+        # back to full-frame pixels, out to the outer edge of the last pixel, inside the frame
+        x0, y0 = max(0.0, x / scale), max(0.0, y / scale)
+        x1, y1 = min(float(W), (x + w) / scale), min(float(H), (y + h) / scale)
+        out.append(tuple(float(round(v)) for v in (x0, y0, x1 - x0, y1 - y0)))
+    return sorted(out), len(moving)
+
+
+def find_table_below(first_gray, box):
+    """A table's top edge just below the block ``box`` (x, y, w, h px): ``(roi, TopEdge)`` or None.
+
+    The edge is searched in rows within 15 % of the block's height of its bottom, beside the block
+    (the wider side), the topmost row at least half as strong as the strongest; accepted when followed over at least twice the block's
+    width, at less than 10 degrees, with a contrast of at least :data:`EDGE_CONTRAST` times the
+    frame's median vertical gradient and :data:`MIN_EDGE`.
+    """
+    import cv2
+
+    from ._geometry import PlaneMap
+    from .targets._table_edge import BLUR_PX, table_top_edge
+
+    H, W = first_gray.shape[:2]
+    x, y, w, h = box
+    gy = cv2.blur(cv2.Sobel(first_gray.astype(np.float32), cv2.CV_32F, 0, 1, ksize=3), (BLUR_PX, 1))
+    noise = float(np.median(np.abs(gy))) + 1e-3
+    v_lo, v_hi = int(max(y + 0.85 * h, 1)), int(min(y + 1.15 * h, H - 2))
+    if v_hi - v_lo < 3:
+        return None
+    sides = [(int(max(x - 2 * w, 0)), int(x)), (int(x + w), int(min(x + 3 * w, W)))]
+    u0, u1 = max(sides, key=lambda s: s[1] - s[0])
+    if u1 - u0 < max(0.5 * w, 10):
+        return None
+    prof = np.abs(gy[v_lo:v_hi, u0:u1]).mean(axis=1)
+    v_edge = v_lo + int(np.argmax(prof >= 0.5 * prof.max()))
+    if prof.max() < max(EDGE_CONTRAST * noise, MIN_EDGE):
+        return None
+    pad = max(4, int(round(0.05 * h)))
+    depth = max(2 * pad, int(round(0.3 * h)))
+    roi = (float(u0), float(max(v_edge - pad, 0)), float(u1 - u0), float(min(depth, H - max(v_edge - pad, 0))))
+    edge = table_top_edge(first_gray, roi, PlaneMap(W, H), follow=True)
+    if edge is None or edge.u_span_px[1] - edge.u_span_px[0] < 2 * w or abs(edge.angle_rad) > math.radians(10):
+        return None
+    return roi, edge
+
+
+def propose_objects(first_gray, samples) -> Proposals:
+    """Blocks (what moves) and the table (the edge they stand on) from the first frame and later
+    samples; see the module docstring.
+
+    Parameters
+    ----------
+    first_gray : ndarray (H, W) uint8
+    samples : sequence of ndarray (H, W) uint8
+
+    Returns
+    -------
+    Proposals
+    """
+    boxes, n_moving = moving_boxes(first_gray, samples)
+    table = edge = None
+    moves = False
+    for b in boxes:
+        found = find_table_below(first_gray, b)
+        if found is not None:
+            table, edge = found
+            break
+    if edge is not None:
+        # what lies below the table's top (the table itself on a shake table) is no block, and a
+        # block's box stops at the table's top
+        (ua, va), (ub, vb) = edge.ends_px
+
+        def top_at(u):
+            return va + (vb - va) * (u - ua) / max(ub - ua, 1e-9)
+
+        kept = []
+        for x, y, w, h in boxes:
+            v_top = max(top_at(x), top_at(x + w))
+            if y >= v_top - 2:
+                continue
+            kept.append((x, y, w, float(min(y + h, math.ceil(v_top + 2)) - y)))
+        boxes = kept
+        # a shake table moves and comes back: changed in any sample, not in most
+        changed, scale = moving_boxes(first_gray, samples, masks=True)
+        x, y, w, h = (int(round(v * scale)) for v in table)
+        moves = any(float(m[y : y + max(h, 1), x : x + max(w, 1)].mean()) > 0.2 for m in changed)
+    return Proposals(tuple(boxes), table, edge, moves, len(samples), n_moving)

@@ -39,12 +39,12 @@ def _probe_fps(path, given: float | None) -> float:
     """Frame rate for the review film's container, Hz (the timeline uses the tracker's own)."""
     if given:
         return float(given)
-    import cv2
+    from ...tracking import probe_video
 
-    cap = cv2.VideoCapture(str(path))
-    fps = cap.get(cv2.CAP_PROP_FPS) if cap.isOpened() else 0.0
-    cap.release()
-    return float(fps) if fps and np.isfinite(fps) and fps > 0 else 50.0
+    # the container's own rate (PyAV's packet clock: OpenCV cannot open every film PyAV reads, AV1);
+    # a film with none is refused by the tracker, which needs one too
+    fps = probe_video(path).fps
+    return float(fps) if fps else 50.0
 
 
 def _measure_video(cfg: ExperimentConfig, progress: bool, keep_film: bool):

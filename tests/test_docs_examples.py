@@ -64,3 +64,28 @@ def test_page_examples_run_as_written(page, tmp_path, monkeypatch):
             assert CHECK.check_output(want, p.stdout, FLAGS), f"{cmd}\nexpected:\n{want}\ngot:\n{p.stdout}"
             n_cmd += 1
     assert n_cmd >= 6
+
+
+def _makefile_var(name: str) -> str:
+    m = re.search(rf"^{name}\s*:?=\s*(\S+)", (ROOT / "Makefile").read_text(encoding="utf-8"), re.M)
+    assert m, f"Makefile sets no {name}"
+    return m.group(1)
+
+
+def test_setup_says_where_the_commands_are():
+    """After ``make demo`` the commands are in the Makefile's venv, not on PATH: README and
+    getting-started say how to reach them (activate, the path, or ``make install-user``), and
+    those paths are where pip puts the entry points of this environment."""
+    venv = _makefile_var("VENV")
+    targets = set(re.findall(r"^([\w-]+):", (ROOT / "Makefile").read_text(encoding="utf-8"), re.M))
+    bin_dir = Path(sys.executable).parent
+    for cmd in ("rocklab", "rerun"):  # both are entry points of the environment the docs describe
+        assert (bin_dir / cmd).is_file(), f"{cmd} is not installed beside {sys.executable}"
+    for page in (ROOT / "README.md", ROOT / "docs" / "getting-started.md"):
+        text = page.read_text(encoding="utf-8")
+        assert f"source {venv}/bin/activate" in text, page.name
+        for cmd in ("rocklab", "rerun"):
+            assert f"{venv}/bin/{cmd}" in text, (page.name, cmd)
+        for target in re.findall(r"`make ([\w-]+)", text):  # every make target named exists
+            assert target in targets, (page.name, target)
+        assert "install-user" in text and "--web-viewer" in text, page.name

@@ -78,5 +78,6 @@ def campaign_rrd(res, path: Path) -> None:
                 static=True,
             )
         rec.reset_time()
-        rec.send_blueprint(campaign_blueprint())
+        hb = [int(round(1000 * x)) for x in t["hb"] if np.isfinite(x)] if len(t) else []
+        rec.send_blueprint(campaign_blueprint((min(hb), max(hb)) if hb else None))
         close_recording(rec, tmp)

@@ -318,17 +318,32 @@ def experiment_blueprint(block_paths: list[str], has_video: bool = True, focus=N
 HB_TIMELINE = "h_over_b_x1000"
 
 
-def campaign_blueprint():
+def campaign_blueprint(hb_x1000: tuple[int, int] | None = None):
     """η vs h/b as a scatter plot (one marker series per experiment, η_H and the truth as
-    references), the campaign's summary (one text document) and the experiments' log."""
+    references), the campaign's summary (one text document) and the experiments' log.
+
+    ``hb_x1000``: (smallest, largest) h/b × 1000 of the experiments; the plot's x axis shows all
+    of them (a viewer otherwise shows a window around its time cursor).
+    """
     import rerun.blueprint as rrb
 
+    axis = None
+    if hb_x1000 is not None:
+        lo, hi = hb_x1000
+        pad = max(500, (hi - lo) // 6)
+        axis = rrb.TimeAxis(
+            view_range=rrb.TimeRange(
+                start=rrb.TimeRangeBoundary.absolute(seq=lo - pad), end=rrb.TimeRangeBoundary.absolute(seq=hi + pad)
+            )
+        )
     return rrb.Blueprint(
         rrb.Horizontal(
             rrb.TimeSeriesView(
                 origin="campaign",
                 contents=["+ campaign/eta_vs_hb/**", "+ campaign/reference/**"],
                 name="η vs h/b (x axis: h/b × 1000); click a marker for its experiment",
+                axis_x=axis,
+                plot_legend=rrb.PlotLegend(corner="RightBottom"),
             ),
             rrb.Vertical(
                 rrb.TextDocumentView(origin="campaign/summary", name="campaign"),

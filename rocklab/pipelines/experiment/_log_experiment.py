@@ -96,13 +96,38 @@ def _focus(ref, t_s, residual_rad):
     return float(ti[k]), t0, t1
 
 
+def _rotate(theta: float, pts) -> np.ndarray:
+    c, s = np.cos(theta), np.sin(theta)
+    return np.asarray(pts, float) @ np.array([[c, s], [-s, c]])
+
+
+def sim_outline(b_m: float, h_m: float, theta_meas_rad: float, theta_sim_rad: float) -> np.ndarray:
+    """Outline of the simulated block, in the measured block's own frame, m (shape (5, 2)).
+
+    The block rocks on a bottom corner (θ > 0 counter-clockwise: the left one). The measured pose
+    fixes the table's base line and the resting place of the block; the simulated block stands at
+    that place, tilted by ``theta_sim_rad`` about its own corner. The result is in the frame of the
+    measured block (centred on its front face, x right, y up), the frame overlays are drawn in.
+    """
+    half = np.array([b_m / 2, h_m / 2])
+    rect = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1], [-1, -1]]) * half
+    sm = 1.0 if theta_meas_rad >= 0 else -1.0
+    ss = 1.0 if theta_sim_rad >= 0 else -1.0
+    # the measured pivot corner, and the block's centre at rest, relative to the measured centre
+    rest_centre = _rotate(theta_meas_rad, [-sm * half[0], -half[1]]) + [sm * half[0], half[1]]
+    pivot_sim = rest_centre + [-ss * half[0], -half[1]]
+    centre_sim = pivot_sim + _rotate(theta_sim_rad, [ss * half[0], half[1]])
+    corners = centre_sim + _rotate(theta_sim_rad, rect)
+    return _rotate(-theta_meas_rad, corners)
+
+
 def _overlay_fn(res):
     """Per-frame overlays: target centres and block outlines mapped back to pixels from the
     tracked poses (θ itself is on the plots, not in a per-frame text line)."""
     tr = res.frames
+    b = res.block
     shapes = []
     if tr is not None and getattr(tr, "plane_map", None) is not None:
-        b = res.block
         rect = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1], [-1, -1]]) * [b.b_m / 2, b.h_m / 2]
         blocks = res.column["objects"] if res.column is not None else [res.config.video.object]
         for o in tr.config.objects:
@@ -112,6 +137,20 @@ def _overlay_fn(res):
             framed = bool(o.dots) or o.marker_positions_m is not None or o.size_m is not None
             outline = rect if (o.id in blocks and framed) else None
             shapes.append((o.id, None if targets is None else np.asarray(targets, float), outline))
+
+    # each law's simulated block beside the measured one (one block only: a column has its own model)
+    sims, t_of, th_of = [], {}, {}
+    main = res.config.video.object if res.config.video is not None else None
+    if res.column is None and any(oid == main and outline is not None for oid, _, outline in shapes):
+        tm = tr[main]
+        t_of = dict(zip(np.asarray(tm.frame, int).tolist(), np.asarray(tm.t_s, float).tolist()))
+        th_of = dict(zip(np.asarray(tm.frame, int).tolist(), np.asarray(tm.theta_rad, float).tolist()))
+        for i, (law, s) in enumerate(res.simulations.items()):
+            # a simulation that came to rest stays upright to the film's end
+            after = 0.0 if s.get("status") == "rest" else np.nan
+            sims.append(
+                (law, np.asarray(s["t_s"], float), np.asarray(s["theta_rad"], float), after, _style(f"sim_{law}", i)[0])
+            )
 
     def fn(idx):
         pts, lines = [], []
@@ -123,7 +162,16 @@ def _overlay_fn(res):
                 q = tr.to_pixels(oid, idx, outline)
                 if np.isfinite(q).all():
                     lines.append(q)
-        return {"points": np.asarray(pts) if pts else None, "outlines": lines}
+        ov = {"points": np.asarray(pts) if pts else None, "outlines": lines, "sim": []}
+        if sims and idx in t_of and np.isfinite(th_of[idx]):
+            for law, ts, ths, after, colour in sims:
+                # before the release the model's block is held at its initial angle
+                th_s = float(np.interp(t_of[idx], ts, ths, left=ths[0], right=after))
+                if np.isfinite(th_s):
+                    q = tr.to_pixels(main, idx, sim_outline(b.b_m, b.h_m, th_of[idx], th_s))
+                    if np.isfinite(q).all():
+                        ov["sim"].append((law, q, colour))
+        return ov
 
     return fn
 

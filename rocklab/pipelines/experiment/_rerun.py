@@ -6,6 +6,7 @@ Entity paths form a hierarchy::
                                            frame (JPEG stills only as the fallback)
     experiment/video/targets               tracked target points (per frame)
     experiment/video/outline               block outline (per frame)
+    experiment/video/sim_<law>             the simulated block's outline (per frame, per law)
     experiment/<block>/theta/measured_video    θ from video, rad
     experiment/<block>/theta/measured_imu      θ from IMU (synced), rad
     experiment/<block>/theta/sim_<law>         simulations, rad
@@ -177,7 +178,8 @@ def log_video_frames(rec, path: str, frames, *, overlays=None, progress=None) ->
     frames : iterable of (frame_index, t_s, jpeg_bytes)
         The frames to show (already decimated: see ``output.video_decimation``).
     overlays : callable(frame_index) -> dict, optional
-        Returns {"points": (k, 2) px, "outlines": list of (m, 2) px polylines}.
+        Returns {"points": (k, 2) px, "outlines": list of (m, 2) px polylines, "sim": list of
+        (law, (m, 2) px polyline, RGB): each simulation's block}.
     Returns the number of frames logged.
     """
     import rerun as rr
@@ -253,7 +255,17 @@ def _log_overlay(rec, path: str, ov: dict) -> None:
     if ov.get("points") is not None and len(ov["points"]):
         rec.log(f"{path}/targets", rr.Points2D(ov["points"], radii=3.0, colors=[0, 255, 0]))
     if ov.get("outlines"):
-        rec.log(f"{path}/outline", rr.LineStrips2D(ov["outlines"], colors=[255, 128, 0]))
+        rec.log(f"{path}/outline", rr.LineStrips2D(ov["outlines"], colors=[255, 128, 0], radii=-2.0))
+    # thin and on top (η_e's topmost): a simulated block that matches the measured one leaves the
+    # orange visible around it
+    for law, q, colour in ov.get("sim") or ():
+        order = 32.0 if law == "eta_e" else 31.0
+        rec.log(
+            f"{path}/sim_{law}",
+            rr.LineStrips2D(
+                [q], colors=[colour], radii=-0.75, draw_order=order, labels=[f"sim {law}"], show_labels=False
+            ),
+        )
 
 
 def experiment_blueprint(block_paths: list[str], has_video: bool = True, focus=None):

@@ -89,3 +89,18 @@ def test_setup_says_where_the_commands_are():
         for target in re.findall(r"`make ([\w-]+)", text):  # every make target named exists
             assert target in targets, (page.name, target)
         assert "install-user" in text and "--web-viewer" in text, page.name
+
+
+def test_demo_names_the_viewer_it_installed(monkeypatch, tmp_path):
+    """``rocklab demo`` ends by saying how to open its recordings: ``rerun`` when that is on the
+    PATH, else the viewer installed beside this Python (``.venv/bin/rerun`` after ``make demo``)."""
+    from rocklab.pipelines.cli.commands._cmd_demo import viewer_command
+
+    bin_dir = Path(sys.executable).parent
+    monkeypatch.setenv("PATH", str(tmp_path))  # nothing on the PATH
+    monkeypatch.chdir(bin_dir.parent)
+    assert viewer_command() == str(Path(bin_dir.name) / "rerun")  # e.g. bin/rerun, from the venv's folder
+    monkeypatch.chdir(tmp_path)
+    assert Path(viewer_command()) == bin_dir / "rerun"
+    monkeypatch.setenv("PATH", str(bin_dir))
+    assert viewer_command() == "rerun"

@@ -4,7 +4,7 @@ VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 
-.PHONY: test test-browser demo bench lint docs venv clean
+.PHONY: test test-browser demo bench lint docs docs-serve install-user venv clean
 
 venv: $(STAMP)
 
@@ -33,6 +33,14 @@ test-browser: $(STAMP)
 
 demo: $(STAMP)
 	$(VENV)/bin/rocklab demo
+	@echo "the commands are in $(VENV)/bin: 'source $(VENV)/bin/activate' (or 'make install-user'), then 'rerun demo_out/results/campaign.rrd'"
+
+# rocklab and rerun on the user's PATH without activating .venv: symlinks in ~/.local/bin
+BINDIR ?= $(HOME)/.local/bin
+install-user: $(STAMP)
+	@mkdir -p "$(BINDIR)"
+	@for c in rocklab rerun; do ln -sf "$(abspath $(VENV))/bin/$$c" "$(BINDIR)/$$c" && echo "linked $(BINDIR)/$$c"; done
+	@case ":$$PATH:" in *":$(BINDIR):"*) ;; *) echo "$(BINDIR) is not on your PATH: add 'export PATH=\"$(BINDIR):\$$PATH\"' to ~/.bashrc";; esac
 
 lint: $(STAMP)
 	$(PY) -m pip install --quiet -e ".[lint]"
@@ -46,6 +54,13 @@ docs: $(STAMP)
 	$(PY) -m pip install --quiet -e ".[docs]"
 	$(PY) -m pytest -q -p no:cacheprovider tests/test_docs_examples.py tests/test_papers_page.py
 	NO_MKDOCS_2_WARNING=1 $(VENV)/bin/mkdocs build --strict --site-dir site
+	@echo "open site/index.html (works from disk) or 'make docs-serve'"
+
+# the site served with live reload at http://127.0.0.1:8000 (DOCS_ADDR=0.0.0.0:8000 for the lab's network)
+DOCS_ADDR ?= 127.0.0.1:8000
+docs-serve: $(STAMP)
+	$(PY) -m pip install --quiet -e ".[docs]"
+	NO_MKDOCS_2_WARNING=1 $(VENV)/bin/mkdocs serve --dev-addr $(DOCS_ADDR)
 
 bench: $(STAMP)
 	@for f in benchmarks/bench_*.py; do echo "== $$f"; $(PY) $$f || exit 1; done

@@ -8,10 +8,16 @@ import numpy as np
 
 __all__ = ["campaign_rrd"]
 
+#: Marker colour per contact type (Okabe-Ito), and of the reference series.
+CONTACT_COLOURS = {"full": [0, 114, 178], "edge": [213, 94, 0]}
+REFERENCE_STYLE = {"eta_H": ([120, 120, 120], "η_H (Housner)", "circle"), "eta_true": ([0, 0, 0], "truth", "cross")}
+
 
 def campaign_rrd(res, path: Path) -> None:
-    """Write ``campaign.rrd``: η_e against h/b, one entity per experiment, each with the links to
-    its own report and recording (folders under ``experiments/``), and the campaign blueprint.
+    """Write ``campaign.rrd``: η_e against h/b as a scatter plot, one marker series per experiment
+    (named by it; its entity also holds a note with the links to its own report and recording,
+    folders under ``experiments/``), η_H and the truth as reference markers, the campaign's
+    summary as one text document, and the campaign blueprint.
 
     Parameters
     ----------
@@ -22,19 +28,24 @@ def campaign_rrd(res, path: Path) -> None:
     import rerun as rr
 
     from ..._io import atomic_path
-    from ..experiment._rerun import campaign_blueprint, close_recording, open_recording
+    from ..experiment._rerun import HB_TIMELINE, campaign_blueprint, close_recording, open_recording
 
     with atomic_path(path, suffix=".rrd") as tmp:
         rec = open_recording("rocklab", tmp, recording_id="campaign")
         t = res.ok_table
+        rec.log("campaign/summary", rr.TextDocument(res.summary_md(), media_type="text/markdown"), static=True)
+        for key, (colour, name, marker) in REFERENCE_STYLE.items():
+            rec.log(
+                f"campaign/reference/{key}",
+                rr.SeriesPoints(colors=colour, names=name, markers=marker, marker_sizes=4.0),
+                static=True,
+            )
         for _, r in t.iterrows():
-            # h/b on a sequence timeline so the viewer plots η against slenderness
-            rec.set_time("h_over_b_x1000", sequence=int(round(1000 * r["hb"])))
-            base = f"campaign/eta/{r['contact']}/b_{int(round(1000 * r['b_m']))}mm"
-            rec.log(f"{base}/eta_e", rr.Scalars(float(r["eta_e"])))
-            rec.log(f"{base}/eta_H", rr.Scalars(float(r["eta_H"])))
-            if np.isfinite(r.get("eta_true", np.nan)):
-                rec.log(f"{base}/eta_true", rr.Scalars(float(r["eta_true"])))
+            # h/b on a sequence timeline: the viewer's plot takes its x axis from the timeline
+            rec.set_time(HB_TIMELINE, sequence=int(round(1000 * r["hb"])))
+            for key in REFERENCE_STYLE:
+                if np.isfinite(r.get(key, np.nan)):
+                    rec.log(f"campaign/reference/{key}", rr.Scalars(float(r[key])))
             rec.log(
                 "campaign/experiments",
                 rr.TextLog(
@@ -42,27 +53,19 @@ def campaign_rrd(res, path: Path) -> None:
                     f"η_H = {r['eta_H']:.4f}"
                 ),
             )
-        rec.reset_time()
-        # η_e against h/b as labelled points, one entity per experiment: clicking a point selects
-        # that experiment and shows where its own report and recording are
-        for _, r in t.iterrows():
             if not np.isfinite(r["eta_e"]):
                 continue
             name = str(r["experiment"])
             folder = Path(str(r["out"])).name
             ent = f"campaign/eta_vs_hb/{r['contact']}/{name}"
-            colour = [0, 114, 178] if r["contact"] == "full" else [213, 94, 0]
+            rec.log(ent, rr.Scalars(float(r["eta_e"])))
+            colour = CONTACT_COLOURS.get(str(r["contact"]), [0, 158, 115])
             rec.log(
                 ent,
-                rr.Points2D(
-                    [[float(r["hb"]), -float(r["eta_e"])]],
-                    labels=[name],
-                    colors=[colour],
-                    radii=[0.06],
-                    show_labels=False,
-                ),
+                rr.SeriesPoints(colors=colour, names=f"η_e {name}", markers="circle", marker_sizes=5.0),
                 static=True,
             )
+            # selecting the marker shows this note: where the experiment's own outputs are
             rec.log(
                 ent,
                 rr.TextDocument(
@@ -74,5 +77,7 @@ def campaign_rrd(res, path: Path) -> None:
                 ),
                 static=True,
             )
-        rec.send_blueprint(campaign_blueprint())
+        rec.reset_time()
+        hb = [int(round(1000 * x)) for x in t["hb"] if np.isfinite(x)] if len(t) else []
+        rec.send_blueprint(campaign_blueprint((min(hb), max(hb)) if hb else None))
         close_recording(rec, tmp)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 
 import numpy as np
 
@@ -9,7 +10,8 @@ from ._rerun import (
     close_recording,
     experiment_blueprint,
     log_events,
-    log_series,
+    log_impact_markers,
+    log_series as _log_series,
     log_video_asset,
     log_video_frames,
     open_recording,
@@ -45,12 +47,35 @@ def _style(key: str, i: int = 0):
     return SIM_COLOURS.get(law, _SPARE[i % len(_SPARE)]), 1.5
 
 
-def _theta(rec, bp: str, key: str, t, th, name: str, i: int = 0) -> int:
+def _theta(rec, bp: str, key: str, t, th, name: str, i: int = 0, t_min_s: float | None = None) -> int:
     """θ of one series in rad and in degrees (``theta`` and ``theta_deg``), in its colour."""
     colour, width = _style(key, i)
-    n = log_series(rec, f"{bp}/theta/{key}", t, th, color=colour, width=width, name=name)
-    log_series(rec, f"{bp}/theta_deg/{key}", t, np.degrees(np.asarray(th, float)), color=colour, width=width, name=name)
+    kw = dict(color=colour, width=width, name=name, t_min_s=t_min_s)
+    n = _log_series(rec, f"{bp}/theta/{key}", t, th, **kw)
+    _log_series(rec, f"{bp}/theta_deg/{key}", t, np.degrees(np.asarray(th, float)), **kw)
     return n
+
+
+def _film_start_s(res) -> float | None:
+    """Time of the film's first logged frame, s (None without a film in the recording)."""
+    if res.config.video is None or res.video is None or not len(res.video.frame_index):
+        return None
+    i0 = int(res.video.frame_index[0])
+    if res.video.kind == "av1" and res.frames is not None and res.frames.tracks:
+        tr0 = res.frames.tracks[0]
+        hit = np.flatnonzero(np.asarray(tr0.frame, int) == i0)
+        if hit.size:
+            return float(np.asarray(tr0.t_s, float)[hit[0]])
+    return i0 / float(res.frames.fps)
+
+
+def _impact_times(sim: dict, t_min_s: float | None) -> np.ndarray:
+    """Impact times of one simulation, s (those from ``t_min_s`` on)."""
+    imp = sim.get("impacts")
+    if imp is None or not len(imp):
+        return np.empty(0)
+    t = imp["t_s"].to_numpy(float)
+    return t if t_min_s is None else t[t >= t_min_s]
 
 
 def _focus(ref, t_s, residual_rad):
@@ -71,14 +96,38 @@ def _focus(ref, t_s, residual_rad):
     return float(ti[k]), t0, t1
 
 
+def _rotate(theta: float, pts) -> np.ndarray:
+    c, s = np.cos(theta), np.sin(theta)
+    return np.asarray(pts, float) @ np.array([[c, s], [-s, c]])
+
+
+def sim_outline(b_m: float, h_m: float, theta_meas_rad: float, theta_sim_rad: float) -> np.ndarray:
+    """Outline of the simulated block, in the measured block's own frame, m (shape (5, 2)).
+
+    The block rocks on a bottom corner (θ > 0 counter-clockwise: the left one). The measured pose
+    fixes the table's base line and the resting place of the block; the simulated block stands at
+    that place, tilted by ``theta_sim_rad`` about its own corner. The result is in the frame of the
+    measured block (centred on its front face, x right, y up), the frame overlays are drawn in.
+    """
+    half = np.array([b_m / 2, h_m / 2])
+    rect = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1], [-1, -1]]) * half
+    sm = 1.0 if theta_meas_rad >= 0 else -1.0
+    ss = 1.0 if theta_sim_rad >= 0 else -1.0
+    # the measured pivot corner, and the block's centre at rest, relative to the measured centre
+    rest_centre = _rotate(theta_meas_rad, [-sm * half[0], -half[1]]) + [sm * half[0], half[1]]
+    pivot_sim = rest_centre + [-ss * half[0], -half[1]]
+    centre_sim = pivot_sim + _rotate(theta_sim_rad, [ss * half[0], half[1]])
+    corners = centre_sim + _rotate(theta_sim_rad, rect)
+    return _rotate(-theta_meas_rad, corners)
+
+
 def _overlay_fn(res):
     """Per-frame overlays: target centres and block outlines mapped back to pixels from the
-    tracked poses, and a θ label."""
+    tracked poses (θ itself is on the plots, not in a per-frame text line)."""
     tr = res.frames
-    t, th = res.measured.get("video", (None, None))
+    b = res.block
     shapes = []
     if tr is not None and getattr(tr, "plane_map", None) is not None:
-        b = res.block
         rect = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1], [-1, -1]]) * [b.b_m / 2, b.h_m / 2]
         blocks = res.column["objects"] if res.column is not None else [res.config.video.object]
         for o in tr.config.objects:
@@ -88,6 +137,20 @@ def _overlay_fn(res):
             framed = bool(o.dots) or o.marker_positions_m is not None or o.size_m is not None
             outline = rect if (o.id in blocks and framed) else None
             shapes.append((o.id, None if targets is None else np.asarray(targets, float), outline))
+
+    # each law's simulated block beside the measured one (one block only: a column has its own model)
+    sims, t_of, th_of = [], {}, {}
+    main = res.config.video.object if res.config.video is not None else None
+    if res.column is None and any(oid == main and outline is not None for oid, _, outline in shapes):
+        tm = tr[main]
+        t_of = dict(zip(np.asarray(tm.frame, int).tolist(), np.asarray(tm.t_s, float).tolist()))
+        th_of = dict(zip(np.asarray(tm.frame, int).tolist(), np.asarray(tm.theta_rad, float).tolist()))
+        for i, (law, s) in enumerate(res.simulations.items()):
+            # a simulation that came to rest stays upright to the film's end
+            after = 0.0 if s.get("status") == "rest" else np.nan
+            sims.append(
+                (law, np.asarray(s["t_s"], float), np.asarray(s["theta_rad"], float), after, _style(f"sim_{law}", i)[0])
+            )
 
     def fn(idx):
         pts, lines = [], []
@@ -99,9 +162,15 @@ def _overlay_fn(res):
                 q = tr.to_pixels(oid, idx, outline)
                 if np.isfinite(q).all():
                     lines.append(q)
-        ov = {"points": np.asarray(pts) if pts else None, "outlines": lines}
-        if th is not None and idx < len(th) and np.isfinite(th[idx]):
-            ov["label"] = f"θ = {np.degrees(th[idx]):+.2f}°"
+        ov = {"points": np.asarray(pts) if pts else None, "outlines": lines, "sim": []}
+        if sims and idx in t_of and np.isfinite(th_of[idx]):
+            for law, ts, ths, after, colour in sims:
+                # before the release the model's block is held at its initial angle
+                th_s = float(np.interp(t_of[idx], ts, ths, left=ths[0], right=after))
+                if np.isfinite(th_s):
+                    q = tr.to_pixels(main, idx, sim_outline(b.b_m, b.h_m, th_of[idx], th_s))
+                    if np.isfinite(q).all():
+                        ov["sim"].append((law, q, colour))
         return ov
 
     return fn
@@ -110,8 +179,16 @@ def _overlay_fn(res):
 def log_experiment(
     res, rrd_path=None, *, spawn: bool = False, connect: str | None = None, progress: bool = False
 ) -> dict:
-    """Write the experiment to ``rrd_path`` (and/or a live viewer). Returns rows per entity sent."""
+    """Write the experiment to ``rrd_path`` (and/or a live viewer). Returns rows per entity sent.
+
+    With a film, nothing is logged before its first frame: the viewer opens with its time cursor
+    at the timeline's start, which is then the film's first frame.
+    """
     import rerun as rr
+
+    t_min = _film_start_s(res)
+    log_series = functools.partial(_log_series, t_min_s=t_min)
+    theta = functools.partial(_theta, t_min_s=t_min)
 
     rec = open_recording("rocklab", rrd_path, spawn=spawn, connect=connect, recording_id=f"experiment-{res.name}")
     rows: dict[str, int] = {}
@@ -129,9 +206,9 @@ def log_experiment(
     )
 
     for name, (t, th) in res.measured.items():
-        rows[f"{blk}/theta/measured_{name}"] = _theta(rec, blk, f"measured_{name}", t, th, f"measured ({name})")
+        rows[f"{blk}/theta/measured_{name}"] = theta(rec, blk, f"measured_{name}", t, th, f"measured ({name})")
     for i, (law, s) in enumerate(res.simulations.items()):
-        rows[f"{blk}/theta/sim_{law}"] = _theta(
+        rows[f"{blk}/theta/sim_{law}"] = theta(
             rec, blk, f"sim_{law}", s["t_s"], s["theta_rad"], f"sim {law} (η = {s['eta']:.4g})", i
         )
         colour, width = _style(f"sim_{law}", i)
@@ -139,7 +216,7 @@ def log_experiment(
             rec, f"{blk}/energy/sim_{law}", s["t_s"], s["energy_J"], color=colour, width=width, name=f"sim {law} (J)"
         )
     if res.truth is not None:
-        rows[f"{blk}/theta/truth"] = _theta(rec, blk, "truth", res.truth["t_s"], res.truth["theta_rad"], "truth")
+        rows[f"{blk}/theta/truth"] = theta(rec, blk, "truth", res.truth["t_s"], res.truth["theta_rad"], "truth")
     if res.video_imu_residual is not None:
         rows[f"{blk}/residual/video_minus_imu"] = log_series(
             rec, f"{blk}/residual/video_minus_imu", *res.video_imu_residual
@@ -159,23 +236,33 @@ def log_experiment(
     ref_law = "eta_e" if "eta_e" in res.simulations else next(iter(res.simulations), None)
     ref = res.simulations.get(ref_law)
     focus = _focus(ref, t_p, residual.get(ref_law))
+    for i, (law, s) in enumerate(res.simulations.items()):
+        # each law's impacts as markers on the θ plots: an impact is where θ passes through 0
+        t_imp = _impact_times(s, t_min)
+        if t_imp.size:
+            colour = _style(f"sim_{law}", i)[0]
+            for sub in ("theta", "theta_deg"):
+                rows[f"{blk}/{sub}/impacts_{law}"] = log_impact_markers(
+                    rec, f"{blk}/{sub}/impacts_{law}", t_imp, np.zeros(t_imp.size), color=colour, name=f"impacts {law}"
+                )
     if ref is not None and len(ref["impacts"]):
         imp = ref["impacts"]
+        keep = imp["t_s"].to_numpy(float) >= (-np.inf if t_min is None else t_min)
         txt = [
-            f"impact {i + 1}: ω⁻ = {a:+.3f} rad/s → ω⁺ = {c:+.3f} rad/s (η = {e:.3f})"
+            f"impact {i + 1} (sim {ref_law}): ω⁻ = {a:+.3f} rad/s → ω⁺ = {c:+.3f} rad/s (η = {e:.3f})"
             for i, (a, c, e) in enumerate(zip(imp["omega_before_rad_s"], imp["omega_after_rad_s"], imp["eta"]))
         ]
-        log_events(rec, f"{blk}/impacts", imp["t_s"].to_numpy(float), txt, values=np.zeros(len(imp)))
-        rows[f"{blk}/impacts"] = len(imp)
+        log_events(rec, f"{blk}/impacts", imp["t_s"].to_numpy(float)[keep], [x for x, k in zip(txt, keep) if k])
+        rows[f"{blk}/impacts"] = int(keep.sum())
     block_paths = [blk]
     if res.column is not None:
         c = res.column
         block_paths = [f"{ROOT}/{o}" for o in c["objects"]]
         for i, bp in enumerate(block_paths):
-            rows[f"{bp}/theta/measured_video"] = _theta(
+            rows[f"{bp}/theta/measured_video"] = theta(
                 rec, bp, "measured_video", c["t_s"], c["theta_measured_rad"][:, i], "measured (video)"
             )
-            rows[f"{bp}/theta/sim_column"] = _theta(
+            rows[f"{bp}/theta/sim_column"] = theta(
                 rec, bp, "sim_column", c["sim_t_s"], c["theta_sim_rad"][:, i], "column model"
             )
             sim_on = np.interp(c["t_s"], c["sim_t_s"], c["theta_sim_rad"][:, i], left=np.nan, right=np.nan)
@@ -184,7 +271,7 @@ def log_experiment(
             )
             if "theta_truth_rad" in c:
                 tt, th = c["theta_truth_rad"]
-                rows[f"{bp}/theta/truth"] = _theta(rec, bp, "truth", tt, th[:, i], "truth")
+                rows[f"{bp}/theta/truth"] = theta(rec, bp, "truth", tt, th[:, i], "truth")
         conf = c["configurations"]
         if len(conf):
             log_events(

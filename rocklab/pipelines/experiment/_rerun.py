@@ -6,21 +6,24 @@ Entity paths form a hierarchy::
                                            frame (JPEG stills only as the fallback)
     experiment/video/targets               tracked target points (per frame)
     experiment/video/outline               block outline (per frame)
-    experiment/video/label                 θ label (per frame)
+    experiment/video/sim_<law>             the simulated block's outline (per frame, per law)
     experiment/<block>/theta/measured_video    θ from video, rad
     experiment/<block>/theta/measured_imu      θ from IMU (synced), rad
     experiment/<block>/theta/sim_<law>         simulations, rad
     experiment/<block>/theta/truth             synthetic truth, rad
+    experiment/<block>/theta/impacts_<law>     each simulation's impacts: markers at θ = 0
     experiment/<block>/theta_deg/...           the same θ series in degrees
     experiment/<block>/residual/video_minus_imu, .../measured_minus_sim_eta_e
     experiment/<block>/energy/sim_<law>    energy, J
-    experiment/<block>/impacts             impacts as events (TextLog + points)
+    experiment/<block>/impacts             the η_e simulation's impacts, one text line each
     experiment/table/displacement_m, velocity_m_s, acceleration_m_s2
     experiment/geometry                    block and calibration (static)
 
 Long series go in with ``send_columns``; geometry and calibration are
 ``static``. The blueprint (video + θ plot + residual plot) is built by
-:func:`experiment_blueprint`, apart from the data.
+:func:`experiment_blueprint`, apart from the data. A viewer opens a recording with its time
+cursor at the start of the ``time`` timeline, so a run with a film logs nothing before the film's
+first frame (the IMU log's earlier samples stay in ``series.csv``): the film shows on first load.
 """
 
 from __future__ import annotations
@@ -34,6 +37,7 @@ __all__ = [
     "close_recording",
     "log_series",
     "log_events",
+    "log_impact_markers",
     "log_video_frames",
     "log_video_asset",
     "read_rrd_scalars",
@@ -99,16 +103,29 @@ def close_recording(rec, rrd_path=None) -> None:
             raise OSError(errno.EIO, "the Rerun recording was not written (disk full or folder removed?)", str(p))
 
 
-def log_series(rec, path: str, t_s, values, *, color=None, width: float | None = None, name: str | None = None) -> int:
+def log_series(
+    rec,
+    path: str,
+    t_s,
+    values,
+    *,
+    color=None,
+    width: float | None = None,
+    name: str | None = None,
+    t_min_s: float | None = None,
+) -> int:
     """Send a whole scalar series on the ``time`` timeline (NaNs dropped). Returns rows sent.
 
-    ``color`` (RGB 0-255), ``width`` (points) and ``name`` style the line (static).
+    ``color`` (RGB 0-255), ``width`` (points) and ``name`` style the line (static); samples
+    before ``t_min_s`` (s) are left out.
     """
     import rerun as rr
 
     t = np.asarray(t_s, float)
     v = np.asarray(values, float)
     ok = np.isfinite(t) & np.isfinite(v)
+    if t_min_s is not None:
+        ok &= t >= t_min_s
     if not ok.any():
         return 0
     rec.send_columns(path, indexes=[rr.TimeColumn(TIMELINE, duration=t[ok])], columns=rr.Scalars.columns(scalars=v[ok]))
@@ -135,6 +152,23 @@ def log_events(rec, path: str, t_s, texts, values=None) -> None:
     rec.reset_time()
 
 
+def log_impact_markers(rec, path: str, t_s, values, *, color, name: str) -> int:
+    """Impacts as markers (no line) on a θ plot: ``values`` (same unit as the plot) at ``t_s`` (s).
+
+    Returns the number of markers sent.
+    """
+    import rerun as rr
+
+    t = np.asarray(t_s, float)
+    v = np.asarray(values, float)
+    ok = np.isfinite(t) & np.isfinite(v)
+    if not ok.any():
+        return 0
+    rec.send_columns(path, indexes=[rr.TimeColumn(TIMELINE, duration=t[ok])], columns=rr.Scalars.columns(scalars=v[ok]))
+    rec.log(path, rr.SeriesPoints(colors=color, markers="diamond", marker_sizes=5.0, names=name), static=True)
+    return int(ok.sum())
+
+
 def log_video_frames(rec, path: str, frames, *, overlays=None, progress=None) -> int:
     """Log video frames (JPEG stills, the fallback of :func:`log_video_asset`) on the ``time`` and
     ``frame`` timelines.
@@ -144,7 +178,8 @@ def log_video_frames(rec, path: str, frames, *, overlays=None, progress=None) ->
     frames : iterable of (frame_index, t_s, jpeg_bytes)
         The frames to show (already decimated: see ``output.video_decimation``).
     overlays : callable(frame_index) -> dict, optional
-        Returns {"points": (k, 2) px, "outlines": list of (m, 2) px polylines, "label": str}.
+        Returns {"points": (k, 2) px, "outlines": list of (m, 2) px polylines, "sim": list of
+        (law, (m, 2) px polyline, RGB): each simulation's block}.
     Returns the number of frames logged.
     """
     import rerun as rr
@@ -220,9 +255,17 @@ def _log_overlay(rec, path: str, ov: dict) -> None:
     if ov.get("points") is not None and len(ov["points"]):
         rec.log(f"{path}/targets", rr.Points2D(ov["points"], radii=3.0, colors=[0, 255, 0]))
     if ov.get("outlines"):
-        rec.log(f"{path}/outline", rr.LineStrips2D(ov["outlines"], colors=[255, 128, 0]))
-    if ov.get("label"):
-        rec.log(f"{path}/label", rr.TextLog(ov["label"]))
+        rec.log(f"{path}/outline", rr.LineStrips2D(ov["outlines"], colors=[255, 128, 0], radii=-2.0))
+    # thin and on top (η_e's topmost): a simulated block that matches the measured one leaves the
+    # orange visible around it
+    for law, q, colour in ov.get("sim") or ():
+        order = 32.0 if law == "eta_e" else 31.0
+        rec.log(
+            f"{path}/sim_{law}",
+            rr.LineStrips2D(
+                [q], colors=[colour], radii=-0.75, draw_order=order, labels=[f"sim {law}"], show_labels=False
+            ),
+        )
 
 
 def experiment_blueprint(block_paths: list[str], has_video: bool = True, focus=None):
@@ -260,7 +303,8 @@ def experiment_blueprint(block_paths: list[str], has_video: bool = True, focus=N
     extra.append(rrb.TimeSeriesView(origin="experiment/table", name="table"))
     left = [rrb.Spatial2DView(origin="experiment/video", name="video")] if has_video else []
     left.append(rrb.TextLogView(origin="experiment", name="events"))
-    panel = None
+    # always on the ``time`` timeline (the film's ``frame`` timeline would hide every plot)
+    panel = rrb.TimePanel(timeline=TIMELINE, play_state="paused")
     if focus is not None:
         _, t0, t1 = focus
         panel = rrb.TimePanel(
@@ -276,26 +320,51 @@ def experiment_blueprint(block_paths: list[str], has_video: bool = True, focus=N
             rrb.Vertical(rrb.Vertical(*plots), rrb.Vertical(*res), rrb.Tabs(*extra), row_shares=[3, 2, 2]),
             column_shares=[1, 1],
         ),
-        *([panel] if panel is not None else []),
+        panel,
         collapse_panels=True,
     )
 
 
-def campaign_blueprint():
-    """Restitution vs slenderness plots for a campaign."""
+#: The campaign recording's x axis: h/b × 1000 on a sequence timeline (a viewer's plots take their
+#: x from a timeline, and sequence timelines hold integers).
+HB_TIMELINE = "h_over_b_x1000"
+
+
+def campaign_blueprint(hb_x1000: tuple[int, int] | None = None):
+    """η vs h/b as a scatter plot (one marker series per experiment, η_H and the truth as
+    references), the campaign's summary (one text document) and the experiments' log.
+
+    ``hb_x1000``: (smallest, largest) h/b × 1000 of the experiments; the plot's x axis shows all
+    of them (a viewer otherwise shows a window around its time cursor).
+    """
     import rerun.blueprint as rrb
 
+    axis = None
+    if hb_x1000 is not None:
+        lo, hi = hb_x1000
+        pad = max(500, (hi - lo) // 6)
+        axis = rrb.TimeAxis(
+            view_range=rrb.TimeRange(
+                start=rrb.TimeRangeBoundary.absolute(seq=lo - pad), end=rrb.TimeRangeBoundary.absolute(seq=hi + pad)
+            )
+        )
     return rrb.Blueprint(
         rrb.Horizontal(
-            rrb.Vertical(
-                rrb.Spatial2DView(origin="campaign/eta_vs_hb", name="η_e vs h/b (y down: −η_e); click a point"),
-                rrb.TimeSeriesView(origin="campaign/eta", name="η vs h/b (x axis: h/b × 1000)"),
+            rrb.TimeSeriesView(
+                origin="campaign",
+                contents=["+ campaign/eta_vs_hb/**", "+ campaign/reference/**"],
+                name="η vs h/b (x axis: h/b × 1000); click a marker for its experiment",
+                axis_x=axis,
+                plot_legend=rrb.PlotLegend(corner="RightBottom"),
             ),
             rrb.Vertical(
-                rrb.TextDocumentView(origin="campaign/eta_vs_hb", name="experiment"),
-                rrb.TextLogView(origin="campaign", name="experiments"),
+                rrb.TextDocumentView(origin="campaign/summary", name="campaign"),
+                rrb.TextLogView(origin="campaign/experiments", name="experiments"),
+                row_shares=[3, 1],
             ),
-        )
+            column_shares=[3, 2],
+        ),
+        rrb.TimePanel(timeline=HB_TIMELINE, play_state="paused"),
     )
 
 

@@ -117,7 +117,7 @@ class TargetsConfig:
         How every object is followed unless it names its own ``style``: printed
         markers, dot targets, the block's outline, optical flow in a region, or
         ``markerless`` (the region's own texture and edges registered against a
-        keyframe; see :mod:`rocklab.tracking.video.targets._markerless`).
+        keyframe; see "Markers or none" in the lab guide).
     dictionary : str
         OpenCV predefined dictionary name (``DICT_4X4_50``, ``DICT_APRILTAG_36h11``...).
     marker_size_m : float or None

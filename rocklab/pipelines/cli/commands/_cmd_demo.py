@@ -2,7 +2,25 @@
 
 from __future__ import annotations
 
+import shutil
+import sys
+from pathlib import Path
+
 from .._cli_base import count
+
+
+def viewer_command() -> str:
+    """How to call Rerun's viewer from here: ``rerun`` when it is on the PATH, else the one
+    installed beside this Python (``.venv/bin/rerun`` after ``make demo``, relative when it can be)."""
+    if shutil.which("rerun"):
+        return "rerun"
+    exe = Path(sys.executable).parent / "rerun"
+    if not exe.is_file():
+        return "rerun"
+    try:
+        return str(exe.relative_to(Path.cwd()))
+    except ValueError:
+        return str(exe)
 
 
 def register(sub):
@@ -25,8 +43,9 @@ def run(args) -> int:
     res, t = run_demo(args.out, workers=args.workers, progress=not args.no_progress)
     print(res.summary_text())
     print(f"(rendered sessions in {t['render_s']:.0f} s, campaign in {t['campaign_s']:.0f} s)")
+    rerun = viewer_command()
     print(
         f"look: {args.out}/results/campaign.csv, {args.out}/results/figures/, "
-        f"rerun {args.out}/results/campaign.rrd, rerun {args.out}/results/experiments/<run>/session.rrd"
+        f"{rerun} {args.out}/results/campaign.rrd, {rerun} {args.out}/results/experiments/<run>/session.rrd"
     )
     return 0 if res.n_ok == len(res.runs) else 1

@@ -159,3 +159,44 @@ def test_kind_is_checked():
         TrackConfig.from_dict(
             {"targets": {"style": "markerless"}, "objects": [{"id": "b", "kind": "pont", "roi": [0, 0, 9, 9]}]}
         )
+
+
+def test_no_scale_stays_no_scale_when_the_last_frame_is_lost():
+    """A markerless object has no metric scale: x_m, y_m empty and W-TRACK-NOSCALE, also when its
+    last frame is lost (the lost frame's default flag had claimed metres: x_m = x_px - W/2, 'm')."""
+    frames, truth, _ = _disk_film(seed=4, mark=True)
+    frames = frames[:-3] + [np.full_like(frames[0], 150)] * 3  # the object gone at the end
+    res, codes = _track(frames)
+    tr = res["ball"]
+    assert tr.status[-1] != "ok" and tr.ok.sum() >= len(frames) - 6
+    assert "W-TRACK-NOSCALE" in codes
+    assert np.isnan(tr.m_per_unit) and np.all(np.isnan(tr.x_m)) and np.all(np.isnan(tr.y_m))
+    assert np.nanmax(np.abs(tr.x_px[tr.ok] - truth[tr.ok, 0] - (tr.x_px[0] - truth[0, 0]))) < 1.0
+
+
+def test_preview_draws_a_point_without_an_angle(tmp_path, run_cli):
+    """`track preview` of a kind = "point" object: the sheet is drawn (a NaN angle crashed it, exit 3)."""
+    import cv2
+    from _render import write_video
+
+    frames, truth, _ = _disk_film(seed=5)
+    write_video(tmp_path / "film.mkv", frames[:30], 25.0)
+    u0, v0 = truth[0]
+    (tmp_path / "track.toml").write_text(
+        '[targets]\nstyle = "markerless"\n[reference]\nlevel = "none"\n[[objects]]\nid = "ball"\nkind = "point"\n'
+        f"roi = [{round(u0 - R - 8)}, {round(v0 - R - 8)}, {round(2 * R + 16)}, {round(2 * R + 16)}]\n"
+    )
+    rc, out, err = run_cli(
+        "track",
+        "preview",
+        tmp_path / "film.mkv",
+        "--config",
+        tmp_path / "track.toml",
+        "-o",
+        tmp_path / "sheet.png",
+        "--frames",
+        4,
+    )
+    assert rc == 0, err
+    sheet = cv2.imread(str(tmp_path / "sheet.png"))
+    assert sheet is not None and sheet.shape[0] >= H and sheet.shape[1] >= W

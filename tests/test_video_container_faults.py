@@ -268,3 +268,50 @@ def test_an_av1_film_is_read_by_pyav_where_opencv_cannot(tmp_path, run_cli, ext)
     np.testing.assert_allclose(tr["t_s"], t, rtol=0, atol=1e-9)
     assert (tr["status"] == "ok").all()
     assert np.max(np.abs(tr["theta_rad"] - _theta(t + 0.05))) < math.radians(0.3)
+
+
+def test_a_film_whose_packets_carry_no_times_is_counted_not_timed(tmp_path, monkeypatch):
+    """Every packet at time 0 (a muxer that wrote no times): the frames are counted and timed by the
+    given rate (was a ZeroDivisionError, exit 3, even with --fps)."""
+    import dataclasses
+
+    from rocklab.tracking.video import _video
+
+    path = tmp_path / "cfr.mkv"
+    _write(path, [_marker_frame(t) for t in _theta(np.arange(12) / 30.0)], np.arange(12) * 33, Fraction(1, 1000))
+    real = _video.container_info
+
+    def timeless(p):
+        ci = real(p)
+        return dataclasses.replace(ci, frame_times_s=np.zeros(len(ci.frame_times_s)), rate_hz=None)
+
+    monkeypatch.setattr(_video, "container_info", timeless)
+    info = probe_video(path)
+    assert info.n_frames == 12 and info.frame_times_s is None
+    b = track_video(path, TrackConfig.from_dict(CFG), fps=30.0)["block_1"]
+    np.testing.assert_allclose(b.t_s, np.arange(12) / 30.0)
+    assert np.nanmax(np.abs(b.theta_rad - _theta(b.t_s))) < math.radians(0.3)
+
+
+def test_an_mp4_cut_before_its_index_names_the_cause(tmp_path, run_cli):
+    """An MP4 whose index (moov, written last) was cut off: exit 2 saying so and to copy it again
+    (was "convert it to .mkv/.mp4" for a file that is one)."""
+    import av
+
+    path = tmp_path / "cut.mp4"
+    with av.open(str(path), "w") as c:
+        s = c.add_stream("libx264", rate=25)
+        s.width, s.height, s.pix_fmt = 160, 120, "yuv420p"
+        for k in range(25):
+            f = np.full((120, 160), 40 + 4 * k, np.uint8)
+            for pkt in s.encode(av.VideoFrame.from_ndarray(f, format="gray")):
+                c.mux(pkt)
+        for pkt in s.encode():
+            c.mux(pkt)
+    data = path.read_bytes()
+    assert data.find(b"moov") > data.find(b"mdat") > 0  # the index at the end, as cameras write it
+    path.write_bytes(data[: data.find(b"moov") - 4])
+    (tmp_path / "t.toml").write_text('[targets]\nstyle = "aruco"\n[[objects]]\nid = "b"\nmarkers = [1]\n')
+    rc, out, err = run_cli("track", path, "--config", tmp_path / "t.toml")
+    assert rc == 2 and len(err.strip().splitlines()) == 1, err
+    assert "without its index" in err and "copy it again" in err and "convert" not in err

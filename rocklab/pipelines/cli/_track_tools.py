@@ -344,21 +344,13 @@ def _draw_pose(img, res, frame):
             continue
         u, v, th = float(t.x_px[i]), float(t.y_px[i]), float(t.theta_rad[i] + res.level_rad)
         L = 0.06 * max(out.shape[:2])
-        for ang, ln in ((th, L), (th + math.pi / 2, 0.6 * L)):  # object x and y axes (image v points down)
-            cv2.line(
-                out, (int(u), int(v)), (int(u + ln * math.cos(ang)), int(v - ln * math.sin(ang))), col, 2, cv2.LINE_AA
-            )
+        if math.isfinite(th):  # no axes where the angle is not measured (kind "point", a disk)
+            for ang, ln in ((th, L), (th + math.pi / 2, 0.6 * L)):  # object x and y axes (image v down)
+                p1 = (int(u + ln * math.cos(ang)), int(v - ln * math.sin(ang)))
+                cv2.line(out, (int(u), int(v)), p1, col, 2, cv2.LINE_AA)
         cv2.circle(out, (int(u), int(v)), 4, col, -1)
-        cv2.putText(
-            out,
-            f"{t.object}: theta {math.degrees(t.theta_rad[i]):.4g} deg",
-            (8, 46 + 20 * k),
-            cv2.FONT_HERSHEY_SIMPLEX,
-            0.55,
-            col,
-            2,
-            cv2.LINE_AA,
-        )
+        angle = f"theta {math.degrees(t.theta_rad[i]):.4g} deg" if math.isfinite(th) else "position only"
+        cv2.putText(out, f"{t.object}: {angle}", (8, 46 + 20 * k), cv2.FONT_HERSHEY_SIMPLEX, 0.55, col, 2, cv2.LINE_AA)
     return out
 
 

@@ -26,6 +26,7 @@ __all__ = [
     "orient",
     "UPRIGHT",
     "luma",
+    "why_unopenable",
 ]
 
 #: The display matrix of a picture shown as stored (see :func:`frame_orientation`).
@@ -270,3 +271,20 @@ def container_info(path) -> ContainerInfo:
         # cut short still claims its whole length
         n_header = int(round(duration_s * rate))
     return ContainerInfo(times, aspect, order, rot, rate, dropped, n_header, q, ori, size)
+
+
+def why_unopenable(p) -> str:
+    """Why a file no reader opens is not a video, with the fix (one line)."""
+    try:
+        with open(p, "rb") as f:
+            head = f.read(12)
+    except OSError:
+        head = b""
+    if head[4:8] in (b"ftyp", b"mdat", b"wide", b"free"):
+        # an MP4/MOV's index (moov) is written when the recording stops: a cut copy has none
+        return (
+            "an MP4/MOV file without its index (moov box), so no frame can be found: the recording "
+            "or the copy was cut short; copy it again from the camera or card (a cut recording can "
+            "be rebuilt with a tool such as untrunc and a good file of the same camera)"
+        )
+    return "cannot open as a video (unknown format or corrupt file); convert it to .mkv/.mp4 or an image sequence 'dir/%05d.png'"

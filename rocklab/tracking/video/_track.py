@@ -346,13 +346,13 @@ def assemble_tracks(observations, config: TrackConfig, fps: float, width_px: int
     for o in config.objects:
         a = {k: np.full(n, np.nan) for k in ("X", "Y", "th", "sig", "scale", "q")}
         st = np.full(n, "lost", dtype=object)
-        metric = True
+        metric = False  # metres only where a measured frame says so: a lost frame's flag is a default
         for r in by[o.id]:
             i = pos[r.frame]
             a["X"][i], a["Y"][i], a["th"][i], a["sig"][i] = r.X, r.Y, r.theta_rad, r.sigma_theta_rad
             a["scale"][i], a["q"][i] = r.scale, r.quality
             st[i] = r.status
-            metric = r.metric
+            metric = metric or (r.status == "ok" and r.metric)
         # An angle step no rocking block makes between frames is a misdetection, not motion.
         th = a["th"]
         okk = np.flatnonzero(st == "ok")

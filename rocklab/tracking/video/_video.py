@@ -30,7 +30,7 @@ from pathlib import Path
 import numpy as np
 
 from ..._errors import InputError
-from ._container import UPRIGHT, container_info, frame_orientation, luma, orient, shown_pts
+from ._container import UPRIGHT, container_info, why_unopenable, frame_orientation, luma, orient, shown_pts
 
 __all__ = ["VideoInfo", "probe_video", "iter_video_frames", "container_info"]
 
@@ -124,10 +124,7 @@ def _open(path):
     cap = cv2.VideoCapture(str(p))
     if not cap.isOpened():
         cap.release()
-        raise InputError(
-            f"{p}: cannot open as a video (unknown format or corrupt file); "
-            "convert it to .mkv/.mp4 or an image sequence 'dir/%05d.png'"
-        )
+        raise InputError(f"{p}: {why_unopenable(p)}")
     return cap
 
 
@@ -162,6 +159,10 @@ def probe_video(path) -> VideoInfo:
     if not np.isfinite(fps) or fps <= 0 or fps > 1e5 or "%" in str(path):
         fps = None
     times = ci.frame_times_s
+    if times is not None and len(times) > 1 and not float(times[-1]) > float(times[0]):
+        # a muxer that wrote no times (every frame at 0): the frames are counted, not timed; the
+        # rate is the option's or OpenCV's, and without either the tracker asks for --fps
+        n, times = len(times), None
     if times is not None and len(times) > 1:
         # count and rate from the packets: OpenCV's are estimates (a Matroska film's duration x a
         # rate rounded from its 1 ms ticks; a variable-rate phone film reports its time base)

@@ -55,6 +55,20 @@ def render(seed=0):
     return frames, theta, roi
 
 
+def grey_frames(path) -> list:
+    """Every frame of the film at ``path`` as grey uint8 images (H, W), read as a user would with
+    ``cv2.VideoCapture``."""
+    cap = cv2.VideoCapture(str(path))
+    got = []
+    while True:
+        ok, img = cap.read()
+        if not ok:
+            break
+        got.append(cv2.cvtColor(img, cv2.COLOR_BGR2GRAY))
+    cap.release()
+    return got
+
+
 def plain_opencv(frames, roi):
     x, y, w, h = (int(v) for v in roi)
     mask = np.zeros_like(frames[0])
@@ -138,14 +152,7 @@ def decode_included(frames, theta, roi) -> None:
         )
 
         def plain(p):
-            cap = cv2.VideoCapture(str(p))
-            got = []
-            while True:
-                ok, img = cap.read()
-                if not ok:
-                    break
-                got.append(cv2.cvtColor(img, cv2.COLOR_BGR2GRAY))
-            return plain_opencv(got, roi)
+            return plain_opencv(grey_frames(p), roi)
 
         theta = np.tile(theta, REPEAT)
         print(
@@ -184,17 +191,11 @@ def verification_cost(frames, roi, repeats: int = 3) -> None:
     films = [("rendered 1920x1080", frames, roi)]
     real = Path(__file__).resolve().parents[2] / "shared" / "data" / "video" / "pendulum_film2_vga.mp4"
     if real.exists():
-        cap = cv2.VideoCapture(str(real))
-        got = []
-        while True:
-            ok, img = cap.read()
-            if not ok:
-                break
-            got.append(cv2.cvtColor(img, cv2.COLOR_BGR2GRAY))
+        got = grey_frames(real)
         films.append((f"real pendulum film {got[0].shape[1]}x{got[0].shape[0]}", got, (310, 66, 70, 74)))
     else:
         print(f"  (real film not found at {real}: rendered frames only)")
-    print("verification cost: the same tracker with every pose accepted unchecked, 1 thread, best of 3")
+    print(f"verification cost: the same tracker with every pose accepted unchecked, 1 thread, best of {repeats}")
     cv2.setNumThreads(1)
     for name, fr, r in films:
         best = {"verified": np.inf, "unverified": np.inf}

@@ -61,6 +61,24 @@ def _held_scale(dev) -> float:
     return float(np.percentile(dev, 90) / 1.6449) if dev.size else 0.0
 
 
+#: Why a record has no release: the block was not held still before it moved.
+STARTS_IN_MOTION = (
+    "record starts in motion: no rest plateau before release; keep ~0.1 s of the block at rest before the thread burns"
+)
+#: Why a record has no release: nothing departs from the first level.
+NEVER_MOVES = "block never moves: no release in the record"
+
+
+def _no_release(message, index, theta0_rad, sigma_rad, n_plateau) -> ReleaseInfo:
+    """A record without a release (``found=False``, ``t_s`` NaN) and why."""
+    return ReleaseInfo(False, float("nan"), int(index), float(theta0_rad), float(sigma_rad), int(n_plateau), message)
+
+
+def _at_zero(theta0_rad) -> str:
+    """Why a record has no release: its plateau is within noise of upright."""
+    return f"initial angle {theta0_rad:.3g} rad is within noise of 0: no tilted start (thread-burn release) found"
+
+
 def detect_release(t_s, theta_rad, min_plateau: int = 3) -> ReleaseInfo:
     """Find the initial rest plateau at θ0 and the moment the block starts to move.
 
@@ -110,16 +128,8 @@ def _noise_release(t_s, theta_rad, min_plateau: int = 3) -> ReleaseInfo:
     if not run3.any():
         sig = _held_scale(y - float(np.median(y)))
         if abs(lvl) < 10 * max(sig, 1e-9):
-            return ReleaseInfo(
-                False,
-                float("nan"),
-                n,
-                lvl,
-                sig,
-                n,
-                f"initial angle {lvl:.3g} rad is within noise of 0: no tilted start (thread-burn release) found",
-            )
-        return ReleaseInfo(False, float("nan"), n, lvl, sig, n, "block never moves: no release in the record")
+            return _no_release(_at_zero(lvl), n, lvl, sig, n)
+        return _no_release(NEVER_MOVES, n, lvl, sig, n)
     g = int(np.argmax(run3))
     i = g
     while i > 0 and y[i - 1] * s > y[i] * s:
@@ -148,26 +158,9 @@ def _noise_release(t_s, theta_rad, min_plateau: int = 3) -> ReleaseInfo:
     a_pl = 2.0 * abs(np.polynomial.polynomial.polyfit(t[:n_pl] - t[0], y[:n_pl], 2)[2]) if n_pl >= 3 else np.inf
     a_rel = 2.0 * abs(y[g] - med) / max(t[g] - t[n_pl], 1e-12) ** 2
     if n_pl < m0 // 2 or a_pl > 0.05 * a_rel:
-        return ReleaseInfo(
-            False,
-            float("nan"),
-            0,
-            med,
-            sig,
-            0,
-            "record starts in motion: no rest plateau before "
-            "release; keep ~0.1 s of the block at rest before the thread burns",
-        )
+        return _no_release(STARTS_IN_MOTION, 0, med, sig, 0)
     if abs(med) < 10 * max(sig, 1e-9):
-        return ReleaseInfo(
-            False,
-            float("nan"),
-            i,
-            med,
-            sig,
-            n_pl,
-            f"initial angle {med:.3g} rad is within noise of 0: no tilted start (thread-burn release) found",
-        )
+        return _no_release(_at_zero(med), i, med, sig, n_pl)
     moved = np.flatnonzero(s * (med - y[i : g + 1]) > 6.0 * sig)  # first sample clearly under way
     return ReleaseInfo(True, float(t[max(i - 1, 0)]), i + int(moved[0]) if moved.size else g, med, sig, n_pl)
 
@@ -193,16 +186,7 @@ def _threshold_release(t_s, theta_rad, min_plateau: int = 3) -> ReleaseInfo:
     med = float(np.median(y[:m0]))
     floor = max(1e-3 * abs(med), 1e-7)
     if np.ptp(fit0) > max(4.0 * sig, floor) or np.any(np.abs(y[:m0] - med) > max(8.0 * sig, floor)):
-        return ReleaseInfo(
-            False,
-            float("nan"),
-            0,
-            med,
-            sig,
-            0,
-            "record starts in motion: no rest plateau before "
-            "release; keep ~0.1 s of the block at rest before the thread burns",
-        )
+        return _no_release(STARTS_IN_MOTION, 0, med, sig, 0)
     # grow the plateau until the departure: 3 consecutive samples beyond tolerance on the same
     # side (a released block accelerates away; an isolated noise spike does not persist)
     i = m0
@@ -220,7 +204,7 @@ def _threshold_release(t_s, theta_rad, min_plateau: int = 3) -> ReleaseInfo:
             sig = float(np.std(y[:i], ddof=1))
             tol = max(6.0 * sig, floor)
     if i >= n:
-        return ReleaseInfo(False, float("nan"), n, med, sig, n, "block never moves: no release in the record")
+        return _no_release(NEVER_MOVES, n, med, sig, n)
     # the departure is quadratic in time: step back to where |θ − θ0| was ~1 σ
     sig = float(np.std(y[:i], ddof=1))
     j = i
@@ -230,15 +214,7 @@ def _threshold_release(t_s, theta_rad, min_plateau: int = 3) -> ReleaseInfo:
     med = float(np.median(y[:n_pl]))  # plateau only: early-motion samples would bias θ0 towards 0
     sig = float(np.std(y[:n_pl], ddof=1))
     if abs(med) < 10 * max(sig, 1e-6):
-        return ReleaseInfo(
-            False,
-            float("nan"),
-            i,
-            med,
-            sig,
-            n_pl,
-            f"initial angle {med:.3g} rad is within noise of 0: no tilted start (thread-burn release) found",
-        )
+        return _no_release(_at_zero(med), i, med, sig, n_pl)
     return ReleaseInfo(True, float(t[max(j - 1, 0)]), i, med, sig, n_pl)
 
 

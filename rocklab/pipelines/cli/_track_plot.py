@@ -69,12 +69,14 @@ def track_figure(res, path, title: str = ""):
         ax1.legend(loc="upper right", fontsize=7)
         ax2.plot(t, tr.quality, lw=0.7, color="k", label="quality")
         ax2.set_ylim(-0.15, 1.05)
-        counts = []
-        for st, colour in STATUS_COLOURS.items():
+        # every status but ok is marked (one the table does not name, in grey)
+        unnamed = sorted(set(tr.status.tolist()) - set(STATUS_COLOURS) - {"ok"})
+        for st in [*STATUS_COLOURS, *unnamed]:
             m = tr.status == st
             if m.any():
-                ax2.vlines(t[m], -0.14, -0.02, color=colour, lw=1.2, label=f"{st} ({int(m.sum())})")
-                counts.append(st)
+                ax2.vlines(
+                    t[m], -0.14, -0.02, color=STATUS_COLOURS.get(st, "0.6"), lw=1.2, label=f"{st} ({int(m.sum())})"
+                )
         ax2.set_ylabel("quality (strip: not ok)")
         ax2.set_xlabel("t, s")
         ax2.legend(loc="lower right", fontsize=7, ncol=2)

@@ -9,22 +9,23 @@ __all__ = ["make_detector"]
 
 
 class _MixedDetector:
-    """Objects of different target styles: one detector per style, results merged."""
+    """Objects of different target styles: one detector per style, results merged.
+
+    ``parts``: (object ids, detector) per style; questions about one object go to its own.
+    """
 
     def __init__(self, parts):
         self.parts = parts
 
     def detect(self, gray, frame):
         out = {}
-        for d in self.parts:
+        for _, d in self.parts:
             out.update(d.detect(gray, frame))
         return out
 
     def _ask(self, method, oid):
-        for d in self.parts:
-            if hasattr(d, method) and oid in getattr(d, "trackers", {oid: None}):
-                return getattr(d, method)(oid)
-        return None
+        d = next((d for ids, d in self.parts if oid in ids), None)
+        return getattr(d, method)(oid) if hasattr(d, method) else None
 
     def lost_reason(self, oid):
         """Why object ``oid`` was lost in the last frame, from its own style's detector."""
@@ -48,8 +49,8 @@ def make_detector(config, pm, first_gray):
             objects=tuple(o for o in config.objects if style(o) == st),
             targets=dataclasses.replace(config.targets, style=st),
         )
-        parts.append(_make_single(sub, pm, first_gray))
-    return parts[0] if len(parts) == 1 else _MixedDetector(parts)
+        parts.append(({o.id for o in sub.objects}, _make_single(sub, pm, first_gray)))
+    return parts[0][1] if len(parts) == 1 else _MixedDetector(parts)
 
 
 def _make_single(config, pm, first_gray):

@@ -59,12 +59,25 @@ def symmetry_centre(region) -> np.ndarray:
     The least-squares point of ``sum(((p - c) x g)^2)``: linear in ``c``, so solved in closed
     form; a disk's centre wherever it sits in the region.
     """
-    x, y, gx, gy = _gradients(region)
+    return _centre_of(*_gradients(region))
+
+
+def _centre_of(x, y, gx, gy) -> np.ndarray:
     # (p - c) x g = (x gy - y gx) - (cx gy - cy gx): least squares in (cx, cy)
     A = np.column_stack((gy.ravel(), -gx.ravel()))
     b = (x * gy - y * gx).ravel()
     c, *_ = np.linalg.lstsq(A, b, rcond=None)
     return c
+
+
+def _share_of(x, y, gx, gy, centre) -> float:
+    """:func:`turn_share` from the region's coordinates and gradients (:func:`_gradients`)."""
+    if float(np.max(np.hypot(gx, gy))) < FLAT_GRADIENT:
+        return float("nan")
+    x, y = x - centre[0], y - centre[1]
+    tangential = float(np.sum((x * gy - y * gx) ** 2))
+    radial = float(np.sum((x * gx + y * gy) ** 2))
+    return tangential / (tangential + radial)
 
 
 def turn_share(region, centre=None) -> float:
@@ -94,21 +107,16 @@ def turn_share(region, centre=None) -> float:
     >>> 0.4 < turn_share(rng.random((81, 81)) * 255) < 0.6
     True
     """
-    x, y, gx, gy = _gradients(region)
-    if float(np.max(np.hypot(gx, gy))) < FLAT_GRADIENT:
-        return float("nan")
-    cx, cy = symmetry_centre(region) if centre is None else centre
-    x, y = x - cx, y - cy
-    tangential = float(np.sum((x * gy - y * gx) ** 2))
-    radial = float(np.sum((x * gx + y * gy) ** 2))
-    return tangential / (tangential + radial)
+    g = _gradients(region)
+    return _share_of(*g, _centre_of(*g) if centre is None else centre)
 
 
 def theta_unobservable(region):
     """Why the angle of the object in ``region`` (h, w) cannot be measured and its centre of
     symmetry (px from pixel (0, 0), (2,)); ``(None, None)`` when the angle can be measured."""
-    c = symmetry_centre(region)
-    share = turn_share(region, c)
+    g = _gradients(region)
+    c = _centre_of(*g)
+    share = _share_of(*g, c)
     if not share >= MIN_TURN_SHARE:
         return (
             f"its appearance barely changes when it turns (turning share of its gradients "

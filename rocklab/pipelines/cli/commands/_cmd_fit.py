@@ -26,7 +26,7 @@ def register(sub):
     p = sub.add_parser(
         "fit",
         help="restitution calibration: eta_e, eta_mat, inverse k, k regression",
-        description=__doc__.split("\n\n")[0],
+        description=(__doc__ or "").split("\n\n")[0],
     )
     fs = p.add_subparsers(dest="fit_command", metavar="WHAT")
 

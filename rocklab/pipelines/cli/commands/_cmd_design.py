@@ -18,7 +18,7 @@ import sys
 from ...._errors import InputError
 
 
-from .._cli_base import count
+from .._cli_base import add_base_motion_args, base_motion_from_args, count
 from .._cli_base import emit_json as _emit
 
 
@@ -106,7 +106,28 @@ def register(sub):
     p.add_argument("--beta", type=float, help="arch inclusion angle, rad")
     p.add_argument("--thickness", type=float, help="arch thickness t_a, m")
     p.add_argument("--radius", type=float, help="arch centre-line radius r_a, m")
-    p.add_argument("--json", action="store_true")
+    add_base_motion_args(p)
+    p.add_argument(
+        "--eta",
+        type=float,
+        default=None,
+        help="time history: restitution at every impact (default the mechanism's own, Table I; "
+        "the wall, asymmetric frame and arch have none and need it)",
+    )
+    p.add_argument(
+        "--kappa",
+        choices=("kappa1", "kappa2"),
+        default="kappa1",
+        help="time history: scaling of the equivalent blocks, Eq. 19 (kappa1) or Eq. 20 (kappa2)",
+    )
+    p.add_argument("--phi0", type=float, default=0.0, help="time history: initial rotation, rad (signed)")
+    p.add_argument(
+        "-o",
+        "--output",
+        default=None,
+        help="time history: write t_s and phi_<model>_rad of the mechanism and its equivalent blocks (CSV)",
+    )
+    p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
     p.set_defaults(func=run)
 
 
@@ -286,6 +307,8 @@ def _R_alpha(args):
 
 def run_equivalent(args) -> int:
     from .... import models as m
+    from ....blocks import G as G_M_S2
+    from ....models import mechanisms as mm
 
     mech = args.mechanism
     extra = {}
@@ -298,18 +321,34 @@ def run_equivalent(args) -> int:
             "wall": lambda: m.wall_parameters(R, a, args.alpha_I),
         }[mech]()
         out = fp.to_dict()
+        if mech == "wall":
+            w = mm.wall_mechanism(R, a, alpha_I=args.alpha_I)
+            pair = (w, None)
+        else:
+            # Table I: the strut and the symmetric frame are the block with their own p (alpha_I)
+            aI = {"block": args.alpha_I, "strut": 1.0}.get(mech, G_M_S2 / (R * fp.p_rad_s**2))
+            pair = (mm.block_mechanism(R, a, aI, eta=fp.eta, name=mech), None)
     elif mech == "asym-frame":
         _need(args, "b", "H", "H1", "L", "h")
         pos, neg = m.asymmetric_frame(args.b, args.H, args.H1, args.L, args.h, *args.masses)
         fpp, fpn = pos.parameters(), neg.parameters()
         out = fpp.to_dict()
+        pair = (pos, neg)
         extra = {"negative": fpn.to_dict()}
     else:
         _need(args, "beta", "thickness", "radius")
-        mm, info = m.arch_mechanism(args.beta, args.thickness, args.radius)
-        out = mm.parameters().to_dict()
+        arch, info = m.arch_mechanism(args.beta, args.thickness, args.radius)
+        out = arch.parameters().to_dict()
+        pair = (arch, None)
         extra = {"hinges": list(info["hinges"]), "faces": info["faces"]}
     out.update(extra)
+    base = base_motion_from_args(args)
+    if base is None:
+        for opt in ("eta", "output"):
+            if getattr(args, opt) is not None:
+                raise InputError(f"equivalent {mech}: --{opt} is for a time history; add --base-motion FILE")
+    else:
+        out["time_history"] = _equivalent_history(args, mech, base, pair)
     if args.json:
         _emit(out)
     else:
@@ -317,5 +356,34 @@ def run_equivalent(args) -> int:
         print(f"{mech}: " + ", ".join(f"{k} = {out[k]:.5g}" for k in keys))
         if "negative" in out:
             print("negative direction: " + ", ".join(f"{k} = {out['negative'][k]:.5g}" for k in keys))
+        for name, r in out.get("time_history", {}).get("models", {}).items():
+            over = (
+                f"overturned at {r['t_overturn_s']:.4g} s" if r["overturned"] else f"peak {r['peak_ratio']:.4g} phi_cr"
+            )
+            print(f"  {name:9s}: {r['n_impacts']} impacts, {over}, status {r['status']}")
+            if r["status"] == "falling":
+                print(f"rocklab equivalent: note: {name}: {r['message']}", file=sys.stderr)
     sys.stdout.flush()
     return 0
+
+
+def _equivalent_history(args, mech: str, base, pair) -> dict:
+    """The mechanism and its equivalent blocks under ``base`` (DeJong & Dimitrakopoulos Fig. 14)."""
+    from ...._io import write_frame_atomic
+    from ....models import mechanisms as mm
+
+    pos, neg = pair
+    hist = mm.mechanism_time_histories(pos, base, eta=args.eta, negative=neg, phi0_rad=args.phi0, kappa=args.kappa)
+    if args.output:
+        import pandas as pd
+
+        cols = {"t_s": base.t_s}
+        for name, r in hist.items():
+            cols[f"phi_{name}_rad"] = r.phi_rad
+        write_frame_atomic(args.output, pd.DataFrame(cols))
+    return {
+        "base_motion": base.name,
+        "eta": next(iter(hist.values())).eta,
+        "kappa": args.kappa,
+        "models": {name: r.to_dict() for name, r in hist.items()},
+    }

@@ -136,7 +136,7 @@ def _oas(args):
     if args.list:
         ins.append(("list --list", Path(args.list)))
     try:
-        items = expand_records(args.record, args.list)
+        items = expand_records(args.record, args.list, recursive=getattr(args, "recursive", False))
     except Exception:  # noqa: BLE001 - an unreadable list is reported by the command itself
         items = [(None, r, "") for r in args.record]
     ins += [("record", Path(p)) for _, p, _ in items]

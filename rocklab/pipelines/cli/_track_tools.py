@@ -62,7 +62,7 @@ def _propose(video, info, gray):
     return props, min(window, duration) if duration else window
 
 
-def track_init(video, out, *, objects=(), table=None, marker_size_m=None, preview=None, side=(False, False)):
+def track_init(video, out, *, objects=(), table=None, marker_size_m=None, preview=None, side=(False, False), fps=None):
     """Write a commented ``track.toml`` for ``video`` (and a preview PNG); returns (config, notes).
 
     Without markers and without ``objects``, the objects that move in the first seconds and the
@@ -75,6 +75,8 @@ def track_init(video, out, *, objects=(), table=None, marker_size_m=None, previe
         ``NAME=x,y,w,h`` regions (px, first frame), followed markerless.
     table : str or None
         ``x,y,w,h`` of a markerless table (round its top edge: it levels the angles).
+    fps : float or None
+        Frame rate written to the config (``--fps``: an image folder or a film without one).
     marker_size_m : float or None
         Printed marker side, m, when markers are used.
     preview : path or None
@@ -134,14 +136,14 @@ def track_init(video, out, *, objects=(), table=None, marker_size_m=None, previe
         gray,
         regions=regions or None,
         table_roi=troi,
-        fps=None if info.fps else 50.0,
+        fps=fps if fps else (None if info.fps else 50.0),
         marker_size_m=marker_size_m,
         found=found,
         level_line_px=line,
     )
     notes = pnotes + notes
-    if not info.fps:
-        notes.append("the container has no frame rate: fps = 50 written; correct it")
+    if not info.fps and not fps:
+        notes.append("the film has no frame rate: fps = 50 written; correct it (or give --fps)")
     head = [
         f"# track.toml written by 'rocklab track init' from {video.name} ({info.width_px}x{info.height_px}, "
         f"{info.n_frames} frames, {info.fps or 'unknown'} fps)",

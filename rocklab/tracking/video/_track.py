@@ -461,8 +461,8 @@ def track_video(path, config: TrackConfig, fps: float | None = None, progress: b
             times = np.column_stack((times, times + half)).ravel()
         n_expected = 2 * info.n_frames
     if rate is None:
-        raise InputError(f"{path}: the container has no frame rate; pass --fps N "
-                         "(or set [video] fps in the config)")
+        raise InputError(f"{path}: the film has no frame rate (an image folder has one only from its timestamps.csv); "
+                         "pass --fps N (or set [video] fps in the config)")
     v = config.video
     start, stop = v.start_frame, v.stop_frame
     ref_frame = config.reference.board.frame if config.reference.board is not None else start

@@ -31,6 +31,7 @@ import numpy as np
 
 from ..._errors import InputError
 from ._container import UPRIGHT, container_info, why_unopenable, frame_orientation, luma, orient, shown_pts
+from .sequences import FrameStoreReader, frame_store
 
 __all__ = ["VideoInfo", "probe_video", "iter_video_frames", "container_info"]
 
@@ -131,6 +132,9 @@ def _open(path):
 def probe_video(path) -> VideoInfo:
     """Open ``path`` and read its frame count, rate, size, pixel aspect and frame times.
 
+    ``path`` is a video file, a folder of numbered frames or a high-speed camera's file (see
+    :func:`iter_video_frames`); a folder's rate and times come from its ``timestamps.csv``.
+
     Raises
     ------
     InputError
@@ -138,6 +142,11 @@ def probe_video(path) -> VideoInfo:
     """
     import cv2
 
+    store = frame_store(_open_checked(path))
+    if store is not None:  # an image folder or a high-speed camera's file: its own size, rate and times
+        dropped = store.n_dropped
+        return VideoInfo(str(path), store.n_frames, store.fps, store.width_px, store.height_px, 1.0, store.times_s,
+                         n_dropped=dropped)
     ci = container_info(path)
     n, fps, size = 0, 0.0, None
     try:  # OpenCV: count and rate where the packets have no times; image sequences
@@ -373,7 +382,8 @@ def iter_video_frames(
     Parameters
     ----------
     path : path-like
-        A video file or an OpenCV image-sequence pattern (``dir/%05d.png``).
+        A video file, a folder of numbered frames (:mod:`.sequences`), a Photron ``.cih``/``.mraw``
+        or Phantom ``.cine`` (:mod:`.sequences`), or an OpenCV image-sequence pattern (``dir/%05d.png``).
     start, stop : int, int or None
         Half-open frame range.
     prefetch : int
@@ -404,6 +414,8 @@ def iter_video_frames(
         # OpenCV's FFmpeg reader cannot convert interlaced pictures ("Cannot convert interlaced to
         # progressive frames") and returns the previous picture again, silently: decode with PyAV
         cap = _PyAVReader(path, first, gray=not color)
+    elif (store := frame_store(_open_checked(path))) is not None:
+        cap = FrameStoreReader(store, first, gray=not color)
     else:
         # PyAV for every film it opens (grey from the luma plane: no YUV -> BGR -> grey), so grey
         # and colour frames are the same frames, upright and at the same indices

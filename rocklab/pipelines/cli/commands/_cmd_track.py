@@ -33,8 +33,8 @@ def register(sub):
     )
     p.add_argument(
         "video",
-        help="video file (.mkv/.mp4/...) or image sequence 'dir/%%05d.png'; or 'init' / "
-        "'preview' followed by the video",
+        help="video file (.mkv/.mp4/...), a folder of numbered PNG/JPEG/TIFF frames (timed by its "
+        "timestamps.csv or --fps), a Photron .cih/.mraw or Phantom .cine; or 'init' / 'preview' followed by the video",
     )
     p.add_argument("video2", nargs="?", default=None, metavar="VIDEO", help=argparse.SUPPRESS)
     p.add_argument(
@@ -147,6 +147,7 @@ def _tools(args) -> int:
             marker_size_m=args.marker_size,
             preview=preview,
             side=(not args.out, not args.preview),
+            fps=args.fps,
         )
         if args.json:
             from .._cli_base import emit_json

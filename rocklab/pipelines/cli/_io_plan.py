@@ -68,13 +68,21 @@ def _track(args):
             preview = _opt(args.preview) or out.with_name(out.stem + "_init.png")
             return ins, [("-o", out), ("--preview", preview)]
         cfg_ins, _ = _track_config_inputs(_opt(args.config) or video.parent / "track.toml")
-        return ins + cfg_ins, [("-o", _opt(args.out) or video.parent / "track_preview.png")]
+        return ins + cfg_ins + _fixes(args), [("-o", _opt(args.out) or video.parent / "track_preview.png")]
     video = Path(args.video)
     cfg_ins, cfg = _track_config_inputs(_opt(args.config) or video.parent / "track.toml")
     outs = track_outputs(_opt(args.out) or video.parent / "tracks.csv")
     if cfg is None or cfg.table is None:
         outs.pop(TABLE)
-    return _video("video", video) + cfg_ins, [*outs.items(), ("--plot", _opt(getattr(args, "plot", None)))]
+    return _video("video", video) + cfg_ins + _fixes(args), [
+        *outs.items(),
+        ("--plot", _opt(getattr(args, "plot", None))),
+    ]
+
+
+def _fixes(args) -> list:
+    f = _opt(getattr(args, "corrections", None))
+    return [] if f is None else [("--corrections", f)]
 
 
 def _track3d(args):

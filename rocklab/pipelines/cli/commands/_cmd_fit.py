@@ -159,7 +159,8 @@ def _read_track(path: Path, obj: str | None, nan: str):
     y = pd.to_numeric(df["theta_rad"], errors="coerce").to_numpy(float)
     bad = ~(np.isfinite(t) & np.isfinite(y))
     if "status" in df.columns:
-        bad |= df["status"].astype(str).str.lower().ne("ok").to_numpy()
+        # a frame corrected by hand is a sample the user vouches for (tracks.csv marks it so)
+        bad |= ~df["status"].astype(str).str.lower().isin(("ok", "corrected")).to_numpy()
     if bad.any() and nan == "raise":
         line = int(df["_line"].to_numpy()[np.flatnonzero(bad)[0]])
         raise InputError(

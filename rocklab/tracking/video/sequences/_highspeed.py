@@ -37,7 +37,8 @@ class HighSpeedFilm:
     n_frames : int
     width_px, height_px : int
     fps : float or None
-        The camera's recording rate, Hz.
+        The film's frame rate, Hz: the camera's recording rate (over the MRAW's ``Save Step``
+        when it kept every k-th frame).
     times_s : ndarray (n,) or None
         Each frame's time from the file, s, the first at 0 (CINE's time block; None for MRAW).
     gain : float
@@ -99,7 +100,10 @@ def _mraw(path: Path) -> HighSpeedFilm:
     if str(info.get("Color Type", "Mono")).lower() not in ("mono", "monochrome", ""):
         raise InputError(f"{cih}: a colour MRAW ({info.get('Color Type')}); export it as grey or as an image sequence")
     n, h, w = images.shape
-    fps = float(info.get("Record Rate(fps)") or 0) or None
+    # a film saved with every k-th frame ("Save Step : k") runs at the recording rate over k
+    step = info.get("Save Step", 1)
+    step = step if isinstance(step, int) and step > 0 else 1
+    fps = float(info.get("Record Rate(fps)") or 0) / step or None
     frame = images.__getitem__
     bits = int(info.get("Color Bit", 16))
     return HighSpeedFilm(path, n, int(w), int(h), fps, None, 1.0 if bits == 8 else _gain(frame, n), bits, frame)
@@ -124,11 +128,32 @@ def _cine(path: Path) -> HighSpeedFilm:
     def frame(i: int):
         return next(frame_reader(str(path), header, start_frame=i + 1, count=1))
 
-    t = np.asarray(header.get("timestamp", ()), float)
-    times = t - t[0] if len(t) == n and n > 1 and t[-1] > t[0] else None
     fps = float(setup.FrameRate or 0) or None
-    bits = int(setup.RealBPP or bih.biBitCount)
+    times = _cine_times(np.asarray(header.get("timestamp", ()), float), n, fps, path)
+    from pycine.raw import read_bpp
+
+    bits = int(read_bpp(header))  # a packed 10-bit film is 12-bit once linearised
     return HighSpeedFilm(path, n, int(bih.biWidth), abs(int(bih.biHeight)), fps, times, _gain(frame, n), bits, frame)
+
+
+def _cine_times(t: np.ndarray, n: int, fps: float | None, path: Path) -> np.ndarray | None:
+    """The CINE's time block as frame times (s, the first at 0), or None where it has none or
+    contradicts the rate: every interval must be positive and under 10 frame periods."""
+    if len(t) != n or n < 2:
+        return None
+    d = np.diff(t)
+    bad = np.flatnonzero(~(d > 0) | (d > 10.0 / fps if fps else False))
+    if bad.size:
+        from ...._diagnostics import warn
+
+        k = int(bad[0]) + 1
+        warn(
+            "W-VIDEO-TIMES",
+            f"{path}: the time block puts frame {k} {d[k - 1]:.6g} s after frame {k - 1} "
+            f"({bad.size} such interval(s)) at {fps or 0:g} frames/s; t_s follows the rate, check frame {k}",
+        )
+        return None
+    return t - t[0]
 
 
 def open_highspeed(path) -> HighSpeedFilm:

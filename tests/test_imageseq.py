@@ -173,3 +173,20 @@ def test_highspeed_formats_name_their_package_when_it_is_missing(tmp_path, monke
     for f, pkg in (("a.cine", "pycine-lite"), ("b.cih", "pymraw")):
         with pytest.raises(InputError, match=f"needs the package {pkg}; install it"):
             probe_video(tmp_path / f)
+
+
+def test_run_takes_an_image_folder_as_its_film(synth, run_cli, tmp_path):
+    import re
+    import shutil
+
+    d, frames = synth
+    s = tmp_path / "s"
+    shutil.copytree(d, s)
+    _dump(s / "frames", frames, "png16")
+    toml = re.sub(r'path = "video\.mkv"', 'path = "frames"\nfps = 50', (s / "experiment.toml").read_text())
+    (s / "experiment.toml").write_text(toml + "\n[output]\nrrd = false\nfigures = false\n")
+    rc, _, err = run_cli("run", s / "experiment.toml", "--out", tmp_path / "out")
+    assert rc == 0, err
+    rep = json.loads((tmp_path / "out" / "report.json").read_text())
+    assert rep["fit"]["eta_e"] == pytest.approx(rep["truth"]["eta"], abs=0.01)
+    assert rep["truth"]["theta_rms_error_rad"] < 2e-3

@@ -101,8 +101,14 @@ def test_toml_corrections_read_as_the_csv(tmp_path):
         '[[corrections]]\nobject = "table"\nt_s = 1.4\nto_t_s = 1.46\naction = "drop"\n'
     )
     c = tmp_path / "fix.csv"
-    c.write_text("object,frame,to_frame,t_s,to_t_s,action,theta_rad\nblock_1,40,44,,,,0.01\ntable,,,1.4,1.46,drop,\n")
+    c.write_text(
+        "# hand fixes\nobject,frame,to_frame,t_s,to_t_s,action,theta_rad\nblock_1,40,44,,,,0.01\n\n"
+        "# the table's reflection\ntable,,,1.4,1.46,drop,\n"
+    )
     a, b = load_corrections(t), load_corrections(c)
+    assert b[1].where.endswith("fix.csv, line 6")  # lines as the file numbers them, comments included
+    with pytest.raises(InputError, match=r"fix.csv, line 6: object 'table' is not tracked \(objects: block_1\)"):
+        load_corrections(c, objects=["block_1"])
     assert [x.to_dict() | {"where": ""} for x in a] == [x.to_dict() | {"where": ""} for x in b]
     assert a[0].frames == (40, 44) and a[0].theta_rad == 0.01 and a[1].times_s == (1.4, 1.46)
 

@@ -124,8 +124,11 @@ def _one(row: dict, where: str) -> Correction:
     return Correction(obj, frames, times, action, vals["x_m"], vals["y_m"], th, where)
 
 
-def load_corrections(path) -> tuple[Correction, ...]:
+def load_corrections(path, objects=None) -> tuple[Correction, ...]:
     """Read a corrections file (CSV or TOML, see the module's doc).
+
+    ``objects`` (ids), when given, are the objects there are: a correction naming another is an
+    error before any tracking.
 
     Raises
     ------
@@ -147,15 +150,35 @@ def load_corrections(path) -> tuple[Correction, ...]:
         extra = sorted(set(d) - {"corrections"})
         if not isinstance(rows, list) or extra:
             raise InputError(f"{p}: give each correction as a [[corrections]] table (found {extra or 'none'})")
-        return tuple(_one(r, f"{p}, correction {k}") for k, r in enumerate(rows, start=1))
-    import pandas as pd
+        out = tuple(_one(r, f"{p}, correction {k}") for k, r in enumerate(rows, start=1))
+    else:
+        out = _read_csv(p)
+    for c in out:
+        if objects is not None and c.object not in objects:
+            raise InputError(
+                f"{c.where}: object {c.object!r} is not tracked (objects: {', '.join(objects)}); fix the name"
+            )
+    return out
+
+
+def _read_csv(p: Path) -> tuple[Correction, ...]:
+    import csv
 
     try:
-        df = pd.read_csv(p, comment="#", skipinitialspace=True, dtype=str, keep_default_na=False)
-    except Exception as e:  # noqa: BLE001 - pandas raises many types; one line names the file
-        raise InputError(f"{p}: not a readable CSV ({type(e).__name__}); one correction per row") from None
-    df.columns = [str(c).strip() for c in df.columns]
-    return tuple(_one(dict(r), f"{p}, line {k + 2}") for k, r in enumerate(df.to_dict("records")))
+        lines = p.read_text(encoding="utf-8").splitlines()
+    except (OSError, UnicodeDecodeError) as e:
+        raise InputError(f"{p}: cannot read the corrections ({type(e).__name__}); give a CSV text file") from None
+    rows = [(k, ln) for k, ln in enumerate(lines, start=1) if ln.strip() and not ln.lstrip().startswith("#")]
+    if not rows:
+        raise InputError(f"{p}: no header; the first line names the columns (object, frame or t_s, action, ...)")
+    parsed = list(csv.reader([ln for _, ln in rows], skipinitialspace=True))
+    head = [h.strip() for h in parsed[0]]
+    out = []
+    for (k, _), vals in zip(rows[1:], parsed[1:]):
+        if len(vals) > len(head):
+            raise InputError(f"{p}, line {k}: {len(vals)} values for {len(head)} columns; fix the row")
+        out.append(_one({h: v.strip() for h, v in zip(head, vals)}, f"{p}, line {k}"))
+    return tuple(out)
 
 
 def _rows(c: Correction, frame: np.ndarray, t_s: np.ndarray, partial: bool = False) -> np.ndarray:

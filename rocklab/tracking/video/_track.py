@@ -466,7 +466,7 @@ def track_video(path, config: TrackConfig, fps: float | None = None, progress: b
         raise InputError(f"{path}: the film has no frame rate (an image folder has one only from its timestamps.csv); "
                          "pass --fps N (or set [video] fps in the config)")
     v = config.video
-    fixes = load_corrections(v.corrections) if v.corrections else ()  # read before the long run: errors first
+    fixes = load_corrections(v.corrections, [o.id for o in config.objects]) if v.corrections else ()  # errors first
     start, stop = v.start_frame, v.stop_frame
     ref_frame = config.reference.board.frame if config.reference.board is not None else start
     first = None

@@ -264,11 +264,9 @@ def open_image_sequence(folder) -> ImageSequence:
     if first.dtype == np.uint8:
         gain, bits = 1.0, 8
     elif first.dtype == np.uint16:
-        import cv2 as _cv
-
         peaks = [int(first.max())]
         for f in {order[len(order) // 2], order[-1]}:
-            img = _cv.imread(str(f), _cv.IMREAD_UNCHANGED)
+            img = cv2.imread(str(f), cv2.IMREAD_UNCHANGED)
             if img is not None:
                 peaks.append(int(img.max()))
         gain, bits = depth_gain(max(peaks)), 16

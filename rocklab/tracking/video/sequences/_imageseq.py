@@ -24,6 +24,7 @@ frame count, a rate and each frame's time.
 
 from __future__ import annotations
 
+import functools
 import re
 from dataclasses import dataclass
 from pathlib import Path
@@ -216,12 +217,24 @@ def _header_size(f: Path):
 def open_image_sequence(folder) -> ImageSequence:
     """Open a folder of frames as a film (see the module's doc for the rules).
 
+    A command opens its film several times (probe, first frame, frames): the folder is listed
+    and its headers read once while neither it nor its ``timestamps.csv`` changes.
+
     Raises
     ------
     InputError
         No frames, frames of several kinds or names, a gap in the numbering without timestamps,
         frames of different sizes, a timestamps file that does not fit the frames.
     """
+    folder = Path(folder)
+    stamp = [folder.stat().st_mtime_ns]
+    ts = folder / TIMESTAMPS_FILE
+    stamp.append(ts.stat().st_mtime_ns if ts.is_file() else 0)
+    return _open_cached(str(folder.resolve()), *stamp)
+
+
+@functools.lru_cache(maxsize=4)
+def _open_cached(folder: str, *_stamp) -> ImageSequence:
     folder = Path(folder)
     imgs = _frames(folder)
     times, listed = _timestamps(folder)

@@ -53,8 +53,9 @@ class VideoInfo:
     pixel_aspect : float
         Width / height of one stored pixel (the container's sample aspect ratio; 1 if it says none).
     frame_times_s : ndarray (n,) or None
-        Each frame's presentation time from the container, s, the first frame at 0 (None when
-        PyAV cannot read the container, e.g. an image sequence).
+        Each frame's presentation time from the container (an image folder's ``timestamps.csv``,
+        a CINE's time block), s, the first frame at 0 (None when there is none: an OpenCV
+        image-sequence pattern, a folder without timestamps, a Photron MRAW).
     field_order : {"tff", "bff"} or None
         Interlaced video: which field is exposed first (top or bottom); None for progressive.
     rotation_deg : int
@@ -144,9 +145,8 @@ def probe_video(path) -> VideoInfo:
 
     store = frame_store(_open_checked(path))
     if store is not None:  # an image folder or a high-speed camera's file: its own size, rate and times
-        dropped = store.n_dropped
         return VideoInfo(str(path), store.n_frames, store.fps, store.width_px, store.height_px, 1.0, store.times_s,
-                         n_dropped=dropped)
+                         n_dropped=store.n_dropped)
     ci = container_info(path)
     n, fps, size = 0, 0.0, None
     try:  # OpenCV: count and rate where the packets have no times; image sequences

@@ -203,10 +203,11 @@ def _timestamps(folder: Path):
 
 
 def _header_size(f: Path):
-    """(width, height, bits) from the file's header (Pillow reads no pixels for this)."""
-    from PIL import Image
-
+    """(width, height, bits) from the file's header (Pillow reads no pixels for this); None where
+    Pillow cannot say (then the frame's size is checked when it is read)."""
     try:
+        from PIL import Image
+
         with Image.open(f) as im:
             bits = 16 if im.mode.startswith("I;16") or im.mode in ("I", "F") else 8
             return im.size[0], im.size[1], bits

@@ -190,3 +190,12 @@ def test_run_takes_an_image_folder_as_its_film(synth, run_cli, tmp_path):
     rep = json.loads((tmp_path / "out" / "report.json").read_text())
     assert rep["fit"]["eta_e"] == pytest.approx(rep["truth"]["eta"], abs=0.01)
     assert rep["truth"]["theta_rms_error_rad"] < 2e-3
+
+
+def test_a_damaged_frame_in_the_middle_stops_the_run_naming_it(synth, run_cli, tmp_path):
+    d, frames = synth
+    folder = _dump(tmp_path / "png16", frames[:30], "png16")
+    (folder / "frame_00017.png").write_bytes(b"\x89PNG\r\n\x1a\n" + bytes(40))  # cut short by a failed copy
+    rc, _, err = run_cli("track", folder, "--config", d / "track.toml", "--fps", 50, "-o", tmp_path / "t.csv")
+    assert rc == 2 and "frame_00017.png: cannot decode the image" in err and len(err.strip().splitlines()) == 1
+    assert not (tmp_path / "t.csv").exists()

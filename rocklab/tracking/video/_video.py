@@ -342,10 +342,9 @@ def _pyav_reader(path, first: int, gray: bool = True):
     if "%" in str(path):
         return None
     try:
-        r = _PyAVReader(path, first, gray=gray)
+        return _PyAVReader(path, first, gray=gray)
     except Exception:  # noqa: BLE001 - PyAV raises many types; OpenCV's reader is the fallback
         return None
-    return r
 
 
 def _fields(img, order: str):
@@ -480,6 +479,8 @@ def iter_video_frames(
     def worker():
         try:
             produce(put)
+        except InputError as e:  # a frame that cannot be read (a folder's): raised by the consumer
+            put(e)
         finally:
             put(done)
 
@@ -490,6 +491,8 @@ def iter_video_frames(
             item = q.get()
             if item is done:
                 break
+            if isinstance(item, InputError):
+                raise item
             yield item
     finally:
         stop_flag.set()

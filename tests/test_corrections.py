@@ -89,6 +89,10 @@ def test_a_correction_gives_the_truth_back_and_says_so(mistrack, run_cli, tmp_pa
     assert counts["corrected"] == 5 and counts["dropped"] == 4
     assert [c["n_frames"] for c in s["corrections"]] == [1, 1, 1, 1, 1, 4]
     assert s["corrections"][-1]["where"].endswith("fix.csv, line 7") and s["corrections"][-1]["action"] == "drop"
+    rc, out, err = run_cli(
+        "track", folder, "--config", d / "track.toml", "--fps", 50, "-o", tmp_path / "t2.csv", "--corrections", fix
+    )
+    assert rc == 0 and "corrections: 6 applied (5 frame(s) corrected, 4 dropped" in out
     # fit restitution takes the corrected samples as measured, not the dropped ones
     rc, out, err = run_cli("fit", "restitution", tmp_path / "t.csv", "--width", 0.1, "--height", 0.2, "--json")
     assert json.loads(out)["n_skipped"] == len(dropped) + int((rb.status != "ok").sum())

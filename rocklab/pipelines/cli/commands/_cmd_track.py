@@ -146,6 +146,12 @@ def run(args) -> int:
                 else f"median sigma_theta {d['median_sigma_theta_rad']:.4g} rad"
             )
             print(f"{oid}: {d['n_ok']}/{res.n_frames} frames ok, {angle}")
+        if res.corrections:
+            n = {a: sum(c["n_frames"] for c in res.corrections if c["action"] == a) for a in ("set", "drop")}
+            print(
+                f"corrections: {len(res.corrections)} applied ({n['set']} frame(s) corrected, {n['drop']} dropped; "
+                "status corrected/dropped in the CSV)"
+            )
         print(f"wrote {out}")
     return 0
 

@@ -93,6 +93,10 @@ def run(args) -> int:
     """Run ``rocklab track`` with parsed ``args``; returns the exit status (0 ok)."""
     import math
 
+    if args.at is not None and args.video != "preview":
+        raise InputError("--at T_S: shows the frames around a time in 'rocklab track preview VIDEO --at T_S' only")
+    if args.corrections is not None and args.video == "init":
+        raise InputError("--corrections: applies to 'rocklab track' and 'track preview', not to 'track init'")
     if args.video in ("init", "preview"):
         return _tools(args)
     if args.video2 is not None:

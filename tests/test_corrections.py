@@ -172,6 +172,10 @@ def test_preview_at_a_time_shows_the_frames_around_it_with_the_correction(mistra
         "track", "preview", folder, "--config", d / "track.toml", "--fps", 50, "--at", 9.0, "-o", sheet
     )
     assert rc == 2 and "past the end of the film" in err
+    rc, _, err = run_cli(
+        "track", folder, "--config", d / "track.toml", "--fps", 50, "--at", 0.5, "-o", tmp_path / "x.csv"
+    )
+    assert rc == 2 and "--at T_S: shows the frames around a time in 'rocklab track preview" in err
 
 
 def test_run_applies_the_experiment_corrections_and_reports_them(mistrack, run_cli, tmp_path):

@@ -33,6 +33,7 @@ class SourceVideo:
     track_config: Path | None = None
     object: str = "block_1"
     fps: float | None = None
+    corrections: Path | None = None  # manual corrections of the track (rocklab.tracking._corrections)
 
 
 @dataclass(frozen=True)
@@ -109,6 +110,8 @@ class ExperimentConfig:
             if src is None:
                 continue
             out.append(src.path)
+            if getattr(src, "corrections", None):
+                out.append(src.corrections)
             tc = getattr(src, "track_config", None)
             if tc:
                 out.append(tc)
@@ -308,10 +311,11 @@ def load_experiment(path) -> ExperimentConfig:
     video = track = imu = None
     if "video" in data.get("sources", {}):
         video = SourceVideo(
-            path=r.file("sources.video.path"),
+            path=r.file("sources.video.path", allow_dir=True),
             track_config=r.file("sources.video.track_config", required=False),
             object=r.get("sources.video.object", "block_1", kind=str),
             fps=r.get("sources.video.fps", kind=float, positive=True),
+            corrections=r.file("sources.video.corrections", required=False),
         )
     if "track" in data.get("sources", {}):
         track = SourceTrack(path=r.file("sources.track.path"), object=r.get("sources.track.object", kind=str))
@@ -436,6 +440,7 @@ EXAMPLE_TOML = textwrap.dedent(
     track_config = "track.toml"
     object = "block_1"                # which tracked object is this block
     fps = 50                          # only if the container has none
+    corrections = "fix.csv"           # optional: manual corrections of the track (drop / set)
 
     [sources.track]                   # ... or an already tracked CSV (t_s, theta_rad[, object])
     path = "tracks.csv"

@@ -25,7 +25,7 @@ from .._cli_base import emit_json as _emit
 def register(sub):
     """Add this module's subcommand(s) to the ``rocklab`` parser ``sub``."""
     p = sub.add_parser("pulse", help="pulse parameters of a record (a_max, I_max, t_p)")
-    p.add_argument("record")
+    p.add_argument("record", help="the record file (.AT2, CSV t_s,acc_m_s2, two-column text)")
     p.add_argument(
         "--units",
         default=None,
@@ -35,7 +35,15 @@ def register(sub):
     p.set_defaults(func=run)
 
     p = sub.add_parser("oas", help="Overturning Acceleration Spectrum and t_I of record(s)")
-    p.add_argument("record", nargs="*", help="record files or folders of records (every visible file in them)")
+    p.add_argument(
+        "record",
+        nargs="*",
+        help="record files or folders of records (every visible record in them; other files and "
+        "subfolders are left out with a note)",
+    )
+    p.add_argument(
+        "--recursive", action="store_true", help="also read the records in the folders' subfolders (at any depth)"
+    )
     p.add_argument(
         "--list",
         default=None,
@@ -50,12 +58,22 @@ def register(sub):
     )
     p.add_argument("--slenderness", type=float, default=12.0, help="block h/b (default 12)")
     p.add_argument("--levels", type=int, default=80, help="a_p/a_p,min levels 1..level-max (80)")
-    p.add_argument("--level-max", type=float, default=10.0)
+    p.add_argument("--level-max", type=float, default=10.0, help="largest a_p/a_p,min level (default 10)")
     p.add_argument("--sizes", type=int, default=120, help="log-spaced R from 1000 m to 0.1 m (120)")
     p.add_argument("--refine", type=count(0), default=10, help="bisection steps on the boundary (10)")
-    p.add_argument("--criterion", choices=("angle", "fall"), default="angle")
+    p.add_argument(
+        "--criterion",
+        choices=("angle", "fall"),
+        default="angle",
+        help="overturned when theta reaches alpha (angle, default) or the block falls (fall)",
+    )
     p.add_argument("--free", default="energy", help="after the record: energy | none | SECONDS")
-    p.add_argument("--search", choices=("scan", "contiguous"), default="scan")
+    p.add_argument(
+        "--search",
+        choices=("scan", "contiguous"),
+        default="scan",
+        help="boundary search: every level of the grid (scan, default) or the first contiguous overturning region",
+    )
     p.add_argument("--eta", type=float, default=None, help="restitution (default Housner)")
     p.add_argument(
         "-o",
@@ -76,8 +94,8 @@ def register(sub):
     )
     p.add_argument("--workers", type=count(1), default=None, help="local processes for several records")
     p.add_argument("--scheduler", default=None, help="Dask distributed scheduler address")
-    p.add_argument("--no-progress", action="store_true")
-    p.add_argument("--json", action="store_true")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
     p.set_defaults(func=run)
 
     p = sub.add_parser("design", help="pier width for a PGA and t_I (thesis Eq. 21/23)")
@@ -88,16 +106,20 @@ def register(sub):
     p.add_argument("--alpha-I", type=float, default=None, help="I_O/(m R^2) (4/3 solid, 1 mass on top)")
     p.add_argument("--cm-ratio", type=float, default=None, help="centre-of-mass height / H")
     p.add_argument("--g", type=float, default=None, help="gravity, m/s^2 (default 9.80665)")
-    p.add_argument("--json", action="store_true")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
     p.set_defaults(func=run)
 
     p = sub.add_parser("equivalent", help="equivalent-block parameters of a rocking mechanism")
-    p.add_argument("mechanism", choices=("block", "strut", "frame", "wall", "asym-frame", "arch"))
+    p.add_argument(
+        "mechanism",
+        choices=("block", "strut", "frame", "wall", "asym-frame", "arch"),
+        help="the rocking mechanism (DeJong & Dimitrakopoulos 2014)",
+    )
     p.add_argument("--R", type=float, help="corner-to-centre distance of the (column/wall) block, m")
     p.add_argument("--alpha", type=float, help="slenderness angle, rad")
     p.add_argument("--b", type=float, help="width b (block) or half-width (asym-frame), m")
     p.add_argument("--h", type=float, help="height h (block) or beam half-depth (asym-frame), m")
-    p.add_argument("--alpha-I", type=float, default=4.0 / 3.0)
+    p.add_argument("--alpha-I", type=float, default=4.0 / 3.0, help="I_O/(m R^2) of each block (default 4/3: solid)")
     p.add_argument("--gamma", type=float, default=0.0, help="frame: m_beam / m_columns")
     p.add_argument("--H", type=float, help="asym-frame: half-height of the left column, m")
     p.add_argument("--H1", type=float, help="asym-frame: half-height of the right column, m")
@@ -216,7 +238,10 @@ def _run_oas_batch(args, kw) -> int:
     from ...spectra._spectra_batch import expand_records, oas_table
 
     skipped: list = []
-    items = expand_records(args.record, args.list, skipped)
+    notes: list = []
+    items = expand_records(args.record, args.list, skipped, recursive=args.recursive, notes=notes)
+    for n in notes:
+        sys.stderr.write(f"rocklab oas: note: {n}\n")
     for f in skipped:
         sys.stderr.write(f"rocklab oas: not reading {f}: an output rocklab wrote (name it to read it as a record)\n")
     if not items:

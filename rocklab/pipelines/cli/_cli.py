@@ -46,6 +46,7 @@ COMMAND_MODULES = (
     "_cmd_demo",
     "_cmd_column",
     "_cmd_design",
+    "_cmd_curve",
 )
 
 

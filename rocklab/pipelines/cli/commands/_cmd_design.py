@@ -18,7 +18,7 @@ import sys
 from ...._errors import InputError
 
 
-from .._cli_base import add_base_motion_args, base_motion_from_args, count
+from .._cli_base import PULSE_HELP, add_base_motion_args, base_motion_from_args, count, pulse_from_spec
 from .._cli_base import emit_json as _emit
 
 
@@ -44,6 +44,7 @@ def register(sub):
     p.add_argument(
         "--recursive", action="store_true", help="also read the records in the folders' subfolders (at any depth)"
     )
+    p.add_argument("--pulse", default=None, metavar="KIND,PEAK,T_P[,N]", help="the OAS of " + PULSE_HELP)
     p.add_argument(
         "--list",
         default=None,
@@ -202,13 +203,15 @@ def run_oas(args) -> int:
         raise InputError(f"--slenderness {args.slenderness}: h/b must be > 0 (e.g. 12)")
     from pathlib import Path
 
-    if not args.record and not args.list:
-        raise InputError("rocklab oas: give record files, folders of records, or --list FILE")
+    if args.pulse is not None and (args.record or args.list or args.band):
+        raise InputError("rocklab oas: --pulse is one base motion; give it without records, --list or --band")
+    if not args.record and not args.list and args.pulse is None:
+        raise InputError("rocklab oas: give record files, folders of records, --list FILE or --pulse KIND,PEAK,T_P")
     if args.list or args.band or len(args.record) > 1 or any(Path(r).is_dir() for r in args.record):
         return _run_oas_batch(args, kw)
     from ....models import load_base_motion, overturning_spectrum, pulse_parameters
 
-    rec = load_base_motion(args.record[0], units=args.units)
+    rec = pulse_from_spec(args.pulse) if args.pulse is not None else load_base_motion(args.record[0], units=args.units)
     o = overturning_spectrum(rec, args.slenderness, **kw)
     if args.out:
         write_frame_atomic(args.out, o.to_frame())

@@ -184,8 +184,8 @@ def _flight(eom, y, t, t_end, tb, ab, side, phi_hi):
     def over(tt, yy):
         return yy[0] - phi_hi
 
-    impact.terminal, impact.direction = True, -1  # type: ignore[attr-defined]  # scipy's event protocol
-    over.terminal, over.direction = True, 1  # type: ignore[attr-defined]
+    impact.terminal, impact.direction = True, -1  # scipy's event protocol
+    over.terminal, over.direction = True, 1
     k = max(int(np.searchsorted(tb, t, side="right")) - 1, 0)
     pieces = []
     while t < t_end:

@@ -145,8 +145,8 @@ def probe_video(path) -> VideoInfo:
 
     store = frame_store(_open_checked(path))
     if store is not None:  # an image folder or a high-speed camera's file: its own size, rate and times
-        return VideoInfo(str(path), store.n_frames, store.fps, store.width_px, store.height_px, 1.0, store.times_s,
-                         n_dropped=store.n_dropped)
+        s = store
+        return VideoInfo(str(path), s.n_frames, s.fps, s.width_px, s.height_px, 1.0, s.times_s, n_dropped=s.n_dropped)
     ci = container_info(path)
     n, fps, size = 0, 0.0, None
     try:  # OpenCV: count and rate where the packets have no times; image sequences

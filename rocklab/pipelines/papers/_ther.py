@@ -5,6 +5,8 @@ from __future__ import annotations
 import numpy as np
 
 from ._gallery import Built, Entry, number
+from ._ther_spectra import BUILDERS as _SPECTRA
+from ._ther_spectra import NEEDS_RECORDS as _SPECTRA_RECORDS
 
 __all__ = ["ENTRIES"]
 
@@ -254,7 +256,8 @@ def fig14(ctx) -> Built:
     return Built(df, nums, note)
 
 
-BUILDERS = {4: fig4, 12: fig12, 29: fig29, 14: fig14}
+BUILDERS = {4: fig4, 12: fig12, 29: fig29, 14: fig14, **_SPECTRA}
+NEEDS_RECORDS = {14, *_SPECTRA_RECORDS}
 
 
 def _entries():
@@ -266,7 +269,7 @@ def _entries():
         elif n == 34:
             out.append(Entry(key, cap, lambda ctx, k=key: _curve(ctx, k, ["half-sine", "full-sine"])))
         elif n in BUILDERS:
-            out.append(Entry(key, cap, BUILDERS[n], needs_records=(n == 14)))
+            out.append(Entry(key, cap, BUILDERS[n], needs_records=n in NEEDS_RECORDS))
         else:
             out.append(Entry(key, cap, why_not=WHY.get(n, OPEN)))
     for n, cap in TABLES.items():

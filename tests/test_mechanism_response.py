@@ -12,7 +12,9 @@ from rocklab.models.mechanisms import (
     asymmetric_frame,
     block_mechanism,
     block_parameters,
-    equivalent_block_dimensions,
+    conical_shell_geometry,
+    conical_shell_parameters,
+    equivalent_block,
     equivalent_block_mechanism,
     free_rocking_period_eq24,
     mechanism_response,
@@ -132,12 +134,35 @@ def test_record_ending_past_critical_is_falling_not_ok():
     assert mechanism_response(mech, longer, 0.9).status == "overturned"
 
 
-def test_equivalent_block_dimensions_round_trip():
-    b, h = 0.3, 1.5
-    blk = Block(b, h)
-    fp = block_parameters(blk.R_m, blk.alpha_rad)
-    hb, hh = equivalent_block_dimensions(fp)
-    assert (2 * hb, 2 * hh) == pytest.approx((b, h), rel=1e-12)
+def test_equivalent_block_round_trip_and_mechanisms():
+    blk = Block(0.3, 1.5)
+    eq = equivalent_block(block_parameters(blk.R_m, blk.alpha_rad), match="kappa1")
+    assert (eq.b_m, eq.h_m) == pytest.approx((0.3, 1.5), rel=1e-12)
+    pos, _ = asymmetric_frame(0.15, 1.5, 1.2, 3.0, 0.2, 1.0, 1.0, 1.0)
+    fp = pos.parameters()
+    eq = equivalent_block(fp)  # same p, and the exact uplift the design check uses (g tan alpha)
+    assert eq.p_rad_s == pytest.approx(fp.p_rad_s, rel=1e-12)
+    assert eq.uplift_acc_m_s2 == pytest.approx(G * fp.lambda_, rel=1e-12)
+    assert equivalent_block(fp, "kappa2").alpha_rad == pytest.approx(fp.theta_cr_kappa2_rad, rel=1e-12)
+
+
+def test_conical_shell_inertia_by_quadrature():
+    # a thin uniform conical shell rocking on its base rim: centroid, R and I_O from the surface itself
+    H, r = 10.0, 2.0
+    z = (np.arange(4000) + 0.5) / 4000 * H
+    ph = (np.arange(720) + 0.5) / 720 * 2 * np.pi
+    Z, P = np.meshgrid(z, ph, indexing="ij")
+    rho = r * (1 - Z / H)
+    w = rho  # surface element ~ rho dz dphi (the slant factor is constant)
+    x = rho * np.cos(P)
+    zc = (w * Z).sum() / w.sum()
+    I_O = (w * ((x - r) ** 2 + Z**2)).sum() / w.sum()  # per unit mass, about the rim tangent at (r, 0, 0)
+    R, a, aI = conical_shell_geometry(H, r)
+    assert zc == pytest.approx(H / 3, rel=1e-6)
+    assert R == pytest.approx(math.hypot(r, zc), rel=1e-6)
+    assert aI * R * R == pytest.approx(I_O, rel=1e-5)
+    fp = conical_shell_parameters(H, r)
+    assert fp.lambda_ == pytest.approx(3 * r / H) and fp.p_rad_s == pytest.approx(math.sqrt(G / (aI * R)))
 
 
 def test_bad_inputs():
@@ -166,3 +191,16 @@ def test_cli_equivalent_time_history(run_cli, tmp_path):
     assert "impacts" in out
     rc, out, err = run_cli("equivalent", "wall", "--R", "1", "--alpha", "0.12", "--eta", "0.8")
     assert rc == 2 and "--base-motion" in err
+    rc, out, err = run_cli("equivalent", "wall", "--R", "1", "--alpha", "0.12")
+    assert rc == 0 and "eta = none (give --eta)" in out and "nan" not in out
+    rc, out, err = run_cli(
+        "equivalent", "cone", "--H", "10", "--base-radius", "2", "--pulse", "half-sine,0.8g,0.5", "--json"
+    )
+    assert rc == 0, err
+    import json
+
+    d = json.loads(out)
+    assert d["lambda"] == pytest.approx(0.6) and d["equivalent_block"]["b_m"] > 0
+    # the cone is Table I's block: its nonlinear history and its nonlinear equivalent block agree
+    h = d["time_history"]["models"]
+    assert h["nonlinear"]["n_impacts"] == h["block"]["n_impacts"]

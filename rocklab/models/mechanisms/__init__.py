@@ -11,7 +11,10 @@ from ._equivalent import (
     FundamentalParameters,
     Mechanism,
     block_parameters,
+    conical_shell_geometry,
+    conical_shell_parameters,
     equivalence_errors,
+    equivalent_block,
     frame_parameters,
     free_rocking_period_eq24,
     linear_sine_pulse_response,
@@ -22,13 +25,7 @@ from ._equivalent import (
     wall_parameters,
 )
 from ._mechanisms import arch_mechanism, asymmetric_frame, block_mechanism, four_bar_mechanism
-from ._response import (
-    MechanismResponse,
-    equivalent_block_dimensions,
-    equivalent_block_mechanism,
-    mechanism_response,
-    mechanism_time_histories,
-)
+from ._response import MechanismResponse, equivalent_block_mechanism, mechanism_response, mechanism_time_histories
 
 __all__ = [
     "FundamentalParameters",
@@ -51,5 +48,7 @@ __all__ = [
     "mechanism_response",
     "mechanism_time_histories",
     "equivalent_block_mechanism",
-    "equivalent_block_dimensions",
+    "equivalent_block",
+    "conical_shell_geometry",
+    "conical_shell_parameters",
 ]

@@ -30,11 +30,14 @@ from ..._errors import positive as _pos
 from ...blocks import G, inertia_coefficient
 
 __all__ = [
+    "equivalent_block",
     "FundamentalParameters",
     "Mechanism",
     "block_parameters",
     "strut_parameters",
     "frame_parameters",
+    "conical_shell_geometry",
+    "conical_shell_parameters",
     "wall_parameters",
     "wall_mechanism",
     "free_rocking_period_eq24",
@@ -116,6 +119,30 @@ def _fp(p, phi_cr, lam, lam_lin, eta, name):
 # -- closed forms ---------------------------------------------------------------
 
 
+def equivalent_block(fp: FundamentalParameters, match: str = "uplift", alpha_I: float = 4.0 / 3.0):
+    """The solid rectangular block that stands in for a mechanism in the OAS and the design check.
+
+    Its frequency parameter is the mechanism's p (p^2 = g / (alpha_I R), so R = g / (alpha_I p^2))
+    and its slenderness is chosen by ``match``:
+
+    - ``"uplift"`` (default): tan(alpha) = lambda, the mechanism's exact uplift acceleration (Eq. 10),
+      which the design check's a_p,min = g tan(alpha) then reproduces;
+    - ``"kappa1"`` / ``"kappa2"``: alpha = theta_cr of Eq. 17 with kappa1 (= lambda_lin) or kappa2.
+
+    Returns
+    -------
+    rocklab.Block
+        Full width ``2 R sin(alpha)`` and height ``2 R cos(alpha)``, m, solid (alpha_I as given).
+    """
+    from ...blocks import Block
+
+    alpha = {"uplift": math.atan(fp.lambda_), "kappa1": fp.theta_cr_rad, "kappa2": fp.theta_cr_kappa2_rad}.get(match)
+    if alpha is None:
+        raise InputError(f"match={match!r}: choose 'uplift', 'kappa1' or 'kappa2'")
+    R = G / (inertia_coefficient(alpha_I) * fp.p_rad_s**2)
+    return Block(2 * R * math.sin(alpha), 2 * R * math.cos(alpha), alpha_I=alpha_I, name=f"{fp.mechanism} equivalent")
+
+
 def block_parameters(R_m: float, alpha_rad: float, alpha_I: float = 4.0 / 3.0) -> FundamentalParameters:
     """Rocking block (Table I): p = sqrt(g/(alpha_I R)), theta_cr = alpha, lambda = tan(alpha),
     lambda_lin = alpha, eta = 1 - 2 sin^2(alpha)/alpha_I (Housner)."""
@@ -128,6 +155,28 @@ def strut_parameters(R_m: float, alpha_rad: float) -> FundamentalParameters:
     alpha_I = 1, i.e. p = sqrt(g/R) (a pendulum), eta = 1 - 2 sin^2(alpha) = cos(2 alpha)."""
     fp = block_parameters(R_m, alpha_rad, 1.0)
     return FundamentalParameters(**{**asdict(fp), "mechanism": "strut"})
+
+
+def conical_shell_geometry(H_m: float, r_m: float) -> tuple:
+    """A thin uniform conical shell (a spire) rocking on its base rim: ``(R_m, alpha_rad, alpha_I)``.
+
+    The lateral surface of height H and base radius r has its centre of mass at H/3; about the
+    tangent to the base rim (the rocking axis) I_O = m (5 r^2 / 4 + H^2 / 6), so with
+    R^2 = r^2 + H^2/9 and tan(alpha) = 3 r / H, alpha_I = I_O / (m R^2). DeJong & Dimitrakopoulos
+    list the shell in Table I (its expressions are in the table, not in the extracted text); these
+    are derived here from the surface integrals and checked by quadrature in the tests.
+    """
+    H, r = _pos("H_m", H_m), _pos("r_m", r_m)
+    R2 = r * r + H * H / 9.0
+    return math.sqrt(R2), math.atan2(3.0 * r, H), (1.25 * r * r + H * H / 6.0) / R2
+
+
+def conical_shell_parameters(H_m: float, r_m: float) -> FundamentalParameters:
+    """Table I's rocking conical shell: the block of :func:`conical_shell_geometry`'s R, alpha, alpha_I
+    (p^2 = g / (alpha_I R), theta_cr = alpha, lambda = tan alpha, eta by angular momentum)."""
+    R, a, aI = conical_shell_geometry(H_m, r_m)
+    fp = block_parameters(R, a, aI)
+    return FundamentalParameters(**{**asdict(fp), "mechanism": "conical-shell"})
 
 
 def frame_parameters(R_m: float, alpha_rad: float, gamma: float, alpha_I: float = 4.0 / 3.0) -> FundamentalParameters:

@@ -34,13 +34,7 @@ from ..._errors import InputError
 from ...blocks import G
 from ._equivalent import FundamentalParameters, Mechanism
 
-__all__ = [
-    "MechanismResponse",
-    "mechanism_response",
-    "equivalent_block_mechanism",
-    "mechanism_time_histories",
-    "equivalent_block_dimensions",
-]
+__all__ = ["MechanismResponse", "mechanism_response", "equivalent_block_mechanism", "mechanism_time_histories"]
 
 #: The mechanism is at rest when its rate after an impact is below this, rad/s (it rises by less
 #: than 1e-18 rad: the impacts of a settling mechanism converge geometrically, Zeno-like).
@@ -463,20 +457,3 @@ def mechanism_time_histories(
         mp, mn = (equivalent_block_mechanism(fp, lin, kappa) for fp in fps)
         out[name] = mechanism_response(mp, base, eta, mn, phi0_rad, scale=k, model=name, tabulate=False)
     return out
-
-
-def equivalent_block_dimensions(fp: FundamentalParameters, kappa: str = "kappa1", alpha_I: float = 4.0 / 3.0):
-    """Half-width and half-height of the rectangular block with the same p and alpha = theta_cr.
-
-    For a solid rectangular block p^2 = g / (alpha_I R) (alpha_I = 4/3) and alpha = theta_cr, so
-    R = g / (alpha_I p^2), b = R sin(alpha), h = R cos(alpha). This block feeds
-    :func:`~rocklab.models.spectra.overturning_spectrum` and the design check.
-
-    Returns
-    -------
-    (b_m, h_m) : (float, float)
-        Half-width and half-height, m.
-    """
-    th = fp.theta_cr_rad if kappa == "kappa1" else fp.theta_cr_kappa2_rad
-    R = G / (alpha_I * fp.p_rad_s**2)
-    return R * math.sin(th), R * math.cos(th)

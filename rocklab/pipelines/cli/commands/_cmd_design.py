@@ -113,8 +113,8 @@ def register(sub):
     p = sub.add_parser("equivalent", help="equivalent-block parameters of a rocking mechanism")
     p.add_argument(
         "mechanism",
-        choices=("block", "strut", "frame", "wall", "asym-frame", "arch"),
-        help="the rocking mechanism (DeJong & Dimitrakopoulos 2014)",
+        choices=("block", "strut", "frame", "wall", "asym-frame", "arch", "cone"),
+        help="the rocking mechanism (DeJong & Dimitrakopoulos 2014; cone: a thin conical shell, a spire)",
     )
     p.add_argument("--R", type=float, help="corner-to-centre distance of the (column/wall) block, m")
     p.add_argument("--alpha", type=float, help="slenderness angle, rad")
@@ -122,7 +122,8 @@ def register(sub):
     p.add_argument("--h", type=float, help="height h (block) or beam half-depth (asym-frame), m")
     p.add_argument("--alpha-I", type=float, default=4.0 / 3.0, help="I_O/(m R^2) of each block (default 4/3: solid)")
     p.add_argument("--gamma", type=float, default=0.0, help="frame: m_beam / m_columns")
-    p.add_argument("--H", type=float, help="asym-frame: half-height of the left column, m")
+    p.add_argument("--H", type=float, help="asym-frame: half-height of the left column; cone: height, m")
+    p.add_argument("--base-radius", type=float, help="cone: radius of the shell's base, m")
     p.add_argument("--H1", type=float, help="asym-frame: half-height of the right column, m")
     p.add_argument("--L", type=float, help="asym-frame: distance between the columns' left faces, m")
     p.add_argument("--masses", type=float, nargs=3, default=(1.0, 1.0, 1.0), help="m_AB m_BC m_CD")
@@ -356,6 +357,12 @@ def run_equivalent(args) -> int:
             # Table I: the strut and the symmetric frame are the block with their own p (alpha_I)
             aI = {"block": args.alpha_I, "strut": 1.0}.get(mech, G_M_S2 / (R * fp.p_rad_s**2))
             pair = (mm.block_mechanism(R, a, aI, eta=fp.eta, name=mech), None)
+    elif mech == "cone":
+        _need(args, "H", "base-radius")
+        R, a, aI = mm.conical_shell_geometry(args.H, args.base_radius)
+        fp = mm.conical_shell_parameters(args.H, args.base_radius)
+        out = fp.to_dict()
+        pair = (mm.block_mechanism(R, a, aI, eta=fp.eta, name="conical-shell"), None)
     elif mech == "asym-frame":
         _need(args, "b", "H", "H1", "L", "h")
         pos, neg = m.asymmetric_frame(args.b, args.H, args.H1, args.L, args.h, *args.masses)
@@ -370,6 +377,10 @@ def run_equivalent(args) -> int:
         pair = (arch, None)
         extra = {"hinges": list(info["hinges"]), "faces": info["faces"]}
     out.update(extra)
+    eq = mm.equivalent_block(
+        mm.FundamentalParameters(**{k: v for k, v in out.items() if k in _FP_KEYS} | {"lambda_": out["lambda"]})
+    )
+    out["equivalent_block"] = {"b_m": eq.b_m, "h_m": eq.h_m, "match": "uplift"}
     base = base_motion_from_args(args)
     if base is None:
         for opt in ("eta", "output"):
@@ -381,9 +392,22 @@ def run_equivalent(args) -> int:
         _emit(out)
     else:
         keys = ("p_rad_s", "theta_cr_rad", "lambda", "lambda_lin", "eta", "kappa1", "kappa2", "phi_cr_rad")
-        print(f"{mech}: " + ", ".join(f"{k} = {out[k]:.5g}" for k in keys))
+
+        def line(d):
+            # a mechanism without a restitution of its own (the paper gives none) says so, not "nan"
+            return ", ".join(
+                f"{k} = none (give --eta)" if k == "eta" and not math.isfinite(d[k]) else f"{k} = {d[k]:.5g}"
+                for k in keys
+            )
+
+        print(f"{mech}: " + line(out))
         if "negative" in out:
-            print("negative direction: " + ", ".join(f"{k} = {out['negative'][k]:.5g}" for k in keys))
+            print("negative direction: " + line(out["negative"]))
+        e = out["equivalent_block"]
+        print(
+            f"equivalent block for the OAS and the design check: b = {e['b_m']:.4g} m, h = {e['h_m']:.4g} m "
+            "(the same p; tan(alpha) = lambda, the exact uplift)"
+        )
         for name, r in out.get("time_history", {}).get("models", {}).items():
             over = (
                 f"overturned at {r['t_overturn_s']:.4g} s" if r["overturned"] else f"peak {r['peak_ratio']:.4g} phi_cr"
@@ -393,6 +417,10 @@ def run_equivalent(args) -> int:
                 print(f"rocklab equivalent: note: {name}: {r['message']}", file=sys.stderr)
     sys.stdout.flush()
     return 0
+
+
+#: FundamentalParameters' fields as ``to_dict`` prints them (``lambda`` is ``lambda_`` there).
+_FP_KEYS = ("p_rad_s", "theta_cr_rad", "lambda_lin", "eta", "phi_cr_rad", "kappa1", "kappa2", "mechanism")
 
 
 def _equivalent_history(args, mech: str, base, pair) -> dict:

@@ -17,6 +17,7 @@ from ._oas import (
     simplified_oas,
 )
 from ._oas_curve import OverturningCurve, overturning_curve
+from ._oas_sets import CharacteristicOAS, TItpRegression, characteristic_oas, oas_convex_hull, tI_tp_regression
 from ._oas_band import BAND_ENSEMBLE, TIBand, t_I_band
 from ._pulses import (
     F_SINE,
@@ -48,6 +49,11 @@ __all__ = [
     "overturning_spectrum",
     "OverturningCurve",
     "overturning_curve",
+    "CharacteristicOAS",
+    "characteristic_oas",
+    "oas_convex_hull",
+    "TItpRegression",
+    "tI_tp_regression",
     "critical_impulse",
     "normalised_critical_impulse",
     "fit_inclined_line",

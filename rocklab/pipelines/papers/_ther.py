@@ -7,6 +7,8 @@ import numpy as np
 from ._gallery import Built, Entry, number
 from ._ther_spectra import BUILDERS as _SPECTRA
 from ._ther_spectra import NEEDS_RECORDS as _SPECTRA_RECORDS
+from ._ther_sets import BUILDERS as _SETS
+from ._ther_sets import NEEDS_RECORDS as _SETS_RECORDS
 
 __all__ = ["ENTRIES"]
 
@@ -256,8 +258,8 @@ def fig14(ctx) -> Built:
     return Built(df, nums, note)
 
 
-BUILDERS = {4: fig4, 12: fig12, 29: fig29, 14: fig14, **_SPECTRA}
-NEEDS_RECORDS = {14, *_SPECTRA_RECORDS}
+BUILDERS = {4: fig4, 12: fig12, 29: fig29, 14: fig14, **_SPECTRA, **_SETS}
+NEEDS_RECORDS = {14, *_SPECTRA_RECORDS, *_SETS_RECORDS}
 
 
 def _entries():

@@ -155,7 +155,8 @@ def plot_frame_error_maps(
 
 
 def plot_tI_vs_tp(table, path, slenderness: float = 12.0):
-    """t_I against t_p across records (the thesis's Fig. 56 kind), the thesis's Table 4 values overlaid.
+    """t_I against t_p across records (the thesis's Fig. 53 kind), its regression line and
+    correlation when 3 or more records have both, the thesis's Table 4 values overlaid.
 
     ``table`` is the record table of ``rocklab oas`` (``t_p_s, t_I_s, thesis_t_p_s, thesis_t_I_s, name``).
     """
@@ -196,6 +197,17 @@ def plot_tI_vs_tp(table, path, slenderness: float = 12.0):
         else 1.0
     )
     ax.plot([0, lim], [0, lim], "k:", lw=0.8, label="t_I = t_p")
+    if len(ok) >= 3:
+        from ...models.spectra import tI_tp_regression
+
+        reg = tI_tp_regression(ok["t_p_s"], ok["t_I_s"])
+        ax.plot(
+            [0, lim],
+            [reg.intercept, reg.intercept + reg.slope * lim],
+            "C0--",
+            lw=0.9,
+            label=f"t_I = {reg.slope:.3f} t_p + {reg.intercept:.3f} s (r = {reg.r:.3f}, n = {reg.n})",
+        )
     ax.set_xlim(0, lim)
     ax.set_ylim(0, lim)
     ax.set_xlabel("pulse duration t_p (s)")

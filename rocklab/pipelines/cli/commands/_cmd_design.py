@@ -278,8 +278,14 @@ def _run_oas_batch(args, kw) -> int:
 
         plot_tI_vs_tp(tab, args.plot, args.slenderness)
     n_bad = int((tab["error"] != "").sum())
+    reg = None
+    ok = tab[(tab["error"] == "") & tab["t_I_s"].notna() & tab["t_p_s"].notna()]
+    if len(ok) >= 3:  # thesis Fig. 53: t_I against t_p across the records
+        from ....models.spectra import tI_tp_regression
+
+        reg = tI_tp_regression(ok["t_p_s"], ok["t_I_s"]).to_dict()
     if args.json:
-        _emit({"records": tab.to_dict(orient="records"), "failed": n_bad})
+        _emit({"records": tab.to_dict(orient="records"), "failed": n_bad, "tI_tp_regression": reg})
     else:
         cols = (
             ["name", "t_p_s", "t_I_s"]
@@ -289,6 +295,11 @@ def _run_oas_batch(args, kw) -> int:
         show = tab[cols]
         print(show.to_string(index=False, float_format=lambda v: f"{v:.4g}"))
         print(f"{len(tab) - n_bad}/{len(tab)} records done" + (f", {n_bad} failed (see above)" if n_bad else ""))
+        if reg is not None:
+            print(
+                f"t_I = {reg['slope']:.4g} t_p + {reg['intercept']:.4g} s over {reg['n']} records, "
+                f"correlation r = {reg['r']:.4g} (thesis Fig. 53)"
+            )
     return 0 if n_bad == 0 else 1
 
 

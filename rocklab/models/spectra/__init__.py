@@ -29,11 +29,15 @@ from ._pulses import (
     pulse_parameters,
     pulse_shape,
 )
+from ._record_measures import RecordMeasures, record_measures, response_spectrum
 from ._records import BUNDLED_RECORDS, UNITS_TO_M_S2, BaseMotion, bundled_record, load_base_motion
 
 __all__ = [
     "BaseMotion",
     "load_base_motion",
+    "RecordMeasures",
+    "record_measures",
+    "response_spectrum",
     "UNITS_TO_M_S2",
     "bundled_record",
     "BUNDLED_RECORDS",

@@ -24,7 +24,9 @@ from .._cli_base import emit_json as _emit
 
 def register(sub):
     """Add this module's subcommand(s) to the ``rocklab`` parser ``sub``."""
-    p = sub.add_parser("pulse", help="pulse parameters of a record (a_max, I_max, t_p)")
+    p = sub.add_parser(
+        "pulse", help="pulse parameters of a record (a_max, I_max, t_p) and its PGV, PGD, Arias, D5-95, T_v"
+    )
     p.add_argument("record", help="the record file (.AT2, CSV t_s,acc_m_s2, two-column text)")
     p.add_argument(
         "--units",
@@ -166,14 +168,23 @@ def run(args) -> int:
 def run_pulse(args) -> int:
     from ....models import load_base_motion, pulse_parameters
 
-    pp = pulse_parameters(load_base_motion(args.record, units=args.units))
-    d = pp.to_dict()
+    from ....models.spectra import record_measures
+
+    base = load_base_motion(args.record, units=args.units)
+    pp = pulse_parameters(base)
+    rm = record_measures(base)
+    d = pp.to_dict() | {"measures": rm.to_dict()}
     if args.json:
         _emit(d)
     else:
         print(
             f"{pp.name}: a_max = {pp.a_max_m_s2:.4f} m/s2, I_max = {pp.I_max_m_s:.4f} m/s, "
             f"t_p = {pp.t_p_s:.4f} s (lobe {pp.lobe_start_s:.2f}-{pp.lobe_end_s:.2f} s)"
+        )
+        tv = f"{rm.t_v_s:.4g} s" if math.isfinite(rm.t_v_s) else "outside 0.1-10 s"
+        print(
+            f"  PGV = {rm.pgv_m_s:.4g} m/s, PGD = {rm.pgd_m:.4g} m (linear baseline removed), Arias = "
+            f"{rm.arias_m_s:.4g} m/s, D5-95 = {rm.d5_95_s:.4g} s, velocity-pulse period T_v = {tv}"
         )
     return 0
 

@@ -81,6 +81,7 @@ class ExperimentResult:
     video: object = None  # the review film (rocklab.pipelines.experiment._review_video.ReviewVideo)
     diagnostics: tuple = ()  # rocklab._diagnostics.Diagnostic raised while analysing
     audit: dict | None = None  # rocklab.pipelines.experiment._audit_stage.audit_experiment
+    validation: object = None  # base-excited runs: rocklab.pipelines._validation.Validation
 
     def to_dict(self) -> dict:
         """The numbers of ``report.json`` (units in keys)."""
@@ -144,6 +145,7 @@ class ExperimentResult:
                 "bytes": self.video.n_bytes,
                 "note": self.video.note,
             },
+            "validation": None if self.validation is None else self.validation.to_dict(),
             "timings_s": self.timings_s,
             "units": {
                 "t": "s",
@@ -278,7 +280,8 @@ def analyse_experiment(
     from ._audit_stage import audit_experiment
 
     audit = audit_experiment(cfg, measured, tr, track_rows)
-    if cfg.fit_restitution:
+    forced = table is not None and "acc_m_s2" in table
+    if cfg.fit_restitution and not forced:
         from ...fitting import fit_restitution
 
         t2 = time.perf_counter()
@@ -295,14 +298,28 @@ def analyse_experiment(
         if fit_d.get("status") == "failed":
             status = "partial"
             msgs.append(f"restitution fit failed: {fit_d.get('message')}")
+    prep = validation = None
+    if forced:  # a free-rocking fit means nothing under a moving table: η_e from half cycles instead
+        from .._validation import prepare_forced, validate_forced_run
+
+        t2 = time.perf_counter()
+        prep = prepare_forced(cfg, block, prim, table, table_sync, msgs)
+        timings["fit_s"] = time.perf_counter() - t2
+        if prep is not None and cfg.fit_restitution:
+            fit_d = prep.fit.to_dict()
+            status = "partial" if fit_d["status"] == "failed" else status
     t3 = time.perf_counter()
     sims = _simulate_laws(cfg, block, prim, fit_d, table, msgs)
     timings["simulate_s"] = time.perf_counter() - t3
+    if prep is not None and sims:
+        t4 = time.perf_counter()
+        validation = validate_forced_run(prep, block, {law: s["eta"] for law, s in sims.items()})
+        timings["validation_s"] = time.perf_counter() - t4
 
     truth = None
     if cfg.truth is not None:
         truth = _truth(cfg, prim, msgs)
-    return result(fit=fit_d, simulations=sims, truth=truth, status=status, audit=audit)
+    return result(fit=fit_d, simulations=sims, truth=truth, status=status, audit=audit, validation=validation)
 
 
 def _eta_for_law(law, cfg, block, fit_d, msgs):

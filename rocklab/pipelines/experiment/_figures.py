@@ -78,6 +78,9 @@ def experiment_figures(res, out_dir) -> dict[str, Path]:
             )
     if val is not None:
         ax.axvline(val.horizon_s, color="k", ls=":", lw=1.0, label=f"predictability horizon ({val.reference_law})")
+        # overturned members reach ±π/2 (6 α for a stocky block): keep the measurement readable
+        peak = max(float(np.nanmax(np.abs(th))) for _, th in res.measured.values()) / alpha
+        ax.set_ylim(-max(1.1, 1.3 * peak), max(1.1, 1.3 * peak))
     if res.truth is not None:
         ax.plot(
             res.truth["t_s"], np.asarray(res.truth["theta_rad"]) / alpha, lw=0.6, color="k", alpha=0.5, label="truth"

@@ -142,3 +142,24 @@ def test_run_reports_validation_and_bands(tmp_path):
     summary = (tmp_path / "out" / "summary.md").read_text()
     assert "Predictability horizon" in summary and "**inconsistent**" in summary
     assert json.loads((tmp_path / "out" / "report.json").read_text())["validation"]["n_members"] == 64
+
+
+def test_half_cycles_stop_where_the_block_passes_alpha():
+    """A table can carry a block past α and back; the simulator cannot start there (an InputError
+    stopped ``rocklab run``): the half cycles end before the first |θ| ≥ 0.98 α."""
+    from rocklab import Block
+    from rocklab.fitting import fit_forced_restitution, half_cycle_segments
+    from rocklab.models import BaseMotion
+
+    block = Block(0.06, 0.225)
+    alpha = block.alpha_rad
+    t = np.arange(0, 4, 0.02)
+    y = np.where((t >= 2.5) & (t < 3.0), 1.2, 0.5) * alpha * np.sin(2 * np.pi * t)  # -1.2 α at 2.75 s
+    segs = half_cycle_segments(t, y, alpha)
+    # extrema every 0.5 s from 0.25 s: the four half cycles up to 2.25 s; the next reaches past α,
+    # and the one after would start there
+    assert len(segs) == 4 and max(t[s[2][-1]] for s in segs) < 2.5
+    assert np.allclose([s[0] for s in segs], [0.25, 0.75, 1.25, 1.75], atol=1e-3)
+    base = BaseMotion(np.arange(0, 5, 0.01), np.zeros(500), name="still")
+    fit = fit_forced_restitution(t, y, block, base)  # no InputError from a start past α
+    assert 1 <= fit.n_segments <= 4  # (the fit may leave out a half cycle it cannot follow)

@@ -134,9 +134,12 @@ def half_cycle_segments(t_s, theta_rad, alpha_rad: float, min_amp_frac: float = 
                 keep[-1] = int(k)
             continue
         keep.append(int(k))
+    # a block at or past α has overturned (or is about to): nothing after it is rocking
+    over = np.flatnonzero(np.abs(np.nan_to_num(y)) >= 0.98 * alpha_rad)
+    t_over = t[over[0]] if over.size else np.inf
     segs = []
     for a, b in zip(keep[:-1], keep[1:]):
-        if t_max_s is not None and t[b] > t_max_s:
+        if (t_max_s is not None and t[b] > t_max_s) or t[b + 1 if b + 1 < t.size else b] >= t_over:
             break
         idx = np.arange(a + 1, b + 2 if b + 1 < y.size else b + 1)
         idx = idx[np.isfinite(y[idx])]

@@ -309,7 +309,8 @@ def analyse_experiment(
             fit_d = prep.fit.to_dict()
             status = "partial" if fit_d["status"] == "failed" else status
     t3 = time.perf_counter()
-    sims = _simulate_laws(cfg, block, prim, fit_d, table, msgs)
+    # a block resting on the table before the shaking starts flat, not at the tracker's offset
+    sims = _simulate_laws(cfg, block, prim, fit_d, table, msgs, None if prep is None else prep.theta0_rad)
     timings["simulate_s"] = time.perf_counter() - t3
     if prep is not None and sims:
         t4 = time.perf_counter()
@@ -347,7 +348,7 @@ def _eta_for_law(law, cfg, block, fit_d, msgs):
     raise AssertionError(law)
 
 
-def _simulate_laws(cfg, block, prim, fit_d, table, msgs) -> dict:
+def _simulate_laws(cfg, block, prim, fit_d, table, msgs, theta0_rad=None) -> dict:
     from ...models import simulate
 
     t_meas, th_meas = prim
@@ -358,7 +359,7 @@ def _simulate_laws(cfg, block, prim, fit_d, table, msgs) -> dict:
     if table is None and fit_ok:  # thread-burn release as fitted
         theta0, t_rel = float(fit_d["theta0_rad"]), float(fit_d["release_t_s"])
     else:  # forced run or no fit: start at the first valid sample, θ measured there
-        theta0, t_rel = float(th_meas[ok][0]), float(t_meas[ok][0])
+        theta0, t_rel = float(th_meas[ok][0]) if theta0_rad is None else theta0_rad, float(t_meas[ok][0])
     dur = cfg.duration_s or float(np.nanmax(t_meas) - t_rel)
     base = None
     if table is not None and "acc_m_s2" in table:

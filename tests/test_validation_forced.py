@@ -45,7 +45,7 @@ def test_eta_from_half_cycles_covers_the_truth(eta):
     assert (hi - lo) / 2 <= 0.01
     assert abs(fit.eta_e - eta) < 0.004
     # the table bias (+0.01 m/s² as measured, mirrored for the simulator) is found, not read as η
-    assert fit.base_bias_m_s2 == pytest.approx(-0.01, abs=0.009)
+    assert -0.021 < fit.base_bias_m_s2 < -0.004  # (measured -0.0102 and -0.0176 for the two η)
     assert fit.rms_residual_rad < 1e-3  # half cycles restarted from the data follow it to ~noise
 
 

@@ -62,6 +62,8 @@ class ForcedRestitutionFit:
     base_bias_m_s2 : float
         Constant offset of the base acceleration (as given to the fit) profiled with η_e, m/s²:
         a table tilt or the gravity removal's error.
+    base_bias_se_m_s2 : float
+        Its standard error, m/s² (least squares, doubled for correlated residuals).
     status : str
         "ok", "suspect" (η_e at the edge of the searched range) or "failed".
     message : str
@@ -78,6 +80,7 @@ class ForcedRestitutionFit:
     message: str = ""
     base_bias_m_s2: float = float("nan")
     n_samples: int = 0
+    base_bias_se_m_s2: float = float("nan")
 
     def to_dict(self) -> dict:
         """JSON-ready numbers (units in keys)."""
@@ -92,6 +95,7 @@ class ForcedRestitutionFit:
             "longest_segment_s": f(self.longest_segment_s),
             "rms_residual_rad": f(self.rms_residual_rad),
             "base_bias_m_s2": f(self.base_bias_m_s2),
+            "base_bias_se_m_s2": f(self.base_bias_se_m_s2),
             "n_samples": int(self.n_samples),
             "status": self.status,
             "message": self.message,
@@ -298,6 +302,10 @@ def fit_forced_restitution(
     k_hat = int(np.argmin(np.abs(fine - eta_hat)))
     # the residual asks for +b on the base: the base as given is offset by -b
     bias = -float(Aa[:, k_hat].sum() / max(C[:, k_hat].sum(), 1e-300))
+    # its standard error, least squares with the residual variance per degree of freedom, doubled
+    # for the residuals' correlation from sample to sample
+    dof = max(n_samples - 2 * n - 2, 1)
+    bias_se = 2.0 * float(np.sqrt(max(sse_hat, 0.0) / dof / max(C[:, k_hat].sum(), 1e-300)))
     status, msg = "ok", (f"{n_out} of {n + n_out} half cycles left out (residual above 4x the median)" if n_out else "")
     edge = 0.0025
     if eta_hat <= max(lo, fine[0]) + edge or eta_hat >= min(hi, fine[-1]) - edge:
@@ -312,6 +320,7 @@ def fit_forced_restitution(
         n_segments=n,
         segment_eta=fine[np.argmin(E, axis=1)],
         base_bias_m_s2=bias,
+        base_bias_se_m_s2=bias_se,
         n_samples=int(n_samples),
         longest_segment_s=float(max(t[s[2][-1]] - s[0] for s in segs)),
         rms_residual_rad=float(np.sqrt(max(sse_hat, 0.0) / n_samples)),

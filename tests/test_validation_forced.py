@@ -141,6 +141,7 @@ def test_run_reports_validation_and_bands(tmp_path):
         assert inside == pytest.approx(v["laws"][law]["band_coverage"], abs=1.01 / len(ser))
     summary = (tmp_path / "out" / "summary.md").read_text()
     assert "Predictability horizon" in summary and "**inconsistent**" in summary
+    assert f"from {rep['fit']['n_segments']} half cycles under the measured table motion" in summary
     assert json.loads((tmp_path / "out" / "report.json").read_text())["validation"]["n_members"] == 64
 
 

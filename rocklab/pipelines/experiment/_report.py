@@ -61,7 +61,15 @@ def _summary_md(res, figs: dict, rrd: bool) -> str:
         f"p = {_g(res.block.p_rad_s)} rad/s, η_H = {_g(res.block.eta_H)}; contact: {res.config.contact}",
         "",
     ]
-    if f:
+    if f and f.get("method") == "half-cycle segments":  # a shake-table run (see the validation below)
+        ci = f.get("ci95_eta_e") or [None, None]
+        lines += [
+            f"η_e = {_g(f.get('eta_e'))} (95 % CI {_g(ci[0])} – {_g(ci[1])}) from {f.get('n_segments')} half cycles "
+            f"under the measured table motion, residual RMS {_g(f.get('rms_residual_rad'))} rad "
+            f"(fit status {f.get('status')})",
+            "",
+        ]
+    elif f:
         ci = f.get("ci95_eta_e") or [None, None]
         lines += [
             f"η_e = {_g(f.get('eta_e'))} (95 % CI {_g(ci[0])} – {_g(ci[1])}), "

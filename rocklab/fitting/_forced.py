@@ -52,7 +52,8 @@ class ForcedRestitutionFit:
     n_segments : int
         Half-cycle segments used.
     segment_eta : ndarray, (n_segments,)
-        The η each segment alone prefers (its grid minimum): a spread check.
+        The η each half cycle alone prefers (its own start state profiled, no bias): the impact
+        it contains, one by one.
     longest_segment_s : float
         Longest single prediction, s (to compare with the predictability horizon).
     rms_residual_rad : float
@@ -154,6 +155,17 @@ def half_cycle_segments(t_s, theta_rad, alpha_rad: float, min_amp_frac: float = 
         tp = float(np.clip(tp, t[a - 1] - t[a], t[a + 1] - t[a]))
         segs.append((float(t[a] + tp), float(np.polyval(c, tp)), idx))
     return segs
+
+
+def _vertex(x, f):
+    """Abscissa of the minimum of samples f(x) on a uniform grid: the parabola through the best node
+    and its neighbours (the node itself at the grid's edge)."""
+    k = int(np.argmin(f))
+    if k == 0 or k == len(x) - 1:
+        return float(x[k])
+    den = f[k - 1] - 2 * f[k] + f[k + 1]
+    h = x[1] - x[0]
+    return float(x[k] + (0.5 * h * (f[k - 1] - f[k + 1]) / den if den > 0 else 0.0))
 
 
 def fit_forced_restitution(
@@ -318,7 +330,7 @@ def fit_forced_restitution(
         ci95=(float(ci[0]), float(ci[1])),
         se=se,
         n_segments=n,
-        segment_eta=fine[np.argmin(E, axis=1)],
+        segment_eta=np.array([_vertex(fine, row) for row in E]),
         base_bias_m_s2=bias,
         base_bias_se_m_s2=bias_se,
         n_samples=int(n_samples),

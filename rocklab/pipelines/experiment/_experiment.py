@@ -307,6 +307,7 @@ def analyse_experiment(
         timings["fit_s"] = time.perf_counter() - t2
         if prep is not None and cfg.fit_restitution:
             fit_d = prep.fit.to_dict()
+            per_imp = np.asarray(fit_d["segment_eta"], float)  # the impact of each half cycle
             status = "partial" if fit_d["status"] == "failed" else status
     t3 = time.perf_counter()
     # a block resting on the table before the shaking starts flat, not at the tracker's offset

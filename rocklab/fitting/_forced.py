@@ -321,6 +321,9 @@ def fit_forced_restitution(
     status, msg = "ok", (f"{n_out} of {n + n_out} half cycles left out (residual above 4x the median)" if n_out else "")
     edge = 0.0025
     if eta_hat <= max(lo, fine[0]) + edge or eta_hat >= min(hi, fine[-1]) - edge:
+        from .._diagnostics import warn
+
+        warn("W-FIT-BOUND", f"η_e from half cycles = {eta_hat:.4f} at the edge of {fine[0]:.3f}–{fine[-1]:.3f}")
         status, msg = (
             "suspect",
             f"η_e = {eta_hat:.4f} lies at the edge of the searched range {fine[0]:.3f}–{fine[-1]:.3f}",

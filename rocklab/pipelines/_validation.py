@@ -145,14 +145,19 @@ def _uncertainty(cfg, block, table, table_sync, y, msgs):
     fin = np.isfinite(aa)
     peak = float(np.nanmax(np.abs(aa)))
     dt_tab = float(np.nanmedian(np.diff(ta)))
+    from .._diagnostics import warn
+
     if cfg.table.source == "record":
-        msgs.append("validation: the table motion is the record (the command): noise 2 % of its peak assumed")
+        warn(
+            "W-VALID-ASSUMED", f"{cfg.path}: the table motion is a record (the command); noise 2 % of its peak assumed"
+        )
         sa, sb, st = 0.02 * peak, 0.0, dt_tab
     else:
         w = _rest_window(aa[fin])
         if w is None:
-            msgs.append(
-                "validation: the table acceleration has no rest before the shaking: noise 2 % of its peak assumed"
+            warn(
+                "W-VALID-ASSUMED",
+                f"{cfg.path}: the table acceleration has no rest before the shaking; noise 2 % of its peak assumed",
             )
             sa, sb = 0.02 * peak, 0.0
         else:

@@ -197,3 +197,15 @@ def test_each_half_cycle_gives_its_impact_eta():
     assert fit.n_segments >= 10
     assert np.all(np.abs(fit.segment_eta - eta) < 0.0015)  # (measured: at most 5e-4)
     assert abs(fit.eta_e - eta) < 5e-4 and abs(fit.base_bias_m_s2) < 2e-3
+
+
+def test_rest_before_the_shaking_survives_one_outlier():
+    """A table acceleration differentiated from video starts with one off sample; its rest still
+    gives the noise (it was taken as 'no rest', and 2 % of the peak assumed: 53x the noise)."""
+    from rocklab.pipelines._validation import _rest_window, _robust_sd
+
+    rng = np.random.default_rng(0)
+    x = np.concatenate(([0.3], 0.01 * rng.standard_normal(300), np.linspace(0.5, 5.0, 40)))
+    w = _rest_window(x)
+    assert w is not None and w.stop == 301
+    assert _robust_sd(x[w]) == pytest.approx(0.01, rel=0.2)

@@ -118,7 +118,8 @@ def _horizon_fraction():
 
 
 def _rest_window(x, k_sigma=6.0, n_min=10):
-    """Indices of the initial rest of ``x``: until it first leaves ±k σ of its start level."""
+    """Indices of the initial rest of ``x``: until it first stays outside ±k σ of its start level
+    for three samples (one outlier, a differentiated track's first sample, does not end it)."""
     x = np.asarray(x, float)
     head = x[: max(n_min, 20)]
     head = head[np.isfinite(head)]
@@ -127,7 +128,9 @@ def _rest_window(x, k_sigma=6.0, n_min=10):
     lev = float(np.median(head))
     sig = 1.4826 * float(np.median(np.abs(np.diff(head)))) / np.sqrt(2.0)
     sig = max(sig, 1e-12)
-    out = np.flatnonzero(~(np.abs(x - lev) <= k_sigma * sig))
+    away = ~(np.abs(x - lev) <= k_sigma * sig)
+    run = away[:-2] & away[1:-1] & away[2:]
+    out = np.flatnonzero(run)
     n = int(out[0]) if out.size else x.size
     return slice(0, n) if n >= n_min else None
 

@@ -4,7 +4,7 @@ VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 
-.PHONY: test test-browser demo bench lint docs docs-serve install-user venv clean
+.PHONY: test test-browser demo bench lint docs docs-serve install-user venv clean figures
 
 venv: $(STAMP)
 
@@ -50,6 +50,10 @@ lint: $(STAMP)
 
 # the documentation site (MkDocs Material + mkdocstrings), warnings are errors; the pages'
 # examples and equation tables are checked first, so the site cannot show rotten commands
+# the papers' figures and tables (docs/gallery.md); the thesis's MUL009 figure when ../shared is there
+figures: $(STAMP)
+	$(PY) -m rocklab papers --out figures $$(test -d ../shared/data/records && echo --records ../shared/data/records)
+
 docs: $(STAMP)
 	$(PY) -m pip install --quiet -e ".[docs]"
 	$(PY) -m pytest -q -p no:cacheprovider tests/test_docs_examples.py tests/test_papers_page.py

@@ -192,6 +192,11 @@ WARNING_CODES: dict[str, tuple[str, str]] = {
         "a frame rate given in the config or with --fps contradicts the container's own clock: "
         "t_s follows the given rate; remove it unless the film's clock is known wrong",
     ),
+    "W-VIDEO-TIMES": (
+        "suspect",
+        "a high-speed film's own frame times contradict its frame rate (a frame stamped far from "
+        "the others: a damaged or cut time block): t_s follows the rate; check the frames named",
+    ),
     "W-VIDEO-MIRRORED": (
         "suspect",
         "the film's display matrix mirrors the picture: it is tracked as shown, so theta's sign is "

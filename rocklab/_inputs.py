@@ -27,10 +27,15 @@ def _file_id(path) -> tuple[int, int] | None:
 
 
 def sequence_files(pattern) -> list[Path]:
-    """The files an image-sequence pattern (``dir/%05d.png``) names; ``[pattern]`` for a plain path."""
+    """The files an image-sequence pattern (``dir/%05d.png``) names; every visible file of a folder
+    of frames (its timestamps too); a Photron header and its ``.mraw``; ``[pattern]`` for a plain path."""
     import re
 
     p = Path(pattern)
+    if p.is_dir():
+        return sorted(f for f in p.iterdir() if f.is_file() and not f.name.startswith("."))
+    if p.suffix.lower() in (".cih", ".cihx", ".mraw"):
+        return [p] + [q for q in (p.with_suffix(s) for s in (".cih", ".cihx", ".mraw")) if q != p and q.exists()]
     if "%" not in p.name:
         return [p]
     try:

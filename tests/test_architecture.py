@@ -104,8 +104,8 @@ def _subpackage(mod):
     return parts[1] if len(parts) >= 2 else ""
 
 
-#: The one-release aliases of names that moved from tracking to synth (rocklab.tracking.__getattr__).
-ALIASES = {("rocklab.tracking", "rocklab.synth")}
+#: Allowed imports against the layering (none: the tracking -> synth forwarding shim is gone).
+ALIASES: set = set()
 
 
 @pytest.mark.parametrize(
@@ -144,15 +144,14 @@ def test_only_pipelines_draw_or_log_to_rerun():
     assert not bad
 
 
-def test_moved_names_keep_a_deprecated_alias_for_one_release():
+def test_synth_names_live_in_synth_only():
+    # simulated sessions are a simulator of the lab, not a measurement: tracking does not forward them
     import rocklab.synth
     import rocklab.tracking
 
-    with pytest.warns(DeprecationWarning, match="rocklab.tracking.synth_session moved to rocklab.synth"):
-        f = rocklab.tracking.synth_session
-    assert f is rocklab.synth.synth_session
-    with pytest.raises(AttributeError):
-        rocklab.tracking.no_such_name  # noqa: B018
+    assert callable(rocklab.synth.synth_session)
+    for name in ("synth_session", "SynthSession", "simulate_imu_log"):
+        assert not hasattr(rocklab.tracking, name)
 
 
 def test_packages_hold_at_most_12_modules_where_split():
@@ -173,7 +172,7 @@ def test_packages_hold_at_most_12_modules_where_split():
         "fitting",
         "pipelines",
         "pipelines/cli",
-        "pipelines/cli/commands",
+        # pipelines/cli/commands is cut by concept, one module per rocklab command, however many
         "pipelines/experiment",
         "pipelines/campaign",
         "pipelines/spectra",

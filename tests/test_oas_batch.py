@@ -70,12 +70,14 @@ def test_batch_folder_list_duplicates_and_outputs(tmp_path, run_cli):
     )
     assert rc == 1  # some failed: say so
     tab = pd.DataFrame(json.loads(out)["records"])
-    assert list(tab.name) == ["README", "pulse_a", "pulse_b", "pulse_a", "nope"]
-    errs = [e for e in err.strip().splitlines()]
-    assert len(errs) == 3 and all(e.startswith("rocklab oas: error: ") for e in errs)
+    assert list(tab.name) == ["pulse_a", "pulse_b", "pulse_a", "nope"]  # README.md is no record
+    lines = err.strip().splitlines()
+    errs = [e for e in lines if e.startswith("rocklab oas: error: ")]
+    notes = [e for e in lines if e.startswith("rocklab oas: note: ")]
+    assert len(errs) == 2 and len(notes) == 1 and len(lines) == 3
     assert any("set.txt, line 2: nope.csv not found" in e for e in errs)
     assert any("same record name as" in e and "other/pulse_a.csv" in e for e in errs)
-    assert any("README.md, line 1" in e for e in errs)
+    assert "README.md: skipped, not a record" in notes[0]
     ok = tab[tab.error == ""]
     assert list(ok.name) == ["pulse_a", "pulse_b"]
     # one full sine: its largest lobe is half a period
@@ -83,7 +85,7 @@ def test_batch_folder_list_duplicates_and_outputs(tmp_path, run_cli):
     assert (ok.t_I_s > 0).all() and ok.t_I_s.iloc[1] > ok.t_I_s.iloc[0]
     csv = pd.read_csv(tmp_path / "t" / "table.csv")
     pq = pd.read_parquet(tmp_path / "t" / "table.parquet")
-    assert len(csv) == len(pq) == 5
+    assert len(csv) == len(pq) == 4
     np.testing.assert_allclose(pq.t_I_s.to_numpy(float), csv.t_I_s.to_numpy(float), rtol=1e-5)
     assert (tmp_path / "t" / "tI.png").stat().st_size > 10_000
 
@@ -99,6 +101,47 @@ def test_batch_fema_records_get_the_thesis_values(shared_data, tmp_path, run_cli
     # t_p as printed within 0.35 % (Table 4: 0.405 s and 0.367 s)
     assert tab.t_p_s.tolist() == pytest.approx(tab.thesis_t_p_s.tolist(), rel=0.0035)
     assert math.isclose(tab.thesis_t_I_s[0], 0.266) and math.isclose(tab.thesis_t_I_s[1], 0.360)
+
+
+def test_record_folder_skips_other_files_and_names_each_subfolder(tmp_path):
+    top = tmp_path / "records"
+    (top / "far-field" / "deeper").mkdir(parents=True)
+    _sine_record(top / "a.csv", 0.6)
+    (top / "b.AT2").write_text("PEER\nx\nACCELERATION TIME SERIES IN UNITS OF G\nNPTS=  3, DT= .0100 SEC\n0. 0. 0.\n")
+    (top / "c.txt").write_text("0.0  0.0\n0.01 0.1e-3\n")  # two-column text: a record
+    (top / "LICENSE.txt").write_text("The source code is licensed under a BSD 2-Clause License.\n1, 2\n")
+    (top / "fig.png").write_bytes(b"\x89PNG\r\n\x1a\n\x00\x00\x00\rIHDR")
+    (top / "meta.json").write_text('{"n": 1}')
+    (top / "broken.csv").write_text("t_s,acc_g\n0,x\n")  # a damaged record stays a record: its reader says why
+    _sine_record(top / "far-field" / "d.csv", 0.8)
+    _sine_record(top / "far-field" / "deeper" / "e.csv", 0.9)
+    notes: list = []
+    names = [n for n, _, _ in expand_records([top], notes=notes)]
+    assert names == ["a", "b", "broken", "c"]
+    assert len(notes) == 4
+    assert sum("skipped, not a record" in n for n in notes) == 3
+    assert any("LICENSE.txt" in n for n in notes) and any(
+        "fig.png: skipped, not a record (a binary file)" in n for n in notes
+    )
+    sub = [n for n in notes if "subfolder" in n]
+    assert len(sub) == 1 and "far-field/" in sub[0] and "--recursive" in sub[0]
+    notes = []
+    names = [n for n, _, _ in expand_records([top], notes=notes, recursive=True)]
+    assert names == ["a", "b", "broken", "c", "d", "e"] and not any("subfolder" in n for n in notes)
+
+
+def test_oas_recursive_reads_the_shared_records_and_notes_the_licence(shared_data, tmp_path, run_cli):
+    folder = shared_data / "records"
+    args = ("oas", folder, "--sizes", 8, "--levels", 6, "--refine", 1, "--workers", 1, "--no-progress", "--json")
+    rc, out, err = run_cli(*args)
+    names = [r["name"] for r in json.loads(out)["records"]]
+    assert rc == 0, err
+    assert "EE-UQ-LICENSE" not in names and not any(n.startswith("SortedEQFile") for n in names)
+    assert "EE-UQ-LICENSE.txt: skipped, not a record" in err and "fema-p695-far-field/: a subfolder" in err
+    rc, out, err = run_cli(*args, "--recursive", "--units", "g")
+    names = [r["name"] for r in json.loads(out)["records"]]
+    assert rc == 0, err
+    assert sum(n.startswith("SortedEQFile") for n in names) == 2 and "subfolder" not in err
 
 
 def test_expand_records_missing_file_is_a_row_not_a_crash(tmp_path):

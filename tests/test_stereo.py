@@ -267,3 +267,24 @@ def test_no_sync_on_lagged_films_is_a_warning_and_silent_once_aligned(session):
     with collecting() as diags:
         check_unsynchronised(again, "cam1.mkv", "aligned")
     assert not diags
+
+
+def test_films_as_folders_of_frames_calibrate_and_track_as_the_films(session, tmp_path):
+    import cv2
+
+    from rocklab.tracking import iter_video_frames
+
+    d, _, rig, sp = session
+    folders = {}
+    for name in ("calib_cam1", "calib_cam2", "cam1", "cam2"):
+        f = folders[name] = tmp_path / name
+        f.mkdir()
+        for i, g in iter_video_frames(d / f"{name}.mkv"):  # 16-bit, as a 12-bit camera writes them
+            cv2.imwrite(str(f / f"img_{i:05d}.png"), g.astype(np.uint16) * 16)
+    rig2 = calibrate_stereo(folders["calib_cam1"], folders["calib_cam2"])
+    assert rig2.rms_px == pytest.approx(rig.rms_px, rel=1e-9) and rig2.baseline_m == pytest.approx(rig.baseline_m)
+    with pytest.raises(InputError, match="no frame rate.*timestamps.csv.*--fps"):
+        track_dots_stereo(folders["cam1"], folders["cam2"], rig2)
+    sp2 = track_dots_stereo(folders["cam1"], folders["cam2"], rig2, fps=150.0)
+    np.testing.assert_allclose(sp2.t_s, sp.t_s, atol=1e-12)
+    np.testing.assert_allclose(sp2.xyz_m, sp.xyz_m, atol=1e-9)

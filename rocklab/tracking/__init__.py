@@ -95,29 +95,3 @@ __all__: list[str] = [
     "sync_imu_to_track",
     "track_rate",
 ]
-
-#: Names that moved to :mod:`rocklab.synth` (simulated lab sessions are a simulator of the lab, not a
-#: measurement); reachable here for one release with a DeprecationWarning.
-_MOVED_TO_SYNTH = (
-    "synth_session",
-    "SynthSession",
-    "load_synth_session",
-    "simulate_imu_log",
-    "write_ximu_csv",
-    "write_ximu3_csv",
-)
-
-
-def __getattr__(name):
-    if name in _MOVED_TO_SYNTH:
-        import warnings
-
-        import rocklab.synth as synth
-
-        warnings.warn(
-            f"rocklab.tracking.{name} moved to rocklab.synth.{name}; import it from there",
-            DeprecationWarning,
-            stacklevel=2,
-        )
-        return getattr(synth, name)
-    raise AttributeError(f"module 'rocklab.tracking' has no attribute {name!r}")

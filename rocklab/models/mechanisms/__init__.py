@@ -3,7 +3,8 @@
 Fundamental rocking parameters of a block, a strut, a frame, a wall, an asymmetric frame and
 an arch (:func:`block_parameters`, :func:`frame_parameters`, :func:`wall_mechanism`,
 :func:`asymmetric_frame`, :func:`arch_mechanism`, by Lagrange's equations, Eq. 7-20), the
-linearised equation's closed forms (Eq. 24-25, 40-42) and the equivalence errors.
+linearised equation's closed forms (Eq. 24-25, 40-42), the equivalence errors, and time histories
+of a mechanism and its equivalent blocks under base motion (:func:`mechanism_time_histories`).
 """
 
 from ._equivalent import (
@@ -20,7 +21,14 @@ from ._equivalent import (
     wall_mechanism,
     wall_parameters,
 )
-from ._mechanisms import arch_mechanism, asymmetric_frame, four_bar_mechanism
+from ._mechanisms import arch_mechanism, asymmetric_frame, block_mechanism, four_bar_mechanism
+from ._response import (
+    MechanismResponse,
+    equivalent_block_dimensions,
+    equivalent_block_mechanism,
+    mechanism_response,
+    mechanism_time_histories,
+)
 
 __all__ = [
     "FundamentalParameters",
@@ -31,6 +39,7 @@ __all__ = [
     "wall_parameters",
     "wall_mechanism",
     "four_bar_mechanism",
+    "block_mechanism",
     "asymmetric_frame",
     "arch_mechanism",
     "free_rocking_period_eq24",
@@ -38,4 +47,9 @@ __all__ = [
     "sine_pulse_max_response",
     "linear_sine_pulse_response",
     "equivalence_errors",
+    "MechanismResponse",
+    "mechanism_response",
+    "mechanism_time_histories",
+    "equivalent_block_mechanism",
+    "equivalent_block_dimensions",
 ]

@@ -15,7 +15,7 @@ import numpy as np
 
 from ..._errors import InputError
 from ...blocks import G
-from ._equivalent import Mechanism, _pos
+from ._equivalent import Mechanism, _pos, block_parameters
 
 __all__ = ["four_bar_mechanism", "asymmetric_frame", "arch_mechanism"]
 
@@ -25,6 +25,10 @@ __all__ = ["four_bar_mechanism", "asymmetric_frame", "arch_mechanism"]
 
 def _cross(u, v) -> float:
     return float(u[0] * v[1] - u[1] * v[0])
+
+
+def _wrap(a: float) -> float:
+    return (a + math.pi) % (2 * math.pi) - math.pi
 
 
 def _rot(v, t):
@@ -81,8 +85,10 @@ def four_bar_mechanism(A, B, C, D, bodies, name: str = "four-bar") -> Mechanism:
         e = d / dd
         n = np.array([-e[1], e[0]])
         Cp = Bp + x * e + side0 * y * n  # keep the rest configuration's branch
-        t2 = math.atan2(*(Cp - Bp)[::-1]) - ang_bc0
-        t3 = math.atan2(*(Cp - D)[::-1]) - ang_dc0
+        # rotations from rest wrapped to (-pi, pi]: a link pointing along -x at rest (a mirrored
+        # frame's beam) would otherwise jump by 2 pi between neighbouring phi
+        t2 = _wrap(math.atan2(*(Cp - Bp)[::-1]) - ang_bc0)
+        t3 = _wrap(math.atan2(*(Cp - D)[::-1]) - ang_dc0)
         r = [A + _rot(cms[0] - A, -phi), Bp + _rot(cms[1] - B0, t2), D + _rot(cms[2] - D, t3)]
         return np.array(r), np.array([-phi, t2, t3])
 
@@ -299,3 +305,40 @@ def arch_mechanism(inclusion_angle_rad: float, thickness_m: float, radius_m: flo
         "mirrored": mirror,
         "lambda": _lambda_at_rest(pts, bodies),
     }
+
+
+# -- single-body mechanisms of Table I -------------------------------------------------
+
+
+def block_mechanism(
+    R_m: float, alpha_rad: float, alpha_I: float = 4.0 / 3.0, eta: float | None = None, name: str = "block"
+) -> Mechanism:
+    """A rocking block (or any structure of Table I) as a :class:`Mechanism`, per unit mass.
+
+    M = alpha_I R^2, V = g R cos(alpha - phi), B = R cos(alpha - phi): Lagrange gives Eq. 2,
+    phi'' = -p^2 (sin(alpha - phi) + u_g''/g cos(alpha - phi)) with p^2 = g / (alpha_I R). The
+    strut is ``alpha_I = 1``; the symmetric frame of mass ratio gamma is the block with
+    ``alpha_I = (4/3 + 4 gamma) / (1 + 2 gamma)`` (the same p, alpha and lambda, Eq. 35-37).
+
+    Parameters
+    ----------
+    R_m : float
+        Pivot-to-centre-of-mass distance, m.
+    alpha_rad : float
+        Slenderness angle, rad.
+    alpha_I : float
+        I_O / (m R^2).
+    eta : float, optional
+        Restitution; default Housner's 1 - 2 sin^2(alpha) / alpha_I (angular momentum, Table I).
+    """
+    fp = block_parameters(R_m, alpha_rad, alpha_I)
+    R, a, aI = float(R_m), float(alpha_rad), float(alpha_I)
+    return Mechanism(
+        M=lambda f: aI * R * R,
+        V=lambda f: G * R * math.cos(a - f),
+        B=lambda f: R * math.cos(a - f),
+        phi_max=math.pi / 2,
+        name=name,
+        eta=fp.eta if eta is None else float(eta),
+        eom=lambda f: (aI * R * R, 0.0, G * R * math.sin(a - f), R * math.cos(a - f)),
+    )

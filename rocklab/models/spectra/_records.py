@@ -33,6 +33,7 @@ from ._record_units import UNITS_TO_M_S2, _at2_units, _stated_wins, _unit_factor
 __all__ = [
     "BaseMotion",
     "load_base_motion",
+    "not_a_record",
     "check_plausible",
     "MIN_SAMPLES",
     "UNITS_TO_M_S2",
@@ -213,6 +214,37 @@ def load_base_motion(
     else:
         bm = _read_columns(path, text, units or default_units, dt_s, nm)
     return check_plausible(bm)
+
+
+def not_a_record(path) -> str:
+    """Why the file ``path`` is plainly not a record ("" when it may be one), from its first 4 kB.
+
+    A folder of records often holds other files (a licence, a README, a figure): they are told
+    apart by what :func:`load_base_motion` would read, not by their names. A record is a file with
+    an ``NPTS=`` header (AT2), a ``.csv``, or text whose first data line is numbers (or a CSV
+    header naming ``t_s``/``acc_``); anything else (binary, prose, JSON) is not one. A damaged
+    record still looks like one, so its reader reports the damage.
+    """
+    path = Path(path)
+    try:
+        with open(path, "rb") as f:
+            head = f.read(4096)
+    except OSError as e:
+        return f"cannot be read ({e.strerror})"
+    if b"\x00" in head:
+        return "a binary file"
+    text = head.decode("utf-8", errors="replace")
+    if not text.strip() or re.search(r"NPTS\s*=", text, re.I) or path.suffix.lower() == ".csv":
+        return ""
+    for ln in text.splitlines():
+        s = ln.strip()
+        if not s or s.startswith("#"):
+            continue
+        toks = s.replace(",", " ").split()
+        if all(_NUM.fullmatch(t) for t in toks) or re.search(r"\bt_s\b|\bacc_", s):
+            return ""
+        break
+    return "neither an AT2 (NPTS header), a CSV nor numeric columns"
 
 
 def _read_at2(path: Path, text: str, units: str | None, name: str, default_units: str | None = None) -> BaseMotion:

@@ -46,6 +46,8 @@ COMMAND_MODULES = (
     "_cmd_demo",
     "_cmd_column",
     "_cmd_design",
+    "_cmd_curve",
+    "_cmd_papers",
 )
 
 
@@ -87,7 +89,7 @@ def _check_file_outputs(args) -> None:
 
 
 #: Commands whose ``--out`` is a folder (checked by :func:`rocklab._outdir.check_output_dir`).
-FOLDER_COMMANDS = ("run", "campaign", "synth", "demo")
+FOLDER_COMMANDS = ("run", "campaign", "synth", "demo", "papers")
 
 _ERRNO_FIX = {
     errno.ENOSPC: "no space left on the device; free space or choose another output location",

@@ -1,10 +1,10 @@
-"""Command-line options shared by ``rocklab simulate`` and ``rocklab column``: a base-motion record."""
+"""Command-line options shared by the commands that take a base motion: a record file or a pulse."""
 
 from __future__ import annotations
 
 from ..._errors import InputError
 
-__all__ = ["add_base_motion_args", "base_motion_from_args", "emit_json", "count"]
+__all__ = ["add_base_motion_args", "base_motion_from_args", "pulse_from_spec", "PULSE_HELP", "emit_json", "count"]
 
 
 def count(minimum: int):
@@ -24,8 +24,16 @@ def count(minimum: int):
     return parse
 
 
+#: Help text of ``--pulse`` (one place for every command that takes it).
+PULSE_HELP = (
+    "a simple pulse instead of a record, KIND,PEAK,T_P[,N]: KIND half-sine, sine (one full sine), "
+    "n-half-sines, rectangular, triangular, cycloidal-a, cycloidal-b; PEAK with its unit (0.3g or "
+    "2.94m/s2); T_P the duration of one lobe (half a cycle), s; N lobes of n-half-sines"
+)
+
+
 def add_base_motion_args(p) -> None:
-    """``--base-motion FILE [--units U] [--scale-pga X]``."""
+    """``--base-motion FILE [--units U] [--scale-pga X]`` or ``--pulse KIND,PEAK,T_P[,N]``."""
     p.add_argument(
         "--base-motion", default=None, help="base acceleration record (.AT2, CSV t_s,acc_m_s2, 2-column text)"
     )
@@ -36,12 +44,51 @@ def add_base_motion_args(p) -> None:
         "a file's own units win, a conflict is an error",
     )
     p.add_argument("--scale-pga", type=float, default=None, help="scale the record to this PGA (in --units, default g)")
+    p.add_argument("--pulse", default=None, metavar="KIND,PEAK,T_P[,N]", help=PULSE_HELP)
+
+
+def pulse_from_spec(spec: str, option: str = "--pulse"):
+    """The :class:`~rocklab.models.BaseMotion` of ``KIND,PEAK,T_P[,N]`` (peak ``0.3g`` or ``2.94m/s2``).
+
+    The pulse is sampled at t_p/200 and followed by one t_p of zeros (the commands integrate on
+    past the record as free rocking).
+    """
+    from ...blocks import G
+    from ...models import pulse_motion
+
+    parts = [x.strip() for x in str(spec).split(",")]
+    fix = f"give {option} KIND,PEAK,T_P[,N], e.g. {option} half-sine,0.3g,0.5"
+    if len(parts) not in (3, 4):
+        raise InputError(f"{option} {spec!r}: {len(parts)} fields; {fix}")
+    kind, peak, tp = parts[:3]
+    low = peak.lower().replace(" ", "")
+    for unit, factor in (("m/s2", 1.0), ("m/s^2", 1.0), ("g", G)):
+        if low.endswith(unit):
+            num = low[: -len(unit)]
+            break
+    else:
+        raise InputError(f"{option} {spec!r}: peak {peak!r} has no unit; write it as 0.3g or 2.94m/s2")
+    try:
+        a = float(num) * factor
+        t_p = float(tp)
+        n = int(parts[3]) if len(parts) == 4 else 1
+    except ValueError:
+        raise InputError(f"{option} {spec!r}: PEAK and T_P must be numbers, N a whole number; {fix}") from None
+    if not (a > 0 and t_p > 0 and n >= 1) or not (a < float("inf") and t_p < float("inf")):
+        raise InputError(f"{option} {spec!r}: peak and t_p must be finite and > 0, N >= 1; {fix}")
+    base = pulse_motion(kind, t_p, a, n=n, pad_s=t_p)
+    return base
 
 
 def base_motion_from_args(args):
     """The :class:`BaseMotion` the options name (SI units), or None for free rocking."""
     from ...models import load_base_motion
 
+    pulse = getattr(args, "pulse", None)
+    if pulse is not None:
+        if args.base_motion is not None or args.scale_pga is not None or args.units is not None:
+            raise InputError("--pulse replaces --base-motion/--units/--scale-pga; give one or the other")
+        return pulse_from_spec(pulse)
     if args.base_motion is None:
         if args.scale_pga is not None or args.units is not None:
             raise InputError("--scale-pga/--units need --base-motion FILE")

@@ -68,13 +68,21 @@ def _track(args):
             preview = _opt(args.preview) or out.with_name(out.stem + "_init.png")
             return ins, [("-o", out), ("--preview", preview)]
         cfg_ins, _ = _track_config_inputs(_opt(args.config) or video.parent / "track.toml")
-        return ins + cfg_ins, [("-o", _opt(args.out) or video.parent / "track_preview.png")]
+        return ins + cfg_ins + _fixes(args), [("-o", _opt(args.out) or video.parent / "track_preview.png")]
     video = Path(args.video)
     cfg_ins, cfg = _track_config_inputs(_opt(args.config) or video.parent / "track.toml")
     outs = track_outputs(_opt(args.out) or video.parent / "tracks.csv")
     if cfg is None or cfg.table is None:
         outs.pop(TABLE)
-    return _video("video", video) + cfg_ins, [*outs.items(), ("--plot", _opt(getattr(args, "plot", None)))]
+    return _video("video", video) + cfg_ins + _fixes(args), [
+        *outs.items(),
+        ("--plot", _opt(getattr(args, "plot", None))),
+    ]
+
+
+def _fixes(args) -> list:
+    f = _opt(getattr(args, "corrections", None))
+    return [] if f is None else [("--corrections", f)]
 
 
 def _track3d(args):
@@ -136,7 +144,7 @@ def _oas(args):
     if args.list:
         ins.append(("list --list", Path(args.list)))
     try:
-        items = expand_records(args.record, args.list)
+        items = expand_records(args.record, args.list, recursive=getattr(args, "recursive", False))
     except Exception:  # noqa: BLE001 - an unreadable list is reported by the command itself
         items = [(None, r, "") for r in args.record]
     ins += [("record", Path(p)) for _, p, _ in items]

@@ -20,6 +20,8 @@ STATUS_COLOURS = {
     "low_quality": "tab:gray",
     "outlier": "gold",
     "interpolated": "tab:cyan",
+    "corrected": "tab:blue",
+    "dropped": "black",
 }
 
 

@@ -62,7 +62,7 @@ def _propose(video, info, gray):
     return props, min(window, duration) if duration else window
 
 
-def track_init(video, out, *, objects=(), table=None, marker_size_m=None, preview=None, side=(False, False)):
+def track_init(video, out, *, objects=(), table=None, marker_size_m=None, preview=None, side=(False, False), fps=None):
     """Write a commented ``track.toml`` for ``video`` (and a preview PNG); returns (config, notes).
 
     Without markers and without ``objects``, the objects that move in the first seconds and the
@@ -75,6 +75,8 @@ def track_init(video, out, *, objects=(), table=None, marker_size_m=None, previe
         ``NAME=x,y,w,h`` regions (px, first frame), followed markerless.
     table : str or None
         ``x,y,w,h`` of a markerless table (round its top edge: it levels the angles).
+    fps : float or None
+        Frame rate written to the config (``--fps``: an image folder or a film without one).
     marker_size_m : float or None
         Printed marker side, m, when markers are used.
     preview : path or None
@@ -134,14 +136,14 @@ def track_init(video, out, *, objects=(), table=None, marker_size_m=None, previe
         gray,
         regions=regions or None,
         table_roi=troi,
-        fps=None if info.fps else 50.0,
+        fps=fps if fps else (None if info.fps else 50.0),
         marker_size_m=marker_size_m,
         found=found,
         level_line_px=line,
     )
     notes = pnotes + notes
-    if not info.fps:
-        notes.append("the container has no frame rate: fps = 50 written; correct it")
+    if not info.fps and not fps:
+        notes.append("the film has no frame rate: fps = 50 written; correct it (or give --fps)")
     head = [
         f"# track.toml written by 'rocklab track init' from {video.name} ({info.width_px}x{info.height_px}, "
         f"{info.n_frames} frames, {info.fps or 'unknown'} fps)",
@@ -286,9 +288,25 @@ def _draw_top_edge(out, img, cfg, table) -> None:
 PREVIEW_SPAN_S = 10.0
 
 
-def track_preview(video, config, out, *, n_frames: int = 6, progress: bool = False, side: bool = False):
+def track_preview(
+    video,
+    config,
+    out,
+    *,
+    n_frames: int = 6,
+    progress: bool = False,
+    side: bool = False,
+    fps=None,
+    at_s=None,
+    corrections=None,
+):
     """Track the first :data:`PREVIEW_SPAN_S` seconds of ``video`` (all of a shorter film) and write
-    a contact sheet of ``n_frames`` frames spread over them (PNG); returns (result, frames drawn)."""
+    a contact sheet of ``n_frames`` frames spread over them (PNG); returns (result, frames drawn).
+
+    With ``at_s`` the film is tracked from its start frame to just past ``at_s`` (s) and the sheet
+    shows the ``n_frames`` consecutive frames around it. ``fps`` is ``--fps``; ``corrections`` a
+    corrections file applied after tracking (in place of the config's).
+    """
     from dataclasses import replace
 
     from ...tracking import load_track_config, track_video
@@ -296,18 +314,45 @@ def track_preview(video, config, out, *, n_frames: int = 6, progress: bool = Fal
     video = Path(video)
     if not 1 <= int(n_frames) <= 48:
         raise InputError(f"--frames {n_frames}: give 1 to 48 frames for the sheet")
+    if at_s is not None and not (math.isfinite(at_s) and at_s >= 0):
+        raise InputError(f"--at {at_s}: give a time in the film, s (>= 0)")
     from ...tracking.video._video import iter_video_frames, probe_video
 
     vinfo = probe_video(video)  # the sheet shows the frames (fields) as tracked: square pixels
     cfg = load_track_config(config)
+    fixes = corrections or cfg.video.corrections
+    if fixes is not None:  # applied to the span tracked here: those outside it are not an error
+        from ...tracking._corrections import load_corrections
+
+        fixes = load_corrections(fixes)
+        cfg = replace(cfg, video=replace(cfg.video, corrections=None))
     # frames (fields) in the span: the container's rate, or the config's when it has none
-    rate = (vinfo.fps or cfg.video.fps or 50.0) * (2 if vinfo.field_order is not None else 1)
-    stop = cfg.video.start_frame + max(int(round(PREVIEW_SPAN_S * rate)), 1)
+    rate = (fps or vinfo.fps or cfg.video.fps or 50.0) * (2 if vinfo.field_order is not None else 1)
+    if at_s is not None:
+        n_all = vinfo.n_frames * (2 if vinfo.field_order is not None else 1)
+        if vinfo.frame_times_s is not None and not fps and len(vinfo.frame_times_s):
+            end_s = float(vinfo.frame_times_s[-1])
+        else:
+            end_s = (n_all - 1) / rate
+        if at_s > end_s + 0.5 / rate:
+            raise InputError(f"--at {at_s:g}: past the end of the film ({end_s:.4g} s); give a time in it")
+        stop = cfg.video.start_frame + int(round(at_s * rate)) + int(n_frames) + 2
+    else:
+        stop = cfg.video.start_frame + max(int(round(PREVIEW_SPAN_S * rate)), 1)
     if cfg.video.stop_frame is None or stop < cfg.video.stop_frame:
         cfg = replace(cfg, video=replace(cfg.video, stop_frame=stop))
-    res = track_video(video, cfg, progress=progress)
+    res = track_video(video, cfg, fps=fps, progress=progress)
+    if fixes:
+        from ...tracking._corrections import apply_corrections
+
+        res = apply_corrections(res, fixes, partial=True)
     frames = np.asarray(res.tracks[0].frame)
-    pick = frames[np.unique(np.round(np.linspace(0, frames.size - 1, int(n_frames))).astype(int))]
+    if at_s is not None:
+        k = int(np.argmin(np.abs(np.asarray(res.tracks[0].t_s, float) - at_s)))
+        lo = min(max(k - (int(n_frames) - 1) // 2, 0), max(frames.size - int(n_frames), 0))
+        pick = frames[lo : lo + int(n_frames)]
+    else:
+        pick = frames[np.unique(np.round(np.linspace(0, frames.size - 1, int(n_frames))).astype(int))]
     tiles = []
     for f in pick:  # decode only the frames shown (a long film is not kept in memory)
         for i, _, img in iter_video_frames(
@@ -324,9 +369,10 @@ def _draw_pose(img, res, frame):
     import cv2
 
     out = img.copy() if img.ndim == 3 else cv2.cvtColor(img, cv2.COLOR_GRAY2BGR)
+    t0 = res.tracks[0]
     cv2.putText(
         out,
-        f"frame {frame}  t = {frame / res.fps:.3f} s",
+        f"frame {frame}  t = {float(t0.t_s[np.flatnonzero(t0.frame == frame)[0]]):.3f} s",
         (8, 22),
         cv2.FONT_HERSHEY_SIMPLEX,
         0.6,
@@ -337,7 +383,23 @@ def _draw_pose(img, res, frame):
     for k, t in enumerate(res.tracks):
         col = _COLOURS[k % len(_COLOURS)]
         i = int(np.flatnonzero(t.frame == frame)[0])
-        if t.status[i] != "ok" or t.x_px is None or not np.isfinite(t.x_px[i]):
+        fixed = t.status[i] == "corrected"
+        if fixed:  # a hand-set pose: white, and said so
+            col = (255, 255, 255)
+        if fixed and t.x_px is not None and not np.isfinite(t.x_px[i]):
+            th_deg = math.degrees(t.theta_rad[i]) if np.isfinite(t.theta_rad[i]) else math.nan
+            cv2.putText(
+                out,
+                f"{t.object}: corrected, theta {th_deg:.4g} deg",
+                (8, 46 + 20 * k),
+                cv2.FONT_HERSHEY_SIMPLEX,
+                0.55,
+                col,
+                2,
+                cv2.LINE_AA,
+            )
+            continue
+        if t.status[i] not in ("ok", "corrected") or t.x_px is None or not np.isfinite(t.x_px[i]):
             cv2.putText(
                 out, f"{t.object}: {t.status[i]}", (8, 46 + 20 * k), cv2.FONT_HERSHEY_SIMPLEX, 0.55, col, 2, cv2.LINE_AA
             )
@@ -350,6 +412,7 @@ def _draw_pose(img, res, frame):
                 cv2.line(out, (int(u), int(v)), p1, col, 2, cv2.LINE_AA)
         cv2.circle(out, (int(u), int(v)), 4, col, -1)
         angle = f"theta {math.degrees(t.theta_rad[i]):.4g} deg" if math.isfinite(th) else "position only"
+        angle += " (corrected)" if fixed else ""
         cv2.putText(out, f"{t.object}: {angle}", (8, 46 + 20 * k), cv2.FONT_HERSHEY_SIMPLEX, 0.55, col, 2, cv2.LINE_AA)
     return out
 

@@ -4,69 +4,8 @@ A commented example is in ``examples/experiment.toml`` and in
 :data:`EXAMPLE_TOML`. Paths in the file are relative to the file's folder.
 Every error names the file, the key and (where it can be found) the line.
 
-Schema (all lengths in m, times in s, angles in rad)::
-
-    name = "B6M_full_01"              # optional; defaults to the file's folder name
-
-    [block]                           # either a catalogue id ...
-    id = "B6M"                        # Čeh et al. (2018) Table 2 (B1S..B10L)
-    # ... or dimensions (override the catalogue when both are given)
-    b_m = 0.045
-    h_m = 0.2025
-    mass_kg = 1.0896                  # optional
-
-    [contact]
-    type = "full"                     # full | edge
-    l_c_m = 0.0015                    # edge only: width of the base strip
-    k = 0.9                           # optional: k for eta_M (else from l_c or the Eq. 19 regression)
-
-    [sources]
-    primary = "video"                 # video | imu | track
-
-    [sources.video]                   # a video and its tracking config ...
-    path = "video.mkv"
-    track_config = "track.toml"
-    object = "block_1"                # which tracked object is this block
-    fps = 50                          # only if the container has none
-
-    [sources.track]                   # ... or an already tracked CSV (t_s, theta_rad[, object])
-    path = "tracks.csv"
-    object = "block_1"
-
-    [sources.imu]                     # x-IMU / x-IMU3 / Fusion log folder or CSV
-    path = "imu/block_1"
-    axis = "auto"                     # x|y|z with optional sign, or auto
-    rate_hz = 256                     # only if the log does not say
-
-    [sources.table]                   # shake-table runs: base motion from ...
-    from = "video"                    # video (tracked table object) | imu | record | none
-    object = "table"
-    imu = "imu/table"                 # when from = "imu"
-    record = "elcentro.AT2"           # when from = "record"
-    units = "g"
-
-    [sync]
-    method = "xcorr"                  # xcorr | none
-    max_offset_s = 5.0
-
-    [fit]
-    restitution = true
-    window = "middle50"               # middle50 | all | first
-
-    [simulate]
-    laws = ["housner", "eta_e", "modified"]   # also "eta_e_first", "given" (uses eta below)
-    eta = 0.93                        # optional: a known constant restitution, simulated as "given"
-    duration_s = 0                    # 0: as long as the measurement
-
-    [column]                          # column experiments (thesis §4.3): tracked objects bottom to top
-    objects = ["block_1", "block_2", "block_3"]
-    cut_m = 0.002                     # cut edge at every joint, m
-    impacts = 1                       # consecutive impacts per joint closing (thesis: 2)
-
-    [output]
-    rrd = true
-    video_decimation = 1              # log every n-th frame to Rerun
-    figures = true
+The schema, with every key and its default, is :data:`EXAMPLE_TOML` (all lengths in m, times in
+s, angles in rad).
 """
 
 from __future__ import annotations
@@ -94,6 +33,7 @@ class SourceVideo:
     track_config: Path | None = None
     object: str = "block_1"
     fps: float | None = None
+    corrections: Path | None = None  # manual corrections of the track (rocklab.tracking._corrections)
 
 
 @dataclass(frozen=True)
@@ -170,6 +110,8 @@ class ExperimentConfig:
             if src is None:
                 continue
             out.append(src.path)
+            if getattr(src, "corrections", None):
+                out.append(src.corrections)
             tc = getattr(src, "track_config", None)
             if tc:
                 out.append(tc)
@@ -369,10 +311,11 @@ def load_experiment(path) -> ExperimentConfig:
     video = track = imu = None
     if "video" in data.get("sources", {}):
         video = SourceVideo(
-            path=r.file("sources.video.path"),
+            path=r.file("sources.video.path", allow_dir=True),
             track_config=r.file("sources.video.track_config", required=False),
             object=r.get("sources.video.object", "block_1", kind=str),
             fps=r.get("sources.video.fps", kind=float, positive=True),
+            corrections=r.file("sources.video.corrections", required=False),
         )
     if "track" in data.get("sources", {}):
         track = SourceTrack(path=r.file("sources.track.path"), object=r.get("sources.track.object", kind=str))
@@ -473,4 +416,70 @@ def _catalogue() -> dict:
     }
 
 
-EXAMPLE_TOML = textwrap.dedent(__doc__.split("Schema (all lengths in m, times in s, angles in rad)::\n\n", 1)[1])
+EXAMPLE_TOML = textwrap.dedent(
+    """\
+    name = "B6M_full_01"              # optional; defaults to the file's folder name
+
+    [block]                           # either a catalogue id ...
+    id = "B6M"                        # Čeh et al. (2018) Table 2 (B1S..B10L)
+    # ... or dimensions (override the catalogue when both are given)
+    b_m = 0.045
+    h_m = 0.2025
+    mass_kg = 1.0896                  # optional
+
+    [contact]
+    type = "full"                     # full | edge
+    l_c_m = 0.0015                    # edge only: width of the base strip
+    k = 0.9                           # optional: k for eta_M (else from l_c or the Eq. 19 regression)
+
+    [sources]
+    primary = "video"                 # video | imu | track
+
+    [sources.video]                   # a video and its tracking config ...
+    path = "video.mkv"
+    track_config = "track.toml"
+    object = "block_1"                # which tracked object is this block
+    fps = 50                          # only if the container has none
+    corrections = "fix.csv"           # optional: manual corrections of the track (drop / set)
+
+    [sources.track]                   # ... or an already tracked CSV (t_s, theta_rad[, object])
+    path = "tracks.csv"
+    object = "block_1"
+
+    [sources.imu]                     # x-IMU / x-IMU3 / Fusion log folder or CSV
+    path = "imu/block_1"
+    axis = "auto"                     # x|y|z with optional sign, or auto
+    rate_hz = 256                     # only if the log does not say
+
+    [sources.table]                   # shake-table runs: base motion from ...
+    from = "video"                    # video (tracked table object) | imu | record | none
+    object = "table"
+    imu = "imu/table"                 # when from = "imu"
+    record = "elcentro.AT2"           # when from = "record"
+    units = "g"
+
+    [sync]
+    method = "xcorr"                  # xcorr | none
+    max_offset_s = 5.0
+
+    [fit]
+    restitution = true
+    window = "middle50"               # middle50 | all | first
+
+    [simulate]
+    laws = ["housner", "eta_e", "modified"]   # also "eta_e_first", "given" (uses eta below)
+    eta = 0.93                        # optional: a known constant restitution, simulated as "given"
+    duration_s = 0                    # 0: as long as the measurement
+
+    [column]                          # column experiments (thesis §4.3): tracked objects bottom to top
+    objects = ["block_1", "block_2", "block_3"]
+    cut_m = 0.002                     # cut edge at every joint, m
+    impacts = 1                       # consecutive impacts per joint closing (thesis: 2)
+
+    [output]
+    rrd = true
+    video_decimation = 1              # log every n-th frame to Rerun
+    figures = true
+"""
+)
+"""The commented schema of ``experiment.toml``: every key, its default and its choices."""

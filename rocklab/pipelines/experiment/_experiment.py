@@ -95,6 +95,7 @@ class ExperimentResult:
             "contact": {"type": self.config.contact, "l_c_m": self.config.l_c_m, "k": self.config.k},
             "primary_source": self.primary,
             "sources": sorted(self.measured),
+            "track_corrections": list(getattr(self.frames, "corrections", ())),
             "sync": self.sync,
             "video_vs_imu_rms_rad": (
                 float(np.sqrt(np.nanmean(np.square(self.video_imu_residual[1]))))

@@ -51,6 +51,10 @@ def _measure_video(cfg: ExperimentConfig, progress: bool, keep_film: bool):
     from ...tracking import load_track_config, track_video
 
     tcfg = load_track_config(cfg.video.track_config) if cfg.video.track_config else None
+    if tcfg is not None and cfg.video.corrections is not None:  # the experiment's hand fixes win
+        from dataclasses import replace
+
+        tcfg = replace(tcfg, video=replace(tcfg.video, corrections=str(cfg.video.corrections)))
     film = ReviewFilm(_probe_fps(cfg.video.path, cfg.video.fps), cfg.video_decimation) if keep_film else None
     tr = track_video(cfg.video.path, tcfg, fps=cfg.video.fps, progress=progress, on_frame=film)
     df = tr.to_frame()

@@ -62,29 +62,55 @@ def table4_row(name: str, table=None):
     return None
 
 
-def expand_records(paths, list_file=None, skipped: list | None = None) -> list:
+def expand_records(
+    paths, list_file=None, skipped: list | None = None, recursive: bool = False, notes: list | None = None
+) -> list:
     """``[(name, path, error)]`` of the records named on the command line.
 
-    A folder stands for every visible file in it (sorted) except the outputs rocklab
+    A folder stands for every visible record file in it (sorted) except the outputs rocklab
     wrote there (:func:`rocklab._outdir.rocklab_wrote`: a table of an earlier ``oas -o``
-    into the folder is not a record; appended to ``skipped`` when given); ``list_file``
-    holds one path per line (relative to the list's folder; ``#`` starts a comment). A
-    missing file and a second record of the same name get an ``error`` (one line), so the
-    rest of the batch still runs and the table says what happened to each.
+    into the folder is not a record; appended to ``skipped`` when given). A file in a folder
+    that is plainly not a record (a licence, a README: :func:`rocklab.models.spectra._records.not_a_record`)
+    and a subfolder (read with ``recursive``) are left out with one line each in ``notes``,
+    never silently. ``list_file`` holds one path per line (relative to the list's folder; ``#``
+    starts a comment). A missing file and a second record of the same name get an ``error``
+    (one line), so the rest of the batch still runs and the table says what happened to each.
     """
     from pathlib import Path
 
     from ..._outdir import rocklab_wrote
+    from ...models.spectra._records import not_a_record
+
+    def folder(p: Path) -> list:
+        found = []
+        for f in sorted(p.iterdir()):
+            if f.name.startswith("."):
+                continue
+            if f.is_dir():
+                if recursive:
+                    found += folder(f)
+                elif notes is not None:
+                    notes.append(f"{f}/: a subfolder, not read; add --recursive to read the records in subfolders")
+                continue
+            if not f.is_file():
+                continue
+            if rocklab_wrote(f):
+                if skipped is not None:
+                    skipped.append(f)
+                continue
+            why = not_a_record(f)
+            if why:
+                if notes is not None:
+                    notes.append(f"{f}: skipped, not a record ({why})")
+                continue
+            found.append((f, ""))
+        return found
 
     items = []
     for p in paths:
         p = Path(p)
         if p.is_dir():
-            files = [f for f in sorted(p.iterdir()) if f.is_file() and not f.name.startswith(".")]
-            ours = [f for f in files if rocklab_wrote(f)]
-            if skipped is not None:
-                skipped += ours
-            items += [(f, "") for f in files if f not in ours]
+            items += folder(p)
         else:
             items.append((p, "" if p.is_file() else f"{p}: not found; check the path"))
     if list_file is not None:

@@ -397,7 +397,7 @@ def check_films(film1, film2, rig: StereoRig, fps: float | None = None) -> float
     rate1 = fps or i1.fps
     rate2 = fps or i2.fps
     if not rate1:
-        raise InputError(f"{where(film1)}the container has no frame rate; give --fps")
+        raise InputError(f"{where(film1)}the film has no frame rate (an image folder has one only from its timestamps.csv); give --fps")
     if fps is None and rate2 and abs(rate1 - rate2) > 1e-3 * rate1:
         raise InputError(f"{where(film2)}{rate2:.6g} frames/s but {film1} has {rate1:.6g}; the two cameras must run "
                          "at one rate (give --fps if a container is wrong)")

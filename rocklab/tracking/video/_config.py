@@ -97,6 +97,10 @@ class VideoConfig:
     calibration : str or None
         Path (relative to the TOML file) of a ``.npz`` with ``camera_matrix``
         and ``dist_coeffs`` (as written by :func:`rocklab.tracking.calibrate_camera`).
+    corrections : str or None
+        Path (relative to the TOML file) of a corrections file (CSV or TOML: per object and frame
+        or time range, ``drop`` or set ``x_m``/``y_m``/``theta_rad``/``theta_deg``), applied after
+        tracking; the frames it changes have status ``corrected`` or ``dropped``.
     """
 
     fps: float | None = None
@@ -105,6 +109,7 @@ class VideoConfig:
     camera_matrix: tuple | None = None
     dist_coeffs: tuple | None = None
     calibration: str | None = None
+    corrections: str | None = None
 
 
 @dataclass(frozen=True)
@@ -331,7 +336,8 @@ class TrackConfig:
     @property
     def named_files(self) -> tuple[Path, ...]:
         """The files the config names, which a tracking run reads (its lens calibration)."""
-        return () if self.video.calibration is None else (Path(self.video.calibration),)
+        v = self.video
+        return tuple(Path(f) for f in (v.calibration, v.corrections) if f is not None)
 
     def object(self, oid: str) -> ObjectConfig:
         for o in self.objects:
@@ -386,11 +392,12 @@ def load_track_config(path) -> TrackConfig:
     except tomllib.TOMLDecodeError as e:
         raise InputError(f"{path}: not valid TOML ({e}); fix the syntax") from None
     cfg = TrackConfig.from_dict(d, source=path, text=text)
-    v = cfg.video
-    if v.calibration is not None and not Path(v.calibration).is_absolute():
-        import dataclasses
+    import dataclasses
 
-        cfg = dataclasses.replace(cfg, video=dataclasses.replace(v, calibration=str(path.parent / v.calibration)))
+    for key in ("calibration", "corrections"):  # paths relative to the TOML file
+        f = getattr(cfg.video, key)
+        if f is not None and not Path(f).is_absolute():
+            cfg = dataclasses.replace(cfg, video=dataclasses.replace(cfg.video, **{key: str(path.parent / f)}))
     return cfg
 
 

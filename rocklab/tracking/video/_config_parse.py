@@ -200,10 +200,11 @@ class ConfigParser:
             self.err(s, "dist_coeffs", "must have 4, 5, 8, 12 or 14 coefficients")
         if dist is not None and K is None:
             self.err(s, "camera_matrix", "dist_coeffs need a camera_matrix too")
-        cal = d.get("calibration")
-        if cal is not None and not isinstance(cal, str):
-            self.err(s, "calibration", "must be a path string")
-        return VideoConfig(fps, start, stop, K, dist, cal)
+        cal, fix = d.get("calibration"), d.get("corrections")
+        for key, v in (("calibration", cal), ("corrections", fix)):
+            if v is not None and not isinstance(v, str):
+                self.err(s, key, "must be a path string")
+        return VideoConfig(fps, start, stop, K, dist, cal, fix)
 
     def targets(self, d):
         s = "targets"

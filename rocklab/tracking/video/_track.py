@@ -19,6 +19,7 @@ import numpy as np
 from ..._blas import one_blas_thread
 from ..._diagnostics import warn
 from ..._errors import InputError
+from .._corrections import apply_corrections, load_corrections
 from ._checks import _check_frames, _check_rate, _interpolate, _look, _tee, _why_lost
 from ._config import TrackConfig
 from ._geometry import PlaneMap, fit_similarity
@@ -234,6 +235,7 @@ class TrackResult:
     plane_map: PlaneMap | None = field(default=None, repr=False, compare=False)
     level_source: str = "none"
     level_sigma_rad: float = math.nan
+    corrections: tuple = ()  # manual corrections applied (dicts: rocklab.tracking._corrections)
 
     def __getitem__(self, oid: str) -> ObjectTrack:
         for t in self.tracks:
@@ -317,7 +319,7 @@ class TrackResult:
         return {"source": self.source, "fps": self.fps, "n_frames": self.n_frames,
                 "width_px": self.width_px, "height_px": self.height_px, "plane": self.plane,
                 "level_rad": self.level_rad, "level_source": self.level_source,
-                "level_sigma_rad": self.level_sigma_rad, "objects": per}
+                "level_sigma_rad": self.level_sigma_rad, "objects": per, "corrections": list(self.corrections)}
 
 
 def assemble_tracks(observations, config: TrackConfig, fps: float, width_px: int, height_px: int,
@@ -461,9 +463,10 @@ def track_video(path, config: TrackConfig, fps: float | None = None, progress: b
             times = np.column_stack((times, times + half)).ravel()
         n_expected = 2 * info.n_frames
     if rate is None:
-        raise InputError(f"{path}: the container has no frame rate; pass --fps N "
-                         "(or set [video] fps in the config)")
+        raise InputError(f"{path}: the film has no frame rate (an image folder has one only from its timestamps.csv); "
+                         "pass --fps N (or set [video] fps in the config)")
     v = config.video
+    fixes = load_corrections(v.corrections, [o.id for o in config.objects]) if v.corrections else ()  # errors first
     start, stop = v.start_frame, v.stop_frame
     ref_frame = config.reference.board.frame if config.reference.board is not None else start
     first = None
@@ -488,4 +491,4 @@ def track_video(path, config: TrackConfig, fps: float | None = None, progress: b
     res = assemble_tracks(obs, config, rate, info.width_px, info.height_px, pm, path, frame_times_s=times)
     expected = (min(stop, n_expected) if stop else n_expected) - start
     _check_frames(res, expected, path, info)
-    return res
+    return apply_corrections(res, fixes) if fixes else res  # the config's hand fixes

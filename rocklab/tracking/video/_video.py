@@ -31,6 +31,7 @@ import numpy as np
 
 from ..._errors import InputError
 from ._container import UPRIGHT, container_info, why_unopenable, frame_orientation, luma, orient, shown_pts
+from .sequences import FrameStoreReader, frame_store
 
 __all__ = ["VideoInfo", "probe_video", "iter_video_frames", "container_info"]
 
@@ -52,8 +53,9 @@ class VideoInfo:
     pixel_aspect : float
         Width / height of one stored pixel (the container's sample aspect ratio; 1 if it says none).
     frame_times_s : ndarray (n,) or None
-        Each frame's presentation time from the container, s, the first frame at 0 (None when
-        PyAV cannot read the container, e.g. an image sequence).
+        Each frame's presentation time from the container (an image folder's ``timestamps.csv``,
+        a CINE's time block), s, the first frame at 0 (None when there is none: an OpenCV
+        image-sequence pattern, a folder without timestamps, a Photron MRAW).
     field_order : {"tff", "bff"} or None
         Interlaced video: which field is exposed first (top or bottom); None for progressive.
     rotation_deg : int
@@ -131,6 +133,9 @@ def _open(path):
 def probe_video(path) -> VideoInfo:
     """Open ``path`` and read its frame count, rate, size, pixel aspect and frame times.
 
+    ``path`` is a video file, a folder of numbered frames or a high-speed camera's file (see
+    :func:`iter_video_frames`); a folder's rate and times come from its ``timestamps.csv``.
+
     Raises
     ------
     InputError
@@ -138,6 +143,10 @@ def probe_video(path) -> VideoInfo:
     """
     import cv2
 
+    store = frame_store(_open_checked(path))
+    if store is not None:  # an image folder or a high-speed camera's file: its own size, rate and times
+        s = store
+        return VideoInfo(str(path), s.n_frames, s.fps, s.width_px, s.height_px, 1.0, s.times_s, n_dropped=s.n_dropped)
     ci = container_info(path)
     n, fps, size = 0, 0.0, None
     try:  # OpenCV: count and rate where the packets have no times; image sequences
@@ -333,10 +342,9 @@ def _pyav_reader(path, first: int, gray: bool = True):
     if "%" in str(path):
         return None
     try:
-        r = _PyAVReader(path, first, gray=gray)
+        return _PyAVReader(path, first, gray=gray)
     except Exception:  # noqa: BLE001 - PyAV raises many types; OpenCV's reader is the fallback
         return None
-    return r
 
 
 def _fields(img, order: str):
@@ -373,7 +381,8 @@ def iter_video_frames(
     Parameters
     ----------
     path : path-like
-        A video file or an OpenCV image-sequence pattern (``dir/%05d.png``).
+        A video file, a folder of numbered frames (:mod:`.sequences`), a Photron ``.cih``/``.mraw``
+        or Phantom ``.cine`` (:mod:`.sequences`), or an OpenCV image-sequence pattern (``dir/%05d.png``).
     start, stop : int, int or None
         Half-open frame range.
     prefetch : int
@@ -404,6 +413,8 @@ def iter_video_frames(
         # OpenCV's FFmpeg reader cannot convert interlaced pictures ("Cannot convert interlaced to
         # progressive frames") and returns the previous picture again, silently: decode with PyAV
         cap = _PyAVReader(path, first, gray=not color)
+    elif (store := frame_store(_open_checked(path))) is not None:
+        cap = FrameStoreReader(store, first, gray=not color)
     else:
         # PyAV for every film it opens (grey from the luma plane: no YUV -> BGR -> grey), so grey
         # and colour frames are the same frames, upright and at the same indices
@@ -468,6 +479,8 @@ def iter_video_frames(
     def worker():
         try:
             produce(put)
+        except InputError as e:  # a frame that cannot be read (a folder's): raised by the consumer
+            put(e)
         finally:
             put(done)
 
@@ -478,6 +491,8 @@ def iter_video_frames(
             item = q.get()
             if item is done:
                 break
+            if isinstance(item, InputError):
+                raise item
             yield item
     finally:
         stop_flag.set()

@@ -18,14 +18,14 @@ import sys
 from ...._errors import InputError
 
 
-from .._cli_base import count
+from .._cli_base import PULSE_HELP, add_base_motion_args, base_motion_from_args, count, pulse_from_spec
 from .._cli_base import emit_json as _emit
 
 
 def register(sub):
     """Add this module's subcommand(s) to the ``rocklab`` parser ``sub``."""
     p = sub.add_parser("pulse", help="pulse parameters of a record (a_max, I_max, t_p)")
-    p.add_argument("record")
+    p.add_argument("record", help="the record file (.AT2, CSV t_s,acc_m_s2, two-column text)")
     p.add_argument(
         "--units",
         default=None,
@@ -35,7 +35,16 @@ def register(sub):
     p.set_defaults(func=run)
 
     p = sub.add_parser("oas", help="Overturning Acceleration Spectrum and t_I of record(s)")
-    p.add_argument("record", nargs="*", help="record files or folders of records (every visible file in them)")
+    p.add_argument(
+        "record",
+        nargs="*",
+        help="record files or folders of records (every visible record in them; other files and "
+        "subfolders are left out with a note)",
+    )
+    p.add_argument(
+        "--recursive", action="store_true", help="also read the records in the folders' subfolders (at any depth)"
+    )
+    p.add_argument("--pulse", default=None, metavar="KIND,PEAK,T_P[,N]", help="the OAS of " + PULSE_HELP)
     p.add_argument(
         "--list",
         default=None,
@@ -50,12 +59,22 @@ def register(sub):
     )
     p.add_argument("--slenderness", type=float, default=12.0, help="block h/b (default 12)")
     p.add_argument("--levels", type=int, default=80, help="a_p/a_p,min levels 1..level-max (80)")
-    p.add_argument("--level-max", type=float, default=10.0)
+    p.add_argument("--level-max", type=float, default=10.0, help="largest a_p/a_p,min level (default 10)")
     p.add_argument("--sizes", type=int, default=120, help="log-spaced R from 1000 m to 0.1 m (120)")
     p.add_argument("--refine", type=count(0), default=10, help="bisection steps on the boundary (10)")
-    p.add_argument("--criterion", choices=("angle", "fall"), default="angle")
+    p.add_argument(
+        "--criterion",
+        choices=("angle", "fall"),
+        default="angle",
+        help="overturned when theta reaches alpha (angle, default) or the block falls (fall)",
+    )
     p.add_argument("--free", default="energy", help="after the record: energy | none | SECONDS")
-    p.add_argument("--search", choices=("scan", "contiguous"), default="scan")
+    p.add_argument(
+        "--search",
+        choices=("scan", "contiguous"),
+        default="scan",
+        help="boundary search: every level of the grid (scan, default) or the first contiguous overturning region",
+    )
     p.add_argument("--eta", type=float, default=None, help="restitution (default Housner)")
     p.add_argument(
         "-o",
@@ -76,8 +95,8 @@ def register(sub):
     )
     p.add_argument("--workers", type=count(1), default=None, help="local processes for several records")
     p.add_argument("--scheduler", default=None, help="Dask distributed scheduler address")
-    p.add_argument("--no-progress", action="store_true")
-    p.add_argument("--json", action="store_true")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
     p.set_defaults(func=run)
 
     p = sub.add_parser("design", help="pier width for a PGA and t_I (thesis Eq. 21/23)")
@@ -88,16 +107,20 @@ def register(sub):
     p.add_argument("--alpha-I", type=float, default=None, help="I_O/(m R^2) (4/3 solid, 1 mass on top)")
     p.add_argument("--cm-ratio", type=float, default=None, help="centre-of-mass height / H")
     p.add_argument("--g", type=float, default=None, help="gravity, m/s^2 (default 9.80665)")
-    p.add_argument("--json", action="store_true")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
     p.set_defaults(func=run)
 
     p = sub.add_parser("equivalent", help="equivalent-block parameters of a rocking mechanism")
-    p.add_argument("mechanism", choices=("block", "strut", "frame", "wall", "asym-frame", "arch"))
+    p.add_argument(
+        "mechanism",
+        choices=("block", "strut", "frame", "wall", "asym-frame", "arch"),
+        help="the rocking mechanism (DeJong & Dimitrakopoulos 2014)",
+    )
     p.add_argument("--R", type=float, help="corner-to-centre distance of the (column/wall) block, m")
     p.add_argument("--alpha", type=float, help="slenderness angle, rad")
     p.add_argument("--b", type=float, help="width b (block) or half-width (asym-frame), m")
     p.add_argument("--h", type=float, help="height h (block) or beam half-depth (asym-frame), m")
-    p.add_argument("--alpha-I", type=float, default=4.0 / 3.0)
+    p.add_argument("--alpha-I", type=float, default=4.0 / 3.0, help="I_O/(m R^2) of each block (default 4/3: solid)")
     p.add_argument("--gamma", type=float, default=0.0, help="frame: m_beam / m_columns")
     p.add_argument("--H", type=float, help="asym-frame: half-height of the left column, m")
     p.add_argument("--H1", type=float, help="asym-frame: half-height of the right column, m")
@@ -106,7 +129,28 @@ def register(sub):
     p.add_argument("--beta", type=float, help="arch inclusion angle, rad")
     p.add_argument("--thickness", type=float, help="arch thickness t_a, m")
     p.add_argument("--radius", type=float, help="arch centre-line radius r_a, m")
-    p.add_argument("--json", action="store_true")
+    add_base_motion_args(p)
+    p.add_argument(
+        "--eta",
+        type=float,
+        default=None,
+        help="time history: restitution at every impact (default the mechanism's own, Table I; "
+        "the wall, asymmetric frame and arch have none and need it)",
+    )
+    p.add_argument(
+        "--kappa",
+        choices=("kappa1", "kappa2"),
+        default="kappa1",
+        help="time history: scaling of the equivalent blocks, Eq. 19 (kappa1) or Eq. 20 (kappa2)",
+    )
+    p.add_argument("--phi0", type=float, default=0.0, help="time history: initial rotation, rad (signed)")
+    p.add_argument(
+        "-o",
+        "--output",
+        default=None,
+        help="time history: write t_s and phi_<model>_rad of the mechanism and its equivalent blocks (CSV)",
+    )
+    p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
     p.set_defaults(func=run)
 
 
@@ -159,13 +203,15 @@ def run_oas(args) -> int:
         raise InputError(f"--slenderness {args.slenderness}: h/b must be > 0 (e.g. 12)")
     from pathlib import Path
 
-    if not args.record and not args.list:
-        raise InputError("rocklab oas: give record files, folders of records, or --list FILE")
+    if args.pulse is not None and (args.record or args.list or args.band):
+        raise InputError("rocklab oas: --pulse is one base motion; give it without records, --list or --band")
+    if not args.record and not args.list and args.pulse is None:
+        raise InputError("rocklab oas: give record files, folders of records, --list FILE or --pulse KIND,PEAK,T_P")
     if args.list or args.band or len(args.record) > 1 or any(Path(r).is_dir() for r in args.record):
         return _run_oas_batch(args, kw)
     from ....models import load_base_motion, overturning_spectrum, pulse_parameters
 
-    rec = load_base_motion(args.record[0], units=args.units)
+    rec = pulse_from_spec(args.pulse) if args.pulse is not None else load_base_motion(args.record[0], units=args.units)
     o = overturning_spectrum(rec, args.slenderness, **kw)
     if args.out:
         write_frame_atomic(args.out, o.to_frame())
@@ -195,7 +241,10 @@ def _run_oas_batch(args, kw) -> int:
     from ...spectra._spectra_batch import expand_records, oas_table
 
     skipped: list = []
-    items = expand_records(args.record, args.list, skipped)
+    notes: list = []
+    items = expand_records(args.record, args.list, skipped, recursive=args.recursive, notes=notes)
+    for n in notes:
+        sys.stderr.write(f"rocklab oas: note: {n}\n")
     for f in skipped:
         sys.stderr.write(f"rocklab oas: not reading {f}: an output rocklab wrote (name it to read it as a record)\n")
     if not items:
@@ -286,6 +335,8 @@ def _R_alpha(args):
 
 def run_equivalent(args) -> int:
     from .... import models as m
+    from ....blocks import G as G_M_S2
+    from ....models import mechanisms as mm
 
     mech = args.mechanism
     extra = {}
@@ -298,18 +349,34 @@ def run_equivalent(args) -> int:
             "wall": lambda: m.wall_parameters(R, a, args.alpha_I),
         }[mech]()
         out = fp.to_dict()
+        if mech == "wall":
+            w = mm.wall_mechanism(R, a, alpha_I=args.alpha_I)
+            pair = (w, None)
+        else:
+            # Table I: the strut and the symmetric frame are the block with their own p (alpha_I)
+            aI = {"block": args.alpha_I, "strut": 1.0}.get(mech, G_M_S2 / (R * fp.p_rad_s**2))
+            pair = (mm.block_mechanism(R, a, aI, eta=fp.eta, name=mech), None)
     elif mech == "asym-frame":
         _need(args, "b", "H", "H1", "L", "h")
         pos, neg = m.asymmetric_frame(args.b, args.H, args.H1, args.L, args.h, *args.masses)
         fpp, fpn = pos.parameters(), neg.parameters()
         out = fpp.to_dict()
+        pair = (pos, neg)
         extra = {"negative": fpn.to_dict()}
     else:
         _need(args, "beta", "thickness", "radius")
-        mm, info = m.arch_mechanism(args.beta, args.thickness, args.radius)
-        out = mm.parameters().to_dict()
+        arch, info = m.arch_mechanism(args.beta, args.thickness, args.radius)
+        out = arch.parameters().to_dict()
+        pair = (arch, None)
         extra = {"hinges": list(info["hinges"]), "faces": info["faces"]}
     out.update(extra)
+    base = base_motion_from_args(args)
+    if base is None:
+        for opt in ("eta", "output"):
+            if getattr(args, opt) is not None:
+                raise InputError(f"equivalent {mech}: --{opt} is for a time history; add --base-motion FILE")
+    else:
+        out["time_history"] = _equivalent_history(args, mech, base, pair)
     if args.json:
         _emit(out)
     else:
@@ -317,5 +384,34 @@ def run_equivalent(args) -> int:
         print(f"{mech}: " + ", ".join(f"{k} = {out[k]:.5g}" for k in keys))
         if "negative" in out:
             print("negative direction: " + ", ".join(f"{k} = {out['negative'][k]:.5g}" for k in keys))
+        for name, r in out.get("time_history", {}).get("models", {}).items():
+            over = (
+                f"overturned at {r['t_overturn_s']:.4g} s" if r["overturned"] else f"peak {r['peak_ratio']:.4g} phi_cr"
+            )
+            print(f"  {name:9s}: {r['n_impacts']} impacts, {over}, status {r['status']}")
+            if r["status"] == "falling":
+                print(f"rocklab equivalent: note: {name}: {r['message']}", file=sys.stderr)
     sys.stdout.flush()
     return 0
+
+
+def _equivalent_history(args, mech: str, base, pair) -> dict:
+    """The mechanism and its equivalent blocks under ``base`` (DeJong & Dimitrakopoulos Fig. 14)."""
+    from ...._io import write_frame_atomic
+    from ....models import mechanisms as mm
+
+    pos, neg = pair
+    hist = mm.mechanism_time_histories(pos, base, eta=args.eta, negative=neg, phi0_rad=args.phi0, kappa=args.kappa)
+    if args.output:
+        import pandas as pd
+
+        cols = {"t_s": base.t_s}
+        for name, r in hist.items():
+            cols[f"phi_{name}_rad"] = r.phi_rad
+        write_frame_atomic(args.output, pd.DataFrame(cols))
+    return {
+        "base_motion": base.name,
+        "eta": next(iter(hist.values())).eta,
+        "kappa": args.kappa,
+        "models": {name: r.to_dict() for name, r in hist.items()},
+    }

@@ -26,7 +26,7 @@ def register(sub):
     p = sub.add_parser(
         "fit",
         help="restitution calibration: eta_e, eta_mat, inverse k, k regression",
-        description=__doc__.split("\n\n")[0],
+        description=(__doc__ or "").split("\n\n")[0],
     )
     fs = p.add_subparsers(dest="fit_command", metavar="WHAT")
 
@@ -35,8 +35,19 @@ def register(sub):
     r.add_argument("--width", type=float, required=True, help="block width b, m")
     r.add_argument("--height", type=float, required=True, help="block height h, m")
     r.add_argument("--object", default=None, help="object id in tracks.csv (default: the only block)")
-    r.add_argument("--window", choices=("middle50", "all", "first"), default="middle50")
-    r.add_argument("--objective", choices=("theta", "peaks"), default="theta")
+    r.add_argument(
+        "--window",
+        choices=("middle50", "all", "first"),
+        default="middle50",
+        help="samples compared: between the impacts at 25 %% and 75 %% of the count (Čeh's middle 50 %%, "
+        "default), the whole response, or the first half-period after an impact",
+    )
+    r.add_argument(
+        "--objective",
+        choices=("theta", "peaks"),
+        default="theta",
+        help="least squares on theta(t) (default) or on the arches' amplitudes and half-periods",
+    )
     r.add_argument(
         "--fit-offset",
         action="store_true",
@@ -53,10 +64,20 @@ def register(sub):
     e = fs.add_parser("eta-mat", help="material restitution eta_mat from edge-contact results (Čeh Eq. 16)")
     e.add_argument("table", help="CSV with block,b_m,h_m,eta_e")
     e.add_argument("--lc-m", type=float, default=0.0015, help="base strip width l_c, m (default 0.0015)")
-    e.add_argument("--contact", choices=("inner", "midway"), default="inner")
+    e.add_argument(
+        "--contact",
+        choices=("inner", "midway"),
+        default="inner",
+        help="impulse at the strip's inner edge, k = 1 - 2 l_c/b (default), or midway across it, k = 1 - l_c/b",
+    )
     e.add_argument("--rule", choices=("mean", "median", "lsq"), default="mean", help="averaging rule")
     e.add_argument("--min-hb", type=float, default=0.0, help="use only blocks with h/b >= this")
-    e.add_argument("--nan", choices=("raise", "skip"), default="raise")
+    e.add_argument(
+        "--nan",
+        choices=("raise", "skip"),
+        default="raise",
+        help="rows with NaN: stop with an error (default) or skip them",
+    )
     _common(e)
 
     k = fs.add_parser("k-table", help="k and b_bar per full-contact block (Čeh Eq. 17-18) and the k regression")
@@ -64,7 +85,12 @@ def register(sub):
     k.add_argument("--eta-mat", type=float, required=True, help="material restitution (Čeh: 0.989)")
     k.add_argument("--form", default="ceh19", help="regression form: ceh19|linear|quadratic_b|hb_only|interaction")
     k.add_argument("--feasible-only", action="store_true", help="fit the regression to k <= 1 blocks only")
-    k.add_argument("--nan", choices=("raise", "skip"), default="raise")
+    k.add_argument(
+        "--nan",
+        choices=("raise", "skip"),
+        default="raise",
+        help="rows with NaN: stop with an error (default) or skip them",
+    )
     _common(k)
 
     q = fs.add_parser("k-predict", help="predict k, eta_M and b_bar for a new block (Čeh Eq. 19 by default)")
@@ -133,7 +159,8 @@ def _read_track(path: Path, obj: str | None, nan: str):
     y = pd.to_numeric(df["theta_rad"], errors="coerce").to_numpy(float)
     bad = ~(np.isfinite(t) & np.isfinite(y))
     if "status" in df.columns:
-        bad |= df["status"].astype(str).str.lower().ne("ok").to_numpy()
+        # a frame corrected by hand is a sample the user vouches for (tracks.csv marks it so)
+        bad |= ~df["status"].astype(str).str.lower().isin(("ok", "corrected")).to_numpy()
     if bad.any() and nan == "raise":
         line = int(df["_line"].to_numpy()[np.flatnonzero(bad)[0]])
         raise InputError(

@@ -24,7 +24,7 @@ def register(sub):
     """Add ``stereo`` to the ``rocklab`` parser ``sub``."""
     p = sub.add_parser("stereo", help="two-camera 3D dot tracking: calibrate a rig, track a test", description=__doc__)
     p.add_argument("action", choices=("calibrate", "track"), help="calibrate | track")
-    p.add_argument("film1", help="camera 1's film")
+    p.add_argument("film1", help="camera 1's film (a video file, a folder of frames, a .cih/.mraw or .cine)")
     p.add_argument("film2", help="camera 2's film")
     p.add_argument(
         "-o",
@@ -114,8 +114,8 @@ def _check_rig(rig, path) -> None:
 def run(args) -> int:
     """Run ``rocklab stereo`` with parsed ``args``; returns the exit status (0 ok)."""
     for f in (args.film1, args.film2):
-        if not Path(f).is_file():
-            raise InputError(f"{f}: not found; give the two cameras' films")
+        if not (Path(f).is_file() or Path(f).is_dir()):  # a folder of frames is a film too
+            raise InputError(f"{f}: not found; give the two cameras' films (video files or folders of frames)")
     if args.action == "calibrate":
         return _calibrate(args)
     return _track(args)

@@ -10,9 +10,12 @@
   [--marker-size M] -o track.toml``: a config from the first frame (markers found by
   trying the common dictionaries, or the named regions followed markerless), commented,
   plus ``track_init.png`` with every detection, region and the level line drawn.
-- ``rocklab track preview VIDEO --config track.toml [-o sheet.png] [--frames 6]``: a
-  contact sheet of frames spread over the first 10 s (the span tracked: a quick check) with
-  each object's pose and θ drawn.
+- ``rocklab track preview VIDEO --config track.toml [-o sheet.png] [--frames 6] [--at T_S]``: a
+  contact sheet of frames spread over the first 10 s (the span tracked: a quick check), or of
+  consecutive frames around ``T_S``, with each object's pose and θ drawn (a corrected frame's
+  pose in white and marked "corrected", a dropped one named).
+- ``--corrections FILE`` (track, preview): manual corrections applied after tracking (see
+  :mod:`rocklab.tracking._corrections`); ``tracks.csv`` marks the frames ``corrected`` or ``dropped``.
 - ``track init`` on a film without markers and without ``--object`` proposes the objects that
   move in the first seconds and the table edge they stand on, draws them over a pixel grid and
   prints each as the option to re-run with.
@@ -33,8 +36,8 @@ def register(sub):
     )
     p.add_argument(
         "video",
-        help="video file (.mkv/.mp4/...) or image sequence 'dir/%%05d.png'; or 'init' / "
-        "'preview' followed by the video",
+        help="video file (.mkv/.mp4/...), a folder of numbered PNG/JPEG/TIFF frames (timed by its "
+        "timestamps.csv or --fps), a Photron .cih/.mraw or Phantom .cine; or 'init' / 'preview' followed by the video",
     )
     p.add_argument("video2", nargs="?", default=None, metavar="VIDEO", help=argparse.SUPPRESS)
     p.add_argument(
@@ -55,7 +58,26 @@ def register(sub):
     p.add_argument("--frames", type=int, default=6, help="preview: frames on the contact sheet (default 6)")
     p.add_argument("--config", default=None, help="track.toml (default: track.toml next to the video)")
     p.add_argument("-o", "--out", default=None, help="output CSV (default: tracks.csv next to the video)")
-    p.add_argument("--fps", type=float, default=None, help="frame rate; required when the container has none")
+    p.add_argument(
+        "--fps",
+        type=float,
+        default=None,
+        help="frame rate; required when the film has none (an image folder without timestamps.csv)",
+    )
+    p.add_argument(
+        "--corrections",
+        default=None,
+        metavar="FILE",
+        help="track, preview: manual corrections (CSV or TOML: per object and frame or time range, drop or "
+        "set x_m/y_m/theta_rad/theta_deg) applied after tracking; overrides [video] corrections",
+    )
+    p.add_argument(
+        "--at",
+        type=float,
+        default=None,
+        metavar="T_S",
+        help="preview: show consecutive frames around this time, s (default: frames spread over the first 10 s)",
+    )
     p.add_argument(
         "--plot",
         default=None,
@@ -71,6 +93,10 @@ def run(args) -> int:
     """Run ``rocklab track`` with parsed ``args``; returns the exit status (0 ok)."""
     import math
 
+    if args.at is not None and args.video != "preview":
+        raise InputError("--at T_S: shows the frames around a time in 'rocklab track preview VIDEO --at T_S' only")
+    if args.corrections is not None and args.video == "init":
+        raise InputError("--corrections: applies to 'rocklab track' and 'track preview', not to 'track init'")
     if args.video in ("init", "preview"):
         return _tools(args)
     if args.video2 is not None:
@@ -89,7 +115,7 @@ def run(args) -> int:
         raise InputError(f"{cfg_path}: tracking config not found; pass --config track.toml")
     if args.fps is not None and not (math.isfinite(args.fps) and args.fps > 0):
         raise InputError(f"--fps {args.fps}: must be a positive number of frames per second")
-    cfg = load_track_config(cfg_path)
+    cfg = _with_corrections(load_track_config(cfg_path), args.corrections)
     res = track_video(video, cfg, fps=args.fps, progress=args.progress)
     out = Path(args.out) if args.out else video.parent / "tracks.csv"
     write_frame_atomic(out, res.to_frame(), float_format="%.9g", side=not args.out)
@@ -124,6 +150,12 @@ def run(args) -> int:
                 else f"median sigma_theta {d['median_sigma_theta_rad']:.4g} rad"
             )
             print(f"{oid}: {d['n_ok']}/{res.n_frames} frames ok, {angle}")
+        if res.corrections:
+            n = {a: sum(c["n_frames"] for c in res.corrections if c["action"] == a) for a in ("set", "drop")}
+            print(
+                f"corrections: {len(res.corrections)} applied ({n['set']} frame(s) corrected, {n['drop']} dropped; "
+                "status corrected/dropped in the CSV)"
+            )
         print(f"wrote {out}")
     return 0
 
@@ -147,6 +179,7 @@ def _tools(args) -> int:
             marker_size_m=args.marker_size,
             preview=preview,
             side=(not args.out, not args.preview),
+            fps=args.fps,
         )
         if args.json:
             from .._cli_base import emit_json
@@ -178,8 +211,26 @@ def _tools(args) -> int:
     if not cfg_path.exists():
         raise InputError(f"{cfg_path}: tracking config not found; pass --config track.toml")
     out = Path(args.out) if args.out else video.parent / "track_preview.png"
-    res, frames = track_preview(video, cfg_path, out, n_frames=args.frames, progress=args.progress, side=not args.out)
-    print(
-        f"wrote {out}: frames {', '.join(map(str, frames))} (of the first {PREVIEW_SPAN_S:g} s, tracked for the check)"
+    res, frames = track_preview(
+        video,
+        cfg_path,
+        out,
+        n_frames=args.frames,
+        progress=args.progress,
+        side=not args.out,
+        fps=args.fps,
+        at_s=args.at,
+        corrections=args.corrections,
     )
+    span = f"around t = {args.at:g} s" if args.at is not None else f"of the first {PREVIEW_SPAN_S:g} s"
+    print(f"wrote {out}: frames {', '.join(map(str, frames))} ({span}, tracked for the check)")
     return 0
+
+
+def _with_corrections(cfg, path):
+    """The config with ``--corrections`` in place of its ``[video] corrections``."""
+    if path is None:
+        return cfg
+    from dataclasses import replace
+
+    return replace(cfg, video=replace(cfg.video, corrections=str(path)))

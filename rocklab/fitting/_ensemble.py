@@ -4,8 +4,8 @@ One deterministic simulation of a shake-table run cannot validate a law: the res
 chaotic, so an error of a few per mil in the measured table motion moves it by a large
 fraction of α within a few impacts. :func:`simulate_ensemble` runs ``n`` simulations
 (default :data:`DEFAULT_ENSEMBLE_SIZE` = 64) that sample what the run does not know
-exactly (:class:`InputUncertainty`): white noise and a constant bias on every table
-acceleration sample, the clock offset between table and block, the block's width and
+exactly (:class:`InputUncertainty`): white noise on every table acceleration sample, a
+constant bias and a scale error of the table acceleration, the clock offset between table and block, the block's width and
 height, the start angle and the law's η. :func:`judge_law` compares the measured θ(t)
 with it:
 

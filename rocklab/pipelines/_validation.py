@@ -141,15 +141,15 @@ def _robust_sd(x):
     return 1.4826 * float(np.median(np.abs(d - np.median(d)))) / np.sqrt(2.0)
 
 
-def _uncertainty(cfg, block, table, table_sync, y, msgs):
+def _uncertainty(cfg, table, table_sync, y, msgs):
+    """(InputUncertainty, rest level of θ in rad, whether θ starts at rest) from what the run measured."""
+    from .._diagnostics import warn
     from ..fitting import InputUncertainty
 
     ta, aa = np.asarray(table["t_s"], float), np.asarray(table["acc_m_s2"], float)
     fin = np.isfinite(aa)
     peak = float(np.nanmax(np.abs(aa)))
     dt_tab = float(np.nanmedian(np.diff(ta)))
-    from .._diagnostics import warn
-
     if cfg.table.source == "record":
         warn(
             "W-VALID-ASSUMED", f"{cfg.path}: the table motion is a record (the command); noise 2 % of its peak assumed"
@@ -235,7 +235,7 @@ def prepare_forced(cfg, block, prim, table, table_sync, msgs: list):
         msgs.append("validation skipped: fewer than 20 valid θ samples or no table acceleration")
         return None
     t, y = t[ok], y[ok]
-    unc, level, at_rest = _uncertainty(cfg, block, table, table_sync, y, msgs)
+    unc, level, at_rest = _uncertainty(cfg, table, table_sync, y, msgs)
     yl = y - level
     # t = 0 of the base is the measurement's t = 0 (the segments start anywhere on that clock)
     base = base_from_table(table, 0.0, str(cfg.path), sign=-1.0)

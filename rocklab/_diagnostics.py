@@ -92,6 +92,12 @@ WARNING_CODES: dict[str, tuple[str, str]] = {
         "start and the block's dimensions",
     ),
     "W-FIT-BOUND": ("suspect", "the fitted parameter sits at a bound of its search range"),
+    "W-VALID-ASSUMED": (
+        "note",
+        "a shake-table run's validation assumed the table acceleration's noise (2 % of its peak): the "
+        "table motion is a record (the command, not a measurement) or its log has no rest before the "
+        "shaking; its bands and verdicts rest on that guess. Log the table with an IMU from rest",
+    ),
     "W-FIT-UNITS": (
         "suspect",
         "block dimensions outside 1 mm - 20 m or h/b outside 0.5 - 50: probably not in metres, or b and h swapped",

@@ -5,12 +5,24 @@ flags), :func:`per_impact_eta` (data-only per-impact η), :func:`energy_loss_fro
 (thesis Eq. 12). Repeats: :func:`fit_many`, :func:`summarize_repeats`, :func:`campaign_table` (per-block
 η_e table for the campaign functions). Campaign:
 :func:`fit_eta_mat` (Eq. 16), :func:`k_table` (Eq. 17–18), :func:`fit_k_regression`
-(Eq. 19) and :meth:`KRegression.predict`. Čeh's tables ship as package data
+(Eq. 19) and :meth:`KRegression.predict`. Shake-table runs: :func:`fit_forced_restitution`
+(η_e from half cycles), :func:`simulate_ensemble` and :func:`judge_law` (a verdict per law). Čeh's tables ship as package data
 (:func:`ceh_catalogue`, :func:`catalogue_block`).
 """
 
 from ._campaign import ETA_MAT_RULES, EtaMatResult, KTableResult, fit_eta_mat, k_table, read_block_table
 from ._catalogue import catalogue_block, ceh_catalogue, ceh_full_contact, ceh_table5
+from ._ensemble import (
+    DEFAULT_ENSEMBLE_SIZE,
+    HORIZON_FRACTION,
+    Ensemble,
+    InputUncertainty,
+    LawVerdict,
+    judge_law,
+    response_statistics,
+    simulate_ensemble,
+)
+from ._forced import ETA_SYSTEMATIC, ForcedRestitutionFit, fit_forced_restitution, half_cycle_segments
 from ._impacts import (
     EnergyLoss,
     ReleaseInfo,
@@ -40,6 +52,19 @@ __all__ = [
     "find_crossings",
     "arch_peaks",
     "check_record",
+    # shake-table runs
+    "fit_forced_restitution",
+    "ForcedRestitutionFit",
+    "half_cycle_segments",
+    "ETA_SYSTEMATIC",
+    "simulate_ensemble",
+    "judge_law",
+    "response_statistics",
+    "InputUncertainty",
+    "Ensemble",
+    "LawVerdict",
+    "DEFAULT_ENSEMBLE_SIZE",
+    "HORIZON_FRACTION",
     # repeats
     "fit_many",
     "summarize_repeats",

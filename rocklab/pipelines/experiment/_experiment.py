@@ -81,6 +81,7 @@ class ExperimentResult:
     video: object = None  # the review film (rocklab.pipelines.experiment._review_video.ReviewVideo)
     diagnostics: tuple = ()  # rocklab._diagnostics.Diagnostic raised while analysing
     audit: dict | None = None  # rocklab.pipelines.experiment._audit_stage.audit_experiment
+    validation: object = None  # base-excited runs: rocklab.pipelines._validation.Validation
 
     def to_dict(self) -> dict:
         """The numbers of ``report.json`` (units in keys)."""
@@ -145,6 +146,7 @@ class ExperimentResult:
                 "bytes": self.video.n_bytes,
                 "note": self.video.note,
             },
+            "validation": None if self.validation is None else self.validation.to_dict(),
             "timings_s": self.timings_s,
             "units": {
                 "t": "s",
@@ -279,7 +281,8 @@ def analyse_experiment(
     from ._audit_stage import audit_experiment
 
     audit = audit_experiment(cfg, measured, tr, track_rows)
-    if cfg.fit_restitution:
+    forced = table is not None and "acc_m_s2" in table
+    if cfg.fit_restitution and not forced:
         from ...fitting import fit_restitution
 
         t2 = time.perf_counter()
@@ -296,14 +299,30 @@ def analyse_experiment(
         if fit_d.get("status") == "failed":
             status = "partial"
             msgs.append(f"restitution fit failed: {fit_d.get('message')}")
+    prep = validation = None
+    if forced:  # a free-rocking fit means nothing under a moving table: η_e from half cycles instead
+        from .._validation import prepare_forced, validate_forced_run
+
+        t2 = time.perf_counter()
+        prep = prepare_forced(cfg, block, prim, table, table_sync, msgs)
+        timings["fit_s"] = time.perf_counter() - t2
+        if prep is not None and cfg.fit_restitution:
+            fit_d = prep.fit.to_dict()
+            per_imp = np.asarray(fit_d["segment_eta"], float)  # the impact of each half cycle
+            status = "partial" if fit_d["status"] == "failed" else status
     t3 = time.perf_counter()
-    sims = _simulate_laws(cfg, block, prim, fit_d, table, msgs)
+    # a block resting on the table before the shaking starts flat, not at the tracker's offset
+    sims = _simulate_laws(cfg, block, prim, fit_d, table, msgs, None if prep is None else prep.theta0_rad)
     timings["simulate_s"] = time.perf_counter() - t3
+    if prep is not None and sims:
+        t4 = time.perf_counter()
+        validation = validate_forced_run(prep, block, {law: s["eta"] for law, s in sims.items()})
+        timings["validation_s"] = time.perf_counter() - t4
 
     truth = None
     if cfg.truth is not None:
         truth = _truth(cfg, prim, msgs)
-    return result(fit=fit_d, simulations=sims, truth=truth, status=status, audit=audit)
+    return result(fit=fit_d, simulations=sims, truth=truth, status=status, audit=audit, validation=validation)
 
 
 def _eta_for_law(law, cfg, block, fit_d, msgs):
@@ -331,7 +350,7 @@ def _eta_for_law(law, cfg, block, fit_d, msgs):
     raise AssertionError(law)
 
 
-def _simulate_laws(cfg, block, prim, fit_d, table, msgs) -> dict:
+def _simulate_laws(cfg, block, prim, fit_d, table, msgs, theta0_rad=None) -> dict:
     from ...models import simulate
 
     t_meas, th_meas = prim
@@ -342,7 +361,7 @@ def _simulate_laws(cfg, block, prim, fit_d, table, msgs) -> dict:
     if table is None and fit_ok:  # thread-burn release as fitted
         theta0, t_rel = float(fit_d["theta0_rad"]), float(fit_d["release_t_s"])
     else:  # forced run or no fit: start at the first valid sample, θ measured there
-        theta0, t_rel = float(th_meas[ok][0]), float(t_meas[ok][0])
+        theta0, t_rel = float(th_meas[ok][0]) if theta0_rad is None else theta0_rad, float(t_meas[ok][0])
     dur = cfg.duration_s or float(np.nanmax(t_meas) - t_rel)
     base = None
     if table is not None and "acc_m_s2" in table:

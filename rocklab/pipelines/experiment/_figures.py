@@ -55,14 +55,32 @@ def experiment_figures(res, out_dir) -> dict[str, Path]:
     fig, ax = plt.subplots(figsize=(10, 4))
     for name, (t, th) in res.measured.items():
         ax.plot(t, np.asarray(th) / alpha, lw=1.2, label=f"measured ({name})")
+    val = res.validation
     for law, sim in res.simulations.items():
-        ax.plot(
+        (line,) = ax.plot(
             sim["t_s"],
             np.asarray(sim["theta_rad"]) / alpha,
             lw=0.9,
             ls="--",
             label=f"simulated, {law} (η={sim['eta']:.3f})",
         )
+        band = val.bands.get(law) if val is not None else None
+        if band is not None:
+            v = val.laws[law]
+            ax.fill_between(
+                band[0],
+                band[1] / alpha,
+                band[2] / alpha,
+                color=line.get_color(),
+                alpha=0.15,
+                lw=0,
+                label=f"{law}: 5–95 % of {val.n_members} runs, {v.verdict} (coverage {v.band_coverage:.2f})",
+            )
+    if val is not None:
+        ax.axvline(val.horizon_s, color="k", ls=":", lw=1.0, label=f"predictability horizon ({val.reference_law})")
+        # overturned members reach ±π/2 (6 α for a stocky block): keep the measurement readable
+        peak = max(float(np.nanmax(np.abs(th))) for _, th in res.measured.values()) / alpha
+        ax.set_ylim(-max(1.1, 1.3 * peak), max(1.1, 1.3 * peak))
     if res.truth is not None:
         ax.plot(
             res.truth["t_s"], np.asarray(res.truth["theta_rad"]) / alpha, lw=0.6, color="k", alpha=0.5, label="truth"

@@ -215,6 +215,23 @@ def log_experiment(
         rows[f"{blk}/energy/sim_{law}"] = log_series(
             rec, f"{blk}/energy/sim_{law}", s["t_s"], s["energy_J"], color=colour, width=width, name=f"sim {law} (J)"
         )
+    val = res.validation
+    for i, law in enumerate(res.simulations):
+        band = val.bands.get(law) if val is not None else None
+        if band is None:
+            continue
+        # the ensemble's 5–95 % band as two thin lines in the law's colour
+        colour = _style(f"sim_{law}", i)[0]
+        for q, th in (("p05", band[1]), ("p95", band[2])):
+            key = f"band_{law}_{q}"
+            rows[f"{blk}/theta/{key}"] = log_series(
+                rec, f"{blk}/theta/{key}", band[0], th, color=colour, width=0.5, name=f"{law} {q[1:]} % of ensemble"
+            )
+            log_series(rec, f"{blk}/theta_deg/{key}", band[0], np.degrees(th), color=colour, width=0.5, name=key)
+    if val is not None:
+        verdicts = ", ".join(f"{law} {v.verdict} (score {v.score:.3g})" for law, v in val.laws.items())
+        log_events(rec, f"{blk}/validation", np.array([val.horizon_s]), [f"predictability horizon; {verdicts}"])
+        rows[f"{blk}/validation"] = 1
     if res.truth is not None:
         rows[f"{blk}/theta/truth"] = theta(rec, blk, "truth", res.truth["t_s"], res.truth["theta_rad"], "truth")
     if res.video_imu_residual is not None:

@@ -25,6 +25,10 @@ def series_frame(res):
             cols[f"theta_{name}_rad"] = np.interp(t, tn, thn, left=np.nan, right=np.nan)
     for law, s in res.simulations.items():
         cols[f"theta_sim_{law}_rad"] = np.interp(t, s["t_s"], s["theta_rad"], left=np.nan, right=np.nan)
+    if res.validation is not None:  # the 5–95 % band of each law's ensemble (predicted measurement)
+        for law, (tb, lo, hi) in res.validation.bands.items():
+            cols[f"theta_sim_{law}_p05_rad"] = np.interp(t, tb, lo, left=np.nan, right=np.nan)
+            cols[f"theta_sim_{law}_p95_rad"] = np.interp(t, tb, hi, left=np.nan, right=np.nan)
     if res.truth is not None:
         cols["theta_truth_rad"] = np.interp(t, res.truth["t_s"], res.truth["theta_rad"], left=np.nan, right=np.nan)
     if res.table is not None:
@@ -57,7 +61,15 @@ def _summary_md(res, figs: dict, rrd: bool) -> str:
         f"p = {_g(res.block.p_rad_s)} rad/s, η_H = {_g(res.block.eta_H)}; contact: {res.config.contact}",
         "",
     ]
-    if f:
+    if f and f.get("method") == "half-cycle segments":  # a shake-table run (see the validation below)
+        ci = f.get("ci95_eta_e") or [None, None]
+        lines += [
+            f"η_e = {_g(f.get('eta_e'))} (95 % CI {_g(ci[0])} – {_g(ci[1])}) from {f.get('n_segments')} half cycles "
+            f"under the measured table motion, residual RMS {_g(f.get('rms_residual_rad'))} rad "
+            f"(fit status {f.get('status')})",
+            "",
+        ]
+    elif f:
         ci = f.get("ci95_eta_e") or [None, None]
         lines += [
             f"η_e = {_g(f.get('eta_e'))} (95 % CI {_g(ci[0])} – {_g(ci[1])}), "
@@ -102,6 +114,10 @@ def _summary_md(res, figs: dict, rrd: bool) -> str:
             else f"| {law} | {_g(s['eta'])} | – | {len(s['impacts'])} |"
         )
     lines.append("")
+    if res.validation is not None:
+        from .._validation import summary_lines
+
+        lines += summary_lines(res.validation, res.block.alpha_rad)
     if res.truth is not None:
         lines += [
             f"Synthetic truth: η = {_g(res.truth.get('eta'))}, measured θ RMS error "

@@ -27,7 +27,7 @@ def run(args) -> int:
         args.config, args.out, force=args.force, spawn=args.spawn, connect=args.connect, progress=args.progress
     )
     if args.json:
-        keys = ("name", "status", "fit", "simulations", "sync", "video_vs_imu_rms_rad", "truth")
+        keys = ("name", "status", "fit", "simulations", "sync", "video_vs_imu_rms_rad", "truth", "validation")
         out = {k: report.get(k) for k in keys}
         out["ran"] = ran
         print(dumps_json(out))
@@ -37,6 +37,12 @@ def run(args) -> int:
         f = report.get("fit") or {}
         eta = f.get("eta_e")
         eta_s = f"{eta:.4g}" if isinstance(eta, (int, float)) else "not fitted"
+        val = report.get("validation")
+        if val:  # a shake-table run: η_e from its half cycles and the verdict of every law
+            ve = (val.get("eta_e") or {}).get("eta_e")
+            if not isinstance(eta, (int, float)) and isinstance(ve, (int, float)) and ve == ve:
+                eta_s = f"{ve:.4g} (half cycles)"
+            eta_s += "; " + ", ".join(f"{law} {v['verdict']}" for law, v in val["laws"].items())
         print(
             f"{report['name']}: {report['status']}; eta_e = {eta_s}, "
             f"outputs in {args.out} (summary.md, report.json, session.rrd)",

@@ -235,7 +235,7 @@ class CampaignResult:
             )
             for _, r in t.iterrows():
                 ci = f"[{r['ci_lo']:.3f}, {r['ci_hi']:.3f}]" if np.isfinite(r.get("ci_lo", np.nan)) else ""
-                eta_e = f"{r['eta_e']:>8.3f}" if np.isfinite(r["eta_e"]) else f"{'(forced)':>8}"
+                eta_e = f"{r['eta_e']:>8.3f}" if np.isfinite(r["eta_e"]) else f"{'forced':>8}"
                 lines.append(
                     f"{str(r['experiment'])[:21]:<22}{str(r['block'])[:6]:<7}{r['contact']:<8}"
                     f"{r['eta_H']:>8.3f}{eta_e}{ci:>18}"

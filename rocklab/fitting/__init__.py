@@ -13,11 +13,13 @@ flags), :func:`per_impact_eta` (data-only per-impact η), :func:`energy_loss_fro
 from ._campaign import ETA_MAT_RULES, EtaMatResult, KTableResult, fit_eta_mat, k_table, read_block_table
 from ._catalogue import catalogue_block, ceh_catalogue, ceh_full_contact, ceh_table5
 from ._ensemble import (
+    BUDGET_SOURCES,
     DEFAULT_ENSEMBLE_SIZE,
     HORIZON_FRACTION,
     Ensemble,
     InputUncertainty,
     LawVerdict,
+    error_budget,
     judge_law,
     response_statistics,
     simulate_ensemble,
@@ -58,6 +60,8 @@ __all__ = [
     "half_cycle_segments",
     "ETA_SYSTEMATIC",
     "simulate_ensemble",
+    "error_budget",
+    "BUDGET_SOURCES",
     "judge_law",
     "response_statistics",
     "InputUncertainty",

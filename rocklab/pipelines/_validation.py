@@ -85,6 +85,9 @@ class Validation:
     rest_level_rad : float
     seconds : float
         Wall time of all ensembles, s.
+    error_budget : dict or None
+        :func:`rocklab.fitting.error_budget` of the reference law inside the horizon: each measured
+        input's share of the model's spread (table noise, bias, scale, clock, sizes, θ0, η).
     """
 
     horizon_s: float
@@ -96,6 +99,7 @@ class Validation:
     n_members: int
     rest_level_rad: float
     seconds: float
+    error_budget: dict | None = None
 
     def to_dict(self) -> dict:
         return {
@@ -108,6 +112,7 @@ class Validation:
             "uncertainty": self.uncertainty,
             "rest_level_rad": float(self.rest_level_rad),
             "ensemble_s": float(self.seconds),
+            "error_budget": self.error_budget,
         }
 
 
@@ -306,6 +311,14 @@ def validate_forced_run(prep: ForcedPrep, block, laws: dict, *, n=None, seed=0) 
         )
         bands[law] = (t, ens.band_rad[0] + prep.level_rad, ens.band_rad[1] + prep.level_rad)
     ref = next((k for k in ("given", "eta_e") if k in verdicts), next(iter(verdicts)))
+    from ..fitting import error_budget
+
+    h = verdicts[ref].horizon_s
+    budget = error_budget(
+        block, prep.table["t_s"], prep.table["acc_m_s2"], t, eta=float(todo[ref]),
+        eta_sd=fit.se if ref == "eta_e" and good else 0.0, theta0_rad=prep.theta0_rad, t_start_s=float(t[0]),
+        unc=unc, t_end_s=float(h) if h is not None and np.isfinite(h) else None, n=max(8, n // 2), seed=seed,
+    )  # fmt: skip
     return Validation(
         horizon_s=verdicts[ref].horizon_s,
         reference_law=ref,
@@ -316,6 +329,7 @@ def validate_forced_run(prep: ForcedPrep, block, laws: dict, *, n=None, seed=0) 
         n_members=n,
         rest_level_rad=prep.level_rad,
         seconds=secs,
+        error_budget=budget,
     )
 
 
@@ -352,4 +366,18 @@ def summary_lines(v: Validation, alpha_rad: float) -> list[str]:
         f"{_g(1000 * unc['length_m'])} mm, θ noise {_g(unc['meas_noise_rad'])} rad.",
         "",
     ]
+    b = v.error_budget
+    if b:
+        names = {
+            "acc_noise_m_s2": "table noise", "acc_bias_m_s2": "table bias", "acc_scale": "table scale",
+            "sync_s": "clock offset", "length_m": "block size", "theta0_rad": "θ0", "eta": "η",
+        }  # fmt: skip
+        parts = sorted(b["sources"].items(), key=lambda kv: -kv[1]["share"])
+        lines += [
+            f"Error budget up to {_g(b['t_end_s'])} s (share of the model's spread of θ; all inputs together: "
+            f"{_g(b['all_sd_rad'])} rad RMS): "
+            + ", ".join(f"{names.get(k, k)} {100 * d['share']:.3g} %" for k, d in parts if d["share"] > 0)
+            + ".",
+            "",
+        ]
     return lines

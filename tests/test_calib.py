@@ -272,3 +272,45 @@ def test_track_init_writes_the_lens_and_refuses_one_of_another_size(tmp_path, ru
     rc, _, err = run_cli("track", "init", s / "video.mkv", "--lens", tmp_path / "hd.json", "-o", tmp_path / "u.toml")
     assert rc == 2 and "calibrated on 1280x720 px pictures, the film is 960x540 px" in err
     assert len(err.strip().splitlines()) == 1 and not (tmp_path / "u.toml").exists()
+
+
+def test_lens_from_a_charuco_film_recovers_the_rendered_camera(tmp_path):
+    from rocklab.synth import synth_stereo
+
+    r = synth_stereo(tmp_path / "s", size=(641, 463), f_px=800.0, n_board=12, seed=4, duration_s=0.2)
+    cam = r["cameras"][0]
+    film = r["paths"]["calib_cam1"]
+    lens = calibrate_lens(film, "charuco,9x6,0.03,0.022,DICT_5X5_100")
+    assert (lens.n_seen, lens.n_views, lens.status) == (12, 12, "ok")
+    assert lens.K[0, 0] == pytest.approx(cam.K[0, 0], rel=0.01)  # 802.2 px for 800
+    assert lens.K[1, 1] == pytest.approx(cam.K[1, 1], rel=0.01)
+    assert abs(lens.K[0, 0] - cam.K[0, 0]) < 3 * lens.sigma_px["fx"]
+    assert lens.dist[0] == pytest.approx(cam.dist[0], abs=0.02)
+    assert lens.rms_px < 0.3
+    # every other frame of the film: half the views (six views fix f to about 1 %: may be flagged weak)
+    with collecting() as diags:
+        half = calibrate_lens(film, "charuco,9x6,0.03,0.022,DICT_5X5_100", every=2)
+    assert (half.n_seen, half.n_views) == (6, 6)
+    assert {d.code for d in diags} <= {"W-CALIB-WEAK"} and (half.status == "weak") == bool(diags)
+
+
+@pytest.mark.parametrize(
+    "text, match",
+    [
+        ("{not json", "not a lens file"),
+        ('{"camera_matrix": [[1, 0], [0, 1]], "dist_coeffs": [0, 0, 0, 0], "size_px": [640, 480]}', "'camera_matrix'"),
+        (
+            '{"camera_matrix": [[500, 0, 320], [0, 500, 240], [0, 0, 1]], "dist_coeffs": [0, 0, 0], "size_px": [640, 480]}',
+            "'dist_coeffs' must be 4, 5, 8, 12 or 14",
+        ),
+        ('{"camera_matrix": [[500, 0, 320], [0, 500, 240], [0, 0, 1]], "dist_coeffs": [0, 0, 0, 0]}', "size_px"),
+    ],
+)
+def test_damaged_lens_files_are_one_line_errors(tmp_path, text, match):
+    f = tmp_path / "lens.json"
+    f.write_text(text)
+    with pytest.raises(InputError, match=match) as e:
+        load_lens(f)
+    assert str(e.value).startswith(str(f)) and "rocklab calibrate" in str(e.value)
+    with pytest.raises(InputError, match="lens file not found"):
+        load_lens(tmp_path / "none.json")

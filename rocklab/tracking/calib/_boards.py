@@ -154,7 +154,7 @@ def parse_board(spec: str, option: str = "--board") -> Board:
         raise InputError(
             f"{option} {spec!r}: COLSxROWS must be two whole numbers and the sizes numbers in metres; {_EXAMPLE}"
         ) from None
-    if not (math.isfinite(square) and 0 < square < 1):
+    if kind == "checkerboard" and not (math.isfinite(square) and 0 < square < 1):
         raise InputError(
             f"{option} {spec!r}: the square side {parts[2]} must be in metres (0 < SQUARE_M < 1, e.g. 0.025)"
         )
@@ -164,10 +164,10 @@ def parse_board(spec: str, option: str = "--board") -> Board:
         return Board("checkerboard", c, r, square)
     if min(c, r) < 3:
         raise InputError(f"{option} {spec!r}: a ChArUco board has at least 3x3 squares (e.g. 9x6)")
-    if not (math.isfinite(marker) and 0 < marker < square):
+    if not (math.isfinite(square) and math.isfinite(marker) and 0 < marker < square < 1):
         raise InputError(
             f"{option} {spec!r}: the marker side ({parts[3]} m) must be positive and smaller than the square side "
-            f"({parts[2]} m), e.g. 0.03,0.022"
+            f"({parts[2]} m), both in metres, e.g. 0.03,0.022"
         )
     if not parts[4].startswith("DICT_") or not hasattr(cv2.aruco, parts[4]):
         raise InputError(

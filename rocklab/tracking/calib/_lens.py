@@ -220,7 +220,7 @@ def calibrate_lens(source, board, *, every: int | None = None, fix_k3: bool = Fa
     rel = max(sigma["fx"] / K[0, 0], sigma["fy"] / K[1, 1])
     if not rel <= WEAK_SIGMA_REL:
         problems.append(
-            f"the focal length is known to {100 * rel:.2g} % (1-sigma) from {len(keep)} views: add views with the "
+            f"the focal length is known to {100 * rel:.3g} % (1-sigma) from {len(keep)} views: add views with the "
             "board tilted 20-45 degrees in different directions, filling the picture's corners"
         )
     if not rms <= WEAK_RMS_PX:

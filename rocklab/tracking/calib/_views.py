@@ -1,8 +1,8 @@
 """The pictures of a calibration: a film, a folder of photos or a file pattern.
 
 A folder of calibration photos is a set of views, not a film: it needs no frame rate, and gaps in
-its numbering (a blurred photo deleted) are fine; names of several patterns (``left01.jpg``,
-``right01.jpg``) are two cameras' photos and refused. Its pictures are taken
+its numbering (a blurred photo deleted) are fine; one number under two names (``left01.jpg``,
+``right01.jpg``) means two cameras' photos, refused. Its pictures are taken
 in the order of the numbers in their names (``left2.jpg`` before ``left10.jpg``). A pattern such as
 ``'calib/left*.jpg'`` (quoted, so the shell does not expand it) picks some files of a folder. A
 film (video file, Photron, Phantom) is read frame by frame, every ``every``-th frame.
@@ -26,6 +26,7 @@ __all__ = ["Views", "open_views", "frames_by_index", "warn_lost", "MAX_FILM_VIEW
 MAX_FILM_VIEWS = 100
 _IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".tif", ".tiff", ".bmp")
 _DIGITS = re.compile(r"(\d+)")
+_LAST_NUMBER = re.compile(r"^(.*?)(\d+)(\D*)$")
 
 
 def _natural(p: Path):
@@ -178,12 +179,20 @@ def open_views(source, every: int | None = None) -> Views:
         pass  # a folder of another kind (a high-speed camera's) is read as a film below
     elif p.is_dir() or is_pattern:
         files = _pictures(s)
-        kinds = sorted({_DIGITS.sub("N", f.stem) for f in files})
-        if p.is_dir() and len(kinds) > 1:
-            # left01.jpg and right01.jpg side by side: two cameras' photos, which one calibration would mix
+        by_kind: dict = {}
+        for f in files:
+            m = _LAST_NUMBER.match(f.stem)
+            if m:
+                by_kind.setdefault((m.group(1), m.group(3)), set()).add(int(m.group(2)))
+        kinds = sorted(by_kind)
+        shared = any(by_kind[a] & by_kind[b] for i, a in enumerate(kinds) for b in kinds[i + 1 :])
+        if p.is_dir() and shared:
+            # left01.jpg and right01.jpg (or cam1_0001 and cam2_0001) side by side: two cameras' photos,
+            # which one calibration would mix
+            shown = ", ".join("N".join(k) for k in kinds[:3])
             raise InputError(
-                f"{p}: pictures named in {len(kinds)} ways ({', '.join(kinds[:3])}); one camera's photos per "
-                f"calibration: give a quoted pattern such as '{p / (kinds[0].replace('N', '*') + files[0].suffix)}'"
+                f"{p}: pictures named in {len(kinds)} ways ({shown}); one camera's photos per "
+                f"calibration: give a quoted pattern such as '{p / ('*'.join(kinds[0]) + files[0].suffix)}'"
             )
         nums = [_DIGITS.findall(f.stem) for f in files]
         numbers = tuple(int(n[-1]) for n in nums) if all(nums) else None

@@ -110,10 +110,11 @@ def run_calibrate(args) -> int:
     lens.save(out, side=not args.out)
     d = dict(lens.to_dict(), lens_json=str(out))
     sx, sy = lens.sigma_px["fx"], lens.sigma_px["fy"]
+    worst = lens.views[max(range(lens.n_views), key=lambda k: lens.view_rms_px[k])]
     lines = [
         f"calibrated from {lens.n_views} of {lens.n_seen} pictures ({lens.board}): fx {lens.K[0, 0]:.2f} +/- {sx:.2g} px, "
         f"fy {lens.K[1, 1]:.2f} +/- {sy:.2g} px, principal point ({lens.K[0, 2]:.1f}, {lens.K[1, 2]:.1f}) px; "
-        f"reprojection RMS {lens.rms_px:.3g} px; status {lens.status}",
+        f"reprojection RMS {lens.rms_px:.3g} px (worst view {worst} {max(lens.view_rms_px):.3g} px); status {lens.status}",
         f"wrote {out}; use it with [video] calibration = \"{out.name}\" in track.toml (or 'rocklab track init --lens {out}')",
     ]
     _emit(args, d, lines)

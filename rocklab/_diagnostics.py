@@ -239,7 +239,8 @@ WARNING_CODES: dict[str, tuple[str, str]] = {
         "suspect",
         "a camera calibration is weakly determined: a focal length's 1-sigma exceeds 1 % of it (too few "
         "views, or views that do not tilt the board), or the reprojection RMS exceeds 1 px (a wrong board "
-        "spec, blur, a bent or moving board); the lens file carries status 'weak'",
+        "spec, blur, a bent or moving board; for two cameras, photos paired wrongly); a lens file carries "
+        "status 'weak'",
     ),
 }
 

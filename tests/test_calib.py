@@ -124,7 +124,7 @@ def test_synthetic_checkerboard_lens_from_a_folder_without_rate(tmp_path):
     assert json.loads(out.read_text())["format"] == "rocklab-lens/1"
 
 
-def test_synthetic_stereo_checkerboard_baseline(tmp_path):
+def test_synthetic_stereo_checkerboard_baseline(tmp_path, run_cli):
     import cv2
 
     # camera 2: 0.12 m to the right of camera 1, turned 5 degrees towards the board between them
@@ -147,6 +147,11 @@ def test_synthetic_stereo_checkerboard_baseline(tmp_path):
     np.testing.assert_allclose(rig.T, T12, atol=1.5e-3)
     assert rig.K2[0, 0] == pytest.approx(800.0, rel=3e-3)
     assert rig.rms_px["stereo"] < 0.2
+    # photos paired wrongly (the right camera's numbered one off): the stereo fit cannot close, said
+    _write(tmp_path / "shifted", "right", right, [(k + 1) % 10 + 1 for k in range(10)])
+    with collecting() as diags:
+        bad = calibrate_stereo(str(tmp_path / "pairs" / "left*.png"), str(tmp_path / "shifted" / "right*.png"), BOARD)
+    assert bad.rms_px["stereo"] > 1.0 and [d.code for d in diags] == ["W-CALIB-WEAK"]
     # a pair whose partner is missing is named, not silently shifted
     (tmp_path / "pairs" / "right04.png").unlink()
     with pytest.raises(InputError, match=r"no picture numbered 4, which .*left\*\.png has"):
@@ -154,6 +159,18 @@ def test_synthetic_stereo_checkerboard_baseline(tmp_path):
     # the folder of both cameras' photos is not one camera's
     with pytest.raises(InputError, match=r"named in 2 ways \(leftN, rightN\); .*'.*left\*\.png'"):
         calibrate_lens(tmp_path / "pairs", BOARD)
+    # the same pictures as two lossless films, through the CLI: the same rig
+    from _render import write_video
+
+    write_video(tmp_path / "left.mkv", left, 25.0)
+    write_video(tmp_path / "right.mkv", right, 25.0)
+    rc, out, err = run_cli(
+        "stereo", "calibrate", tmp_path / "left.mkv", tmp_path / "right.mkv", "--board", BOARD, "--json"
+    )
+    assert rc == 0, err
+    s = json.loads(out)
+    assert s["n_frames"] == 10 and s["baseline_m"] == pytest.approx(rig.baseline_m, rel=1e-9)
+    assert s["board"] == BOARD and (tmp_path / "stereo.json").is_file()
 
 
 def test_real_checkerboard_pairs_match_bouguets_published_baseline():

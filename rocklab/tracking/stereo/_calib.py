@@ -272,6 +272,17 @@ def calibrate_stereo(film1, film2, board=None, *, every: int | None = None) -> S
             f"{where(film2)}the two cameras are {baseline_m:.3g} m apart after calibration: no depth can be "
             f"triangulated; film the board with two cameras at least {MIN_BASELINE_M:g} m apart"
         )
+    from ..calib._lens import WEAK_RMS_PX
+
+    if not max(rms1, rms2, float(rms)) <= WEAK_RMS_PX:
+        from ..._diagnostics import warn
+
+        warn(
+            "W-CALIB-WEAK",
+            f"{film1}, {film2}: reprojection RMS {rms1:.3g} / {rms2:.3g} px (each camera), {float(rms):.3g} px "
+            f"(stereo), expected well under {WEAK_RMS_PX:g} px: check the board spec (square side, corner count), "
+            "blur, and that the board is flat and still in each pose",
+        )
     return StereoRig(
         K1,
         np.asarray(d1, float).ravel(),

@@ -241,6 +241,13 @@ WARNING_CODES: dict[str, tuple[str, str]] = {
         "fits the targets' epipolar lines far better: the 3D points of moving targets are skewed; "
         "run without --no-sync",
     ),
+    "W-CALIB-WEAK": (
+        "suspect",
+        "a camera calibration is weakly determined: a focal length's 1-sigma exceeds 1 % of it (too few "
+        "views, or views that do not tilt the board), or the reprojection RMS exceeds 1 px (a wrong board "
+        "spec, blur, a bent or moving board; for two cameras, photos paired wrongly); a lens file carries "
+        "status 'weak'",
+    ),
 }
 
 

@@ -7,12 +7,15 @@ Sub-packages:
 - :mod:`rocklab.tracking.rigid`: 3D point imports (CSV, C3D), rigid poses, the rocking
   decomposition and the assumption audit;
 - :mod:`rocklab.tracking.stereo`: two cameras (calibration, sync, 3D dots and markers).
+- :mod:`rocklab.tracking.calib`: camera calibration from checkerboard and ChArUco pictures (films,
+  folders of photos): one camera's lens file, and the boards the stereo calibration reads.
 
 The clock synchronisation of an IMU to a video track is here (:func:`sync_offset`,
 :func:`sync_imu_to_track`). The most used names of the sub-packages are re-exported.
 """
 
 from ._sync import SyncResult, sync_events, sync_imu_to_track, sync_offset, track_rate
+from .calib import Board, Lens, calibrate_lens, load_lens, parse_board
 from .imu import (
     ImuLog,
     ImuRotation,
@@ -80,6 +83,11 @@ __all__: list[str] = [
     "SimilarityFit",
     "fit_similarity",
     "calibrate_camera",
+    "Board",
+    "parse_board",
+    "Lens",
+    "calibrate_lens",
+    "load_lens",
     "ImuLog",
     "read_imu",
     "read_ximu_registers",

@@ -66,7 +66,8 @@ def _track(args):
         if args.video == "init":
             out = _opt(args.out) or video.parent / "track.toml"
             preview = _opt(args.preview) or out.with_name(out.stem + "_init.png")
-            return ins, [("-o", out), ("--preview", preview)]
+            lens = _opt(getattr(args, "lens", None))
+            return ins + ([("--lens", lens)] if lens is not None else []), [("-o", out), ("--preview", preview)]
         cfg_ins, _ = _track_config_inputs(_opt(args.config) or video.parent / "track.toml")
         return ins + cfg_ins + _fixes(args), [("-o", _opt(args.out) or video.parent / "track_preview.png")]
     video = Path(args.video)
@@ -100,6 +101,15 @@ def _stereo(args):
         ins.append(("calibration --calib", Path(args.calib)))
     outs = stereo_track_outputs(_opt(args.out) or f1.parent / "tracks.csv")
     return ins, [*outs.items(), ("--rrd", _opt(args.rrd))]
+
+
+def lens_out(args) -> Path:
+    """Where ``rocklab calibrate`` writes its lens file: ``-o``, else ``lens.json`` beside the source."""
+    return Path(args.out) if args.out else Path(args.source).parent / "lens.json"
+
+
+def _calibrate(args):
+    return [("source", Path(args.source))], [("-o", lens_out(args))]
 
 
 def _imu(args):
@@ -159,6 +169,7 @@ _PLANS = {
     "track": _track,
     "track3d": _track3d,
     "stereo": _stereo,
+    "calibrate": _calibrate,
     "imu": _imu,
     "simulate": _simulate,
     "column": _column,

@@ -62,7 +62,9 @@ def _propose(video, info, gray):
     return props, min(window, duration) if duration else window
 
 
-def track_init(video, out, *, objects=(), table=None, marker_size_m=None, preview=None, side=(False, False), fps=None):
+def track_init(
+    video, out, *, objects=(), table=None, marker_size_m=None, preview=None, side=(False, False), fps=None, lens=None
+):
     """Write a commented ``track.toml`` for ``video`` (and a preview PNG); returns (config, notes).
 
     Without markers and without ``objects``, the objects that move in the first seconds and the
@@ -81,6 +83,9 @@ def track_init(video, out, *, objects=(), table=None, marker_size_m=None, previe
         Printed marker side, m, when markers are used.
     preview : path or None
         PNG with every detection, region and the level line drawn on the first frame.
+    lens : path or None
+        A lens file (``rocklab calibrate``) written as ``[video] calibration`` (relative to the
+        config's folder); refused when calibrated at another picture size than the film's.
 
     Returns
     -------
@@ -132,6 +137,14 @@ def track_init(video, out, *, objects=(), table=None, marker_size_m=None, previe
             if troi is not None:
                 proposed += (f"--table {_box_text(troi)}",)
             pnotes = _proposal_notes(props, window, gray.size)
+    lens_rel = None
+    if lens is not None:
+        import os
+
+        from ...tracking.video._geometry import load_calibration
+
+        load_calibration(lens, (info.width_px, info.height_px))
+        lens_rel = Path(os.path.relpath(Path(lens).resolve(), out.resolve().parent)).as_posix()
     cfg, notes, found = suggest_config(
         gray,
         regions=regions or None,
@@ -142,6 +155,11 @@ def track_init(video, out, *, objects=(), table=None, marker_size_m=None, previe
         level_line_px=line,
     )
     notes = pnotes + notes
+    if lens_rel is not None:
+        import dataclasses
+
+        cfg = dataclasses.replace(cfg, video=dataclasses.replace(cfg.video, calibration=lens_rel))
+        notes.append(f"lens {lens_rel}: detected points are undistorted with it before any geometry")
     if not info.fps and not fps:
         notes.append("the film has no frame rate: fps = 50 written; correct it (or give --fps)")
     head = [

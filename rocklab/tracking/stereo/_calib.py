@@ -1,12 +1,12 @@
-"""Stereo calibration from a film of a ChArUco board seen by both cameras.
+"""Stereo calibration from films or photos of a board seen by both cameras.
 
-Each camera's intrinsics and distortion come from ``cv2.calibrateCamera`` on
-the ChArUco corners it sees (OpenCV's ``CharucoDetector``, which interpolates
-the chessboard corners from the ArUco markers, so a partly seen board still
-counts); the relative pose from ``cv2.stereoCalibrate`` on the corners both see
-in the same frame, with the intrinsics refined jointly. The board is held
-still in each pose, so the two films need no synchronisation for this step,
-only the same number of frames in the same order.
+The board is a checkerboard or a ChArUco board (:mod:`rocklab.tracking.calib`: a ChArUco
+board still counts when partly seen, a checkerboard only whole). Each camera's intrinsics and
+distortion come from ``cv2.calibrateCamera`` on the corners it sees; the relative pose from
+``cv2.stereoCalibrate`` on the corners both see in the same picture, with the intrinsics
+refined jointly. The board is held still in each pose, so the two films need no
+synchronisation for this step, only the same poses in the same order (photos: paired by
+the number in their names).
 """
 
 from __future__ import annotations
@@ -18,8 +18,17 @@ from pathlib import Path
 import numpy as np
 
 from ..._errors import InputError, where
+from ..calib._views import frames_by_index, warn_lost
 
-__all__ = ["StereoRig", "calibrate_stereo", "load_rig", "DEFAULT_BOARD", "charuco_board"]
+__all__ = [
+    "StereoRig",
+    "calibrate_stereo",
+    "load_rig",
+    "DEFAULT_BOARD",
+    "charuco_board",
+    "frames_by_index",
+    "warn_lost",
+]
 
 #: Default board: 9 x 6 squares of 30 mm, 22 mm markers, DICT_5X5_100.
 DEFAULT_BOARD = {"squares": (9, 6), "square_m": 0.03, "marker_m": 0.022, "dictionary": "DICT_5X5_100"}
@@ -54,6 +63,8 @@ class StereoRig:
         Reprojection RMS: ``cam1``, ``cam2`` (single-camera) and ``stereo``, px.
     n_frames : int
         Board poses both cameras saw.
+    board : str
+        The board's ``--board`` spec.
     """
 
     K1: np.ndarray
@@ -65,6 +76,7 @@ class StereoRig:
     size: tuple
     rms_px: dict
     n_frames: int
+    board: str = ""
 
     @property
     def baseline_m(self) -> float:
@@ -90,6 +102,7 @@ class StereoRig:
             "rms_px": dict(self.rms_px),
             "n_frames": self.n_frames,
             "baseline_m": self.baseline_m,
+            "board": self.board,
         }
 
     def save(self, path) -> Path:
@@ -114,6 +127,7 @@ def load_rig(path) -> StereoRig:
             tuple(d["size_px"]),
             dict(d.get("rms_px", {})),
             int(d.get("n_frames", 0)),
+            str(d.get("board", "")),
         )
     except FileNotFoundError:
         raise InputError(f"{where(path)}not found; make one with 'rocklab stereo calibrate'") from None
@@ -131,119 +145,95 @@ def charuco_board(spec: dict):
     return cv2.aruco.CharucoBoard(tuple(spec["squares"]), float(spec["square_m"]), float(spec["marker_m"]), d)
 
 
-def frames_by_index(path, lost: list | None = None):
-    """Grey frames of the film at ``path``, one per slot of its container's clock.
+def _board(board):
+    from ..calib._boards import board_from_dict, parse_board
 
-    A frame the camera dropped or a damaged packet lost is a black picture (nothing is detected
-    in it), so frame ``i`` of one camera stays frame ``i`` of the other. ``(path, n_undecoded,
-    n_dropped, n_slots)`` is appended to ``lost`` at the end, for the caller to warn from its own
-    thread (:func:`warn_lost`).
-    """
-    from ..video._video import iter_video_frames, probe_video
-
-    info = probe_video(path)
-    slot = np.arange(info.n_frames)
-    if info.n_dropped and info.frame_times_s is not None and info.fps:
-        slot = np.rint(info.frame_times_s * info.fps).astype(int)
-    n = int(slot[-1]) + 1 if len(slot) else 0
-    nxt, n_undecoded, blank = 0, 0, None
-    for i, gray in iter_video_frames(path):
-        k = int(slot[i]) if i < len(slot) else i
-        blank = np.zeros_like(gray) if blank is None else blank
-        for _ in range(nxt, k):
-            yield blank
-        n_undecoded += max(k - nxt, 0)
-        yield gray
-        nxt = k + 1
-    if blank is not None:
-        for _ in range(nxt, n):
-            yield blank
-        n_undecoded += max(n - nxt, 0)
-    if lost is not None:
-        lost.append((str(path), n_undecoded - info.n_dropped, info.n_dropped, max(n, nxt)))
+    if board is None or isinstance(board, dict):
+        return board_from_dict(dict(DEFAULT_BOARD, **(board or {})))
+    return parse_board(board) if isinstance(board, str) else board
 
 
-def warn_lost(lost) -> None:
-    """W-VIDEO-DROPPED and W-VIDEO-DAMAGED for each film of :func:`frames_by_index` that lost frames."""
-    from ..._diagnostics import warn
-
-    for path, n_bad, n_dropped, n in lost:
-        if n_dropped:
-            warn(
-                "W-VIDEO-DROPPED",
-                f"{path}: the camera dropped {n_dropped} of {n} frames (gaps in the container's clock); "
-                "they count as frames without targets, so the two films stay paired frame by frame",
-            )
-        if n_bad > 0:
-            warn(
-                "W-VIDEO-DAMAGED",
-                f"{path}: {n_bad} of the {n} frames the container holds did not decode (damaged "
-                "packets); they count as frames without targets, so the two films stay paired frame by frame",
-            )
-
-
-def _detect(path, board, lost=None):
-    """Per frame ``{corner id: (u, v)}`` of the ChArUco corners in the film at ``path``."""
-    import cv2
-
-    from ..video._video import probe_video
-
-    info = probe_video(path)
-    det = cv2.aruco.CharucoDetector(board)
-    out = []
-    for gray in frames_by_index(path, lost):
-        cc, ci, _, _ = det.detectBoard(gray)
-        out.append({} if ci is None else {int(i): c for i, c in zip(ci.ravel(), cc.reshape(-1, 2))})
-    return out, (info.width_px, info.height_px)
+def _pair(v1, v2, n1, n2, film1, film2):
+    """Views of two cameras paired: by the number in the photos' names where both have one
+    (``left03.jpg`` with ``right03.jpg``), else in order."""
+    if v1.numbers is not None and v2.numbers is not None and not (v1.is_film or v2.is_film):
+        if len(set(v1.numbers)) == len(v1.numbers) and len(set(v2.numbers)) == len(v2.numbers):
+            miss = sorted(set(v1.numbers) ^ set(v2.numbers))
+            if miss:
+                k = miss[0]
+                has, lacks = (film1, film2) if k in v1.numbers else (film2, film1)
+                raise InputError(
+                    f"{where(lacks)}no picture numbered {k}, which {has} has ({len(miss)} unpaired); the two cameras' "
+                    "photos are paired by the number in their names: remove the unpaired ones"
+                )
+            return [v1.numbers.index(k) for k in sorted(v1.numbers)], [v2.numbers.index(k) for k in sorted(v1.numbers)]
+    if n1 != n2:
+        raise InputError(
+            f"{where(film2)}{n2} frames, but {Path(str(film1)).name} has {n1}; the two "
+            "calibration films must show the same board poses frame by frame (trim them to match)"
+        )
+    return list(range(n1)), list(range(n2))
 
 
-def calibrate_stereo(film1, film2, board: dict | None = None) -> StereoRig:
-    """Calibrate two cameras from films of a ChArUco board.
+def calibrate_stereo(film1, film2, board=None, *, every: int | None = None) -> StereoRig:
+    """Calibrate two cameras from films or photos of a board both see.
 
     Parameters
     ----------
-    film1, film2 : path-like
-        The two cameras' films, frame ``i`` of each showing the same board pose.
-    board : dict, optional
-        ``squares`` (columns, rows), ``square_m``, ``marker_m``, ``dictionary``
-        (default :data:`DEFAULT_BOARD`).
+    film1, film2 : path-like or str
+        The two cameras' pictures: films (frame ``i`` of each showing the same board pose),
+        folders of photos or file patterns (paired by the number in their names, else in order;
+        :func:`rocklab.tracking.calib.open_views`).
+    board : Board, str or dict, optional
+        A :class:`~rocklab.tracking.calib.Board`, a ``--board`` spec (``checkerboard,9x6,0.025``,
+        ``charuco,9x6,0.03,0.022,DICT_5X5_100``) or a ChArUco dict with ``squares`` (columns,
+        rows), ``square_m``, ``marker_m``, ``dictionary`` (default :data:`DEFAULT_BOARD`).
+    every : int or None
+        Films: every ``every``-th frame (None: every frame).
 
     Returns
     -------
     StereoRig
+        ``k3`` is held at 0 in both cameras (the rig's distortion has ``k1, k2, p1, p2``).
     """
     import cv2
 
-    spec = dict(DEFAULT_BOARD, **(board or {}))
-    b = charuco_board(spec)
-    obj_all = b.getChessboardCorners()
+    from ..calib._lens import detect_views, not_found_hint, usable
+    from ..calib._views import open_views
+
+    b = _board(board)
+    if b.kind == "checkerboard" and b.cols == b.rows:
+        raise InputError(
+            f"--board {b.spec}: a square pattern of inner corners can be numbered from any of its four corners, "
+            "so two cameras cannot agree on corner i; use a board with unequal counts (e.g. 9x6)"
+        )
+    obj_all = b.object_points()
+    v1, v2 = open_views(film1, every or 1), open_views(film2, every or 1)
     lost: list = []
-    det1, size1 = _detect(film1, b, lost)
-    det2, size2 = _detect(film2, b, lost)
+    _, det1, size1 = detect_views(v1, b, lost)
+    _, det2, size2 = detect_views(v2, b, lost)
     warn_lost(lost)
     from ..video._checks import check_mirrored
     from ..video._video import probe_video
 
-    for film in (film1, film2):
-        check_mirrored(probe_video(film), film)
-    if len(det1) != len(det2):
-        raise InputError(
-            f"{where(film2)}{len(det2)} frames, but {Path(film1).name} has {len(det1)}; the two "
-            "calibration films must show the same board poses frame by frame (trim them to match)"
-        )
+    for v in (v1, v2):
+        if v.is_film:
+            check_mirrored(probe_video(v.source), v.source)
+    i1, i2 = _pair(v1, v2, len(det1), len(det2), film1, film2)
+    det1, det2 = [det1[i] for i in i1], [det2[i] for i in i2]
     if size1 != size2:
         raise InputError(
-            f"{where(film2)}frame size {size2} differs from {Path(film1).name}'s {size1}; "
+            f"{where(film2)}frame size {size2} differs from {Path(str(film1)).name}'s {size1}; "
             "calibrate cameras of one size (or give each its own calibration)"
         )
 
     def per_camera(dets, film):
-        ok = [d for d in dets if len(d) >= MIN_CORNERS]
+        ok = [d for d in dets if usable(d, b)]
         if len(ok) < MIN_FRAMES:
             raise InputError(
-                f"{where(film)}the board is seen (>= {MIN_CORNERS} corners) in {len(ok)} of "
-                f"{len(dets)} frames; need {MIN_FRAMES}: film more poses, closer, sharper, and check "
-                f"the board ({spec['squares'][0]}x{spec['squares'][1]} squares, {spec['dictionary']})"
+                f"{where(film)}the board is seen (whole, or >= {MIN_CORNERS} ChArUco corners) in {len(ok)} of "
+                f"{len(dets)} pictures; need {MIN_FRAMES}: "
+                f"film more poses, closer, sharper, and {not_found_hint(b)}"
             )
         obj = [obj_all[sorted(d)].astype(np.float32) for d in ok]
         img = [np.array([d[i] for i in sorted(d)], np.float32) for d in ok]
@@ -255,14 +245,14 @@ def calibrate_stereo(film1, film2, board: dict | None = None) -> StereoRig:
     obj, img1, img2 = [], [], []
     for a, c in zip(det1, det2):
         common = sorted(set(a) & set(c))
-        if len(common) >= MIN_CORNERS:
+        if usable(a, b) and usable(c, b) and len(common) >= MIN_CORNERS:
             obj.append(obj_all[common].astype(np.float32))
             img1.append(np.array([a[i] for i in common], np.float32))
             img2.append(np.array([c[i] for i in common], np.float32))
     if len(obj) < MIN_FRAMES:
         raise InputError(
-            f"{where(film1)}the board is seen by both cameras at once in {len(obj)} frames; need "
-            f"{MIN_FRAMES}: hold it where both see it (check {Path(film2).name} too)"
+            f"{where(film1)}the board is seen by both cameras at once in {len(obj)} pictures; need "
+            f"{MIN_FRAMES}: hold it where both see it (check {Path(str(film2)).name} too)"
         )
     # one film given twice (or two copies of one camera) calibrates to a zero baseline that
     # triangulates nothing: the corners then agree to the detector's rounding in every frame
@@ -282,6 +272,17 @@ def calibrate_stereo(film1, film2, board: dict | None = None) -> StereoRig:
             f"{where(film2)}the two cameras are {baseline_m:.3g} m apart after calibration: no depth can be "
             f"triangulated; film the board with two cameras at least {MIN_BASELINE_M:g} m apart"
         )
+    from ..calib._lens import WEAK_RMS_PX
+
+    if not max(rms1, rms2, float(rms)) <= WEAK_RMS_PX:
+        from ..._diagnostics import warn
+
+        warn(
+            "W-CALIB-WEAK",
+            f"{film1}, {film2}: reprojection RMS {rms1:.3g} / {rms2:.3g} px (each camera), {float(rms):.3g} px "
+            f"(stereo), expected well under {WEAK_RMS_PX:g} px: check the board spec (square side, corner count), "
+            "blur, and that the board is flat and still in each pose",
+        )
     return StereoRig(
         K1,
         np.asarray(d1, float).ravel(),
@@ -292,4 +293,5 @@ def calibrate_stereo(film1, film2, board: dict | None = None) -> StereoRig:
         tuple(size1),
         {"cam1": rms1, "cam2": rms2, "stereo": float(rms)},
         len(obj),
+        b.spec,
     )

@@ -95,8 +95,10 @@ class VideoConfig:
     dist_coeffs : tuple of float, or None
         OpenCV distortion coefficients ``(k1, k2, p1, p2[, k3, ...])``.
     calibration : str or None
-        Path (relative to the TOML file) of a ``.npz`` with ``camera_matrix``
-        and ``dist_coeffs`` (as written by :func:`rocklab.tracking.calibrate_camera`).
+        Path (relative to the TOML file) of a lens file (``lens.json`` from ``rocklab calibrate
+        FILM_OR_FOLDER --board ...``, calibrated at the film's size) or of a ``.npz`` with
+        ``camera_matrix`` and ``dist_coeffs`` (:func:`rocklab.tracking.calibrate_camera`); replaces
+        ``camera_matrix`` and ``dist_coeffs``.
     corrections : str or None
         Path (relative to the TOML file) of a corrections file (CSV or TOML: per object and frame
         or time range, ``drop`` or set ``x_m``/``y_m``/``theta_rad``/``theta_deg``), applied after

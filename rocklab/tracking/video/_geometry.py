@@ -191,8 +191,28 @@ def plane_homography_from_points(img_px, obj_m, plane_map: PlaneMap):
     return H
 
 
-def load_calibration(path):
-    """Read ``camera_matrix`` (3, 3) and ``dist_coeffs`` (k,) from a ``.npz``."""
+def load_calibration(path, size_px=None):
+    """Read ``camera_matrix`` (3, 3) and ``dist_coeffs`` (k,) from a lens file or a ``.npz``.
+
+    Parameters
+    ----------
+    path : path-like
+        A lens file (``.json``, :func:`rocklab.tracking.calib.calibrate_lens`) or a ``.npz`` with
+        ``camera_matrix`` and ``dist_coeffs`` (:func:`calibrate_camera`).
+    size_px : (int, int) or None
+        The film's (width, height): a lens file calibrated at another size is refused.
+    """
+    if str(path).lower().endswith(".json"):
+        from ..calib._lens import load_lens
+
+        lens = load_lens(path)
+        if size_px is not None and tuple(int(v) for v in size_px) != tuple(lens.size):
+            w, h = lens.size
+            raise InputError(
+                f"{path}: the lens was calibrated on {w}x{h} px pictures, the film is {size_px[0]}x{size_px[1]} px; "
+                "its focal length and centre do not apply: calibrate at the film's size (rocklab calibrate)"
+            )
+        return lens.K, lens.dist
     try:
         with np.load(path) as z:
             K = np.asarray(z["camera_matrix"], float).reshape(3, 3)

@@ -23,7 +23,7 @@ def make_plane_map(config: TrackConfig, width_px: int, height_px: int, first_gra
     v = config.video
     K, dist = v.camera_matrix, v.dist_coeffs
     if v.calibration:
-        K, dist = load_calibration(v.calibration)
+        K, dist = load_calibration(v.calibration, (width_px, height_px))
     ref = config.reference
     pm = PlaneMap(width_px, height_px, K, dist, ref.homography)
     if ref.homography is not None:

@@ -1,8 +1,16 @@
-"""``rocklab stereo``: two-camera 3D tracking of dots or ArUco markers (a GOM Pontos-style rig).
+"""``rocklab stereo``: two-camera 3D tracking of dots or ArUco markers (a GOM Pontos-style rig);
+``rocklab calibrate``: one camera's lens.
 
-- ``rocklab stereo calibrate CALIB1 CALIB2 -o stereo.json [--board 9x6,0.03,0.022,DICT_5X5_100]``:
-  intrinsics, distortion and relative pose from films of a ChArUco board seen by both
-  cameras; prints the reprojection RMS (px) and the baseline (m).
+- ``rocklab stereo calibrate LEFT RIGHT -o stereo.json [--board checkerboard,9x6,0.025]``:
+  intrinsics, distortion and relative pose from films, folders of photos or quoted file
+  patterns (``'calib/left*.jpg'``) of a board seen by both cameras (photos paired by the number
+  in their names); prints the reprojection RMS (px) and the baseline (m). ``--board`` is
+  ``checkerboard,COLSxROWS,SQUARE_M`` (inner corners) or ``charuco,COLSxROWS,SQUARE_M,MARKER_M,DICT``
+  (squares; default ``charuco,9x6,0.03,0.022,DICT_5X5_100``).
+- ``rocklab calibrate FILM_OR_FOLDER --board ... -o lens.json [--every N] [--fix-k3]``: one
+  camera's intrinsics and distortion (the lens file ``track.toml`` names in ``[video]
+  calibration`` and ``rocklab track init --lens`` writes there); prints fx, fy, their 1-sigma and
+  the reprojection RMS. No frame rate is needed.
 - ``rocklab stereo track FILM1 FILM2 --calib stereo.json -o tracks.csv [--targets dots|aruco]
   [--fps F] [--no-sync] [--body NAME=P1,...] [--rest ...]``: dots detected and followed (or
   ArUco corners found by id), clock offset estimated (no shared trigger needed), matched
@@ -18,6 +26,12 @@ import math
 from pathlib import Path
 
 from ...._errors import InputError
+
+#: ``--board``'s two forms and their corner conventions (rocklab.tracking.calib.parse_board).
+BOARD_HELP = (
+    "checkerboard,COLSxROWS,SQUARE_M (COLSxROWS = INNER corners, e.g. 9x6 on a board of 10x7 squares) or "
+    "charuco,COLSxROWS,SQUARE_M,MARKER_M,DICT (COLSxROWS = squares, e.g. charuco,9x6,0.03,0.022,DICT_5X5_100)"
+)
 
 
 def register(sub):
@@ -35,8 +49,11 @@ def register(sub):
     p.add_argument(
         "--board",
         default=None,
-        metavar="CxR,SQUARE_M,MARKER_M,DICT",
-        help="calibrate: ChArUco board (default 9x6,0.03,0.022,DICT_5X5_100)",
+        metavar="SPEC",
+        help="calibrate: the board, " + BOARD_HELP + " (default charuco,9x6,0.03,0.022,DICT_5X5_100)",
+    )
+    p.add_argument(
+        "--every", type=int, default=None, metavar="N", help="calibrate, films: every N-th frame (default: all)"
     )
     p.add_argument("--calib", default=None, help="track: stereo.json from 'rocklab stereo calibrate'")
     p.add_argument("--fps", type=float, default=None, help="track: frame rate, Hz (default: the containers')")
@@ -60,27 +77,54 @@ def register(sub):
     p.add_argument("--json", action="store_true", help="print a JSON summary on stdout")
     p.add_argument("--progress", action="store_true", help="progress bar on stderr")
     p.set_defaults(func=run)
+    _register_calibrate(sub)
+
+
+def _register_calibrate(sub):
+    p = sub.add_parser(
+        "calibrate",
+        help="one camera's lens (intrinsics, distortion) from pictures of a checkerboard or ChArUco board",
+        description=__doc__,
+    )
+    p.add_argument("source", help="a film, a folder of photos or a quoted pattern such as 'calib/cam*.jpg'")
+    p.add_argument("--board", required=True, metavar="SPEC", help="the board: " + BOARD_HELP)
+    p.add_argument("-o", "--out", default=None, help="lens file (default: lens.json beside SOURCE)")
+    p.add_argument(
+        "--every", type=int, default=None, metavar="N", help="films: every N-th frame (default: <= 100 frames)"
+    )
+    p.add_argument("--fix-k3", action="store_true", help="hold the radial term k3 at 0 (few views, a mild lens)")
+    p.add_argument("--json", action="store_true", help="print a JSON summary on stdout")
+    p.set_defaults(func=run_calibrate)
+
+
+def run_calibrate(args) -> int:
+    """Run ``rocklab calibrate`` with parsed ``args``; returns the exit status (0 ok)."""
+    from ....tracking.calib import calibrate_lens, parse_board
+    from .._io_plan import lens_out
+
+    board = parse_board(args.board)
+    out = lens_out(args)
+    if out.suffix.lower() != ".json":
+        raise InputError(f"-o {out}: the lens file is JSON; give e.g. -o lens.json")
+    lens = calibrate_lens(args.source, board, every=args.every, fix_k3=args.fix_k3)
+    lens.save(out, side=not args.out)
+    d = dict(lens.to_dict(), lens_json=str(out))
+    sx, sy = lens.sigma_px["fx"], lens.sigma_px["fy"]
+    worst = lens.views[max(range(lens.n_views), key=lambda k: lens.view_rms_px[k])]
+    lines = [
+        f"calibrated from {lens.n_views} of {lens.n_seen} pictures ({lens.board}): fx {lens.K[0, 0]:.2f} +/- {sx:.2g} px, "
+        f"fy {lens.K[1, 1]:.2f} +/- {sy:.2g} px, principal point ({lens.K[0, 2]:.1f}, {lens.K[1, 2]:.1f}) px; "
+        f"reprojection RMS {lens.rms_px:.3g} px (worst view {worst} {max(lens.view_rms_px):.3g} px); status {lens.status}",
+        f"wrote {out}; use it with [video] calibration = \"{out.name}\" in track.toml (or 'rocklab track init --lens {out}')",
+    ]
+    _emit(args, d, lines)
+    return 0
 
 
 def _board(spec):
-    if spec is None:
-        return None
-    try:
-        squares, sq, mk, dic = spec.split(",")
-        c, r = (int(v) for v in squares.lower().split("x"))
-        board = {"squares": (c, r), "square_m": float(sq), "marker_m": float(mk), "dictionary": dic.strip()}
-    except ValueError:
-        raise InputError(
-            f"--board {spec!r}: give COLSxROWS,SQUARE_M,MARKER_M,DICT, e.g. 9x6,0.03,0.022,DICT_5X5_100"
-        ) from None
-    if min(c, r) < 3:
-        raise InputError(f"--board {spec!r}: a ChArUco board has at least 3x3 squares (e.g. 9x6)")
-    if not (math.isfinite(board["square_m"]) and 0 < board["marker_m"] < board["square_m"]):
-        raise InputError(
-            f"--board {spec!r}: the marker side ({mk.strip()} m) must be positive and smaller than the "
-            f"square side ({sq.strip()} m), e.g. 0.03,0.022"
-        )
-    return board
+    from ....tracking.calib import parse_board
+
+    return None if spec is None else parse_board(spec)
 
 
 #: Shapes of a ``stereo.json``'s arrays (StereoRig's fields).
@@ -114,11 +158,17 @@ def _check_rig(rig, path) -> None:
 def run(args) -> int:
     """Run ``rocklab stereo`` with parsed ``args``; returns the exit status (0 ok)."""
     for f in (args.film1, args.film2):
-        if not (Path(f).is_file() or Path(f).is_dir()):  # a folder of frames is a film too
+        pattern = args.action == "calibrate" and any(c in f for c in "*?[")
+        if not (Path(f).is_file() or Path(f).is_dir() or pattern):  # a folder of frames is a film too
             raise InputError(f"{f}: not found; give the two cameras' films (video files or folders of frames)")
     if args.action == "calibrate":
         return _calibrate(args)
     return _track(args)
+
+
+def stereo_out(film1) -> Path:
+    """``stereo.json`` beside camera 1's film, folder or pattern."""
+    return Path(film1).parent / "stereo.json"
 
 
 def _emit(args, d, lines):
@@ -131,19 +181,13 @@ def _emit(args, d, lines):
 
 
 def _calibrate(args) -> int:
-    import cv2
-
     from ....tracking.stereo import calibrate_stereo
 
     board = _board(args.board)
-    if board is not None and not hasattr(cv2.aruco, board["dictionary"]):
-        raise InputError(
-            f"--board: unknown ArUco dictionary {board['dictionary']!r}; e.g. DICT_5X5_100, DICT_4X4_50, DICT_6X6_250"
-        )
     from ...._io import write_json_atomic
 
-    out = Path(args.out) if args.out else Path(args.film1).parent / "stereo.json"
-    rig = calibrate_stereo(args.film1, args.film2, board)
+    out = Path(args.out) if args.out else stereo_out(args.film1)
+    rig = calibrate_stereo(args.film1, args.film2, board, every=args.every)
     write_json_atomic(out, rig.to_dict(), side=not args.out)  # StereoRig.save's file; a default name keeps a user's
     d = dict(rig.to_dict(), stereo_json=str(out))
     _emit(

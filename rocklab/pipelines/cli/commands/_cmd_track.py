@@ -7,9 +7,10 @@
   object's theta (with its 1-sigma band), image position and quality, every frame that is not
   ``ok`` marked by its status.
 - ``rocklab track init VIDEO [--object NAME=x,y,w,h ...] [--table x,y,w,h]
-  [--marker-size M] -o track.toml``: a config from the first frame (markers found by
+  [--marker-size M] [--lens lens.json] -o track.toml``: a config from the first frame (markers found by
   trying the common dictionaries, or the named regions followed markerless), commented,
-  plus ``track_init.png`` with every detection, region and the level line drawn.
+  plus ``track_init.png`` with every detection, region and the level line drawn; ``--lens``
+  (from ``rocklab calibrate``) is written as ``[video] calibration``.
 - ``rocklab track preview VIDEO --config track.toml [-o sheet.png] [--frames 6] [--at T_S]``: a
   contact sheet of frames spread over the first 10 s (the span tracked: a quick check), or of
   consecutive frames around ``T_S``, with each object's pose and θ drawn (a corrected frame's
@@ -54,6 +55,12 @@ def register(sub):
         help="init: a markerless table's region (round its top edge: it levels the angles)",
     )
     p.add_argument("--marker-size", type=float, default=None, help="init: printed marker side, m")
+    p.add_argument(
+        "--lens",
+        default=None,
+        metavar="LENS_JSON",
+        help="init: a lens file from 'rocklab calibrate', written as [video] calibration (points undistorted)",
+    )
     p.add_argument("--preview", default=None, help="init: preview PNG (default: <config stem>_init.png)")
     p.add_argument("--frames", type=int, default=6, help="preview: frames on the contact sheet (default 6)")
     p.add_argument("--config", default=None, help="track.toml (default: track.toml next to the video)")
@@ -95,6 +102,8 @@ def run(args) -> int:
 
     if args.at is not None and args.video != "preview":
         raise InputError("--at T_S: shows the frames around a time in 'rocklab track preview VIDEO --at T_S' only")
+    if args.lens is not None and args.video != "init":
+        raise InputError("--lens: applies to 'rocklab track init'; a config names its lens in [video] calibration")
     if args.corrections is not None and args.video == "init":
         raise InputError("--corrections: applies to 'rocklab track' and 'track preview', not to 'track init'")
     if args.video in ("init", "preview"):
@@ -180,6 +189,7 @@ def _tools(args) -> int:
             preview=preview,
             side=(not args.out, not args.preview),
             fps=args.fps,
+            lens=args.lens,
         )
         if args.json:
             from .._cli_base import emit_json

@@ -236,7 +236,10 @@ def _find_board(gray, board):
             return None
         # The sector-based detector leaves ~0.2 px errors; cornerSubPix is exact on X-junctions.
         spacing = float(np.median(np.hypot(*np.diff(corners.reshape(-1, 2), axis=0).T)))
-        win = int(np.clip(0.3 * spacing, 2, 10))
+        # a fifth of the spacing: at three tenths real photos gave 0.31 px RMS instead of 0.18 (calib)
+        from ..calib._boards import SUBPIX_WINDOW
+
+        win = int(np.clip(SUBPIX_WINDOW * spacing, 2, 10))
         corners = cv2.cornerSubPix(
             gray,
             corners.astype(np.float32).reshape(-1, 1, 2),

@@ -278,7 +278,7 @@ def _entries():
         why = {
             1: "measured data of other authors (quoted, not computed)",
             2: "the model column (Housner with the 5 mm cut corners, Eq. A3) needs the blocks' widths, given in "
-            "Fig. 23 only; from h/b alone Housner loses 31.1 % and 19.3 % (printed 28.4 % and 17.7 %); the "
+            "Fig. 23 only; from h/b alone Housner loses 31.2 % and 19.4 % (printed 28.4 % and 17.7 %); the "
             "experiment columns are the thesis's measurements",
             3: "as Table 2: the wires' and cut corners' model losses need the blocks' widths (Fig. 23 only)",
             4: "needs the 44 FEMA far-field records (not shipped): `python benchmarks/oas_fema44.py` computes it where they are",

@@ -13,7 +13,7 @@ import math
 import numpy as np
 import pytest
 
-from rocklab._diagnostics import RocklabWarning
+from rocklab._diagnostics import RocklabWarning, collecting
 
 from rocklab import InputError
 from rocklab.fitting import (
@@ -277,3 +277,17 @@ def test_campaign_table_groups_runs_and_feeds_k_table():
     assert tab.loc["B2M", "eta_e"] == pytest.approx(0.671, abs=1e-12) and tab.loc["B2M", "n_used"] == 2
     kt = k_table(tab.reset_index(), eta_mat=0.989, form=None)
     assert set(kt.per_block.block) == {"B6M", "B2M"}
+
+
+def test_interval_reaching_the_search_bound_is_suspect():
+    # a profile flat out to the search range: the data do not constrain eta_e within it. It was
+    # reported "ok" (a demo B9M film of 13 s gave [0.05, 0.968]); now W-FIT-BOUND, suspect.
+    t, y, _ = synthetic(3, eta=0.93, noise=0.002)
+    with collecting():
+        f = fit_restitution(t, y, B6M, eta_bounds=(0.9297, 0.934))
+    assert not f.at_bound  # both estimates are inside the range (0.92995, 0.93135) ...
+    assert f.ci95_eta_e[0] == pytest.approx(0.9297)  # ... but the interval runs into its lower end
+    assert f.status == "suspect" and "W-FIT-BOUND" in f.warnings and "95 % interval" in f.message
+    with collecting():
+        wide = fit_restitution(t, y, B6M)
+    assert wide.status == "ok" and "W-FIT-BOUND" not in wide.warnings

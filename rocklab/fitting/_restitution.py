@@ -425,6 +425,14 @@ def fit_restitution(t_s, theta_rad, block, window: str = "middle50", objective: 
     if eta_at_bound:
         diags.append(warn("W-FIT-BOUND", f"{name or 'block'}: {', '.join(eta_at_bound)} at the bound of the search "
                                          f"(eta in [{lo_b:g}, {hi_b:g}])"))
+    elif np.isfinite(ci[0]) and min(ci[0] - lo_b, hi_b - ci[1]) < 1e-4:
+        # a flat profile: the window's data do not pin eta_e down (seen on a 13 s film whose middle
+        # half is millimetre rocking under tracking noise: [0.05, 0.968] reported as ok)
+        diags.append(warn("W-FIT-BOUND", f"{name or 'block'}: the 95 % interval of eta_e, [{ci[0]:.4g}, {ci[1]:.4g}], "
+                                         f"reaches the bound of the search (eta in [{lo_b:g}, {hi_b:g}]): the "
+                                         "window's data do not constrain eta_e; fit window = \"first\" or a "
+                                         "shorter record"))
+        msg = "; ".join(x for x in (msg, diags[-1].message) if x)
     return RestitutionFit(
         eta_e=float(eta_hat), eta_e_first=float(eta_first), ci95_eta_e=ci, theta0_rad=float(s0 * theta0_hat),
         release_t_s=float(tr_hat), rms_residual_rad=rms, sigma_theta_rad=float(rel.sigma_rad),

@@ -63,7 +63,7 @@ BG_FRACTION = 0.9
 #: outline to be placed.
 MIN_FG = 0.05
 #: Largest move of the object's outline inside the template, as a fraction of its larger side.
-DRIFT_FRAC = 0.06
+DRIFT_FRAC = 0.075
 #: Margin round the template in which the outline is placed, as a fraction of its larger side:
 #: a box drawn smaller than the object, or a pose slid off it, still sees the whole outline.
 OUTLINE_MARGIN_FRAC = 0.25
@@ -269,7 +269,7 @@ class PoseVerifier:
         last2 = None if last is None else last[:2]
         reason = self.check(float(score), centre, theta, pred, last2, gap, bg, back, known)
         self.learn_outline(tr)
-        if reason is None and self.offset0 is not None and back is not None:
+        if reason is None and self.offset0 is not None and back is not None and self._in_frame(tr, W, gray.shape):
             # the object's outline against the background has moved round the template's centre:
             # the pose slid off the object (a spinning object's texture, a keyframe that learned
             # a still edge of the wall)
@@ -279,6 +279,15 @@ class PoseVerifier:
                 reason, self.hint, self.recent = "drift", (Wd, o), []
         self._pending = (float(score), centre, theta, pred, last2, gap, frame)
         return reason
+
+    def _in_frame(self, tr, W, shape):
+        """Whether the grown template grid under the pose ``W`` lies inside a frame of ``shape``
+        (an object partly out of the picture has no whole outline to place)."""
+        m = self.margin
+        w, h = self.size
+        grid = np.array([[-m, -m], [w + m, -m], [-m, h + m], [w + m, h + m]], float) + tr.origin
+        c = grid @ np.asarray(W, float)[:, :2].T + np.asarray(W, float)[:, 2]
+        return bool(c.min() >= 0 and c[:, 0].max() <= shape[1] and c[:, 1].max() <= shape[0])
 
     def outline_moved(self, o, W):
         """Whether the outline's centroid ``o`` (:func:`fg_offset` on the grown template grid under

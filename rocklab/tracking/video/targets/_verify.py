@@ -17,9 +17,12 @@ and, for the outline, its own first frame:
   (the first frame, with the object's first region filled in once the object has left it)
   on nearly all of its pixels: a pose frozen on a patch of wall is a lost lock;
 * **outline** (``drift``): once the background behind the object's first region is known, the
-  centroid of the pixels that differ from the background must stay where it was in the user's
-  region, within :data:`DRIFT_FRAC` of the template: a keyframe renewed over a still edge of
-  the wall lets the pose slide off a spinning object while every correlation stays high.
+  object's silhouette against it, registered round the pose (:mod:`._occlusion`), must lie where
+  the pose puts it, within :data:`._occlusion.DRIFT_FRAC` of the template: a spinning object's
+  texture, or a keyframe renewed over a still edge of the wall, lets the pose slide off the
+  object while every correlation stays high. The pose moved onto the outline is where the
+  object is searched for first (and verified like any other pose); the motion checks forget
+  the poses of the slide.
 
 A frame that fails is lost with that reason; only verified frames renew the keyframe and teach
 the limits, so a wrong lock cannot teach the tracker to accept itself.
@@ -31,6 +34,8 @@ import collections
 import math
 
 import numpy as np
+
+from ._occlusion import OUTLINE_MARGIN_FRAC, OutlineRef, warp_grown
 
 __all__ = ["PoseVerifier", "search_whole_frame", "MIN_SCORE", "MAX_STEP_RAD"]
 
@@ -59,18 +64,8 @@ MAX_TURN_RAD = 1.0
 #: fraction of the pixels whose background is known is background.
 BG_TOL = 10.0
 BG_FRACTION = 0.9
-#: Least fraction of a patch standing out of the background (and left as background) for its
-#: outline to be placed.
-MIN_FG = 0.05
-#: Largest move of the object's outline inside the template, as a fraction of its larger side.
-DRIFT_FRAC = 0.075
-#: Margin round the template in which the outline is placed, as a fraction of its larger side:
-#: a box drawn smaller than the object, or a pose slid off it, still sees the whole outline.
-OUTLINE_MARGIN_FRAC = 0.25
-#: A pixel belongs to the outline where it differs from the background by this fraction of the
-#: window's strongest differences (its 98th percentile): a soft shadow or a change of exposure
-#: darkens the wall by a fraction of what the object does.
-FG_REL = 0.4
+#: Steps towards the outline tried when a pose has slid off it.
+HINT_STEPS = 3
 #: Fraction of the patch whose background must be known for the background check to apply.
 BG_KNOWN = 0.5
 
@@ -95,14 +90,13 @@ class PoseVerifier:
         #: the outline's margin round the template, px, and the first region grown by it (the
         #: part of the first frame whose background is learned once the object has left it)
         self.margin = int(math.ceil(OUTLINE_MARGIN_FRAC * max(size)))
+        self.outline = None  # the object's outline in the user's region, once its background is known
+        self.hint = None  # a pose that failed the outline, moved onto the outline
         H, W = first_gray.shape[:2]
         m = self.margin
         self.outer = (max(box[0] - m, 0), max(box[1] - m, 0), min(box[2] + m, W), min(box[3] + m, H))
         self.filled = False  # the first region's background seen (the object has left it)
         self.tmpl0 = first_gray[box[1] : box[3], box[0] : box[2]].astype(np.float32)
-        #: where the object stands out of the background in the user's region: its changed pixels'
-        #: centroid from the region's centre (template px), once that background is known
-        self.offset0 = None
         self.size = size
         self.scores = collections.deque(maxlen=300)
         self.residuals = collections.deque(maxlen=300)
@@ -205,33 +199,12 @@ class PoseVerifier:
                 self.bg[v0:v1, u0:u1] = gray[v0:v1, u0:u1]
                 self.filled = True
 
-    def learn_outline(self, tr):
-        """Once the background is known: where the object's outline stood in the user's region."""
-        if self.filled and self.offset0 is None and not getattr(self, "_outline_tried", False):
-            self._outline_tried = True
-            W0 = np.array([[1, 0, 0], [0, 1, 0]], np.float32)
-            pair = self.warp_grown(tr, self.first, W0), self.warp_grown(tr, self.bg, W0)
-            self.offset0 = None if any(p is None for p in pair) else fg_offset(*pair)
-
-    def warp_grown(self, tr, img, W):
-        """``img`` resampled by the pose ``W`` onto the template's grid grown by :attr:`margin`
-        on every side (float32), or None off the frame."""
-        import cv2
-
-        m = self.margin
-        crop, off = tr._window(img, W, m + 4)
-        if crop is None:
-            return None
-        Wd = W.astype(np.float32).copy()
-        Wd[:, 2] += (W[:, :2] @ (tr.origin - m)).astype(np.float32) - off
-        w, h = self.size
-        return cv2.warpAffine(
-            crop,
-            Wd,
-            (w + 2 * m, h + 2 * m),
-            flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP,
-            borderMode=cv2.BORDER_REPLICATE,
-        )
+    def learn_outline(self):
+        """Once the background is known: the object's outline in the user's region."""
+        if self.filled and self.outline is None:
+            u0, v0, u1, v1 = self.box
+            self.outline = OutlineRef(self.first[v0:v1, u0:u1], self.bg[v0:v1, u0:u1], self.size)
+            self.first = None  # needed no more
 
     # -- with a tracker ----------------------------------------------------------------
     def verify(self, tr, gray, W, frame, score):
@@ -257,26 +230,26 @@ class PoseVerifier:
             (c0, t0, _), (c1, t1, _) = self.recent
             pred = (2 * c1 - c0, 2 * t1 - t0)
         bg = back = known = bg_g = back_g = None
-        self.hint = None  # (pose, outline centroid) of a pose whose outline moved
+        self.hint = None
         # the background is known where the first frame did not show the object, and everywhere
         # once the object has left its first region: only then is the check worth its two warps
         if self.filled or self._clear(centre):
-            bg_g, back_g = self.warp_grown(tr, self.bg, W), self.warp_grown(tr, gray, W)
+            bg_g, back_g = warp_grown(tr, self.bg, W, self.margin), warp_grown(tr, gray, W, self.margin)
             if bg_g is not None and back_g is not None:
                 m = self.margin
                 bg, back = bg_g[m:-m, m:-m], back_g[m:-m, m:-m]
                 known = np.ones_like(bg)
         last2 = None if last is None else last[:2]
         reason = self.check(float(score), centre, theta, pred, last2, gap, bg, back, known)
-        self.learn_outline(tr)
-        if reason is None and self.offset0 is not None and back is not None and self._in_frame(tr, W, gray.shape):
-            # the object's outline against the background has moved round the template's centre:
-            # the pose slid off the object (a spinning object's texture, a keyframe that learned
-            # a still edge of the wall)
-            o = fg_offset(back_g, bg_g)
-            if o is not None and self.outline_moved(o, W):
+        self.learn_outline()
+        if reason is None and self.outline is not None and back is not None and self._in_frame(tr, W, gray.shape):
+            # the object's outline against the background is not where the pose puts it: the
+            # pose slid off the object (a spinning object's texture, a keyframe that learned a
+            # still edge of the wall)
+            found = self.outline.locate(tr, gray, self.bg, W, (back_g, bg_g))
+            if found is not None and self.outline.moved(found):
                 # the poses since the last frame checked here were the slide: no anchor for motion
-                reason, self.hint, self.recent = "drift", (Wd, o), []
+                reason, self.hint, self.recent = "drift", found[2], []
         self._pending = (float(score), centre, theta, pred, last2, gap, frame)
         return reason
 
@@ -289,15 +262,6 @@ class PoseVerifier:
         c = grid @ np.asarray(W, float)[:, :2].T + np.asarray(W, float)[:, 2]
         return bool(c.min() >= 0 and c[:, 0].max() <= shape[1] and c[:, 1].max() <= shape[0])
 
-    def outline_moved(self, o, W):
-        """Whether the outline's centroid ``o`` (:func:`fg_offset` on the grown template grid under
-        the pose ``W``) has left the place it had in the user's region: in the template, and in
-        the image as the object stood (a spinning ball's texture can turn the pose about a point
-        off the ball while its centroid keeps its place in the template)."""
-        lim = DRIFT_FRAC * max(self.size)
-        o_img = np.asarray(W, float)[:, :2] @ o
-        return float(np.hypot(*(o - self.offset0))) > lim or float(np.hypot(*(o_img - self.offset0))) > lim
-
     def _clear(self, centre):
         """Whether a pose centred at ``centre`` (px) keeps the template off the first region."""
         half = 0.5 * math.hypot(*self.size)
@@ -307,33 +271,24 @@ class PoseVerifier:
     def reacquire(self, tr, gray, frame, min_cc):
         """The object anywhere in ``gray`` (:func:`search_whole_frame` from the last verified angle,
         then the tracker's fit from there), verified: (W, cc, score), or None."""
-        hint, self.hint = getattr(self, "hint", None), None
-        for W_o in self._outline_poses(tr, *hint) if hint is not None else ():
-            # the object where its outline is, as the pose turned it or as it stood: the
-            # outline found it, the template's correlation and every other check must agree
-            back = tr._warp_back(gray, W_o)
-            if back is None:
-                continue
-            cc = max(_ncc(back, tr.tmpl0), _ncc(back, tr.key))
-            if cc >= min_cc and self.verify(tr, gray, W_o, frame, cc) is None:
-                return W_o, cc, cc
+        for _ in range(HINT_STEPS):
+            hint, self.hint = self.hint, None
+            if hint is None:
+                break
+            # the object where its outline is: the outline found it, the template's correlation
+            # and every other check must agree (a slide beyond the margin takes a few steps)
+            back = tr._warp_back(gray, hint)
+            cc = -1.0 if back is None else max(_ncc(back, tr.tmpl0), _ncc(back, tr.key))
+            if cc < min_cc:
+                break
+            if self.verify(tr, gray, hint, frame, cc) is None:
+                return hint, cc, cc
         th = self.recent[-1][1] if self.recent else 0.0
         W_s = search_whole_frame(tr, tr.key, gray, th)
         alt = tr._ecc(tr.key, gray, W_s) if W_s is not None else None
         if alt is None or alt[1] < min_cc:
             return None
         return None if self.verify(tr, gray, alt[0], frame, alt[1]) is not None else (alt[0], alt[1], alt[1])
-
-    def _outline_poses(self, tr, W, o):
-        """Poses that put the object's outline (centroid ``o`` on the grown grid under ``W``) where
-        it stood in the user's region: ``W``'s turn, then no turn (first-frame px -> image px)."""
-        A = W[:, :2]
-        g = A @ (tr.centre0 + o) + W[:, 2]  # the outline's centroid in the image, px
-        out = []
-        for B in (A, np.eye(2)):
-            t = g - B @ (tr.centre0 + self.offset0)
-            out.append(np.column_stack((B, t)).astype(np.float32))
-        return out
 
     def confirm(self, gray, size):
         """Learn from the pose just verified (its correlation, motion and the background it uncovers)."""
@@ -343,21 +298,6 @@ class PoseVerifier:
         footprint = (centre[0] - half, centre[1] - half, centre[0] + half, centre[1] + half)
         self.accept(score, centre, pred, last, gap, gray, footprint)
         self.recent = (self.recent + [(centre, theta, frame)])[-2:]
-
-
-def fg_offset(patch, bg):
-    """Centroid of the pixels of ``patch`` that stand out of ``bg`` (by :data:`FG_REL` of the
-    window's strongest differences, at least :data:`BG_TOL`) from the patch's centre, px (2,);
-    None when too few or nearly all do (no outline to place)."""
-    d = np.abs(patch - bg)
-    flat = d.ravel()
-    k = int(0.98 * (flat.size - 1))
-    fg = d >= max(BG_TOL, FG_REL * float(np.partition(flat, k)[k]))
-    if not MIN_FG <= fg.mean() <= 1.0 - MIN_FG:
-        return None
-    ys, xs = np.nonzero(fg)
-    h, w = fg.shape
-    return np.array([xs.mean() - (w - 1) / 2, ys.mean() - (h - 1) / 2])
 
 
 def _ncc(a, b):

@@ -201,7 +201,7 @@ def test_outline_check_sees_a_slide_a_turn_about_a_point_off_the_object_not_a_sh
 
     side, origin = 52, (74, 65)  # the box's centre 9 px above the disk's (100, 100)
     tr = Stub(origin, (side, side))
-    ref = OutlineRef(scene((100, 100))[65:117, 74:126], wall[65:117, 74:126], (side, side))
+    ref = OutlineRef(scene((100, 100)), wall, (74, 65, 74 + side, 65 + side))
     frame = scene((200, 120), shadow=0.3)
 
     def pose(theta, centre):

@@ -12,7 +12,9 @@ slides across the ball, and the pose slides with it while every correlation stay
 object's outline against the background does not slide. Once the background behind the user's
 region is known, the object's *silhouette* there (how far each pixel stands out of the
 background, :func:`silhouette`) is the reference; in every frame the silhouette round the pose is
-registered against it by normalised cross-correlation over a window grown round the template.
+registered against it by normalised cross-correlation over a window grown round the template
+(the reference itself grown round the user's region, so a box drawn smaller than the object
+does not cut the object's outline).
 The shift found is how far the pose has slid off the object; the pose moved by it is where the
 outline puts the object (a start for re-acquisition, verified like any other pose, never
 reported as it is).
@@ -157,7 +159,10 @@ DRIFT_FRAC = 0.075
 MIN_SIL_CC = 0.5
 #: Margin round the template searched for the outline, as a fraction of its larger side: a box
 #: drawn smaller than the object, or a pose slid off it, still sees the whole outline.
-OUTLINE_MARGIN_FRAC = 0.25
+OUTLINE_MARGIN_FRAC = 0.2
+#: Larger side of the template at which the outline is registered, px (a larger object is
+#: registered on a reduced copy: a pixel there is at most 1/60 of it).
+OUTLINE_SIDE_PX = 64.0
 #: Turns smaller than this leave the image's frame and the pose's the same, rad.
 TURN_SAME_RAD = 0.02
 
@@ -199,23 +204,33 @@ class OutlineRef:
 
     Parameters
     ----------
-    first_region, bg_region : ndarray (h, w) float32
-        The user's region in the first frame and the background behind it.
-    size : tuple of int
-        The template's (width, height), px.
+    first, bg : ndarray (H, W) float32
+        The first frame and the background behind it (known round the user's region).
+    box : tuple of int
+        The user's region, (u0, v0, u1, v1) px.
 
     Attributes
     ----------
-    ref : ndarray (h, w) float32 or None
-        The silhouette in the user's region; None when the object does not stand out there.
+    ref : ndarray float32 or None
+        The silhouette over the user's region grown by :attr:`margin` (a box drawn smaller than
+        the object does not cut its outline); None when the object does not stand out there.
     """
 
-    def __init__(self, first_region, bg_region, size):
-        self.size = size
-        self.margin = int(math.ceil(OUTLINE_MARGIN_FRAC * max(size)))
-        s = silhouette(first_region, bg_region)
+    def __init__(self, first, bg, box):
+        u0, v0, u1, v1 = box
+        self.size = (u1 - u0, v1 - v0)
+        m = self.margin = int(math.ceil(OUTLINE_MARGIN_FRAC * max(self.size)))
+        H, W = first.shape[:2]
+        x0, y0, x1, y1 = max(u0 - m, 0), max(v0 - m, 0), min(u1 + m, W), min(v1 + m, H)
+        s = silhouette(first[y0:y1, x0:x1], bg[y0:y1, x0:x1])
         fg = 0.0 if s is None else float(np.mean(s > 0.5))
         self.ref = s if MIN_FG <= fg <= 1.0 - MIN_FG and float(s.std()) > 0 else None
+        #: where the reference lies in a window grown by twice the margin round the template
+        self.at = np.array([x0 - (u0 - 2 * m), y0 - (v0 - 2 * m)], float)
+        #: the scale the registration runs at (its cost grows as the fourth power of the size)
+        self.scale = min(1.0, OUTLINE_SIDE_PX / max(self.size))
+        if self.ref is not None and self.scale < 1.0:
+            self.ref = _reduce(self.ref, self.scale)
 
     def locate(self, tr, frame, bg, W, grown=None):
         """Register the outline round the pose ``W`` (first-frame px -> image px).
@@ -227,7 +242,8 @@ class OutlineRef:
         frame, bg : ndarray (H, W)
             The frame and the background.
         grown : tuple of ndarray, optional
-            (frame, background) already resampled by ``W`` onto the grown grid.
+            (frame, background) already resampled by ``W`` onto the template's grid grown by
+            twice :attr:`margin`.
 
         Returns
         -------
@@ -248,22 +264,26 @@ class OutlineRef:
             c = A @ tr.centre0 + Wd[:, 2]
             cands.append(np.column_stack((np.eye(2), c - tr.centre0)))
         worst = None
-        m = self.margin
+        m2 = 2 * self.margin
         for k, Wc in enumerate(cands):
             if k == 0 and grown is not None:
                 back, bgw = grown
             else:
-                back, bgw = (warp_grown(tr, img, Wc.astype(np.float32), m) for img in (frame, bg))
+                back, bgw = (warp_grown(tr, img, Wc.astype(np.float32), m2) for img in (frame, bg))
             if back is None or bgw is None:
                 continue
             s = silhouette(back, bgw)
             if s is None or float(s.std()) == 0.0:
                 continue
+            if self.scale < 1.0:
+                s = _reduce(s, self.scale)
+            if s.shape[0] < self.ref.shape[0] or s.shape[1] < self.ref.shape[1]:
+                continue
             res = cv2.matchTemplate(s, self.ref, cv2.TM_CCOEFF_NORMED)
             shift, cc = _peak(res)
             # at the edge of the search: the outline lies farther than the margin
             edge = min(shift.min(), res.shape[1] - 1 - shift[0], res.shape[0] - 1 - shift[1]) < 0.5
-            shift -= m
+            shift = shift / self.scale - self.at
             slide = math.inf if edge else float(np.hypot(*shift))
             # the pose must sit on the outline in its own frame and in the image's
             if worst is None or (slide, -cc) > (worst[0], -worst[1]):
@@ -276,6 +296,13 @@ class OutlineRef:
         """Whether a :meth:`locate` result says the pose has left the object."""
         slide, cc, _ = found
         return slide > DRIFT_FRAC * max(self.size) or cc < MIN_SIL_CC
+
+
+def _reduce(img, f):
+    """``img`` reduced by the factor ``f`` < 1 (area averaging)."""
+    import cv2
+
+    return cv2.resize(img, None, fx=f, fy=f, interpolation=cv2.INTER_AREA)
 
 
 def warp_grown(tr, img, W, margin):

@@ -202,8 +202,7 @@ class PoseVerifier:
     def learn_outline(self):
         """Once the background is known: the object's outline in the user's region."""
         if self.filled and self.outline is None:
-            u0, v0, u1, v1 = self.box
-            self.outline = OutlineRef(self.first[v0:v1, u0:u1], self.bg[v0:v1, u0:u1], self.size)
+            self.outline = OutlineRef(self.first, self.bg, self.box)
             self.first = None  # needed no more
 
     # -- with a tracker ----------------------------------------------------------------
@@ -234,9 +233,9 @@ class PoseVerifier:
         # the background is known where the first frame did not show the object, and everywhere
         # once the object has left its first region: only then is the check worth its two warps
         if self.filled or self._clear(centre):
-            bg_g, back_g = warp_grown(tr, self.bg, W, self.margin), warp_grown(tr, gray, W, self.margin)
+            m = 2 * self.margin
+            bg_g, back_g = warp_grown(tr, self.bg, W, m), warp_grown(tr, gray, W, m)
             if bg_g is not None and back_g is not None:
-                m = self.margin
                 bg, back = bg_g[m:-m, m:-m], back_g[m:-m, m:-m]
                 known = np.ones_like(bg)
         last2 = None if last is None else last[:2]

@@ -161,8 +161,8 @@ MIN_SIL_CC = 0.5
 #: drawn smaller than the object, or a pose slid off it, still sees the whole outline.
 OUTLINE_MARGIN_FRAC = 0.2
 #: Larger side of the template at which the outline is registered, px (a larger object is
-#: registered on a reduced copy: a pixel there is at most 1/60 of it).
-OUTLINE_SIDE_PX = 64.0
+#: registered on a reduced copy: a pixel there is at most 1/40 of it, and sub-pixel peaks).
+OUTLINE_SIDE_PX = 40.0
 #: Turns smaller than this leave the image's frame and the pose's nearly the same, rad: the
 #: silhouette's place moves by under 0.15 of its distance from the template's centre.
 TURN_SAME_RAD = 0.15

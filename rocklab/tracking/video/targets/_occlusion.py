@@ -1,10 +1,30 @@
-"""Part of a markerless object covered (a hand, the thread): which part, and a fit on the rest.
+"""Which part of the frame is the markerless object: a part covered, and its outline.
 
-The registered template is cut into ``GRID x GRID`` cells and each cell's correlation with the
-frame, warped back by the pose, is measured. When most cells match and some do not, something
-covers part of the object: the keyframe is not renewed from that frame (it would learn the
-occluder), and the pose is fitted again on the matching cells alone, so a hand over the top of a
-block neither biases its angle nor loses it while enough of the face stays in view.
+**Covered** (a hand, the thread): the registered template is cut into ``GRID x GRID`` cells
+and each cell's correlation with the frame, warped back by the pose, is measured. When most
+cells match and some do not, something covers part of the object: the keyframe is not renewed
+from that frame (it would learn the occluder), and the pose is fitted again on the matching
+cells alone, so a hand over the top of a block neither biases its angle nor loses it while
+enough of the face stays in view.
+
+**Outline** (a check of the pose that the object's texture cannot fool): a texture registration follows the texture: on a ball that spins while it swings the texture
+slides across the ball, and the pose slides with it while every correlation stays high. The
+object's outline against the background does not slide. Once the background behind the user's
+region is known, the object's *silhouette* there (how far each pixel stands out of the
+background, :func:`silhouette`) is the reference; in every frame the silhouette round the pose is
+registered against it by normalised cross-correlation over a window grown round the template
+(the reference itself grown round the user's region, so a box drawn smaller than the object
+does not cut the object's outline).
+The shift found is how far the pose has slid off the object; the pose moved by it is where the
+outline puts the object (a start for re-acquisition, verified like any other pose, never
+reported as it is).
+
+The registration is made in the pose's frame and, when the pose has turned, in the image's
+(the object as it stood), and both must agree: a spinning ball's texture can turn the pose about
+a point off the ball, and in the turned frame the ball's silhouette then matches. (For an object
+that does turn, the image's frame places the pose within ``2 sin(turn / 2)`` times the distance
+from the template's centre to the silhouette's, a few percent of the object for a box drawn
+round it.)
 """
 
 from __future__ import annotations
@@ -13,7 +33,16 @@ import math
 
 import numpy as np
 
-__all__ = ["GRID", "cell_correlations", "partly_covered", "cell_pixels", "masked_fit"]
+__all__ = [
+    "GRID",
+    "cell_correlations",
+    "partly_covered",
+    "cell_pixels",
+    "masked_fit",
+    "OutlineRef",
+    "silhouette",
+    "warp_grown",
+]
 
 #: Cells per side of the grid laid over the template.
 GRID = 4
@@ -111,3 +140,192 @@ def masked_fit(tracker, tmpl, gray, W0):
     if r is None or r[1] < MASKED_CC:
         return None
     return W, float(r[1]), mask, float(cells.mean())
+
+
+# -- the outline ---------------------------------------------------------------------------
+
+
+#: A grey difference below this is "unchanged", grey levels.
+BG_TOL = 10.0
+#: A pixel starts to stand out where it differs from the background by this fraction of the
+#: window's strongest differences (their 98th percentile), and fully at that percentile: a soft
+#: shadow or a change of exposure darkens the wall by a fraction of what the object does.
+FG_REL = 0.4
+#: Least fraction of the user's region standing out of the background for an outline to exist.
+MIN_FG = 0.05
+#: Largest slide of the pose off the outline, as a fraction of the template's larger side.
+DRIFT_FRAC = 0.075
+#: Lowest silhouette correlation at which the outline is where the pose puts it.
+MIN_SIL_CC = 0.5
+#: Margin round the template searched for the outline, as a fraction of its larger side: a box
+#: drawn smaller than the object, or a pose slid off it, still sees the whole outline.
+OUTLINE_MARGIN_FRAC = 0.2
+#: Larger side of the template at which the outline is registered, px (a larger object is
+#: registered on a reduced copy: a pixel there is at most 1/40 of it, and sub-pixel peaks).
+OUTLINE_SIDE_PX = 40.0
+#: Turns smaller than this leave the image's frame and the pose's nearly the same, rad: the
+#: silhouette's place moves by under 0.15 of its distance from the template's centre.
+TURN_SAME_RAD = 0.15
+
+
+def silhouette(patch, bg):
+    """How far each pixel of ``patch`` stands out of ``bg``: 0 below :data:`FG_REL` of the
+    strongest differences (at least :data:`BG_TOL`), 1 at their 98th percentile (float32, the
+    shape of ``patch``); None when nothing stands out."""
+    import cv2
+
+    d = cv2.absdiff(np.asarray(patch, np.float32), np.asarray(bg, np.float32))
+    flat = d[::2, ::2].ravel()  # a quarter of the pixels tell the percentile
+    k = int(0.98 * (flat.size - 1))
+    hi = float(np.partition(flat, k)[k])
+    lo = max(BG_TOL, FG_REL * hi)
+    if hi <= lo:
+        return None
+    return np.clip((d - lo) * (1.0 / (hi - lo)), 0.0, 1.0)
+
+
+def _peak(res):
+    """Sub-pixel location (x, y) of the maximum of ``res`` and its value (parabola through the
+    neighbours where the maximum is inside)."""
+    import cv2
+
+    _, val, _, (x, y) = cv2.minMaxLoc(res)
+    out = [float(x), float(y)]
+    for axis, (i, n) in enumerate(((x, res.shape[1]), (y, res.shape[0]))):
+        if 0 < i < n - 1:
+            a, b, c = (
+                (res[y, i - 1], res[y, i], res[y, i + 1]) if axis == 0 else (res[i - 1, x], res[i, x], res[i + 1, x])
+            )
+            den = a - 2 * b + c
+            if den < 0:
+                out[axis] += float(np.clip(0.5 * (a - c) / den, -0.5, 0.5))
+    return np.array(out), float(val)
+
+
+class OutlineRef:
+    """One object's outline in its first frame, and its registration in later frames.
+
+    Parameters
+    ----------
+    first, bg : ndarray (H, W) float32
+        The first frame and the background behind it (known round the user's region).
+    box : tuple of int
+        The user's region, (u0, v0, u1, v1) px.
+
+    Attributes
+    ----------
+    ref : ndarray float32 or None
+        The silhouette over the user's region grown by :attr:`margin` (a box drawn smaller than
+        the object does not cut its outline); None when the object does not stand out there.
+    """
+
+    def __init__(self, first, bg, box):
+        u0, v0, u1, v1 = box
+        self.size = (u1 - u0, v1 - v0)
+        m = self.margin = int(math.ceil(OUTLINE_MARGIN_FRAC * max(self.size)))
+        H, W = first.shape[:2]
+        x0, y0, x1, y1 = max(u0 - m, 0), max(v0 - m, 0), min(u1 + m, W), min(v1 + m, H)
+        s = silhouette(first[y0:y1, x0:x1], bg[y0:y1, x0:x1])
+        fg = 0.0 if s is None else float(np.mean(s > 0.5))
+        self.ref = s if MIN_FG <= fg <= 1.0 - MIN_FG and float(s.std()) > 0 else None
+        #: where the reference lies in a window grown by twice the margin round the template
+        self.at = np.array([x0 - (u0 - 2 * m), y0 - (v0 - 2 * m)], float)
+        #: the scale the registration runs at (its cost grows as the fourth power of the size)
+        self.scale = min(1.0, OUTLINE_SIDE_PX / max(self.size))
+        if self.ref is not None and self.scale < 1.0:
+            a, b = (_reduce(img[y0:y1, x0:x1], self.scale) for img in (first, bg))
+            self.ref = silhouette(a, b)
+
+    def locate(self, tr, frame, bg, W, grown=None):
+        """Register the outline round the pose ``W`` (first-frame px -> image px).
+
+        Parameters
+        ----------
+        tr : MarkerlessTracker
+            Gives the template's place in the first frame (``origin``, ``centre0``) and windows.
+        frame, bg : ndarray (H, W)
+            The frame and the background.
+        grown : tuple of ndarray, optional
+            (frame, background) already resampled by ``W`` onto the template's grid grown by
+            twice :attr:`margin`.
+
+        Returns
+        -------
+        (slide_px, cc, pose) or None
+            How far the pose has slid off the outline, px (inf: beyond the margin searched), the
+            silhouettes' correlation, and the pose moved towards the outline (float32 (2, 3)),
+            from the frame (the pose's or the image's) that disagrees most. None without an
+            outline to register.
+        """
+        import cv2
+
+        if self.ref is None:
+            return None
+        Wd = np.asarray(W, float)
+        A = Wd[:, :2]
+        cands = [Wd]
+        if abs(math.atan2(A[1, 0] - A[0, 1], A[0, 0] + A[1, 1])) > TURN_SAME_RAD:
+            c = A @ tr.centre0 + Wd[:, 2]
+            cands.append(np.column_stack((np.eye(2), c - tr.centre0)))
+        worst = None
+        m2 = 2 * self.margin
+        for k, Wc in enumerate(cands):
+            if k == 0 and grown is not None:
+                back, bgw = grown
+            else:
+                back, bgw = (warp_grown(tr, img, Wc.astype(np.float32), m2) for img in (frame, bg))
+            if back is None or bgw is None:
+                continue
+            if self.scale < 1.0:
+                back, bgw = _reduce(back, self.scale), _reduce(bgw, self.scale)
+            s = silhouette(back, bgw)
+            if s is None:
+                continue
+            if s.shape[0] < self.ref.shape[0] or s.shape[1] < self.ref.shape[1]:
+                continue
+            res = cv2.matchTemplate(s, self.ref, cv2.TM_CCOEFF_NORMED)
+            shift, cc = _peak(res)
+            if not math.isfinite(cc):  # a window all one value
+                continue
+            # at the edge of the search: the outline lies farther than the margin
+            edge = min(shift.min(), res.shape[1] - 1 - shift[0], res.shape[0] - 1 - shift[1]) < 0.5
+            shift = shift / self.scale - self.at
+            slide = math.inf if edge else float(np.hypot(*shift))
+            # the pose must sit on the outline in its own frame and in the image's
+            if worst is None or (slide, -cc) > (worst[0], -worst[1]):
+                pose = Wc.copy()
+                pose[:, 2] += Wc[:, :2] @ shift
+                worst = (slide, cc, pose.astype(np.float32))
+        return worst
+
+    def moved(self, found):
+        """Whether a :meth:`locate` result says the pose has left the object."""
+        slide, cc, _ = found
+        return slide > DRIFT_FRAC * max(self.size) or cc < MIN_SIL_CC
+
+
+def _reduce(img, f):
+    """``img`` reduced by the factor ``f`` < 1 (area averaging)."""
+    import cv2
+
+    return cv2.resize(img, None, fx=f, fy=f, interpolation=cv2.INTER_AREA)
+
+
+def warp_grown(tr, img, W, margin):
+    """``img`` resampled by the pose ``W`` onto the template's grid grown by ``margin`` px on
+    every side (float32), or None off the frame."""
+    import cv2
+
+    crop, off = tr._window(img, W, margin + 4)
+    if crop is None:
+        return None
+    Wd = np.asarray(W, np.float32).copy()
+    Wd[:, 2] += (Wd[:, :2].astype(float) @ (tr.origin - margin)).astype(np.float32) - off
+    w, h = tr.size
+    return cv2.warpAffine(
+        crop,
+        Wd,
+        (w + 2 * margin, h + 2 * margin),
+        flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP,
+        borderMode=cv2.BORDER_REPLICATE,
+    )

@@ -17,9 +17,12 @@ and, for the outline, its own first frame:
   (the first frame, with the object's first region filled in once the object has left it)
   on nearly all of its pixels: a pose frozen on a patch of wall is a lost lock;
 * **outline** (``drift``): once the background behind the object's first region is known, the
-  centroid of the pixels that differ from the background must stay where it was in the user's
-  region, within :data:`DRIFT_FRAC` of the template: a keyframe renewed over a still edge of
-  the wall lets the pose slide off a spinning object while every correlation stays high.
+  object's silhouette against it, registered round the pose (:mod:`._occlusion`), must lie where
+  the pose puts it, within :data:`._occlusion.DRIFT_FRAC` of the template: a spinning object's
+  texture, or a keyframe renewed over a still edge of the wall, lets the pose slide off the
+  object while every correlation stays high. The pose moved onto the outline is where the
+  object is searched for first (and verified like any other pose); the motion checks forget
+  the poses of the slide.
 
 A frame that fails is lost with that reason; only verified frames renew the keyframe and teach
 the limits, so a wrong lock cannot teach the tracker to accept itself.
@@ -31,6 +34,8 @@ import collections
 import math
 
 import numpy as np
+
+from ._occlusion import OUTLINE_MARGIN_FRAC, OutlineRef, warp_grown
 
 __all__ = ["PoseVerifier", "search_whole_frame", "MIN_SCORE", "MAX_STEP_RAD"]
 
@@ -59,11 +64,8 @@ MAX_TURN_RAD = 1.0
 #: fraction of the pixels whose background is known is background.
 BG_TOL = 10.0
 BG_FRACTION = 0.9
-#: Least fraction of a patch standing out of the background (and left as background) for its
-#: outline to be placed.
-MIN_FG = 0.05
-#: Largest move of the object's outline inside the template, as a fraction of its larger side.
-DRIFT_FRAC = 0.1
+#: Steps towards the outline tried when a pose has slid off it.
+HINT_STEPS = 3
 #: Fraction of the patch whose background must be known for the background check to apply.
 BG_KNOWN = 0.5
 
@@ -83,12 +85,18 @@ class PoseVerifier:
 
     def __init__(self, first_gray, box, size):
         self.bg = first_gray.astype(np.float32)
+        self.first = self.bg.copy()
         self.box = box
+        #: the outline's margin round the template, px, and the first region grown by it (the
+        #: part of the first frame whose background is learned once the object has left it)
+        self.margin = int(math.ceil(OUTLINE_MARGIN_FRAC * max(size)))
+        self.outline = None  # the object's outline in the user's region, once its background is known
+        self.hint = None  # a pose that failed the outline, moved onto the outline
+        H, W = first_gray.shape[:2]
+        m = self.margin
+        self.outer = (max(box[0] - m, 0), max(box[1] - m, 0), min(box[2] + m, W), min(box[3] + m, H))
         self.filled = False  # the first region's background seen (the object has left it)
         self.tmpl0 = first_gray[box[1] : box[3], box[0] : box[2]].astype(np.float32)
-        #: where the object stands out of the background in the user's region: its changed pixels'
-        #: centroid from the region's centre (template px), once that background is known
-        self.offset0 = None
         self.size = size
         self.scores = collections.deque(maxlen=300)
         self.residuals = collections.deque(maxlen=300)
@@ -186,21 +194,16 @@ class PoseVerifier:
             self.speeds.append(float(np.hypot(*(centre - last[0]))))
         if gray is not None and footprint is not None and not self.filled:
             x0, y0, x1, y1 = footprint
-            u0, v0, u1, v1 = self.box
-            if x1 < u0 or x0 > u1 or y1 < v0 or y0 > v1:  # the first region is uncovered now
+            u0, v0, u1, v1 = self.outer
+            if x1 < u0 or x0 > u1 or y1 < v0 or y0 > v1:  # the grown first region is uncovered now
                 self.bg[v0:v1, u0:u1] = gray[v0:v1, u0:u1]
                 self.filled = True
-                self.offset0 = self._fg_offset(self.tmpl0, self.bg[v0:v1, u0:u1])
 
-    def _fg_offset(self, patch, bg):
-        """Centroid of the pixels of ``patch`` that differ from ``bg`` from the patch's centre
-        (template px, (2,)), or None when too few or nearly all differ (no outline to place)."""
-        fg = np.abs(patch - bg) >= BG_TOL
-        if not MIN_FG <= fg.mean() <= 1.0 - MIN_FG:
-            return None
-        ys, xs = np.nonzero(fg)
-        h, w = fg.shape
-        return np.array([xs.mean() - (w - 1) / 2, ys.mean() - (h - 1) / 2])
+    def learn_outline(self):
+        """Once the background is known: the object's outline in the user's region."""
+        if self.filled and self.outline is None:
+            self.outline = OutlineRef(self.first, self.bg, self.box)
+            self.first = None  # needed no more
 
     # -- with a tracker ----------------------------------------------------------------
     def verify(self, tr, gray, W, frame, score):
@@ -225,22 +228,38 @@ class PoseVerifier:
         if len(self.recent) == 2 and self.recent[1][2] - self.recent[0][2] == 1:
             (c0, t0, _), (c1, t1, _) = self.recent
             pred = (2 * c1 - c0, 2 * t1 - t0)
-        bg = back = known = None
+        bg = back = known = bg_g = back_g = None
+        self.hint = None
         # the background is known where the first frame did not show the object, and everywhere
         # once the object has left its first region: only then is the check worth its two warps
         if self.filled or self._clear(centre):
-            bg, back = tr._warp_back(self.bg, W), tr._warp_back(gray, W)
-            known = None if bg is None or back is None else np.ones_like(bg)
+            m = 2 * self.margin
+            bg_g, back_g = warp_grown(tr, self.bg, W, m), warp_grown(tr, gray, W, m)
+            if bg_g is not None and back_g is not None:
+                bg, back = bg_g[m:-m, m:-m], back_g[m:-m, m:-m]
+                known = np.ones_like(bg)
         last2 = None if last is None else last[:2]
         reason = self.check(float(score), centre, theta, pred, last2, gap, bg, back, known)
-        if reason is None and self.offset0 is not None and back is not None and bg is not None:
-            # the object's outline against the background has moved inside the template: the
-            # pose slid off the object (a keyframe that learned a still edge of the wall)
-            o = self._fg_offset(back, bg)
-            if o is not None and float(np.hypot(*(o - self.offset0))) > DRIFT_FRAC * max(self.size):
-                reason = "drift"
+        self.learn_outline()
+        if reason is None and self.outline is not None and back is not None and self._in_frame(tr, W, gray.shape):
+            # the object's outline against the background is not where the pose puts it: the
+            # pose slid off the object (a spinning object's texture, a keyframe that learned a
+            # still edge of the wall)
+            found = self.outline.locate(tr, gray, self.bg, W, (back_g, bg_g))
+            if found is not None and self.outline.moved(found):
+                # the poses since the last frame checked here were the slide: no anchor for motion
+                reason, self.hint, self.recent = "drift", found[2], []
         self._pending = (float(score), centre, theta, pred, last2, gap, frame)
         return reason
+
+    def _in_frame(self, tr, W, shape):
+        """Whether the grown template grid under the pose ``W`` lies inside a frame of ``shape``
+        (an object partly out of the picture has no whole outline to place)."""
+        m = self.margin
+        w, h = self.size
+        grid = np.array([[-m, -m], [w + m, -m], [-m, h + m], [w + m, h + m]], float) + tr.origin
+        c = grid @ np.asarray(W, float)[:, :2].T + np.asarray(W, float)[:, 2]
+        return bool(c.min() >= 0 and c[:, 0].max() <= shape[1] and c[:, 1].max() <= shape[0])
 
     def _clear(self, centre):
         """Whether a pose centred at ``centre`` (px) keeps the template off the first region."""
@@ -251,6 +270,18 @@ class PoseVerifier:
     def reacquire(self, tr, gray, frame, min_cc):
         """The object anywhere in ``gray`` (:func:`search_whole_frame` from the last verified angle,
         then the tracker's fit from there), verified: (W, cc, score), or None."""
+        for _ in range(HINT_STEPS):
+            hint, self.hint = self.hint, None
+            if hint is None:
+                break
+            # the object where its outline is: the outline found it, the template's correlation
+            # and every other check must agree (a slide beyond the margin takes a few steps)
+            back = tr._warp_back(gray, hint)
+            cc = -1.0 if back is None else max(_ncc(back, tr.tmpl0), _ncc(back, tr.key))
+            if cc < min_cc:
+                break
+            if self.verify(tr, gray, hint, frame, cc) is None:
+                return hint, cc, cc
         th = self.recent[-1][1] if self.recent else 0.0
         W_s = search_whole_frame(tr, tr.key, gray, th)
         alt = tr._ecc(tr.key, gray, W_s) if W_s is not None else None
@@ -266,6 +297,12 @@ class PoseVerifier:
         footprint = (centre[0] - half, centre[1] - half, centre[0] + half, centre[1] + half)
         self.accept(score, centre, pred, last, gap, gray, footprint)
         self.recent = (self.recent + [(centre, theta, frame)])[-2:]
+
+
+def _ncc(a, b):
+    """Zero-mean normalised correlation of two images of one shape."""
+    a, b = a - a.mean(), b - b.mean()
+    return float((a * b).sum() / (math.sqrt(float((a * a).sum()) * float((b * b).sum())) + 1e-9))
 
 
 def best_turned_match(image, tmpl, theta, turns_deg, min_cc):

@@ -314,12 +314,7 @@ def mechanism_response(
         t0 = t
         t, y, event, pieces = _flight(eoms[side], y, t, t_end, tb, ab, side, limit[side])
         for lo, hi, sol in pieces:
-            i0, i1 = np.searchsorted(t_out, [lo, hi], side="left")
-            i1 = i1 + 1 if i1 < t_out.size and t_out[i1] == hi else i1
-            if i1 > i0:
-                yy = sol(t_out[i0:i1])
-                phi_out[i0:i1] = side * kappa[side] * yy[0]
-                om_out[i0:i1] = side * kappa[side] * yy[1]
+            fill(lo, hi, lambda tt, sol=sol, k=side * kappa[side]: tuple(k * sol(tt)))
         if event == "over":
             overturned, t_over = True, t
             phi_out[t_out > t_over] = np.nan

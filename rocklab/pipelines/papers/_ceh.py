@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..experiment._figures import pyplot as _plt
+from ..experiment._figures import save_png as _save
 from ._gallery import Built, Entry, number
 
 __all__ = ["ENTRIES"]
@@ -52,18 +54,6 @@ WHY = {
         for k in (17, 18, 19, 20)
     },
 }
-
-
-def _plt():
-    from ..experiment._figures import pyplot
-
-    return pyplot()
-
-
-def _save(fig, path):
-    from ..experiment._figures import save_png
-
-    save_png(fig, path, dpi=110)
 
 
 def fig3(ctx) -> Built:

@@ -7,23 +7,13 @@ from functools import lru_cache
 
 import numpy as np
 
+from ..experiment._figures import pyplot as _plt
+from ..experiment._figures import save_png as _save
 from ._gallery import Built, Entry, number
 
 __all__ = ["ENTRIES"]
 
 DRAWING = "a drawing of the geometry: no data to regenerate (the geometry is in the mechanism's docstring)"
-
-
-def _plt():
-    from ..experiment._figures import pyplot
-
-    return pyplot()
-
-
-def _save(fig, path):
-    from ..experiment._figures import save_png
-
-    save_png(fig, path, dpi=110)
 
 
 def table1(ctx) -> Built:

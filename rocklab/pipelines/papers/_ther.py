@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..experiment._figures import pyplot as _plt
+from ..experiment._figures import save_png as _save
 from ._gallery import Built, Entry, number
 from ._ther_spectra import BUILDERS as _SPECTRA
 from ._ther_spectra import NEEDS_RECORDS as _SPECTRA_RECORDS
@@ -88,18 +90,6 @@ WHY = {
     **{k: DRAWING for k in (1, 2, 5, 6, 7, 10, 11, 15, 16, 17, 18, 19, 20, 21, 22, 23, 24, 28, 30, 38, 51, 54, 59)},
     **{k: EXPERIMENT for k in (25, 26, 27, 31, 32)},
 }
-
-
-def _plt():
-    from ..experiment._figures import pyplot
-
-    return pyplot()
-
-
-def _save(fig, path):
-    from ..experiment._figures import save_png
-
-    save_png(fig, path, dpi=110)
 
 
 def fig4(ctx) -> Built:
@@ -227,9 +217,10 @@ def fig14(ctx) -> Built:
     import pandas as pd
 
     from ...blocks import Block
-    from ...models import load_base_motion, simulate
+    from ...models import simulate
+    from ._ther_spectra import _mul009
 
-    rec = load_base_motion(ctx.records / "fema-p695-far-field" / "SortedEQFile_120111.txt", units="g")
+    rec = _mul009(ctx)
     blk = Block(0.63, 2.52)  # the thesis's b = 0.315 m, h = 1.261 m are half sizes
     out, nums = {}, {}
     for law, kw in (("housner", {}), ("bumps", {"n": 1})):

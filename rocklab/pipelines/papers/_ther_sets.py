@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..experiment._figures import pyplot as _plt
+from ..experiment._figures import save_png as _save
 from ._gallery import Built, number
 
 __all__ = ["BUILDERS", "NEEDS_RECORDS"]
@@ -12,29 +14,12 @@ __all__ = ["BUILDERS", "NEEDS_RECORDS"]
 GRID = dict(levels=30, sizes=60)
 
 
-def _plt():
-    from ..experiment._figures import pyplot
-
-    return pyplot()
-
-
-def _save(fig, path):
-    from ..experiment._figures import save_png
-
-    save_png(fig, path, dpi=110)
-
-
 def _records(ctx):
-    """Every record under ``--records`` (the two-column FEMA files in g), by name."""
+    """Every record under ``--records``, read as ``rocklab oas FOLDER --recursive --units g`` reads it."""
     from ...models import load_base_motion
+    from ..spectra._spectra_batch import expand_records
 
-    out = []
-    for p in sorted(ctx.records.rglob("*")):
-        if p.suffix.upper() == ".AT2":
-            out.append(load_base_motion(p))
-        elif p.suffix == ".txt" and p.name.startswith("SortedEQFile"):
-            out.append(load_base_motion(p, units="g"))
-    return out
+    return [load_base_motion(p, units="g") for _, p, err in expand_records([ctx.records], recursive=True) if not err]
 
 
 _CACHE: dict = {}

@@ -4,24 +4,14 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..experiment._figures import pyplot as _plt
+from ..experiment._figures import save_png as _save
 from ._gallery import Built, number
 
 __all__ = ["BUILDERS", "NEEDS_RECORDS"]
 
 #: The thesis's FF-1 record (FEMA P695 120111, Northridge Beverly Hills - Mulhol 009), in ``--records``.
 MUL009 = ("fema-p695-far-field", "SortedEQFile_120111.txt")
-
-
-def _plt():
-    from ..experiment._figures import pyplot
-
-    return pyplot()
-
-
-def _save(fig, path):
-    from ..experiment._figures import save_png
-
-    save_png(fig, path, dpi=110)
 
 
 def _free(law, **kw):
@@ -73,9 +63,7 @@ def fig13(ctx) -> Built:
     ax.set(xlabel="t [s]", ylabel="theta / alpha", title="H/B = 4, released at alpha/2")
     ax.legend()
     _save(fig, ctx.png("ther:Fig. 13"))
-    slower = float(np.abs(b.theta_rad[:n]).max())
     nums = {"bump_impacts": number(None, int(b.n_impacts), ""), "housner_impacts": number(None, int(h.n_impacts), "")}
-    del slower
     return Built(
         df, nums, f"the bump loses less energy per impact: {b.n_impacts} impacts against Housner's {h.n_impacts} in 6 s"
     )

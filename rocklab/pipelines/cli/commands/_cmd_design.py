@@ -388,20 +388,19 @@ def run_equivalent(args) -> int:
     elif mech == "asym-frame":
         _need(args, "b", "H", "H1", "L", "h")
         pos, neg = m.asymmetric_frame(args.b, args.H, args.H1, args.L, args.h, *args.masses)
-        fpp, fpn = pos.parameters(), neg.parameters()
-        out = fpp.to_dict()
+        fp, fpn = pos.parameters(), neg.parameters()
+        out = fp.to_dict()
         pair = (pos, neg)
         extra = {"negative": fpn.to_dict()}
     else:
         _need(args, "beta", "thickness", "radius")
         arch, info = m.arch_mechanism(args.beta, args.thickness, args.radius)
-        out = arch.parameters().to_dict()
+        fp = arch.parameters()
+        out = fp.to_dict()
         pair = (arch, None)
         extra = {"hinges": list(info["hinges"]), "faces": info["faces"]}
     out.update(extra)
-    eq = mm.equivalent_block(
-        mm.FundamentalParameters(**{k: v for k, v in out.items() if k in _FP_KEYS} | {"lambda_": out["lambda"]})
-    )
+    eq = mm.equivalent_block(fp)
     out["equivalent_block"] = {"b_m": eq.b_m, "h_m": eq.h_m, "match": "uplift"}
     base = base_motion_from_args(args)
     if base is None:
@@ -439,10 +438,6 @@ def run_equivalent(args) -> int:
                 print(f"rocklab equivalent: note: {name}: {r['message']}", file=sys.stderr)
     sys.stdout.flush()
     return 0
-
-
-#: FundamentalParameters' fields as ``to_dict`` prints them (``lambda`` is ``lambda_`` there).
-_FP_KEYS = ("p_rad_s", "theta_cr_rad", "lambda_lin", "eta", "phi_cr_rad", "kappa1", "kappa2", "mechanism")
 
 
 def _equivalent_history(args, mech: str, base, pair) -> dict:

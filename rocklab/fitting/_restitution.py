@@ -414,7 +414,6 @@ def fit_restitution(t_s, theta_rad, block, window: str = "middle50", objective: 
         at_bound.append("release_t_s")
     flags = _suspicion(t, y - offset, win_res if objective_used == "theta" else np.array([]), rms, sigma, pie,
                        tc, alpha)
-    msg = "; ".join(([f"{n_skip} NaN sample(s) skipped"] if n_skip else []) + [d.message for d in diags])
     noise = max(rel.sigma_rad, RESIDUAL_FLOOR_RAD)
     if np.isfinite(rms) and rms > RESIDUAL_FACTOR * noise:
         diags.append(warn("W-FIT-RESIDUAL", f"{name or 'block'}: the fitted simulation misses the measurement by "
@@ -432,7 +431,8 @@ def fit_restitution(t_s, theta_rad, block, window: str = "middle50", objective: 
                                          f"reaches the bound of the search (eta in [{lo_b:g}, {hi_b:g}]): the "
                                          "window's data do not constrain eta_e; fit window = \"first\" or a "
                                          "shorter record"))
-        msg = "; ".join(x for x in (msg, diags[-1].message) if x)
+    # every warning the fit raised is in its message (the fit object travels without the stderr lines)
+    msg = "; ".join(([f"{n_skip} NaN sample(s) skipped"] if n_skip else []) + [d.message for d in diags])
     return RestitutionFit(
         eta_e=float(eta_hat), eta_e_first=float(eta_first), ci95_eta_e=ci, theta0_rad=float(s0 * theta0_hat),
         release_t_s=float(tr_hat), rms_residual_rad=rms, sigma_theta_rad=float(rel.sigma_rad),

@@ -2,7 +2,9 @@
 
 The campaign (all rendered by :func:`rocklab.synth.synth_session` with ArUco
 targets and x-IMU logs, 960×540 at 50 fps; at this size η_e of a 4.5 cm wide
-block comes back within 1e-4 of the truth):
+block comes back within 1e-4 of the truth). The runs read the camcorder-like
+H.264 film ``video.mp4`` (17 Mbit/s at 1080p, scaled by pixels), as a lab's
+footage would be; ``camcorder=False`` reads the lossless ``video.mkv`` instead:
 
 - full-contact free rocking of Čeh Table 2 blocks (B3M, B5M, B7M, B9M, B4L), whose
   true restitution is Čeh Table 3's η_e,full, so the campaign fits k per block and
@@ -94,7 +96,19 @@ def _edit_experiment(path: Path, name: str, block_id: str, contact: str, table: 
     path.write_text(text + extra, encoding="utf-8")
 
 
-def _render_one(d: Path, seed: int, name: str, bid: str, contact: str, table: str, size, fps) -> Path:
+def _use_film(cfg: Path, camcorder: bool) -> None:
+    """Point the session's video source at the H.264 film (the synth writes the lossless one)."""
+    if not camcorder:
+        return
+    text = cfg.read_text(encoding="utf-8")
+    if text.count('path = "video.mkv"') != 1:
+        raise AssertionError(f"{cfg}: expected one video.mkv source in the synth's experiment.toml")
+    cfg.write_text(text.replace('path = "video.mkv"', 'path = "video.mp4"'), encoding="utf-8")
+
+
+def _render_one(
+    d: Path, seed: int, name: str, bid: str, contact: str, table: str, size, fps, camcorder: bool = True
+) -> Path:
     from ...fitting import catalogue_block
     from ...synth import synth_session
 
@@ -109,7 +123,7 @@ def _render_one(d: Path, seed: int, name: str, bid: str, contact: str, table: st
             size=size,
             targets="aruco",
             duration_s=4.0,
-            mp4=False,
+            mp4=camcorder,
             imu=False,
             force=True,
         )
@@ -118,6 +132,7 @@ def _render_one(d: Path, seed: int, name: str, bid: str, contact: str, table: st
             text.replace(f'name = "synth-seed{seed}"', f'name = "{name}"') + "\n[output]\nvideo_decimation = 5\n",
             encoding="utf-8",
         )
+        _use_film(cfg, camcorder)
         return cfg
     blk = catalogue_block(bid)
     kw = (
@@ -135,25 +150,36 @@ def _render_one(d: Path, seed: int, name: str, bid: str, contact: str, table: st
         targets="aruco",
         block=blk,
         eta=_true_eta(bid, contact),
-        mp4=False,
+        mp4=camcorder,
         force=True,
         **kw,
     )
     _edit_experiment(cfg, name, bid, contact, table)
+    _use_film(cfg, camcorder)
     return cfg
 
 
 def make_demo_campaign(
-    root, *, size=(960, 540), fps: float = 50.0, progress: bool = True, runs=DEMO_RUNS, workers: int = 2
+    root,
+    *,
+    size=(960, 540),
+    fps: float = 50.0,
+    progress: bool = True,
+    runs=DEMO_RUNS,
+    workers: int = 2,
+    camcorder: bool = True,
 ) -> list[Path]:
-    """Render the demo sessions into ``root/<run>/`` (skips sessions already there), in parallel."""
+    """Render the demo sessions into ``root/<run>/`` (skips sessions already there), in parallel.
+
+    ``camcorder`` (default) points each run at the H.264 film; ``False`` at the lossless one.
+    """
 
     from tqdm import tqdm
 
     root = Path(root)
     root.mkdir(parents=True, exist_ok=True)
     todo = [
-        (root / name, seed, name, bid, contact, table, size, fps)
+        (root / name, seed, name, bid, contact, table, size, fps, camcorder)
         for seed, (name, bid, contact, table) in enumerate(runs)
         if not (root / name / "experiment.toml").is_file()
     ]
@@ -171,7 +197,15 @@ def make_demo_campaign(
     return [root / name / "experiment.toml" for name, *_ in runs]
 
 
-def run_demo(out_dir="demo_out", *, workers: int = 2, progress: bool = True, size=(960, 540), runs=DEMO_RUNS):
+def run_demo(
+    out_dir="demo_out",
+    *,
+    workers: int = 2,
+    progress: bool = True,
+    size=(960, 540),
+    runs=DEMO_RUNS,
+    camcorder: bool = True,
+):
     """Make the demo campaign under ``out_dir/sessions`` and run it into ``out_dir/results``."""
     from ._campaign import run_campaign
 
@@ -180,7 +214,9 @@ def run_demo(out_dir="demo_out", *, workers: int = 2, progress: bool = True, siz
     out_dir = check_output_dir(out_dir, need_bytes=300 * 1024 * 1024)
     claim_dir(out_dir, ("sessions", "results"), command="demo")
     t0 = time.perf_counter()
-    make_demo_campaign(out_dir / "sessions", size=size, progress=progress, runs=runs, workers=workers)
+    make_demo_campaign(
+        out_dir / "sessions", size=size, progress=progress, runs=runs, workers=workers, camcorder=camcorder
+    )
     t1 = time.perf_counter()
     res = run_campaign(out_dir / "sessions", out_dir / "results", workers=workers, progress=progress)
     t2 = time.perf_counter()

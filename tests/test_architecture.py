@@ -144,6 +144,12 @@ def test_config_stands_on_the_ground_floor():
     assert not bad, bad
 
 
+def test_only_config_reads_toml():
+    # track.toml, experiment.toml and corrections are read through rocklab.config's one reader
+    readers = {mod for mod, deps in _imports().items() if "tomllib" in deps}
+    assert readers and readers <= {"rocklab.config._toml"}, readers
+
+
 def test_tracking_uses_the_physics_only_where_known():
     users = {
         mod

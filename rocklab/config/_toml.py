@@ -114,7 +114,7 @@ class TomlDoc:
         for k, v in table.items():
             if k in known:
                 continue
-            what = "table" if isinstance(v, (dict, list)) and (isinstance(v, dict) or _tables(v)) else "key"
+            what = "table" if isinstance(v, dict) or _array_of_tables(v) else "key"
             near = difflib.get_close_matches(str(k), known, n=1)
             hint = f"did you mean '{near[0]}'? " if near else ""
             section = key_name(key)
@@ -212,10 +212,6 @@ def _key_line(lines, start: int, rest: Key) -> int | None:
         if pat.match(lines[i]):
             return i + 1
     return None
-
-
-def _tables(v: list) -> bool:
-    return bool(v) and all(isinstance(x, dict) for x in v)
 
 
 # ---------------------------------------------------------------------- writing

@@ -124,7 +124,7 @@ def test_experiment_config_round_trips_through_its_own_toml(tmp_path):
     d = _files(tmp_path)
     cfg = ExperimentConfig(
         path=(d / "experiment.toml").resolve(),
-        name="run 1 \"quoted\"",
+        name='run 1 "quoted"',
         b_m=0.045,
         h_m=0.2025,
         mass_kg=None,
@@ -175,7 +175,7 @@ def test_example_documents_exactly_the_schema():
 
     documented = set(leaves(tomllib.loads(EXAMPLE_TOML)))
     schema = {(*t, k) for t, keys in SCHEMA.items() for k in keys if (*t, k) not in SCHEMA}
-    assert documented == schema, (documented ^ schema)
+    assert documented == schema, documented ^ schema
 
 
 def test_block_id_needs_the_catalogue_it_is_given(tmp_path):

@@ -63,6 +63,7 @@ kind = "charuco"
         (("objects", 1), 14),
         (("reference", "board", "kind"), 18),
         (("reference", "level"), None),  # neither [reference] nor the key in the text
+        (("b_m",), None),  # a root key that is absent: not the [block] key of that name
     ],
 )
 def test_line_finder(key, line):
@@ -72,6 +73,13 @@ def test_line_finder(key, line):
 def test_line_finder_reads_dotted_keys_in_a_parent_table():
     text = '[sources]\nprimary = "video"\nvideo.path = "v.mkv"\n'
     assert TomlDoc(tomllib.loads(text), text).line_of(("sources", "video", "path")) == 3
+
+
+def test_a_table_that_is_a_value_is_an_error(tmp_path):
+    p = tmp_path / "experiment.toml"
+    p.write_text('name = "x"\nblock = 3\n')
+    with pytest.raises(InputError, match=r"line 2: 'block' must be a table"):
+        load_experiment_config(p)
 
 
 def test_one_unknown_key_rule_for_both_files(tmp_path):

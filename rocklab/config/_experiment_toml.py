@@ -131,16 +131,13 @@ class ExperimentConfig:
     def input_files(self) -> list[Path]:
         """Every input file the run reads (for the unchanged-inputs check)."""
         out = [self.path]
-        for src in (self.video, self.track, self.imu):
-            if src is None:
-                continue
-            out.append(src.path)
-            if getattr(src, "corrections", None):
-                out.append(src.corrections)
-            tc = getattr(src, "track_config", None)
-            if tc:
-                out.append(tc)
-                out.extend(_track_config_files(tc))
+        if self.video is not None:
+            out.append(self.video.path)
+            if self.video.corrections:
+                out.append(self.video.corrections)
+            if self.video.track_config:
+                out += [self.video.track_config, *_track_config_files(self.video.track_config)]
+        out += [src.path for src in (self.track, self.imu) if src is not None]
         for p in (self.table.imu, self.table.record, self.truth):
             if p:
                 out.append(p)
@@ -207,7 +204,7 @@ _FIELDS = {
 }
 
 #: Every table of ``experiment.toml`` and its keys (what the unknown-key rule checks against).
-SCHEMA = {
+SCHEMA: dict[tuple, tuple] = {
     (): ("name", "truth", "block", "contact", "sources", "sync", "fit", "simulate", "column", "output"),
     ("block",): ("id", "b_m", "h_m", "mass_kg"),
     ("sources",): ("primary", "video", "track", "imu", "table"),
@@ -294,7 +291,15 @@ class _Reader(TomlDoc):
             v = tuple(v)
         return v
 
-    def file(self, key, required=True, allow_dir=False) -> Path | None:
+    def path(self, key, allow_dir=False) -> Path:
+        """The existing file (or folder, with ``allow_dir``) a required key names."""
+        p = self.file(key, required=True, allow_dir=allow_dir)
+        if p is None:
+            self.fail(key, "is required")
+        return p
+
+    def file(self, key, required=False, allow_dir=False) -> Path | None:
+        """The existing file (or folder) ``key`` names, relative to the config's folder."""
         v = self.typed(key, self.at(key), str)
         if v is None:
             if required:
@@ -428,17 +433,17 @@ def _sources(r: _Reader, path: Path, sources: dict):
     if "video" in sources:
         V = SourceVideo
         video = V(
-            path=r.file((s, "video", "path"), allow_dir=True),
+            path=r.path((s, "video", "path"), allow_dir=True),
             track_config=r.file((s, "video", "track_config"), required=False),
             object=r.get((s, "video", "object"), str, default_of(V, "object")),
             fps=r.get((s, "video", "fps"), float, positive=True),
             corrections=r.file((s, "video", "corrections"), required=False),
         )
     if "track" in sources:
-        track = SourceTrack(path=r.file((s, "track", "path")), object=r.get((s, "track", "object"), str))
+        track = SourceTrack(path=r.path((s, "track", "path")), object=r.get((s, "track", "object"), str))
     if "imu" in sources:
         imu = SourceImu(
-            path=r.file((s, "imu", "path"), allow_dir=True),
+            path=r.path((s, "imu", "path"), allow_dir=True),
             axis=r.get((s, "imu", "axis"), str, default_of(SourceImu, "axis")),
             rate_hz=r.get((s, "imu", "rate_hz"), float, positive=True),
         )

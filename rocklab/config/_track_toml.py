@@ -393,10 +393,14 @@ def load_track_config(path) -> TrackConfig:
     """
     path = Path(path)
     cfg = _read(TomlDoc.read(path, "tracking config"))
-    for key in ("calibration", "corrections"):  # paths relative to the TOML file
-        f = getattr(cfg.video, key)
-        if f is not None and not Path(f).is_absolute():
-            cfg = dataclasses.replace(cfg, video=dataclasses.replace(cfg.video, **{key: str(path.parent / f)}))
+    v = cfg.video
+
+    def near(f: str | None) -> str | None:  # paths relative to the TOML file
+        return f if f is None or Path(f).is_absolute() else str(path.parent / f)
+
+    if (near(v.calibration), near(v.corrections)) != (v.calibration, v.corrections):
+        v = dataclasses.replace(v, calibration=near(v.calibration), corrections=near(v.corrections))
+        cfg = dataclasses.replace(cfg, video=v)
     return cfg
 
 
@@ -420,7 +424,8 @@ def _read(doc: TomlDoc) -> TrackConfig:
     if not objs or not isinstance(objs, list):
         doc.fail(("objects",), "needs at least one [[objects]] entry (id, kind, markers/dots/roi)")
     objects = tuple(_object(doc, o, i, targets) for i, o in enumerate(objs))
-    seen, seen_markers = set(), {}
+    seen: set[str] = set()
+    seen_markers: dict[int, str] = {}
     for i, o in enumerate(objects):
         if o.id in seen:
             doc.fail(("objects", i, "id"), f"= {o.id!r} is a duplicate object id; ids must be unique")

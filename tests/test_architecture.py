@@ -10,8 +10,8 @@ import pytest
 PKG = Path(__file__).resolve().parents[1] / "rocklab"
 
 # Known and documented exceptions, each to disappear with the restructure of issue 16:
-#: TrackConfig.from_dict imports its parser lazily, and the parser builds TrackConfig.
-KNOWN_CYCLES = [{"rocklab.tracking.video._config", "rocklab.tracking.video._config_parse"}]
+#: None left: track.toml's schema and reader are one module of rocklab.config.
+KNOWN_CYCLES: list = []
 #: Measurement modules that call the physics (the table-motion filters, the IMU table model).
 TRACKING_TO_MODELS = {"rocklab.tracking.video._motion", "rocklab.tracking.imu._table"}
 
@@ -115,6 +115,8 @@ ALIASES: set = set()
         ("fitting", {"pipelines", "tracking", "synth"}),
         ("tracking", {"pipelines", "fitting", "synth"}),
         ("synth", {"pipelines", "fitting"}),
+        # the ground floor: config files' schemas, which every package may read
+        ("config", {"models", "fitting", "pipelines", "tracking", "synth"}),
     ],
 )
 def test_dependencies_flow_one_way(layer, forbidden):
@@ -126,6 +128,26 @@ def test_dependencies_flow_one_way(layer, forbidden):
             if d.startswith("rocklab.") and _subpackage(d) in forbidden and (mod, d) not in ALIASES:
                 bad.append(f"{mod} -> {d}")
     assert not bad
+
+
+def test_config_stands_on_the_ground_floor():
+    # rocklab.config may use only the package's base modules (errors, diagnostics, atomic
+    # files, blocks) besides third-party code, so every layer can import it
+    base = {"rocklab._errors", "rocklab._diagnostics", "rocklab._io", "rocklab.blocks"}
+    bad = {
+        f"{mod} -> {d}"
+        for mod, deps in _imports().items()
+        if _subpackage(mod) == "config"
+        for d in deps
+        if d.startswith("rocklab") and _subpackage(d) != "config" and d not in base
+    }
+    assert not bad, bad
+
+
+def test_only_config_reads_toml():
+    # track.toml, experiment.toml and corrections are read through rocklab.config's one reader
+    readers = {mod for mod, deps in _imports().items() if "tomllib" in deps}
+    assert readers and readers <= {"rocklab.config._toml"}, readers
 
 
 def test_tracking_uses_the_physics_only_where_known():
@@ -181,7 +203,6 @@ LONG_FUNCTIONS = {
     "models.rocking._single:simulate",  # 153
     "pipelines.experiment._figures:experiment_figures",  # 138
     "fitting._forced:fit_forced_restitution",  # 134
-    "pipelines.experiment._config:load_experiment",  # 132
     "pipelines.cli.commands._cmd_design:register",  # 131
     "pipelines.experiment._experiment:analyse_experiment",  # 127
     "models.rocking._event:run_event",  # 126

@@ -52,15 +52,12 @@ def _check_unique_names(configs, root: Path) -> None:
     """Experiment names label a campaign's rows, blocks, links and Rerun entities, so two
     experiments of one name would be merged in its fits and figures: refused before any work.
     A config that cannot be read is left to its own run, which reports it as failed."""
-    import tomllib
+    from ...config import experiment_name
 
     seen: dict[str, Path] = {}
     for c in configs:
-        try:
-            name = tomllib.loads(c.read_text(encoding="utf-8")).get("name", c.parent.name)
-        except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError):
-            continue
-        if not isinstance(name, str):
+        name = experiment_name(c)
+        if name is None:
             continue
         if name in seen:
             raise InputError(

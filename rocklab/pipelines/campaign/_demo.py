@@ -61,49 +61,44 @@ def _true_eta(block_id: str, contact: str) -> float:
     return float(cat.loc[block_id, "eta_e_full"])
 
 
-def _edit_experiment(path: Path, name: str, block_id: str, contact: str, table: str) -> None:
-    """Adapt the synth's experiment.toml: run name, catalogue id, contact, forced-run options."""
-    import re
-
-    text = path.read_text(encoding="utf-8")
-    text, n = re.subn(r'(?m)^name = ".*"$', f'name = "{name}"', text, count=1)
-    if n != 1:
-        raise AssertionError(f"{path}: no name line in the synth's experiment.toml")
-
-    def sub(old, new):
-        nonlocal text
-        if text.count(old) != 1:
-            raise AssertionError(f"{path}: expected one {old!r} in the synth's experiment.toml")
-        text = text.replace(old, new)
-
-    sub("[block]\n", f'[block]\nid = "{block_id}"\n')
+def _edit_experiment(path: Path, name: str, block_id: str, contact: str, table: str, camcorder: bool) -> None:
+    """Adapt the synth's experiment.toml through its schema: run name, catalogue id, contact,
+    forced-run options."""
+    changes: dict = dict(name=name, block_id=block_id)
     if contact == "edge":
-        sub('[contact]\ntype = "full"\n', f'[contact]\ntype = "edge"\nl_c_m = {L_C_M}\n')
-    extra = "\n[output]\nvideo_decimation = 5\n"
+        changes.update(contact="edge", l_c_m=L_C_M)
     if table != "none":
+        from ...config import SourceTable
+
         # forced rocking: no free-rocking restitution fit; simulate the table-driven response
         # a record's table acceleration has content a 50 fps camera cannot sample: drive the
         # simulation from the table IMU (256 Hz), synced to the video by its acceleration
-        sub(
-            '[sources.table]\nfrom = "video"\nobject = "table"\n',
-            '[sources.table]\nfrom = "imu"\nobject = "table"\nimu = "imu/table"\n',
-        )
+        changes.update(table=SourceTable(source="imu", object="table", imu=path.parent.resolve() / "imu" / "table"))
         # (the η a lab would have calibrated on free rocking of the same block: here the truth)
-        extra += (
-            '\n[fit]\nrestitution = false\n\n[simulate]\nlaws = ["housner", "modified"]\n'
-            f"eta = {_true_eta(block_id, contact):.6f}\n"
-        )
-    path.write_text(text + extra, encoding="utf-8")
+        eta = float(f"{_true_eta(block_id, contact):.6f}")
+        changes.update(fit_restitution=False, laws=("housner", "modified", "given"), eta_given=eta)
+    _rewrite_experiment(path, camcorder, **changes)
 
 
-def _use_film(cfg: Path, camcorder: bool) -> None:
-    """Point the session's video source at the H.264 film (the synth writes the lossless one)."""
-    if not camcorder:
-        return
-    text = cfg.read_text(encoding="utf-8")
-    if text.count('path = "video.mkv"') != 1:
-        raise AssertionError(f"{cfg}: expected one video.mkv source in the synth's experiment.toml")
-    cfg.write_text(text.replace('path = "video.mkv"', 'path = "video.mp4"'), encoding="utf-8")
+def _rewrite_experiment(path: Path, camcorder: bool, **changes) -> None:
+    """Read the synth's experiment.toml, change fields of its :class:`ExperimentConfig` (the
+    demo logs every 5th frame to Rerun; ``camcorder`` points the video source at the H.264 film
+    the synth writes beside the lossless one) and write it back."""
+    from dataclasses import replace
+
+    from ..._io import write_text_atomic
+    from ..experiment._config import load_experiment
+
+    cfg = load_experiment(path)
+    if camcorder:
+        mp4 = cfg.video.path.with_suffix(".mp4")
+        if not mp4.is_file():
+            raise AssertionError(f"{path}: the synth wrote no camcorder film {mp4.name}")
+        changes["video"] = replace(cfg.video, path=mp4)
+    cfg = replace(cfg, video_decimation=5, **changes)
+    write_text_atomic(
+        path, cfg.to_toml(header=("Experiment config of the demo campaign (rocklab demo).",)), stamp=False
+    )
 
 
 def _render_one(
@@ -127,12 +122,7 @@ def _render_one(
             imu=False,
             force=True,
         )
-        text = cfg.read_text(encoding="utf-8")
-        cfg.write_text(
-            text.replace(f'name = "synth-seed{seed}"', f'name = "{name}"') + "\n[output]\nvideo_decimation = 5\n",
-            encoding="utf-8",
-        )
-        _use_film(cfg, camcorder)
+        _rewrite_experiment(cfg, camcorder, name=name)
         return cfg
     blk = catalogue_block(bid)
     kw = (
@@ -154,8 +144,7 @@ def _render_one(
         force=True,
         **kw,
     )
-    _edit_experiment(cfg, name, bid, contact, table)
-    _use_film(cfg, camcorder)
+    _edit_experiment(cfg, name, bid, contact, table, camcorder)
     return cfg
 
 

@@ -163,12 +163,12 @@ def track_init(
     if not info.fps and not fps:
         notes.append("the film has no frame rate: fps = 50 written; correct it (or give --fps)")
     head = [
-        f"# track.toml written by 'rocklab track init' from {video.name} ({info.width_px}x{info.height_px}, "
+        f"track.toml written by 'rocklab track init' from {video.name} ({info.width_px}x{info.height_px}, "
         f"{info.n_frames} frames, {info.fps or 'unknown'} fps)",
-        "# Schema: docs/track-toml.md",
+        "Schema: docs/track-toml.md",
+        *notes,
     ]
-    head += [f"# {n}" for n in notes]
-    write_text_atomic(out, "\n".join(head) + "\n\n" + cfg.to_toml(), side=side[0])
+    write_text_atomic(out, cfg.to_toml(header=head), side=side[0])
     if preview is not None:
         save_bgr_png(Path(preview), draw_init_preview(img, cfg, found, grid=found is None), side=side[1])
     return cfg, notes, proposed

@@ -1,7 +1,7 @@
 """Video tracking: from a film to each object's x, y and θ per frame.
 
 - ``track.toml`` configs (:class:`TrackConfig`, :func:`load_track_config`; the reference page
-  is generated from :mod:`._config`);
+  is generated from :mod:`rocklab.config`);
 - reading films (:func:`probe_video`, :func:`iter_video_frames`);
 - camera geometry: lens calibration, the image-to-plane map, similarity fits
   (:class:`PlaneMap`, :func:`calibrate_camera`, :func:`fit_similarity`);
@@ -11,7 +11,7 @@
 - the target detectors in :mod:`.targets`.
 """
 
-from ._config import (
+from ...config import (
     BoardConfig,
     MotionConfig,
     ObjectConfig,

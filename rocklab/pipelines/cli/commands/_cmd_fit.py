@@ -19,6 +19,7 @@ import sys
 from pathlib import Path
 
 from ...._errors import InputError, where
+from ....config import FIT_WINDOWS
 
 
 def register(sub):
@@ -37,8 +38,8 @@ def register(sub):
     r.add_argument("--object", default=None, help="object id in tracks.csv (default: the only block)")
     r.add_argument(
         "--window",
-        choices=("middle50", "all", "first"),
-        default="middle50",
+        choices=FIT_WINDOWS,
+        default=FIT_WINDOWS[0],
         help="samples compared: between the impacts at 25 %% and 75 %% of the count (Čeh's middle 50 %%, "
         "default), the whole response, or the first half-period after an impact",
     )

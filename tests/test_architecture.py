@@ -203,7 +203,6 @@ LONG_FUNCTIONS = {
     "models.rocking._single:simulate",  # 153
     "pipelines.experiment._figures:experiment_figures",  # 138
     "fitting._forced:fit_forced_restitution",  # 134
-    "pipelines.cli.commands._cmd_design:register",  # 131
     "pipelines.experiment._experiment:analyse_experiment",  # 127
     "models.rocking._event:run_event",  # 126
 }

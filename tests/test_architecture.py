@@ -202,7 +202,6 @@ LONG_FUNCTIONS = {
     "pipelines.experiment._log_experiment:log_experiment",  # 155
     "models.rocking._single:simulate",  # 153
     "pipelines.experiment._figures:experiment_figures",  # 138
-    "fitting._forced:fit_forced_restitution",  # 134
     "pipelines.experiment._experiment:analyse_experiment",  # 127
     "models.rocking._event:run_event",  # 126
 }

@@ -12,8 +12,10 @@ PKG = Path(__file__).resolve().parents[1] / "rocklab"
 # Known and documented exceptions, each to disappear with the restructure of issue 16:
 #: TrackConfig.from_dict imports its parser lazily, and the parser builds TrackConfig.
 KNOWN_CYCLES = [{"rocklab.tracking.video._config", "rocklab.tracking.video._config_parse"}]
-#: Measurement modules that call the physics (the table-motion filters, the IMU table model).
-TRACKING_TO_MODELS = {"rocklab.tracking.video._motion", "rocklab.tracking.imu._table"}
+#: Measurement modules that call the physics (none: the base motion they make lives in rocklab.series).
+TRACKING_TO_MODELS: set = set()
+#: What the ground floor (rocklab.series, the data that crosses packages) may import from rocklab.
+SERIES_MAY_IMPORT = {"rocklab.blocks", "rocklab._errors", "rocklab._diagnostics", "rocklab._io"}
 
 
 def _module_name(path: Path) -> str:
@@ -125,6 +127,31 @@ def test_dependencies_flow_one_way(layer, forbidden):
         for d in deps:
             if d.startswith("rocklab.") and _subpackage(d) in forbidden and (mod, d) not in ALIASES:
                 bad.append(f"{mod} -> {d}")
+    assert not bad
+
+
+def test_series_is_the_ground_floor():
+    graph = _imports()
+    series = [m for m in graph if m == "rocklab.series" or m.startswith("rocklab.series.")]
+    assert len(series) >= 4  # the package and its modules were found
+    bad = [
+        f"{m} -> {d}"
+        for m in series
+        for d in graph[m]
+        if d.startswith("rocklab") and not d.startswith("rocklab.series") and d not in SERIES_MAY_IMPORT
+    ]
+    assert not bad
+
+
+def test_model_subpackages_do_not_import_up_into_spectra():
+    # the simulator's input (BaseMotion) lives in rocklab.series, not in the record readers
+    bad = [
+        f"{m} -> {d}"
+        for m, deps in _imports().items()
+        if m.startswith(("rocklab.models.rocking", "rocklab.models.column"))
+        for d in deps
+        if d.startswith("rocklab.models.spectra")
+    ]
     assert not bad
 
 

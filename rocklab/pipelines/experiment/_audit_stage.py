@@ -19,22 +19,22 @@ import numpy as np
 
 __all__ = ["audit_experiment", "fit_exclusions"]
 
-_3D_COLUMNS = ("pivot_slide_m", "pivot_uplift_m", "twist_rad", "out_of_plane_rad")
 
-
-def _from_tracks_csv(df):
+def _from_tracks_csv(rows):
+    """``rows``: one object's :class:`rocklab.series.Tracks`."""
     from ...tracking.rigid import audit_rocking
 
-    t, th = df["t_s"].to_numpy(float), df["theta_rad"].to_numpy(float)
-    sig = float(np.nanmedian(df["sigma_theta_rad"])) if "sigma_theta_rad" in df.columns else None
-    if all(c in df.columns for c in _3D_COLUMNS):
+    t, th = rows.theta()
+    cols = rows.frame.columns
+    sig = float(np.nanmedian(rows.column("sigma_theta_rad"))) if "sigma_theta_rad" in cols else None
+    if rows.is_3d:
         return audit_rocking(
             t,
             th,
-            slide_m=df["pivot_slide_m"].to_numpy(float),
-            uplift_m=df["pivot_uplift_m"].to_numpy(float),
-            twist_rad=df["twist_rad"].to_numpy(float),
-            out_of_plane_rad=df["out_of_plane_rad"].to_numpy(float),
+            slide_m=rows.column("pivot_slide_m"),
+            uplift_m=rows.column("pivot_uplift_m"),
+            twist_rad=rows.column("twist_rad"),
+            out_of_plane_rad=rows.column("out_of_plane_rad"),
             sigma_theta_rad=sig,
             source="3d",
         )

@@ -212,7 +212,7 @@ def analyse_experiment(
         timings["track_s"] = time.perf_counter() - t0
     if cfg.track is not None:
         track_rows = _read_track_csv(cfg.track.path, cfg.track.object)
-        measured["track"] = (track_rows["t_s"].to_numpy(float), track_rows["theta_rad"].to_numpy(float))
+        measured["track"] = track_rows.theta()  # the samples `rocklab fit restitution` fits
     rot = None
     if cfg.imu is not None:
         t1 = time.perf_counter()

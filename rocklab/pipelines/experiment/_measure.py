@@ -18,21 +18,10 @@ __all__: list[str] = []
 
 
 def _read_track_csv(path: Path, obj: str | None):
-    """The rows of ``obj`` in a tracked CSV (``t_s, theta_rad`` and whatever else it has), checked."""
-    import pandas as pd
+    """The rows of ``obj`` in a tracked CSV (:class:`rocklab.series.Tracks`), checked."""
+    from ...series import read_tracks
 
-    try:
-        df = pd.read_csv(path)
-    except Exception as e:  # noqa: BLE001 - pandas raises many types
-        raise InputError(f"{path}: not a readable CSV ({type(e).__name__})") from None
-    for c in ("t_s", "theta_rad"):
-        if c not in df.columns:
-            raise InputError(f"{path}, line 1: missing column {c!r}; a track CSV needs t_s, theta_rad")
-    if obj is not None and "object" in df.columns:
-        df = df[df["object"].astype(str) == obj]
-        if df.empty:
-            raise InputError(f"{path}: no rows for object {obj!r}; check [sources.track] object")
-    return df
+    return read_tracks(path).rows(obj, fix="[sources.track] object")
 
 
 def _probe_fps(path, given: float | None) -> float:
@@ -57,9 +46,10 @@ def _measure_video(cfg: ExperimentConfig, progress: bool, keep_film: bool):
         tcfg = replace(tcfg, video=replace(tcfg.video, corrections=str(cfg.video.corrections)))
     film = ReviewFilm(_probe_fps(cfg.video.path, cfg.video.fps), cfg.video_decimation) if keep_film else None
     tr = track_video(cfg.video.path, tcfg, fps=cfg.video.fps, progress=progress, on_frame=film)
+    from ...series import Tracks
+
     df = tr.to_frame()
-    sel = df[df["object"] == cfg.video.object]
-    if sel.empty:
+    if cfg.video.object not in set(df["object"]):
         raise InputError(
             f"{cfg.path}: [sources.video] object {cfg.video.object!r} was never tracked in "
             f"{cfg.video.path.name}; objects seen: {sorted(set(df['object']))}"
@@ -74,7 +64,8 @@ def _measure_video(cfg: ExperimentConfig, progress: bool, keep_film: bool):
             "acc_m_s2": np.asarray(tm.ax_m_s2),
         }
     review = film.finish() if film is not None else None
-    return (sel["t_s"].to_numpy(float), sel["theta_rad"].to_numpy(float)), table, tr, review
+    # the samples tracks.csv would give `rocklab fit restitution`: usable statuses only
+    return Tracks.from_frame(df).rows(cfg.video.object).theta(), table, tr, review
 
 
 def _measure_imu(cfg: ExperimentConfig):

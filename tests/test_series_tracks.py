@@ -1,0 +1,162 @@
+"""``tracks.csv`` has one definition (rocklab.series): one reader, one writer, one status rule,
+so ``rocklab fit restitution`` and ``rocklab run`` fit the same samples of the same file."""
+
+import json
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from rocklab import Block, InputError
+from rocklab.models import simulate
+from rocklab.series import TRACK3D_COLUMNS, TRACK_COLUMNS, USABLE_STATUSES, TableMotion, read_tracks, write_tracks
+
+FPS = 100.0
+ETA = 0.9
+
+
+def _rows(n, obj="block_1", t0=0.0, extra3d=False, seed=0):
+    rng = np.random.default_rng(seed)
+    t = t0 + np.arange(n) / FPS
+    cols = {
+        "frame": np.arange(n),
+        "t_s": t,
+        "object": obj,
+        "x_px": rng.normal(size=n),
+        "y_px": rng.normal(size=n),
+        "x_m": rng.normal(size=n),
+        "y_m": rng.normal(size=n),
+        "theta_rad": rng.normal(0, 0.05, n),
+        "sigma_theta_rad": np.full(n, 1e-3),
+        "quality": np.ones(n),
+        "status": np.array(["ok"] * n, dtype=object),
+    }
+    if extra3d:
+        for c in TRACK3D_COLUMNS[len(TRACK_COLUMNS) :]:
+            cols[c] = rng.normal(size=n)
+    return pd.DataFrame(cols)
+
+
+@pytest.mark.parametrize("suffix", [".csv", ".parquet"])
+@pytest.mark.parametrize("extra3d", [False, True])
+def test_write_then_read_gives_the_same_rows(tmp_path, suffix, extra3d):
+    # absolute times (epoch seconds) at 100 fps: 9 digits would merge every sample into a few times
+    df = _rows(50, t0=1.7e9 + 0.123456, extra3d=extra3d)
+    df.loc[[3, 7], "status"] = ["lost", "dropped"]
+    df.loc[[3, 7], ["x_m", "y_m", "theta_rad"]] = np.nan
+    p = write_tracks(tmp_path / f"tracks{suffix}", df)
+    back = read_tracks(p)
+    assert back.is_3d == extra3d
+    assert np.array_equal(back.column("t_s"), df["t_s"].to_numpy(float))  # exact
+    assert np.unique(back.column("t_s")).size == 50
+    got, want = back.column("theta_rad"), df["theta_rad"].to_numpy(float)
+    assert np.allclose(got, want, rtol=1e-8, atol=0, equal_nan=True)
+    assert list(back.frame["status"]) == list(df["status"])
+    assert back.column("line")[0] == 2  # line 1 is the header
+
+
+def test_writer_refuses_rows_of_another_layout(tmp_path):
+    df = _rows(5).drop(columns=["quality"])
+    with pytest.raises(ValueError, match="TRACK_COLUMNS"):
+        write_tracks(tmp_path / "tracks.csv", df)
+    assert not (tmp_path / "tracks.csv").exists()
+
+
+def test_usable_rows_follow_the_status_not_the_value(tmp_path):
+    df = _rows(8)
+    # every status but ok/corrected is unusable even where the row holds a number
+    df["status"] = ["ok", "corrected", "interpolated", "low_quality", "outlier", " OK ", "lost", "ok"]
+    df.loc[7, "theta_rad"] = np.nan  # ok but no value: unusable too
+    p = write_tracks(tmp_path / "tracks.csv", df)
+    rows = read_tracks(p).rows("block_1")
+    assert rows.usable().tolist() == [True, True, False, False, False, True, False, False]
+    t, th = rows.theta()
+    assert t.size == 8 and np.isnan(th[[2, 3, 4, 6, 7]]).all()
+    assert np.allclose(th[[0, 1, 5]], df["theta_rad"].to_numpy(float)[[0, 1, 5]], rtol=1e-8, atol=0)
+    assert set(USABLE_STATUSES) == {"ok", "corrected"}
+
+
+def test_the_block_is_picked_or_named(tmp_path):
+    df = pd.concat([_rows(4, "table"), _rows(4, "block_1")], ignore_index=True)
+    p = write_tracks(tmp_path / "tracks.csv", df)
+    tr = read_tracks(p)
+    assert tr.block_id() == "block_1"  # the only object that is not the table
+    assert tr.rows().column("frame").tolist() == [0, 1, 2, 3]
+    assert (tr.rows("table").frame["object"] == "table").all()
+    with pytest.raises(InputError, match=r"object 'block_2' not in the file.*fix \[sources.track\] object"):
+        tr.rows("block_2", fix="[sources.track] object")
+    two = write_tracks(tmp_path / "two.csv", pd.concat([df, _rows(4, "block_2")], ignore_index=True))
+    with pytest.raises(InputError, match="several objects"):
+        read_tracks(two).rows()
+
+
+def test_reader_names_the_missing_column(tmp_path):
+    p = tmp_path / "t.csv"
+    pd.DataFrame({"t_s": [0.0, 0.1], "angle": [0.0, 0.1]}).to_csv(p, index=False)
+    with pytest.raises(InputError, match=r"t\.csv, line 1: missing column\(s\) \['theta_rad'\]"):
+        read_tracks(p)
+
+
+def test_table_motion_from_acceleration_has_no_displacement():
+    t = np.arange(200) / 200.0
+    a = np.sin(2 * np.pi * 3 * t)
+    tm = TableMotion.from_acceleration(t + 5.0, a, source="imu")
+    assert tm.x_m is None and list(tm.columns()) == ["acc_m_s2"]
+    bm = tm.to_base_motion()
+    assert bm.t_s[0] == 0.0 and bm.dt_s == pytest.approx(1 / 200.0)
+    assert np.array_equal(bm.acc_m_s2, a)
+
+
+def _session(tmp_path):
+    """A free-rocking track of block_1 (and a still table) with frames lost, dropped, corrected,
+    interpolated and of low quality; the not-usable rows hold wrong numbers, not NaN."""
+    blk = Block(0.1, 0.2)
+    theta0 = 0.7 * blk.alpha_rad
+    sim = simulate(blk, theta0_rad=theta0, duration_s=5.0, restitution="constant", eta=ETA)
+    t_rel = 0.4
+    t = np.arange(0, 5.0, 1 / FPS)
+    th = np.where(t < t_rel, theta0, np.interp(t - t_rel, sim.t_s, sim.theta_rad))
+    th = th + np.random.default_rng(3).normal(0, np.radians(0.02), t.size)
+    df = _rows(t.size)
+    df["t_s"], df["theta_rad"] = t, th
+    status = np.array(["ok"] * t.size, dtype=object)
+    k = np.arange(t.size)
+    for every, start, what in ((23, 61, "interpolated"), (29, 70, "low_quality"), (31, 90, "outlier")):
+        sel = (k >= start) & (k < 300) & ((k - start) % every == 0)
+        status[sel] = what
+        df.loc[sel, "theta_rad"] = th[sel] + 0.03  # a number, but a wrong one
+    status[150:153] = "lost"
+    status[200:202] = "dropped"
+    df.loc[np.isin(status, ("lost", "dropped")), "theta_rad"] = np.nan
+    status[[120, 260]] = "corrected"  # vouched for by hand: kept
+    df["status"] = status
+    table = _rows(t.size, "table")
+    table["t_s"], table["theta_rad"] = t, 0.0
+    d = tmp_path / "exp"
+    d.mkdir()
+    write_tracks(d / "tracks.csv", pd.concat([table, df], ignore_index=True))
+    (d / "experiment.toml").write_text(
+        'name = "same-samples"\n[block]\nb_m = 0.1\nh_m = 0.2\n'
+        '[sources.track]\npath = "tracks.csv"\nobject = "block_1"\n[output]\nrrd = false\n'
+    )
+    return d, int(np.sum(~np.isin(status, USABLE_STATUSES)))
+
+
+def test_fit_and_run_fit_the_same_samples(tmp_path, run_cli):
+    d, n_bad = _session(tmp_path)
+    assert n_bad > 20
+    rc, out, err = run_cli(
+        "fit", "restitution", d / "tracks.csv", "--width", "0.1", "--height", "0.2", "--nan", "skip", "--json"
+    )
+    assert rc == 0, err
+    fit = json.loads(out)
+    assert fit["n_skipped"] == n_bad
+    rc, out, err = run_cli("run", d / "experiment.toml", "--out", tmp_path / "out", "--json")
+    rep = json.loads((tmp_path / "out" / "report.json").read_text())
+    assert rep["fit"]["status"] == fit["status"] == "ok"
+    assert f"{n_bad} samples of the track" in " ".join(rep["messages"])
+    for key in ("eta_e", "theta0_rad", "release_t_s", "rms_residual_rad"):
+        assert rep["fit"][key] == pytest.approx(fit[key], rel=1e-9, abs=1e-12), key
+    per = [np.array(x["per_impact_eta"], dtype=float) for x in (rep["fit"], fit)]  # null: no eta there
+    np.testing.assert_allclose(per[0], per[1], rtol=1e-9, equal_nan=True)
+    assert abs(fit["eta_e"] - ETA) < 0.02  # and the samples they share are the right ones

@@ -12,11 +12,12 @@ from __future__ import annotations
 import numpy as np
 
 from ..._errors import InputError
+from ...series import TableMotion
 
 __all__ = ["analyse_column", "base_from_table"]
 
 
-def base_from_table(table: dict, t0_s: float, where: str, *, sign: float = 1.0, dt_s: float = 1e-3):
+def base_from_table(table: TableMotion, t0_s: float, where: str, *, sign: float = 1.0, dt_s: float = 1e-3):
     """The measured table acceleration as a :class:`BaseMotion` starting at ``t0_s``.
 
     A near-critical rocking response is sensitive to how frame-rate samples are
@@ -28,8 +29,8 @@ def base_from_table(table: dict, t0_s: float, where: str, *, sign: float = 1.0, 
 
     from ...models import BaseMotion
 
-    tt = np.asarray(table["t_s"], float)
-    aa = np.asarray(table["acc_m_s2"], float)
+    tt = np.asarray(table.t_s, float)
+    aa = np.asarray(table.ax_m_s2, float)
     fin = np.isfinite(tt) & np.isfinite(aa)
     if fin.sum() < 4:
         raise InputError(

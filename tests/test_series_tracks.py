@@ -160,3 +160,31 @@ def test_fit_and_run_fit_the_same_samples(tmp_path, run_cli):
     per = [np.array(x["per_impact_eta"], dtype=float) for x in (rep["fit"], fit)]  # null: no eta there
     np.testing.assert_allclose(per[0], per[1], rtol=1e-9, equal_nan=True)
     assert abs(fit["eta_e"] - ETA) < 0.02  # and the samples they share are the right ones
+
+
+def test_reader_refuses_a_damaged_table(tmp_path):
+    p = tmp_path / "tracks.parquet"
+    p.write_bytes(b"PAR1 not really parquet")
+    with pytest.raises(InputError, match=r"tracks\.parquet: not a readable table"):
+        read_tracks(p)
+
+
+def test_experiment_stages_are_objects_until_the_report(tmp_path):
+    from rocklab.pipelines.experiment import analyse_experiment, load_experiment
+    from rocklab.pipelines.experiment._result import FitStage, LawSimulation
+
+    d, n_bad = _session(tmp_path)
+    res = analyse_experiment(load_experiment(d / "experiment.toml"))
+    assert isinstance(res.fit, FitStage) and not res.fit.forced
+    assert all(isinstance(s, LawSimulation) for s in res.simulations.values())
+    th0, t_rel = res.fit.release()
+    assert abs(t_rel - 0.4) < 0.02 and abs(res.fit.eta_e - ETA) < 0.02
+    # the eta_e law simulates with the fitted value and starts at the fitted release
+    sim = res.simulations["eta_e"]
+    assert sim.eta == res.fit.eta_e and sim.t_s[0] == pytest.approx(t_rel, abs=1e-12)
+    assert sim.theta_rad[0] == pytest.approx(th0, abs=1e-12)
+    rep = res.to_dict()
+    assert rep["fit"]["eta_e"] == res.fit.eta_e and rep["fit"]["excluded_impacts"] == []
+    np.testing.assert_array_equal(rep["per_impact_eta"], res.fit.fit.per_impact_eta)  # NaN where none
+    assert rep["simulations"]["eta_e"]["n_impacts"] == len(sim.impacts) > 10
+    assert rep["table"] is None and rep["sync"] is None and rep["audit"]["verdict"] == res.audit.verdict

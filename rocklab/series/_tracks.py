@@ -217,10 +217,10 @@ def read_tracks(path) -> Tracks:
             df = pd.read_csv(path)
     except pd.errors.EmptyDataError:
         raise InputError(f"{where(path)}empty file; need columns t_s,theta_rad") from None
-    except ImportError:
-        raise InputError(f"{where(path)}reading Parquet needs pyarrow; install it or give the CSV") from None
     except Exception as e:  # noqa: BLE001 - pandas and pyarrow raise many types for a damaged file
-        raise InputError(f"{where(path)}not a readable table ({type(e).__name__}); give a tracks.csv") from None
+        raise InputError(
+            f"{where(path)}not a readable table ({type(e).__name__}); give a CSV or Parquet file with t_s, theta_rad"
+        ) from None
     return Tracks(_checked(df, path), path)
 
 
@@ -246,10 +246,7 @@ def write_tracks(path, frame, *, side: bool = False) -> Path:
     path = Path(path)
     with atomic_path(path, side=side) as tmp:
         if path.suffix.lower() == ".parquet":
-            try:
-                frame.to_parquet(tmp, index=False)
-            except ImportError:
-                raise InputError(f"{path}: writing Parquet needs pyarrow; install it or write a .csv") from None
+            frame.to_parquet(tmp, index=False)
         else:
             out = frame.copy()
             out["t_s"] = [repr(float(v)) for v in out["t_s"].to_numpy(float)]

@@ -150,18 +150,18 @@ def experiment_figures(res, out_dir) -> dict[str, Path]:
 
     if res.column is not None:
         c = res.column
-        n = len(c["objects"])
+        n = len(c.objects)
         fig, axs = plt.subplots(n, 1, figsize=(10, 2.2 * n + 1), sharex=True, squeeze=False)
-        for i, (ax, o) in enumerate(zip(axs[:, 0], c["objects"])):
-            ax.plot(c["t_s"], c["theta_measured_rad"][:, i], lw=1.2, label="measured (video)")
-            ax.plot(c["sim_t_s"], c["theta_sim_rad"][:, i], lw=0.9, ls="--", label="column model")
-            if "theta_truth_rad" in c:
-                tt, th = c["theta_truth_rad"]
+        for i, (ax, o) in enumerate(zip(axs[:, 0], c.objects)):
+            ax.plot(c.t_s, c.theta_measured_rad[:, i], lw=1.2, label="measured (video)")
+            ax.plot(c.sim_t_s, c.theta_sim_rad[:, i], lw=0.9, ls="--", label="column model")
+            if c.theta_truth is not None:
+                tt, th = c.theta_truth
                 ax.plot(tt, th[:, i], lw=0.6, color="k", alpha=0.5, label="truth")
             ax.set_ylabel(f"θ {o} (rad)")
             ax.grid(alpha=0.3)
         axs[0, 0].legend(fontsize=8)
-        axs[0, 0].set_title(f"{res.name}: column, measured vs simulated (status {c['status']})")
+        axs[0, 0].set_title(f"{res.name}: column, measured vs simulated (status {c.status})")
         axs[-1, 0].set_xlabel("t (s)")
         figs["column"] = save_png(fig, out / "column.png")
 

@@ -126,7 +126,7 @@ def _overlay_fn(res):
     shapes = []
     if tr is not None and getattr(tr, "plane_map", None) is not None:
         rect = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1], [-1, -1]]) * [b.b_m / 2, b.h_m / 2]
-        blocks = res.column["objects"] if res.column is not None else [res.config.video.object]
+        blocks = res.column.objects if res.column is not None else [res.config.video.object]
         for o in tr.config.objects:
             targets = o.dots if o.dots else o.marker_positions_m
             # the outline assumes the object frame is centred on the block's front face (as
@@ -271,22 +271,22 @@ def log_experiment(
     block_paths = [blk]
     if res.column is not None:
         c = res.column
-        block_paths = [f"{ROOT}/{o}" for o in c["objects"]]
+        block_paths = [f"{ROOT}/{o}" for o in c.objects]
         for i, bp in enumerate(block_paths):
             rows[f"{bp}/theta/measured_video"] = theta(
-                rec, bp, "measured_video", c["t_s"], c["theta_measured_rad"][:, i], "measured (video)"
+                rec, bp, "measured_video", c.t_s, c.theta_measured_rad[:, i], "measured (video)"
             )
             rows[f"{bp}/theta/sim_column"] = theta(
-                rec, bp, "sim_column", c["sim_t_s"], c["theta_sim_rad"][:, i], "column model"
+                rec, bp, "sim_column", c.sim_t_s, c.theta_sim_rad[:, i], "column model"
             )
-            sim_on = np.interp(c["t_s"], c["sim_t_s"], c["theta_sim_rad"][:, i], left=np.nan, right=np.nan)
+            sim_on = np.interp(c.t_s, c.sim_t_s, c.theta_sim_rad[:, i], left=np.nan, right=np.nan)
             rows[f"{bp}/residual/measured_minus_sim"] = log_series(
-                rec, f"{bp}/residual/measured_minus_sim", c["t_s"], c["theta_measured_rad"][:, i] - sim_on
+                rec, f"{bp}/residual/measured_minus_sim", c.t_s, c.theta_measured_rad[:, i] - sim_on
             )
-            if "theta_truth_rad" in c:
-                tt, th = c["theta_truth_rad"]
+            if c.theta_truth is not None:
+                tt, th = c.theta_truth
                 rows[f"{bp}/theta/truth"] = theta(rec, bp, "truth", tt, th[:, i], "truth")
-        conf = c["configurations"]
+        conf = c.configurations
         if len(conf):
             log_events(
                 rec,

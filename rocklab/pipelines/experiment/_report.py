@@ -36,15 +36,13 @@ def series_frame(res):
             cols[f"table_{k}"] = np.interp(t, res.table.t_s, v, left=np.nan, right=np.nan)
     if res.column is not None:
         c = res.column
-        for i, o in enumerate(c["objects"]):
-            cols[f"theta_{o}_video_rad"] = np.interp(
-                t, c["t_s"], c["theta_measured_rad"][:, i], left=np.nan, right=np.nan
-            )
+        for i, o in enumerate(c.objects):
+            cols[f"theta_{o}_video_rad"] = np.interp(t, c.t_s, c.theta_measured_rad[:, i], left=np.nan, right=np.nan)
             cols[f"theta_{o}_sim_column_rad"] = np.interp(
-                t, c["sim_t_s"], c["theta_sim_rad"][:, i], left=np.nan, right=np.nan
+                t, c.sim_t_s, c.theta_sim_rad[:, i], left=np.nan, right=np.nan
             )
-            if "theta_truth_rad" in c:
-                tt, th = c["theta_truth_rad"]
+            if c.theta_truth is not None:
+                tt, th = c.theta_truth
                 cols[f"theta_{o}_truth_rad"] = np.interp(t, tt, th[:, i], left=np.nan, right=np.nan)
     return pd.DataFrame(cols)
 
@@ -131,30 +129,27 @@ def _summary_md(res, figs: dict, rrd: bool) -> str:
         ]
     if res.column is not None:
         c = res.column
-        cmp_ = c["comparison"]
+        cmp_ = c.comparison
         lines += [
-            f"Column of {len(c['objects'])} blocks (cut {1000 * c['cut_m']:.1f} mm, "
-            f"{c['impacts_per_closing']} impact(s) per closing): simulation status {c['status']}",
+            f"Column of {len(c.objects)} blocks (cut {1000 * c.cut_m:.1f} mm, "
+            f"{c.impacts_per_closing} impact(s) per closing): simulation status {c.status}",
             "",
             "| block | RMS measured − simulated (rad) | peak measured (rad) | peak simulated (rad) |",
             "|---|---|---|---|",
         ]
-        for o, r, pm, ps in zip(
-            c["objects"], cmp_["rms_theta_rad"], cmp_["peak_measured_rad"], cmp_["peak_simulated_rad"]
-        ):
+        for o, r, pm, ps in zip(c.objects, cmp_.rms_theta_rad, cmp_.peak_measured_rad, cmp_.peak_simulated_rad):
             lines.append(f"| {o} | {_g(r)} | {_g(pm)} | {_g(ps)} |")
-        sq = cmp_["sequence"]
+        sq = cmp_.sequence
         lines += [
             "",
-            f"Opening/closing sequence, measured vs simulated: {sq['n_matched']} of "
-            f"{sq['n_measured']} measured / {sq['n_simulated']} simulated events matched "
-            f"(median timing error {_g(sq['timing_error_s'])} s)",
+            f"Opening/closing sequence, measured vs simulated: {sq.n_matched} of "
+            f"{sq.n_measured} measured / {sq.n_simulated} simulated events matched "
+            f"(median timing error {_g(sq.timing_error_s)} s)",
         ]
-        if "sequence_vs_truth" in c:
-            st = c["sequence_vs_truth"]
+        if c.sequence_vs_truth is not None:
+            st = c.sequence_vs_truth
             lines += [
-                f"Measured sequence vs truth: same sequence = {st['same_sequence']} "
-                f"({st['n_matched']}/{st['n_measured']} events)"
+                f"Measured sequence vs truth: same sequence = {st.same_sequence} ({st.n_matched}/{st.n_measured} events)"
             ]
         lines.append("")
     for d in res.diagnostics:

@@ -15,7 +15,15 @@ from ... import __version__
 from ...series import TableMotion
 from ._config import ExperimentConfig
 
-__all__ = ["ExperimentResult", "FitStage", "ExcludedImpact", "LawSimulation", "TruthComparison", "ClockSync"]
+__all__ = [
+    "ExperimentResult",
+    "FitStage",
+    "ExcludedImpact",
+    "LawSimulation",
+    "TruthComparison",
+    "ClockSync",
+    "ColumnStage",
+]
 
 
 @dataclass(frozen=True)
@@ -192,6 +200,66 @@ class ClockSync:
 
 
 @dataclass(frozen=True)
+class ColumnStage:
+    """A column experiment: the tracked blocks against the column model under the measured table.
+
+    Attributes
+    ----------
+    objects : tuple of str
+        The blocks, bottom to top.
+    t_s : ndarray, shape (m,)
+    theta_measured_rad : ndarray, shape (m, n)
+        Tracked angles, counter-clockwise as the camera sees them.
+    sim_t_s : ndarray, shape (k,)
+    theta_sim_rad : ndarray, shape (k, n)
+        The column model's angles, in the measurement's sense.
+    status : str
+        The simulation's end state.
+    configurations : pandas.DataFrame
+        The model's joint configurations, on the measured clock.
+    comparison : rocklab.models.ColumnComparison
+    cut_m : float
+        The joints' cut, m.
+    impacts_per_closing : int
+    theta_truth : (t_s, theta_rad (m', n)) or None
+        A synthetic session's true angles.
+    sequence_vs_truth : rocklab.models.SequenceComparison or None
+        The measured opening/closing sequence against the truth's.
+    theta_rms_error_rad : list of float or None
+        Per block, RMS of measured − true θ.
+    """
+
+    objects: tuple
+    t_s: np.ndarray
+    theta_measured_rad: np.ndarray
+    sim_t_s: np.ndarray
+    theta_sim_rad: np.ndarray
+    status: str
+    configurations: object
+    comparison: object
+    cut_m: float
+    impacts_per_closing: int
+    theta_truth: tuple | None = None
+    sequence_vs_truth: object = None
+    theta_rms_error_rad: list | None = None
+
+    def to_dict(self) -> dict:
+        """``report.json``'s ``column``."""
+        d = {
+            "objects": list(self.objects),
+            "status": self.status,
+            "comparison": self.comparison.to_dict(),
+            "cut_m": self.cut_m,
+            "impacts_per_closing": self.impacts_per_closing,
+        }
+        if self.sequence_vs_truth is not None:
+            d["sequence_vs_truth"] = self.sequence_vs_truth.to_dict()
+        if self.theta_rms_error_rad is not None:
+            d["theta_rms_error_rad"] = list(self.theta_rms_error_rad)
+        return d
+
+
+@dataclass(frozen=True)
 class ExperimentResult:
     """Everything one experiment produced. SI units; θ in rad, t in s.
 
@@ -222,8 +290,8 @@ class ExperimentResult:
         Seconds each stage took.
     frames : rocklab.tracking.TrackResult or None
         The video tracker's result (per-frame overlays).
-    column : dict or None
-        Column experiments: :func:`rocklab.pipelines.experiment._column_run.analyse_column`.
+    column : ColumnStage or None
+        Column experiments (:func:`rocklab.pipelines.experiment._column_run.analyse_column`).
     video : ReviewVideo or None
         The review film (:mod:`rocklab.pipelines.experiment._review_video`).
     diagnostics : tuple of rocklab._diagnostics.Diagnostic
@@ -250,7 +318,7 @@ class ExperimentResult:
     messages: list = field(default_factory=list)
     timings_s: dict = field(default_factory=dict)
     frames: object = None
-    column: dict | None = None
+    column: ColumnStage | None = None
     video: object = None
     diagnostics: tuple = ()
     audit: object = None
@@ -280,7 +348,7 @@ class ExperimentResult:
             "simulations": {law: s.to_dict() for law, s in self.simulations.items()},
             "table": None if self.table is None else _table_peaks(self.table),
             "truth": None if self.truth is None else self.truth.to_dict(),
-            "column": None if self.column is None else _column_numbers(self.column),
+            "column": None if self.column is None else self.column.to_dict(),
             "review_video": None
             if self.video is None
             else {
@@ -308,21 +376,6 @@ def _table_peaks(table: TableMotion) -> dict:
         "peak_disp_m": None if table.x_m is None else float(np.nanmax(np.abs(table.x_m))),
         "peak_acc_m_s2": float(np.nanmax(np.abs(table.ax_m_s2))),
     }
-
-
-_COLUMN_KEYS = (
-    "objects",
-    "status",
-    "comparison",
-    "cut_m",
-    "impacts_per_closing",
-    "sequence_vs_truth",
-    "theta_rms_error_rad",
-)
-
-
-def _column_numbers(column: dict) -> dict:
-    return {k: column[k] for k in _COLUMN_KEYS if k in column}
 
 
 def _versions() -> dict:

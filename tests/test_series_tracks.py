@@ -188,3 +188,51 @@ def test_experiment_stages_are_objects_until_the_report(tmp_path):
     np.testing.assert_array_equal(rep["per_impact_eta"], res.fit.fit.per_impact_eta)  # NaN where none
     assert rep["simulations"]["eta_e"]["n_impacts"] == len(sim.impacts) > 10
     assert rep["table"] is None and rep["sync"] is None and rep["audit"]["verdict"] == res.audit.verdict
+
+
+@pytest.fixture(scope="module")
+def rendered(tmp_path_factory):
+    """A rendered free-rocking session (``rocklab synth``) whose target is hidden for two frames
+    (filled by interpolation, asked for in track.toml), with a frame dropped and one corrected by
+    hand, tracked to tracks.csv."""
+    from rocklab.pipelines import main
+
+    root = tmp_path_factory.mktemp("rendered")
+    s = root / "s"
+    argv = ["synth", "--out", s, "--seed", 5, "--size", "480x270", "--no-imu", "--occlusion", "0.82,0.86"]
+    assert main([str(a) for a in argv]) == 0
+    toml = s / "track.toml"
+    text = toml.read_text()
+    assert "interpolate_max_gap_frames = 0" in text
+    toml.write_text(text.replace("interpolate_max_gap_frames = 0", "interpolate_max_gap_frames = 8"))
+    (root / "fix.csv").write_text(
+        "object,frame,to_frame,t_s,to_t_s,action,theta_rad\nblock_1,35,,,,drop,\nblock_1,60,,,,,0.05\n"
+    )
+    argv = ["track", s / "video.mkv", "--config", toml, "-o", root / "tracks.csv", "--corrections", root / "fix.csv"]
+    assert main([str(a) for a in argv]) == 0
+    for src in ("track", "video"):
+        (s / f"exp_{src}.toml").write_text(
+            f'name = "{src}"\n[block]\nb_m = 0.1\nh_m = 0.2\n[sources]\nprimary = "{src}"\n'
+            '[sources.track]\npath = "../tracks.csv"\nobject = "block_1"\n'
+            '[sources.video]\npath = "video.mkv"\ntrack_config = "track.toml"\nobject = "block_1"\n'
+            'corrections = "../fix.csv"\n[output]\nrrd = false\nfigures = false\n'
+        )
+    return root
+
+
+def test_fit_and_run_use_the_same_samples_of_a_rendered_session(rendered, run_cli):
+    status = read_tracks(rendered / "tracks.csv").rows("block_1").frame["status"].value_counts().to_dict()
+    assert status["interpolated"] >= 2 and status["dropped"] == 1 and status["corrected"] == 1
+    n_bad = status["interpolated"] + status["dropped"]
+    rc, out, err = run_cli(
+        "fit", "restitution", rendered / "tracks.csv", "--width", 0.1, "--height", 0.2, "--nan", "skip", "--json"
+    )
+    fit = json.loads(out)
+    assert rc == 0 and fit["status"] == "ok" and fit["n_skipped"] == n_bad, err
+    assert abs(fit["eta_e"] - 0.75) < 0.02  # the session's true eta
+    for src, rel in (("track", 1e-12), ("video", 1e-8)):  # tracks.csv holds 9 significant digits
+        run_cli("run", rendered / "s" / f"exp_{src}.toml", "--out", rendered / f"out_{src}")
+        rep = json.loads((rendered / f"out_{src}" / "report.json").read_text())["fit"]
+        assert rep["n_skipped"] == n_bad, src  # the interpolated samples are not fitted by either
+        for key in ("eta_e", "theta0_rad", "release_t_s"):
+            assert rep[key] == pytest.approx(fit[key], rel=rel), (src, key)

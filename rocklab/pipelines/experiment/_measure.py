@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from ..._errors import InputError
-from ...series import TableMotion
+from ...series import TableMotion, Tracks, read_tracks
 from ._config import ExperimentConfig
 from ._review_video import ReviewFilm
 
@@ -20,8 +20,6 @@ __all__: list[str] = []
 
 def _read_track_csv(path: Path, obj: str | None):
     """The rows of ``obj`` in a tracked CSV (:class:`rocklab.series.Tracks`), checked."""
-    from ...series import read_tracks
-
     return read_tracks(path).rows(obj, fix="[sources.track] object")
 
 
@@ -47,8 +45,6 @@ def _measure_video(cfg: ExperimentConfig, progress: bool, keep_film: bool):
         tcfg = replace(tcfg, video=replace(tcfg.video, corrections=str(cfg.video.corrections)))
     film = ReviewFilm(_probe_fps(cfg.video.path, cfg.video.fps), cfg.video_decimation) if keep_film else None
     tr = track_video(cfg.video.path, tcfg, fps=cfg.video.fps, progress=progress, on_frame=film)
-    from ...series import Tracks
-
     df = tr.to_frame()
     if cfg.video.object not in set(df["object"]):
         raise InputError(

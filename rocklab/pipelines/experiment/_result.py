@@ -8,12 +8,20 @@ plain dicts only in :meth:`ExperimentResult.to_dict`, for ``report.json``.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ... import __version__
+from ...blocks import Block
 from ...series import TableMotion
 from ._config import ExperimentConfig
+from ._review_video import ReviewVideo
+
+if TYPE_CHECKING:
+    from ...fitting import ForcedRestitutionFit, RestitutionFit
+    from ...tracking import SyncResult, TrackResult
+    from ...tracking.rigid import AuditResult
 
 __all__ = [
     "ExperimentResult",
@@ -63,7 +71,7 @@ class FitStage:
         A free fit's impacts flagged by the audit (None for a forced fit: it has no impacts).
     """
 
-    fit: object
+    fit: RestitutionFit | ForcedRestitutionFit
     excluded_impacts: tuple | None = None
 
     @property
@@ -188,8 +196,8 @@ class ClockSync:
         The table IMU, from the table accelerations.
     """
 
-    imu: object = None
-    table_imu: object = None
+    imu: SyncResult | None = None
+    table_imu: SyncResult | None = None
 
     def to_dict(self) -> dict:
         """The block IMU's numbers, with ``table_imu`` nested (``report.json``'s ``sync``)."""
@@ -304,7 +312,7 @@ class ExperimentResult:
 
     name: str
     config: ExperimentConfig
-    block: object
+    block: Block
     measured: dict
     primary: str
     sync: ClockSync | None
@@ -317,11 +325,11 @@ class ExperimentResult:
     status: str
     messages: list = field(default_factory=list)
     timings_s: dict = field(default_factory=dict)
-    frames: object = None
+    frames: TrackResult | None = None
     column: ColumnStage | None = None
-    video: object = None
+    video: ReviewVideo | None = None
     diagnostics: tuple = ()
-    audit: object = None
+    audit: AuditResult | None = None
     validation: object = None
 
     def to_dict(self) -> dict:

@@ -126,7 +126,7 @@ def speed(n=64, repeats=3):
     run = make_run(0)
     blk, (t, _), tab = run["block"], run["prim"], run["table"]
     unc = InputUncertainty(0.049, 0.003, 1e-3, 2e-4, 4e-4, 4e-4)
-    simulate_ensemble(blk, tab["t_s"], tab["acc_m_s2"], t, eta=run["eta"], theta0_rad=0.0, t_start_s=0.0, unc=unc, n=2)
+    simulate_ensemble(blk, tab.t_s, tab.ax_m_s2, t, eta=run["eta"], theta0_rad=0.0, t_start_s=0.0, unc=unc, n=2)
     best = np.inf
     for _ in range(repeats):
         t0 = time.perf_counter()

@@ -16,7 +16,7 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
-PACKAGES = ["blocks", "models", "fitting", "tracking", "synth"]
+PACKAGES = ["blocks", "series", "models", "fitting", "tracking", "synth"]
 HREF = re.compile(r'href="([^"]*)"')
 
 

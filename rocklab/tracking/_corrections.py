@@ -31,11 +31,10 @@ from pathlib import Path
 import numpy as np
 
 from .._errors import InputError
+from ..series import CORRECTION_STATUSES
 
 __all__ = ["Correction", "load_corrections", "apply_corrections", "CORRECTION_STATUSES"]
 
-#: Statuses a correction gives a frame (``tracks.csv``'s ``status``).
-CORRECTION_STATUSES = ("corrected", "dropped")
 _WHERE = ("frame", "to_frame", "t_s", "to_t_s")
 _VALUES = ("x_m", "y_m", "theta_rad", "theta_deg")
 _KEYS = ("object", "action", *_WHERE, *_VALUES)

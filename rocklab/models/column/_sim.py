@@ -27,7 +27,7 @@ import numpy as np
 from ..._errors import InputError
 from ...blocks import G as G_STD
 from ...blocks import Block
-from ..spectra._records import BaseMotion
+from ...series import BaseMotion
 
 if TYPE_CHECKING:
     import pandas as pd

@@ -33,7 +33,7 @@ import numpy as np
 from ..._errors import InputError, check_memory, check_time
 from ...blocks import G
 from ._newmark import STATUS_NAMES, run_single
-from ..spectra._records import BaseMotion
+from ...series import BaseMotion
 from ._restitution import make_restitution
 from ._result import RockingResult, block_energy
 

@@ -60,7 +60,7 @@ from ..._errors import InputError
 from ...blocks import G, inertia_coefficient
 from ..rocking._batch import free_rocking_overturns, simulate_batch
 from ._oas_grid import adaptive_verdicts, boundary_verdicts
-from ._records import BaseMotion
+from ...series import BaseMotion
 
 __all__ = ["OASResult", "overturning_spectrum", "normalised_critical_impulse", "critical_impulse",
            "fit_inclined_line", "simplified_oas", "OAS_DEFAULTS"]

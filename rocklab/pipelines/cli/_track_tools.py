@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from ..._errors import InputError
+from ...series import USABLE_STATUSES
 
 __all__ = ["track_init", "track_preview", "draw_init_preview", "contact_sheet"]
 
@@ -417,7 +418,7 @@ def _draw_pose(img, res, frame):
                 cv2.LINE_AA,
             )
             continue
-        if t.status[i] not in ("ok", "corrected") or t.x_px is None or not np.isfinite(t.x_px[i]):
+        if t.status[i] not in USABLE_STATUSES or t.x_px is None or not np.isfinite(t.x_px[i]):
             cv2.putText(
                 out, f"{t.object}: {t.status[i]}", (8, 46 + 20 * k), cv2.FONT_HERSHEY_SIMPLEX, 0.55, col, 2, cv2.LINE_AA
             )

@@ -58,11 +58,7 @@ def experiment_figures(res, out_dir) -> dict[str, Path]:
     val = res.validation
     for law, sim in res.simulations.items():
         (line,) = ax.plot(
-            sim["t_s"],
-            np.asarray(sim["theta_rad"]) / alpha,
-            lw=0.9,
-            ls="--",
-            label=f"simulated, {law} (η={sim['eta']:.3f})",
+            sim.t_s, np.asarray(sim.theta_rad) / alpha, lw=0.9, ls="--", label=f"simulated, {law} (η={sim.eta:.3f})"
         )
         band = val.bands.get(law) if val is not None else None
         if band is not None:
@@ -82,16 +78,14 @@ def experiment_figures(res, out_dir) -> dict[str, Path]:
         peak = max(float(np.nanmax(np.abs(th))) for _, th in res.measured.values()) / alpha
         ax.set_ylim(-max(1.1, 1.3 * peak), max(1.1, 1.3 * peak))
     if res.truth is not None:
-        ax.plot(
-            res.truth["t_s"], np.asarray(res.truth["theta_rad"]) / alpha, lw=0.6, color="k", alpha=0.5, label="truth"
-        )
+        ax.plot(res.truth.t_s, np.asarray(res.truth.theta_rad) / alpha, lw=0.6, color="k", alpha=0.5, label="truth")
     # the assumption audit's flags, where they happened (the impacts a fit should not trust)
-    flags = (res.audit or {}).get("flags") or []
+    flags = res.audit.flags if res.audit is not None else ()
     for i, f in enumerate(flags):
-        ax.axvline(f["t_s"], color="crimson", lw=0.8, alpha=0.7, label="audit flag" if i == 0 else None)
+        ax.axvline(f.t_s, color="crimson", lw=0.8, alpha=0.7, label="audit flag" if i == 0 else None)
         ax.annotate(
-            f"{f['kind']}",
-            (f["t_s"], 1.0),
+            f"{f.kind}",
+            (f.t_s, 1.0),
             xycoords=("data", "axes fraction"),
             rotation=90,
             va="top",
@@ -101,7 +95,7 @@ def experiment_figures(res, out_dir) -> dict[str, Path]:
         )
     ax.set_xlabel("t (s)")
     ax.set_ylabel("θ/α (-)")
-    verdict = (res.audit or {}).get("verdict")
+    verdict = res.audit.verdict if res.audit is not None else None
     ax.set_title(f"{res.name}: rotation, measured vs simulated" + (f" (audit: {verdict})" if verdict else ""))
     ax.legend(fontsize=8, ncol=2)
     ax.grid(alpha=0.3)
@@ -111,7 +105,7 @@ def experiment_figures(res, out_dir) -> dict[str, Path]:
         fig, ax = plt.subplots(figsize=(6, 4))
         k = np.arange(1, len(res.per_impact_eta) + 1)
         ax.plot(k, res.per_impact_eta, "o-", label="per impact (local fits)")
-        ex = [e["impact"] for e in res.fit.get("excluded_impacts") or [] if 1 <= e["impact"] <= len(k)]
+        ex = [e.impact for e in res.fit.excluded_impacts or () if 1 <= e.impact <= len(k)]
         if ex:
             ax.plot(
                 ex,
@@ -122,8 +116,8 @@ def experiment_figures(res, out_dir) -> dict[str, Path]:
                 mew=2,
                 label="flagged by the audit (not to trust)",
             )
-        if np.isfinite(res.fit.get("eta_e", np.nan)):
-            ax.axhline(res.fit["eta_e"], color="C1", label=f"η_e = {res.fit['eta_e']:.4f}")
+        if np.isfinite(res.fit.eta_e):
+            ax.axhline(res.fit.eta_e, color="C1", label=f"η_e = {res.fit.eta_e:.4f}")
         ax.axhline(res.block.eta_H, color="k", ls=":", label=f"η_H = {res.block.eta_H:.4f}")
         ax.set_xlabel("impact number")
         ax.set_ylabel("η = ω⁺/ω⁻")
@@ -134,7 +128,7 @@ def experiment_figures(res, out_dir) -> dict[str, Path]:
     if res.simulations:
         fig, ax = plt.subplots(figsize=(8, 4))
         for law, sim in res.simulations.items():
-            imp = sim.get("impacts")
+            imp = sim.impacts
             if imp is not None and len(imp):
                 e_ratio = (np.asarray(imp["omega_after_rad_s"]) / np.asarray(imp["omega_before_rad_s"])) ** 2
                 ax.plot(np.arange(1, len(e_ratio) + 1), 1 - e_ratio, "o-", ms=3, label=law)
@@ -156,29 +150,30 @@ def experiment_figures(res, out_dir) -> dict[str, Path]:
 
     if res.column is not None:
         c = res.column
-        n = len(c["objects"])
+        n = len(c.objects)
         fig, axs = plt.subplots(n, 1, figsize=(10, 2.2 * n + 1), sharex=True, squeeze=False)
-        for i, (ax, o) in enumerate(zip(axs[:, 0], c["objects"])):
-            ax.plot(c["t_s"], c["theta_measured_rad"][:, i], lw=1.2, label="measured (video)")
-            ax.plot(c["sim_t_s"], c["theta_sim_rad"][:, i], lw=0.9, ls="--", label="column model")
-            if "theta_truth_rad" in c:
-                tt, th = c["theta_truth_rad"]
+        for i, (ax, o) in enumerate(zip(axs[:, 0], c.objects)):
+            ax.plot(c.t_s, c.theta_measured_rad[:, i], lw=1.2, label="measured (video)")
+            ax.plot(c.sim_t_s, c.theta_sim_rad[:, i], lw=0.9, ls="--", label="column model")
+            if c.theta_truth is not None:
+                tt, th = c.theta_truth
                 ax.plot(tt, th[:, i], lw=0.6, color="k", alpha=0.5, label="truth")
             ax.set_ylabel(f"θ {o} (rad)")
             ax.grid(alpha=0.3)
         axs[0, 0].legend(fontsize=8)
-        axs[0, 0].set_title(f"{res.name}: column, measured vs simulated (status {c['status']})")
+        axs[0, 0].set_title(f"{res.name}: column, measured vs simulated (status {c.status})")
         axs[-1, 0].set_xlabel("t (s)")
         figs["column"] = save_png(fig, out / "column.png")
 
     if res.table is not None:
         fig, axs = plt.subplots(3, 1, figsize=(10, 6), sharex=True)
-        tt = res.table["t_s"]
+        tt = res.table.t_s
+        cols = res.table.columns()
         for ax, key, lab in zip(
             axs, ("disp_m", "vel_m_s", "acc_m_s2"), ("displacement (m)", "velocity (m/s)", "acceleration (m/s²)")
         ):
-            if key in res.table:
-                ax.plot(tt, res.table[key], lw=0.9)
+            if key in cols:
+                ax.plot(tt, cols[key], lw=0.9)
             ax.set_ylabel(lab)
             ax.grid(alpha=0.3)
         axs[-1].set_xlabel("t (s)")

@@ -24,7 +24,8 @@ from ...config import (
 from ._geometry import PlaneMap, SimilarityFit, calibrate_camera, fit_similarity
 from ._init import find_markers, suggest_config
 from ._level import level_from_reference
-from ._motion import TableMotion, choose_sg_window, estimate_noise, table_motion
+from ...series import TableMotion
+from ._motion import choose_sg_window, estimate_noise, table_motion
 from ._track import TRACK_COLUMNS, ObjectTrack, Observation, TrackResult, assemble_tracks, track_frames, track_video
 from ._video import VideoInfo, iter_video_frames, probe_video
 

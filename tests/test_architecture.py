@@ -227,7 +227,6 @@ def _function_lengths():
 #: a new long function fails, and so does a listed one that has become short (take it off).
 LONG_FUNCTIONS = {
     "fitting._restitution:fit_restitution",  # 210
-    "pipelines.experiment._log_experiment:log_experiment",  # 154
     "models.rocking._single:simulate",  # 153
     "pipelines.experiment._figures:experiment_figures",  # 133
     "models.rocking._event:run_event",  # 126

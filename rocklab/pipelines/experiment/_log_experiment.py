@@ -181,15 +181,28 @@ def log_experiment(
     With a film, nothing is logged before its first frame: the viewer opens with its time cursor
     at the timeline's start, which is then the film's first frame.
     """
-    import rerun as rr
-
     t_min = _film_start_s(res)
-    log_series = functools.partial(_log_series, t_min_s=t_min)
-    theta = functools.partial(_theta, t_min_s=t_min)
-
     rec = open_recording("rocklab", rrd_path, spawn=spawn, connect=connect, recording_id=f"experiment-{res.name}")
     rows: dict[str, int] = {}
     blk = f"{ROOT}/block_1"
+    _log_geometry(rec, res)
+    focus = _log_block(rec, res, blk, t_min, rows)
+    block_paths = _log_column(rec, res, t_min, rows) if res.column is not None else [blk]
+    if res.table is not None:
+        for k, v in res.table.columns().items():
+            rows[f"{ROOT}/table/{k}"] = _log_series(rec, f"{ROOT}/table/{k}", res.table.t_s, v, t_min_s=t_min)
+    has_video = res.config.video is not None
+    if has_video:
+        _log_film(rec, res, progress, rows)
+    rec.send_blueprint(experiment_blueprint(block_paths, has_video=has_video, focus=focus))
+    close_recording(rec, rrd_path)
+    return rows
+
+
+def _log_geometry(rec, res) -> None:
+    """The block's dimensions and contact as a static text document."""
+    import rerun as rr
+
     b = res.block
     rec.log(
         f"{ROOT}/geometry",
@@ -202,6 +215,12 @@ def log_experiment(
         static=True,
     )
 
+
+def _log_block(rec, res, blk: str, t_min, rows: dict):
+    """θ measured and simulated, energies, the ensemble's bands, residuals and impacts of the
+    single block; returns the time window the blueprint focuses on."""
+    log_series = functools.partial(_log_series, t_min_s=t_min)
+    theta = functools.partial(_theta, t_min_s=t_min)
     for name, (t, th) in res.measured.items():
         rows[f"{blk}/theta/measured_{name}"] = theta(rec, blk, f"measured_{name}", t, th, f"measured ({name})")
     for i, (law, s) in enumerate(res.simulations.items()):
@@ -268,70 +287,66 @@ def log_experiment(
         ]
         log_events(rec, f"{blk}/impacts", imp["t_s"].to_numpy(float)[keep], [x for x, k in zip(txt, keep) if k])
         rows[f"{blk}/impacts"] = int(keep.sum())
-    block_paths = [blk]
-    if res.column is not None:
-        c = res.column
-        block_paths = [f"{ROOT}/{o}" for o in c.objects]
-        for i, bp in enumerate(block_paths):
-            rows[f"{bp}/theta/measured_video"] = theta(
-                rec, bp, "measured_video", c.t_s, c.theta_measured_rad[:, i], "measured (video)"
-            )
-            rows[f"{bp}/theta/sim_column"] = theta(
-                rec, bp, "sim_column", c.sim_t_s, c.theta_sim_rad[:, i], "column model"
-            )
-            sim_on = np.interp(c.t_s, c.sim_t_s, c.theta_sim_rad[:, i], left=np.nan, right=np.nan)
-            rows[f"{bp}/residual/measured_minus_sim"] = log_series(
-                rec, f"{bp}/residual/measured_minus_sim", c.t_s, c.theta_measured_rad[:, i] - sim_on
-            )
-            if c.theta_truth is not None:
-                tt, th = c.theta_truth
-                rows[f"{bp}/theta/truth"] = theta(rec, bp, "truth", tt, th[:, i], "truth")
-        conf = c.configurations
-        if len(conf):
-            log_events(
-                rec,
-                f"{ROOT}/column/configurations",
-                conf["t_s"].to_numpy(float),
-                [f"joint {j}: {st} ({ev})" for j, st, ev in zip(conf["joint"], conf["state"], conf["event"])],
-            )
-            rows[f"{ROOT}/column/configurations"] = len(conf)
-    if res.table is not None:
-        for k, v in res.table.columns().items():
-            rows[f"{ROOT}/table/{k}"] = log_series(rec, f"{ROOT}/table/{k}", res.table.t_s, v)
+    return focus
 
-    has_video = res.config.video is not None
-    if has_video:
-        bar = None
-        if progress:
-            from tqdm import tqdm
 
-            bar = tqdm(desc="rerun: video frames", unit="frame", leave=False)
-        # the film was encoded while the tracker decoded it (analyse_experiment(keep_video=...))
-        fps = res.frames.fps
-        film = res.video
-        if film is not None and film.kind == "av1":
-            tr0 = res.frames.tracks[0]  # the tracker's own frame times (a variable-rate film's)
-            t_of = dict(zip(np.asarray(tr0.frame, int).tolist(), np.asarray(tr0.t_s, float).tolist()))
-            t_film = [t_of.get(int(i), i / fps) for i in film.frame_index]
-            rows[f"{ROOT}/video"] = log_video_asset(
-                rec,
-                f"{ROOT}/video",
-                film.data,
-                film.frame_index,
-                fps,
-                overlays=_overlay_fn(res),
-                progress=bar,
-                frame_t_s=t_film,
-            )
-        else:
-            frames = (
-                (i, i / fps, data) for i, data in (zip(film.frame_index, film.stills) if film is not None else ())
-            )
-            rows[f"{ROOT}/video"] = log_video_frames(
-                rec, f"{ROOT}/video", frames, overlays=_overlay_fn(res), progress=bar
-            )
-        if bar is not None:
-            bar.close()
-    rec.send_blueprint(experiment_blueprint(block_paths, has_video=has_video, focus=focus))
-    close_recording(rec, rrd_path)
-    return rows
+def _log_column(rec, res, t_min, rows: dict) -> list:
+    """Each block of a column run (measured, model, truth, residual) and the joints' configurations;
+    returns the blocks' entity paths."""
+    log_series = functools.partial(_log_series, t_min_s=t_min)
+    theta = functools.partial(_theta, t_min_s=t_min)
+    c = res.column
+    block_paths = [f"{ROOT}/{o}" for o in c.objects]
+    for i, bp in enumerate(block_paths):
+        rows[f"{bp}/theta/measured_video"] = theta(
+            rec, bp, "measured_video", c.t_s, c.theta_measured_rad[:, i], "measured (video)"
+        )
+        rows[f"{bp}/theta/sim_column"] = theta(rec, bp, "sim_column", c.sim_t_s, c.theta_sim_rad[:, i], "column model")
+        sim_on = np.interp(c.t_s, c.sim_t_s, c.theta_sim_rad[:, i], left=np.nan, right=np.nan)
+        rows[f"{bp}/residual/measured_minus_sim"] = log_series(
+            rec, f"{bp}/residual/measured_minus_sim", c.t_s, c.theta_measured_rad[:, i] - sim_on
+        )
+        if c.theta_truth is not None:
+            tt, th = c.theta_truth
+            rows[f"{bp}/theta/truth"] = theta(rec, bp, "truth", tt, th[:, i], "truth")
+    conf = c.configurations
+    if len(conf):
+        log_events(
+            rec,
+            f"{ROOT}/column/configurations",
+            conf["t_s"].to_numpy(float),
+            [f"joint {j}: {st} ({ev})" for j, st, ev in zip(conf["joint"], conf["state"], conf["event"])],
+        )
+        rows[f"{ROOT}/column/configurations"] = len(conf)
+    return block_paths
+
+
+def _log_film(rec, res, progress: bool, rows: dict) -> None:
+    """The review film: the AV1 asset with one reference per frame, or JPEG stills."""
+    bar = None
+    if progress:
+        from tqdm import tqdm
+
+        bar = tqdm(desc="rerun: video frames", unit="frame", leave=False)
+    # the film was encoded while the tracker decoded it (analyse_experiment(keep_video=...))
+    fps = res.frames.fps
+    film = res.video
+    if film is not None and film.kind == "av1":
+        tr0 = res.frames.tracks[0]  # the tracker's own frame times (a variable-rate film's)
+        t_of = dict(zip(np.asarray(tr0.frame, int).tolist(), np.asarray(tr0.t_s, float).tolist()))
+        t_film = [t_of.get(int(i), i / fps) for i in film.frame_index]
+        rows[f"{ROOT}/video"] = log_video_asset(
+            rec,
+            f"{ROOT}/video",
+            film.data,
+            film.frame_index,
+            fps,
+            overlays=_overlay_fn(res),
+            progress=bar,
+            frame_t_s=t_film,
+        )
+    else:
+        frames = ((i, i / fps, data) for i, data in (zip(film.frame_index, film.stills) if film is not None else ()))
+        rows[f"{ROOT}/video"] = log_video_frames(rec, f"{ROOT}/video", frames, overlays=_overlay_fn(res), progress=bar)
+    if bar is not None:
+        bar.close()

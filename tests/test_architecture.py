@@ -228,7 +228,6 @@ def _function_lengths():
 LONG_FUNCTIONS = {
     "fitting._restitution:fit_restitution",  # 210
     "models.rocking._single:simulate",  # 153
-    "pipelines.experiment._figures:experiment_figures",  # 133
     "models.rocking._event:run_event",  # 126
 }
 

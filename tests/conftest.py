@@ -19,6 +19,18 @@ def shared_data() -> Path:
     return SHARED_DATA
 
 
+@pytest.fixture(scope="session")
+def sine_session(tmp_path_factory) -> Path:
+    """One rendered shake-table session shared by the tests that only read it: a block with ArUco
+    markers on a sine-driven table (seed 3, 960x540 at 50 fps, 1.2 s, lossless film, no IMU).
+    Tests must not write into it (copy what they change into their own ``tmp_path``)."""
+    from rocklab.synth import synth_session
+
+    out = tmp_path_factory.mktemp("sine_session") / "s"
+    synth_session(out, seed=3, table="sine", size=(960, 540), duration_s=1.2, imu=False, mp4=False)
+    return out
+
+
 @pytest.fixture
 def run_cli(capsys):
     """Run the rocklab CLI in-process; returns (exit_code, stdout, stderr)."""

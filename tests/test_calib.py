@@ -260,16 +260,14 @@ def test_views_of_a_folder_keep_the_numbers_order(tmp_path):
     assert v.labels == ("shot1.png", "shot2.png", "shot10.png") and v.numbers == (1, 2, 10)
 
 
-def test_track_init_writes_the_lens_and_refuses_one_of_another_size(tmp_path, run_cli):
+def test_track_init_writes_the_lens_and_refuses_one_of_another_size(tmp_path, run_cli, sine_session):
     import tomllib
 
     import pandas as pd
 
-    from rocklab.synth import synth_session
     from rocklab.tracking.calib import Lens
 
-    s = tmp_path / "s"
-    synth_session(s, seed=3, table="sine", size=(960, 540), duration_s=1.2, imu=False, mp4=False)
+    s = sine_session
     v = tomllib.loads((s / "track.toml").read_text())["video"]  # the render's own lens
     K, dist = np.array(v["camera_matrix"]), np.array(v["dist_coeffs"])
     Lens(K, dist, (960, 540), 0.1, {}, "synthetic", ("truth",)).save(tmp_path / "lens.json")

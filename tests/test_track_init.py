@@ -10,12 +10,8 @@ import pytest
 
 
 @pytest.fixture(scope="module")
-def session(tmp_path_factory):
-    from rocklab.synth import synth_session
-
-    out = tmp_path_factory.mktemp("init") / "s"
-    synth_session(out, seed=3, table="sine", size=(960, 540), duration_s=1.2, imu=False, mp4=False)
-    return out
+def session(sine_session):
+    return sine_session
 
 
 def test_init_finds_markers_and_tracks_unedited(session, tmp_path, run_cli):

@@ -144,15 +144,13 @@ def test_real_pendulum_footage(shared_data):
     assert abs(T_track / T_blob - 1) <= 5e-4, (T_track, T_blob)
 
 
-def test_mixed_styles_aruco_block_on_markerless_table(tmp_path):
+def test_mixed_styles_aruco_block_on_markerless_table(tmp_path, sine_session):
     """A block with ArUco markers on a table followed markerless (issue: mixed styles per object)."""
     import pandas as pd
 
     from rocklab.tracking import load_track_config, track_video
-    from rocklab.synth import synth_session
 
-    out = tmp_path / "s"
-    synth_session(out, seed=3, table="sine", size=(960, 540), duration_s=1.8, imu=False, mp4=False)
+    out = sine_session  # shared, read only: the edited config goes to tmp_path
     text = (out / "track.toml").read_text()
     # the table object becomes markerless: a roi round the left part of its top edge (texture, a
     # marker, and the top edge that levels the angles)
@@ -161,8 +159,8 @@ def test_mixed_styles_aruco_block_on_markerless_table(tmp_path):
         'id = "table"\nkind = "table"\nstyle = "markerless"\nroi = [125.0, 322.0, 290.0, 44.0]\n',
         1,
     )
-    (out / "track.toml").write_text(text)
-    cfg = load_track_config(out / "track.toml")
+    (tmp_path / "track.toml").write_text(text)
+    cfg = load_track_config(tmp_path / "track.toml")
     assert cfg.object("table").style == "markerless" and cfg.targets.style == "aruco"
     res = track_video(out / "video.mkv", cfg)
     truth = pd.read_csv(out / "truth.csv")

@@ -207,12 +207,41 @@ def run_experiment(
 ) -> tuple[dict, bool]:
     """Run one experiment and write its outputs into ``out_dir`` atomically.
 
+    Parameters
+    ----------
+    config_path : path
+        The experiment's ``experiment.toml``.
+    out_dir : path
+        Output folder (``report.json``, ``summary.md``, ``series.csv``, ``figures/``,
+        ``session.rrd``); an existing rocklab output is replaced only when its inputs changed.
+    force : bool
+        Run even when the inputs and config are unchanged.
+    spawn, connect : bool, str
+        Also stream the review to a new Rerun viewer, or to one at this address.
+    progress : bool
+        Progress bars on stderr.
+
     Returns
     -------
     report : dict
         The content of ``report.json``.
     ran : bool
         False when the inputs and config were unchanged and nothing was done.
+
+    Examples
+    --------
+    A rendered free-rocking session (the truth is η = 0.75), tracked, fitted and simulated:
+
+    >>> import pathlib, tempfile
+    >>> from rocklab.synth import synth_session
+    >>> from rocklab.pipelines import run_experiment
+    >>> d = pathlib.Path(tempfile.mkdtemp())
+    >>> s = synth_session(d / "s", seed=1, size=(480, 270), duration_s=3.0, mp4=False, imu=False)
+    >>> report, ran = run_experiment(d / "s" / "experiment.toml", d / "out")
+    >>> report["status"], round(report["fit"]["eta_e"], 3), ran
+    ('ok', 0.75, True)
+    >>> run_experiment(d / "s" / "experiment.toml", d / "out")[1]  # unchanged inputs: nothing to do
+    False
     """
     from ..._outdir import check_output_dir, publish_dir, stage_dir
 

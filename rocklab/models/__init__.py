@@ -10,6 +10,8 @@ Sub-packages, one subject each (the paper equations they implement are in each d
 Every public name of the sub-packages is also here.
 """
 
+# first: numba's cache must see the modules a kernel compiles in before any kernel is defined
+from . import _numba_cache  # noqa: F401
 from .column import (
     STATE_NAMES,
     Column,

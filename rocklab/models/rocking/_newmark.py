@@ -20,10 +20,10 @@ restitution law gives omega+ and the rest of the step continues with the other
 equation (several impacts per step are allowed).
 
 Free rocking (full equation, no base record or past its end) runs its steps
-between impacts in the lean loop :func:`~rocklab.models.rocking._newmark_free.free_steps`
+between impacts in the lean loop :func:`~rocklab.models.rocking._newmark_lean.free_steps`
 (same trapezoidal step, solved by a jerk-corrected predictor and a checked
-fixed-point update), rocking under the record in its twin
-:func:`~rocklab.models.rocking._newmark_forced.forced_steps`, and steps at rest in which
+fixed-point update), rocking under the record in the same loop with the base term,
+:func:`~rocklab.models.rocking._newmark_lean.forced_steps`, and steps at rest in which
 the base stays below the uplift level in a short scan; impacts, uplift,
 overturning and anything else the lean loops decline are handled by the
 general step here (``lean=False``: every step, the reference in the tests).
@@ -43,14 +43,7 @@ from numba import njit, prange
 
 from ...blocks import G
 from ._newmark_contact import contact_tau, cross_fraction, restitution_at, store_impact
-from ._newmark_forced import forced_steps
-from ._newmark_free import free_steps, sdcd
-from .._numba_cache import drop_stale_cache
-
-
-# run_block compiles in the kernels of _newmark_free, _newmark_forced and _newmark_contact (see _numba_cache)
-drop_stale_cache("_newmark.*.nbi", ("_newmark_free.py", "_newmark_forced.py", "_newmark_contact.py",
-                                    "_newmark.py"), __file__)
+from ._newmark_lean import forced_steps, free_steps, sdcd
 
 #: Status codes returned by the kernel.
 ROCKING, REST, OVERTURNED, NO_UPLIFT = 0, 1, 2, 3
@@ -223,10 +216,10 @@ def run_block(p, alpha, theta0, omega0, h, n_steps, acc, acc_t0, acc_dt, scale,
     countdown = out_every  # output every out_every steps (no integer modulo in the hot loop)
     t_end = 0.0
     # free rocking (full equation, no base record or past its end: ug = 0 exactly) runs
-    # in the lean loop of _newmark_free; anything else (impact in the step,
+    # in the lean loop free_steps; anything else (impact in the step,
     # |theta| >= alpha, rest) is left to the general step below, which takes that
     # step from the same state. One sample of margin keeps _ug_at's rounding out.
-    # Under the record the same holds for _newmark_forced (steps ending inside the record;
+    # Under the record the same holds for forced_steps (steps ending inside the record;
     # its fixed-point update needs the contraction L = p^2 (1 + max|ug|) h^2 / 4 small).
     t_free = acc_t0 + acc.shape[0] * acc_dt if acc.shape[0] > 0 else -np.inf
     lip = 1.0
@@ -238,7 +231,7 @@ def run_block(p, alpha, theta0, omega0, h, n_steps, acc, acc_t0, acc_dt, scale,
             if step * h > t_free:
                 th, w, a, sc, cc, step, max_abs, n_out, countdown = free_steps(
                     th, w, a, sc, cc, s, step, n_steps, h, p2, alpha, cos_a, max_abs, out_th, out_w, out_e,
-                    n_out, countdown, out_every, e_scale)
+                    n_out, countdown, out_every, e_scale, acc, acc_t0, inv_dta, fac, lip)
             elif lip < 0.01:
                 th, w, a, sc, cc, step, max_abs, n_out, countdown = forced_steps(
                     th, w, a, sc, cc, s, step, n_steps, h, p2, alpha, cos_a, max_abs, out_th, out_w, out_e,

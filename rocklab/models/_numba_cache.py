@@ -27,15 +27,15 @@ __all__ = ["DependencyLocator", "PACKAGES", "install", "module_dependencies"]
 PACKAGES: list[str] = ["rocklab.models."]
 
 # numba >= 0.61 names the class CacheImpl, older releases _CacheImpl
-_IMPL = getattr(caching, "CacheImpl", None) or caching._CacheImpl
+_IMPL = getattr(caching, "CacheImpl", None) or getattr(caching, "_CacheImpl")
 
 
 def _module_file(name: str) -> Path | None:
     """Source file of module ``name`` (``pkg/mod.py`` or ``pkg/mod/__init__.py``) without importing it."""
-    root = sys.modules.get(name.split(".")[0])
-    if root is None or getattr(root, "__file__", None) is None:
+    root_file = getattr(sys.modules.get(name.split(".")[0]), "__file__", None)
+    if root_file is None:
         return None
-    base = Path(root.__file__).resolve().parent.parent.joinpath(*name.split("."))
+    base = Path(root_file).resolve().parent.parent.joinpath(*name.split("."))
     for cand in (base.with_suffix(".py"), base / "__init__.py"):
         if cand.is_file():
             return cand

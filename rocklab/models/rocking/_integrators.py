@@ -18,13 +18,18 @@ A new integrator is a subclass of :class:`Integrator` added to :data:`METHODS`.
 from __future__ import annotations
 
 import math
-from typing import ClassVar, NamedTuple
+from typing import TYPE_CHECKING, ClassVar, NamedTuple
 
 import numpy as np
 
 from ..._errors import InputError
 from ...blocks import G
 from ._newmark import STATUS_NAMES, run_single
+
+if TYPE_CHECKING:
+    from ...blocks import Block
+    from ..spectra._records import BaseMotion
+    from ._restitution import Restitution
 
 __all__ = [
     "METHODS",
@@ -79,13 +84,13 @@ class RockingProblem(NamedTuple):
     None; ``rtol`` and ``ode_method`` concern the ``event`` integrator only.
     """
 
-    block: object
+    block: Block
     theta0_rad: float
     omega0_rad_s: float
     duration_s: float
     dt_s: float
-    law: object
-    base: object
+    law: Restitution
+    base: BaseMotion | None
     linearized: bool
     rest_tol: float
     stop_at_rest: bool

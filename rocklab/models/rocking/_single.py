@@ -80,6 +80,94 @@ def _law(restitution, block, law_params):
 SINGLE_STEPS_PER_S = 3e7
 
 
+def _problem(
+    block,
+    theta0_rad,
+    omega0_rad_s,
+    duration_s,
+    dt_s,
+    restitution,
+    base,
+    stop_at_rest,
+    output_dt_s,
+    linearized,
+    rest_tol,
+    max_impacts,
+    rtol,
+    ode_method,
+    fall_rad,
+    law_params,
+) -> RockingProblem:
+    """``simulate``'s arguments checked (InputError naming the parameter) into a :class:`RockingProblem`."""
+    alpha = block.alpha_rad
+    th0 = _finite("theta0_rad", theta0_rad)
+    w0 = _finite("omega0_rad_s", omega0_rad_s)
+    T = _finite("duration_s", duration_s, positive=True)
+    dt = _finite("dt_s", dt_s, positive=True)
+    rest_tol = _finite("rest_tol", rest_tol, positive=True)
+    if abs(th0) >= alpha:
+        raise InputError(
+            f"theta0_rad={th0}: |theta0| must be < alpha = {alpha:.6g} rad "
+            "(the block would fall at release); give a smaller initial rotation"
+        )
+    if dt > T:
+        raise InputError(f"dt_s={dt}: time step longer than duration_s={T}; use a smaller dt")
+    fall = 0.5 * math.pi if fall_rad is None else _finite("fall_rad", fall_rad, positive=True)
+    if not (alpha <= fall <= 0.5 * math.pi):
+        raise InputError(f"fall_rad={fall}: must be between alpha = {alpha:.6g} and pi/2 rad")
+    law = _law(restitution, block, law_params)
+    if base is not None and not isinstance(base, BaseMotion):
+        raise InputError(
+            f"base={type(base).__name__}: give a rocklab.models.BaseMotion "
+            "(e.g. BaseMotion.from_samples(acc, dt_s, 'g')) or None"
+        )
+    every, resample = 1, None
+    if output_dt_s is not None:
+        odt = _finite("output_dt_s", output_dt_s, positive=True)
+        if odt < dt:
+            raise InputError(f"output_dt_s={odt}: must be >= dt_s={dt}")
+        if odt > T:
+            raise InputError(f"output_dt_s={odt}: longer than duration_s={T}; give a spacing <= the duration")
+        k = int(round(odt / dt))
+        if abs(k * dt - odt) <= 1e-9 * odt:
+            every = k
+        else:
+            resample = odt  # e.g. a camera frame rate: store every step, then Hermite (RockingResult.at)
+    return RockingProblem(
+        block,
+        th0,
+        w0,
+        T,
+        dt,
+        law,
+        base,
+        bool(linearized),
+        rest_tol,
+        bool(stop_at_rest),
+        every,
+        resample,
+        int(max_impacts),
+        fall,
+        rtol,
+        ode_method,
+    )
+
+
+def _check_cost(problem: RockingProblem) -> None:
+    """InputError before a run that would not fit in memory or would take far too long."""
+    T, dt, every, n_steps = problem.duration_s, problem.dt_s, problem.output_every, problem.n_steps
+    check_memory(
+        40.0 * n_steps / every,
+        f"{T:g} s at dt = {dt:g} s ({n_steps} steps stored every {every})",
+        "shorten duration_s or give a coarser output_dt_s",
+    )
+    check_time(
+        T / dt / SINGLE_STEPS_PER_S,
+        f"{T:g} s at dt = {dt:g} s ({T / dt:.3g} steps)",
+        "give a coarser dt_s (e.g. 1e-4 s) or a shorter duration_s",
+    )
+
+
 def simulate(
     block,
     theta0_rad: float = 0.0,
@@ -167,73 +255,29 @@ def simulate(
         problem the method does not integrate (``taylor`` with a base record).
     """
     meth = integrator(method)
-    alpha = block.alpha_rad
-    th0 = _finite("theta0_rad", theta0_rad)
-    w0 = _finite("omega0_rad_s", omega0_rad_s)
-    T = _finite("duration_s", duration_s, positive=True)
-    dt = _finite("dt_s", dt_s, positive=True)
-    rest_tol = _finite("rest_tol", rest_tol, positive=True)
-    if abs(th0) >= alpha:
-        raise InputError(
-            f"theta0_rad={th0}: |theta0| must be < alpha = {alpha:.6g} rad "
-            "(the block would fall at release); give a smaller initial rotation"
-        )
-    if dt > T:
-        raise InputError(f"dt_s={dt}: time step longer than duration_s={T}; use a smaller dt")
-    fall = 0.5 * math.pi if fall_rad is None else _finite("fall_rad", fall_rad, positive=True)
-    if not (alpha <= fall <= 0.5 * math.pi):
-        raise InputError(f"fall_rad={fall}: must be between alpha = {alpha:.6g} and pi/2 rad")
-    law = _law(restitution, block, law_params)
-    if base is not None and not isinstance(base, BaseMotion):
-        raise InputError(
-            f"base={type(base).__name__}: give a rocklab.models.BaseMotion "
-            "(e.g. BaseMotion.from_samples(acc, dt_s, 'g')) or None"
-        )
-    every, resample = 1, None
-    if output_dt_s is not None:
-        odt = _finite("output_dt_s", output_dt_s, positive=True)
-        if odt < dt:
-            raise InputError(f"output_dt_s={odt}: must be >= dt_s={dt}")
-        if odt > T:
-            raise InputError(f"output_dt_s={odt}: longer than duration_s={T}; give a spacing <= the duration")
-        k = int(round(odt / dt))
-        if abs(k * dt - odt) <= 1e-9 * odt:
-            every = k
-        else:
-            resample = odt  # e.g. a camera frame rate: store every step, then Hermite (RockingResult.at)
-    problem = RockingProblem(
+    problem = _problem(
         block,
-        th0,
-        w0,
-        T,
-        dt,
-        law,
+        theta0_rad,
+        omega0_rad_s,
+        duration_s,
+        dt_s,
+        restitution,
         base,
-        bool(linearized),
+        stop_at_rest,
+        output_dt_s,
+        linearized,
         rest_tol,
-        bool(stop_at_rest),
-        every,
-        resample,
-        int(max_impacts),
-        fall,
+        max_impacts,
         rtol,
         ode_method,
+        fall_rad,
+        law_params,
     )
     meth.check(problem)
-    n_steps = problem.n_steps
-    check_memory(
-        40.0 * n_steps / every,
-        f"{T:g} s at dt = {dt:g} s ({n_steps} steps stored every {every})",
-        "shorten duration_s or give a coarser output_dt_s",
-    )
-    check_time(
-        T / dt / SINGLE_STEPS_PER_S,
-        f"{T:g} s at dt = {dt:g} s ({T / dt:.3g} steps)",
-        "give a coarser dt_s (e.g. 1e-4 s) or a shorter duration_s",
-    )
+    _check_cost(problem)
     out = meth.run(problem)
-    if meth.any_output_grid:
-        resample = None  # sampled on the output grid directly
+    # an integrator that samples any grid has sampled the output grid directly
+    resample = None if meth.any_output_grid else problem.resample_dt_s
     for a in out[:5]:
         a.setflags(write=False)
     res = RockingResult(
@@ -248,9 +292,9 @@ def simulate(
         fall_t_s=float(out.fall_t_s),
         max_abs_theta_rad=float(out.max_abs_theta_rad),
         block=block,
-        restitution=law,
+        restitution=problem.law,
         method=meth.name,
-        dt_s=dt,
+        dt_s=problem.dt_s,
         n_impacts=int(out.n_impacts),
         linearized=bool(linearized),
         base_name=base.name if base is not None else "",

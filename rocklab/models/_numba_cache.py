@@ -143,9 +143,14 @@ class DependencyLocator(caching._CacheLocator):
 
 
 def install() -> None:
-    """Put :class:`DependencyLocator` first in numba's locator list (once)."""
-    if DependencyLocator not in _IMPL._locator_classes:
-        _IMPL._locator_classes.insert(0, DependencyLocator)
+    """Put :class:`DependencyLocator` first in numba's locator list (once).
+
+    A numba without the list (a future release) keeps its own locators: kernels are still
+    cached, stamped with their own file only.
+    """
+    classes = getattr(_IMPL, "_locator_classes", None)
+    if isinstance(classes, list) and DependencyLocator not in classes:
+        classes.insert(0, DependencyLocator)
 
 
 install()

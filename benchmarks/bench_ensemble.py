@@ -27,6 +27,8 @@ from types import SimpleNamespace
 
 import numpy as np
 
+from rocklab.series import TableMotion
+
 SHARED = Path(__file__).resolve().parents[2] / "shared" / "data" / "records"
 
 
@@ -95,8 +97,8 @@ def make_run(seed: int, acc_noise=0.049, acc_bias=0.01, sync_sd=2e-4):
         block=block,
         eta=eta,
         prim=(t, y),
-        table={"t_s": ti, "acc_m_s2": acc},
-        sync={"residual_ms": 0.135},
+        table=TableMotion.from_acceleration(ti, acc, "imu"),
+        sync=SimpleNamespace(residual_ms=0.135),  # the table IMU's clock (a SyncResult's residual)
         truth=truth,
         record=name,
         block_id=bid,
@@ -124,15 +126,15 @@ def speed(n=64, repeats=3):
     run = make_run(0)
     blk, (t, _), tab = run["block"], run["prim"], run["table"]
     unc = InputUncertainty(0.049, 0.003, 1e-3, 2e-4, 4e-4, 4e-4)
-    simulate_ensemble(blk, tab["t_s"], tab["acc_m_s2"], t, eta=run["eta"], theta0_rad=0.0, t_start_s=0.0, unc=unc, n=2)
+    simulate_ensemble(blk, tab.t_s, tab.ax_m_s2, t, eta=run["eta"], theta0_rad=0.0, t_start_s=0.0, unc=unc, n=2)
     best = np.inf
     for _ in range(repeats):
         t0 = time.perf_counter()
         simulate_ensemble(
-            blk, tab["t_s"], tab["acc_m_s2"], t, eta=run["eta"], theta0_rad=0.0, t_start_s=0.0, unc=unc, n=n
+            blk, tab.t_s, tab.ax_m_s2, t, eta=run["eta"], theta0_rad=0.0, t_start_s=0.0, unc=unc, n=n
         )
         best = min(best, time.perf_counter() - t0)
-    base = BaseMotion(tab["t_s"] - tab["t_s"][0], -tab["acc_m_s2"], name="table")
+    base = BaseMotion(tab.t_s - tab.t_s[0], -tab.ax_m_s2, name="table")
     t0 = time.perf_counter()
     for _ in range(n):
         simulate(

@@ -33,3 +33,9 @@ def test_demo_sessions_carry_the_stated_truth(tmp_path):
     assert eta_edge == pytest.approx(float(eta_modified(b3.alpha_rad, 0.933333)) * ETA_MAT_TRUE, abs=1e-5)
     eta_full = json.loads((cfgs[1].parent / "session.json").read_text())["blocks"][0]["eta_true"]
     assert full.contact == "full" and eta_full == pytest.approx(0.914)  # Čeh Table 3, B5M
+    # the runs read the camcorder-like H.264 film, as a lab's footage is; --lossless the FFV1 one
+    assert edge.video.path.name == "video.mp4" and edge.video.path.is_file()
+    (lossless,) = make_demo_campaign(
+        tmp_path / "lossless", size=(320, 180), progress=False, runs=runs[:1], camcorder=False
+    )
+    assert load_experiment(lossless).video.path.name == "video.mkv"

@@ -1,6 +1,7 @@
 """``rocklab campaign``: parallel experiments, a failing one reported, campaign fits with known truth."""
 
 import json
+from pathlib import Path
 import re
 
 import numpy as np
@@ -158,3 +159,39 @@ def test_campaign_links_follow_the_output_folder_not_the_name(tmp_path, run_cli)
     for link, name in zip(sorted(links), ("granite_a", "granite_b")):
         rep = json.loads((out / link).parent.joinpath("report.json").read_text())
         assert rep["name"] == name
+
+
+def _report(name, bid, contact, *, fit=None, half_cycles=None):
+    blk = catalogue_block(bid)
+    rep = {
+        "name": name,
+        "status": "ok",
+        "block": {"name": bid, "b_m": blk.b_m, "h_m": blk.h_m, "eta_H": blk.eta_H},
+        "contact": {"type": contact, "l_c_m": L_C if contact == "edge" else 0.0},
+        "fit": fit,
+    }
+    if half_cycles is not None:
+        rep["validation"] = {"eta_e": half_cycles}
+    return {"config": f"{name}/experiment.toml", "out": f"out/{name}", "ok": True, "report": rep}
+
+
+def test_a_base_excited_runs_half_cycle_eta_is_shown_but_not_pooled():
+    # Čeh's η_mat (Eq. 16) and k (Eq. 18) are free-rocking quantities: a shake-table run's half-cycle
+    # η_e is reported in its row, and the campaign fits come from the free runs alone
+    from rocklab.pipelines.campaign._campaign import CampaignResult, _campaign_fits, _row
+
+    truth = {b: eta_modified(catalogue_block(b).alpha_rad, edge_contact_k(catalogue_block(b).b_m, L_C)) * ETA_MAT
+             for b in ("B3M", "B5M")}
+    runs = [
+        _report("B3M_edge", "B3M", "edge", fit={"eta_e": truth["B3M"], "ci95_eta_e": [truth["B3M"]] * 2}),
+        _report("B5M_edge", "B5M", "edge", fit={"eta_e": truth["B5M"], "ci95_eta_e": [truth["B5M"]] * 2}),
+        # a forced run whose half-cycle η is far off: pooling it would move η_mat by ~10 %
+        _report("B5M_table", "B5M", "edge", half_cycles={"eta_e": 0.6, "ci95_eta_e": [0.59, 0.61], "status": "ok"}),
+    ]
+    table = pd.DataFrame([_row(r) for r in runs])
+    assert list(table["eta_e_source"]) == ["free", "free", "half_cycles"]
+    assert table["eta_e"].iloc[2] == pytest.approx(0.6) and table["ci_hi"].iloc[2] == pytest.approx(0.61)
+    eta_mat, _ = _campaign_fits(table, [])
+    assert eta_mat["eta_mat"] == pytest.approx(ETA_MAT, abs=1e-9)
+    text = CampaignResult(out_dir=Path("out"), runs=runs, table=table).summary_text()
+    assert "0.600" in text and "hc" in text.split("B5M_table")[1].splitlines()[0]

@@ -39,13 +39,14 @@ def test_review_opens_on_the_impact_with_the_largest_residual(tmp_path):
     import pandas as pd
 
     from rocklab.pipelines.experiment._log_experiment import _focus
+    from rocklab.pipelines.experiment._stages import LawSimulation
 
     t = np.linspace(0, 3, 3001)
     sim = 0.05 * np.cos(6 * t)
     impacts = pd.DataFrame({"t_s": [0.25, 0.77, 1.30, 1.82, 2.35]})
     measured = sim.copy()
     measured[(t > 1.75) & (t < 1.86)] += 0.004  # the model misses most around the 4th impact
-    ref = {"t_s": t, "theta_rad": sim, "impacts": impacts}
+    ref = LawSimulation("eta_e", 0.9, t, sim, 0 * t, impacts, "rest", None)
     t_imp, t0, t1 = _focus(ref, t, measured - sim)
     assert t_imp == 1.82 and (t0, t1) == (0.77, 2.35)  # two half-cycles either side
     assert _focus(None, t, measured - sim) is None
@@ -121,15 +122,15 @@ def test_review_opens_on_the_film_with_impacts_marked(tmp_path):
     assert sum(text_rows.values()) < 0.5 * len(video_t)  # the event log is not flooded
     assert len(res.simulations) >= 2
     for law, s in res.simulations.items():
-        want = s["impacts"]["t_s"].to_numpy(float)
+        want = s.impact_times_s()
         want = want[want >= t_film0]
         assert want.size >= 3
         for sub in ("theta", "theta_deg"):
             t_m, v_m = read_rrd_scalars(path, f"experiment/block_1/{sub}/impacts_{law}")
             assert np.allclose(t_m, np.sort(want), rtol=0, atol=1e-9) and np.all(v_m == 0.0)
         # and θ of the simulation does cross 0 there (the markers sit on the curve)
-        th_at = np.interp(want, s["t_s"], s["theta_rad"])
-        assert np.max(np.abs(th_at)) < 0.05 * np.max(np.abs(s["theta_rad"]))
+        th_at = np.interp(want, s.t_s, s.theta_rad)
+        assert np.max(np.abs(th_at)) < 0.05 * np.max(np.abs(s.theta_rad))
 
     # each law's simulated block drawn on the film: η_e (fitted, the truth within 0.001) lies on
     # the measured outline, Housner's η (0.70 against the true 0.75) drifts away from it

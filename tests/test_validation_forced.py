@@ -10,6 +10,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from rocklab.series import TableMotion
+
 
 def _forced_run(eta, seed, *, block_id="B5L", acc_bias=0.01):
     """Truth and measurement of a block on a table playing El Centro (as ``rocklab synth`` makes it):
@@ -29,7 +31,7 @@ def _forced_run(eta, seed, *, block_id="B5L", acc_bias=0.01):
     truth = -np.interp(t, r.t_s, r.theta_rad)  # the camera's θ is counter-clockwise
     ti = np.arange(-0.7, 8.5, 1 / 256.0)
     acc = table.a(np.clip(ti, 0, None)) + 0.049 * rng.standard_normal(ti.size) + acc_bias
-    return block, table, t, truth + 4e-4 * rng.standard_normal(t.size), {"t_s": ti, "acc_m_s2": acc}
+    return block, table, t, truth + 4e-4 * rng.standard_normal(t.size), TableMotion.from_acceleration(ti, acc, "imu")
 
 
 @pytest.mark.parametrize("eta", [0.937, 0.89])
@@ -68,7 +70,7 @@ def test_verdicts_tell_the_true_eta_from_five_percent_off_and_housner():
     eta = 0.937
     block, _, t, y, tab = _forced_run(eta, seed=4)
     cfg = SimpleNamespace(table=SimpleNamespace(source="imu"), path="test")
-    prep = prepare_forced(cfg, block, (t, y + 4.5e-4), tab, {"residual_ms": 0.1}, [])
+    prep = prepare_forced(cfg, block, (t, y + 4.5e-4), tab, SimpleNamespace(residual_ms=0.1), [])
     assert prep.level_rad == pytest.approx(4.5e-4, abs=2e-4)  # the measurement's zero, from its rest
     laws = {"true": eta, "minus5": 0.95 * eta, "plus5": 1.05 * eta, "housner": block.eta_H}
     v = validate_forced_run(prep, block, laws, n=32)
@@ -192,7 +194,7 @@ def test_each_half_cycle_gives_its_impact_eta():
     )  # fmt: skip
     t = np.arange(400) / 50.0
     ti = np.arange(-0.5, 8.5, 1 / 256.0)
-    tab = {"t_s": ti, "acc_m_s2": table.a(np.clip(ti, 0, None))}
+    tab = TableMotion.from_acceleration(ti, table.a(np.clip(ti, 0, None)), "imu")
     fit = fit_forced_restitution(t, -np.interp(t, r.t_s, r.theta_rad), block, base_from_table(tab, 0.0, "t", sign=-1.0))
     assert fit.n_segments >= 10
     assert np.all(np.abs(fit.segment_eta - eta) < 0.0015)  # (measured: at most 5e-4)

@@ -168,6 +168,88 @@ def _vertex(x, f):
     return float(x[k] + (0.5 * h * (f[k - 1] - f[k + 1]) / den if den > 0 else 0.0))
 
 
+#: m/s², the step of the table-bias sensitivity
+_BIAS_STEP = 0.01
+
+
+def _segment_stats(seg, eta, t, y, block, base_ts, dt_s):
+    """(e, a, c) of one half cycle at ``eta``: with P the projection off its start-state columns,
+    r its residual and g its sensitivity to a table bias, e = |P r|², a = (P g)·(P r), c = |P g|²."""
+    from ..models import BaseMotion, simulate
+
+    tp, thp, idx = seg
+    bt, ba = base_ts
+    tt = t[idx] - tp
+    dur = float(tt[-1]) + 0.01
+    h_th = max(1e-3 * abs(thp), 1e-5)
+    h_w = 1e-3 * block.p_rad_s * block.alpha_rad
+    db = _BIAS_STEP
+    cols = []
+    for th0, w0, bias in ((thp, 0.0, 0.0), (thp + h_th, 0.0, 0.0), (thp, -np.sign(thp) * h_w, 0.0), (thp, 0.0, db)):
+        r = simulate(
+            block,
+            theta0_rad=th0,
+            omega0_rad_s=w0,
+            duration_s=dur,
+            dt_s=dt_s,
+            restitution="constant",
+            eta=float(eta),
+            base=BaseMotion(bt - tp, ba + bias, name="segment"),
+            output_dt_s=10 * dt_s,
+            stop_at_rest=False,
+        )
+        th = np.asarray(r.theta_rad)
+        cols.append(np.interp(tt, r.t_s, th, right=th[-1]))
+    m0 = cols[0]
+    A = np.column_stack([(cols[1] - m0) / h_th, (cols[2] - m0) / h_w])
+    Q, _ = np.linalg.qr(A)
+    rr = y[idx] - m0
+    g = (cols[3] - m0) / db
+    pr, pg = rr - Q @ (Q.T @ rr), g - Q @ (Q.T @ g)
+    return float(pr @ pr), float(pg @ pr), float(pg @ pg)
+
+
+def _profiled_total(E, Aa, C, w):
+    """Summed squared residual at every fine node, one table bias profiled over all segments
+    (segment weights ``w``)."""
+    return w @ E - (w @ Aa) ** 2 / np.maximum(w @ C, 1e-300)
+
+
+def _estimate(fine, E, Aa, C, w):
+    """η at the minimum of the weighted profiled total (a parabola through the three nearest nodes)."""
+    tot = _profiled_total(E, Aa, C, w)
+    k = int(np.argmin(tot))
+    if k == 0 or k == fine.size - 1:
+        return float(fine[k])
+    c = np.polyfit(fine[k - 1 : k + 2] - fine[k], tot[k - 1 : k + 2], 2)
+    return float(fine[k] + (np.clip(-c[1] / (2 * c[0]), -0.0025, 0.0025) if c[0] > 0 else 0.0))
+
+
+def _interval(estimate, eta_hat, n, n_boot, seed):
+    """95 % interval and standard error of η_e over ``n`` segments: bootstrap (widened to Student's
+    t), the jackknife when its spread is the larger, and the method's systematic term."""
+    from scipy.stats import t as student_t
+
+    rng = np.random.default_rng(seed)
+    boot = np.array([estimate(np.bincount(rng.integers(0, n, n), minlength=n).astype(float)) for _ in range(n_boot)])
+    # few segments: the percentile interval is widened to Student's t with n - 1 degrees of freedom
+    infl = float(student_t.ppf(0.975, n - 1) / 1.959964) * np.sqrt(n / (n - 1))
+    q_lo, q_hi = np.percentile(boot, [2.5, 97.5])
+    # one half cycle with a sharp minimum can carry most of the information; the bootstrap then
+    # varies little (that segment is in 63 % of the resamples) while leaving it out moves η_e:
+    # the jackknife's spread is taken when it is the larger
+    jack = np.array([estimate(np.where(np.arange(n) == i, 0.0, 1.0)) for i in range(n)])
+    se_jack = float(np.sqrt((n - 1) / n * np.sum((jack - jack.mean()) ** 2)))
+    se_boot = float(boot.std(ddof=1))
+    q = float(student_t.ppf(0.975, n - 1))
+    lo_half = max(infl * (eta_hat - q_lo), q * se_jack)
+    hi_half = max(infl * (q_hi - eta_hat), q * se_jack)
+    # plus the method's own systematic error, in quadrature (see ETA_SYSTEMATIC)
+    z_sys = 1.959964 * ETA_SYSTEMATIC
+    ci = (eta_hat - float(np.hypot(lo_half, z_sys)), eta_hat + float(np.hypot(hi_half, z_sys)))
+    return ci, float(np.hypot(max(infl * se_boot, se_jack), ETA_SYSTEMATIC))
+
+
 def fit_forced_restitution(
     t_s,
     theta_rad,
@@ -208,59 +290,21 @@ def fit_forced_restitution(
     -------
     ForcedRestitutionFit
     """
-    from ..models import BaseMotion, simulate
-
     t = np.asarray(t_s, float)
     y = np.asarray(theta_rad, float)
     segs = half_cycle_segments(t, y, block.alpha_rad, min_amp_frac, t_max_s)
     nan = float("nan")
-
-    def failed(msg):
-        return ForcedRestitutionFit(nan, (nan, nan), nan, len(segs), np.empty(0), nan, nan, "failed", msg)
-
     if len(segs) < 4:
-        return failed(
-            f"{len(segs)} half cycles above {min_amp_frac:g} α: need at least 4 to fit η from a base-excited run"
-        )
-    bt, ba = np.asarray(base.t_s, float), np.asarray(base.acc_m_s2, float)
+        msg = f"{len(segs)} half cycles above {min_amp_frac:g} α: need at least 4 to fit η from a base-excited run"
+        return ForcedRestitutionFit(nan, (nan, nan), nan, len(segs), np.empty(0), nan, nan, "failed", msg)
+    base_ts = (np.asarray(base.t_s, float), np.asarray(base.acc_m_s2, float))
 
-    db = 0.01  # m/s², the step of the table-bias sensitivity
-
-    def seg_stats(seg, eta):
-        """(e, a, c) of one segment: with P the projection off its start-state columns, r its
-        residual and g its sensitivity to a table bias, e = |P r|², a = (P g)·(P r), c = |P g|²."""
-        tp, thp, idx = seg
-        tt = t[idx] - tp
-        dur = float(tt[-1]) + 0.01
-        h_th = max(1e-3 * abs(thp), 1e-5)
-        h_w = 1e-3 * block.p_rad_s * block.alpha_rad
-        cols = []
-        for th0, w0, bias in ((thp, 0.0, 0.0), (thp + h_th, 0.0, 0.0), (thp, -np.sign(thp) * h_w, 0.0), (thp, 0.0, db)):
-            r = simulate(
-                block,
-                theta0_rad=th0,
-                omega0_rad_s=w0,
-                duration_s=dur,
-                dt_s=dt_s,
-                restitution="constant",
-                eta=float(eta),
-                base=BaseMotion(bt - tp, ba + bias, name="segment"),
-                output_dt_s=10 * dt_s,
-                stop_at_rest=False,
-            )
-            th = np.asarray(r.theta_rad)
-            cols.append(np.interp(tt, r.t_s, th, right=th[-1]))
-        m0 = cols[0]
-        A = np.column_stack([(cols[1] - m0) / h_th, (cols[2] - m0) / h_w])
-        Q, _ = np.linalg.qr(A)
-        rr = y[idx] - m0
-        g = (cols[3] - m0) / db
-        pr, pg = rr - Q @ (Q.T @ rr), g - Q @ (Q.T @ g)
-        return float(pr @ pr), float(pg @ pr), float(pg @ pg)
+    def stats(seg, eta):
+        return _segment_stats(seg, eta, t, y, block, base_ts, dt_s)
 
     lo, hi = (float(x) for x in eta_bounds)
     coarse = np.linspace(lo, hi, int(round((hi - lo) / 0.02)) + 1)
-    Sc = np.array([[seg_stats(s, e)[0] for e in coarse] for s in segs])
+    Sc = np.array([[stats(s, e)[0] for e in coarse] for s in segs])
     # a half cycle the model cannot follow at any η (a lost or wrong sample, a start the linearised
     # profile misses) would outweigh all others in the sum: segments whose best RMS residual is
     # above 4x the median segment's are left out (and counted)
@@ -272,45 +316,13 @@ def fit_forced_restitution(
     # the fine grid around the median of the segments' own minima, robust to one odd segment
     c = float(np.median(coarse[np.argmin(Sc, axis=1)]))
     fine = np.arange(max(lo, c - 0.04), min(hi, c + 0.04) + 1e-12, 0.0025)
-    E, Aa, C = np.moveaxis(np.array([[seg_stats(s, e) for e in fine] for s in segs]), 2, 0)
+    E, Aa, C = np.moveaxis(np.array([[stats(s, e) for e in fine] for s in segs]), 2, 0)
     n = len(segs)
-
-    def total(w):
-        """Summed squared residual at every fine node, one table bias profiled over all segments."""
-        return w @ E - (w @ Aa) ** 2 / np.maximum(w @ C, 1e-300)
-
-    def estimate(w):
-        tot = total(w)
-        k = int(np.argmin(tot))
-        if k == 0 or k == fine.size - 1:
-            return float(fine[k])
-        c = np.polyfit(fine[k - 1 : k + 2] - fine[k], tot[k - 1 : k + 2], 2)
-        return float(fine[k] + (np.clip(-c[1] / (2 * c[0]), -0.0025, 0.0025) if c[0] > 0 else 0.0))
-
     ones = np.ones(n)
-    eta_hat = estimate(ones)
-    rng = np.random.default_rng(seed)
-    boot = np.array([estimate(np.bincount(rng.integers(0, n, n), minlength=n).astype(float)) for _ in range(n_boot)])
-    from scipy.stats import t as student_t
-
-    # few segments: the percentile interval is widened to Student's t with n - 1 degrees of freedom
-    infl = float(student_t.ppf(0.975, n - 1) / 1.959964) * np.sqrt(n / (n - 1))
-    q_lo, q_hi = np.percentile(boot, [2.5, 97.5])
-    # one half cycle with a sharp minimum can carry most of the information; the bootstrap then
-    # varies little (that segment is in 63 % of the resamples) while leaving it out moves η_e:
-    # the jackknife's spread is taken when it is the larger
-    jack = np.array([estimate(np.where(np.arange(n) == i, 0.0, 1.0)) for i in range(n)])
-    se_jack = float(np.sqrt((n - 1) / n * np.sum((jack - jack.mean()) ** 2)))
-    se_boot = float(boot.std(ddof=1))
-    q = float(student_t.ppf(0.975, n - 1))
-    lo_half = max(infl * (eta_hat - q_lo), q * se_jack)
-    hi_half = max(infl * (q_hi - eta_hat), q * se_jack)
-    # plus the method's own systematic error, in quadrature (see ETA_SYSTEMATIC)
-    z_sys = 1.959964 * ETA_SYSTEMATIC
-    ci = (eta_hat - float(np.hypot(lo_half, z_sys)), eta_hat + float(np.hypot(hi_half, z_sys)))
-    se = float(np.hypot(max(infl * se_boot, se_jack), ETA_SYSTEMATIC))
+    eta_hat = _estimate(fine, E, Aa, C, ones)
+    ci, se = _interval(lambda w: _estimate(fine, E, Aa, C, w), eta_hat, n, n_boot, seed)
     n_samples = sum(s[2].size for s in segs)
-    sse_hat = float(np.interp(eta_hat, fine, total(ones)))
+    sse_hat = float(np.interp(eta_hat, fine, _profiled_total(E, Aa, C, ones)))
     k_hat = int(np.argmin(np.abs(fine - eta_hat)))
     # the residual asks for +b on the base: the base as given is offset by -b
     bias = -float(Aa[:, k_hat].sum() / max(C[:, k_hat].sum(), 1e-300))

@@ -40,6 +40,7 @@ from scipy.stats import chi2
 from .._diagnostics import warn
 from .._errors import InputError
 from ..blocks import is_lab_size
+from ..config import FIT_WINDOWS
 from ._impacts import _crossings, arch_peaks, check_record, per_impact_eta
 from ._release import settle_release
 from ._fit_checks import RESIDUAL_FACTOR, RESIDUAL_FLOOR_RAD, _cut_at_gap, _suspicion
@@ -47,7 +48,7 @@ from ._simfit import _ac_factor, _grid_then_brent, _Problem, _profile_ci
 
 __all__ = ["RestitutionFit", "fit_restitution", "WINDOWS", "OBJECTIVES"]
 
-WINDOWS = ("middle50", "all", "first")
+WINDOWS = FIT_WINDOWS
 OBJECTIVES = ("theta", "peaks")
 
 

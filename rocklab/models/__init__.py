@@ -11,7 +11,9 @@ Every public name of the sub-packages is also here.
 """
 
 # first: numba's cache must see the modules a kernel compiles in before any kernel is defined
-from . import _numba_cache  # noqa: F401
+from ._numba_cache import install as _install_numba_cache
+
+_install_numba_cache()
 from .column import (
     STATE_NAMES,
     Column,

@@ -151,7 +151,7 @@ def _uncertainty(cfg, table, table_sync, y, msgs):
     from .._diagnostics import warn
     from ..fitting import InputUncertainty
 
-    ta, aa = np.asarray(table["t_s"], float), np.asarray(table["acc_m_s2"], float)
+    ta, aa = np.asarray(table.t_s, float), np.asarray(table.ax_m_s2, float)
     fin = np.isfinite(aa)
     peak = float(np.nanmax(np.abs(aa)))
     dt_tab = float(np.nanmedian(np.diff(ta)))
@@ -173,7 +173,7 @@ def _uncertainty(cfg, table, table_sync, y, msgs):
             sa = _robust_sd(rest)
             sb = sa / np.sqrt(rest.size)
         if table_sync is not None:
-            st = max(float(table_sync.get("residual_ms") or 0.0) / 1000.0, 0.25 * dt_tab)
+            st = max(float(table_sync.residual_ms or 0.0) / 1000.0, 0.25 * dt_tab)
         else:
             st = 0.0
     wy = _rest_window(y)
@@ -207,7 +207,7 @@ class ForcedPrep:
     theta0_rad: float
     unc: object  # rocklab.fitting.InputUncertainty
     fit: object  # rocklab.fitting.ForcedRestitutionFit
-    table: dict
+    table: object  # rocklab.series.TableMotion, the fitted bias taken out
 
 
 def prepare_forced(cfg, block, prim, table, table_sync, msgs: list):
@@ -219,9 +219,9 @@ def prepare_forced(cfg, block, prim, table, table_sync, msgs: list):
     block : rocklab.Block
     prim : (t_s, theta_rad)
         The primary measurement, on the table's clock.
-    table : dict
-        ``t_s``, ``acc_m_s2`` of the table (the video's sense of x).
-    table_sync : dict or None
+    table : rocklab.series.TableMotion
+        The table's motion (the video's sense of x).
+    table_sync : rocklab.tracking.SyncResult or None
         The table IMU's synchronisation (``residual_ms``), when it was synchronised.
     msgs : list
         Notes are appended.
@@ -236,7 +236,7 @@ def prepare_forced(cfg, block, prim, table, table_sync, msgs: list):
 
     t, y = (np.asarray(v, float) for v in prim)
     ok = np.isfinite(y)
-    if ok.sum() < 20 or not np.isfinite(np.asarray(table["acc_m_s2"], float)).any():
+    if ok.sum() < 20 or not np.isfinite(np.asarray(table.ax_m_s2, float)).any():
         msgs.append("validation skipped: fewer than 20 valid θ samples or no table acceleration")
         return None
     t, y = t[ok], y[ok]
@@ -254,7 +254,7 @@ def prepare_forced(cfg, block, prim, table, table_sync, msgs: list):
         sm = float(fit.rms_residual_rad * np.sqrt(fit.n_samples / dof))
         # the table's bias the fit found (a tilted table, the gravity removal) is taken out of the
         # ensemble's input: the base was the mirrored acceleration, so the table's offset is -bias
-        table = dict(table, acc_m_s2=np.asarray(table["acc_m_s2"], float) + fit.base_bias_m_s2)
+        table = dataclasses.replace(table, ax_m_s2=np.asarray(table.ax_m_s2, float) + fit.base_bias_m_s2)
         sb = float(np.hypot(unc.acc_bias_m_s2, fit.base_bias_se_m_s2))
         unc = dataclasses.replace(unc, meas_noise_rad=max(sm, unc.meas_noise_rad), acc_bias_m_s2=sb)
     return ForcedPrep(t, yl, level, 0.0 if at_rest else float(yl[0]), unc, fit, table)
@@ -288,8 +288,8 @@ def validate_forced_run(prep: ForcedPrep, block, laws: dict, *, n=None, seed=0) 
         sd = fit.se if law == "eta_e" and good else 0.0
         ens = simulate_ensemble(
             block,
-            prep.table["t_s"],
-            prep.table["acc_m_s2"],
+            prep.table.t_s,
+            prep.table.ax_m_s2,
             t,
             eta=float(eta),
             eta_sd=sd,
@@ -315,7 +315,7 @@ def validate_forced_run(prep: ForcedPrep, block, laws: dict, *, n=None, seed=0) 
 
     h = verdicts[ref].horizon_s
     budget = error_budget(
-        block, prep.table["t_s"], prep.table["acc_m_s2"], t, eta=float(todo[ref]),
+        block, prep.table.t_s, prep.table.ax_m_s2, t, eta=float(todo[ref]),
         eta_sd=fit.se if ref == "eta_e" and good else 0.0, theta0_rad=prep.theta0_rad, t_start_s=float(t[0]),
         unc=unc, t_end_s=float(h) if h is not None and np.isfinite(h) else None, n=max(8, n // 2), seed=seed,
     )  # fmt: skip

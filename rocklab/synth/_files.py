@@ -128,7 +128,7 @@ class VideoPair:
 
 
 def write_track_toml(path: Path, *, style, camera, objects, marker_size_m, dot_diameter_m, calibrated=True) -> str:
-    """``track.toml`` through the tracker's own schema (:class:`TrackConfig`).
+    """``track.toml`` through the tracker's own schema (:class:`rocklab.config.TrackConfig`).
 
     No frame rate: the film's container has each frame's time, and a rate written here would
     re-time any other film the config is reused on.
@@ -137,10 +137,10 @@ def write_track_toml(path: Path, *, style, camera, objects, marker_size_m, dot_d
     (else the tracker works from the marker size / dot layout alone).
     ``objects``: list of dicts with ``id, kind`` and ``markers`` +
     ``marker_positions_m`` / ``dots`` / ``roi`` + ``size_m`` + ``theta0_rad``.
-    Validated by parsing it back with :func:`load_track_config`.
+    Validated by parsing it back with :func:`rocklab.config.load_track_config`.
     """
     from .._io import write_text_atomic
-    from ..tracking.video._config import TrackConfig, load_track_config
+    from ..config import TrackConfig, load_track_config
 
     d = {"video": {}, "targets": {"style": style}, "reference": {"level": "table"}, "objects": []}
     if calibrated:
@@ -161,10 +161,11 @@ def write_track_toml(path: Path, *, style, camera, objects, marker_size_m, dot_d
                 v = o[k]
                 e[k] = v.tolist() if isinstance(v, np.ndarray) else v
         d["objects"].append(e)
-    cfg = TrackConfig.from_dict(d)
-    text = (
-        "# Tracking config written by 'rocklab synth' (schema: rocklab/tracking/video/_config.py).\n"
-        "# Object origins: block = centre of its front face, table = top centre of its front face.\n" + cfg.to_toml()
+    text = TrackConfig.from_dict(d).to_toml(
+        header=(
+            "Tracking config written by 'rocklab synth' (schema: docs/track-toml.md).",
+            "Object origins: block = centre of its front face, table = top centre of its front face.",
+        )
     )
     write_text_atomic(path, text, stamp=False)  # an input of `rocklab run`, not an output
     load_track_config(path)  # round-trip check: the tracker can read what we wrote
@@ -172,46 +173,32 @@ def write_track_toml(path: Path, *, style, camera, objects, marker_size_m, dot_d
 
 
 def write_experiment_toml(path: Path, *, name, block, table_kind, imu_objects, column=None) -> str:
-    """``experiment.toml`` for ``rocklab run`` (schema: ``rocklab/pipelines/experiment/_config.py``).
+    """``experiment.toml`` for ``rocklab run``, through its schema (:class:`rocklab.config.ExperimentConfig`).
 
     ``block``: dict with ``id, b_m, h_m, mass_kg`` of the block the run fits;
     ``imu_objects``: object ids that have ``imu/<id>/`` logs; ``column``: object
     ids bottom to top for a stacked column (or None).
     """
     from .._io import write_text_atomic
+    from ..config import ExperimentConfig, SourceImu, SourceTable, SourceVideo
 
-    lines = [
-        f'name = "{name}"',
-        'truth = "truth.csv"',
-        "",
-        "[block]",
-        f"b_m = {block['b_m']!r}",
-        f"h_m = {block['h_m']!r}",
-        f"mass_kg = {block['mass_kg']!r}",
-        "",
-        "[contact]",
-        'type = "full"',
-        "",
-        "[sources]",
-        'primary = "video"',
-        "",
-        "[sources.video]",
-        'path = "video.mkv"',
-        'track_config = "track.toml"',
-        f'object = "{block["id"]}"',
-        "",
-    ]
-    if block["id"] in imu_objects:
-        lines += ["[sources.imu]", f'path = "imu/{block["id"]}"', 'axis = "y"', ""]
-    if table_kind == "none":
-        lines += ["[sources.table]", 'from = "none"', ""]
-    else:
-        lines += ["[sources.table]", 'from = "video"', 'object = "table"', ""]
-    if column:
-        lines += ["[column]", "objects = [" + ", ".join(f'"{c}"' for c in column) + "]", ""]
-    text = (
-        "# Experiment config written by 'rocklab synth' (schema: rocklab/pipelines/experiment/_config.py).\n"
-        + "\n".join(lines)
+    path = Path(path)
+    folder = path.parent
+    bid = block["id"]
+    cfg = ExperimentConfig(
+        path=path,
+        name=name,
+        b_m=float(block["b_m"]),
+        h_m=float(block["h_m"]),
+        mass_kg=float(block["mass_kg"]),
+        block_id=None,
+        primary="video",
+        video=SourceVideo(path=folder / "video.mkv", track_config=folder / "track.toml", object=bid),
+        imu=SourceImu(path=folder / "imu" / bid, axis="y") if bid in imu_objects else None,
+        table=SourceTable() if table_kind == "none" else SourceTable(source="video", object="table"),
+        columns=tuple(column or ()),
+        truth=folder / "truth.csv",
     )
+    text = cfg.to_toml(header=("Experiment config written by 'rocklab synth' (schema: docs/experiment-toml.md).",))
     write_text_atomic(path, text, stamp=False)  # an input of `rocklab run`, not an output
     return text

@@ -35,7 +35,7 @@ def write_object_imu(
     """Simulate and write ``folder/<oid>_CalInertialAndMag.csv`` + ``_Registers.csv``.
 
     ``block_motion`` (a ``BlockMotion``) and ``block`` for a sensor on a block;
-    only ``table`` (a ``TableMotion``) for the sensor on the table. Errors: a
+    only ``table`` (a ``TableProgram``) for the sensor on the table. Errors: a
     gyro bias of 0.2..1 deg/s per axis, white noise (0.1 deg/s, 0.005 g), one
     or two bursts of lost packets; the log starts 0.5..1.5 s before the video and
     ends at ``t_end_s`` (video time), which the motions must cover: before their

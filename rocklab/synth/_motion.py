@@ -21,14 +21,16 @@ import numpy as np
 
 from .._errors import InputError
 
-__all__ = ["TableMotion", "sine_pulse_table", "record_table", "still_table", "BlockMotion"]
+__all__ = ["TableProgram", "sine_pulse_table", "record_table", "still_table", "BlockMotion"]
 
 _SINE_PEAK = 0.6495190525534192  # max |(sin x - sin 2x / 2) / 2| on [0, 2 pi]
 
 
 @dataclass(frozen=True)
-class TableMotion:
-    """Horizontal table displacement ``u(t)`` (m) with consistent ``v``, ``a``.
+class TableProgram:
+    """A prescribed horizontal table displacement ``u(t)`` (m) with consistent ``v``, ``a``: the
+    motion a simulated session drives the table with (a measured one is
+    :class:`rocklab.series.TableMotion`).
 
     Attributes
     ----------
@@ -94,13 +96,13 @@ class TableMotion:
         return self.start_s + float(self._spline.x[-1])
 
     def base_motion(self, t_end_s: float, dt_s: float = 5e-4):
-        """The table acceleration as a :class:`~rocklab.models.BaseMotion` from t = 0 (None when still).
+        """The table acceleration as a :class:`~rocklab.series.BaseMotion` from t = 0 (None when still).
 
         For records the knots are the record's own samples: the cubic spline's
         second derivative is linear between knots, exactly what the simulator's
         linear interpolation of the base record reproduces.
         """
-        from ..models import BaseMotion
+        from ..series import BaseMotion
 
         if self.kind == "none":
             return None
@@ -116,11 +118,11 @@ class TableMotion:
         return BaseMotion(t, self.a(t), name="sine-pulse", source="synth")
 
 
-def still_table() -> TableMotion:
-    return TableMotion("none", 0.0, {"kind": "none"})
+def still_table() -> TableProgram:
+    return TableProgram("none", 0.0, {"kind": "none"})
 
 
-def sine_pulse_table(start_s: float, period_s: float = 0.6, amplitude_m: float = 0.045) -> TableMotion:
+def sine_pulse_table(start_s: float, period_s: float = 0.6, amplitude_m: float = 0.045) -> TableProgram:
     """One smooth sine cycle (thesis §4.3, Fig. 31: period 0.6 s, amplitude 45 mm).
 
     ``u(t) = A' sin(w t) sin^2(w t / 2)`` on one period, scaled so that
@@ -131,7 +133,7 @@ def sine_pulse_table(start_s: float, period_s: float = 0.6, amplitude_m: float =
         if not (math.isfinite(v) and v > 0):
             raise InputError(f"{name}={v!r}: must be positive")
     w = 2 * math.pi / period_s
-    return TableMotion(
+    return TableProgram(
         "sine",
         float(start_s),
         {
@@ -150,10 +152,10 @@ def sine_pulse_table(start_s: float, period_s: float = 0.6, amplitude_m: float =
 
 def record_table(
     base, start_s: float, length_s: float, stroke_m: float, target_pga_m_s2: float, name: str = "record"
-) -> TableMotion:
+) -> TableProgram:
     """A ground-motion record made playable by a table of limited stroke.
 
-    As shake-table labs do: the record (a :class:`~rocklab.models.BaseMotion`)
+    As shake-table labs do: the record (a :class:`~rocklab.series.BaseMotion`)
     is cut to ``length_s``, scaled to ``target_pga_m_s2``, high-pass filtered
     (4th-order Butterworth, zero phase) with the lowest corner frequency that
     keeps the doubly integrated displacement within ``stroke_m``, and tapered
@@ -205,7 +207,7 @@ def record_table(
         "table = clamped cubic spline through u",
     }
     start = round(start_s / dt) * dt
-    return TableMotion("record", float(start), info, sp)
+    return TableProgram("record", float(start), info, sp)
 
 
 @dataclass(frozen=True)
@@ -230,7 +232,7 @@ class BlockMotion:
     x0_m: float
     t_s: np.ndarray
     phi_rad: np.ndarray
-    table: TableMotion
+    table: TableProgram
     release_s: float | None = None
 
     def phi(self, t):

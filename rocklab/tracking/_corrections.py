@@ -31,11 +31,10 @@ from pathlib import Path
 import numpy as np
 
 from .._errors import InputError
+from ..series import CORRECTION_STATUSES
 
 __all__ = ["Correction", "load_corrections", "apply_corrections", "CORRECTION_STATUSES"]
 
-#: Statuses a correction gives a frame (``tracks.csv``'s ``status``).
-CORRECTION_STATUSES = ("corrected", "dropped")
 _WHERE = ("frame", "to_frame", "t_s", "to_t_s")
 _VALUES = ("x_m", "y_m", "theta_rad", "theta_deg")
 _KEYS = ("object", "action", *_WHERE, *_VALUES)
@@ -140,17 +139,18 @@ def load_corrections(path, objects=None) -> tuple[Correction, ...]:
     if not p.is_file():
         raise InputError(f"{p}: corrections file not found; check the path")
     if p.suffix.lower() == ".toml":
-        import tomllib
+        from ..config import TomlDoc
 
-        try:
-            d = tomllib.loads(p.read_text(encoding="utf-8"))
-        except tomllib.TOMLDecodeError as e:
-            raise InputError(f"{p}: not valid TOML ({e}); fix the syntax") from None
+        doc = TomlDoc.read(p, "corrections file")
+        d = doc.data
         rows = d.get("corrections")
         extra = sorted(set(d) - {"corrections"})
         if not isinstance(rows, list) or extra:
             raise InputError(f"{p}: give each correction as a [[corrections]] table (found {extra or 'none'})")
-        out = tuple(_one(r, f"{p}, correction {k}") for k, r in enumerate(rows, start=1))
+        out = tuple(
+            _one(r, f"{p}, line {doc.line_of(('corrections', k - 1))}, correction {k}")
+            for k, r in enumerate(rows, start=1)
+        )
     else:
         out = _read_csv(p)
     for c in out:

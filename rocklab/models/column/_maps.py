@@ -15,7 +15,7 @@ import numpy as np
 
 from ..._errors import InputError
 from ._sim import Column, simulate_column
-from ..spectra._records import BaseMotion
+from ...series import BaseMotion
 
 __all__ = ["sine_pulse", "ColumnMaps", "column_overturning_maps"]
 

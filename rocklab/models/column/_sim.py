@@ -27,7 +27,7 @@ import numpy as np
 from ..._errors import InputError
 from ...blocks import G as G_STD
 from ...blocks import Block
-from ..spectra._records import BaseMotion
+from ...series import BaseMotion
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -319,6 +319,64 @@ def _stride(output_dt_s, dt_s, n_steps) -> int:
 COLUMN_BLOCK_STEPS_PER_S = 3e6
 
 
+def _check_cost(n, duration_s, dt_s, n_float, n_rows):
+    """InputError before a column run that would not fit in memory or would take far too long."""
+    from ..._errors import check_memory, check_time
+
+    check_memory(
+        8.0 * n_rows * (4 * n + 4),
+        f"{duration_s:g} s of a {n}-block column at {dt_s:g} s ({n_rows} stored rows)",
+        "shorten duration_s or give a coarser output_dt_s",
+    )
+    check_time(
+        n_float * n / COLUMN_BLOCK_STEPS_PER_S,
+        f"{duration_s:g} s of a {n}-block column at dt = {dt_s:g} s ({n_float:.3g} steps)",
+        "give a coarser dt_s (e.g. 1e-4 s) or a shorter duration_s",
+    )
+
+
+def _event_tables(EVT, EVI, IMP):
+    """The kernel's configuration changes and impacts (rows already cut to their counts) as tables."""
+    import pandas as pd
+
+    conf = pd.DataFrame(
+        {
+            "t_s": EVT,
+            "joint": EVI[:, 0],
+            "state": [STATE_NAMES[int(x)] for x in EVI[:, 1]],
+            "event": [_KIND[int(x)] for x in EVI[:, 2]],
+        }
+    )
+    imp = pd.DataFrame(
+        {
+            "t_s": IMP[:, 0],
+            "joint": IMP[:, 1].astype(int),
+            "omega_before_rad_s": -IMP[:, 2],
+            "ke_before_J": IMP[:, 3],
+            "ke_after_J": IMP[:, 4],
+            "state_after": [STATE_NAMES[int(x)] for x in IMP[:, 5]],
+        }
+    )
+    return conf, imp
+
+
+def _final_status(code, t_st, phi, om, never_moved):
+    """(status, its time s or NaN, message) from the kernel's status code and the last state."""
+    status = _STATUS[code]
+    msg = ""
+    if status == "end":
+        moving = bool(np.any(om[-1] != 0.0)) or bool(np.any(phi[-1] != 0.0))
+        status = "rocking" if moving else ("no_uplift" if never_moved else "rest")
+        t_st = math.nan
+    elif status == "rest" and never_moved:
+        status = "no_uplift"
+    elif status in ("tension", "sliding"):
+        msg = f"terminated at t={t_st:.6g} s: {status} at a joint (the column may disintegrate)"
+    elif status in ("capacity", "numerical"):
+        msg = f"integration failed at t={t_st:.6g} s ({status}); reduce dt_s or check the input"
+    return status, t_st, msg
+
+
 def simulate_column(
     column: Column,
     base: BaseMotion | None = None,
@@ -386,8 +444,6 @@ def simulate_column(
     -------
     ColumnResult
     """
-    import pandas as pd
-
     from ._core import run_core, run_core_jit
 
     if not isinstance(column, Column):
@@ -424,20 +480,7 @@ def simulate_column(
     n_steps = int(math.ceil(n_float - 1e-9))
     stride = _stride(output_dt_s, dt_s, n_steps)
     n_rows = n_steps // stride + 2
-    from ..._errors import check_memory
-
-    check_memory(
-        8.0 * n_rows * (4 * column.n + 4),
-        f"{duration_s:g} s of a {column.n}-block column at {dt_s:g} s ({n_rows} stored rows)",
-        "shorten duration_s or give a coarser output_dt_s",
-    )
-    from ..._errors import check_time
-
-    check_time(
-        n_float * n / COLUMN_BLOCK_STEPS_PER_S,
-        f"{duration_s:g} s of a {n}-block column at dt = {dt_s:g} s ({n_float:.3g} steps)",
-        "give a coarser dt_s (e.g. 1e-4 s) or a shorter duration_s",
-    )
+    _check_cost(n, duration_s, dt_s, n_float, n_rows)
     par = np.array(
         [g_m_s2, column.mu, t0b, dtb, 1.0 if velocity_terms else 0.0, 1e-14, _quiet_time(column, base, g_m_s2), 0.0]
     )
@@ -478,39 +521,10 @@ def simulate_column(
         if st != 5 or ecap >= 5_000_000:
             break
         ecap *= 10
-    status = _STATUS[int(st)]
     phi = -PHI[:nr]
     om = -VEL[:nr]
-    conf = pd.DataFrame(
-        {
-            "t_s": EVT[:ne],
-            "joint": EVI[:ne, 0],
-            "state": [STATE_NAMES[int(x)] for x in EVI[:ne, 1]],
-            "event": [_KIND[int(x)] for x in EVI[:ne, 2]],
-        }
-    )
-    imp = pd.DataFrame(
-        {
-            "t_s": IMP[:ni, 0],
-            "joint": IMP[:ni, 1].astype(int),
-            "omega_before_rad_s": -IMP[:ni, 2],
-            "ke_before_J": IMP[:ni, 3],
-            "ke_after_J": IMP[:ni, 4],
-            "state_after": [STATE_NAMES[int(x)] for x in IMP[:ni, 5]],
-        }
-    )
-    never_moved = ne == 0
-    msg = ""
-    if status == "end":
-        moving = bool(np.any(om[-1] != 0.0)) or bool(np.any(phi[-1] != 0.0))
-        status = "rocking" if moving else ("no_uplift" if never_moved else "rest")
-        t_st = math.nan
-    elif status == "rest" and never_moved:
-        status = "no_uplift"
-    elif status in ("tension", "sliding"):
-        msg = f"terminated at t={t_st:.6g} s: {status} at a joint (the column may disintegrate)"
-    elif status in ("capacity", "numerical"):
-        msg = f"integration failed at t={t_st:.6g} s ({status}); reduce dt_s or check the input"
+    conf, imp = _event_tables(EVT[:ne], EVI[:ne], IMP[:ni])
+    status, t_st, msg = _final_status(int(st), t_st, phi, om, ne == 0)
     params = dict(
         dt_s=dt_s,
         output_dt_s=float(dt_s if output_dt_s is None else output_dt_s),

@@ -14,7 +14,7 @@ import numpy as np
 
 from ..._errors import InputError
 from ._newmark import run_batch
-from ..spectra._records import BaseMotion
+from ...series import BaseMotion
 from ._result import BatchResult
 
 __all__ = ["simulate_batch", "free_rocking_overturns"]

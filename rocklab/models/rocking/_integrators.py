@@ -28,7 +28,7 @@ from ._newmark import STATUS_NAMES, run_single
 
 if TYPE_CHECKING:
     from ...blocks import Block
-    from ..spectra._records import BaseMotion
+    from ...series import BaseMotion
     from ._restitution import Restitution
 
 __all__ = [

@@ -31,7 +31,7 @@ import math
 import numpy as np
 
 from ..._errors import InputError, check_memory, check_time
-from ..spectra._records import BaseMotion
+from ...series import BaseMotion
 from ._integrators import RockingProblem, integrator
 from ._restitution import make_restitution
 from ._result import RockingResult, block_energy

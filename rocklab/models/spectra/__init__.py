@@ -30,7 +30,8 @@ from ._pulses import (
     pulse_shape,
 )
 from ._record_measures import RecordMeasures, record_measures, response_spectrum
-from ._records import BUNDLED_RECORDS, UNITS_TO_M_S2, BaseMotion, bundled_record, load_base_motion
+from ...series import UNITS_TO_M_S2, BaseMotion
+from ._records import BUNDLED_RECORDS, bundled_record, load_base_motion
 
 __all__ = [
     "BaseMotion",

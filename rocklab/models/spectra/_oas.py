@@ -60,7 +60,7 @@ from ..._errors import InputError
 from ...blocks import G, inertia_coefficient
 from ..rocking._batch import free_rocking_overturns, simulate_batch
 from ._oas_grid import adaptive_verdicts, boundary_verdicts
-from ._records import BaseMotion
+from ...series import BaseMotion
 
 __all__ = [
     "OASResult",
@@ -403,19 +403,7 @@ def overturning_spectrum(
     else:
         over, evaluated = adaptive_verdicts(lambda i, j: _runs(base, scales[i], p[j], args), lv.size, p.size)
 
-    # largest unsafe grid size per level
-    k = np.full(lv.size, -1)
-    for i, row in enumerate(over):
-        if search == "scan":
-            hit = np.flatnonzero(row)
-            if hit.size:
-                k[i] = hit[0]
-        elif row[-1]:
-            safe = np.flatnonzero(~row)
-            k[i] = safe[-1] + 1 if safe.size else 0
-    p_hi = np.where(k >= 0, p[np.clip(k, 0, None)], np.nan)  # unsafe
-    p_lo = np.where(k > 0, p[np.clip(k - 1, 0, None)], np.nan)  # safe neighbour (larger block)
-    p_hi, p_lo = _bisect(base, scales, p_hi, p_lo, refine, args)
+    p_hi, p_lo = _bisect(base, scales, *_first_unsafe(over, p, search), refine, args)
 
     f = lv * p_hi
     icr = normalised_critical_impulse(alpha)
@@ -442,6 +430,26 @@ def overturning_spectrum(
         options=opts,
         evaluated=evaluated,
     )
+
+
+def _first_unsafe(over, p, search):
+    """Per level, p (rad/s) of the largest unsafe grid size and of its safe neighbour (NaN if none).
+
+    ``search="scan"``: the first overturning size from the largest block down; ``"contiguous"``:
+    the largest block of the run of overturning sizes that reaches the smallest block.
+    """
+    k = np.full(over.shape[0], -1)
+    for i, row in enumerate(over):
+        if search == "scan":
+            hit = np.flatnonzero(row)
+            if hit.size:
+                k[i] = hit[0]
+        elif row[-1]:
+            safe = np.flatnonzero(~row)
+            k[i] = safe[-1] + 1 if safe.size else 0
+    p_hi = np.where(k >= 0, p[np.clip(k, 0, None)], np.nan)  # unsafe
+    p_lo = np.where(k > 0, p[np.clip(k - 1, 0, None)], np.nan)  # safe neighbour (larger block)
+    return p_hi, p_lo
 
 
 def _guess_first(guide, lv, p):

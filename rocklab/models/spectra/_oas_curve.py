@@ -14,7 +14,7 @@ import numpy as np
 from ..._errors import InputError
 from ...blocks import G
 from ._oas import _CRIT, OAS_DEFAULTS, _check_opts, _free_code, _runs, normalised_critical_impulse
-from ._records import BaseMotion
+from ...series import BaseMotion
 
 __all__ = ["OverturningCurve", "overturning_curve"]
 

@@ -20,7 +20,8 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from ..._errors import InputError
-from ._records import MIN_SAMPLES, BaseMotion
+from ...series import BaseMotion
+from ._records import MIN_SAMPLES
 
 __all__ = [
     "PulseParameters",

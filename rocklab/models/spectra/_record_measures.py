@@ -13,7 +13,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from ..._errors import InputError
-from ._records import BaseMotion
+from ...series import BaseMotion
 
 __all__ = ["RecordMeasures", "record_measures", "response_spectrum"]
 

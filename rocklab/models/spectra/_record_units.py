@@ -1,6 +1,6 @@
-"""Acceleration units of base-motion records: accepted names, an AT2 header's units field,
-and the rule that a file's own units win over ``--units`` (which applies only to files
-that state none; a disagreement is an error)."""
+"""Acceleration units of base-motion records: an AT2 header's units field, and the rule that a
+file's own units win over ``--units`` (which applies only to files that state none; a
+disagreement is an error). The accepted unit names are :data:`rocklab.series.UNITS_TO_M_S2`."""
 
 from __future__ import annotations
 
@@ -8,31 +8,9 @@ import re
 from pathlib import Path
 
 from ..._errors import InputError
-from ...blocks import G
+from ...series import acc_unit_factor as _unit_factor
 
-__all__ = ["UNITS_TO_M_S2"]
-
-#: Factors from accepted acceleration units to m/s^2.
-UNITS_TO_M_S2 = {
-    "g": G,
-    "m/s2": 1.0,
-    "m/s^2": 1.0,
-    "m_s2": 1.0,
-    "cm/s2": 0.01,
-    "cm/s^2": 0.01,
-    "cm_s2": 0.01,
-    "gal": 0.01,
-    "mm/s2": 0.001,
-}
-
-
-def _unit_factor(units: str, source: str = "") -> float:
-    key = str(units).strip().lower().replace(" ", "")
-    if key not in UNITS_TO_M_S2:
-        raise InputError(
-            f"{source}units={units!r}: unknown acceleration unit; use one of {', '.join(sorted(set(UNITS_TO_M_S2)))}"
-        )
-    return UNITS_TO_M_S2[key]
+__all__: list[str] = []
 
 
 def _stated_wins(path: Path, stated: str, where: str, given: str | None) -> str:

@@ -52,15 +52,12 @@ def _check_unique_names(configs, root: Path) -> None:
     """Experiment names label a campaign's rows, blocks, links and Rerun entities, so two
     experiments of one name would be merged in its fits and figures: refused before any work.
     A config that cannot be read is left to its own run, which reports it as failed."""
-    import tomllib
+    from ...config import experiment_name
 
     seen: dict[str, Path] = {}
     for c in configs:
-        try:
-            name = tomllib.loads(c.read_text(encoding="utf-8")).get("name", c.parent.name)
-        except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError):
-            continue
-        if not isinstance(name, str):
+        name = experiment_name(c)
+        if name is None:
             continue
         if name in seen:
             raise InputError(
@@ -111,7 +108,9 @@ class CampaignResult:
         Per experiment: config, out, ok, error.
     table : pandas.DataFrame
         One row per experiment (experiment, status ok/suspect/failed, error, warnings (the
-        W- codes), block, b_m, h_m, contact, eta_e, ci_lo, ci_hi, eta_H, eta_M, eta_true, ...);
+        W- codes), block, b_m, h_m, contact, eta_e, eta_e_source (``free``: the free-rocking fit;
+        ``half_cycles``: a base-excited run's half cycles under the measured table motion, not
+        pooled into η_mat or k), ci_lo, ci_hi, eta_H, eta_M, eta_true, ...);
         a failed experiment's row carries only its name, status and error.
     eta_mat : dict or None
         Edge-contact η_mat fit (:meth:`to_dict` of the fitting result).
@@ -185,7 +184,9 @@ class CampaignResult:
                 name = str(r["experiment"])
                 folder = Path(str(r["out"])).name
                 ci = f"{g(r.get('ci_lo'))} – {g(r.get('ci_hi'))}" if np.isfinite(r.get("ci_lo", np.nan)) else "–"
-                eta_e = g(r["eta_e"]) if np.isfinite(r["eta_e"]) else "(forced)"
+                eta_e = g(r["eta_e"]) if np.isfinite(r["eta_e"]) else "–"
+                if r.get("eta_e_source") == "half_cycles":
+                    eta_e += " (half cycles)"
                 lines.append(
                     f"| [{name}](experiments/{folder}/report.html) | {r['block']} | {r['contact']} | "
                     f"{g(r.get('hb'))} | {g(r['eta_H'])} | {eta_e} | {ci} | {g(r.get('eta_M'))} | "
@@ -235,12 +236,16 @@ class CampaignResult:
             )
             for _, r in t.iterrows():
                 ci = f"[{r['ci_lo']:.3f}, {r['ci_hi']:.3f}]" if np.isfinite(r.get("ci_lo", np.nan)) else ""
-                eta_e = f"{r['eta_e']:>8.3f}" if np.isfinite(r["eta_e"]) else f"{'forced':>8}"
+                eta_e = f"{r['eta_e']:>8.3f}" if np.isfinite(r["eta_e"]) else f"{'-':>8}"
+                if r.get("eta_e_source") == "half_cycles":
+                    ci += " hc"
                 lines.append(
                     f"{str(r['experiment'])[:21]:<22}{str(r['block'])[:6]:<7}{r['contact']:<8}"
                     f"{r['eta_H']:>8.3f}{eta_e}{ci:>18}"
                     f"{r.get('eta_M', np.nan):>8.3f}{r.get('eta_true', np.nan):>8.3f}"
                 )
+            if (t.get("eta_e_source", "") == "half_cycles").any():
+                lines.append("hc: η_e from the run's half cycles under the measured table motion (not in η_mat or k)")
             for _, r in t[t.get("column", "") != ""].iterrows() if "column" in t else []:
                 c = json.loads(r["column"])
                 lines.append(
@@ -302,6 +307,11 @@ def _row(run: dict) -> dict:
         }
     b = rep["block"]
     fit = rep.get("fit") or {}
+    source = "free" if fit else ""
+    if not fit:
+        # a base-excited run's η_e comes from its half cycles under the measured table motion
+        fit = (rep.get("validation") or {}).get("eta_e") or {}
+        source = "half_cycles" if fit else ""
     ci = fit.get("ci95_eta_e") or [np.nan, np.nan]
     sims = rep.get("simulations") or {}
     truth = rep.get("truth") or {}
@@ -320,6 +330,7 @@ def _row(run: dict) -> dict:
         "l_c_m": rep["contact"]["l_c_m"],
         "eta_H": b["eta_H"],
         "eta_e": fit.get("eta_e", np.nan),
+        "eta_e_source": source,
         "ci_lo": ci[0] if ci[0] is not None else np.nan,
         "ci_hi": ci[1] if ci[1] is not None else np.nan,
         "eta_e_first": fit.get("eta_e_first", np.nan),
@@ -346,8 +357,10 @@ def _campaign_fits(table, msgs):
     from ... import fitting as F
 
     eta_mat = k_tab = None
-    edge = table[(table["contact"] == "edge") & np.isfinite(table["eta_e"])]
-    full = table[(table["contact"] == "full") & np.isfinite(table["eta_e"])]
+    # Čeh's η_mat and k are defined on free rocking; a base-excited run's half-cycle η_e is shown, not pooled
+    free = table[np.isfinite(table["eta_e"]) & (table.get("eta_e_source", "free") == "free")]
+    edge = free[free["contact"] == "edge"]
+    full = free[free["contact"] == "full"]
     if len(edge):
         etab = edge.rename(columns={"experiment": "run"})[["block", "b_m", "h_m", "eta_e", "l_c_m"]]
         r = F.fit_eta_mat(etab, l_c_m=float(edge["l_c_m"].iloc[0]))

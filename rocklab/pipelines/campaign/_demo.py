@@ -2,7 +2,9 @@
 
 The campaign (all rendered by :func:`rocklab.synth.synth_session` with ArUco
 targets and x-IMU logs, 960×540 at 50 fps; at this size η_e of a 4.5 cm wide
-block comes back within 1e-4 of the truth):
+block comes back within 1e-4 of the truth). The runs read the camcorder-like
+H.264 film ``video.mp4`` (17 Mbit/s at 1080p, scaled by pixels), as a lab's
+footage would be; ``camcorder=False`` reads the lossless ``video.mkv`` instead:
 
 - full-contact free rocking of Čeh Table 2 blocks (B3M, B5M, B7M, B9M, B4L), whose
   true restitution is Čeh Table 3's η_e,full, so the campaign fits k per block and
@@ -59,42 +61,49 @@ def _true_eta(block_id: str, contact: str) -> float:
     return float(cat.loc[block_id, "eta_e_full"])
 
 
-def _edit_experiment(path: Path, name: str, block_id: str, contact: str, table: str) -> None:
-    """Adapt the synth's experiment.toml: run name, catalogue id, contact, forced-run options."""
-    import re
-
-    text = path.read_text(encoding="utf-8")
-    text, n = re.subn(r'(?m)^name = ".*"$', f'name = "{name}"', text, count=1)
-    if n != 1:
-        raise AssertionError(f"{path}: no name line in the synth's experiment.toml")
-
-    def sub(old, new):
-        nonlocal text
-        if text.count(old) != 1:
-            raise AssertionError(f"{path}: expected one {old!r} in the synth's experiment.toml")
-        text = text.replace(old, new)
-
-    sub("[block]\n", f'[block]\nid = "{block_id}"\n')
+def _edit_experiment(path: Path, name: str, block_id: str, contact: str, table: str, camcorder: bool) -> None:
+    """Adapt the synth's experiment.toml through its schema: run name, catalogue id, contact,
+    forced-run options."""
+    changes: dict = dict(name=name, block_id=block_id)
     if contact == "edge":
-        sub('[contact]\ntype = "full"\n', f'[contact]\ntype = "edge"\nl_c_m = {L_C_M}\n')
-    extra = "\n[output]\nvideo_decimation = 5\n"
+        changes.update(contact="edge", l_c_m=L_C_M)
     if table != "none":
+        from ...config import SourceTable
+
         # forced rocking: no free-rocking restitution fit; simulate the table-driven response
         # a record's table acceleration has content a 50 fps camera cannot sample: drive the
         # simulation from the table IMU (256 Hz), synced to the video by its acceleration
-        sub(
-            '[sources.table]\nfrom = "video"\nobject = "table"\n',
-            '[sources.table]\nfrom = "imu"\nobject = "table"\nimu = "imu/table"\n',
-        )
+        changes.update(table=SourceTable(source="imu", object="table", imu=path.parent.resolve() / "imu" / "table"))
         # (the η a lab would have calibrated on free rocking of the same block: here the truth)
-        extra += (
-            '\n[fit]\nrestitution = false\n\n[simulate]\nlaws = ["housner", "modified"]\n'
-            f"eta = {_true_eta(block_id, contact):.6f}\n"
-        )
-    path.write_text(text + extra, encoding="utf-8")
+        eta = float(f"{_true_eta(block_id, contact):.6f}")
+        changes.update(fit_restitution=False, laws=("housner", "modified", "given"), eta_given=eta)
+    _rewrite_experiment(path, camcorder, **changes)
 
 
-def _render_one(d: Path, seed: int, name: str, bid: str, contact: str, table: str, size, fps) -> Path:
+def _rewrite_experiment(path: Path, camcorder: bool, **changes) -> None:
+    """Read the synth's experiment.toml, change fields of its :class:`ExperimentConfig` (the
+    demo logs every 5th frame to Rerun; ``camcorder`` points the video source at the H.264 film
+    the synth writes beside the lossless one) and write it back."""
+    from dataclasses import replace
+
+    from ..._io import write_text_atomic
+    from ..experiment._config import load_experiment
+
+    cfg = load_experiment(path)
+    if camcorder:
+        mp4 = cfg.video.path.with_suffix(".mp4")
+        if not mp4.is_file():
+            raise AssertionError(f"{path}: the synth wrote no camcorder film {mp4.name}")
+        changes["video"] = replace(cfg.video, path=mp4)
+    cfg = replace(cfg, video_decimation=5, **changes)
+    write_text_atomic(
+        path, cfg.to_toml(header=("Experiment config of the demo campaign (rocklab demo).",)), stamp=False
+    )
+
+
+def _render_one(
+    d: Path, seed: int, name: str, bid: str, contact: str, table: str, size, fps, camcorder: bool = True
+) -> Path:
     from ...fitting import catalogue_block
     from ...synth import synth_session
 
@@ -109,15 +118,11 @@ def _render_one(d: Path, seed: int, name: str, bid: str, contact: str, table: st
             size=size,
             targets="aruco",
             duration_s=4.0,
-            mp4=False,
+            mp4=camcorder,
             imu=False,
             force=True,
         )
-        text = cfg.read_text(encoding="utf-8")
-        cfg.write_text(
-            text.replace(f'name = "synth-seed{seed}"', f'name = "{name}"') + "\n[output]\nvideo_decimation = 5\n",
-            encoding="utf-8",
-        )
+        _rewrite_experiment(cfg, camcorder, name=name)
         return cfg
     blk = catalogue_block(bid)
     kw = (
@@ -135,25 +140,35 @@ def _render_one(d: Path, seed: int, name: str, bid: str, contact: str, table: st
         targets="aruco",
         block=blk,
         eta=_true_eta(bid, contact),
-        mp4=False,
+        mp4=camcorder,
         force=True,
         **kw,
     )
-    _edit_experiment(cfg, name, bid, contact, table)
+    _edit_experiment(cfg, name, bid, contact, table, camcorder)
     return cfg
 
 
 def make_demo_campaign(
-    root, *, size=(960, 540), fps: float = 50.0, progress: bool = True, runs=DEMO_RUNS, workers: int = 2
+    root,
+    *,
+    size=(960, 540),
+    fps: float = 50.0,
+    progress: bool = True,
+    runs=DEMO_RUNS,
+    workers: int = 2,
+    camcorder: bool = True,
 ) -> list[Path]:
-    """Render the demo sessions into ``root/<run>/`` (skips sessions already there), in parallel."""
+    """Render the demo sessions into ``root/<run>/`` (skips sessions already there), in parallel.
+
+    ``camcorder`` (default) points each run at the H.264 film; ``False`` at the lossless one.
+    """
 
     from tqdm import tqdm
 
     root = Path(root)
     root.mkdir(parents=True, exist_ok=True)
     todo = [
-        (root / name, seed, name, bid, contact, table, size, fps)
+        (root / name, seed, name, bid, contact, table, size, fps, camcorder)
         for seed, (name, bid, contact, table) in enumerate(runs)
         if not (root / name / "experiment.toml").is_file()
     ]
@@ -171,7 +186,15 @@ def make_demo_campaign(
     return [root / name / "experiment.toml" for name, *_ in runs]
 
 
-def run_demo(out_dir="demo_out", *, workers: int = 2, progress: bool = True, size=(960, 540), runs=DEMO_RUNS):
+def run_demo(
+    out_dir="demo_out",
+    *,
+    workers: int = 2,
+    progress: bool = True,
+    size=(960, 540),
+    runs=DEMO_RUNS,
+    camcorder: bool = True,
+):
     """Make the demo campaign under ``out_dir/sessions`` and run it into ``out_dir/results``."""
     from ._campaign import run_campaign
 
@@ -180,7 +203,9 @@ def run_demo(out_dir="demo_out", *, workers: int = 2, progress: bool = True, siz
     out_dir = check_output_dir(out_dir, need_bytes=300 * 1024 * 1024)
     claim_dir(out_dir, ("sessions", "results"), command="demo")
     t0 = time.perf_counter()
-    make_demo_campaign(out_dir / "sessions", size=size, progress=progress, runs=runs, workers=workers)
+    make_demo_campaign(
+        out_dir / "sessions", size=size, progress=progress, runs=runs, workers=workers, camcorder=camcorder
+    )
     t1 = time.perf_counter()
     res = run_campaign(out_dir / "sessions", out_dir / "results", workers=workers, progress=progress)
     t2 = time.perf_counter()

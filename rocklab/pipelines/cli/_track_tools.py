@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from ..._errors import InputError
+from ...series import USABLE_STATUSES
 
 __all__ = ["track_init", "track_preview", "draw_init_preview", "contact_sheet"]
 
@@ -163,12 +164,12 @@ def track_init(
     if not info.fps and not fps:
         notes.append("the film has no frame rate: fps = 50 written; correct it (or give --fps)")
     head = [
-        f"# track.toml written by 'rocklab track init' from {video.name} ({info.width_px}x{info.height_px}, "
+        f"track.toml written by 'rocklab track init' from {video.name} ({info.width_px}x{info.height_px}, "
         f"{info.n_frames} frames, {info.fps or 'unknown'} fps)",
-        "# Schema: docs/track-toml.md",
+        "Schema: docs/track-toml.md",
+        *notes,
     ]
-    head += [f"# {n}" for n in notes]
-    write_text_atomic(out, "\n".join(head) + "\n\n" + cfg.to_toml(), side=side[0])
+    write_text_atomic(out, cfg.to_toml(header=head), side=side[0])
     if preview is not None:
         save_bgr_png(Path(preview), draw_init_preview(img, cfg, found, grid=found is None), side=side[1])
     return cfg, notes, proposed
@@ -417,7 +418,7 @@ def _draw_pose(img, res, frame):
                 cv2.LINE_AA,
             )
             continue
-        if t.status[i] not in ("ok", "corrected") or t.x_px is None or not np.isfinite(t.x_px[i]):
+        if t.status[i] not in USABLE_STATUSES or t.x_px is None or not np.isfinite(t.x_px[i]):
             cv2.putText(
                 out, f"{t.object}: {t.status[i]}", (8, 46 + 20 * k), cv2.FONT_HERSHEY_SIMPLEX, 0.55, col, 2, cv2.LINE_AA
             )

@@ -19,22 +19,22 @@ import numpy as np
 
 __all__ = ["audit_experiment", "fit_exclusions"]
 
-_3D_COLUMNS = ("pivot_slide_m", "pivot_uplift_m", "twist_rad", "out_of_plane_rad")
 
-
-def _from_tracks_csv(df):
+def _from_tracks_csv(rows):
+    """``rows``: one object's :class:`rocklab.series.Tracks`."""
     from ...tracking.rigid import audit_rocking
 
-    t, th = df["t_s"].to_numpy(float), df["theta_rad"].to_numpy(float)
-    sig = float(np.nanmedian(df["sigma_theta_rad"])) if "sigma_theta_rad" in df.columns else None
-    if all(c in df.columns for c in _3D_COLUMNS):
+    t, th = rows.theta()
+    cols = rows.frame.columns
+    sig = float(np.nanmedian(rows.column("sigma_theta_rad"))) if "sigma_theta_rad" in cols else None
+    if rows.is_3d:
         return audit_rocking(
             t,
             th,
-            slide_m=df["pivot_slide_m"].to_numpy(float),
-            uplift_m=df["pivot_uplift_m"].to_numpy(float),
-            twist_rad=df["twist_rad"].to_numpy(float),
-            out_of_plane_rad=df["out_of_plane_rad"].to_numpy(float),
+            slide_m=rows.column("pivot_slide_m"),
+            uplift_m=rows.column("pivot_uplift_m"),
+            twist_rad=rows.column("twist_rad"),
+            out_of_plane_rad=rows.column("out_of_plane_rad"),
             sigma_theta_rad=sig,
             source="3d",
         )
@@ -71,8 +71,9 @@ def _from_video(cfg, tr, measured):
     )
 
 
-def audit_experiment(cfg, measured: dict, tr, track_rows=None) -> dict:
-    """The ``audit`` object of ``report.json`` for the experiment's primary source.
+def audit_experiment(cfg, measured: dict, tr, track_rows=None):
+    """The assumption audit (:class:`rocklab.tracking.rigid.AuditResult`) of the experiment's
+    primary source: ``report.json``'s ``audit``.
 
     ``tr`` is the video's TrackResult and ``track_rows`` the tracked CSV's rows (when those are sources).
     """
@@ -93,15 +94,15 @@ def audit_experiment(cfg, measured: dict, tr, track_rows=None) -> dict:
             f"{', '.join(map(str, res.excluded_impacts)) or 'none'}); their per-impact eta "
             "are not trustworthy",
         )
-    return res.to_dict()
+    return res
 
 
-def fit_exclusions(audit: dict | None, per_impact, max_dt_s: float = 0.02) -> list:
+def fit_exclusions(audit, per_impact, max_dt_s: float = 0.02) -> tuple:
     """The fit's impacts that the audit flagged, with the reasons.
 
     Parameters
     ----------
-    audit : dict
+    audit : rocklab.tracking.rigid.AuditResult or None
         :func:`audit_experiment`'s result.
     per_impact : pandas.DataFrame or None
         The fit's per-impact table (``impact, t_s, ...``).
@@ -110,16 +111,18 @@ def fit_exclusions(audit: dict | None, per_impact, max_dt_s: float = 0.02) -> li
 
     Returns
     -------
-    list of dict
-        ``{"impact": fit impact number, "t_s", "eta": its per-impact eta, "reasons": [...]}``.
+    tuple of ExcludedImpact
+        In the order of the fit's impacts.
     """
-    if not audit or not audit.get("flags") or per_impact is None or len(per_impact) == 0:
-        return []
-    times = np.asarray(audit["impacts_t_s"], float)
+    from ._stages import ExcludedImpact
+
+    if audit is None or not audit.flags or per_impact is None or len(per_impact) == 0:
+        return ()
+    times = np.asarray(audit.impacts_t_s, float)
     fit_t = per_impact["t_s"].to_numpy(float)
     out: dict = {}
-    for f in audit["flags"]:
-        k = f.get("impact")
+    for f in audit.flags:
+        k = f.impact
         if k is None or not 1 <= k <= times.size:
             continue
         j = int(np.argmin(np.abs(fit_t - times[k - 1])))
@@ -135,5 +138,5 @@ def fit_exclusions(audit: dict | None, per_impact, max_dt_s: float = 0.02) -> li
                 "reasons": [],
             },
         )
-        e["reasons"].append(f"{f['kind']} ({f['detail']}): {f['value']:.4g} against {f['tolerance']:.4g} (SI)")
-    return [out[k] for k in sorted(out)]
+        e["reasons"].append(f"{f.kind} ({f.detail}): {f.value:.4g} against {f.tolerance:.4g} (SI)")
+    return tuple(ExcludedImpact(**out[k]) for k in sorted(out))

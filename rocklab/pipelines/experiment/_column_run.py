@@ -9,14 +9,17 @@ opens when, in which direction).
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 
 from ..._errors import InputError
+from ...series import TableMotion
 
 __all__ = ["analyse_column", "base_from_table"]
 
 
-def base_from_table(table: dict, t0_s: float, where: str, *, sign: float = 1.0, dt_s: float = 1e-3):
+def base_from_table(table: TableMotion, t0_s: float, where: str, *, sign: float = 1.0, dt_s: float = 1e-3):
     """The measured table acceleration as a :class:`BaseMotion` starting at ``t0_s``.
 
     A near-critical rocking response is sensitive to how frame-rate samples are
@@ -28,8 +31,8 @@ def base_from_table(table: dict, t0_s: float, where: str, *, sign: float = 1.0, 
 
     from ...models import BaseMotion
 
-    tt = np.asarray(table["t_s"], float)
-    aa = np.asarray(table["acc_m_s2"], float)
+    tt = np.asarray(table.t_s, float)
+    aa = np.asarray(table.ax_m_s2, float)
     fin = np.isfinite(tt) & np.isfinite(aa)
     if fin.sum() < 4:
         raise InputError(
@@ -49,14 +52,14 @@ def _by_object(df, objects, value="theta_rad"):
     return wide.index.to_numpy(float), wide[list(objects)].to_numpy(float)
 
 
-def analyse_column(cfg, track_result, table, truth_path=None) -> dict:
+def analyse_column(cfg, track_result, table, truth_path=None):
     """Simulate the column under the measured table motion and compare with the tracked blocks.
 
-    Returns a dict with ``t_s`` (m,), ``theta_measured_rad`` (m, n) and ``theta_sim_rad`` (k, n)
-    (both counter-clockwise as seen by the camera), ``sim_t_s`` (k,), ``status``,
-    ``configurations`` (DataFrame on the measured clock), ``comparison`` (dict), and, with a
-    truth file, ``theta_truth_rad`` and ``sequence_vs_truth``.
+    Returns a :class:`rocklab.pipelines.experiment._stages.ColumnStage` (with a truth file, its
+    ``theta_truth``, ``sequence_vs_truth`` and ``theta_rms_error_rad`` too).
     """
+    from ._stages import ColumnStage
+
     import pandas as pd
 
     from ...models import Column, compare_sequences, compare_to_measurement, joint_sequence, simulate_column
@@ -78,26 +81,29 @@ def analyse_column(cfg, track_result, table, truth_path=None) -> dict:
     comp = compare_to_measurement(res, t - t0, th, sign=-1.0)
     confs = res.configurations.copy()
     confs["t_s"] = confs["t_s"] + t0
-    out = {
-        "objects": list(objs),
-        "t_s": t,
-        "theta_measured_rad": th,
-        "sim_t_s": np.asarray(res.t_s) + t0,
-        "theta_sim_rad": -np.asarray(res.theta_rad),
-        "status": res.status,
-        "configurations": confs,
-        "comparison": comp.to_dict(),
-        "cut_m": cfg.column_cut_m,
-        "impacts_per_closing": cfg.column_impacts,
-    }
+    out = ColumnStage(
+        objects=tuple(objs),
+        t_s=t,
+        theta_measured_rad=th,
+        sim_t_s=np.asarray(res.t_s) + t0,
+        theta_sim_rad=-np.asarray(res.theta_rad),
+        status=res.status,
+        configurations=confs,
+        comparison=comp,
+        cut_m=cfg.column_cut_m,
+        impacts_per_closing=cfg.column_impacts,
+    )
     if truth_path is not None:
         tr = pd.read_csv(truth_path)
         tt, tth = _by_object(tr[tr["object"].isin(objs)], objs)
         # which joint opens when, from the tracked angles vs from the rendered truth (thesis Fig. 32)
         mseq = joint_sequence(t - t0, -th)
         tseq = joint_sequence(tt - t0, -tth)
-        out["theta_truth_rad"] = (tt, tth)
-        out["sequence_vs_truth"] = compare_sequences(tseq, mseq).to_dict()
         err = th - np.column_stack([np.interp(t, tt, tth[:, i]) for i in range(len(objs))])
-        out["theta_rms_error_rad"] = np.sqrt(np.nanmean(err**2, axis=0)).tolist()
+        out = dataclasses.replace(
+            out,
+            theta_truth=(tt, tth),
+            sequence_vs_truth=compare_sequences(tseq, mseq),
+            theta_rms_error_rad=np.sqrt(np.nanmean(err**2, axis=0)).tolist(),
+        )
     return out

@@ -49,20 +49,27 @@ def experiment_figures(res, out_dir) -> dict[str, Path]:
     """
     plt = pyplot()
     out = Path(out_dir)
-    figs: dict[str, Path] = {}
-    alpha = res.block.alpha_rad
+    figures = {
+        "theta": (_theta_figure, True),
+        "per_impact_eta": (_per_impact_figure, res.fit is not None and len(res.per_impact_eta) > 0),
+        "energy_per_impact": (_energy_figure, bool(res.simulations)),
+        "video_vs_imu": (_video_imu_figure, res.video_imu_residual is not None),
+        "column": (_column_figure, res.column is not None),
+        "table": (_table_figure, res.table is not None),
+    }
+    return {name: draw(plt, res, out) for name, (draw, wanted) in figures.items() if wanted}
 
+
+def _theta_figure(plt, res, out: Path) -> Path:
+    """θ/α measured and simulated, the ensemble bands, the horizon, the truth and the audit flags."""
+    alpha = res.block.alpha_rad
     fig, ax = plt.subplots(figsize=(10, 4))
     for name, (t, th) in res.measured.items():
         ax.plot(t, np.asarray(th) / alpha, lw=1.2, label=f"measured ({name})")
     val = res.validation
     for law, sim in res.simulations.items():
         (line,) = ax.plot(
-            sim["t_s"],
-            np.asarray(sim["theta_rad"]) / alpha,
-            lw=0.9,
-            ls="--",
-            label=f"simulated, {law} (η={sim['eta']:.3f})",
+            sim.t_s, np.asarray(sim.theta_rad) / alpha, lw=0.9, ls="--", label=f"simulated, {law} (η={sim.eta:.3f})"
         )
         band = val.bands.get(law) if val is not None else None
         if band is not None:
@@ -82,16 +89,14 @@ def experiment_figures(res, out_dir) -> dict[str, Path]:
         peak = max(float(np.nanmax(np.abs(th))) for _, th in res.measured.values()) / alpha
         ax.set_ylim(-max(1.1, 1.3 * peak), max(1.1, 1.3 * peak))
     if res.truth is not None:
-        ax.plot(
-            res.truth["t_s"], np.asarray(res.truth["theta_rad"]) / alpha, lw=0.6, color="k", alpha=0.5, label="truth"
-        )
+        ax.plot(res.truth.t_s, np.asarray(res.truth.theta_rad) / alpha, lw=0.6, color="k", alpha=0.5, label="truth")
     # the assumption audit's flags, where they happened (the impacts a fit should not trust)
-    flags = (res.audit or {}).get("flags") or []
+    flags = res.audit.flags if res.audit is not None else ()
     for i, f in enumerate(flags):
-        ax.axvline(f["t_s"], color="crimson", lw=0.8, alpha=0.7, label="audit flag" if i == 0 else None)
+        ax.axvline(f.t_s, color="crimson", lw=0.8, alpha=0.7, label="audit flag" if i == 0 else None)
         ax.annotate(
-            f"{f['kind']}",
-            (f["t_s"], 1.0),
+            f"{f.kind}",
+            (f.t_s, 1.0),
             xycoords=("data", "axes fraction"),
             rotation=90,
             va="top",
@@ -101,90 +106,100 @@ def experiment_figures(res, out_dir) -> dict[str, Path]:
         )
     ax.set_xlabel("t (s)")
     ax.set_ylabel("θ/α (-)")
-    verdict = (res.audit or {}).get("verdict")
+    verdict = res.audit.verdict if res.audit is not None else None
     ax.set_title(f"{res.name}: rotation, measured vs simulated" + (f" (audit: {verdict})" if verdict else ""))
     ax.legend(fontsize=8, ncol=2)
     ax.grid(alpha=0.3)
-    figs["theta"] = save_png(fig, out / "theta.png")
+    return save_png(fig, out / "theta.png")
 
-    if res.fit is not None and len(res.per_impact_eta):
-        fig, ax = plt.subplots(figsize=(6, 4))
-        k = np.arange(1, len(res.per_impact_eta) + 1)
-        ax.plot(k, res.per_impact_eta, "o-", label="per impact (local fits)")
-        ex = [e["impact"] for e in res.fit.get("excluded_impacts") or [] if 1 <= e["impact"] <= len(k)]
-        if ex:
-            ax.plot(
-                ex,
-                np.asarray(res.per_impact_eta)[np.asarray(ex) - 1],
-                "x",
-                color="crimson",
-                ms=10,
-                mew=2,
-                label="flagged by the audit (not to trust)",
-            )
-        if np.isfinite(res.fit.get("eta_e", np.nan)):
-            ax.axhline(res.fit["eta_e"], color="C1", label=f"η_e = {res.fit['eta_e']:.4f}")
-        ax.axhline(res.block.eta_H, color="k", ls=":", label=f"η_H = {res.block.eta_H:.4f}")
-        ax.set_xlabel("impact number")
-        ax.set_ylabel("η = ω⁺/ω⁻")
-        ax.legend(fontsize=8)
+
+def _per_impact_figure(plt, res, out: Path) -> Path:
+    """Per-impact η with the audit's flagged impacts, η_e and η_H."""
+    fig, ax = plt.subplots(figsize=(6, 4))
+    k = np.arange(1, len(res.per_impact_eta) + 1)
+    ax.plot(k, res.per_impact_eta, "o-", label="per impact (local fits)")
+    ex = [e.impact for e in res.fit.excluded_impacts or () if 1 <= e.impact <= len(k)]
+    if ex:
+        ax.plot(
+            ex,
+            np.asarray(res.per_impact_eta)[np.asarray(ex) - 1],
+            "x",
+            color="crimson",
+            ms=10,
+            mew=2,
+            label="flagged by the audit (not to trust)",
+        )
+    if np.isfinite(res.fit.eta_e):
+        ax.axhline(res.fit.eta_e, color="C1", label=f"η_e = {res.fit.eta_e:.4f}")
+    ax.axhline(res.block.eta_H, color="k", ls=":", label=f"η_H = {res.block.eta_H:.4f}")
+    ax.set_xlabel("impact number")
+    ax.set_ylabel("η = ω⁺/ω⁻")
+    ax.legend(fontsize=8)
+    ax.grid(alpha=0.3)
+    return save_png(fig, out / "per_impact_eta.png")
+
+
+def _energy_figure(plt, res, out: Path) -> Path:
+    """Kinetic-energy loss per impact of each simulated law."""
+    fig, ax = plt.subplots(figsize=(8, 4))
+    for law, sim in res.simulations.items():
+        imp = sim.impacts
+        if imp is not None and len(imp):
+            e_ratio = (np.asarray(imp["omega_after_rad_s"]) / np.asarray(imp["omega_before_rad_s"])) ** 2
+            ax.plot(np.arange(1, len(e_ratio) + 1), 1 - e_ratio, "o-", ms=3, label=law)
+    ax.set_xlabel("impact number")
+    ax.set_ylabel("kinetic-energy loss per impact (-)")
+    ax.legend(fontsize=8)
+    ax.grid(alpha=0.3)
+    return save_png(fig, out / "energy_per_impact.png")
+
+
+def _video_imu_figure(plt, res, out: Path) -> Path:
+    """θ video − θ IMU."""
+    t, r = res.video_imu_residual
+    fig, ax = plt.subplots(figsize=(10, 3))
+    ax.plot(t, np.degrees(r), lw=0.8)
+    ax.set_xlabel("t (s)")
+    ax.set_ylabel("θ video − θ IMU (°)")
+    ax.set_title(f"video vs IMU, RMS {np.degrees(np.sqrt(np.nanmean(np.asarray(r) ** 2))):.3f}°")
+    ax.grid(alpha=0.3)
+    return save_png(fig, out / "video_vs_imu.png")
+
+
+def _column_figure(plt, res, out: Path) -> Path:
+    """Each block of a column run: measured, model, truth."""
+    c = res.column
+    n = len(c.objects)
+    fig, axs = plt.subplots(n, 1, figsize=(10, 2.2 * n + 1), sharex=True, squeeze=False)
+    for i, (ax, o) in enumerate(zip(axs[:, 0], c.objects)):
+        ax.plot(c.t_s, c.theta_measured_rad[:, i], lw=1.2, label="measured (video)")
+        ax.plot(c.sim_t_s, c.theta_sim_rad[:, i], lw=0.9, ls="--", label="column model")
+        if c.theta_truth is not None:
+            tt, th = c.theta_truth
+            ax.plot(tt, th[:, i], lw=0.6, color="k", alpha=0.5, label="truth")
+        ax.set_ylabel(f"θ {o} (rad)")
         ax.grid(alpha=0.3)
-        figs["per_impact_eta"] = save_png(fig, out / "per_impact_eta.png")
+    axs[0, 0].legend(fontsize=8)
+    axs[0, 0].set_title(f"{res.name}: column, measured vs simulated (status {c.status})")
+    axs[-1, 0].set_xlabel("t (s)")
+    return save_png(fig, out / "column.png")
 
-    if res.simulations:
-        fig, ax = plt.subplots(figsize=(8, 4))
-        for law, sim in res.simulations.items():
-            imp = sim.get("impacts")
-            if imp is not None and len(imp):
-                e_ratio = (np.asarray(imp["omega_after_rad_s"]) / np.asarray(imp["omega_before_rad_s"])) ** 2
-                ax.plot(np.arange(1, len(e_ratio) + 1), 1 - e_ratio, "o-", ms=3, label=law)
-        ax.set_xlabel("impact number")
-        ax.set_ylabel("kinetic-energy loss per impact (-)")
-        ax.legend(fontsize=8)
+
+def _table_figure(plt, res, out: Path) -> Path:
+    """The table's displacement, velocity and acceleration."""
+    fig, axs = plt.subplots(3, 1, figsize=(10, 6), sharex=True)
+    tt = res.table.t_s
+    cols = res.table.columns()
+    for ax, key, lab in zip(
+        axs, ("disp_m", "vel_m_s", "acc_m_s2"), ("displacement (m)", "velocity (m/s)", "acceleration (m/s²)")
+    ):
+        if key in cols:
+            ax.plot(tt, cols[key], lw=0.9)
+        ax.set_ylabel(lab)
         ax.grid(alpha=0.3)
-        figs["energy_per_impact"] = save_png(fig, out / "energy_per_impact.png")
-
-    if res.video_imu_residual is not None:
-        t, r = res.video_imu_residual
-        fig, ax = plt.subplots(figsize=(10, 3))
-        ax.plot(t, np.degrees(r), lw=0.8)
-        ax.set_xlabel("t (s)")
-        ax.set_ylabel("θ video − θ IMU (°)")
-        ax.set_title(f"video vs IMU, RMS {np.degrees(np.sqrt(np.nanmean(np.asarray(r) ** 2))):.3f}°")
-        ax.grid(alpha=0.3)
-        figs["video_vs_imu"] = save_png(fig, out / "video_vs_imu.png")
-
-    if res.column is not None:
-        c = res.column
-        n = len(c["objects"])
-        fig, axs = plt.subplots(n, 1, figsize=(10, 2.2 * n + 1), sharex=True, squeeze=False)
-        for i, (ax, o) in enumerate(zip(axs[:, 0], c["objects"])):
-            ax.plot(c["t_s"], c["theta_measured_rad"][:, i], lw=1.2, label="measured (video)")
-            ax.plot(c["sim_t_s"], c["theta_sim_rad"][:, i], lw=0.9, ls="--", label="column model")
-            if "theta_truth_rad" in c:
-                tt, th = c["theta_truth_rad"]
-                ax.plot(tt, th[:, i], lw=0.6, color="k", alpha=0.5, label="truth")
-            ax.set_ylabel(f"θ {o} (rad)")
-            ax.grid(alpha=0.3)
-        axs[0, 0].legend(fontsize=8)
-        axs[0, 0].set_title(f"{res.name}: column, measured vs simulated (status {c['status']})")
-        axs[-1, 0].set_xlabel("t (s)")
-        figs["column"] = save_png(fig, out / "column.png")
-
-    if res.table is not None:
-        fig, axs = plt.subplots(3, 1, figsize=(10, 6), sharex=True)
-        tt = res.table["t_s"]
-        for ax, key, lab in zip(
-            axs, ("disp_m", "vel_m_s", "acc_m_s2"), ("displacement (m)", "velocity (m/s)", "acceleration (m/s²)")
-        ):
-            if key in res.table:
-                ax.plot(tt, res.table[key], lw=0.9)
-            ax.set_ylabel(lab)
-            ax.grid(alpha=0.3)
-        axs[-1].set_xlabel("t (s)")
-        axs[0].set_title("table motion")
-        figs["table"] = save_png(fig, out / "table.png")
-    return figs
+    axs[-1].set_xlabel("t (s)")
+    axs[0].set_title("table motion")
+    return save_png(fig, out / "table.png")
 
 
 def campaign_figures(table, out_dir, regression=None) -> dict[str, Path]:
@@ -202,7 +217,9 @@ def campaign_figures(table, out_dir, regression=None) -> dict[str, Path]:
         return figs
     fig, ax = plt.subplots(figsize=(7, 5))
     hb_grid = np.linspace(0.8, 10, 200)
-    fitted = table[np.isfinite(table["eta_e"])]  # forced and column runs have no free-rocking η_e
+    # Čeh's figures are of free rocking: a shake-table run's half-cycle η_e is not drawn here
+    free = table.get("eta_e_source", "free") == "free"
+    fitted = table[np.isfinite(table["eta_e"]) & free]
     for i, (b_m, grp) in enumerate(fitted.groupby("b_m")):
         eta_h = [Block(b_m, hb * b_m).eta_H for hb in hb_grid]
         ax.plot(hb_grid, eta_h, color=f"C{i}", ls=":", lw=1)

@@ -69,12 +69,9 @@ def _film_start_s(res) -> float | None:
     return i0 / float(res.frames.fps)
 
 
-def _impact_times(sim: dict, t_min_s: float | None) -> np.ndarray:
-    """Impact times of one simulation, s (those from ``t_min_s`` on)."""
-    imp = sim.get("impacts")
-    if imp is None or not len(imp):
-        return np.empty(0)
-    t = imp["t_s"].to_numpy(float)
+def _impact_times(sim, t_min_s: float | None) -> np.ndarray:
+    """Impact times of one simulation (a LawSimulation), s (those from ``t_min_s`` on)."""
+    t = sim.impact_times_s()
     return t if t_min_s is None else t[t >= t_min_s]
 
 
@@ -82,13 +79,13 @@ def _focus(ref, t_s, residual_rad):
     """(t_impact_s, t0_s, t1_s): the impact of the simulation ``ref`` nearest the largest
     |measured − simulated| (``residual_rad`` at ``t_s``) and a window of a few half-cycles
     around it, for the blueprint to open on; None without one."""
-    if ref is None or ref.get("impacts") is None or not len(ref["impacts"]):
+    if ref is None or ref.impacts is None or not len(ref.impacts):
         return None
     r = np.abs(np.asarray(residual_rad, float))
     if not np.isfinite(r).any():
         return None
     t_worst = float(np.asarray(t_s, float)[int(np.nanargmax(r))])
-    ti = ref["impacts"]["t_s"].to_numpy(float)
+    ti = ref.impact_times_s()
     k = int(np.argmin(np.abs(ti - t_worst)))
     # two half-cycles either side (impacts k-2 .. k+2), never less than 0.15 s each way
     t0 = min(float(ti[max(k - 2, 0)]), float(ti[k]) - 0.15)
@@ -129,7 +126,7 @@ def _overlay_fn(res):
     shapes = []
     if tr is not None and getattr(tr, "plane_map", None) is not None:
         rect = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1], [-1, -1]]) * [b.b_m / 2, b.h_m / 2]
-        blocks = res.column["objects"] if res.column is not None else [res.config.video.object]
+        blocks = res.column.objects if res.column is not None else [res.config.video.object]
         for o in tr.config.objects:
             targets = o.dots if o.dots else o.marker_positions_m
             # the outline assumes the object frame is centred on the block's front face (as
@@ -147,9 +144,9 @@ def _overlay_fn(res):
         th_of = dict(zip(np.asarray(tm.frame, int).tolist(), np.asarray(tm.theta_rad, float).tolist()))
         for i, (law, s) in enumerate(res.simulations.items()):
             # a simulation that came to rest stays upright to the film's end
-            after = 0.0 if s.get("status") == "rest" else np.nan
+            after = 0.0 if s.status == "rest" else np.nan
             sims.append(
-                (law, np.asarray(s["t_s"], float), np.asarray(s["theta_rad"], float), after, _style(f"sim_{law}", i)[0])
+                (law, np.asarray(s.t_s, float), np.asarray(s.theta_rad, float), after, _style(f"sim_{law}", i)[0])
             )
 
     def fn(idx):
@@ -184,15 +181,28 @@ def log_experiment(
     With a film, nothing is logged before its first frame: the viewer opens with its time cursor
     at the timeline's start, which is then the film's first frame.
     """
-    import rerun as rr
-
     t_min = _film_start_s(res)
-    log_series = functools.partial(_log_series, t_min_s=t_min)
-    theta = functools.partial(_theta, t_min_s=t_min)
-
     rec = open_recording("rocklab", rrd_path, spawn=spawn, connect=connect, recording_id=f"experiment-{res.name}")
     rows: dict[str, int] = {}
     blk = f"{ROOT}/block_1"
+    _log_geometry(rec, res)
+    focus = _log_block(rec, res, blk, t_min, rows)
+    block_paths = _log_column(rec, res, t_min, rows) if res.column is not None else [blk]
+    if res.table is not None:
+        for k, v in res.table.columns().items():
+            rows[f"{ROOT}/table/{k}"] = _log_series(rec, f"{ROOT}/table/{k}", res.table.t_s, v, t_min_s=t_min)
+    has_video = res.config.video is not None
+    if has_video:
+        _log_film(rec, res, progress, rows)
+    rec.send_blueprint(experiment_blueprint(block_paths, has_video=has_video, focus=focus))
+    close_recording(rec, rrd_path)
+    return rows
+
+
+def _log_geometry(rec, res) -> None:
+    """The block's dimensions and contact as a static text document."""
+    import rerun as rr
+
     b = res.block
     rec.log(
         f"{ROOT}/geometry",
@@ -205,15 +215,21 @@ def log_experiment(
         static=True,
     )
 
+
+def _log_block(rec, res, blk: str, t_min, rows: dict):
+    """θ measured and simulated, energies, the ensemble's bands, residuals and impacts of the
+    single block; returns the time window the blueprint focuses on."""
+    log_series = functools.partial(_log_series, t_min_s=t_min)
+    theta = functools.partial(_theta, t_min_s=t_min)
     for name, (t, th) in res.measured.items():
         rows[f"{blk}/theta/measured_{name}"] = theta(rec, blk, f"measured_{name}", t, th, f"measured ({name})")
     for i, (law, s) in enumerate(res.simulations.items()):
         rows[f"{blk}/theta/sim_{law}"] = theta(
-            rec, blk, f"sim_{law}", s["t_s"], s["theta_rad"], f"sim {law} (η = {s['eta']:.4g})", i
+            rec, blk, f"sim_{law}", s.t_s, s.theta_rad, f"sim {law} (η = {s.eta:.4g})", i
         )
         colour, width = _style(f"sim_{law}", i)
         rows[f"{blk}/energy/sim_{law}"] = log_series(
-            rec, f"{blk}/energy/sim_{law}", s["t_s"], s["energy_J"], color=colour, width=width, name=f"sim {law} (J)"
+            rec, f"{blk}/energy/sim_{law}", s.t_s, s.energy_J, color=colour, width=width, name=f"sim {law} (J)"
         )
     val = res.validation
     for i, law in enumerate(res.simulations):
@@ -233,7 +249,7 @@ def log_experiment(
         log_events(rec, f"{blk}/validation", np.array([val.horizon_s]), [f"predictability horizon; {verdicts}"])
         rows[f"{blk}/validation"] = 1
     if res.truth is not None:
-        rows[f"{blk}/theta/truth"] = theta(rec, blk, "truth", res.truth["t_s"], res.truth["theta_rad"], "truth")
+        rows[f"{blk}/theta/truth"] = theta(rec, blk, "truth", res.truth.t_s, res.truth.theta_rad, "truth")
     if res.video_imu_residual is not None:
         rows[f"{blk}/residual/video_minus_imu"] = log_series(
             rec, f"{blk}/residual/video_minus_imu", *res.video_imu_residual
@@ -241,7 +257,7 @@ def log_experiment(
     t_p, th_p = res.measured[res.primary]
     residual = {}
     for i, (law, s) in enumerate(res.simulations.items()):
-        residual[law] = th_p - np.interp(t_p, s["t_s"], s["theta_rad"], left=np.nan, right=np.nan)
+        residual[law] = th_p - np.interp(t_p, s.t_s, s.theta_rad, left=np.nan, right=np.nan)
         rows[f"{blk}/residual/measured_minus_sim_{law}"] = log_series(
             rec,
             f"{blk}/residual/measured_minus_sim_{law}",
@@ -262,8 +278,8 @@ def log_experiment(
                 rows[f"{blk}/{sub}/impacts_{law}"] = log_impact_markers(
                     rec, f"{blk}/{sub}/impacts_{law}", t_imp, np.zeros(t_imp.size), color=colour, name=f"impacts {law}"
                 )
-    if ref is not None and len(ref["impacts"]):
-        imp = ref["impacts"]
+    if ref is not None and len(ref.impacts):
+        imp = ref.impacts
         keep = imp["t_s"].to_numpy(float) >= (-np.inf if t_min is None else t_min)
         txt = [
             f"impact {i + 1} (sim {ref_law}): ω⁻ = {a:+.3f} rad/s → ω⁺ = {c:+.3f} rad/s (η = {e:.3f})"
@@ -271,71 +287,66 @@ def log_experiment(
         ]
         log_events(rec, f"{blk}/impacts", imp["t_s"].to_numpy(float)[keep], [x for x, k in zip(txt, keep) if k])
         rows[f"{blk}/impacts"] = int(keep.sum())
-    block_paths = [blk]
-    if res.column is not None:
-        c = res.column
-        block_paths = [f"{ROOT}/{o}" for o in c["objects"]]
-        for i, bp in enumerate(block_paths):
-            rows[f"{bp}/theta/measured_video"] = theta(
-                rec, bp, "measured_video", c["t_s"], c["theta_measured_rad"][:, i], "measured (video)"
-            )
-            rows[f"{bp}/theta/sim_column"] = theta(
-                rec, bp, "sim_column", c["sim_t_s"], c["theta_sim_rad"][:, i], "column model"
-            )
-            sim_on = np.interp(c["t_s"], c["sim_t_s"], c["theta_sim_rad"][:, i], left=np.nan, right=np.nan)
-            rows[f"{bp}/residual/measured_minus_sim"] = log_series(
-                rec, f"{bp}/residual/measured_minus_sim", c["t_s"], c["theta_measured_rad"][:, i] - sim_on
-            )
-            if "theta_truth_rad" in c:
-                tt, th = c["theta_truth_rad"]
-                rows[f"{bp}/theta/truth"] = theta(rec, bp, "truth", tt, th[:, i], "truth")
-        conf = c["configurations"]
-        if len(conf):
-            log_events(
-                rec,
-                f"{ROOT}/column/configurations",
-                conf["t_s"].to_numpy(float),
-                [f"joint {j}: {st} ({ev})" for j, st, ev in zip(conf["joint"], conf["state"], conf["event"])],
-            )
-            rows[f"{ROOT}/column/configurations"] = len(conf)
-    if res.table is not None:
-        for k in ("disp_m", "vel_m_s", "acc_m_s2"):
-            if k in res.table:
-                rows[f"{ROOT}/table/{k}"] = log_series(rec, f"{ROOT}/table/{k}", res.table["t_s"], res.table[k])
+    return focus
 
-    has_video = res.config.video is not None
-    if has_video:
-        bar = None
-        if progress:
-            from tqdm import tqdm
 
-            bar = tqdm(desc="rerun: video frames", unit="frame", leave=False)
-        # the film was encoded while the tracker decoded it (analyse_experiment(keep_video=...))
-        fps = res.frames.fps
-        film = res.video
-        if film is not None and film.kind == "av1":
-            tr0 = res.frames.tracks[0]  # the tracker's own frame times (a variable-rate film's)
-            t_of = dict(zip(np.asarray(tr0.frame, int).tolist(), np.asarray(tr0.t_s, float).tolist()))
-            t_film = [t_of.get(int(i), i / fps) for i in film.frame_index]
-            rows[f"{ROOT}/video"] = log_video_asset(
-                rec,
-                f"{ROOT}/video",
-                film.data,
-                film.frame_index,
-                fps,
-                overlays=_overlay_fn(res),
-                progress=bar,
-                frame_t_s=t_film,
-            )
-        else:
-            frames = (
-                (i, i / fps, data) for i, data in (zip(film.frame_index, film.stills) if film is not None else ())
-            )
-            rows[f"{ROOT}/video"] = log_video_frames(
-                rec, f"{ROOT}/video", frames, overlays=_overlay_fn(res), progress=bar
-            )
-        if bar is not None:
-            bar.close()
-    rec.send_blueprint(experiment_blueprint(block_paths, has_video=has_video, focus=focus))
-    close_recording(rec, rrd_path)
-    return rows
+def _log_column(rec, res, t_min, rows: dict) -> list:
+    """Each block of a column run (measured, model, truth, residual) and the joints' configurations;
+    returns the blocks' entity paths."""
+    log_series = functools.partial(_log_series, t_min_s=t_min)
+    theta = functools.partial(_theta, t_min_s=t_min)
+    c = res.column
+    block_paths = [f"{ROOT}/{o}" for o in c.objects]
+    for i, bp in enumerate(block_paths):
+        rows[f"{bp}/theta/measured_video"] = theta(
+            rec, bp, "measured_video", c.t_s, c.theta_measured_rad[:, i], "measured (video)"
+        )
+        rows[f"{bp}/theta/sim_column"] = theta(rec, bp, "sim_column", c.sim_t_s, c.theta_sim_rad[:, i], "column model")
+        sim_on = np.interp(c.t_s, c.sim_t_s, c.theta_sim_rad[:, i], left=np.nan, right=np.nan)
+        rows[f"{bp}/residual/measured_minus_sim"] = log_series(
+            rec, f"{bp}/residual/measured_minus_sim", c.t_s, c.theta_measured_rad[:, i] - sim_on
+        )
+        if c.theta_truth is not None:
+            tt, th = c.theta_truth
+            rows[f"{bp}/theta/truth"] = theta(rec, bp, "truth", tt, th[:, i], "truth")
+    conf = c.configurations
+    if len(conf):
+        log_events(
+            rec,
+            f"{ROOT}/column/configurations",
+            conf["t_s"].to_numpy(float),
+            [f"joint {j}: {st} ({ev})" for j, st, ev in zip(conf["joint"], conf["state"], conf["event"])],
+        )
+        rows[f"{ROOT}/column/configurations"] = len(conf)
+    return block_paths
+
+
+def _log_film(rec, res, progress: bool, rows: dict) -> None:
+    """The review film: the AV1 asset with one reference per frame, or JPEG stills."""
+    bar = None
+    if progress:
+        from tqdm import tqdm
+
+        bar = tqdm(desc="rerun: video frames", unit="frame", leave=False)
+    # the film was encoded while the tracker decoded it (analyse_experiment(keep_video=...))
+    fps = res.frames.fps
+    film = res.video
+    if film is not None and film.kind == "av1":
+        tr0 = res.frames.tracks[0]  # the tracker's own frame times (a variable-rate film's)
+        t_of = dict(zip(np.asarray(tr0.frame, int).tolist(), np.asarray(tr0.t_s, float).tolist()))
+        t_film = [t_of.get(int(i), i / fps) for i in film.frame_index]
+        rows[f"{ROOT}/video"] = log_video_asset(
+            rec,
+            f"{ROOT}/video",
+            film.data,
+            film.frame_index,
+            fps,
+            overlays=_overlay_fn(res),
+            progress=bar,
+            frame_t_s=t_film,
+        )
+    else:
+        frames = ((i, i / fps, data) for i, data in (zip(film.frame_index, film.stills) if film is not None else ()))
+        rows[f"{ROOT}/video"] = log_video_frames(rec, f"{ROOT}/video", frames, overlays=_overlay_fn(res), progress=bar)
+    if bar is not None:
+        bar.close()

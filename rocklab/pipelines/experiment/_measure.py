@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from ..._errors import InputError
+from ...series import TableMotion, Tracks, read_tracks
 from ._config import ExperimentConfig
 from ._review_video import ReviewFilm
 
@@ -18,21 +19,8 @@ __all__: list[str] = []
 
 
 def _read_track_csv(path: Path, obj: str | None):
-    """The rows of ``obj`` in a tracked CSV (``t_s, theta_rad`` and whatever else it has), checked."""
-    import pandas as pd
-
-    try:
-        df = pd.read_csv(path)
-    except Exception as e:  # noqa: BLE001 - pandas raises many types
-        raise InputError(f"{path}: not a readable CSV ({type(e).__name__})") from None
-    for c in ("t_s", "theta_rad"):
-        if c not in df.columns:
-            raise InputError(f"{path}, line 1: missing column {c!r}; a track CSV needs t_s, theta_rad")
-    if obj is not None and "object" in df.columns:
-        df = df[df["object"].astype(str) == obj]
-        if df.empty:
-            raise InputError(f"{path}: no rows for object {obj!r}; check [sources.track] object")
-    return df
+    """The rows of ``obj`` in a tracked CSV (:class:`rocklab.series.Tracks`), checked."""
+    return read_tracks(path).rows(obj, fix="[sources.track] object")
 
 
 def _probe_fps(path, given: float | None) -> float:
@@ -58,23 +46,17 @@ def _measure_video(cfg: ExperimentConfig, progress: bool, keep_film: bool):
     film = ReviewFilm(_probe_fps(cfg.video.path, cfg.video.fps), cfg.video_decimation) if keep_film else None
     tr = track_video(cfg.video.path, tcfg, fps=cfg.video.fps, progress=progress, on_frame=film)
     df = tr.to_frame()
-    sel = df[df["object"] == cfg.video.object]
-    if sel.empty:
+    if cfg.video.object not in set(df["object"]):
         raise InputError(
             f"{cfg.path}: [sources.video] object {cfg.video.object!r} was never tracked in "
             f"{cfg.video.path.name}; objects seen: {sorted(set(df['object']))}"
         )
     table = None
     if cfg.table.source in ("video", "imu") and tcfg is not None and tcfg.table is not None:
-        tm = tr.table_motion(cfg.table.object)
-        table = {
-            "t_s": np.asarray(tm.t_s),
-            "disp_m": np.asarray(tm.x_m),
-            "vel_m_s": np.asarray(tm.vx_m_s),
-            "acc_m_s2": np.asarray(tm.ax_m_s2),
-        }
+        table = tr.table_motion(cfg.table.object)
     review = film.finish() if film is not None else None
-    return (sel["t_s"].to_numpy(float), sel["theta_rad"].to_numpy(float)), table, tr, review
+    # the samples tracks.csv would give `rocklab fit restitution`: usable statuses only
+    return Tracks.from_frame(df).rows(cfg.video.object).theta(), table, tr, review
 
 
 def _measure_imu(cfg: ExperimentConfig):
@@ -86,31 +68,42 @@ def _measure_imu(cfg: ExperimentConfig):
     return (np.asarray(rot.t_s, float), np.asarray(rot.theta_rad, float)), rot
 
 
-def _table_from_imu(cfg: ExperimentConfig, video_table: dict | None, msgs: list):
+def _table_from_imu(cfg: ExperimentConfig, video_table: TableMotion | None, msgs: list):
     """Table acceleration from the table IMU, on the video clock when the video tracked the table.
 
     A 50 fps camera cannot measure a record's table acceleration (content above 25 Hz is lost;
     on a synthetic El Centro run the 50 Hz samples turned a surviving block into an overturning
     one), so the IMU (~256 Hz) drives the simulation; its clock is found by cross-correlating its
     acceleration with the video's (t_imu = t_video + offset + drift t_video).
+
+    Returns
+    -------
+    table : TableMotion
+        The IMU's acceleration; with a video table, on its clock and sense, with the video's
+        displacement and velocity interpolated onto the IMU's times.
+    sync : rocklab.tracking.SyncResult or None
+        The table IMU's clock (None without a video table).
     """
     from ...tracking import read_imu, sync_offset, table_acceleration
 
     log = read_imu(cfg.table.imu)
     ta = table_acceleration(log, axis=None)
     t, a = np.asarray(ta.t_s, float), np.asarray(ta.acc_m_s2, float)
-    out = {"t_s": t, "acc_m_s2": a}
-    sync = None
-    if video_table is not None:
-        s = sync_offset(t, a, video_table["t_s"], video_table["acc_m_s2"], max_offset_s=cfg.max_offset_s)
-        sync = s.to_dict()
-        # the video's sense of x is the reference: a_video = sign * a_imu
-        out = {"t_s": (t - s.offset_s) / (1.0 + s.drift), "acc_m_s2": s.sign * a}
-        for k in ("disp_m", "vel_m_s"):  # displacement and velocity stay the video's
-            out[k] = np.interp(out["t_s"], video_table["t_s"], video_table[k], left=np.nan, right=np.nan)
-    else:
+    if video_table is None:
         msgs.append("table IMU used on its own clock: no tracked table on video to sync it with")
-    return out, sync
+        return TableMotion.from_acceleration(t, a, source="imu", object=cfg.table.object), None
+    s = sync_offset(t, a, video_table.t_s, video_table.ax_m_s2, max_offset_s=cfg.max_offset_s)
+    # the video's sense of x is the reference: a_video = sign * a_imu
+    t_v = (t - s.offset_s) / (1.0 + s.drift)
+
+    def on_imu_times(y):  # displacement and velocity stay the video's
+        return np.interp(t_v, video_table.t_s, y, left=np.nan, right=np.nan)
+
+    table = TableMotion(
+        t_v, on_imu_times(video_table.x_m), on_imu_times(video_table.vx_m_s), s.sign * a,
+        object=video_table.object, source="imu",
+    )  # fmt: skip
+    return table, s
 
 
 def _sync(ref, rot, max_offset_s):

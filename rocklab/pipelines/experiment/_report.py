@@ -24,34 +24,74 @@ def series_frame(res):
         if name != res.primary:
             cols[f"theta_{name}_rad"] = np.interp(t, tn, thn, left=np.nan, right=np.nan)
     for law, s in res.simulations.items():
-        cols[f"theta_sim_{law}_rad"] = np.interp(t, s["t_s"], s["theta_rad"], left=np.nan, right=np.nan)
+        cols[f"theta_sim_{law}_rad"] = np.interp(t, s.t_s, s.theta_rad, left=np.nan, right=np.nan)
     if res.validation is not None:  # the 5–95 % band of each law's ensemble (predicted measurement)
         for law, (tb, lo, hi) in res.validation.bands.items():
             cols[f"theta_sim_{law}_p05_rad"] = np.interp(t, tb, lo, left=np.nan, right=np.nan)
             cols[f"theta_sim_{law}_p95_rad"] = np.interp(t, tb, hi, left=np.nan, right=np.nan)
     if res.truth is not None:
-        cols["theta_truth_rad"] = np.interp(t, res.truth["t_s"], res.truth["theta_rad"], left=np.nan, right=np.nan)
+        cols["theta_truth_rad"] = np.interp(t, res.truth.t_s, res.truth.theta_rad, left=np.nan, right=np.nan)
     if res.table is not None:
-        for k in ("disp_m", "vel_m_s", "acc_m_s2"):
-            if k in res.table:
-                cols[f"table_{k}"] = np.interp(t, res.table["t_s"], res.table[k], left=np.nan, right=np.nan)
+        for k, v in res.table.columns().items():
+            cols[f"table_{k}"] = np.interp(t, res.table.t_s, v, left=np.nan, right=np.nan)
     if res.column is not None:
         c = res.column
-        for i, o in enumerate(c["objects"]):
-            cols[f"theta_{o}_video_rad"] = np.interp(
-                t, c["t_s"], c["theta_measured_rad"][:, i], left=np.nan, right=np.nan
-            )
+        for i, o in enumerate(c.objects):
+            cols[f"theta_{o}_video_rad"] = np.interp(t, c.t_s, c.theta_measured_rad[:, i], left=np.nan, right=np.nan)
             cols[f"theta_{o}_sim_column_rad"] = np.interp(
-                t, c["sim_t_s"], c["theta_sim_rad"][:, i], left=np.nan, right=np.nan
+                t, c.sim_t_s, c.theta_sim_rad[:, i], left=np.nan, right=np.nan
             )
-            if "theta_truth_rad" in c:
-                tt, th = c["theta_truth_rad"]
+            if c.theta_truth is not None:
+                tt, th = c.theta_truth
                 cols[f"theta_{o}_truth_rad"] = np.interp(t, tt, th[:, i], left=np.nan, right=np.nan)
     return pd.DataFrame(cols)
 
 
+def _fit_lines(fit) -> list:
+    """The η_e line of ``summary.md`` (``fit``: a FitStage)."""
+    f = fit.fit
+    ci = [_g(x) for x in (f.ci95 if fit.forced else f.ci95_eta_e)]
+    if fit.forced:  # a shake-table run (see the validation below)
+        return [
+            f"η_e = {_g(f.eta_e)} (95 % CI {ci[0]} – {ci[1]}) from {f.n_segments} half cycles "
+            f"under the measured table motion, residual RMS {_g(f.rms_residual_rad)} rad "
+            f"(fit status {f.status})",
+            "",
+        ]
+    return [
+        f"η_e = {_g(f.eta_e)} (95 % CI {ci[0]} – {ci[1]}), "
+        f"η'_e = {_g(f.eta_e_first)}, θ0 = {_g(f.theta0_rad)} rad, "
+        f"release at {_g(f.release_t_s)} s, residual RMS {_g(f.rms_residual_rad)} rad "
+        f"(fit status {f.status})",
+        "",
+    ]
+
+
+def _audit_lines(audit, fit) -> list:
+    """The assumption audit's lines of ``summary.md`` (``audit``: an AuditResult)."""
+    a = audit
+    lines = [
+        f"Assumption audit ({a.source}): **{a.verdict}**, checked {', '.join(a.checked) or 'nothing'}"
+        + (f"; impacts not to trust: {', '.join(map(str, a.excluded_impacts))}" if a.excluded_impacts else ""),
+        "",
+    ]
+    lines += [
+        f"- {f.kind} ({f.detail}) at {_g(f.t_s)} s, impact {f.impact}: {_g(f.value)} "
+        f"(tolerance {_g(f.tolerance)}, SI units)"
+        for f in a.flags
+    ]
+    lines += [""] if a.flags else []
+    excluded = (fit.excluded_impacts if fit is not None else None) or ()
+    for e in excluded:
+        lines.append(
+            f"- per-impact η of fit impact {e.impact} at {_g(e.t_s)} s ({_g(e.eta)}) is not "
+            f"to be trusted: {'; '.join(e.reasons)}"
+        )
+    lines += [""] if excluded else []
+    return lines
+
+
 def _summary_md(res, figs: dict, rrd: bool) -> str:
-    f = res.fit or {}
     lines = [
         f"# {res.name}",
         "",
@@ -61,58 +101,22 @@ def _summary_md(res, figs: dict, rrd: bool) -> str:
         f"p = {_g(res.block.p_rad_s)} rad/s, η_H = {_g(res.block.eta_H)}; contact: {res.config.contact}",
         "",
     ]
-    if f and f.get("method") == "half-cycle segments":  # a shake-table run (see the validation below)
-        ci = f.get("ci95_eta_e") or [None, None]
+    if res.fit is not None:
+        lines += _fit_lines(res.fit)
+    if res.audit is not None:
+        lines += _audit_lines(res.audit, res.fit)
+    if res.sync is not None:
+        imu = res.sync.imu
         lines += [
-            f"η_e = {_g(f.get('eta_e'))} (95 % CI {_g(ci[0])} – {_g(ci[1])}) from {f.get('n_segments')} half cycles "
-            f"under the measured table motion, residual RMS {_g(f.get('rms_residual_rad'))} rad "
-            f"(fit status {f.get('status')})",
-            "",
-        ]
-    elif f:
-        ci = f.get("ci95_eta_e") or [None, None]
-        lines += [
-            f"η_e = {_g(f.get('eta_e'))} (95 % CI {_g(ci[0])} – {_g(ci[1])}), "
-            f"η'_e = {_g(f.get('eta_e_first'))}, θ0 = {_g(f.get('theta0_rad'))} rad, "
-            f"release at {_g(f.get('release_t_s'))} s, residual RMS {_g(f.get('rms_residual_rad'))} rad "
-            f"(fit status {f.get('status')})",
-            "",
-        ]
-    if res.audit:
-        a = res.audit
-        lines += [
-            f"Assumption audit ({a['source']}): **{a['verdict']}**, checked {', '.join(a['checked']) or 'nothing'}"
-            + (
-                f"; impacts not to trust: {', '.join(map(str, a['excluded_impacts']))}" if a["excluded_impacts"] else ""
-            ),
-            "",
-        ]
-        lines += [
-            f"- {f['kind']} ({f['detail']}) at {_g(f['t_s'])} s, impact {f['impact']}: {_g(f['value'])} "
-            f"(tolerance {_g(f['tolerance'])}, SI units)"
-            for f in a["flags"]
-        ]
-        lines += [""] if a["flags"] else []
-        for e in (res.fit or {}).get("excluded_impacts") or []:
-            lines.append(
-                f"- per-impact η of fit impact {e['impact']} at {_g(e['t_s'])} s ({_g(e['eta'])}) is not "
-                f"to be trusted: {'; '.join(e['reasons'])}"
-            )
-        lines += [""] if (res.fit or {}).get("excluded_impacts") else []
-    if res.sync:
-        lines += [
-            f"IMU sync: offset {_g(1000 * res.sync.get('offset_s', float('nan')))} ms, "
-            f"drift {_g(res.sync.get('drift'))}, residual {_g(res.sync.get('residual_ms'))} ms",
+            f"IMU sync: offset {_g(1000 * (imu.offset_s if imu is not None else float('nan')))} ms, "
+            f"drift {_g(None if imu is None else imu.drift)}, "
+            f"residual {_g(None if imu is None else imu.residual_ms)} ms",
             "",
         ]
     lines += ["| simulation | η | RMS vs measured (rad) | impacts |", "|---|---|---|---|"]
     for law, s in res.simulations.items():
-        rms = s.get("rms_vs_measured_rad")
-        lines.append(
-            f"| {law} | {_g(s['eta'])} | {_g(rms)} | {len(s['impacts'])} |"
-            if rms is not None
-            else f"| {law} | {_g(s['eta'])} | – | {len(s['impacts'])} |"
-        )
+        rms = s.rms_vs_measured_rad
+        lines.append(f"| {law} | {_g(s.eta)} | {'–' if rms is None else _g(rms)} | {len(s.impacts)} |")
     lines.append("")
     if res.validation is not None:
         from .._validation import summary_lines
@@ -120,36 +124,32 @@ def _summary_md(res, figs: dict, rrd: bool) -> str:
         lines += summary_lines(res.validation, res.block.alpha_rad)
     if res.truth is not None:
         lines += [
-            f"Synthetic truth: η = {_g(res.truth.get('eta'))}, measured θ RMS error "
-            f"{_g(res.truth.get('theta_rms_error_rad'))} rad",
+            f"Synthetic truth: η = {_g(res.truth.eta)}, measured θ RMS error {_g(res.truth.theta_rms_error_rad)} rad",
             "",
         ]
     if res.column is not None:
         c = res.column
-        cmp_ = c["comparison"]
+        cmp_ = c.comparison
         lines += [
-            f"Column of {len(c['objects'])} blocks (cut {1000 * c['cut_m']:.1f} mm, "
-            f"{c['impacts_per_closing']} impact(s) per closing): simulation status {c['status']}",
+            f"Column of {len(c.objects)} blocks (cut {1000 * c.cut_m:.1f} mm, "
+            f"{c.impacts_per_closing} impact(s) per closing): simulation status {c.status}",
             "",
             "| block | RMS measured − simulated (rad) | peak measured (rad) | peak simulated (rad) |",
             "|---|---|---|---|",
         ]
-        for o, r, pm, ps in zip(
-            c["objects"], cmp_["rms_theta_rad"], cmp_["peak_measured_rad"], cmp_["peak_simulated_rad"]
-        ):
+        for o, r, pm, ps in zip(c.objects, cmp_.rms_theta_rad, cmp_.peak_measured_rad, cmp_.peak_simulated_rad):
             lines.append(f"| {o} | {_g(r)} | {_g(pm)} | {_g(ps)} |")
-        sq = cmp_["sequence"]
+        sq = cmp_.sequence
         lines += [
             "",
-            f"Opening/closing sequence, measured vs simulated: {sq['n_matched']} of "
-            f"{sq['n_measured']} measured / {sq['n_simulated']} simulated events matched "
-            f"(median timing error {_g(sq['timing_error_s'])} s)",
+            f"Opening/closing sequence, measured vs simulated: {sq.n_matched} of "
+            f"{sq.n_measured} measured / {sq.n_simulated} simulated events matched "
+            f"(median timing error {_g(sq.timing_error_s)} s)",
         ]
-        if "sequence_vs_truth" in c:
-            st = c["sequence_vs_truth"]
+        if c.sequence_vs_truth is not None:
+            st = c.sequence_vs_truth
             lines += [
-                f"Measured sequence vs truth: same sequence = {st['same_sequence']} "
-                f"({st['n_matched']}/{st['n_measured']} events)"
+                f"Measured sequence vs truth: same sequence = {st.same_sequence} ({st.n_matched}/{st.n_measured} events)"
             ]
         lines.append("")
     for d in res.diagnostics:

@@ -22,6 +22,10 @@ __all__ = ["ReviewVideo", "ReviewFilm"]
 #: SVT-AV1 settings: preset 10 runs ~400 frames/s at 640x360 on 2 cores; CRF 40 keeps edges
 #: and targets readable at ~0.1 kB per frame of synthetic footage.
 AV1_OPTIONS = {"preset": "10", "crf": "40"}
+#: SVT-AV1 on one logical processor: 20 threads instead of ~50 per encoder. A campaign runs one
+#: encoder per worker process, and a run of the demo hung once inside SVT-AV1 (its "no frame in
+#: undisplayed queue" error, then a deinit waiting forever) with the default thread pools.
+SVT_PARAMS = "lp=1"
 
 
 @dataclass(frozen=True)
@@ -95,6 +99,7 @@ class ReviewFilm:
         self._container = None
         self._stream = None
         self._buf = None
+        self._time_base = Fraction(1, 1)
         self._index: list[int] = []
         self._stills: list[bytes] = []
         self._grey: bool | None = None
@@ -116,11 +121,15 @@ class ReviewFilm:
             self._buf = io.BytesIO()
             self._container = av.open(self._buf, mode="w", format="mp4")
             rate = Fraction(self.fps).limit_denominator(1001)
+            self._time_base = 1 / rate
             s = self._container.add_stream(self.codec, rate=rate)
             # 4:2:0 needs even sizes: the frame is padded by one pixel where needed
             s.width, s.height = w + (w & 1), h + (h & 1)
             s.pix_fmt = "yuv420p"
-            s.options = dict(AV1_OPTIONS, g=str(max(int(round(self.fps)), 1)))
+            opts = dict(AV1_OPTIONS, g=str(max(int(round(self.fps)), 1)))
+            if self.codec == "libsvtav1":
+                opts["svtav1-params"] = SVT_PARAMS
+            s.options = opts
             self._stream = s
             self.kind = "av1"
             self.note = f"AV1 video asset ({self.codec}), every frame"
@@ -144,8 +153,11 @@ class ReviewFilm:
             if (h | w) & 1:
                 pic = cv2.copyMakeBorder(pic, 0, h & 1, 0, w & 1, cv2.BORDER_REPLICATE)
             fmt = "gray" if pic.ndim == 2 else "bgr24"
+            frame = av.VideoFrame.from_ndarray(np.ascontiguousarray(pic), format=fmt)
+            # explicit presentation times: the encoder orders its frames by them
+            frame.pts, frame.time_base = len(self._index), self._time_base
             try:
-                for pkt in self._stream.encode(av.VideoFrame.from_ndarray(np.ascontiguousarray(pic), format=fmt)):
+                for pkt in self._stream.encode(frame):
                     self._container.mux(pkt)
                 self._index.append(int(i))
                 return
@@ -158,10 +170,13 @@ class ReviewFilm:
                 self._stills.append(buf.tobytes())
 
     def _abandon(self, note: str) -> None:
-        try:
-            self._container.close()
-        except Exception:  # noqa: BLE001
-            pass
+        # end the stream before the encoder is freed: SVT-AV1 freed without its end-of-stream
+        # can wait forever in its deinit
+        for end in (lambda: list(self._stream.encode()), self._container.close):
+            try:
+                end()
+            except Exception:  # noqa: BLE001 - the film is abandoned either way
+                pass
         self._container = self._stream = None
         self._index, self.kind, self.note = [], "jpeg", note
 

@@ -91,11 +91,11 @@ class TableAcceleration:
         }
 
     def to_base_motion(self, name: str = "table_imu"):
-        """As a :class:`rocklab.models.BaseMotion`: uniform grid at the log rate, time from 0.
+        """As a :class:`rocklab.series.BaseMotion`: uniform grid at the log rate, time from 0.
 
         Dropped samples are filled by linear interpolation.
         """
-        from ...models import BaseMotion
+        from ...series import BaseMotion
 
         n = int(np.floor((self.t_s[-1] - self.t_s[0]) * self.rate_hz)) + 1
         t = self.t_s[0] + np.arange(n) / self.rate_hz

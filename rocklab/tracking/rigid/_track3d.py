@@ -27,6 +27,7 @@ from ..._errors import InputError, where
 from ._audit import AuditResult, AuditTolerances, audit_rocking
 from ._pose import MIN_POINTS, BodyPoses, body_poses, kabsch, reference_shape
 from ._plausible import check_rate, check_span, check_up, up_evidence
+from ...series import TRACK3D_COLUMNS
 from ._read import PointSeries
 from ._rigidity import check_bodies_disjoint, check_rigid_body
 from ._rocking import (RockingGeometry, axis_vector, find_impacts, fit_pivots, pivot_motion, rocking_axes,
@@ -34,9 +35,6 @@ from ._rocking import (RockingGeometry, axis_vector, find_impacts, fit_pivots, p
 
 __all__ = ["Body3D", "Track3DResult", "track_points3d", "TRACK3D_COLUMNS", "TABLE_NAMES", "parse_bodies"]
 
-#: Columns of ``tracks.csv`` from 3D points: the 2D tracker's, then the out-of-plane measures.
-TRACK3D_COLUMNS = ("frame", "t_s", "object", "x_px", "y_px", "x_m", "y_m", "theta_rad", "sigma_theta_rad",
-                   "quality", "status", "out_of_plane_rad", "twist_rad", "pivot_slide_m", "pivot_uplift_m")
 #: Body names that mean the table (tracked, and the blocks measured relative to it).
 TABLE_NAMES = ("table", "base")
 #: Length of the rest windows at either end of the record, s (at least 5 samples).

@@ -1,7 +1,7 @@
 """Video tracking: from a film to each object's x, y and θ per frame.
 
 - ``track.toml`` configs (:class:`TrackConfig`, :func:`load_track_config`; the reference page
-  is generated from :mod:`._config`);
+  is generated from :mod:`rocklab.config`);
 - reading films (:func:`probe_video`, :func:`iter_video_frames`);
 - camera geometry: lens calibration, the image-to-plane map, similarity fits
   (:class:`PlaneMap`, :func:`calibrate_camera`, :func:`fit_similarity`);
@@ -11,7 +11,7 @@
 - the target detectors in :mod:`.targets`.
 """
 
-from ._config import (
+from ...config import (
     BoardConfig,
     MotionConfig,
     ObjectConfig,
@@ -24,7 +24,8 @@ from ._config import (
 from ._geometry import PlaneMap, SimilarityFit, calibrate_camera, fit_similarity
 from ._init import find_markers, suggest_config
 from ._level import level_from_reference
-from ._motion import TableMotion, choose_sg_window, estimate_noise, table_motion
+from ...series import TableMotion
+from ._motion import choose_sg_window, estimate_noise, table_motion
 from ._track import TRACK_COLUMNS, ObjectTrack, Observation, TrackResult, assemble_tracks, track_frames, track_video
 from ._video import VideoInfo, iter_video_frames, probe_video
 

@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..._errors import InputError
-from ._config import ObjectConfig, ReferenceConfig, TargetsConfig, TrackConfig, VideoConfig
+from ...config import ObjectConfig, ReferenceConfig, TargetsConfig, TrackConfig, VideoConfig
 
 __all__ = ["DICTIONARIES", "MarkerFinding", "find_markers", "suggest_config", "parse_region"]
 

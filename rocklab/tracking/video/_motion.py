@@ -1,74 +1,14 @@
 """Table motion from a tracked displacement: Savitzky-Golay derivatives with the
-window chosen from the measurement noise."""
+window chosen from the measurement noise (the result: :class:`rocklab.series.TableMotion`)."""
 
 from __future__ import annotations
-
-from dataclasses import dataclass
 
 import numpy as np
 
 from ..._errors import InputError
+from ...series import TableMotion
 
-__all__ = ["TableMotion", "table_motion", "estimate_noise", "choose_sg_window"]
-
-
-@dataclass(frozen=True)
-class TableMotion:
-    """Displacement, velocity and acceleration of a tracked table (uniform frame grid).
-
-    Attributes
-    ----------
-    t_s : ndarray (n,)
-    x_m : ndarray (n,)
-        Horizontal displacement, relative to the first valid sample, m (NaN where lost).
-    vx_m_s : ndarray (n,)
-        Savitzky-Golay first derivative, m/s (NaN near gaps).
-    ax_m_s2 : ndarray (n,)
-        Savitzky-Golay second derivative, m/s² (NaN near gaps).
-    window : int
-        Savitzky-Golay window (samples, odd).
-    polyorder : int
-    noise_m : float
-        Estimated white-noise level of ``x_m`` (m), which chose the window.
-    object : str
-    """
-
-    t_s: np.ndarray
-    x_m: np.ndarray
-    vx_m_s: np.ndarray
-    ax_m_s2: np.ndarray
-    window: int
-    polyorder: int
-    noise_m: float
-    object: str = "table"
-
-    @property
-    def window_s(self) -> float:
-        return self.window * float(np.median(np.diff(self.t_s))) if len(self.t_s) > 1 else np.nan
-
-    def to_frame(self):
-        """The result as a pandas DataFrame (SI units in the column names)."""
-        import pandas as pd
-
-        return pd.DataFrame({"t_s": self.t_s, "x_m": self.x_m, "vx_m_s": self.vx_m_s, "ax_m_s2": self.ax_m_s2})
-
-    def to_base_motion(self, name: str | None = None):
-        """As a :class:`rocklab.models.BaseMotion` (gaps filled with 0 m/s²), to drive the simulator."""
-        from ...models import BaseMotion
-
-        a = np.where(np.isfinite(self.ax_m_s2), self.ax_m_s2, 0.0)
-        return BaseMotion.from_arrays(self.t_s - self.t_s[0], a, "m/s2", name=name or f"{self.object} (video)")
-
-    def to_dict(self) -> dict:
-        """Plain dict of the fields, JSON-ready (SI units in the keys)."""
-        return {
-            "object": self.object,
-            "window": self.window,
-            "window_s": self.window_s,
-            "polyorder": self.polyorder,
-            "noise_m": self.noise_m,
-            "max_abs_ax_m_s2": float(np.nanmax(np.abs(self.ax_m_s2))) if np.any(np.isfinite(self.ax_m_s2)) else np.nan,
-        }
+__all__ = ["table_motion", "estimate_noise", "choose_sg_window"]
 
 
 def _segments(ok):

@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..._errors import InputError
-from ._config import TrackConfig
+from ...config import MARKER_STYLES, TrackConfig
 from ._geometry import PlaneMap, board_homography, load_calibration, plane_homography_from_points
 
 __all__ = ["make_plane_map"]
@@ -48,7 +48,7 @@ def _table_plane(config, pm, gray):
     style = config.targets.style
     strict = config.reference.plane == "table"
     why = None
-    if style not in ("aruco", "apriltag") or tab is None:
+    if style not in MARKER_STYLES or tab is None:
         why = "needs the aruco/apriltag style and a table object"
     elif tab.marker_positions_m is None and len(tab.markers) > 1:
         why = "needs the table's marker_positions_m"

@@ -31,8 +31,7 @@ from ._motion import TableMotion, table_motion
 __all__ = ["Observation", "ObjectTrack", "TrackResult", "track_frames", "assemble_tracks",
            "track_video", "make_plane_map", "TRACK_COLUMNS"]
 
-TRACK_COLUMNS = ("frame", "t_s", "object", "x_px", "y_px", "x_m", "y_m", "theta_rad", "sigma_theta_rad",
-                 "quality", "status")
+from ...series import TRACK_COLUMNS  # noqa: E402 - the tracks.csv layout, defined once in rocklab.series
 #: Largest believable rotation between consecutive frames (rad); bigger steps are outliers.
 MAX_STEP_RAD = 0.35
 

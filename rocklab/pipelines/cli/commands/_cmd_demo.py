@@ -33,6 +33,11 @@ def register(sub):
     p.add_argument("--out", default="demo_out", help="output folder (default: demo_out)")
     p.add_argument("--workers", type=count(1), default=2, help="parallel processes (default 2)")
     p.add_argument("--no-progress", action="store_true", help="no progress bars")
+    p.add_argument(
+        "--lossless",
+        action="store_true",
+        help="track the lossless video.mkv films instead of the camcorder-like H.264 video.mp4 (the default)",
+    )
     p.set_defaults(func=run)
 
 
@@ -40,7 +45,7 @@ def run(args) -> int:
     """Run ``rocklab demo`` with parsed ``args``; returns the exit status (0 ok)."""
     from ...campaign._demo import run_demo
 
-    res, t = run_demo(args.out, workers=args.workers, progress=not args.no_progress)
+    res, t = run_demo(args.out, workers=args.workers, progress=not args.no_progress, camcorder=not args.lossless)
     print(res.summary_text())
     print(f"(rendered sessions in {t['render_s']:.0f} s, campaign in {t['campaign_s']:.0f} s)")
     rerun = viewer_command()

@@ -23,7 +23,12 @@ from .._cli_base import emit_json as _emit
 
 
 def register(sub):
-    """Add this module's subcommand(s) to the ``rocklab`` parser ``sub``."""
+    """Add this module's subcommands (pulse, oas, design, equivalent) to the ``rocklab`` parser ``sub``."""
+    for add in (_register_pulse, _register_oas, _register_design, _register_equivalent):
+        add(sub).set_defaults(func=run)
+
+
+def _register_pulse(sub):
     p = sub.add_parser(
         "pulse", help="pulse parameters of a record (a_max, I_max, t_p) and its PGV, PGD, Arias, D5-95, T_v"
     )
@@ -34,8 +39,10 @@ def register(sub):
         help="units of a record that states none (g, m/s2, cm/s2); a file's own units win, a conflict is an error",
     )
     p.add_argument("--json", action="store_true", help="print one JSON object")
-    p.set_defaults(func=run)
+    return p
 
+
+def _register_oas(sub):
     p = sub.add_parser("oas", help="Overturning Acceleration Spectrum and t_I of record(s)")
     p.add_argument(
         "record",
@@ -99,8 +106,10 @@ def register(sub):
     p.add_argument("--scheduler", default=None, help="Dask distributed scheduler address")
     p.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
     p.add_argument("--json", action="store_true", help="print one JSON object")
-    p.set_defaults(func=run)
+    return p
 
+
+def _register_design(sub):
     p = sub.add_parser("design", help="pier width for a PGA and t_I (thesis Eq. 21/23)")
     p.add_argument("--height", type=float, required=True, help="pier height H, m")
     p.add_argument("--ag", type=float, required=True, help="design PGA, g")
@@ -110,8 +119,10 @@ def register(sub):
     p.add_argument("--cm-ratio", type=float, default=None, help="centre-of-mass height / H")
     p.add_argument("--g", type=float, default=None, help="gravity, m/s^2 (default 9.80665)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
-    p.set_defaults(func=run)
+    return p
 
+
+def _register_equivalent(sub):
     p = sub.add_parser("equivalent", help="equivalent-block parameters of a rocking mechanism")
     p.add_argument(
         "mechanism",
@@ -154,7 +165,7 @@ def register(sub):
         help="time history: write t_s and phi_<model>_rad of the mechanism and its equivalent blocks (CSV)",
     )
     p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
-    p.set_defaults(func=run)
+    return p
 
 
 # -- handlers -------------------------------------------------------------------------

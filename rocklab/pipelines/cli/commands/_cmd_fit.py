@@ -19,6 +19,7 @@ import sys
 from pathlib import Path
 
 from ...._errors import InputError, where
+from ....config import FIT_WINDOWS
 
 
 def register(sub):
@@ -37,8 +38,8 @@ def register(sub):
     r.add_argument("--object", default=None, help="object id in tracks.csv (default: the only block)")
     r.add_argument(
         "--window",
-        choices=("middle50", "all", "first"),
-        default="middle50",
+        choices=FIT_WINDOWS,
+        default=FIT_WINDOWS[0],
         help="samples compared: between the impacts at 25 %% and 75 %% of the count (Čeh's middle 50 %%, "
         "default), the whole response, or the first half-period after an impact",
     )
@@ -131,42 +132,21 @@ def run(args) -> int:
 
 
 def _read_track(path: Path, obj: str | None, nan: str):
-    """(t_s, theta_rad, n_skipped) from a tracks.csv / IMU CSV; not-ok rows are NaN rows."""
+    """(t_s, theta_rad, n_skipped) of one object of a tracks.csv / IMU CSV: its usable samples
+    (:meth:`rocklab.series.Tracks.usable`, the rule ``rocklab run`` fits by too)."""
     import numpy as np
-    import pandas as pd
 
-    if not path.is_file():
-        raise FileNotFoundError(2, "not found", str(path))
-    try:
-        df = pd.read_csv(path)
-    except pd.errors.EmptyDataError:
-        raise InputError(f"{where(path)}empty file; need columns t_s,theta_rad") from None
-    missing = [c for c in ("t_s", "theta_rad") if c not in df.columns]
-    if missing:
-        raise InputError(f"{where(path)}missing column(s) {missing}; need t_s and theta_rad (SI units)")
-    df["_line"] = np.arange(len(df)) + 2
-    if "object" in df.columns:
-        ids = [str(x) for x in pd.unique(df["object"].astype(str))]
-        if obj is None:
-            cand = [i for i in ids if i.lower() not in ("table", "base", "reference")]
-            if len(cand) != 1:
-                raise InputError(f"{where(path, key='object')}several objects {ids}; choose one with --object")
-            obj = cand[0]
-        if obj not in ids:
-            raise InputError(f"{where(path, key='object')}object {obj!r} not in the file (has {ids}); fix --object")
-        df = df[df["object"].astype(str) == obj]
-    t = pd.to_numeric(df["t_s"], errors="coerce").to_numpy(float)
-    y = pd.to_numeric(df["theta_rad"], errors="coerce").to_numpy(float)
-    bad = ~(np.isfinite(t) & np.isfinite(y))
-    if "status" in df.columns:
-        # a frame corrected by hand is a sample the user vouches for (tracks.csv marks it so)
-        bad |= ~df["status"].astype(str).str.lower().isin(("ok", "corrected")).to_numpy()
+    from ....series import read_tracks
+
+    rows = read_tracks(path).rows(obj, fix="--object")
+    t, th = rows.theta()
+    bad = ~np.isfinite(th)
     if bad.any() and nan == "raise":
-        line = int(df["_line"].to_numpy()[np.flatnonzero(bad)[0]])
+        line = int(rows.column("line")[np.flatnonzero(bad)[0]])
         raise InputError(
             f"{where(path, line)}NaN or not-ok sample ({int(bad.sum())} such rows); use --nan skip to drop them"
         )
-    return t[~bad], y[~bad], int(bad.sum())
+    return t[~bad], th[~bad], int(bad.sum())
 
 
 def _run_restitution(args) -> int:

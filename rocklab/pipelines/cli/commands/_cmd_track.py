@@ -115,6 +115,7 @@ def run(args) -> int:
         )
 
     from ...._io import write_frame_atomic
+    from ....series import write_tracks
     from ....tracking import load_track_config, track_video
     from .._io_plan import TABLE, track_outputs
 
@@ -127,7 +128,7 @@ def run(args) -> int:
     cfg = _with_corrections(load_track_config(cfg_path), args.corrections)
     res = track_video(video, cfg, fps=args.fps, progress=args.progress)
     out = Path(args.out) if args.out else video.parent / "tracks.csv"
-    write_frame_atomic(out, res.to_frame(), float_format="%.9g", side=not args.out)
+    write_tracks(out, res.to_frame(), side=not args.out)
     summary = res.to_dict()
     summary["tracks_csv"] = str(out)
     if args.plot:

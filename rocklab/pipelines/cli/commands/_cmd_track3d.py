@@ -90,11 +90,11 @@ def write_track3d_outputs(out: Path, series, res, rrd=None, out_side: bool = Fal
 
     ``audit.json`` (and ``out`` when ``out_side``: a default name) never replaces a user's file
     (kept as ``NAME.user-<time>``)."""
-    from ...._io import write_frame_atomic, write_json_atomic
-    from ....tracking.rigid._read import exact_times
+    from ...._io import write_json_atomic
+    from ....series import write_tracks
     from .._io_plan import AUDIT, track3d_outputs
 
-    write_frame_atomic(out, exact_times(res.to_frame()), float_format="%.9g", side=out_side)
+    write_tracks(out, res.to_frame(), side=out_side)
     audit = res.audit_dict()
     audit_path = track3d_outputs(out)[AUDIT]
     write_json_atomic(audit_path, audit, side=True)

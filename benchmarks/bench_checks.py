@@ -29,7 +29,7 @@ CHECKS = (
     "_check_block_rows",
     "_complete_rows",
     "_check_last_token",
-    "_at2_units",
+    "at2_units",
     "clean_stale",
 )
 

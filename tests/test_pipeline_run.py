@@ -170,7 +170,7 @@ def test_summary_numbers_for_people(tmp_path, run_cli):
 def test_run_exit_status_follows_the_report(monkeypatch, tmp_path, run_cli, status, code):
     """A run whose restitution fit failed reports "partial": exit 1, as the README documents
     (it exited 0)."""
-    import rocklab.pipelines.experiment._experiment as exp
+    import rocklab.pipelines.experiment as exp
 
     cfg = tmp_path / "experiment.toml"
     cfg.write_text("")

@@ -97,7 +97,7 @@ def _rigid_body_log(view, mount_m, t0, t_end_s, rate_hz, bias_deg_s, seed, burst
     (column blocks, which do not pivot on their own corners); same error model
     and axes as ``simulate_imu_log``: interval-mean rate and specific force."""
     from ..blocks import G
-    from ..tracking.imu._read import ImuLog
+    from ..tracking.imu import ImuLog
 
     rng = np.random.default_rng(seed)
     dt = 1.0 / rate_hz

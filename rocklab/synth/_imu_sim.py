@@ -27,7 +27,7 @@ import numpy as np
 from .._errors import InputError
 from .._io import atomic_path
 from ..blocks import G
-from ..tracking.imu._read import ImuLog
+from ..tracking.imu import ImuLog
 
 __all__ = ["simulate_imu_log", "write_ximu_csv", "write_ximu3_csv"]
 

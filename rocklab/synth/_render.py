@@ -135,7 +135,7 @@ def _hand_alpha(box, reach, H, W):
     return alpha, (0, R1, C0, C1)
 
 
-def _to_world(outline: np.ndarray, ox, oy, phi):
+def to_world(outline: np.ndarray, ox, oy, phi):
     c, s = np.cos(phi), np.sin(phi)
     x = ox[..., None] + c[..., None] * outline[:, 0] - s[..., None] * outline[:, 1]
     y = oy[..., None] + s[..., None] * outline[:, 0] + c[..., None] * outline[:, 1]
@@ -233,7 +233,7 @@ class Renderer:
 
     def _bbox(self, o: RenderObject, ts):
         ox, oy, phi = (np.atleast_1d(np.asarray(v, float)) for v in o.pose(ts))
-        pts = _to_world(o.texture.outline_m, ox, oy, phi).reshape(-1, 2)
+        pts = to_world(o.texture.outline_m, ox, oy, phi).reshape(-1, 2)
         px = self.cam.project(pts)
         m = self.margin
         c0 = max(0, int(np.floor(px[:, 0].min())) - m)
@@ -249,7 +249,7 @@ class Renderer:
             return 1
         ts = t + self.exposure_s * np.linspace(-0.5, 0.5, 9)
         ox, oy, phi = (np.atleast_1d(np.asarray(v, float)) for v in o.pose(ts))
-        px = self.cam.project(_to_world(o.texture.outline_m, ox, oy, phi).reshape(-1, 2))
+        px = self.cam.project(to_world(o.texture.outline_m, ox, oy, phi).reshape(-1, 2))
         px = px.reshape(len(ts), -1, 2)
         path = np.sum(np.hypot(*np.moveaxis(np.diff(px, axis=0), -1, 0)), axis=0).max()
         return int(min(self.max_sub, max(1, math.ceil(path / self.blur_step_px))))

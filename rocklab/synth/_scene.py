@@ -130,7 +130,7 @@ class Scene:
         return df.sort_values(["frame", "object"], kind="stable").reset_index(drop=True)
 
     def _track_objects(self):
-        from ._render import _to_world
+        from ._render import to_world
 
         objs = []
         first = np.array([0.0])
@@ -149,7 +149,7 @@ class Scene:
                 e["roi"] = _roi_box(self.camera.project(self._inner_points(o, f, ox, oy, phi)))
                 e["theta0_rad"] = float(phi[0]) if e["kind"] == "block" else None
             else:
-                px = self.camera.project(_to_world(o.texture.outline_m, ox, oy, phi).reshape(-1, 2))
+                px = self.camera.project(to_world(o.texture.outline_m, ox, oy, phi).reshape(-1, 2))
                 e["roi"] = _roi_box(px, margin_px=8.0, size=self.size)
                 e["size_m"] = list(f["size_m"])
                 e["theta0_rad"] = float(phi[0])
@@ -164,19 +164,19 @@ class Scene:
         left part up to the first block, from 6 mm above its top edge (the edge levels the
         angles) to its bottom.
         """
-        from ._render import _to_world
+        from ._render import to_world
 
         t0 = np.array([0.0])
         b, h = f["size_m"]
         if o.id == "table":
-            xb = min(float(_to_world(ob.texture.outline_m, *(np.asarray(v, float) for v in ob.pose(t0)))
+            xb = min(float(to_world(ob.texture.outline_m, *(np.asarray(v, float) for v in ob.pose(t0)))
                            [..., 0].min()) for ob in self.objects if ob.id != "table")
             # table body frame: origin at the top centre of the face, y up; its pose is the shift
             local = np.array([[-b / 2 + 0.01, 0.006], [min(xb - float(ox[0]) - 0.02, -b / 4), -h + 0.002]])
-            return _to_world(local, ox, oy, phi).reshape(-1, 2)
+            return to_world(local, ox, oy, phi).reshape(-1, 2)
         a, c, ph = b / 2, h / 2, abs(float(phi[0]))
         k = 0.9 * min(a / (a * np.cos(ph) + c * np.sin(ph)), c / (a * np.sin(ph) + c * np.cos(ph)))
-        centre = _to_world(np.array([[0.0, c]]), ox, oy, phi).reshape(-1, 2)[0]
+        centre = to_world(np.array([[0.0, c]]), ox, oy, phi).reshape(-1, 2)[0]
         return centre + np.array([[-k * a, -k * c], [k * a, k * c]])
 
     def write_files(self, folder: Path, *, imu: bool, imu_rate_hz: float, calibrated: bool) -> dict:

@@ -14,6 +14,7 @@ The clock synchronisation of an IMU to a video track is here (:func:`sync_offset
 :func:`sync_imu_to_track`). The most used names of the sub-packages are re-exported.
 """
 
+from ._corrections import apply_corrections, load_corrections
 from ._sync import SyncResult, sync_events, sync_imu_to_track, sync_offset, track_rate
 from .calib import Board, Lens, calibrate_lens, load_lens, parse_board
 from .imu import (
@@ -57,6 +58,8 @@ from .video import (
 )
 
 __all__: list[str] = [
+    "load_corrections",
+    "apply_corrections",
     "TrackConfig",
     "VideoConfig",
     "TargetsConfig",

@@ -15,7 +15,8 @@ import numpy as np
 
 from ..._errors import InputError
 from ...blocks import G
-from ._equivalent import Mechanism, _pos, block_parameters
+from ..._errors import positive
+from ._equivalent import Mechanism, block_parameters
 
 __all__ = ["four_bar_mechanism", "asymmetric_frame", "arch_mechanism"]
 
@@ -159,11 +160,13 @@ def asymmetric_frame(
         bottom-right) and negative direction (the mirror image; the coordinate is
         still the left column's rotation).
     """
-    b, H, H1, L, h = (_pos(n, v) for n, v in (("b_m", b_m), ("H_m", H_m), ("H1_m", H1_m), ("L_m", L_m), ("h_m", h_m)))
+    b, H, H1, L, h = (
+        positive(n, v) for n, v in (("b_m", b_m), ("H_m", H_m), ("H1_m", H1_m), ("L_m", L_m), ("h_m", h_m))
+    )
     if L <= 2 * b:
         raise InputError(f"L_m={L}: columns overlap; the left-face distance L must exceed the width 2b")
     _comparable("asymmetric frame", b_m=b, H_m=H, H1_m=H1, L_m=L, h_m=h)
-    mA, mB, mC = (_pos(n, v) for n, v in (("m_AB", m_AB), ("m_BC", m_BC), ("m_CD", m_CD)))
+    mA, mB, mC = (positive(n, v) for n, v in (("m_AB", m_AB), ("m_BC", m_BC), ("m_CD", m_CD)))
     yD = 2 * H - 2 * H1
     wbeam = L + 2 * b
     body_ab = (mA, (b, H), mA * (4 * b * b + 4 * H * H) / 12)
@@ -254,8 +257,8 @@ def arch_mechanism(inclusion_angle_rad: float, thickness_m: float, radius_m: flo
         The mechanism (coordinate: clockwise rotation of the left segment) and
         ``{"hinges": (u_A, u_B, u_C, u_D), "faces": ..., "lambda": ...}``.
     """
-    beta = _pos("inclusion_angle_rad", inclusion_angle_rad)
-    t, r = _pos("thickness_m", thickness_m), _pos("radius_m", radius_m)
+    beta = positive("inclusion_angle_rad", inclusion_angle_rad)
+    t, r = positive("thickness_m", thickness_m), positive("radius_m", radius_m)
     if beta > 2 * math.pi * 0.95 or t >= r:
         raise InputError(f"arch: need inclusion angle < 1.9 pi and thickness < radius (got {beta}, {t}, {r})")
     _comparable("arch", thickness_m=t, radius_m=r)

@@ -325,9 +325,9 @@ def overturning_spectrum(
     if not isinstance(base, BaseMotion):
         raise InputError(f"base={type(base).__name__}: expected a BaseMotion (load_base_motion)")
     from ..._errors import check_memory
-    from ._pulses import _check_record
+    from ._pulses import check_record
 
-    base = _check_record(base)  # enough samples, not all zeros
+    base = check_record(base)  # enough samples, not all zeros
     if int(levels) < 1 or int(sizes) < 2:
         raise InputError(f"levels={levels!r}, sizes={sizes!r}: need at least 1 level and 2 sizes")
     check_memory(

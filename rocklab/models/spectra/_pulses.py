@@ -41,7 +41,7 @@ F_SINE = 2.0 / math.pi
 PULSE_KINDS = ("half-sine", "full-sine", "n-half-sines", "rectangular", "triangular", "cycloidal-a", "cycloidal-b")
 
 
-def _check_record(base: BaseMotion) -> BaseMotion:
+def check_record(base: BaseMotion) -> BaseMotion:
     if not isinstance(base, BaseMotion):
         raise InputError(
             f"base={type(base).__name__}: expected a BaseMotion; read the record with rocklab.models.load_base_motion"
@@ -163,7 +163,7 @@ def pulse_parameters(base: BaseMotion, F: float = F_SINE) -> PulseParameters:
     -------
     PulseParameters
     """
-    base = _check_record(base)
+    base = check_record(base)
     if not (math.isfinite(F) and 0 < F <= 1):
         raise InputError(f"F={F!r}: fullness must be in (0, 1]; a half sine has 2/pi")
     a = base.acc_m_s2

@@ -13,7 +13,7 @@ from ...series import acc_unit_factor as _unit_factor
 __all__: list[str] = []
 
 
-def _stated_wins(path: Path, stated: str, where: str, given: str | None) -> str:
+def stated_wins(path: Path, stated: str, where: str, given: str | None) -> str:
     """The file's ``stated`` units; ``given`` (``--units``) must agree (the same factor)."""
     if given is not None and _unit_factor(given, f"{path}: ") != _unit_factor(stated, f"{path}: "):
         raise InputError(
@@ -63,7 +63,7 @@ _OTHER_QUANTITY = {
 }
 
 
-def _at2_units(path: Path, header: list[str], given: str | None = None) -> tuple[str | None, int]:
+def at2_units(path: Path, header: list[str], given: str | None = None) -> tuple[str | None, int]:
     """``(units, line)`` an AT2 header names in a units field, or ``(None, 0)`` when it names none.
 
     Free text (a station called "Galway" or "Portugal") is never read as a unit; a

@@ -28,7 +28,7 @@ from ..._errors import InputError
 from ...blocks import G
 from ...series import BaseMotion
 from ...series import acc_unit_factor as _unit_factor
-from ._record_units import _at2_units, _stated_wins
+from ._record_units import at2_units, stated_wins
 
 __all__ = ["load_base_motion", "not_a_record", "check_plausible", "MIN_SAMPLES", "bundled_record", "BUNDLED_RECORDS"]
 
@@ -133,9 +133,9 @@ def _read_at2(path: Path, text: str, units: str | None, name: str, default_units
     npts, dt = int(m_n.group(1)), float(m_dt.group(1))
     if dt <= 0:
         raise InputError(f"{path}, line {hdr_i + 1}: DT={dt} must be positive")
-    file_units, line = _at2_units(path, lines[:hdr_i], given=units)
+    file_units, line = at2_units(path, lines[:hdr_i], given=units)
     if file_units is not None:
-        units, units_from = _stated_wins(path, file_units, f"the header (line {line})", units), "header"
+        units, units_from = stated_wins(path, file_units, f"the header (line {line})", units), "header"
     elif units is not None:
         units_from = "option"
     else:  # PEER's documented convention when the file names no units
@@ -247,7 +247,7 @@ def _read_csv(path: Path, units: str | None, name: str) -> BaseMotion:
         i = int(np.flatnonzero(bad)[0])
         raise InputError(f"{path}, line {i + 2}: NaN or non-numeric value; clean the record")
     _check_time(path, t, first_line=2)
-    file_units = _stated_wins(path, str(file_units), f"its column {acc_col.strip()!r}", units)
+    file_units = stated_wins(path, str(file_units), f"its column {acc_col.strip()!r}", units)
     f = _unit_factor(file_units, f"{path}: ")
     meta = {"format": "csv", "units_in_file": file_units, "units_from": "column name"}
     return BaseMotion(t, a * f, name=name, source=str(path), meta=meta)

@@ -71,7 +71,7 @@ def _check_unique_names(configs, root: Path) -> None:
 def _one(config: str, out: str, force: bool) -> dict:
     """Worker: run one experiment; never raises (the failure is the result)."""
     from ..._errors import InputError as _IE
-    from ..experiment._experiment import run_experiment
+    from ..experiment import run_experiment
 
     try:
         report, ran = run_experiment(config, out, force=force)
@@ -434,7 +434,7 @@ def run_campaign(
 
 
 def _write_campaign(res: CampaignResult) -> None:
-    from ..experiment._figures import campaign_figures
+    from ..experiment import campaign_figures
     from ..reports import write_html_report
 
     out = res.out_dir

@@ -87,7 +87,7 @@ def _rewrite_experiment(path: Path, camcorder: bool, **changes) -> None:
     from dataclasses import replace
 
     from ..._io import write_text_atomic
-    from ..experiment._config import load_experiment
+    from ..experiment import load_experiment
 
     cfg = load_experiment(path)
     if camcorder:

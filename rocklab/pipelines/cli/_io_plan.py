@@ -148,7 +148,7 @@ def _column(args):
 
 
 def _oas(args):
-    from ..spectra._spectra_batch import expand_records
+    from ..spectra import expand_records
 
     ins = []
     if args.list:

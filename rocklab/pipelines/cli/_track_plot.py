@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..experiment._figures import pyplot, save_png
+from .._plotting import pyplot, save_png
 
 __all__ = ["track_figure"]
 

@@ -17,7 +17,7 @@ _COLOURS = [(0, 200, 255), (255, 120, 0), (0, 220, 0), (220, 0, 220), (0, 0, 255
 
 
 def _first_frame(video: Path):
-    from ...tracking.video._video import iter_video_frames, probe_video
+    from ...tracking.video import iter_video_frames, probe_video
 
     if not video.exists():
         raise InputError(f"{video}: video not found; check the path")
@@ -37,7 +37,7 @@ PROPOSE_SAMPLES = 30
 
 def _samples(video, info, window_s):
     """Grey frames spread over the first ``window_s`` seconds after the first (decoded in one pass)."""
-    from ...tracking.video._video import iter_video_frames
+    from ...tracking.video import iter_video_frames
 
     per = 2 if info.field_order is not None else 1  # a deinterlaced film yields two fields a frame
     n = per * (info.n_frames or 0)
@@ -102,7 +102,7 @@ def track_init(
     """
     from ..._io import write_text_atomic
     from ...tracking.video._init import find_markers, parse_region, suggest_config
-    from ..experiment._figures import save_bgr_png
+    from .._plotting import save_bgr_png
 
     video, out = Path(video), Path(out)
     info, gray, img = _first_frame(video)
@@ -142,7 +142,7 @@ def track_init(
     if lens is not None:
         import os
 
-        from ...tracking.video._geometry import load_calibration
+        from ...tracking.video import load_calibration
 
         load_calibration(lens, (info.width_px, info.height_px))
         lens_rel = Path(os.path.relpath(Path(lens).resolve(), out.resolve().parent)).as_posix()
@@ -291,7 +291,7 @@ def _draw_top_edge(out, img, cfg, table) -> None:
     try:
         edge = table_top_edge(gray, table.roi, make_plane_map(cfg, gray.shape[1], gray.shape[0], gray))
     except InputError:  # a board or table-marker plane that this frame cannot give: the pixels' own
-        from ...tracking.video._geometry import PlaneMap
+        from ...tracking.video import PlaneMap
 
         edge = table_top_edge(gray, table.roi, PlaneMap(gray.shape[1], gray.shape[0]))
     if edge is None:
@@ -335,13 +335,13 @@ def track_preview(
         raise InputError(f"--frames {n_frames}: give 1 to 48 frames for the sheet")
     if at_s is not None and not (math.isfinite(at_s) and at_s >= 0):
         raise InputError(f"--at {at_s}: give a time in the film, s (>= 0)")
-    from ...tracking.video._video import iter_video_frames, probe_video
+    from ...tracking.video import iter_video_frames, probe_video
 
     vinfo = probe_video(video)  # the sheet shows the frames (fields) as tracked: square pixels
     cfg = load_track_config(config)
     fixes = corrections or cfg.video.corrections
     if fixes is not None:  # applied to the span tracked here: those outside it are not an error
-        from ...tracking._corrections import load_corrections
+        from ...tracking import load_corrections
 
         fixes = load_corrections(fixes)
         cfg = replace(cfg, video=replace(cfg.video, corrections=None))
@@ -362,7 +362,7 @@ def track_preview(
         cfg = replace(cfg, video=replace(cfg.video, stop_frame=stop))
     res = track_video(video, cfg, fps=fps, progress=progress)
     if fixes:
-        from ...tracking._corrections import apply_corrections
+        from ...tracking import apply_corrections
 
         res = apply_corrections(res, fixes, partial=True)
     frames = np.asarray(res.tracks[0].frame)
@@ -378,7 +378,7 @@ def track_preview(
             video, int(f), int(f) + 1, prefetch=0, color=True, pixel_aspect=vinfo.pixel_aspect, fields=vinfo.field_order
         ):
             tiles.append(_draw_pose(img, res, i))
-    from ..experiment._figures import save_bgr_png
+    from .._plotting import save_bgr_png
 
     save_bgr_png(Path(out), contact_sheet(tiles), side=side)
     return res, [int(f) for f in pick]

@@ -11,7 +11,10 @@
 
 from ._config import EXAMPLE_TOML, ExperimentConfig, load_experiment
 from ._experiment import ExperimentResult, analyse_experiment, run_experiment
+from ._figures import campaign_figures, experiment_figures
+from ._plots_column import plot_column_maps
 from ._rerun import read_rrd_scalars, read_rrd_summary
+from ._rerun3d import write_track3d_rrd
 
 __all__ = [
     "load_experiment",
@@ -22,4 +25,8 @@ __all__ = [
     "ExperimentResult",
     "read_rrd_summary",
     "read_rrd_scalars",
+    "experiment_figures",
+    "campaign_figures",
+    "plot_column_maps",
+    "write_track3d_rrd",
 ]

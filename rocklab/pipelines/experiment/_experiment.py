@@ -26,7 +26,7 @@ import numpy as np
 from ... import __version__
 from ...series import TableMotion
 from ._config import ExperimentConfig, load_experiment
-from ._measure import _measure_imu, _measure_video, _read_track_csv, _sync, _table_from_imu
+from ._measure import measure_imu, measure_video, read_track_csv, _sync, table_from_imu
 from ._report import write_outputs
 from ._stages import ClockSync, ExperimentResult, FitStage
 from ._simulate_stage import compare_truth, simulate_laws
@@ -66,21 +66,21 @@ def _measure(cfg: ExperimentConfig, progress: bool, keep_video: bool | None, msg
     t0 = time.perf_counter()
     if cfg.video is not None:
         keep = cfg.rrd if keep_video is None else keep_video
-        measured["video"], table, tr, film = _measure_video(cfg, progress, keep_film=keep)
+        measured["video"], table, tr, film = measure_video(cfg, progress, keep_film=keep)
         if film is not None and film.kind != "av1":
             msgs.append(f"review video: {film.note}")
         timings["track_s"] = time.perf_counter() - t0
     if cfg.track is not None:
-        track_rows = _read_track_csv(cfg.track.path, cfg.track.object)
+        track_rows = read_track_csv(cfg.track.path, cfg.track.object)
         measured["track"] = track_rows.theta()  # the samples `rocklab fit restitution` fits
     rot = None
     if cfg.imu is not None:
         t1 = time.perf_counter()
-        measured["imu"], rot = _measure_imu(cfg)
+        measured["imu"], rot = measure_imu(cfg)
         timings["imu_s"] = time.perf_counter() - t1
     table_sync = None
     if cfg.table.source == "imu":
-        table, table_sync = _table_from_imu(cfg, table, msgs)
+        table, table_sync = table_from_imu(cfg, table, msgs)
     elif cfg.table.source == "record":
         from ...models import load_base_motion
 

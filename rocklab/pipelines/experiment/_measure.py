@@ -18,7 +18,7 @@ from ._review_video import ReviewFilm
 __all__: list[str] = []
 
 
-def _read_track_csv(path: Path, obj: str | None):
+def read_track_csv(path: Path, obj: str | None):
     """The rows of ``obj`` in a tracked CSV (:class:`rocklab.series.Tracks`), checked."""
     return read_tracks(path).rows(obj, fix="[sources.track] object")
 
@@ -35,7 +35,7 @@ def _probe_fps(path, given: float | None) -> float:
     return float(fps) if fps else 50.0
 
 
-def _measure_video(cfg: ExperimentConfig, progress: bool, keep_film: bool):
+def measure_video(cfg: ExperimentConfig, progress: bool, keep_film: bool):
     from ...tracking import load_track_config, track_video
 
     tcfg = load_track_config(cfg.video.track_config) if cfg.video.track_config else None
@@ -59,7 +59,7 @@ def _measure_video(cfg: ExperimentConfig, progress: bool, keep_film: bool):
     return Tracks.from_frame(df).rows(cfg.video.object).theta(), table, tr, review
 
 
-def _measure_imu(cfg: ExperimentConfig):
+def measure_imu(cfg: ExperimentConfig):
     from ...tracking import block_rotation, read_imu
 
     log = read_imu(cfg.imu.path, rate_hz=cfg.imu.rate_hz)
@@ -68,7 +68,7 @@ def _measure_imu(cfg: ExperimentConfig):
     return (np.asarray(rot.t_s, float), np.asarray(rot.theta_rad, float)), rot
 
 
-def _table_from_imu(cfg: ExperimentConfig, video_table: TableMotion | None, msgs: list):
+def table_from_imu(cfg: ExperimentConfig, video_table: TableMotion | None, msgs: list):
     """Table acceleration from the table IMU, on the video clock when the video tracked the table.
 
     A 50 fps camera cannot measure a record's table acceleration (content above 25 Hz is lost;

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from ._figures import pyplot, save_png
+from .._plotting import pyplot, save_png
 
 __all__ = ["plot_column_maps", "plot_column_response"]
 

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..experiment._figures import pyplot as _plt
-from ..experiment._figures import save_png as _save
+from .._plotting import pyplot as _plt
+from .._plotting import save_png as _save
 from ._gallery import Built, Entry, number
 
 __all__ = ["ENTRIES"]

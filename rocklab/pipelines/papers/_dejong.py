@@ -7,8 +7,8 @@ from functools import lru_cache
 
 import numpy as np
 
-from ..experiment._figures import pyplot as _plt
-from ..experiment._figures import save_png as _save
+from .._plotting import pyplot as _plt
+from .._plotting import save_png as _save
 from ._gallery import Built, Entry, number
 
 __all__ = ["ENTRIES"]

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..experiment._figures import pyplot as _plt
-from ..experiment._figures import save_png as _save
+from .._plotting import pyplot as _plt
+from .._plotting import save_png as _save
 from ._gallery import Built, Entry, number
 from ._ther_spectra import BUILDERS as _SPECTRA
 from ._ther_spectra import NEEDS_RECORDS as _SPECTRA_RECORDS
@@ -218,9 +218,9 @@ def fig14(ctx) -> Built:
 
     from ...blocks import Block
     from ...models import simulate
-    from ._ther_spectra import _mul009
+    from ._ther_spectra import mul009
 
-    rec = _mul009(ctx)
+    rec = mul009(ctx)
     blk = Block(0.63, 2.52)  # the thesis's b = 0.315 m, h = 1.261 m are half sizes
     out, nums = {}, {}
     for law, kw in (("housner", {}), ("bumps", {"n": 1})):

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..experiment._figures import pyplot as _plt
-from ..experiment._figures import save_png as _save
+from .._plotting import pyplot as _plt
+from .._plotting import save_png as _save
 from ._gallery import Built, number
 
 __all__ = ["BUILDERS", "NEEDS_RECORDS"]
@@ -17,7 +17,7 @@ GRID = dict(levels=30, sizes=60)
 def _records(ctx):
     """Every record under ``--records``, read as ``rocklab oas FOLDER --recursive --units g`` reads it."""
     from ...models import load_base_motion
-    from ..spectra._spectra_batch import expand_records
+    from ..spectra import expand_records
 
     return [load_base_motion(p, units="g") for _, p, err in expand_records([ctx.records], recursive=True) if not err]
 

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..experiment._figures import pyplot as _plt
-from ..experiment._figures import save_png as _save
+from .._plotting import pyplot as _plt
+from .._plotting import save_png as _save
 from ._gallery import Built, number
 
 __all__ = ["BUILDERS", "NEEDS_RECORDS"]
@@ -71,7 +71,7 @@ def fig13(ctx) -> Built:
 
 def _oas_of(ctx, key, base, slenderness=12.0, **kw):
     from ...models import overturning_spectrum
-    from ..spectra._plots_spectra import plot_oas
+    from ..spectra import plot_oas
 
     o = overturning_spectrum(base, slenderness, **kw)
     plot_oas(o, ctx.png(key))
@@ -89,7 +89,7 @@ def fig36(ctx) -> Built:
     )
 
 
-def _mul009(ctx):
+def mul009(ctx):
     from ...models import load_base_motion
 
     return load_base_motion(ctx.records.joinpath(*MUL009), units="g")
@@ -101,9 +101,9 @@ PRINTED_FF1 = {"ther:Fig. 55": (0.27, 0.40, 2.39)}
 
 def _fig_mul009_oas(key):
     def build(ctx) -> Built:
-        from ..spectra._spectra_batch import table4_row
+        from ..spectra import table4_row
 
-        o = _oas_of(ctx, key, _mul009(ctx))
+        o = _oas_of(ctx, key, mul009(ctx))
         row = table4_row("120111")
         tI, tIp, beta = PRINTED_FF1.get(key, (float(row["t_I_s"]), float(row["t_I_prime_s"]), float(row["beta"])))
         nums = {
@@ -150,9 +150,9 @@ def fig52(ctx) -> Built:
     import pandas as pd
 
     from ...models import pulse_parameters
-    from ..spectra._spectra_batch import table4_row
+    from ..spectra import table4_row
 
-    base = _mul009(ctx)
+    base = mul009(ctx)
     pp = pulse_parameters(base)
     row = table4_row("120111")
     df = pd.DataFrame({"t_s": base.t_s, "acc_m_s2": base.acc_m_s2})
@@ -169,7 +169,7 @@ def fig52(ctx) -> Built:
 
 def fig40(ctx) -> Built:
     from ...models import column_overturning_maps
-    from ..experiment._plots_column import plot_column_maps
+    from ..experiment import plot_column_maps
 
     maps = column_overturning_maps()
     plot_column_maps(maps, ctx.png("ther:Fig. 40"))
@@ -278,7 +278,7 @@ def fig39(ctx) -> Built:
 
 def fig41(ctx) -> Built:
     from ...models import column_overturning_maps
-    from ..experiment._plots_column import plot_column_maps
+    from ..experiment import plot_column_maps
 
     maps = column_overturning_maps(n_impacts=2)
     plot_column_maps(maps, ctx.png("ther:Fig. 41"))
@@ -292,7 +292,7 @@ def fig56(ctx) -> Built:
 
     from ...models import bundled_record, load_base_motion, overturning_spectrum, pulse_motion, pulse_parameters
 
-    recs = [bundled_record("elcentro"), load_base_motion(ctx.records / "RSN68_SFERN_PEL090.AT2"), _mul009(ctx)]
+    recs = [bundled_record("elcentro"), load_base_motion(ctx.records / "RSN68_SFERN_PEL090.AT2"), mul009(ctx)]
     plt = _plt()
     fig, ax = plt.subplots(figsize=(6, 3.8), constrained_layout=True)
     frames, nums = [], {}

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..experiment._figures import pyplot, save_png
+from .._plotting import pyplot, save_png
 
 __all__ = ["plot_oas", "plot_overturning_curve", "plot_wall_error_maps", "plot_frame_error_maps"]
 

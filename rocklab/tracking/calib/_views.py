@@ -94,7 +94,7 @@ def frames_by_index(path, lost: list | None = None):
     n_dropped, n_slots)`` is appended to ``lost`` at the end, for the caller to warn from its own
     thread (:func:`warn_lost`).
     """
-    from ..video._video import iter_video_frames, probe_video
+    from ..video import iter_video_frames, probe_video
 
     info = probe_video(path)
     slot = np.arange(info.n_frames)
@@ -201,7 +201,7 @@ def open_views(source, every: int | None = None) -> Views:
         raise InputError(
             f"{s}: not found; give a calibration film, a folder of photos or a pattern such as 'calib/left*.jpg'"
         )
-    from ..video._video import probe_video
+    from ..video import probe_video
 
     n = probe_video(s).n_frames
     step = every or max(1, -(-n // MAX_FILM_VIEWS))

@@ -16,10 +16,10 @@ from ...blocks import G
 
 __all__ = []
 
-_GYRO_UNITS = {"deg/s": math.pi / 180.0, "dps": math.pi / 180.0, "°/s": math.pi / 180.0, "rad/s": 1.0}
-_ACC_UNITS = {"g": G, "m/s2": 1.0, "m/s^2": 1.0, "m/s²": 1.0}
-_TIME_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "µs": 1e-6}
-_ROLES = ("gyro_x", "gyro_y", "gyro_z", "acc_x", "acc_y", "acc_z")
+GYRO_UNITS = {"deg/s": math.pi / 180.0, "dps": math.pi / 180.0, "°/s": math.pi / 180.0, "rad/s": 1.0}
+ACC_UNITS = {"g": G, "m/s2": 1.0, "m/s^2": 1.0, "m/s²": 1.0}
+TIME_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "µs": 1e-6}
+ROLES = ("gyro_x", "gyro_y", "gyro_z", "acc_x", "acc_y", "acc_z")
 _HEAD = re.compile(r"^\s*(gyroscope|accelerometer)\s+([xyz])\s*\(([^)]*)\)\s*$", re.I)
 
 #: Full scale of the x-IMU3 main accelerometer, g (HighGAccelerometer covers impacts).
@@ -76,7 +76,7 @@ def _require_text(path: Path) -> None:
     )
 
 
-def _read_csv(path: Path):
+def read_csv(path: Path):
     """Parse a CSV with pandas' C parser; numeric errors name the first bad line.
 
     All-numeric files go through the numba scanner (``_imu_fastcsv``); the
@@ -146,7 +146,7 @@ def _numeric(df, col, path: Path) -> np.ndarray:
     return v
 
 
-def _inertial_columns(df, path: Path) -> dict[str, tuple[str, float]]:
+def inertial_columns(df, path: Path) -> dict[str, tuple[str, float]]:
     """Find ``Gyroscope X (deg/s)`` ... ``Accelerometer Z (g)`` columns and unit factors."""
     found: dict[str, tuple[str, float]] = {}
     for col in df.columns:
@@ -154,12 +154,12 @@ def _inertial_columns(df, path: Path) -> dict[str, tuple[str, float]]:
         if not m:
             continue
         kind, ax, unit = m.group(1).lower(), m.group(2).lower(), m.group(3).strip().lower()
-        table = _GYRO_UNITS if kind == "gyroscope" else _ACC_UNITS
+        table = GYRO_UNITS if kind == "gyroscope" else ACC_UNITS
         if unit not in table:
             raise InputError(f"{where(path, 1, col)}unknown unit {unit!r}; use one of {', '.join(table)} in the header")
         role = ("gyro_" if kind == "gyroscope" else "acc_") + ax
         found[role] = (col, table[unit])
-    missing = [r for r in _ROLES if r not in found]
+    missing = [r for r in ROLES if r not in found]
     if missing:
         names = ", ".join(("Gyroscope " if r.startswith("gyro") else "Accelerometer ") + r[-1].upper() for r in missing)
         raise InputError(
@@ -169,7 +169,7 @@ def _inertial_columns(df, path: Path) -> dict[str, tuple[str, float]]:
     return found
 
 
-def _stack(df, cols, path) -> tuple[np.ndarray, np.ndarray]:
+def stack(df, cols, path) -> tuple[np.ndarray, np.ndarray]:
     gyro = np.empty((len(df), 3))
     acc = np.empty((len(df), 3))
     for i, ax in enumerate("xyz"):
@@ -180,7 +180,7 @@ def _stack(df, cols, path) -> tuple[np.ndarray, np.ndarray]:
     return gyro, acc
 
 
-def _check_increasing(t: np.ndarray, path: Path, col: str) -> None:
+def check_increasing(t: np.ndarray, path: Path, col: str) -> None:
     d = np.diff(t)
     bad = np.flatnonzero(d <= 0)
     if bad.size:
@@ -192,14 +192,14 @@ def _check_increasing(t: np.ndarray, path: Path, col: str) -> None:
         )
 
 
-def _gap_drops(t: np.ndarray, period: float) -> int:
+def gap_drops(t: np.ndarray, period: float) -> int:
     """Samples missing from gaps longer than 1.5 nominal periods."""
     d = np.diff(t)
     big = d > 1.5 * period
     return int(np.sum(np.rint(d[big] / period) - 1)) if big.any() else 0
 
 
-def _saturation(acc_m_s2: np.ndarray, full_scale_g: float | None) -> np.ndarray:
+def saturation(acc_m_s2: np.ndarray, full_scale_g: float | None) -> np.ndarray:
     """Samples with an axis at full scale.
 
     With a known full scale, |a| >= 0.99 FS.  Otherwise a clipping plateau: an

@@ -44,39 +44,39 @@ import numpy as np
 from ..._errors import InputError, where
 from ...blocks import G
 from ._csv import (
-    _ACC_UNITS,
-    _GYRO_UNITS,
-    _ROLES,
-    _TIME_UNITS,
+    ACC_UNITS,
+    GYRO_UNITS,
+    ROLES,
+    TIME_UNITS,
     XIMU3_FULL_SCALE_G,
-    _check_increasing,
-    _gap_drops,
-    _inertial_columns,
+    check_increasing,
+    gap_drops,
+    inertial_columns,
     _numeric,
-    _read_csv,
-    _saturation,
-    _stack,
+    read_csv,
+    saturation,
+    stack,
 )
 from ._log import ImuLog
-from ._ximu import _read_ximu_gui, read_ximu_registers, ximu_rate_from_registers
+from ._ximu import read_ximu_gui, read_ximu_registers, ximu_rate_from_registers
 
 __all__ = ["ImuLog", "read_imu", "imu_log_files", "read_ximu_registers", "ximu_rate_from_registers"]
 
 
 # --------------------------------------------------------------------------- x-IMU3
 def _read_ximu3(path: Path, rate_hz: float | None, full_scale_g: float | None) -> ImuLog:
-    df = _read_csv(path)
+    df = read_csv(path)
     tcol = "Timestamp (us)"
     if tcol not in df.columns:
         raise InputError(f"{where(path, 1)}missing column 'Timestamp (us)'; not an x-IMU3 Inertial.csv")
-    cols = _inertial_columns(df, path)
-    gyro, acc = _stack(df, cols, path)
+    cols = inertial_columns(df, path)
+    gyro, acc = stack(df, cols, path)
     t = _numeric(df, tcol, path) * 1e-6
-    _check_increasing(t, path, tcol)
+    check_increasing(t, path, tcol)
     period = 1.0 / rate_hz if rate_hz else float(np.median(np.diff(t))) if len(t) > 1 else 1.0
-    dropped = _gap_drops(t, period)
+    dropped = gap_drops(t, period)
     fs = XIMU3_FULL_SCALE_G if full_scale_g is None else full_scale_g
-    sat = _saturation(acc, fs)
+    sat = saturation(acc, fs)
     n_hg = 0
     hg = path.with_name("HighGAccelerometer.csv")
     if sat.any() and hg.is_file():
@@ -85,7 +85,7 @@ def _read_ximu3(path: Path, rate_hz: float | None, full_scale_g: float | None) -
 
 
 def _merge_high_g(hg: Path, t: np.ndarray, acc: np.ndarray, sat: np.ndarray):
-    df = _read_csv(hg)
+    df = read_csv(hg)
     need = ["Timestamp (us)", "X (g)", "Y (g)", "Z (g)"]
     miss = [c for c in need if c not in df.columns]
     if miss:
@@ -93,7 +93,7 @@ def _merge_high_g(hg: Path, t: np.ndarray, acc: np.ndarray, sat: np.ndarray):
             f"{where(hg, 1)}missing columns {', '.join(miss)}; expected 'Timestamp (us),X (g),Y (g),Z (g)'"
         )
     th = _numeric(df, need[0], hg) * 1e-6
-    _check_increasing(th, hg, need[0])
+    check_increasing(th, hg, need[0])
     acc = acc.copy()
     idx = np.flatnonzero(sat)
     for k, c in enumerate(need[1:]):
@@ -103,7 +103,7 @@ def _merge_high_g(hg: Path, t: np.ndarray, acc: np.ndarray, sat: np.ndarray):
 
 # --------------------------------------------------------------------------- generic
 def _read_timed(path: Path, rate_hz, full_scale_g, mapping) -> ImuLog:
-    df = _read_csv(path)
+    df = read_csv(path)
     if mapping:
         cols: dict[str, tuple[str, float]] = {}
         tcol, tf = None, 1.0
@@ -115,15 +115,15 @@ def _read_timed(path: Path, rate_hz, full_scale_g, mapping) -> ImuLog:
                     f"{where(path, 1, name)}mapped column not in the header ({', '.join(df.columns)}); fix the mapping"
                 )
             table = (
-                _TIME_UNITS
+                TIME_UNITS
                 if role == "t"
-                else _GYRO_UNITS
+                else GYRO_UNITS
                 if role.startswith("gyro_")
-                else _ACC_UNITS
+                else ACC_UNITS
                 if role.startswith("acc_")
                 else None
             )
-            if table is None or (role != "t" and role not in _ROLES):
+            if table is None or (role != "t" and role not in ROLES):
                 raise InputError(
                     f"mapping[{name!r}]: unknown role {role!r}; use t, gyro_x|y|z or acc_x|y|z as 'role:unit'"
                 )
@@ -133,14 +133,14 @@ def _read_timed(path: Path, rate_hz, full_scale_g, mapping) -> ImuLog:
                 tcol, tf = name, table[unit]
             else:
                 cols[role] = (name, table[unit])
-        missing = [r for r in _ROLES if r not in cols]
+        missing = [r for r in ROLES if r not in cols]
         if missing:
             raise InputError(
                 f"mapping: roles {', '.join(missing)} not mapped; map every gyro_x|y|z and acc_x|y|z column"
             )
         fmt = "mapped"
     else:
-        cols = _inertial_columns(df, path)
+        cols = inertial_columns(df, path)
         tcol = next((c for c in df.columns if c.lower() in ("time (s)", "t_s")), None)
         tf, fmt = 1.0, "fusion"
         if tcol is None and rate_hz is None:
@@ -148,14 +148,14 @@ def _read_timed(path: Path, rate_hz, full_scale_g, mapping) -> ImuLog:
                 f"{where(path, 1)}no 'Time (s)' column and no rate; add the "
                 "column, pass a mapping, or give the rate with --rate / rate_hz="
             )
-    gyro, acc = _stack(df, cols, path)
+    gyro, acc = stack(df, cols, path)
     if tcol is None:
         t = np.arange(len(df)) / float(rate_hz)
     else:
         t = _numeric(df, tcol, path) * tf
-        _check_increasing(t, path, tcol)
+        check_increasing(t, path, tcol)
     period = 1.0 / rate_hz if rate_hz else float(np.median(np.diff(t))) if len(t) > 1 else 1.0
-    return ImuLog(t, gyro, acc, 1.0 / period, _gap_drops(t, period), _saturation(acc, full_scale_g), str(path), fmt)
+    return ImuLog(t, gyro, acc, 1.0 / period, gap_drops(t, period), saturation(acc, full_scale_g), str(path), fmt)
 
 
 def _resolve(path: Path) -> Path:
@@ -277,9 +277,9 @@ def check_imu_log(log: ImuLog, rate_option_hz: float | None = None) -> ImuLog:
                 f"{log.source}: --rate {rate_option_hz:g} Hz but the timestamps say "
                 f"{ts_rate:.4g} Hz; the timestamps are used",
             )
-            from ._csv import _gap_drops
+            from ._csv import gap_drops
 
-            log = dataclasses.replace(log, rate_hz=ts_rate, dropped_samples=_gap_drops(log.t_s, period))
+            log = dataclasses.replace(log, rate_hz=ts_rate, dropped_samples=gap_drops(log.t_s, period))
         gap = d > max(10 * period, 0.05)
         if gap.any():
             i = int(np.argmax(d))
@@ -301,7 +301,7 @@ def _read_any(p: Path, rate_hz, mapping, full_scale_g) -> ImuLog:
     if mapping:
         return _read_timed(p, rate_hz, full_scale_g, mapping)
     if p.name.endswith(("_CalInertialAndMag.csv", "_CalInertialMagnetic.csv")):
-        return _read_ximu_gui(p, rate_hz, full_scale_g)
+        return read_ximu_gui(p, rate_hz, full_scale_g)
     with open(p, encoding="utf-8", errors="replace") as fh:
         head = fh.readline()
     if "Timestamp (us)" in head:
@@ -313,5 +313,5 @@ def _read_any(p: Path, rate_hz, mapping, full_scale_g) -> ImuLog:
                 f"{where(p)}x-IMU 'Packet number' log without a "
                 "_CalInertialAndMag.csv name; give the rate with --rate / rate_hz="
             )
-        return _read_ximu_gui(p, rate_hz, full_scale_g)
+        return read_ximu_gui(p, rate_hz, full_scale_g)
     return _read_timed(p, rate_hz, full_scale_g, None)

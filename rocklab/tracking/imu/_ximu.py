@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from ..._errors import InputError, where
-from ._csv import _check_increasing, _inertial_columns, _numeric, _read_csv, _saturation, _stack
+from ._csv import check_increasing, inertial_columns, _numeric, read_csv, saturation, stack
 from ._log import ImuLog
 
 __all__ = ["read_ximu_registers", "ximu_rate_from_registers"]
@@ -32,7 +32,7 @@ def read_ximu_registers(path) -> dict:
     written and the integer addresses.
     """
     path = Path(path)
-    df = _read_csv(path)
+    df = read_csv(path)
     for need in ("Address", "Value"):
         if need not in df.columns:
             raise InputError(
@@ -93,7 +93,7 @@ def _ximu_full_scale_g(regs_path: Path) -> float | None:
     return None if v is None else float(2 ** (int(v) + 1))
 
 
-def _read_ximu_gui(path: Path, rate_hz: float | None, full_scale_g: float | None) -> ImuLog:
+def read_ximu_gui(path: Path, rate_hz: float | None, full_scale_g: float | None) -> ImuLog:
     name = path.name
     legacy = name.endswith("_CalInertialMagnetic.csv")
     suffix = "_CalInertialMagnetic.csv" if legacy else "_CalInertialAndMag.csv"
@@ -121,21 +121,21 @@ def _read_ximu_gui(path: Path, rate_hz: float | None, full_scale_g: float | None
                 f"{stated:g} Hz; the register is used (drop --rate)",
             )
             rate_hz = stated
-    df = _read_csv(path)
+    df = read_csv(path)
     if "Packet number" not in df.columns:
         raise InputError(f"{where(path, 1)}missing column 'Packet number'; not an x-IMU GUI export")
-    cols = _inertial_columns(df, path)
-    gyro, acc = _stack(df, cols, path)
+    cols = inertial_columns(df, path)
+    gyro, acc = stack(df, cols, path)
     pk = _numeric(df, "Packet number", path)
     # 16-bit packet counters wrap; unwrap before checking order.
     wrap = np.diff(pk) < -30000
     if wrap.any():
         pk = pk + 65536.0 * np.concatenate(([0], np.cumsum(wrap)))
-    _check_increasing(pk, path, "Packet number")
+    check_increasing(pk, path, "Packet number")
     index, dropped = _ximu_sample_index(pk)
     if full_scale_g is None and regs is not None and regs.is_file():
         full_scale_g = _ximu_full_scale_g(regs)
-    sat = _saturation(acc, full_scale_g)
+    sat = saturation(acc, full_scale_g)
     return ImuLog(index / rate_hz, gyro, acc, float(rate_hz), dropped, sat, str(path), "ximu-gui", pk)
 
 

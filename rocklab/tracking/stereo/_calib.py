@@ -199,7 +199,7 @@ def calibrate_stereo(film1, film2, board=None, *, every: int | None = None) -> S
     import cv2
 
     from ..calib._lens import detect_views, not_found_hint, usable
-    from ..calib._views import open_views
+    from ..calib import open_views
 
     b = _board(board)
     if b.kind == "checkerboard" and b.cols == b.rows:
@@ -214,7 +214,7 @@ def calibrate_stereo(film1, film2, board=None, *, every: int | None = None) -> S
     _, det2, size2 = detect_views(v2, b, lost)
     warn_lost(lost)
     from ..video._checks import check_mirrored
-    from ..video._video import probe_video
+    from ..video import probe_video
 
     for v in (v1, v2):
         if v.is_film:

@@ -376,7 +376,7 @@ def triangulate_tracks(rig: StereoRig, tracks1: DotTracks2D, tracks2: DotTracks2
 
 def check_films(film1, film2, rig: StereoRig, fps: float | None = None) -> float:
     """The common frame rate of two films, or :class:`InputError` when they cannot be one test of ``rig``."""
-    from ..video._video import probe_video
+    from ..video import probe_video
 
     from ..video._checks import check_mirrored
 
@@ -427,7 +427,7 @@ def track_dots_stereo(film1, film2, rig: StereoRig, fps: float | None = None, sy
     -------
     StereoPoints
     """
-    from ..video._video import probe_video
+    from ..video import probe_video
     from ._calib import frames_by_index, warn_lost
 
     rate1 = check_films(film1, film2, rig, fps)

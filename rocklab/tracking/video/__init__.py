@@ -21,7 +21,7 @@ from ...config import (
     VideoConfig,
     load_track_config,
 )
-from ._geometry import PlaneMap, SimilarityFit, calibrate_camera, fit_similarity
+from ._geometry import PlaneMap, SimilarityFit, calibrate_camera, fit_similarity, load_calibration
 from ._init import find_markers, suggest_config
 from ._level import level_from_reference
 from ...series import TableMotion
@@ -30,6 +30,7 @@ from ._track import TRACK_COLUMNS, ObjectTrack, Observation, TrackResult, assemb
 from ._video import VideoInfo, iter_video_frames, probe_video
 
 __all__ = [
+    "load_calibration",
     "TrackConfig",
     "VideoConfig",
     "TargetsConfig",

@@ -203,7 +203,7 @@ def load_calibration(path, size_px=None):
         The film's (width, height): a lens file calibrated at another size is refused.
     """
     if str(path).lower().endswith(".json"):
-        from ..calib._lens import load_lens
+        from ..calib import load_lens
 
         lens = load_lens(path)
         if size_px is not None and tuple(int(v) for v in size_px) != tuple(lens.size):

@@ -20,7 +20,7 @@ def register(sub):
 
 def run(args) -> int:
     """Run ``rocklab campaign`` with parsed ``args``; returns the exit status (0 ok)."""
-    from ...campaign._campaign import run_campaign
+    from ...campaign import run_campaign
 
     res = run_campaign(
         args.dir,

@@ -189,7 +189,7 @@ def _maps(args):
     from tqdm import tqdm
 
     from ....models import column_overturning_maps
-    from ...experiment._plots_column import plot_column_maps
+    from ...experiment import plot_column_maps
 
     k = max(int(args.maps_grid), 2)
     # the region where the columns' overturning boundaries differ (thesis Fig. 40)

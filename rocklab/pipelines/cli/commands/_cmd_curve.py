@@ -90,7 +90,7 @@ def run(args) -> int:
     if args.out:
         write_frame_atomic(args.out, frame)
     if args.plot:
-        from ...spectra._plots_spectra import plot_overturning_curve
+        from ...spectra import plot_overturning_curve
 
         plot_overturning_curve(c, args.plot)
     never = int(np.isnan(c.a_min_ratio).sum())

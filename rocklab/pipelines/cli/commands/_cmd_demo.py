@@ -43,7 +43,7 @@ def register(sub):
 
 def run(args) -> int:
     """Run ``rocklab demo`` with parsed ``args``; returns the exit status (0 ok)."""
-    from ...campaign._demo import run_demo
+    from ...campaign import run_demo
 
     res, t = run_demo(args.out, workers=args.workers, progress=not args.no_progress, camcorder=not args.lossless)
     print(res.summary_text())

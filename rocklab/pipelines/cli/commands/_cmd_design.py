@@ -239,7 +239,7 @@ def run_oas(args) -> int:
     if args.out:
         write_frame_atomic(args.out, o.to_frame())
     if args.plot:
-        from ...spectra._plots_spectra import plot_oas
+        from ...spectra import plot_oas
 
         plot_oas(o, args.plot)
     d = o.to_dict()
@@ -261,7 +261,7 @@ def _run_oas_batch(args, kw) -> int:
     from pathlib import Path
 
     from ...._io import write_frame_atomic
-    from ...spectra._spectra_batch import expand_records, oas_table
+    from ...spectra import expand_records, oas_table
 
     skipped: list = []
     notes: list = []
@@ -296,7 +296,7 @@ def _run_oas_batch(args, kw) -> int:
         with atomic_path(out.with_suffix(".parquet"), side=True) as tmp:
             tab.to_parquet(tmp, index=False)
     if args.plot:
-        from ...spectra._plots_spectra import plot_tI_vs_tp
+        from ...spectra import plot_tI_vs_tp
 
         plot_tI_vs_tp(tab, args.plot, args.slenderness)
     n_bad = int((tab["error"] != "").sum())

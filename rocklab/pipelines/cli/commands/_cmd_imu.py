@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import sys
 
-from ...reports._format import sig
+from ...reports import sig
 
 
 def register(sub):

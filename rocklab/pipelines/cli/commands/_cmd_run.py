@@ -21,7 +21,7 @@ def register(sub):
 def run(args) -> int:
     """Run ``rocklab run`` with parsed ``args``; returns the exit status (0 ok)."""
     from ...._io import dumps_json
-    from ...experiment._experiment import run_experiment
+    from ...experiment import run_experiment
 
     report, ran = run_experiment(
         args.config, args.out, force=args.force, spawn=args.spawn, connect=args.connect, progress=args.progress

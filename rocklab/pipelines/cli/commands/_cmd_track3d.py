@@ -101,7 +101,7 @@ def write_track3d_outputs(out: Path, series, res, rrd=None, out_side: bool = Fal
     summary = res.to_dict()
     summary.update(tracks_csv=str(out), audit_json=str(audit_path), verdict=audit["verdict"])
     if rrd:
-        from ...experiment._rerun3d import write_track3d_rrd
+        from ...experiment import write_track3d_rrd
 
         write_track3d_rrd(rrd, series, res)
         summary["rrd"] = str(rrd)

@@ -41,6 +41,49 @@ def _next_uplift(t_now, rec_t, rec_a, thr, t_stop):
     return float(t0 + min(max(fr, 0.0), 1.0) * (rec_t[k] - t0))
 
 
+def _phase(t, th, w, s, duration_s, ug, p2, alpha, linearized, fall_rad, ode_method, rtol, atol, max_step):
+    """One rocking phase about corner ``s`` from (t s, th rad, w rad/s): ``solve_ivp`` with dense output.
+
+    Events: 0 contact (theta = 0 towards the other side, terminal), 1 |theta| = alpha outward,
+    2 |theta| = fall_rad outward (terminal); ``ug(t)`` is the base acceleration / g.
+    """
+
+    def rhs(tt, y):
+        if linearized:
+            return [y[1], p2 * (y[0] - alpha * s) - p2 * ug(tt)]
+        c = alpha * s - y[0]
+        return [y[1], -p2 * (math.sin(c) + ug(tt) * math.cos(c))]
+
+    def contact(tt, y):
+        return y[0]
+
+    contact.terminal = True
+    contact.direction = -s
+
+    def over(tt, y):
+        return y[0] - s * alpha
+
+    over.direction = s
+
+    def fall(tt, y):
+        return y[0] - s * fall_rad
+
+    fall.terminal = True
+    fall.direction = s
+
+    return solve_ivp(
+        rhs,
+        (t, duration_s),
+        [th, w],
+        method=ode_method,
+        rtol=rtol,
+        atol=atol,
+        events=[contact, over, fall],
+        dense_output=True,
+        max_step=max_step,
+    )
+
+
 def run_event(
     block,
     theta0,
@@ -110,40 +153,7 @@ def run_event(
             resting = False
             ever_moved = True
 
-        def rhs(tt, y, s=s):
-            if linearized:
-                return [y[1], p2 * (y[0] - alpha * s) - p2 * ug(tt)]
-            c = alpha * s - y[0]
-            return [y[1], -p2 * (math.sin(c) + ug(tt) * math.cos(c))]
-
-        def contact(tt, y):
-            return y[0]
-
-        contact.terminal = True
-        contact.direction = -s
-
-        def over(tt, y, s=s):
-            return y[0] - s * alpha
-
-        over.direction = s
-
-        def fall(tt, y, s=s):
-            return y[0] - s * fall_rad
-
-        fall.terminal = True
-        fall.direction = s
-
-        sol = solve_ivp(
-            rhs,
-            (t, duration_s),
-            [th, w],
-            method=ode_method,
-            rtol=rtol,
-            atol=atol,
-            events=[contact, over, fall],
-            dense_output=True,
-            max_step=max_step,
-        )
+        sol = _phase(t, th, w, s, duration_s, ug, p2, alpha, linearized, fall_rad, ode_method, rtol, atol, max_step)
         t_b = float(sol.t[-1])
         m = (t_out >= t - 1e-12) & (t_out <= t_b)
         if m.any():

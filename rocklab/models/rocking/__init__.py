@@ -8,7 +8,7 @@ of :data:`METHODS`, one contract, :class:`Integrator`); :func:`simulate_batch` m
 """
 
 from ._batch import free_rocking_overturns, simulate_batch
-from ._integrators import METHODS, Event, Integrator, KernelResult, Newmark, RockingProblem, Taylor
+from ._integrators import METHODS, Event, Integrator, Newmark, RockingProblem, Taylor
 from ._restitution import (
     RESTITUTION_LAWS,
     Restitution,
@@ -18,7 +18,7 @@ from ._restitution import (
     eta_modified,
     make_restitution,
 )
-from ._result import BatchResult, RockingResult, block_energy
+from ._result import BatchResult, KernelResult, RockingResult, block_energy
 from ._single import simulate
 
 __all__ = [

@@ -15,6 +15,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from ...blocks import G
+from ._result import KernelResult, block_energy
 
 __all__ = ["run_event"]
 
@@ -99,10 +100,12 @@ def run_event(
     atol=1e-13,
     ode_method="DOP853",
     fall_rad=0.5 * math.pi,
-):
-    """Event-driven integration; returns a dict like the Newmark kernel's output.
+    max_impacts=100_000,
+) -> KernelResult:
+    """Event-driven integration on the output times ``t_out`` (n,) s; samples after a stop are dropped.
 
-    ``t_out`` (n,) are the output times (s); samples after a stop are dropped.
+    Returns the :class:`~rocklab.models.rocking.KernelResult` of every integrator (energy from
+    :func:`~rocklab.models.block_energy`, the first ``max_impacts`` impacts in the table).
     """
     alpha, p = block.alpha_rad, block.p_rad_s
     p2 = p * p
@@ -124,7 +127,7 @@ def run_event(
 
     th_out = np.full(t_out.shape, np.nan)
     w_out = np.full(t_out.shape, np.nan)
-    imps = []
+    imps: list[tuple[float, float, float, float]] = []
     t, th, w = 0.0, float(theta0), float(omega0)
     resting = th == 0.0 and w == 0.0
     s = 1.0 if (th > 0 or (th == 0 and w > 0)) else -1.0
@@ -187,13 +190,7 @@ def run_event(
         status = "rocking"
         break
     keep = t_out <= t_end + 1e-12
-    return dict(
-        t=t_out[keep],
-        theta=th_out[keep],
-        omega=w_out[keep],
-        impacts=imps,
-        status=status,
-        t_over=t_over,
-        t_fall=t_fall,
-        max_abs=max_abs,
-    )
+    th_k, w_k = th_out[keep], w_out[keep]
+    imp = np.ascontiguousarray(np.array(imps, float).reshape(-1, 4).T[:, :max_impacts])
+    E = block_energy(block, th_k, w_k, linearized)
+    return KernelResult(t_out[keep], th_k, w_k, E, imp, len(imps), status, t_over, t_fall, max_abs)

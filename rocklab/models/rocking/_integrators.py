@@ -4,8 +4,8 @@
 :class:`RockingProblem`, looks the method up in :data:`METHODS` (or takes an
 :class:`Integrator` instance, as ``solve_ivp`` takes an ``OdeSolver`` class), calls
 :meth:`Integrator.check` for the method's own rules and :meth:`Integrator.run`, which
-returns a :class:`KernelResult`. Every integrator applies the same impact, rest and
-overturning rules (see :mod:`rocklab.models.rocking._single`):
+returns a :class:`~rocklab.models.rocking.KernelResult`. Every integrator applies the same
+impact, rest and overturning rules (see :mod:`rocklab.models.rocking._single`):
 
 - ``newmark``: the numba Newmark kernel with exact contact (:mod:`._newmark`);
 - ``taylor``: Taylor series of order 12 between exact impacts, free rocking of the full
@@ -25,6 +25,7 @@ import numpy as np
 from ..._errors import InputError
 from ...blocks import G
 from ._newmark import STATUS_NAMES, run_single
+from ._result import KernelResult
 
 if TYPE_CHECKING:
     from ...blocks import Block
@@ -34,7 +35,6 @@ if TYPE_CHECKING:
 __all__ = [
     "METHODS",
     "Integrator",
-    "KernelResult",
     "RockingProblem",
     "Newmark",
     "Taylor",
@@ -118,28 +118,6 @@ class RockingProblem(NamedTuple):
             return -np.inf
         over = np.abs(self.base.acc_m_s2) > G * math.tan(self.block.alpha_rad)
         return float(self.base.t_s[np.flatnonzero(over)[-1]]) if over.any() else -np.inf
-
-
-class KernelResult(NamedTuple):
-    """What every integrator returns.
-
-    ``t_s, theta_rad, omega_rad_s, energy_J`` (n,): the output grid, rotation (rad),
-    angular velocity (rad/s) and energy above rest (J); ``impacts`` (4, k) C-contiguous rows
-    t_s, omega_before, omega_after, eta of the first ``max_impacts`` impacts; ``n_impacts``
-    (all of them); ``status`` (``rocking``, ``rest``, ``overturned``, ``no_uplift``);
-    ``overturn_t_s``, ``fall_t_s`` (s, NaN if not reached); ``max_abs_theta_rad``.
-    """
-
-    t_s: np.ndarray
-    theta_rad: np.ndarray
-    omega_rad_s: np.ndarray
-    energy_J: np.ndarray
-    impacts: np.ndarray
-    n_impacts: int
-    status: str
-    overturn_t_s: float
-    fall_t_s: float
-    max_abs_theta_rad: float
 
 
 class Integrator:
@@ -270,11 +248,10 @@ class Event(Integrator):
 
     def run(self, problem: RockingProblem) -> KernelResult:
         from ._event import run_event
-        from ._result import block_energy
 
         odt = problem.dt_s * problem.output_every
         t_grid = np.arange(int(math.floor(problem.duration_s / odt + 1e-9)) + 1) * odt
-        r = run_event(
+        return run_event(
             problem.block,
             problem.theta0_rad,
             problem.omega0_rad_s,
@@ -288,20 +265,7 @@ class Event(Integrator):
             rtol=problem.rtol,
             ode_method=problem.ode_method,
             fall_rad=problem.fall_rad,
-        )
-        imp = np.ascontiguousarray(np.array(r["impacts"], float).reshape(-1, 4).T[:, : problem.max_impacts])
-        E = block_energy(problem.block, r["theta"], r["omega"], problem.linearized)
-        return KernelResult(
-            r["t"],
-            r["theta"],
-            r["omega"],
-            E,
-            imp,
-            len(r["impacts"]),
-            r["status"],
-            r["t_over"],
-            r["t_fall"],
-            r["max_abs"],
+            max_impacts=problem.max_impacts,
         )
 
 

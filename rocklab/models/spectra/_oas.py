@@ -403,7 +403,8 @@ def overturning_spectrum(
     else:
         over, evaluated = adaptive_verdicts(lambda i, j: _runs(base, scales[i], p[j], args), lv.size, p.size)
 
-    p_hi, p_lo = _bisect(base, scales, *_first_unsafe(over, p, search), refine, args)
+    p_hi, p_lo = _first_unsafe(over, p, search)
+    p_hi, p_lo = _bisect(base, scales, p_hi, p_lo, refine, args)
 
     f = lv * p_hi
     icr = normalised_critical_impulse(alpha)

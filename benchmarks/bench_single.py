@@ -24,10 +24,9 @@ import numba
 import numpy as np
 from scipy.integrate import solve_ivp
 
-import rocklab.models.rocking._single as single_mod
 from rocklab import Block
 from rocklab.models import bundled_record, simulate, simulate_batch
-from rocklab.models.rocking._newmark import run_single
+from rocklab.models.rocking import Newmark
 
 
 def plain_dop853(blk, theta0, eta, t_grid, n_impacts, rtol=1e-10):
@@ -162,11 +161,6 @@ def main():
     numba.set_num_threads(nthreads)
 
 
-def general_loop(*args):
-    """run_single with the lean loops off (every step in the general Newton loop)."""
-    return run_single(*args, False)
-
-
 def under_record(rec):
     """One block rocking under a record: lean loops vs general loop vs free rocking vs solve_ivp."""
     big = Block(0.5, 3.0, name="0.5 x 3 m")
@@ -175,16 +169,9 @@ def under_record(rec):
     base = rec.scaled(1.5)
     kwf = dict(kw, restitution="constant", eta=1.0)
 
-    def general():
-        single_mod.run_single = general_loop
-        try:
-            return simulate(big, 0.0, base=base, **kw)
-        finally:
-            single_mod.run_single = run_single
-
     runs = {
         "lean": lambda: simulate(big, 0.0, base=base, **kw),
-        "general": general,
+        "general": lambda: simulate(big, 0.0, base=base, method=Newmark(lean=False), **kw),
         "free": lambda: simulate(big, 0.5 * big.alpha_rad, **kwf),
     }
     for f in runs.values():

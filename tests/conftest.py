@@ -45,18 +45,13 @@ def run_cli(capsys):
 
 
 @pytest.fixture
-def simulate_loop(monkeypatch):
+def simulate_loop():
     """``simulate`` with the kernel's lean loops on (``lean=True``) or off (every step in the
     general Newton loop, the reference for the lean loops): ``simulate_loop(lean, block, **kw)``."""
-    import rocklab.models.rocking._single as single_mod
     from rocklab.models import simulate
-    from rocklab.models.rocking._newmark import run_single
+    from rocklab.models.rocking import Newmark
 
     def run(lean, blk, *args, **kw):
-        monkeypatch.setattr(single_mod, "run_single", lambda *a: run_single(*a, lean))
-        try:
-            return simulate(blk, *args, **kw)
-        finally:
-            monkeypatch.setattr(single_mod, "run_single", run_single)
+        return simulate(blk, *args, method=Newmark(lean=lean), **kw)
 
     return run

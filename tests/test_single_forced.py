@@ -1,4 +1,4 @@
-"""The lean loops under a base record (rocklab.models.rocking._newmark_forced, the rest scan) solve the general loop's steps.
+"""The lean loops under a base record (rocklab.models.rocking._newmark_lean, the rest scan) solve the general loop's steps.
 
 ``simulate`` runs rocking steps under a record in a lean fixed-point loop with
 Taylor-shifted sin/cos and u(t) stepped along each record interval, and skips

@@ -18,8 +18,16 @@ from .._errors import InputError
 from .._diagnostics import warn
 from ._release import ReleaseInfo, detect_release, settle_release
 
-__all__ = ["ReleaseInfo", "detect_release", "find_crossings", "arch_peaks", "per_impact_eta",
-           "EnergyLoss", "energy_loss_from_peaks", "check_record"]
+__all__ = [
+    "ReleaseInfo",
+    "detect_release",
+    "find_crossings",
+    "arch_peaks",
+    "per_impact_eta",
+    "EnergyLoss",
+    "energy_loss_from_peaks",
+    "check_record",
+]
 
 
 def check_record(t_s, theta_rad, nan: str = "raise", name: str = "theta_rad"):
@@ -64,7 +72,7 @@ def find_crossings(t_s, theta_rad, start: int = 0, threshold: float = 0.0) -> np
     side = np.sign(y[i]) or 1.0
     while i < n - 1:
         # next sample on the other side
-        rel = np.flatnonzero(side * y[i + 1:] < 0)
+        rel = np.flatnonzero(side * y[i + 1 :] < 0)
         if rel.size == 0:
             break
         j = i + 1 + rel[0]
@@ -128,8 +136,9 @@ def arch_peaks(t_s, theta_rad, t_cross, release: ReleaseInfo | None = None, sigm
     tc = np.asarray(t_cross, float)
     rows = []
     if release is not None and release.found:
-        rows.append((release.t_s, release.theta0_rad, release.sigma_rad / np.sqrt(max(release.n_plateau, 1)),
-                     release.n_plateau))
+        rows.append(
+            (release.t_s, release.theta0_rad, release.sigma_rad / np.sqrt(max(release.n_plateau, 1)), release.n_plateau)
+        )
     for a, b in zip(tc[:-1], tc[1:]):
         m = (t > a) & (t < b)
         if m.sum() < 3:
@@ -161,8 +170,7 @@ def arch_peaks(t_s, theta_rad, t_cross, release: ReleaseInfo | None = None, sigm
             k = int(np.argmax(s * yy))
             x0, v0 = float(x[k]), float(yy[k])
         res = yy - V @ c
-        sig = sigma_rad if sigma_rad is not None else (
-            float(np.sqrt(res @ res / max(tt.size - deg - 1, 1))))
+        sig = sigma_rad if sigma_rad is not None else (float(np.sqrt(res @ res / max(tt.size - deg - 1, 1))))
         v = np.vander(np.array([x0]), deg + 1, increasing=True)[0]
         se = float(sig * np.sqrt(v @ np.linalg.pinv(V.T @ V) @ v))
         rows.append((float(t0 + sc * x0), v0, se, int(m.sum())))
@@ -186,7 +194,7 @@ def _arch_end_slopes(t, y, ta, tb, powers=(0, 2)):
     L = tb - ta
     u = 2.0 * (x - ta) / L - 1.0
     base = (x - ta) * (tb - x)
-    X = np.column_stack([base * u ** j for j in pw])
+    X = np.column_stack([base * u**j for j in pw])
     c, *_ = np.linalg.lstsq(X, yy, rcond=None)
     qa = float(sum(ci * (-1.0) ** j for ci, j in zip(c, pw)))
     qb = float(np.sum(c))
@@ -209,15 +217,14 @@ def _release_arch_slope(t, y, rel: ReleaseInfo, tc0, powers=(0, 2)):
         ta = 2 * tm - tc0
         L = tc0 - ta
         u = 2.0 * (x - ta) / L - 1.0
-        X = np.column_stack([(x - ta) * (tc0 - x) * u ** j for j in powers])
+        X = np.column_stack([(x - ta) * (tc0 - x) * u**j for j in powers])
         c, *_ = np.linalg.lstsq(X, yy, rcond=None)
         r = yy - X @ c
         return float(r @ r), c, L
 
     dt = float(np.median(np.diff(t)))
     lo, hi = rel.t_s - 4 * dt, min(rel.t_s + 3 * dt, x[0] + 0.5 * dt)
-    res = minimize_scalar(lambda tm: fit(tm)[0], bounds=(lo, hi), method="bounded",
-                          options=dict(xatol=1e-6 * dt))
+    res = minimize_scalar(lambda tm: fit(tm)[0], bounds=(lo, hi), method="bounded", options=dict(xatol=1e-6 * dt))
     _, c, L = fit(res.x)
     return -L * float(np.sum(c)), int(m.sum())
 
@@ -251,8 +258,15 @@ def _crossings(t, y, rel):
     return np.array([_local_crossing_time(t, y, i) for i in ic])
 
 
-def per_impact_eta(t_s, theta_rad, block=None, release: ReleaseInfo | None = None, powers=(0, 2),
-                   max_se: float = 0.0025, crossings_t_s=None) -> pd.DataFrame:
+def per_impact_eta(
+    t_s,
+    theta_rad,
+    block=None,
+    release: ReleaseInfo | None = None,
+    powers=(0, 2),
+    max_se: float = 0.0025,
+    crossings_t_s=None,
+) -> pd.DataFrame:
     """Restitution of each impact from the data alone.
 
     Two estimates per impact:
@@ -290,9 +304,20 @@ def per_impact_eta(t_s, theta_rad, block=None, release: ReleaseInfo | None = Non
     """
     t, y, _ = check_record(t_s, theta_rad)
     rel = release if release is not None else _release_for(t, y, block)
-    cols = ["impact", "t_s", "omega_before_rad_s", "omega_after_rad_s", "eta_velocity",
-            "theta_peak_before_rad", "theta_peak_after_rad", "eta_peaks", "eta_peaks_se", "n_before", "n_after",
-            "ok"]
+    cols = [
+        "impact",
+        "t_s",
+        "omega_before_rad_s",
+        "omega_after_rad_s",
+        "eta_velocity",
+        "theta_peak_before_rad",
+        "theta_peak_after_rad",
+        "eta_peaks",
+        "eta_peaks_se",
+        "n_before",
+        "n_after",
+        "ok",
+    ]
     tc = _crossings(t, y, rel) if crossings_t_s is None else np.asarray(crossings_t_s, float)
     if tc.size == 0:
         return pd.DataFrame(columns=cols)
@@ -311,8 +336,9 @@ def per_impact_eta(t_s, theta_rad, block=None, release: ReleaseInfo | None = Non
         else:
             wa, na = np.nan, 0
         pb, sb = peaks.theta_rad.iloc[k], peaks.se_theta_rad.iloc[k]
-        pa, sa = ((peaks.theta_rad.iloc[k + 1], peaks.se_theta_rad.iloc[k + 1]) if k + 1 < len(peaks)
-                  else (np.nan, np.nan))
+        pa, sa = (
+            (peaks.theta_rad.iloc[k + 1], peaks.se_theta_rad.iloc[k + 1]) if k + 1 < len(peaks) else (np.nan, np.nan)
+        )
         with np.errstate(invalid="ignore", divide="ignore"):
             if alpha is not None:
                 ub, ua = _u_rise(abs(pb), alpha), _u_rise(abs(pa), alpha)
@@ -354,17 +380,26 @@ class EnergyLoss:
 
     def to_dict(self) -> dict:
         """Plain dict of the fields, JSON-ready (SI units in the keys)."""
-        return dict(mean4=self.mean4, start=self.start, eta_equivalent=self.eta_equivalent, exact=self.exact,
-                    loss=[float(x) for x in self.loss], peaks=self.peaks.to_dict(orient="records"))
+        return dict(
+            mean4=self.mean4,
+            start=self.start,
+            eta_equivalent=self.eta_equivalent,
+            exact=self.exact,
+            loss=[float(x) for x in self.loss],
+            peaks=self.peaks.to_dict(orient="records"),
+        )
 
     def report(self) -> str:
         kind = "exact rise of the centre of mass" if self.exact else "small-angle u ~ |theta|"
         n = min(4, self.loss.size - self.start)
-        return "\n".join([
-            "[[Energy loss per rocking (thesis Eq. 12)]]",
-            f"    mean of {n} consecutive losses from #{self.start}: {100 * self.mean4:.2f} %  ({kind})",
-            f"    equivalent restitution sqrt(1 - loss) = {self.eta_equivalent:.4f}",
-            "    losses: " + ", ".join(f"{100 * x:.1f}%" for x in self.loss[:8])])
+        return "\n".join(
+            [
+                "[[Energy loss per rocking (thesis Eq. 12)]]",
+                f"    mean of {n} consecutive losses from #{self.start}: {100 * self.mean4:.2f} %  ({kind})",
+                f"    equivalent restitution sqrt(1 - loss) = {self.eta_equivalent:.4f}",
+                "    losses: " + ", ".join(f"{100 * x:.1f}%" for x in self.loss[:8]),
+            ]
+        )
 
 
 def energy_loss_from_peaks(t_s, theta_rad, block=None, start: int = 0, n_avg: int = 4) -> EnergyLoss:
@@ -393,10 +428,16 @@ def energy_loss_from_peaks(t_s, theta_rad, block=None, start: int = 0, n_avg: in
         u = np.abs(pk.theta_rad.to_numpy())
     pk = pk.assign(u=u)
     loss = (u[:-1] - u[1:]) / u[:-1]
-    sel = loss[start:start + n_avg]
+    sel = loss[start : start + n_avg]
     if sel.size < n_avg:
         raise InputError(f"start={start}: only {loss.size} peak-to-peak losses in the record; need start + {n_avg}")
     m4 = float(np.mean(sel))
     eq = float(np.sqrt(1 - m4))
-    return EnergyLoss(peaks=pk.reset_index(drop=True), loss=loss, mean4=m4, start=int(start), eta_equivalent=eq,
-                      exact=block is not None)
+    return EnergyLoss(
+        peaks=pk.reset_index(drop=True),
+        loss=loss,
+        mean4=m4,
+        start=int(start),
+        eta_equivalent=eq,
+        exact=block is not None,
+    )

@@ -10,6 +10,10 @@ Sub-packages, one subject each (the paper equations they implement are in each d
 Every public name of the sub-packages is also here.
 """
 
+# first: numba's cache must see the modules a kernel compiles in before any kernel is defined
+from ._numba_cache import install as _install_numba_cache
+
+_install_numba_cache()
 from .column import (
     STATE_NAMES,
     Column,

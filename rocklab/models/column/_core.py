@@ -23,7 +23,6 @@ from numba.extending import register_jitable
 from ._events import impact_model, opening_model
 from ._kernels import active_dofs, base_acc, geometry, kinetic_energy, make_work, pivots
 from ._step import evaluate, locate_closing, nm_step, state_checks
-from .._numba_cache import drop_stale_cache
 
 __all__: list[str] = []
 
@@ -404,6 +403,4 @@ def run_core(
     return nr, ne, ni, status, t_status, k_last
 
 
-# run_core inlines the kernels of these modules (see _numba_cache)
-drop_stale_cache("_core.run_core-*.nbi", ("_kernels.py", "_step.py", "_events.py", "_core.py"), __file__)
 run_core_jit = njit(cache=True)(run_core)

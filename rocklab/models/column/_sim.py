@@ -77,8 +77,11 @@ class Column:
             if not isinstance(b, Block):
                 raise InputError(f"blocks[{i}]={b!r}: must be a rocklab.Block")
         object.__setattr__(self, "blocks", blocks)
-        cut = np.broadcast_to(np.asarray(self.cut_m, float), (len(blocks),)).copy() \
-            if np.ndim(self.cut_m) == 0 else np.asarray(self.cut_m, float)
+        cut = (
+            np.broadcast_to(np.asarray(self.cut_m, float), (len(blocks),)).copy()
+            if np.ndim(self.cut_m) == 0
+            else np.asarray(self.cut_m, float)
+        )
         if cut.shape != (len(blocks),):
             raise InputError(f"cut_m has {cut.size} values for {len(blocks)} joints; give one per joint or one for all")
         for j, c in enumerate(cut):
@@ -92,8 +95,9 @@ class Column:
         object.__setattr__(self, "mu", mu)
 
     @classmethod
-    def uniform(cls, b_m: float, H_m: float, n: int, mass_kg: float | None = None, cut_m: float = 0.0,
-                mu: float = math.inf) -> "Column":
+    def uniform(
+        cls, b_m: float, H_m: float, n: int, mass_kg: float | None = None, cut_m: float = 0.0, mu: float = math.inf
+    ) -> "Column":
         """``n`` equal blocks of width ``b_m`` and total height ``H_m`` (m); ``mass_kg`` per block."""
         if int(n) < 1:
             raise InputError(f"n={n}: number of blocks must be >= 1")
@@ -117,13 +121,17 @@ class Column:
         """Packed parameters ``(n, 5)``: m kg, I_G kg m², h m, h/2 m, pivot half-width m."""
         out = np.empty((self.n, 5))
         for i, b in enumerate(self.blocks):
-            out[i] = (b.mass_kg, (b.alpha_I - 1.0) * b.mass_kg * b.R_m ** 2, b.h_m, b.h_m / 2, 0.0)
+            out[i] = (b.mass_kg, (b.alpha_I - 1.0) * b.mass_kg * b.R_m**2, b.h_m, b.h_m / 2, 0.0)
         out[:, 4] = self.half_width_m
         return out
 
     def to_dict(self) -> dict:
         """Plain dict of the fields, JSON-ready (SI units in the keys)."""
-        return {"blocks": [b.to_dict() for b in self.blocks], "cut_m": [float(x) for x in np.atleast_1d(self.cut_m)], "mu": self.mu}
+        return {
+            "blocks": [b.to_dict() for b in self.blocks],
+            "cut_m": [float(x) for x in np.atleast_1d(self.cut_m)],
+            "mu": self.mu,
+        }
 
 
 @dataclass(frozen=True)
@@ -230,13 +238,18 @@ class ColumnResult:
     def to_dict(self) -> dict:
         """Summary: status, peak rotations per block, configuration changes, impact count."""
         return {
-            "status": self.status, "t_status_s": self.t_status_s, "message": self.message,
+            "status": self.status,
+            "t_status_s": self.t_status_s,
+            "message": self.message,
             "n_blocks": self.column.n,
-            "max_abs_theta_rad": [float(x) for x in (self.max_abs_theta_rad if self.max_abs_theta_rad is not None else ())],
+            "max_abs_theta_rad": [
+                float(x) for x in (self.max_abs_theta_rad if self.max_abs_theta_rad is not None else ())
+            ],
             "n_impacts": int(len(self.impacts)),
             "configurations": [
                 {"t_s": float(r.t_s), "joint": int(r.joint), "state": r.state, "event": r.event}
-                for r in self.configurations.itertuples()],
+                for r in self.configurations.itertuples()
+            ],
             "params": dict(self.params),
             "column": self.column.to_dict(),
         }
@@ -295,8 +308,10 @@ def _stride(output_dt_s, dt_s, n_steps) -> int:
         raise InputError(f"output_dt_s={output_dt_s!r}: must be positive (s), inf, or None for every step")
     k = int(round(odt / dt_s))
     if k < 1 or abs(k * dt_s - odt) > 1e-9 * odt:
-        raise InputError(f"output_dt_s={odt:g}: must be a whole multiple of dt_s={dt_s:g} s "
-                         f"(e.g. {max(k, 1) * dt_s:g}), the events stay exact at any spacing")
+        raise InputError(
+            f"output_dt_s={odt:g}: must be a whole multiple of dt_s={dt_s:g} s "
+            f"(e.g. {max(k, 1) * dt_s:g}), the events stay exact at any spacing"
+        )
     return min(k, n_steps + 1)
 
 
@@ -304,11 +319,82 @@ def _stride(output_dt_s, dt_s, n_steps) -> int:
 COLUMN_BLOCK_STEPS_PER_S = 3e6
 
 
-def simulate_column(column: Column, base: BaseMotion | None = None, *, theta0_rad=None, omega0_rad_s=None,
-                    duration_s: float | None = None, dt_s: float = 1e-4, n_impacts: int = 1,
-                    velocity_terms: bool = True, max_enum_closed: int = 9, stop_at_rest: bool = True,
-                    overturn_angle_rad: float | None = None, rest_omega_rad_s: float = 1e-6,
-                    g_m_s2: float = G_STD, output_dt_s: float | None = None, jit: bool = True) -> ColumnResult:
+def _check_cost(n, duration_s, dt_s, n_float, n_rows):
+    """InputError before a column run that would not fit in memory or would take far too long."""
+    from ..._errors import check_memory, check_time
+
+    check_memory(
+        8.0 * n_rows * (4 * n + 4),
+        f"{duration_s:g} s of a {n}-block column at {dt_s:g} s ({n_rows} stored rows)",
+        "shorten duration_s or give a coarser output_dt_s",
+    )
+    check_time(
+        n_float * n / COLUMN_BLOCK_STEPS_PER_S,
+        f"{duration_s:g} s of a {n}-block column at dt = {dt_s:g} s ({n_float:.3g} steps)",
+        "give a coarser dt_s (e.g. 1e-4 s) or a shorter duration_s",
+    )
+
+
+def _event_tables(EVT, EVI, IMP):
+    """The kernel's configuration changes and impacts (rows already cut to their counts) as tables."""
+    import pandas as pd
+
+    conf = pd.DataFrame(
+        {
+            "t_s": EVT,
+            "joint": EVI[:, 0],
+            "state": [STATE_NAMES[int(x)] for x in EVI[:, 1]],
+            "event": [_KIND[int(x)] for x in EVI[:, 2]],
+        }
+    )
+    imp = pd.DataFrame(
+        {
+            "t_s": IMP[:, 0],
+            "joint": IMP[:, 1].astype(int),
+            "omega_before_rad_s": -IMP[:, 2],
+            "ke_before_J": IMP[:, 3],
+            "ke_after_J": IMP[:, 4],
+            "state_after": [STATE_NAMES[int(x)] for x in IMP[:, 5]],
+        }
+    )
+    return conf, imp
+
+
+def _final_status(code, t_st, phi, om, never_moved):
+    """(status, its time s or NaN, message) from the kernel's status code and the last state."""
+    status = _STATUS[code]
+    msg = ""
+    if status == "end":
+        moving = bool(np.any(om[-1] != 0.0)) or bool(np.any(phi[-1] != 0.0))
+        status = "rocking" if moving else ("no_uplift" if never_moved else "rest")
+        t_st = math.nan
+    elif status == "rest" and never_moved:
+        status = "no_uplift"
+    elif status in ("tension", "sliding"):
+        msg = f"terminated at t={t_st:.6g} s: {status} at a joint (the column may disintegrate)"
+    elif status in ("capacity", "numerical"):
+        msg = f"integration failed at t={t_st:.6g} s ({status}); reduce dt_s or check the input"
+    return status, t_st, msg
+
+
+def simulate_column(
+    column: Column,
+    base: BaseMotion | None = None,
+    *,
+    theta0_rad=None,
+    omega0_rad_s=None,
+    duration_s: float | None = None,
+    dt_s: float = 1e-4,
+    n_impacts: int = 1,
+    velocity_terms: bool = True,
+    max_enum_closed: int = 9,
+    stop_at_rest: bool = True,
+    overturn_angle_rad: float | None = None,
+    rest_omega_rad_s: float = 1e-6,
+    g_m_s2: float = G_STD,
+    output_dt_s: float | None = None,
+    jit: bool = True,
+) -> ColumnResult:
     """Simulate a multi-block column under gravity and a horizontal base acceleration.
 
     Parameters
@@ -358,8 +444,6 @@ def simulate_column(column: Column, base: BaseMotion | None = None, *, theta0_ra
     -------
     ColumnResult
     """
-    import pandas as pd
-
     from ._core import run_core, run_core_jit
 
     if not isinstance(column, Column):
@@ -374,15 +458,17 @@ def simulate_column(column: Column, base: BaseMotion | None = None, *, theta0_ra
         duration_s = (float(base.t_s[-1]) + 5.0) if base is not None else 10.0
     if not (math.isfinite(duration_s) and duration_s > 0):
         raise InputError(f"duration_s={duration_s!r}: must be positive (s)")
-    from ..rocking._single import check_step
+    from ..rocking._integrators import check_step
 
     check_step(max(b.p_rad_s for b in column.blocks), dt_s, "dt_s")
     phi0, v0, s0 = _initial_state(column, theta0_rad, omega0_rad_s)
     for j, b in enumerate(column.blocks):  # each joint opens by less than its block's slenderness
         if abs(phi0[j]) >= b.alpha_rad:
-            raise InputError(f"theta0_rad: block {j + 1} starts {abs(phi0[j]):.4g} rad open against the one "
-                             f"below, not < its alpha = {b.alpha_rad:.4g} rad (it would fall at release); "
-                             "give smaller initial angles")
+            raise InputError(
+                f"theta0_rad: block {j + 1} starts {abs(phi0[j]):.4g} rad open against the one "
+                f"below, not < its alpha = {b.alpha_rad:.4g} rad (it would fall at release); "
+                "give smaller initial angles"
+            )
     blk = column.block_array()
     if base is not None:
         accb = np.array(base.acc_m_s2, dtype=float)  # writable: numba types read-only arrays apart
@@ -394,16 +480,10 @@ def simulate_column(column: Column, base: BaseMotion | None = None, *, theta0_ra
     n_steps = int(math.ceil(n_float - 1e-9))
     stride = _stride(output_dt_s, dt_s, n_steps)
     n_rows = n_steps // stride + 2
-    from ..._errors import check_memory
-
-    check_memory(8.0 * n_rows * (4 * column.n + 4), f"{duration_s:g} s of a {column.n}-block column at "
-                 f"{dt_s:g} s ({n_rows} stored rows)", "shorten duration_s or give a coarser output_dt_s")
-    from ..._errors import check_time
-
-    check_time(n_float * n / COLUMN_BLOCK_STEPS_PER_S, f"{duration_s:g} s of a {n}-block column at dt = {dt_s:g} s "
-               f"({n_float:.3g} steps)", "give a coarser dt_s (e.g. 1e-4 s) or a shorter duration_s")
-    par = np.array([g_m_s2, column.mu, t0b, dtb, 1.0 if velocity_terms else 0.0, 1e-14,
-                    _quiet_time(column, base, g_m_s2), 0.0])
+    _check_cost(n, duration_s, dt_s, n_float, n_rows)
+    par = np.array(
+        [g_m_s2, column.mu, t0b, dtb, 1.0 if velocity_terms else 0.0, 1e-14, _quiet_time(column, base, g_m_s2), 0.0]
+    )
     ecap = 20000
     fn = run_core_jit if jit else run_core
     ovt = float(overturn_angle_rad) if overturn_angle_rad else -1.0
@@ -415,42 +495,64 @@ def simulate_column(column: Column, base: BaseMotion | None = None, *, theta0_ra
         EVT = np.empty(ecap)
         EVI = np.empty((ecap, 3), np.int64)
         IMP = np.empty((ecap, 6))
-        nr, ne, ni, st, t_st, k_last = fn(phi0, v0, s0, blk, par, accb, n_steps, float(dt_s),
-                                          int(max_enum_closed), int(n_impacts), float(rest_omega_rad_s),
-                                          bool(stop_at_rest), ovt, stride, PHI, VEL, EN, EVT, EVI, IMP, PEAK)
+        nr, ne, ni, st, t_st, k_last = fn(
+            phi0,
+            v0,
+            s0,
+            blk,
+            par,
+            accb,
+            n_steps,
+            float(dt_s),
+            int(max_enum_closed),
+            int(n_impacts),
+            float(rest_omega_rad_s),
+            bool(stop_at_rest),
+            ovt,
+            stride,
+            PHI,
+            VEL,
+            EN,
+            EVT,
+            EVI,
+            IMP,
+            PEAK,
+        )
         if st != 5 or ecap >= 5_000_000:
             break
         ecap *= 10
-    status = _STATUS[int(st)]
     phi = -PHI[:nr]
     om = -VEL[:nr]
-    conf = pd.DataFrame({"t_s": EVT[:ne], "joint": EVI[:ne, 0],
-                         "state": [STATE_NAMES[int(x)] for x in EVI[:ne, 1]],
-                         "event": [_KIND[int(x)] for x in EVI[:ne, 2]]})
-    imp = pd.DataFrame({"t_s": IMP[:ni, 0], "joint": IMP[:ni, 1].astype(int),
-                        "omega_before_rad_s": -IMP[:ni, 2], "ke_before_J": IMP[:ni, 3],
-                        "ke_after_J": IMP[:ni, 4],
-                        "state_after": [STATE_NAMES[int(x)] for x in IMP[:ni, 5]]})
-    never_moved = ne == 0
-    msg = ""
-    if status == "end":
-        moving = bool(np.any(om[-1] != 0.0)) or bool(np.any(phi[-1] != 0.0))
-        status = "rocking" if moving else ("no_uplift" if never_moved else "rest")
-        t_st = math.nan
-    elif status == "rest" and never_moved:
-        status = "no_uplift"
-    elif status in ("tension", "sliding"):
-        msg = f"terminated at t={t_st:.6g} s: {status} at a joint (the column may disintegrate)"
-    elif status in ("capacity", "numerical"):
-        msg = f"integration failed at t={t_st:.6g} s ({status}); reduce dt_s or check the input"
-    params = dict(dt_s=dt_s, output_dt_s=float(dt_s if output_dt_s is None else output_dt_s),
-                  duration_s=float(duration_s), n_impacts=int(n_impacts),
-                  velocity_terms=bool(velocity_terms), max_enum_closed=int(max_enum_closed),
-                  overturn_angle_rad=overturn_angle_rad, g_m_s2=g_m_s2, rest_omega_rad_s=rest_omega_rad_s,
-                  base=None if base is None else base.name)
+    conf, imp = _event_tables(EVT[:ne], EVI[:ne], IMP[:ni])
+    status, t_st, msg = _final_status(int(st), t_st, phi, om, ne == 0)
+    params = dict(
+        dt_s=dt_s,
+        output_dt_s=float(dt_s if output_dt_s is None else output_dt_s),
+        duration_s=float(duration_s),
+        n_impacts=int(n_impacts),
+        velocity_terms=bool(velocity_terms),
+        max_enum_closed=int(max_enum_closed),
+        overturn_angle_rad=overturn_angle_rad,
+        g_m_s2=g_m_s2,
+        rest_omega_rad_s=rest_omega_rad_s,
+        base=None if base is None else base.name,
+    )
     t = (np.arange(nr) * stride) * dt_s  # the full history's k * dt_s, bit for bit
-    t[nr - 1:] = k_last * dt_s
-    return ColumnResult(column=column, t_s=t, phi_rad=phi, omega_rad_s=om,
-                        theta_rad=np.cumsum(phi, axis=1), energy_J=EN[:nr].sum(axis=1), kinetic_J=EN[:nr, 0].copy(),
-                        configurations=conf, impacts=imp, status=status, t_status_s=float(t_st), message=msg,
-                        params=params, max_abs_theta_rad=PEAK[0].copy(), max_abs_phi_rad=PEAK[1].copy())
+    t[nr - 1 :] = k_last * dt_s
+    return ColumnResult(
+        column=column,
+        t_s=t,
+        phi_rad=phi,
+        omega_rad_s=om,
+        theta_rad=np.cumsum(phi, axis=1),
+        energy_J=EN[:nr].sum(axis=1),
+        kinetic_J=EN[:nr, 0].copy(),
+        configurations=conf,
+        impacts=imp,
+        status=status,
+        t_status_s=float(t_st),
+        message=msg,
+        params=params,
+        max_abs_theta_rad=PEAK[0].copy(),
+        max_abs_phi_rad=PEAK[1].copy(),
+    )

@@ -3,10 +3,12 @@
 Čeh et al. (2018) Eq. 1-4 (motion), Eq. 5-11 (Newmark trapezoidal steps with exact contact),
 Eq. 13-14 (Housner's and the modified restitution); thesis §3.1 and App. A (impacts at
 arbitrary axes, consecutive "bump" impacts). :func:`simulate` runs one block (numba Newmark
-kernel, or scipy's DOP853 with impact events as the reference); :func:`simulate_batch` many.
+kernel, Taylor series, or scipy's DOP853 with impact events as the reference: the integrators
+of :data:`METHODS`, one contract, :class:`Integrator`); :func:`simulate_batch` many.
 """
 
 from ._batch import free_rocking_overturns, simulate_batch
+from ._integrators import METHODS, Event, Integrator, Newmark, RockingProblem, Taylor
 from ._restitution import (
     RESTITUTION_LAWS,
     Restitution,
@@ -16,11 +18,18 @@ from ._restitution import (
     eta_modified,
     make_restitution,
 )
-from ._result import BatchResult, RockingResult, block_energy
+from ._result import BatchResult, KernelResult, RockingResult, block_energy
 from ._single import simulate
 
 __all__ = [
     "simulate",
+    "METHODS",
+    "Integrator",
+    "RockingProblem",
+    "KernelResult",
+    "Newmark",
+    "Taylor",
+    "Event",
     "simulate_batch",
     "free_rocking_overturns",
     "RockingResult",

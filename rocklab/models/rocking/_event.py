@@ -15,6 +15,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from ...blocks import G
+from ._result import KernelResult, block_energy
 
 __all__ = ["run_event"]
 
@@ -41,6 +42,49 @@ def _next_uplift(t_now, rec_t, rec_a, thr, t_stop):
     return float(t0 + min(max(fr, 0.0), 1.0) * (rec_t[k] - t0))
 
 
+def _phase(t, th, w, s, duration_s, ug, p2, alpha, linearized, fall_rad, ode_method, rtol, atol, max_step):
+    """One rocking phase about corner ``s`` from (t s, th rad, w rad/s): ``solve_ivp`` with dense output.
+
+    Events: 0 contact (theta = 0 towards the other side, terminal), 1 |theta| = alpha outward,
+    2 |theta| = fall_rad outward (terminal); ``ug(t)`` is the base acceleration / g.
+    """
+
+    def rhs(tt, y):
+        if linearized:
+            return [y[1], p2 * (y[0] - alpha * s) - p2 * ug(tt)]
+        c = alpha * s - y[0]
+        return [y[1], -p2 * (math.sin(c) + ug(tt) * math.cos(c))]
+
+    def contact(tt, y):
+        return y[0]
+
+    contact.terminal = True
+    contact.direction = -s
+
+    def over(tt, y):
+        return y[0] - s * alpha
+
+    over.direction = s
+
+    def fall(tt, y):
+        return y[0] - s * fall_rad
+
+    fall.terminal = True
+    fall.direction = s
+
+    return solve_ivp(
+        rhs,
+        (t, duration_s),
+        [th, w],
+        method=ode_method,
+        rtol=rtol,
+        atol=atol,
+        events=[contact, over, fall],
+        dense_output=True,
+        max_step=max_step,
+    )
+
+
 def run_event(
     block,
     theta0,
@@ -56,10 +100,12 @@ def run_event(
     atol=1e-13,
     ode_method="DOP853",
     fall_rad=0.5 * math.pi,
-):
-    """Event-driven integration; returns a dict like the Newmark kernel's output.
+    max_impacts=100_000,
+) -> KernelResult:
+    """Event-driven integration on the output times ``t_out`` (n,) s; samples after a stop are dropped.
 
-    ``t_out`` (n,) are the output times (s); samples after a stop are dropped.
+    Returns the :class:`~rocklab.models.rocking.KernelResult` of every integrator (energy from
+    :func:`~rocklab.models.block_energy`, the first ``max_impacts`` impacts in the table).
     """
     alpha, p = block.alpha_rad, block.p_rad_s
     p2 = p * p
@@ -81,7 +127,7 @@ def run_event(
 
     th_out = np.full(t_out.shape, np.nan)
     w_out = np.full(t_out.shape, np.nan)
-    imps = []
+    imps: list[tuple[float, float, float, float]] = []
     t, th, w = 0.0, float(theta0), float(omega0)
     resting = th == 0.0 and w == 0.0
     s = 1.0 if (th > 0 or (th == 0 and w > 0)) else -1.0
@@ -110,40 +156,7 @@ def run_event(
             resting = False
             ever_moved = True
 
-        def rhs(tt, y, s=s):
-            if linearized:
-                return [y[1], p2 * (y[0] - alpha * s) - p2 * ug(tt)]
-            c = alpha * s - y[0]
-            return [y[1], -p2 * (math.sin(c) + ug(tt) * math.cos(c))]
-
-        def contact(tt, y):
-            return y[0]
-
-        contact.terminal = True
-        contact.direction = -s
-
-        def over(tt, y, s=s):
-            return y[0] - s * alpha
-
-        over.direction = s
-
-        def fall(tt, y, s=s):
-            return y[0] - s * fall_rad
-
-        fall.terminal = True
-        fall.direction = s
-
-        sol = solve_ivp(
-            rhs,
-            (t, duration_s),
-            [th, w],
-            method=ode_method,
-            rtol=rtol,
-            atol=atol,
-            events=[contact, over, fall],
-            dense_output=True,
-            max_step=max_step,
-        )
+        sol = _phase(t, th, w, s, duration_s, ug, p2, alpha, linearized, fall_rad, ode_method, rtol, atol, max_step)
         t_b = float(sol.t[-1])
         m = (t_out >= t - 1e-12) & (t_out <= t_b)
         if m.any():
@@ -177,13 +190,7 @@ def run_event(
         status = "rocking"
         break
     keep = t_out <= t_end + 1e-12
-    return dict(
-        t=t_out[keep],
-        theta=th_out[keep],
-        omega=w_out[keep],
-        impacts=imps,
-        status=status,
-        t_over=t_over,
-        t_fall=t_fall,
-        max_abs=max_abs,
-    )
+    th_k, w_k = th_out[keep], w_out[keep]
+    imp = np.ascontiguousarray(np.array(imps, float).reshape(-1, 4).T[:, :max_impacts])
+    E = block_energy(block, th_k, w_k, linearized)
+    return KernelResult(t_out[keep], th_k, w_k, E, imp, len(imps), status, t_over, t_fall, max_abs)

@@ -20,10 +20,10 @@ restitution law gives omega+ and the rest of the step continues with the other
 equation (several impacts per step are allowed).
 
 Free rocking (full equation, no base record or past its end) runs its steps
-between impacts in the lean loop :func:`~rocklab.models.rocking._newmark_free.free_steps`
+between impacts in the lean loop :func:`~rocklab.models.rocking._newmark_lean.free_steps`
 (same trapezoidal step, solved by a jerk-corrected predictor and a checked
-fixed-point update), rocking under the record in its twin
-:func:`~rocklab.models.rocking._newmark_forced.forced_steps`, and steps at rest in which
+fixed-point update), rocking under the record in the same loop with the base term,
+:func:`~rocklab.models.rocking._newmark_lean.forced_steps`, and steps at rest in which
 the base stays below the uplift level in a short scan; impacts, uplift,
 overturning and anything else the lean loops decline are handled by the
 general step here (``lean=False``: every step, the reference in the tests).
@@ -43,14 +43,7 @@ from numba import njit, prange
 
 from ...blocks import G
 from ._newmark_contact import contact_tau, cross_fraction, restitution_at, store_impact
-from ._newmark_forced import forced_steps
-from ._newmark_free import free_steps, sdcd
-from .._numba_cache import drop_stale_cache
-
-
-# run_block compiles in the kernels of _newmark_free, _newmark_forced and _newmark_contact (see _numba_cache)
-drop_stale_cache("_newmark.*.nbi", ("_newmark_free.py", "_newmark_forced.py", "_newmark_contact.py",
-                                    "_newmark.py"), __file__)
+from ._newmark_lean import forced_steps, free_steps, sdcd
 
 #: Status codes returned by the kernel.
 ROCKING, REST, OVERTURNED, NO_UPLIFT = 0, 1, 2, 3
@@ -154,9 +147,31 @@ def _energy(th, w, cc, cos_a, p2, alpha, lin):
 
 
 @njit(cache=True, fastmath={"contract"})
-def run_block(p, alpha, theta0, omega0, h, n_steps, acc, acc_t0, acc_dt, scale,
-              eta_mode, eta_x, eta_y, lin, rest_w2, t_last_uplift, stop_at_rest,
-              out_every, imp_cap, fall_rad=_HALF_PI, stop_on_fall=True, e_scale=1.0, lean=True):
+def run_block(
+    p,
+    alpha,
+    theta0,
+    omega0,
+    h,
+    n_steps,
+    acc,
+    acc_t0,
+    acc_dt,
+    scale,
+    eta_mode,
+    eta_x,
+    eta_y,
+    lin,
+    rest_w2,
+    t_last_uplift,
+    stop_at_rest,
+    out_every,
+    imp_cap,
+    fall_rad=_HALF_PI,
+    stop_on_fall=True,
+    e_scale=1.0,
+    lean=True,
+):
     """Integrate one block for n_steps steps of h (s).
 
     Returns
@@ -223,10 +238,10 @@ def run_block(p, alpha, theta0, omega0, h, n_steps, acc, acc_t0, acc_dt, scale,
     countdown = out_every  # output every out_every steps (no integer modulo in the hot loop)
     t_end = 0.0
     # free rocking (full equation, no base record or past its end: ug = 0 exactly) runs
-    # in the lean loop of _newmark_free; anything else (impact in the step,
+    # in the lean loop free_steps; anything else (impact in the step,
     # |theta| >= alpha, rest) is left to the general step below, which takes that
     # step from the same state. One sample of margin keeps _ug_at's rounding out.
-    # Under the record the same holds for _newmark_forced (steps ending inside the record;
+    # Under the record the same holds for forced_steps (steps ending inside the record;
     # its fixed-point update needs the contraction L = p^2 (1 + max|ug|) h^2 / 4 small).
     t_free = acc_t0 + acc.shape[0] * acc_dt if acc.shape[0] > 0 else -np.inf
     lip = 1.0
@@ -237,12 +252,60 @@ def run_block(p, alpha, theta0, omega0, h, n_steps, acc, acc_t0, acc_dt, scale,
         if lean and not lin and not resting and abs(th) < alpha:
             if step * h > t_free:
                 th, w, a, sc, cc, step, max_abs, n_out, countdown = free_steps(
-                    th, w, a, sc, cc, s, step, n_steps, h, p2, alpha, cos_a, max_abs, out_th, out_w, out_e,
-                    n_out, countdown, out_every, e_scale)
+                    th,
+                    w,
+                    a,
+                    sc,
+                    cc,
+                    s,
+                    step,
+                    n_steps,
+                    h,
+                    p2,
+                    alpha,
+                    cos_a,
+                    max_abs,
+                    out_th,
+                    out_w,
+                    out_e,
+                    n_out,
+                    countdown,
+                    out_every,
+                    e_scale,
+                    acc,
+                    acc_t0,
+                    inv_dta,
+                    fac,
+                    lip,
+                )
             elif lip < 0.01:
                 th, w, a, sc, cc, step, max_abs, n_out, countdown = forced_steps(
-                    th, w, a, sc, cc, s, step, n_steps, h, p2, alpha, cos_a, max_abs, out_th, out_w, out_e,
-                    n_out, countdown, out_every, e_scale, acc, acc_t0, inv_dta, fac, lip)
+                    th,
+                    w,
+                    a,
+                    sc,
+                    cc,
+                    s,
+                    step,
+                    n_steps,
+                    h,
+                    p2,
+                    alpha,
+                    cos_a,
+                    max_abs,
+                    out_th,
+                    out_w,
+                    out_e,
+                    n_out,
+                    countdown,
+                    out_every,
+                    e_scale,
+                    acc,
+                    acc_t0,
+                    inv_dta,
+                    fac,
+                    lip,
+                )
                 u_prev = _ug_at(step * h, acc, acc_t0, inv_dta, fac)
             t_end = step * h
             if step >= n_steps:
@@ -304,8 +367,9 @@ def run_block(p, alpha, theta0, omega0, h, n_steps, acc, acc_t0, acc_dt, scale,
                 rem = h  # a full step: reuse the constants
                 th1, w1, a1, sc1, cc1 = _newmark(th, w, a, s, h, c1h, c4h, u1, p2, alpha, lin, sc, cc)
             else:
-                th1, w1, a1, sc1, cc1 = _newmark(th, w, a, s, rem, 4.0 / (rem * rem), 4.0 / rem, u1, p2,
-                                                 alpha, lin, sc, cc)
+                th1, w1, a1, sc1, cc1 = _newmark(
+                    th, w, a, s, rem, 4.0 / (rem * rem), 4.0 / rem, u1, p2, alpha, lin, sc, cc
+                )
             if th1 * s > 0.0 or (th1 == 0.0 and w1 * s > 0.0):
                 th, w, a, sc, cc = th1, w1, a1, sc1, cc1
                 tc = t1
@@ -388,13 +452,47 @@ def run_block(p, alpha, theta0, omega0, h, n_steps, acc, acc_t0, acc_dt, scale,
             status = REST if ever_moved else NO_UPLIFT
         else:
             status = ROCKING
-    return (out_th[:n_out], out_w[:n_out], out_e[:n_out], n_out, imp[:, :min(n_imp, imp_cap)], n_imp, status,
-            t_over, t_fall, max_abs, t_end, th, w)
+    return (
+        out_th[:n_out],
+        out_w[:n_out],
+        out_e[:n_out],
+        n_out,
+        imp[:, : min(n_imp, imp_cap)],
+        n_imp,
+        status,
+        t_over,
+        t_fall,
+        max_abs,
+        t_end,
+        th,
+        w,
+    )
 
 
 @njit(cache=True)
-def run_single(p, alpha, theta0, omega0, h, n_steps, acc, acc_t0, acc_dt, eta_mode, eta_x, eta_y, lin,
-               rest_w2, t_last_uplift, stop_at_rest, out_every, imp_cap, fall_rad, e_scale, lean=True):
+def run_single(
+    p,
+    alpha,
+    theta0,
+    omega0,
+    h,
+    n_steps,
+    acc,
+    acc_t0,
+    acc_dt,
+    eta_mode,
+    eta_x,
+    eta_y,
+    lin,
+    rest_w2,
+    t_last_uplift,
+    stop_at_rest,
+    out_every,
+    imp_cap,
+    fall_rad,
+    e_scale,
+    lean=True,
+):
     """:func:`run_block` for ``simulate``: output times and a contiguous impact table in the same call.
 
     Returns ``t, theta, omega, energy`` (n_out,; energy times ``e_scale``),
@@ -405,8 +503,30 @@ def run_single(p, alpha, theta0, omega0, h, n_steps, acc, acc_t0, acc_dt, eta_mo
     # writeable law tables and typed (non-literal) flags: the same run_block signature as
     # run_batch's, so the kernel compiles once for both (a second specialisation: ~15 CPU-s cold)
     th, w, e, n_out, imp, n_imp, st, t_over, t_fall, max_abs, t_end, _, _ = run_block(
-        p, alpha, theta0, omega0, h, n_steps, acc, acc_t0, acc_dt, 1.0, eta_mode, eta_x.copy(), eta_y.copy(), lin,
-        rest_w2, t_last_uplift, stop_at_rest, out_every, imp_cap, fall_rad, np.bool_(True), e_scale, np.bool_(lean))
+        p,
+        alpha,
+        theta0,
+        omega0,
+        h,
+        n_steps,
+        acc,
+        acc_t0,
+        acc_dt,
+        1.0,
+        eta_mode,
+        eta_x.copy(),
+        eta_y.copy(),
+        lin,
+        rest_w2,
+        t_last_uplift,
+        stop_at_rest,
+        out_every,
+        imp_cap,
+        fall_rad,
+        np.bool_(True),
+        e_scale,
+        np.bool_(lean),
+    )
     t = np.empty(n_out)
     dto = h * out_every
     for i in range(n_out):
@@ -424,8 +544,7 @@ def _last_over(acc, t0, dta, thr):
 
 
 @njit(cache=True, parallel=True)
-def run_batch(p, alpha, th0, w0, eta, h, n_steps, acc, acc_t0, acc_dt, scale, rest_tol, fall_rad,
-              stop_on_fall):
+def run_batch(p, alpha, th0, w0, eta, h, n_steps, acc, acc_t0, acc_dt, scale, rest_tol, fall_rad, stop_on_fall):
     """m independent blocks in parallel (summaries only); see ``simulate_batch``.
 
     Lives in this module so that numba's on-disk cache of this caller is
@@ -455,8 +574,31 @@ def run_batch(p, alpha, th0, w0, eta, h, n_steps, acc, acc_t0, acc_dt, scale, re
         ey = np.empty(1)
         ey[0] = eta[i]
         fr = fall_rad[i]
-        r = run_block(p[i], a, th0[i], w0[i], h[i], n_steps[i], acc, acc_t0, acc_dt, scale[i],
-                      zero, ex, ey, no, rest_w2, t_last, yes, zero, zero, fr, stop_on_fall, 1.0, yes)
+        r = run_block(
+            p[i],
+            a,
+            th0[i],
+            w0[i],
+            h[i],
+            n_steps[i],
+            acc,
+            acc_t0,
+            acc_dt,
+            scale[i],
+            zero,
+            ex,
+            ey,
+            no,
+            rest_w2,
+            t_last,
+            yes,
+            zero,
+            zero,
+            fr,
+            stop_on_fall,
+            1.0,
+            yes,
+        )
         nimp[i] = r[5]
         status[i] = r[6]
         t_over[i] = r[7]

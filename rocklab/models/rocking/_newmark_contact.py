@@ -5,8 +5,7 @@
 step); :func:`cross_fraction` is where the cubic Hermite of a step reaches a
 given |theta| (overturning and fall times); :func:`restitution_at` and
 :func:`store_impact` apply the restitution law and fill the impact table. Used by
-:func:`~rocklab.models.rocking._newmark.run_block`, which drops its on-disk numba cache
-when this file is newer (numba only tracks the caller's file).
+:func:`~rocklab.models.rocking._newmark.run_block` and the Taylor kernel.
 """
 
 from __future__ import annotations

@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 from functools import cached_property
+from typing import NamedTuple
 
 import numpy as np
 
@@ -14,7 +15,7 @@ if TYPE_CHECKING:
     from ...blocks import Block
     from ._restitution import Restitution
 
-__all__ = ["RockingResult", "BatchResult", "block_energy"]
+__all__ = ["RockingResult", "BatchResult", "KernelResult", "block_energy"]
 
 
 def block_energy(block, theta_rad, omega_rad_s, linearized: bool = False) -> np.ndarray:
@@ -34,6 +35,28 @@ def block_energy(block, theta_rad, omega_rad_s, linearized: bool = False) -> np.
     from ...blocks import G
 
     return 0.5 * I_O * w * w + block.mass_kg * G * block.R_m * (np.cos(a - th) - math.cos(a))
+
+
+class KernelResult(NamedTuple):
+    """What every integrator returns.
+
+    ``t_s, theta_rad, omega_rad_s, energy_J`` (n,): the output grid, rotation (rad),
+    angular velocity (rad/s) and energy above rest (J); ``impacts`` (4, k) C-contiguous rows
+    t_s, omega_before, omega_after, eta of the first ``max_impacts`` impacts; ``n_impacts``
+    (all of them); ``status`` (``rocking``, ``rest``, ``overturned``, ``no_uplift``);
+    ``overturn_t_s``, ``fall_t_s`` (s, NaN if not reached); ``max_abs_theta_rad``.
+    """
+
+    t_s: np.ndarray
+    theta_rad: np.ndarray
+    omega_rad_s: np.ndarray
+    energy_J: np.ndarray
+    impacts: np.ndarray
+    n_impacts: int
+    status: str
+    overturn_t_s: float
+    fall_t_s: float
+    max_abs_theta_rad: float
 
 
 @dataclass(frozen=True)

@@ -7,7 +7,7 @@ with p = sqrt(m g R / I_O) (any alpha_I). A block at rest uplifts only when
 under it). Everything is SI; the base motion is a
 :class:`~rocklab.models.BaseMotion` in m/s^2.
 
-Rules (both integrators):
+Rules (every integrator of :data:`~rocklab.models.rocking.METHODS`):
 
 - **impact** at theta = 0: ``omega+ = eta * omega-`` from the restitution law;
   omega+ decides the new corner (eta < 0: bounce back onto the same corner).
@@ -31,16 +31,12 @@ import math
 import numpy as np
 
 from ..._errors import InputError, check_memory, check_time
-from ...blocks import G
-from ._newmark import STATUS_NAMES, run_single
 from ...series import BaseMotion
+from ._integrators import RockingProblem, integrator
 from ._restitution import make_restitution
 from ._result import RockingResult, block_energy
 
 __all__ = ["simulate"]
-
-_EMPTY = np.zeros(0)
-_EMPTY.setflags(write=False)  # same numba type as a (read-only) BaseMotion array: one compile
 
 
 def _finite(name, v, positive=False):
@@ -80,50 +76,96 @@ def _law(restitution, block, law_params):
     return law
 
 
-def _base_arrays(base):
-    """(acc m/s^2, t0, dt, t_last_uplift-ready arrays) for the kernel."""
-    if base is None:
-        return _EMPTY, 0.0, 1.0
-    if not isinstance(base, BaseMotion):
+#: Speed of the compiled single-block loop used for the time estimate, steps/s (measured on one core).
+SINGLE_STEPS_PER_S = 3e7
+
+
+def _problem(
+    block,
+    theta0_rad,
+    omega0_rad_s,
+    duration_s,
+    dt_s,
+    restitution,
+    base,
+    stop_at_rest,
+    output_dt_s,
+    linearized,
+    rest_tol,
+    max_impacts,
+    rtol,
+    ode_method,
+    fall_rad,
+    law_params,
+) -> RockingProblem:
+    """``simulate``'s arguments checked (InputError naming the parameter) into a :class:`RockingProblem`."""
+    alpha = block.alpha_rad
+    th0 = _finite("theta0_rad", theta0_rad)
+    w0 = _finite("omega0_rad_s", omega0_rad_s)
+    T = _finite("duration_s", duration_s, positive=True)
+    dt = _finite("dt_s", dt_s, positive=True)
+    rest_tol = _finite("rest_tol", rest_tol, positive=True)
+    if abs(th0) >= alpha:
+        raise InputError(
+            f"theta0_rad={th0}: |theta0| must be < alpha = {alpha:.6g} rad "
+            "(the block would fall at release); give a smaller initial rotation"
+        )
+    if dt > T:
+        raise InputError(f"dt_s={dt}: time step longer than duration_s={T}; use a smaller dt")
+    fall = 0.5 * math.pi if fall_rad is None else _finite("fall_rad", fall_rad, positive=True)
+    if not (alpha <= fall <= 0.5 * math.pi):
+        raise InputError(f"fall_rad={fall}: must be between alpha = {alpha:.6g} and pi/2 rad")
+    law = _law(restitution, block, law_params)
+    if base is not None and not isinstance(base, BaseMotion):
         raise InputError(
             f"base={type(base).__name__}: give a rocklab.models.BaseMotion "
             "(e.g. BaseMotion.from_samples(acc, dt_s, 'g')) or None"
         )
-    return np.ascontiguousarray(base.acc_m_s2, float), float(base.t_s[0]), base.dt_s
+    every, resample = 1, None
+    if output_dt_s is not None:
+        odt = _finite("output_dt_s", output_dt_s, positive=True)
+        if odt < dt:
+            raise InputError(f"output_dt_s={odt}: must be >= dt_s={dt}")
+        if odt > T:
+            raise InputError(f"output_dt_s={odt}: longer than duration_s={T}; give a spacing <= the duration")
+        k = int(round(odt / dt))
+        if abs(k * dt - odt) <= 1e-9 * odt:
+            every = k
+        else:
+            resample = odt  # e.g. a camera frame rate: store every step, then Hermite (RockingResult.at)
+    return RockingProblem(
+        block,
+        th0,
+        w0,
+        T,
+        dt,
+        law,
+        base,
+        bool(linearized),
+        rest_tol,
+        bool(stop_at_rest),
+        every,
+        resample,
+        int(max_impacts),
+        fall,
+        rtol,
+        ode_method,
+    )
 
 
-def _last_uplift_t(base, alpha, scale=1.0):
-    if base is None:
-        return -np.inf
-    over = np.abs(base.acc_m_s2 * scale) > G * math.tan(alpha)
-    return float(base.t_s[np.flatnonzero(over)[-1]]) if over.any() else -np.inf
-
-
-#: Largest p*dt the Newmark step may take: beyond it the step cannot follow a rocking half-cycle
-#: (about 1/p long) and the result is meaningless; between P_DT_WARN and it, amplitudes and impact
-#: times are not converged (W-SIM-DT).
-P_DT_MAX = 0.1
-#: Speed of the compiled single-block loop used for the time estimate, steps/s (measured on one core).
-SINGLE_STEPS_PER_S = 3e7
-P_DT_WARN = 0.01
-
-
-def check_step(p_rad_s: float, dt_s: float, option: str = "dt_s") -> None:
-    """:class:`InputError` when ``p dt`` > :data:`P_DT_MAX`; warning ``W-SIM-DT`` above :data:`P_DT_WARN`."""
-    pdt = p_rad_s * dt_s
-    if pdt > P_DT_MAX:
-        raise InputError(
-            f"{option}={dt_s:g} s: too coarse for this block (p = {p_rad_s:.4g} rad/s, p dt = "
-            f"{pdt:.4g} > {P_DT_MAX}); use dt <= {P_DT_WARN / p_rad_s:.4g} s"
-        )
-    if pdt > P_DT_WARN:
-        from ..._diagnostics import warn
-
-        warn(
-            "W-SIM-DT",
-            f"{option}={dt_s:g} s gives p dt = {pdt:.4g} (> {P_DT_WARN}) for p = {p_rad_s:.4g} "
-            f"rad/s; use dt <= {P_DT_WARN / p_rad_s:.4g} s for converged impacts",
-        )
+def _check_cost(problem: RockingProblem) -> None:
+    """InputError before a run that would not fit in memory or would take far too long."""
+    T, dt, every, n_steps = problem.duration_s, problem.dt_s, problem.output_every, problem.n_steps
+    check_memory(
+        40.0 * n_steps / every,
+        f"{T:g} s at dt = {dt:g} s ({n_steps} steps stored every {every})",
+        "shorten duration_s or give a coarser output_dt_s",
+    )
+    check_time(
+        T / dt / SINGLE_STEPS_PER_S,
+        f"{T:g} s at dt = {dt:g} s ({T / dt:.3g} steps)",
+        "give a coarser dt_s (e.g. 1e-4 s) or a shorter duration_s",
+    )
 
 
 def simulate(
@@ -169,12 +211,14 @@ def simulate(
     base : BaseMotion, optional
         Horizontal base acceleration (m/s^2), linearly interpolated onto the
         steps, zero outside the record. None: free rocking.
-    method : {"newmark", "taylor", "event"}
-        Numba Newmark kernel with exact contact (fast; ``dt_s`` sets its accuracy),
-        Taylor series of order 12 between exact impacts (free rocking of the full
-        equation only; ``p h <= 0.2`` steps, impact times to ~1e-10 s;
-        ``dt_s`` or ``output_dt_s`` is only the output grid), or scipy ``solve_ivp``
-        DOP853 with impact events (reference, ``rtol``).
+    method : {"newmark", "taylor", "event"} or Integrator
+        A key of :data:`~rocklab.models.rocking.METHODS`: numba Newmark kernel with
+        exact contact (fast; ``dt_s`` sets its accuracy), Taylor series of order 12
+        between exact impacts (free rocking of the full equation only; ``p h <= 0.2``
+        steps, impact times to ~1e-10 s; ``dt_s`` or ``output_dt_s`` is only the
+        output grid), or scipy ``solve_ivp`` DOP853 with impact events (reference,
+        ``rtol``); or an :class:`~rocklab.models.rocking.Integrator` instance (e.g.
+        ``Newmark(lean=False)``).
     stop_at_rest : bool
         Stop the output when the block is at rest for good (see module doc).
     output_dt_s : float, optional
@@ -207,155 +251,57 @@ def simulate(
     Raises
     ------
     InputError
-        |theta0| >= alpha, non-finite or non-positive numbers, unknown law/method.
+        |theta0| >= alpha, non-finite or non-positive numbers, unknown law/method, a
+        problem the method does not integrate (``taylor`` with a base record).
     """
-    alpha = block.alpha_rad
-    th0 = _finite("theta0_rad", theta0_rad)
-    w0 = _finite("omega0_rad_s", omega0_rad_s)
-    T = _finite("duration_s", duration_s, positive=True)
-    dt = _finite("dt_s", dt_s, positive=True)
-    rest_tol = _finite("rest_tol", rest_tol, positive=True)
-    if abs(th0) >= alpha:
-        raise InputError(
-            f"theta0_rad={th0}: |theta0| must be < alpha = {alpha:.6g} rad "
-            "(the block would fall at release); give a smaller initial rotation"
-        )
-    if dt > T:
-        raise InputError(f"dt_s={dt}: time step longer than duration_s={T}; use a smaller dt")
-    fall = 0.5 * math.pi if fall_rad is None else _finite("fall_rad", fall_rad, positive=True)
-    if not (alpha <= fall <= 0.5 * math.pi):
-        raise InputError(f"fall_rad={fall}: must be between alpha = {alpha:.6g} and pi/2 rad")
-    law = _law(restitution, block, law_params)
-    acc, acc_t0, acc_dt = _base_arrays(base)
-    every, resample = 1, None
-    if output_dt_s is not None:
-        odt = _finite("output_dt_s", output_dt_s, positive=True)
-        if odt < dt:
-            raise InputError(f"output_dt_s={odt}: must be >= dt_s={dt}")
-        if odt > T:
-            raise InputError(f"output_dt_s={odt}: longer than duration_s={T}; give a spacing <= the duration")
-        k = int(round(odt / dt))
-        if abs(k * dt - odt) <= 1e-9 * odt:
-            every = k
-        else:
-            resample = odt  # e.g. a camera frame rate: store every step, then Hermite (RockingResult.at)
-    p = block.p_rad_s
-    rest_w2 = 2.0 * p * p * (math.cos(alpha - rest_tol * alpha) - math.cos(alpha))
-    n_steps = int(math.ceil(T / dt - 1e-9))
-    meth = str(method).lower()
-    if meth == "newmark":
-        check_step(p, dt, "dt_s")
-    check_memory(
-        40.0 * n_steps / every,
-        f"{T:g} s at dt = {dt:g} s ({n_steps} steps stored every {every})",
-        "shorten duration_s or give a coarser output_dt_s",
+    meth = integrator(method)
+    problem = _problem(
+        block,
+        theta0_rad,
+        omega0_rad_s,
+        duration_s,
+        dt_s,
+        restitution,
+        base,
+        stop_at_rest,
+        output_dt_s,
+        linearized,
+        rest_tol,
+        max_impacts,
+        rtol,
+        ode_method,
+        fall_rad,
+        law_params,
     )
-    check_time(
-        T / dt / SINGLE_STEPS_PER_S,
-        f"{T:g} s at dt = {dt:g} s ({T / dt:.3g} steps)",
-        "give a coarser dt_s (e.g. 1e-4 s) or a shorter duration_s",
-    )
-    t_last = _last_uplift_t(base, alpha)
-    if meth == "newmark":
-        t, th, w, E, imp_cols, n_imp, st, t_over, t_fall, max_abs = run_single(
-            p,
-            alpha,
-            th0,
-            w0,
-            dt,
-            n_steps,
-            acc,
-            acc_t0,
-            acc_dt,
-            law.mode,
-            law.eta_x,
-            law.eta_y,
-            bool(linearized),
-            rest_w2,
-            t_last,
-            bool(stop_at_rest),
-            every,
-            int(max_impacts),
-            fall,
-            block.I_O_kg_m2,
-        )
-        status = STATUS_NAMES[st]
-    elif meth == "event":
-        from ._event import run_event
-
-        t_grid = np.arange(int(math.floor(T / (dt * every) + 1e-9)) + 1) * (dt * every)
-        r = run_event(
-            block,
-            th0,
-            w0,
-            T,
-            law,
-            base,
-            bool(linearized),
-            rest_tol,
-            bool(stop_at_rest),
-            t_grid,
-            rtol=rtol,
-            ode_method=ode_method,
-            fall_rad=fall,
-        )
-        t, th, w = r["t"], r["theta"], r["omega"]
-        status, t_over, t_fall, max_abs = r["status"], r["t_over"], r["t_fall"], r["max_abs"]
-        n_imp = len(r["impacts"])
-        imp_cols = np.ascontiguousarray(np.array(r["impacts"], float).reshape(-1, 4).T[:, :max_impacts])
-        E = block_energy(block, th, w, linearized)
-    elif meth == "taylor":
-        from ._taylor import run_taylor
-
-        if base is not None or linearized:
-            raise InputError(
-                f"method='taylor' integrates free rocking of the full equation only; "
-                f"{'a base record' if base is not None else 'linearized=True'} needs method='newmark'"
-            )
-        odt = dt * every if resample is None else resample
-        resample = None  # the series is evaluated on the output grid directly
-        t, th, w, E, imp_cols, n_imp, st, t_over, t_fall, max_abs = run_taylor(
-            p,
-            alpha,
-            th0,
-            w0,
-            int(math.floor(T / odt + 1e-9)) + 1,
-            odt,
-            law.mode,
-            law.eta_x,
-            law.eta_y,
-            rest_w2,
-            bool(stop_at_rest),
-            int(max_impacts),
-            fall,
-            block.I_O_kg_m2,
-        )
-        status = STATUS_NAMES[st]
-    else:
-        raise InputError(f"method={method!r}: use 'newmark', 'taylor' or 'event'")
-    for a in (t, th, w, E, imp_cols):
+    meth.check(problem)
+    _check_cost(problem)
+    out = meth.run(problem)
+    # an integrator that samples any grid has sampled the output grid directly
+    resample = None if meth.any_output_grid else problem.resample_dt_s
+    for a in out[:5]:
         a.setflags(write=False)
     res = RockingResult(
-        t_s=t,
-        theta_rad=th,
-        omega_rad_s=w,
-        energy_J=E,
-        impacts_array=imp_cols,
-        status=status,
-        overturned=status == "overturned",
-        overturn_t_s=float(t_over),
-        fall_t_s=float(t_fall),
-        max_abs_theta_rad=float(max_abs),
+        t_s=out.t_s,
+        theta_rad=out.theta_rad,
+        omega_rad_s=out.omega_rad_s,
+        energy_J=out.energy_J,
+        impacts_array=out.impacts,
+        status=out.status,
+        overturned=out.status == "overturned",
+        overturn_t_s=float(out.overturn_t_s),
+        fall_t_s=float(out.fall_t_s),
+        max_abs_theta_rad=float(out.max_abs_theta_rad),
         block=block,
-        restitution=law,
-        method=meth,
-        dt_s=dt,
-        n_impacts=int(n_imp),
+        restitution=problem.law,
+        method=meth.name,
+        dt_s=problem.dt_s,
+        n_impacts=int(out.n_impacts),
         linearized=bool(linearized),
         base_name=base.name if base is not None else "",
     )
     if resample is None:
         return res
+    t = out.t_s
     t2 = np.arange(int(math.floor(t[-1] / resample + 1e-9)) + 1) * resample
     th2, w2 = res.at(t2)
     E2 = block_energy(block, th2, w2, linearized)

@@ -30,11 +30,7 @@ import math
 import numpy as np
 from numba import njit
 
-from .._numba_cache import drop_stale_cache
 from ._newmark_contact import restitution_at, store_impact
-
-# run_taylor compiles in the impact helpers of _newmark_contact (see _numba_cache)
-drop_stale_cache("_taylor.*.nbi", ("_newmark_contact.py", "_taylor.py"), __file__)
 
 __all__ = ["run_taylor", "ORDER", "P_H"]
 

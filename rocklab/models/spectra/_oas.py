@@ -62,13 +62,31 @@ from ..rocking._batch import free_rocking_overturns, simulate_batch
 from ._oas_grid import adaptive_verdicts, boundary_verdicts
 from ...series import BaseMotion
 
-__all__ = ["OASResult", "overturning_spectrum", "normalised_critical_impulse", "critical_impulse",
-           "fit_inclined_line", "simplified_oas", "OAS_DEFAULTS"]
+__all__ = [
+    "OASResult",
+    "overturning_spectrum",
+    "normalised_critical_impulse",
+    "critical_impulse",
+    "fit_inclined_line",
+    "simplified_oas",
+    "OAS_DEFAULTS",
+]
 
 #: Defaults of :func:`overturning_spectrum` (thesis §5.3: 80 levels 1..10, 120 sizes 1000..0.1 m).
-OAS_DEFAULTS = dict(levels=80, level_max=10.0, sizes=120, R_max_m=1000.0, R_min_m=0.1, refine=10,
-                    criterion="angle", free="energy", search="scan", alpha_I=4.0 / 3.0, eta=None,
-                    max_p_dt=0.001)
+OAS_DEFAULTS = dict(
+    levels=80,
+    level_max=10.0,
+    sizes=120,
+    R_max_m=1000.0,
+    R_min_m=0.1,
+    refine=10,
+    criterion="angle",
+    free="energy",
+    search="scan",
+    alpha_I=4.0 / 3.0,
+    eta=None,
+    max_p_dt=0.001,
+)
 
 _CRIT = {"angle": 0, "fall": 1}
 _GOLDEN = 0.5 * (math.sqrt(5.0) - 1.0)
@@ -161,8 +179,14 @@ class OASResult:
         """Boundary per level: ``level, p_min_rad_s, R_unsafe_max_m, f_rad_s``."""
         import pandas as pd
 
-        return pd.DataFrame({"level": self.levels, "p_min_rad_s": self.p_min_rad_s,
-                             "R_unsafe_max_m": self.R_unsafe_max_m, "f_rad_s": self.f_rad_s})
+        return pd.DataFrame(
+            {
+                "level": self.levels,
+                "p_min_rad_s": self.p_min_rad_s,
+                "R_unsafe_max_m": self.R_unsafe_max_m,
+                "f_rad_s": self.f_rad_s,
+            }
+        )
 
     @property
     def f_min_at(self) -> tuple[float, float]:
@@ -179,10 +203,21 @@ class OASResult:
     def to_dict(self) -> dict:
         """Scalars and options (JSON-ready; arrays are in :meth:`to_frame`)."""
         lv, R = self.f_min_at
-        return dict(name=self.name, t_I_s=self.t_I_s, t_I_prime_s=self.t_I_prime_s, beta=self.beta,
-                    f_min=self.f_min_rad_s, f_min_level=lv, f_min_R_m=R, i_cr=self.i_cr, alpha_rad=self.alpha_rad,
-                    slenderness=1.0 / math.tan(self.alpha_rad), alpha_I=self.alpha_I, eta=self.eta,
-                    options=dict(self.options))
+        return dict(
+            name=self.name,
+            t_I_s=self.t_I_s,
+            t_I_prime_s=self.t_I_prime_s,
+            beta=self.beta,
+            f_min=self.f_min_rad_s,
+            f_min_level=lv,
+            f_min_R_m=R,
+            i_cr=self.i_cr,
+            alpha_rad=self.alpha_rad,
+            slenderness=1.0 / math.tan(self.alpha_rad),
+            alpha_I=self.alpha_I,
+            eta=self.eta,
+            options=dict(self.options),
+        )
 
 
 #: Largest h/b the OAS accepts: alpha = atan(b/h) >= 1 mrad.
@@ -197,26 +232,44 @@ def _check_opts(slenderness, levels, sizes, R_max_m, R_min_m, level_max, alpha_I
     if not (math.isfinite(sl) and sl > 0):
         raise InputError(f"slenderness={slenderness!r}: h/b must be a positive number (e.g. 12)")
     if sl > MAX_SLENDERNESS:
-        raise InputError(f"slenderness={sl:g}: h/b above {MAX_SLENDERNESS:g} (alpha below 1 mrad) is a needle that "
-                         "any imperfection topples, not a rocking block; give the block's h/b (e.g. 12)")
+        raise InputError(
+            f"slenderness={sl:g}: h/b above {MAX_SLENDERNESS:g} (alpha below 1 mrad) is a needle that "
+            "any imperfection topples, not a rocking block; give the block's h/b (e.g. 12)"
+        )
     if int(levels) < 2 or int(sizes) < 2:
         raise InputError(f"levels={levels}, sizes={sizes}: need at least 2 of each")
     if not (R_max_m > R_min_m > 0):
         raise InputError(f"R_max_m={R_max_m}, R_min_m={R_min_m}: need R_max > R_min > 0 (m)")
     if not 1 < level_max <= 1000:
-        raise InputError(f"level_max={level_max}: the a_p/a_p,min range must go above 1 and up to at most 1000 "
-                         "(default 10)")
+        raise InputError(
+            f"level_max={level_max}: the a_p/a_p,min range must go above 1 and up to at most 1000 (default 10)"
+        )
     inertia_coefficient(alpha_I)
     return sl
 
 
-def overturning_spectrum(base: BaseMotion, slenderness: float = 12.0, *, levels: int = 80,
-                         level_max: float = 10.0, sizes: int = 120, R_max_m: float = 1000.0,
-                         R_min_m: float = 0.1, refine: int = 10, criterion: str = "angle",
-                         free="energy", search: str = "scan", alpha_I: float = 4.0 / 3.0,
-                         eta: float | None = None, max_p_dt: float = 0.001, level_offset: float = 0.0,
-                         size_offset: float = 0.0, grid: str = "adaptive",
-                         verdicts: OASResult | None = None, guide: OASResult | None = None) -> OASResult:
+def overturning_spectrum(
+    base: BaseMotion,
+    slenderness: float = 12.0,
+    *,
+    levels: int = 80,
+    level_max: float = 10.0,
+    sizes: int = 120,
+    R_max_m: float = 1000.0,
+    R_min_m: float = 0.1,
+    refine: int = 10,
+    criterion: str = "angle",
+    free="energy",
+    search: str = "scan",
+    alpha_I: float = 4.0 / 3.0,
+    eta: float | None = None,
+    max_p_dt: float = 0.001,
+    level_offset: float = 0.0,
+    size_offset: float = 0.0,
+    grid: str = "adaptive",
+    verdicts: OASResult | None = None,
+    guide: OASResult | None = None,
+) -> OASResult:
     """OAS, transformed OAS, t_I, t'_I and beta of a record for one block slenderness.
 
     Parameters
@@ -277,8 +330,11 @@ def overturning_spectrum(base: BaseMotion, slenderness: float = 12.0, *, levels:
     base = check_record(base)  # enough samples, not all zeros
     if int(levels) < 1 or int(sizes) < 2:
         raise InputError(f"levels={levels!r}, sizes={sizes!r}: need at least 1 level and 2 sizes")
-    check_memory(80.0 * int(levels) * int(sizes), f"an OAS grid of {int(levels)} x {int(sizes)} runs",
-                 "reduce --levels/--sizes (the defaults 80 x 120 resolve t_I)")
+    check_memory(
+        80.0 * int(levels) * int(sizes),
+        f"an OAS grid of {int(levels)} x {int(sizes)} runs",
+        "reduce --levels/--sizes (the defaults 80 x 120 resolve t_I)",
+    )
     if criterion not in _CRIT:
         raise InputError(f"criterion={criterion!r}: use 'angle' (|theta|>=alpha) or 'fall' (|theta|>=pi/2)")
     if search not in ("scan", "contiguous"):
@@ -293,29 +349,47 @@ def overturning_spectrum(base: BaseMotion, slenderness: float = 12.0, *, levels:
     if eta is not None and not (0.0 <= eta_v <= 1.0):
         raise InputError(f"eta={eta!r}: restitution omega+/omega- must be in [0, 1] (1: no energy lost); fix it")
     if eta is None and sl < 1.0:
-        raise InputError(f"slenderness={sl:g}: Housner's restitution 1 - 2 sin^2(alpha)/alpha_I = {eta_v:.3g} "
-                         "holds for slender blocks (h/b >= 1); give h/b >= 1, or the block's restitution eta")
+        raise InputError(
+            f"slenderness={sl:g}: Housner's restitution 1 - 2 sin^2(alpha)/alpha_I = {eta_v:.3g} "
+            "holds for slender blocks (h/b >= 1); give h/b >= 1, or the block's restitution eta"
+        )
     if not (0.0 <= float(level_offset) < 1.0 and 0.0 <= float(size_offset) < 1.0):
         raise InputError(f"level_offset={level_offset!r}, size_offset={size_offset!r}: fractions of a step in [0, 1)")
     step = (float(level_max) - 1.0) / (int(levels) - 1)
     lv = 1.0 + (np.arange(int(levels)) + float(level_offset)) * step
-    R = float(R_max_m) * (float(R_min_m) / float(R_max_m)) ** ((np.arange(int(sizes)) + float(size_offset))
-                                                               / (int(sizes) - 1))
+    R = float(R_max_m) * (float(R_min_m) / float(R_max_m)) ** (
+        (np.arange(int(sizes)) + float(size_offset)) / (int(sizes) - 1)
+    )
     p = np.sqrt(G / (alpha_I * R))
     scales = lv * math.tan(alpha) * G / base.pga_m_s2  # record scaled to a_p = level g tan(alpha)
     if not (math.isfinite(max_p_dt) and 0 < max_p_dt <= 0.5):
         raise InputError(f"max_p_dt={max_p_dt!r}: step times p must be in (0, 0.5]")
     args = (alpha, eta_v, _CRIT[criterion], free_code, free_s, float(max_p_dt))
-    opts = dict(levels=int(levels), level_max=float(level_max), sizes=int(sizes), R_max_m=float(R_max_m),
-                R_min_m=float(R_min_m), refine=int(refine), criterion=criterion, free=free,
-                search=search, max_p_dt=float(max_p_dt), level_offset=float(level_offset),
-                size_offset=float(size_offset), grid=grid)
+    opts = dict(
+        levels=int(levels),
+        level_max=float(level_max),
+        sizes=int(sizes),
+        R_max_m=float(R_max_m),
+        R_min_m=float(R_min_m),
+        refine=int(refine),
+        criterion=criterion,
+        free=free,
+        search=search,
+        max_p_dt=float(max_p_dt),
+        level_offset=float(level_offset),
+        size_offset=float(size_offset),
+        grid=grid,
+    )
     if verdicts is not None:
+
         def grid_of(o):
             return {k: v for k, v in o.items() if k not in ("search", "refine")}
 
-        if (grid_of(verdicts.options) != grid_of(opts) or (verdicts.eta, verdicts.alpha_rad, verdicts.alpha_I)
-                != (eta_v, alpha, float(alpha_I)) or verdicts.name != base.name):
+        if (
+            grid_of(verdicts.options) != grid_of(opts)
+            or (verdicts.eta, verdicts.alpha_rad, verdicts.alpha_I) != (eta_v, alpha, float(alpha_I))
+            or verdicts.name != base.name
+        ):
             raise InputError("verdicts: the earlier OAS differs in more than search/refine; compute this one anew")
         over, evaluated = verdicts.overturned, verdicts.evaluated
     elif grid == "dense":
@@ -323,13 +397,49 @@ def overturning_spectrum(base: BaseMotion, slenderness: float = 12.0, *, levels:
         over = over.reshape(scales.size, p.size)
         evaluated = np.ones_like(over)
     elif grid == "boundary":
-        over, evaluated = boundary_verdicts(lambda i, j: _runs(base, scales[i], p[j], args), lv.size, p.size,
-                                            _guess_first(guide, lv, p))
+        over, evaluated = boundary_verdicts(
+            lambda i, j: _runs(base, scales[i], p[j], args), lv.size, p.size, _guess_first(guide, lv, p)
+        )
     else:
         over, evaluated = adaptive_verdicts(lambda i, j: _runs(base, scales[i], p[j], args), lv.size, p.size)
 
-    # largest unsafe grid size per level
-    k = np.full(lv.size, -1)
+    p_hi, p_lo = _first_unsafe(over, p, search)
+    p_hi, p_lo = _bisect(base, scales, p_hi, p_lo, refine, args)
+
+    f = lv * p_hi
+    icr = normalised_critical_impulse(alpha)
+    f_min = float(np.nanmin(f)) if np.isfinite(f).any() else float("nan")
+    t_I = icr / f_min if math.isfinite(f_min) else float("nan")
+    tIp, beta = fit_inclined_line(f, lv)
+    return OASResult(
+        levels=lv,
+        R_m=R,
+        p_rad_s=p,
+        overturned=over,
+        p_min_rad_s=p_hi,
+        R_unsafe_max_m=G / (alpha_I * p_hi**2),
+        f_rad_s=f,
+        f_min_rad_s=f_min,
+        t_I_s=t_I,
+        t_I_prime_s=tIp,
+        beta=beta,
+        i_cr=icr,
+        alpha_rad=alpha,
+        alpha_I=float(alpha_I),
+        eta=eta_v,
+        name=base.name,
+        options=opts,
+        evaluated=evaluated,
+    )
+
+
+def _first_unsafe(over, p, search):
+    """Per level, p (rad/s) of the largest unsafe grid size and of its safe neighbour (NaN if none).
+
+    ``search="scan"``: the first overturning size from the largest block down; ``"contiguous"``:
+    the largest block of the run of overturning sizes that reaches the smallest block.
+    """
+    k = np.full(over.shape[0], -1)
     for i, row in enumerate(over):
         if search == "scan":
             hit = np.flatnonzero(row)
@@ -340,17 +450,7 @@ def overturning_spectrum(base: BaseMotion, slenderness: float = 12.0, *, levels:
             k[i] = safe[-1] + 1 if safe.size else 0
     p_hi = np.where(k >= 0, p[np.clip(k, 0, None)], np.nan)  # unsafe
     p_lo = np.where(k > 0, p[np.clip(k - 1, 0, None)], np.nan)  # safe neighbour (larger block)
-    p_hi, p_lo = _bisect(base, scales, p_hi, p_lo, refine, args)
-
-    f = lv * p_hi
-    icr = normalised_critical_impulse(alpha)
-    f_min = float(np.nanmin(f)) if np.isfinite(f).any() else float("nan")
-    t_I = icr / f_min if math.isfinite(f_min) else float("nan")
-    tIp, beta = fit_inclined_line(f, lv)
-    return OASResult(levels=lv, R_m=R, p_rad_s=p, overturned=over, p_min_rad_s=p_hi,
-                     R_unsafe_max_m=G / (alpha_I * p_hi ** 2), f_rad_s=f, f_min_rad_s=f_min,
-                     t_I_s=t_I, t_I_prime_s=tIp, beta=beta, i_cr=icr, alpha_rad=alpha,
-                     alpha_I=float(alpha_I), eta=eta_v, name=base.name, options=opts, evaluated=evaluated)
+    return p_hi, p_lo
 
 
 def _guess_first(guide, lv, p):
@@ -378,9 +478,17 @@ def _runs(base, scale, p, args):
     # chunk: a golden-ratio interleave spreads the long runs over both (1.6x -> 1.9x on 2 cores)
     p = np.broadcast_to(np.asarray(p, float), np.shape(scale))
     order = np.argsort((np.arange(p.size) * _GOLDEN) % 1.0, kind="stable")
-    b = simulate_batch(p[order], alpha, base=base, scale=np.asarray(scale, float)[order], eta=eta, dt_s=base.dt_s,
-                       free_after_s=free_s if free_code == 2 else 0.0,
-                       fall_rad=alpha if crit == 0 else None, max_p_dt=max_p_dt)
+    b = simulate_batch(
+        p[order],
+        alpha,
+        base=base,
+        scale=np.asarray(scale, float)[order],
+        eta=eta,
+        dt_s=base.dt_s,
+        free_after_s=free_s if free_code == 2 else 0.0,
+        fall_rad=alpha if crit == 0 else None,
+        max_p_dt=max_p_dt,
+    )
     over = np.asarray(b.overturned, bool)
     if free_code == 1:
         rocking = b.status == 0
@@ -438,9 +546,8 @@ def fit_inclined_line(f, levels):
     f, A = f[ok], A[ok]
     a_lo, a_hi = A.min(), A.max()
     # maximise (a_hi - a_lo) c + (a_hi^2 - a_lo^2)/2 s  -> minimise the negative
-    cost = -np.array([a_hi - a_lo, 0.5 * (a_hi ** 2 - a_lo ** 2)])
-    res = linprog(cost, A_ub=np.c_[np.ones_like(A), A], b_ub=f, bounds=[(0, None), (0, None)],
-                  method="highs")
+    cost = -np.array([a_hi - a_lo, 0.5 * (a_hi**2 - a_lo**2)])
+    res = linprog(cost, A_ub=np.c_[np.ones_like(A), A], b_ub=f, bounds=[(0, None), (0, None)], method="highs")
     if res.status != 0:
         return float("nan"), float("nan")
     c, s = res.x
@@ -448,8 +555,14 @@ def fit_inclined_line(f, levels):
     return (1.0 / c if c > tol else math.inf), (1.0 / s if s > tol else math.inf)
 
 
-def simplified_oas(p_rad_s, t_I_s: float, t_I_prime_s: float | None = None, beta: float | None = None,
-                   i_cr: float = 1.0, kind: str = "eq21"):
+def simplified_oas(
+    p_rad_s,
+    t_I_s: float,
+    t_I_prime_s: float | None = None,
+    beta: float | None = None,
+    i_cr: float = 1.0,
+    kind: str = "eq21",
+):
     """Simplified OAS a_p/a_p,min as a function of p (thesis Eq. 21, 29, 30).
 
     Parameters

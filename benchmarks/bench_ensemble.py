@@ -130,9 +130,7 @@ def speed(n=64, repeats=3):
     best = np.inf
     for _ in range(repeats):
         t0 = time.perf_counter()
-        simulate_ensemble(
-            blk, tab.t_s, tab.ax_m_s2, t, eta=run["eta"], theta0_rad=0.0, t_start_s=0.0, unc=unc, n=n
-        )
+        simulate_ensemble(blk, tab.t_s, tab.ax_m_s2, t, eta=run["eta"], theta0_rad=0.0, t_start_s=0.0, unc=unc, n=n)
         best = min(best, time.perf_counter() - t0)
     base = BaseMotion(tab.t_s - tab.t_s[0], -tab.ax_m_s2, name="table")
     t0 = time.perf_counter()

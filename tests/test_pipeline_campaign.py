@@ -180,8 +180,10 @@ def test_a_base_excited_runs_half_cycle_eta_is_shown_but_not_pooled():
     # η_e is reported in its row, and the campaign fits come from the free runs alone
     from rocklab.pipelines.campaign._campaign import CampaignResult, _campaign_fits, _row
 
-    truth = {b: eta_modified(catalogue_block(b).alpha_rad, edge_contact_k(catalogue_block(b).b_m, L_C)) * ETA_MAT
-             for b in ("B3M", "B5M")}
+    truth = {
+        b: eta_modified(catalogue_block(b).alpha_rad, edge_contact_k(catalogue_block(b).b_m, L_C)) * ETA_MAT
+        for b in ("B3M", "B5M")
+    }
     runs = [
         _report("B3M_edge", "B3M", "edge", fit={"eta_e": truth["B3M"], "ci95_eta_e": [truth["B3M"]] * 2}),
         _report("B5M_edge", "B5M", "edge", fit={"eta_e": truth["B5M"], "ci95_eta_e": [truth["B5M"]] * 2}),

@@ -13,7 +13,7 @@ from ..blocks import Block
 __all__ = ["build_scene", "Scene"]
 
 TABLE_THICK_M = 0.06
-_MOUNT_FRAC = 0.85          # IMU height on the block, fraction of h
+_MOUNT_FRAC = 0.85  # IMU height on the block, fraction of h
 #: The IMUs keep logging this long after the last video frame, s (as in the lab: the
 #: camera is stopped first). The blocks and the table are simulated to the end of the
 #: logs, so a block still rocking when the video ends keeps rocking in its IMU log.
@@ -22,9 +22,8 @@ IMU_TAIL_S = 0.5
 
 def _blocks(block, n):
     if block is None:
-        heights = (0.20, 0.22, 0.21) if n == 3 else (0.20,)   # all survive the 45 mm sine pulse
-        return [Block(0.1, h, depth_m=0.3, density_kg_m3=2700.0, name=f"block_{i + 1}")
-                for i, h in enumerate(heights)]
+        heights = (0.20, 0.22, 0.21) if n == 3 else (0.20,)  # all survive the 45 mm sine pulse
+        return [Block(0.1, h, depth_m=0.3, density_kg_m3=2700.0, name=f"block_{i + 1}") for i, h in enumerate(heights)]
     bl = list(block) if isinstance(block, (list, tuple)) else [block] * n
     if len(bl) != n or not all(isinstance(b, Block) for b in bl):
         raise InputError(f"block: give one rocklab.Block or a list of {n} Blocks")
@@ -41,8 +40,9 @@ def _layout(layout, n):
     if layout not in ("column", "side"):
         raise InputError(f"layout={layout!r}: use 'column' (stacked) or 'side' (side by side)")
     if layout == "column" and column_api() is None:
-        raise InputError("layout='column': this rocklab has no column model (rocklab.models.simulate_column); "
-                         "use layout='side'")
+        raise InputError(
+            "layout='column': this rocklab has no column model (rocklab.models.simulate_column); use layout='side'"
+        )
     return layout
 
 
@@ -50,8 +50,9 @@ def _simulate(blk, *, theta0_sim, base, horizon_s, restitution, eta):
     from ..models import simulate
 
     law = {"eta": eta} if restitution == "constant" else {}
-    return simulate(blk, theta0_rad=theta0_sim, duration_s=horizon_s, dt_s=1e-4,
-                    restitution=restitution, base=base, **law)
+    return simulate(
+        blk, theta0_rad=theta0_sim, duration_s=horizon_s, dt_s=1e-4, restitution=restitution, base=base, **law
+    )
 
 
 def _table_motion(kind, seed_rng, *, record, amplitude, period, stroke, blocks, start_s, horizon_s):
@@ -84,7 +85,7 @@ class Scene:
     targets: str
     camera: object
     plane_maps: tuple
-    objects: list                 # RenderObject, table first
+    objects: list  # RenderObject, table first
     block_motions: list
     table: object
     sims: list
@@ -106,10 +107,20 @@ class Scene:
     def renderer(self):
         from ._render import Renderer
 
-        return Renderer(self.camera, self.objects, self.background, self.illumination,
-                        exposure_s=self.exposure_s, readout_s=self.readout_s, noise_dn=self.noise_dn,
-                        rng=np.random.default_rng(self.noise_seed), occluders=self.occluders,
-                        plane_maps=self.plane_maps, flicker=self.flicker, flicker_seed=self.noise_seed)
+        return Renderer(
+            self.camera,
+            self.objects,
+            self.background,
+            self.illumination,
+            exposure_s=self.exposure_s,
+            readout_s=self.readout_s,
+            noise_dn=self.noise_dn,
+            rng=np.random.default_rng(self.noise_seed),
+            occluders=self.occluders,
+            plane_maps=self.plane_maps,
+            flicker=self.flicker,
+            flicker_seed=self.noise_seed,
+        )
 
     # ------------------------------------------------------------------ truth
     def truth_frame(self):
@@ -119,13 +130,35 @@ class Scene:
         parts = []
         for bm in self.block_motions:
             x, y = bm.centre(t)
-            parts.append(pd.DataFrame({"frame": np.arange(self.n_frames), "t_s": t, "object": bm.id,
-                                       "x_m": x, "y_m": y, "theta_rad": bm.phi(t),
-                                       "vx_m_s": np.nan, "ax_m_s2": np.nan}))
+            parts.append(
+                pd.DataFrame(
+                    {
+                        "frame": np.arange(self.n_frames),
+                        "t_s": t,
+                        "object": bm.id,
+                        "x_m": x,
+                        "y_m": y,
+                        "theta_rad": bm.phi(t),
+                        "vx_m_s": np.nan,
+                        "ax_m_s2": np.nan,
+                    }
+                )
+            )
         tb = self.table
-        parts.append(pd.DataFrame({"frame": np.arange(self.n_frames), "t_s": t, "object": "table",
-                                   "x_m": tb.u(t), "y_m": 0.0, "theta_rad": 0.0,
-                                   "vx_m_s": tb.v(t), "ax_m_s2": tb.a(t)}))
+        parts.append(
+            pd.DataFrame(
+                {
+                    "frame": np.arange(self.n_frames),
+                    "t_s": t,
+                    "object": "table",
+                    "x_m": tb.u(t),
+                    "y_m": 0.0,
+                    "theta_rad": 0.0,
+                    "vx_m_s": tb.v(t),
+                    "ax_m_s2": tb.a(t),
+                }
+            )
+        )
         df = pd.concat(parts, ignore_index=True)
         return df.sort_values(["frame", "object"], kind="stable").reset_index(drop=True)
 
@@ -169,8 +202,11 @@ class Scene:
         t0 = np.array([0.0])
         b, h = f["size_m"]
         if o.id == "table":
-            xb = min(float(to_world(ob.texture.outline_m, *(np.asarray(v, float) for v in ob.pose(t0)))
-                           [..., 0].min()) for ob in self.objects if ob.id != "table")
+            xb = min(
+                float(to_world(ob.texture.outline_m, *(np.asarray(v, float) for v in ob.pose(t0)))[..., 0].min())
+                for ob in self.objects
+                if ob.id != "table"
+            )
             # table body frame: origin at the top centre of the face, y up; its pose is the shift
             local = np.array([[-b / 2 + 0.01, 0.006], [min(xb - float(ox[0]) - 0.02, -b / 4), -h + 0.002]])
             return to_world(local, ox, oy, phi).reshape(-1, 2)
@@ -186,16 +222,25 @@ class Scene:
 
         write_frame_atomic(folder / "truth.csv", self.truth_frame())
         f1 = self.features[self.block_motions[0].id]
-        write_track_toml(folder / "track.toml", style=self.targets, camera=self.camera,
-                         objects=self._track_objects(), marker_size_m=f1.get("marker_size_m"),
-                         dot_diameter_m=f1.get("dot_diameter_m"), calibrated=calibrated)
+        write_track_toml(
+            folder / "track.toml",
+            style=self.targets,
+            camera=self.camera,
+            objects=self._track_objects(),
+            marker_size_m=f1.get("marker_size_m"),
+            dot_diameter_m=f1.get("dot_diameter_m"),
+            calibrated=calibrated,
+        )
         b0 = self.sims[0]["block"]
         imu_info = self._write_imu(folder, imu_rate_hz) if imu else {}
-        write_experiment_toml(folder / "experiment.toml", name=f"synth-seed{self.seed}",
-                              block={"id": self.block_motions[0].id, "b_m": b0["b_m"], "h_m": b0["h_m"],
-                                     "mass_kg": b0["mass_kg"]},
-                              table_kind=self.table.kind, imu_objects=set(imu_info),
-                              column=[m.id for m in self.block_motions] if self.layout == "column" else None)
+        write_experiment_toml(
+            folder / "experiment.toml",
+            name=f"synth-seed{self.seed}",
+            block={"id": self.block_motions[0].id, "b_m": b0["b_m"], "h_m": b0["h_m"], "mass_kg": b0["mass_kg"]},
+            table_kind=self.table.kind,
+            imu_objects=set(imu_info),
+            column=[m.id for m in self.block_motions] if self.layout == "column" else None,
+        )
         return self._meta(imu_info)
 
     def _write_imu(self, folder: Path, rate_hz: float) -> dict:
@@ -207,14 +252,25 @@ class Scene:
         blocks = {s["id"]: s["block"] for s in self.sims}
         for k, bm in enumerate(self.block_motions):
             bd = blocks[bm.id]
-            blk = Block(bd["b_m"], bd["h_m"], depth_m=bd["depth_m"], mass_kg=bd["mass_kg"],
-                        alpha_I=bd["alpha_I"])
-            out[bm.id] = write_object_imu(folder / "imu" / bm.id, bm.id, block_motion=bm, block=blk,
-                                          mount_m=(0.0, _MOUNT_FRAC * bm.h_m), t_end_s=t_end,
-                                          rate_hz=rate_hz, rng=np.random.default_rng(seqs[k]))
-        out["table"] = write_object_imu(folder / "imu" / "table", "table", table=self.table,
-                                        t_end_s=t_end, rate_hz=rate_hz,
-                                        rng=np.random.default_rng(seqs[-1]))
+            blk = Block(bd["b_m"], bd["h_m"], depth_m=bd["depth_m"], mass_kg=bd["mass_kg"], alpha_I=bd["alpha_I"])
+            out[bm.id] = write_object_imu(
+                folder / "imu" / bm.id,
+                bm.id,
+                block_motion=bm,
+                block=blk,
+                mount_m=(0.0, _MOUNT_FRAC * bm.h_m),
+                t_end_s=t_end,
+                rate_hz=rate_hz,
+                rng=np.random.default_rng(seqs[k]),
+            )
+        out["table"] = write_object_imu(
+            folder / "imu" / "table",
+            "table",
+            table=self.table,
+            t_end_s=t_end,
+            rate_hz=rate_hz,
+            rng=np.random.default_rng(seqs[-1]),
+        )
         return out
 
     def _meta(self, imu_info) -> dict:
@@ -230,25 +286,35 @@ class Scene:
                 g["dots"] = np.asarray(f["dots"]).tolist()
             feats[oid] = g
         return {
-            "rocklab_version": __version__, "seed": self.seed, "params": self.params,
-            "fps": self.fps, "size_px": list(self.size), "n_frames": self.n_frames,
-            "duration_s": self.n_frames / self.fps, "targets": self.targets,
-            "exposure_s": self.exposure_s, "rolling_shutter_readout_s": self.readout_s,
-            "noise_dn": self.noise_dn, "psf_sigma_px": 0.5,
-            "blocks": self.sims, "table": self.table.info | {"width_m": self.table_width_m,
-                                                              "thickness_m": TABLE_THICK_M},
+            "rocklab_version": __version__,
+            "seed": self.seed,
+            "params": self.params,
+            "fps": self.fps,
+            "size_px": list(self.size),
+            "n_frames": self.n_frames,
+            "duration_s": self.n_frames / self.fps,
+            "targets": self.targets,
+            "exposure_s": self.exposure_s,
+            "rolling_shutter_readout_s": self.readout_s,
+            "noise_dn": self.noise_dn,
+            "psf_sigma_px": 0.5,
+            "blocks": self.sims,
+            "table": self.table.info | {"width_m": self.table_width_m, "thickness_m": TABLE_THICK_M},
             "occlusions": [o.__dict__ for o in self.occluders],
-            "camera": cam, "features_object_frame": feats, "video": self.video_info, "imu": imu_info,
+            "camera": cam,
+            "features_object_frame": feats,
+            "video": self.video_info,
+            "imu": imu_info,
             "conventions": {
                 "world": "rocking plane, x right, y up as seen by the camera, table top y = 0, m",
                 "theta_rad": "counter-clockwise angle seen by the camera (tracker convention) = "
-                             "-theta of rocklab.models.simulate with base = table ax_m_s2",
+                "-theta of rocklab.models.simulate with base = table ax_m_s2",
                 "t_s": "frame i is centred on t_s = i / fps (with rolling shutter: the middle row)",
                 "x_m, y_m": "blocks: centre of the front face; table: top centre of its front face",
                 "object_frame": "origin as x_m, y_m; x right, y up when upright",
                 "simulated_span": f"truth.csv covers the video frames; the motions (and blocks' "
-                                  f"impact_t_s, n_impacts, sim_status, max_abs_theta_rad) run on to "
-                                  f"the end of the IMU logs, {IMU_TAIL_S} s after the last frame",
+                f"impact_t_s, n_impacts, sim_status, max_abs_theta_rad) run on to "
+                f"the end of the IMU logs, {IMU_TAIL_S} s after the last frame",
             },
         }
 
@@ -264,11 +330,31 @@ def _roi_box(px, margin_px: float = 0.0, size=None) -> list:
     return [round(float(u0), 1), round(float(v0), 1), round(float(u1 - u0), 1), round(float(v1 - v0), 1)]
 
 
-def build_scene(*, seed, blocks, table, fps, size, targets, duration_s, occlusion, rolling_shutter,
-                block, restitution, eta, theta0_rad, record, table_amplitude_m, table_period_s,
-                table_stroke_m, exposure_s, noise_dn, distortion, layout=None, texture="procedural") -> Scene:
-    from ._render import Occluder, RenderObject
-    from ._render_targets import block_texture, table_texture
+def build_scene(
+    *,
+    seed,
+    blocks,
+    table,
+    fps,
+    size,
+    targets,
+    duration_s,
+    occlusion,
+    rolling_shutter,
+    block,
+    restitution,
+    eta,
+    theta0_rad,
+    record,
+    table_amplitude_m,
+    table_period_s,
+    table_stroke_m,
+    exposure_s,
+    noise_dn,
+    distortion,
+    layout=None,
+    texture="procedural",
+) -> Scene:
     from ._camera import make_camera
 
     ss = np.random.SeedSequence(seed)
@@ -277,7 +363,7 @@ def build_scene(*, seed, blocks, table, fps, size, targets, duration_s, occlusio
     blks = _blocks(block, blocks)
     n = len(blks)
     layout = _layout(layout, n)
-    if layout == "column" and block is None:      # thesis §4.3: three 100 x 200 mm granite blocks
+    if layout == "column" and block is None:  # thesis §4.3: three 100 x 200 mm granite blocks
         blks = [Block(0.1, 0.2, depth_m=0.3, density_kg_m3=2700.0, name=f"block_{i + 1}") for i in range(n)]
     if table_amplitude_m is None:
         # The column overturns under the full 45 mm smooth pulse (its peak acceleration is
@@ -290,8 +376,17 @@ def build_scene(*, seed, blocks, table, fps, size, targets, duration_s, occlusio
     # for the IMU's interval means. Fixed-step integration: the part under the video is the
     # same as a run stopped at the video's end.
     sim_end = horizon + IMU_TAIL_S + 0.5 / fps + 0.1
-    tbl = _table_motion(table, rng_m, record=record, amplitude=table_amplitude_m, period=table_period_s,
-                        stroke=table_stroke_m, blocks=blks, start_s=rest_s, horizon_s=max(horizon, 3.0))
+    tbl = _table_motion(
+        table,
+        rng_m,
+        record=record,
+        amplitude=table_amplitude_m,
+        period=table_period_s,
+        stroke=table_stroke_m,
+        blocks=blks,
+        start_s=rest_s,
+        horizon_s=max(horizon, 3.0),
+    )
     base = tbl.base_motion(sim_end)
     spacing = 0.35
     xs = [0.0] if n == 1 else [-spacing, 0.0, spacing]
@@ -303,19 +398,24 @@ def build_scene(*, seed, blocks, table, fps, size, targets, duration_s, occlusio
             if not abs(p) < b.alpha_rad:
                 raise InputError(f"theta0_rad={p!r}: must be within ±alpha = ±{b.alpha_rad:.4f} rad")
     if layout == "column":
-        motions, sims, ends = _column_motions(blks, tbl, base, table, rest_s, sim_end, rng_m,
-                                              None if theta0_rad is None else float(np.ravel(theta0_rad)[0]))
+        motions, sims, ends = _column_motions(
+            blks,
+            tbl,
+            base,
+            table,
+            rest_s,
+            sim_end,
+            rng_m,
+            None if theta0_rad is None else float(np.ravel(theta0_rad)[0]),
+        )
     else:
-        motions, sims, ends = _single_motions(blks, xs, phi0, tbl, base, table, rest_s, sim_end, rng_m,
-                                              restitution, eta)
+        motions, sims, ends = _single_motions(
+            blks, xs, phi0, tbl, base, table, rest_s, sim_end, rng_m, restitution, eta
+        )
     if duration_s is None:
         duration_s = float(np.clip(max(ends) + 0.6, 2.0, 12.0))
     n_frames = max(2, int(round(duration_s * fps)))
-    for m, sim in zip(motions, sims):
-        # a run cut short while still moving would freeze the block in the IMU log's tail
-        if sim["sim_status"] == "rocking" and float(m.t_s[-1]) < n_frames / fps + IMU_TAIL_S:
-            raise AssertionError(f"{m.id}: simulated to {float(m.t_s[-1]):.3f} s only, before the "
-                                 f"IMU logs end at {n_frames / fps + IMU_TAIL_S:.3f} s")
+    _check_motions_cover(motions, sims, n_frames / fps + IMU_TAIL_S)
     W, H = size
     h_max = max(b.h_m for b in blks)
     stack = sum(b.h_m for b in blks) if layout == "column" else h_max
@@ -326,58 +426,192 @@ def build_scene(*, seed, blocks, table, fps, size, targets, duration_s, occlusio
     maps = cam.plane_maps()
     mpp = cam.m_per_px((0.0, 0.5 * h_max))
     texel, psf_m = mpp / 4.0, 0.5 * mpp
-    rng_t = np.random.default_rng(s_tex)
+    objects, feats = _textured_objects(
+        blks, motions, tbl, table, targets, table_w, texel, psf_m, np.random.default_rng(s_tex), texture
+    )
+    background, illum = _background(maps, size, targets, np.random.default_rng(s_bg), texture)
+    occl = _occluders(occlusion, [o.id for o in objects])
+    exposure = 0.5 / fps if exposure_s is None else float(exposure_s)
+    params = _scene_params(
+        blocks=blocks,
+        table=table,
+        fps=fps,
+        size=size,
+        targets=targets,
+        duration_s=duration_s,
+        rolling_shutter=rolling_shutter,
+        restitution=restitution,
+        eta=eta,
+        table_amplitude_m=table_amplitude_m,
+        table_period_s=table_period_s,
+        table_stroke_m=table_stroke_m,
+        noise_dn=noise_dn,
+        distortion=distortion,
+        layout=layout,
+    )
+    return Scene(
+        seed,
+        fps,
+        tuple(size),
+        n_frames,
+        targets,
+        cam,
+        maps,
+        objects,
+        motions,
+        tbl,
+        sims,
+        params,
+        occl,
+        background,
+        illum,
+        exposure,
+        (0.8 / fps) if rolling_shutter else 0.0,
+        float(noise_dn),
+        s_noise,
+        s_imu,
+        feats,
+        table_w,
+        layout=layout,
+    )
+
+
+def _check_motions_cover(motions, sims, t_end_s: float) -> None:
+    """Every block still rocking is simulated to the end of the IMU logs, ``t_end_s``."""
+    for m, sim in zip(motions, sims):
+        # a run cut short while still moving would freeze the block in the IMU log's tail
+        if sim["sim_status"] == "rocking" and float(m.t_s[-1]) < t_end_s:
+            raise AssertionError(
+                f"{m.id}: simulated to {float(m.t_s[-1]):.3f} s only, before the IMU logs end at {t_end_s:.3f} s"
+            )
+
+
+def _textured_objects(blks, motions, tbl, table, targets, table_w, texel, psf_m, rng_t, texture):
+    """The table and each block as textured render objects, and the features (markers, dots)
+    each carries in its own frame."""
+    from ._render import RenderObject
+    from ._render_targets import block_texture, table_texture
+
     objects, feats = [], {}
     dot_dia = min(min(0.16 * b.b_m, 0.08 * b.h_m) for b in blks)
-    tt = table_texture(table_w, TABLE_THICK_M, targets, marker_ids=(0, 7), marker_size_m=0.75 * TABLE_THICK_M,
-                       dot_diameter_m=dot_dia, texel_m=texel, psf_px_m=psf_m, rng=rng_t)
-    objects.append(RenderObject("table", tt, lambda t, _tb=tbl: (_tb.u(t), np.zeros_like(np.asarray(t, float)),
-                                                                np.zeros_like(np.asarray(t, float))),
-                                static=(table == "none")))
+    tt = table_texture(
+        table_w,
+        TABLE_THICK_M,
+        targets,
+        marker_ids=(0, 7),
+        marker_size_m=0.75 * TABLE_THICK_M,
+        dot_diameter_m=dot_dia,
+        texel_m=texel,
+        psf_px_m=psf_m,
+        rng=rng_t,
+    )
+    objects.append(
+        RenderObject(
+            "table",
+            tt,
+            lambda t, _tb=tbl: (_tb.u(t), np.zeros_like(np.asarray(t, float)), np.zeros_like(np.asarray(t, float))),
+            static=(table == "none"),
+        )
+    )
     feats["table"] = dict(tt.features, size_m=[table_w, TABLE_THICK_M], origin="top centre of the front face")
     for k, (blk, bm) in enumerate(zip(blks, motions)):
-        tex = block_texture(blk.b_m, blk.h_m, targets, marker_ids=(2 * k + 1, 2 * k + 2),
-                            marker_size_m=min(0.6 * blk.b_m, 0.3 * blk.h_m), dot_diameter_m=dot_dia,
-                            texel_m=texel, psf_px_m=psf_m, rng=rng_t,
-                            # stacked plain blocks alternate in shade so the joints are visible
-                            face_value=(212.0, 176.0)[k % 2] if targets == "edges" else None, texture=texture)
+        tex = block_texture(
+            blk.b_m,
+            blk.h_m,
+            targets,
+            marker_ids=(2 * k + 1, 2 * k + 2),
+            marker_size_m=min(0.6 * blk.b_m, 0.3 * blk.h_m),
+            dot_diameter_m=dot_dia,
+            texel_m=texel,
+            psf_px_m=psf_m,
+            rng=rng_t,
+            # stacked plain blocks alternate in shade so the joints are visible
+            face_value=(212.0, 176.0)[k % 2] if targets == "edges" else None,
+            texture=texture,
+        )
         objects.append(RenderObject(bm.id, tex, bm.pose))
         f = dict(tex.features, size_m=[blk.b_m, blk.h_m], origin="centre of the front face")
-        shift = np.array([0.0, blk.h_m / 2])         # body (bottom centre) -> face centre origin
+        shift = np.array([0.0, blk.h_m / 2])  # body (bottom centre) -> face centre origin
         if "markers" in f:
             f["markers"] = {m: c - shift for m, c in f["markers"].items()}
         if "dots" in f:
             f["dots"] = f["dots"] - shift
         feats[bm.id] = f
-    background, illum = _background(maps, size, targets, np.random.default_rng(s_bg), texture)
+    return objects, feats
+
+
+def _occluders(occlusion, ids):
+    """The occluders asked for (``(t0, t1)`` or a dict with object, t0_s, t1_s, kind), checked
+    against the scene's object ids."""
+    from ._render import Occluder
+
     occl = []
     if occlusion is not None:
         if isinstance(occlusion, dict):
-            occl.append(Occluder(str(occlusion.get("object", "block_1")), float(occlusion["t0_s"]),
-                                 float(occlusion["t1_s"]), str(occlusion.get("kind", "patch"))))
+            occl.append(
+                Occluder(
+                    str(occlusion.get("object", "block_1")),
+                    float(occlusion["t0_s"]),
+                    float(occlusion["t1_s"]),
+                    str(occlusion.get("kind", "patch")),
+                )
+            )
         else:
             t0, t1 = (float(v) for v in occlusion)
             occl.append(Occluder("block_1", t0, t1))
-    ids = [o.id for o in objects]
     for oc in occl:
         if oc.object not in ids or not oc.t1_s > oc.t0_s or oc.kind not in ("patch", "hand"):
-            raise InputError(f"occlusion={occlusion!r}: needs an object among {', '.join(ids)}, t1_s > t0_s "
-                             "and kind 'patch' or 'hand'")
-    exposure = 0.5 / fps if exposure_s is None else float(exposure_s)
-    params = {"blocks": blocks, "table": table, "fps": fps, "size": list(size), "targets": targets,
-              "duration_s": duration_s, "rolling_shutter": rolling_shutter, "restitution": restitution,
-              "eta": eta, "table_amplitude_m": table_amplitude_m, "table_period_s": table_period_s,
-              "table_stroke_m": table_stroke_m, "noise_dn": noise_dn, "distortion": distortion,
-              "layout": {"single": "single block", "side": "independent blocks side by side",
-                         "column": "stacked column (rocklab.models.simulate_column)"}[layout]}
-    return Scene(seed, fps, tuple(size), n_frames, targets, cam, maps, objects, motions, tbl, sims,
-                 params, occl, background, illum, exposure, (0.8 / fps) if rolling_shutter else 0.0,
-                 float(noise_dn), s_noise, s_imu, feats, table_w, layout=layout)
+            raise InputError(
+                f"occlusion={occlusion!r}: needs an object among {', '.join(ids)}, t1_s > t0_s "
+                "and kind 'patch' or 'hand'"
+            )
+    return occl
+
+
+def _scene_params(
+    *,
+    blocks,
+    table,
+    fps,
+    size,
+    targets,
+    duration_s,
+    rolling_shutter,
+    restitution,
+    eta,
+    table_amplitude_m,
+    table_period_s,
+    table_stroke_m,
+    noise_dn,
+    distortion,
+    layout,
+) -> dict:
+    """The render's parameters as written to ``session.json``."""
+    return {
+        "blocks": blocks,
+        "table": table,
+        "fps": fps,
+        "size": list(size),
+        "targets": targets,
+        "duration_s": duration_s,
+        "rolling_shutter": rolling_shutter,
+        "restitution": restitution,
+        "eta": eta,
+        "table_amplitude_m": table_amplitude_m,
+        "table_period_s": table_period_s,
+        "table_stroke_m": table_stroke_m,
+        "noise_dn": noise_dn,
+        "distortion": distortion,
+        "layout": {
+            "single": "single block",
+            "side": "independent blocks side by side",
+            "column": "stacked column (rocklab.models.simulate_column)",
+        }[layout],
+    }
 
 
 def _block_info(blk) -> dict:
-    return blk.to_dict() | {"alpha_rad": blk.alpha_rad, "R_m": blk.R_m, "p_rad_s": blk.p_rad_s,
-                            "eta_H": blk.eta_H}
+    return blk.to_dict() | {"alpha_rad": blk.alpha_rad, "R_m": blk.R_m, "p_rad_s": blk.p_rad_s, "eta_H": blk.eta_H}
 
 
 def _single_motions(blks, xs, phi0, tbl, base, table, rest_s, sim_end_s, rng_m, restitution, eta):
@@ -389,28 +623,42 @@ def _single_motions(blks, xs, phi0, tbl, base, table, rest_s, sim_end_s, rng_m, 
         oid = f"block_{k + 1}"
         if table == "none":
             release = round(rest_s + 0.3 * k + float(rng_m.uniform(0.0, 0.1)), 4)
-            res = _simulate(blk, theta0_sim=-phi0[k], base=None, horizon_s=max(sim_end_s - release, 0.5),
-                            restitution=restitution, eta=eta)
+            res = _simulate(
+                blk,
+                theta0_sim=-phi0[k],
+                base=None,
+                horizon_s=max(sim_end_s - release, 0.5),
+                restitution=restitution,
+                eta=eta,
+            )
             t = np.concatenate(([0.0], release + res.t_s))
             ph = np.concatenate(([phi0[k]], -res.theta_rad))
         else:
             release = None
-            res = _simulate(blk, theta0_sim=0.0, base=base, horizon_s=sim_end_s,
-                            restitution=restitution, eta=eta)
+            res = _simulate(blk, theta0_sim=0.0, base=base, horizon_s=sim_end_s, restitution=restitution, eta=eta)
             t, ph = res.t_s, -res.theta_rad
         ends.append(float(t[-1]))
         motions.append(BlockMotion(oid, blk.b_m, blk.h_m, xs[k], t, ph, tbl, release))
         imp = res.impacts
-        sims.append({"id": oid, "block": _block_info(blk), "x0_m": xs[k], "release_s": release,
-                     "theta0_rad": phi0[k] if table == "none" else 0.0,
-                     "restitution": restitution,
-                     "eta_true": (float(eta) if restitution == "constant" else
-                                  (blk.eta_H if restitution == "housner" else None)),
-                     "sim_status": res.status, "overturned": bool(res.overturned),
-                     "n_impacts": int(res.n_impacts),
-                     "impact_t_s": [float(v) + (release or 0.0) for v in imp["t_s"]] if len(imp) else [],
-                     "impact_eta": [float(v) for v in imp["eta"]] if len(imp) else [],
-                     "max_abs_theta_rad": float(res.max_abs_theta_rad)})
+        sims.append(
+            {
+                "id": oid,
+                "block": _block_info(blk),
+                "x0_m": xs[k],
+                "release_s": release,
+                "theta0_rad": phi0[k] if table == "none" else 0.0,
+                "restitution": restitution,
+                "eta_true": (
+                    float(eta) if restitution == "constant" else (blk.eta_H if restitution == "housner" else None)
+                ),
+                "sim_status": res.status,
+                "overturned": bool(res.overturned),
+                "n_impacts": int(res.n_impacts),
+                "impact_t_s": [float(v) + (release or 0.0) for v in imp["t_s"]] if len(imp) else [],
+                "impact_eta": [float(v) for v in imp["eta"]] if len(imp) else [],
+                "max_abs_theta_rad": float(res.max_abs_theta_rad),
+            }
+        )
     return motions, sims, ends
 
 
@@ -429,8 +677,10 @@ def _column_motions(blks, tbl, base, table, rest_s, sim_end_s, rng_m, phi0=None)
         if phi0 is None:
             phi0 = 0.5 * alpha_col
         elif not abs(phi0) < alpha_col:
-            raise InputError(f"theta0_rad={phi0!r}: the column tips as one body; give |theta0| < "
-                             f"{alpha_col:.4f} rad (its slenderness angle)")
+            raise InputError(
+                f"theta0_rad={phi0!r}: the column tips as one body; give |theta0| < "
+                f"{alpha_col:.4f} rad (its slenderness angle)"
+            )
         release = round(rest_s + float(rng_m.uniform(0.0, 0.1)), 4)
         res = simulate_column(col, None, theta0_rad=[-phi0] * n, duration_s=max(sim_end_s - release, 0.5))
         psi0 = np.zeros((1, n))
@@ -441,19 +691,41 @@ def _column_motions(blks, tbl, base, table, rest_s, sim_end_s, rng_m, phi0=None)
         phi0, release = 0.0, None
         res = simulate_column(col, base, duration_s=sim_end_s)
         t, psi = res.t_s, -res.phi_rad
-    cm = ColumnMotion(np.array([b.b_m for b in blks]), np.array([b.h_m for b in blks]),
-                      np.asarray(col.half_width_m, float), 0.0, t, psi, tbl, release)
+    cm = ColumnMotion(
+        np.array([b.b_m for b in blks]),
+        np.array([b.h_m for b in blks]),
+        np.asarray(col.half_width_m, float),
+        0.0,
+        t,
+        psi,
+        tbl,
+        release,
+    )
     motions = [ColumnBlockView(f"block_{k + 1}", cm, k) for k in range(n)]
     imp = res.impacts
-    common = {"x0_m": 0.0, "release_s": release, "restitution": "column impact model (rocklab.models)",
-              "eta_true": None, "sim_status": res.status, "overturned": bool(res.overturned),
-              "n_impacts": int(len(imp)),
-              "impact_t_s": [float(v) + (release or 0.0) for v in imp["t_s"]] if len(imp) else [],
-              "impact_joint": [int(v) for v in imp["joint"]] if len(imp) else [],
-              "column_status_t_s": float(res.t_status_s)}
-    sims = [{"id": m.id, "block": _block_info(b), "theta0_rad": phi0, "layout": "column",
-             "max_abs_theta_rad": float(res.max_abs_theta_rad[k])} | common
-            for k, (m, b) in enumerate(zip(motions, blks))]
+    common = {
+        "x0_m": 0.0,
+        "release_s": release,
+        "restitution": "column impact model (rocklab.models)",
+        "eta_true": None,
+        "sim_status": res.status,
+        "overturned": bool(res.overturned),
+        "n_impacts": int(len(imp)),
+        "impact_t_s": [float(v) + (release or 0.0) for v in imp["t_s"]] if len(imp) else [],
+        "impact_joint": [int(v) for v in imp["joint"]] if len(imp) else [],
+        "column_status_t_s": float(res.t_status_s),
+    }
+    sims = [
+        {
+            "id": m.id,
+            "block": _block_info(b),
+            "theta0_rad": phi0,
+            "layout": "column",
+            "max_abs_theta_rad": float(res.max_abs_theta_rad[k]),
+        }
+        | common
+        for k, (m, b) in enumerate(zip(motions, blks))
+    ]
     return motions, sims, [tbl.end_s, float(t[-1])]
 
 

@@ -53,9 +53,20 @@ import numpy as np
 from ..._diagnostics import warn
 from ..._errors import InputError
 from ...blocks import G
-from ._motion import (axis_vector, cumtrapz, first_motion, forced_run, last_motion_end,
-                          motion_mask, moving_average, quat_mul, rownorm, still_acc_start,
-                          tilt_about, twist_angle)
+from ._motion import (
+    axis_vector,
+    cumtrapz,
+    first_motion,
+    forced_run,
+    last_motion_end,
+    motion_mask,
+    moving_average,
+    quat_mul,
+    rownorm,
+    still_acc_start,
+    tilt_about,
+    twist_angle,
+)
 from ._read import ImuLog
 from ._validity import RockingCheck, check_rocking, warn_no_rest, warn_not_rocking
 
@@ -139,28 +150,40 @@ class ImuRotation:
         """``t_s, theta_rad, omega_rad_s, acc_{x,y,z}_m_s2`` (+ ``theta_ahrs_rad``)."""
         import pandas as pd
 
-        d = {"t_s": self.t_s, "theta_rad": self.theta_rad, "omega_rad_s": self.omega_rad_s,
-             "acc_x_m_s2": self.acc_m_s2[:, 0], "acc_y_m_s2": self.acc_m_s2[:, 1],
-             "acc_z_m_s2": self.acc_m_s2[:, 2]}
+        d = {
+            "t_s": self.t_s,
+            "theta_rad": self.theta_rad,
+            "omega_rad_s": self.omega_rad_s,
+            "acc_x_m_s2": self.acc_m_s2[:, 0],
+            "acc_y_m_s2": self.acc_m_s2[:, 1],
+            "acc_z_m_s2": self.acc_m_s2[:, 2],
+        }
         if self.ahrs_theta_rad is not None:
             d["theta_ahrs_rad"] = self.ahrs_theta_rad
         return pd.DataFrame(d)
 
     def to_dict(self) -> dict:
         """JSON-ready summary (the ``rocklab imu --json`` keys)."""
-        return {"format": self.format, "sample_rate_hz": float(self.rate_hz),
-                "n_samples": int(len(self.t_s)), "dropped_samples": int(self.dropped_samples),
-                "gyro_bias_rad_s": [float(v) for v in self.gyro_bias_rad_s],
-                "axis": [float(v) for v in self.axis],
-                "theta0_rad": float(self.theta0_rad), "drift_rad_s": float(self.drift_rad_s),
-                "release_t_s": float(self.release_t_s),
-                "impact_t_s": [float(v) for v in self.impact_t_s],
-                "rest_t_s": float(self.rest_t_s),
-                "ahrs_rms_diff_rad": float(self.ahrs_rms_diff_rad),
-                "status": self.status, "message": self.message, "run_kind": self.run_kind,
-                "axis_tilt_rad": float(self.rocking.axis_tilt_rad) if self.rocking else float("nan"),
-                "axis_share": float(self.rocking.axis_share) if self.rocking else float("nan"),
-                "source": self.source}
+        return {
+            "format": self.format,
+            "sample_rate_hz": float(self.rate_hz),
+            "n_samples": int(len(self.t_s)),
+            "dropped_samples": int(self.dropped_samples),
+            "gyro_bias_rad_s": [float(v) for v in self.gyro_bias_rad_s],
+            "axis": [float(v) for v in self.axis],
+            "theta0_rad": float(self.theta0_rad),
+            "drift_rad_s": float(self.drift_rad_s),
+            "release_t_s": float(self.release_t_s),
+            "impact_t_s": [float(v) for v in self.impact_t_s],
+            "rest_t_s": float(self.rest_t_s),
+            "ahrs_rms_diff_rad": float(self.ahrs_rms_diff_rad),
+            "status": self.status,
+            "message": self.message,
+            "run_kind": self.run_kind,
+            "axis_tilt_rad": float(self.rocking.axis_tilt_rad) if self.rocking else float("nan"),
+            "axis_share": float(self.rocking.axis_share) if self.rocking else float("nan"),
+            "source": self.source,
+        }
 
 
 def _check_gyro_vs_tilt(source, gyro_change_rad, tilt_change_rad, status, msg):
@@ -173,9 +196,12 @@ def _check_gyro_vs_tilt(source, gyro_change_rad, tilt_change_rad, status, msg):
     tol = 0.2 * max(abs(tilt_change_rad), abs(gyro_change_rad)) + np.deg2rad(1.0)
     if abs(mismatch) <= tol:
         return status, msg
-    d = warn("W-IMU-AXES", f"{source}: the gyro integrates to {np.rad2deg(gyro_change_rad):.4g} deg between the "
-                           f"rests but the accelerometer tilts by {np.rad2deg(tilt_change_rad):.4g} deg; check "
-                           "the gyro columns (axes, deg/s vs rad/s), --axis and the clock")
+    d = warn(
+        "W-IMU-AXES",
+        f"{source}: the gyro integrates to {np.rad2deg(gyro_change_rad):.4g} deg between the "
+        f"rests but the accelerometer tilts by {np.rad2deg(tilt_change_rad):.4g} deg; check "
+        "the gyro columns (axes, deg/s vs rad/s), --axis and the clock",
+    )
     return ("suspect" if status == "ok" else status), (msg + "; " if msg else "") + d.message
 
 
@@ -187,8 +213,11 @@ def _check_still_tilt(log: ImuLog, fs: float) -> None:
     c = float(np.dot(a0, a1) / (np.linalg.norm(a0) * np.linalg.norm(a1) + 1e-300))
     ang = float(np.arccos(np.clip(c, -1.0, 1.0)))
     if ang > np.deg2rad(2.0):
-        warn("W-IMU-AXES", f"{log.source}: the gyro shows no motion but gravity turned by {np.rad2deg(ang):.4g} "
-                           "deg between the start and the end; check the gyro columns' units (deg/s vs rad/s)")
+        warn(
+            "W-IMU-AXES",
+            f"{log.source}: the gyro shows no motion but gravity turned by {np.rad2deg(ang):.4g} "
+            "deg between the start and the end; check the gyro columns' units (deg/s vs rad/s)",
+        )
 
 
 def _vertical_axis(f: np.ndarray) -> np.ndarray:
@@ -198,10 +227,16 @@ def _vertical_axis(f: np.ndarray) -> np.ndarray:
     return v
 
 
-def block_rotation(log: ImuLog, axis: str | None = None, *, release: str = "auto",
-                   ahrs: bool = False,
-                   still_gyro_deg_s: float = 2.0, still_acc_g: float = 0.03,
-                   min_rest_s: float = 0.1) -> ImuRotation:
+def block_rotation(
+    log: ImuLog,
+    axis: str | None = None,
+    *,
+    release: str = "auto",
+    ahrs: bool = False,
+    still_gyro_deg_s: float = 2.0,
+    still_acc_g: float = 0.03,
+    min_rest_s: float = 0.1,
+) -> ImuRotation:
     """Rotation of a rocking block about its rocking axis from its IMU log.
 
     Parameters
@@ -231,13 +266,13 @@ def block_rotation(log: ImuLog, axis: str | None = None, *, release: str = "auto
     if n < 8:
         raise InputError(f"{log.source}: {n} samples; need at least 8 to estimate a rotation")
     if release not in ("auto", "thread", "none"):
-        raise InputError(f"release={release!r}: use 'auto', 'thread' (thread-burn release) "
-                         "or 'none' (forced run on a shake table)")
+        raise InputError(
+            f"release={release!r}: use 'auto', 'thread' (thread-burn release) or 'none' (forced run on a shake table)"
+        )
     t, gyro, acc, fs = log.t_s, log.gyro_rad_s, log.acc_m_s2, float(log.rate_hz)
     moving = motion_mask(t, gyro, acc, fs, np.deg2rad(still_gyro_deg_s), still_acc_g * G)
     min_run = max(2, int(round(0.1 * fs)))
-    forced, i_carry, i_carry_end = forced_run(t, gyro, acc, fs, np.deg2rad(still_gyro_deg_s),
-                                               still_acc_g * G, min_run)
+    forced, i_carry, i_carry_end = forced_run(t, gyro, acc, fs, np.deg2rad(still_gyro_deg_s), still_acc_g * G, min_run)
     if release != "auto":
         forced = release == "none"
     i_move = first_motion(moving, min_run)
@@ -253,18 +288,7 @@ def block_rotation(log: ImuLog, axis: str | None = None, *, release: str = "auto
         i_end = last_motion_end(moving, 1) or i_move
         if forced and i_carry_end is not None:
             i_end = max(i_end, i_carry_end)
-    # Rest windows (trim 50 ms next to motion: the smoothing widens motion edges).
-    guard = max(1, int(round(0.05 * fs)))
-    min_rest = max(3, int(round(min_rest_s * fs)))
-    s0, s1 = 0, max(0, i_move - guard)
-    if s1 - s0 < min_rest:
-        s0, s1 = 0, max(3, min(n, int(0.5 * fs)))
-        status = "no_rest_before" if status == "ok" else status
-        msg = msg or "no rest before the first motion: bias from the first 0.5 s"
-    e0, e1 = min(n, i_end + guard), n
-    has_end = (e1 - e0) >= min_rest and status != "no_motion"
-    if not has_end and status == "ok":
-        status, msg = "no_rest_after", "still moving at the end: drift not anchored"
+    s0, s1, e0, e1, has_end, min_rest, status, msg = _rest_windows(n, fs, i_move, i_end, min_rest_s, status, msg)
     bias = gyro[s0:s1].mean(axis=0)
     w = gyro - bias
     if axis is None:
@@ -276,8 +300,7 @@ def block_rotation(log: ImuLog, axis: str | None = None, *, release: str = "auto
     if has_end:
         e0 = _strict_rest_start(omega, e0, e1, float(np.std(omega[s0:s1])), fs, min_rest)
         if forced:
-            e0 = still_acc_start(acc, e0, e1, float(np.linalg.norm(np.std(acc[s0:s1], axis=0))),
-                                  fs, min_rest)
+            e0 = still_acc_start(acc, e0, e1, float(np.linalg.norm(np.std(acc[s0:s1], axis=0))), fs, min_rest)
             if e1 - e0 < min_rest:
                 has_end = False
                 if status == "ok":
@@ -321,21 +344,64 @@ def block_rotation(log: ImuLog, axis: str | None = None, *, release: str = "auto
         ref = th_start if abs(th_start) > np.deg2rad(1.0) else theta[np.argmax(np.abs(theta))]
         if ref < 0:
             u, theta, omega, th_start, drift = -u, -theta, -omega, -th_start, -drift
-    release_t = (_release_time(t, omega, i_move, s0, s1)
-                 if status != "no_motion" and not forced else np.nan)
-    impacts = (_impacts(t, theta, omega, acc, moving, i_move, i_end, fs)
-               if status != "no_motion" else np.empty(0))
+    release_t = _release_time(t, omega, i_move, s0, s1) if status != "no_motion" and not forced else np.nan
+    impacts = _impacts(t, theta, omega, acc, moving, i_move, i_end, fs) if status != "no_motion" else np.empty(0)
     rest_t = float(t[e0]) if has_end else np.nan
     ahrs_theta, ahrs_rms = None, np.nan
     if ahrs:
-        ahrs_theta = ahrs_rotation(log, u, bias, ref_slice=(e0, e1) if has_end else (s0, s1),
-                                   ref_theta=float(theta[e0:e1].mean() if has_end else th_start))
-        a, b = (i_move, i_end) if status != "no_motion" else (0, n)
-        diff = (ahrs_theta[a:b] - theta[a:b] + np.pi) % (2 * np.pi) - np.pi
-        ahrs_rms = float(np.sqrt(np.mean(diff ** 2)))
-    return ImuRotation(t, theta, omega, acc, u, bias, th_start, float(drift), release_t,
-                       impacts, rest_t, fs, log.dropped_samples, log.format, log.source,
-                       ahrs_theta, ahrs_rms, status, msg, "forced" if forced else "thread", rocking)
+        ref = (e0, e1) if has_end else (s0, s1)
+        span = (i_move, i_end) if status != "no_motion" else (0, n)
+        ref_theta = float(theta[e0:e1].mean() if has_end else th_start)
+        ahrs_theta, ahrs_rms = _ahrs_comparison(log, u, bias, theta, ref, ref_theta, span)
+    return ImuRotation(
+        t,
+        theta,
+        omega,
+        acc,
+        u,
+        bias,
+        th_start,
+        float(drift),
+        release_t,
+        impacts,
+        rest_t,
+        fs,
+        log.dropped_samples,
+        log.format,
+        log.source,
+        ahrs_theta,
+        ahrs_rms,
+        status,
+        msg,
+        "forced" if forced else "thread",
+        rocking,
+    )
+
+
+def _rest_windows(n, fs, i_move, i_end, min_rest_s, status, msg):
+    """The rest windows before and after the motion, samples ``[s0, s1)`` and ``[e0, e1)``
+    (50 ms trimmed next to the motion: the smoothing widens its edges), whether the end one is
+    long enough, the shortest rest in samples, and the status with its message."""
+    guard = max(1, int(round(0.05 * fs)))
+    min_rest = max(3, int(round(min_rest_s * fs)))
+    s0, s1 = 0, max(0, i_move - guard)
+    if s1 - s0 < min_rest:
+        s0, s1 = 0, max(3, min(n, int(0.5 * fs)))
+        status = "no_rest_before" if status == "ok" else status
+        msg = msg or "no rest before the first motion: bias from the first 0.5 s"
+    e0, e1 = min(n, i_end + guard), n
+    has_end = (e1 - e0) >= min_rest and status != "no_motion"
+    if not has_end and status == "ok":
+        status, msg = "no_rest_after", "still moving at the end: drift not anchored"
+    return s0, s1, e0, e1, has_end, min_rest, status, msg
+
+
+def _ahrs_comparison(log, u, bias, theta, ref_slice, ref_theta, span):
+    """imufusion's AHRS tilt about ``u`` and its RMS difference from ``theta`` over ``span``, rad."""
+    ahrs_theta = ahrs_rotation(log, u, bias, ref_slice=ref_slice, ref_theta=ref_theta)
+    a, b = span
+    diff = (ahrs_theta[a:b] - theta[a:b] + np.pi) % (2 * np.pi) - np.pi
+    return ahrs_theta, float(np.sqrt(np.mean(diff**2)))
 
 
 def _strict_rest_start(omega, e0, e1, sigma, fs, min_rest) -> int:
@@ -349,7 +415,7 @@ def _strict_rest_start(omega, e0, e1, sigma, fs, min_rest) -> int:
     until the end of the log.
     """
     w = max(2, int(round(0.25 * fs)))
-    thr = sigma ** 2 * (1.0 + 6.0 * np.sqrt(2.0 / w)) + np.deg2rad(0.02) ** 2
+    thr = sigma**2 * (1.0 + 6.0 * np.sqrt(2.0 / w)) + np.deg2rad(0.02) ** 2
     busy = moving_average(omega[e0:e1] ** 2, w) >= thr
     hits = np.flatnonzero(busy)
     start = e0 if hits.size == 0 else e0 + int(hits[-1]) + 1 + w // 2
@@ -391,14 +457,14 @@ def _impacts(t, theta, omega, acc, moving, i_move, i_end, fs) -> np.ndarray:
     a, b = i_move, min(i_end, len(t) - 1)
     if b - a < 4:
         return np.empty(0)
-    th = theta[a:b + 1]
+    th = theta[a : b + 1]
     cross = a + np.flatnonzero(np.signbit(th[1:]) != np.signbit(th[:-1]))
     if cross.size == 0:
         return np.empty(0)
     n = len(t)
     spike = np.zeros(n)
     i0, i1 = max(1, a - 1), min(n - 1, b + 2)  # only where impacts can be
-    spike[i0:i1] = rownorm(acc[i0:i1] - 0.5 * (acc[i0 - 1:i1 - 1] + acc[i0 + 1:i1 + 1]))
+    spike[i0:i1] = rownorm(acc[i0:i1] - 0.5 * (acc[i0 - 1 : i1 - 1] + acc[i0 + 1 : i1 + 1]))
     spike_thr = max(8.0 * float(np.median(spike[a:b])), 0.05 * G)
     jumps = np.abs(np.diff(omega))
     jump_thr = max(4.0 * float(np.median(jumps[a:b])), np.deg2rad(0.3))
@@ -438,8 +504,9 @@ def _subsample(t, omega, j) -> float:
     return float(t[j] - 0.5 * dt + f * dt)
 
 
-def ahrs_quaternions(log: ImuLog, bias_rad_s=None, gain: float = 0.5,
-                     acceleration_rejection_deg: float = 10.0) -> np.ndarray:
+def ahrs_quaternions(
+    log: ImuLog, bias_rad_s=None, gain: float = 0.5, acceleration_rejection_deg: float = 10.0
+) -> np.ndarray:
     """imufusion AHRS orientation (gyro + accelerometer, no magnetometer), (n, 4) w, x, y, z.
 
     imufusion 1.3 API: ``Ahrs().set_settings(AhrsSettings(...))`` then
@@ -451,10 +518,17 @@ def ahrs_quaternions(log: ImuLog, bias_rad_s=None, gain: float = 0.5,
 
     fs = float(log.rate_hz)
     ahrs = imufusion.Ahrs()
-    ahrs.set_settings(imufusion.AhrsSettings(
-        sample_rate=fs, convention=imufusion.CONVENTION_NWU, gain=gain,
-        gyroscope_range=2000.0, acceleration_rejection=acceleration_rejection_deg,
-        magnetic_rejection=0.0, rejection_timeout=int(5 * fs)))
+    ahrs.set_settings(
+        imufusion.AhrsSettings(
+            sample_rate=fs,
+            convention=imufusion.CONVENTION_NWU,
+            gain=gain,
+            gyroscope_range=2000.0,
+            acceleration_rejection=acceleration_rejection_deg,
+            magnetic_rejection=0.0,
+            rejection_timeout=int(5 * fs),
+        )
+    )
     bias = np.zeros(3) if bias_rad_s is None else np.asarray(bias_rad_s, float)
     gyro_dps = np.rad2deg(log.gyro_rad_s - bias)
     acc_g = log.acc_m_s2 / G
@@ -470,9 +544,15 @@ def ahrs_quaternions(log: ImuLog, bias_rad_s=None, gain: float = 0.5,
     return q
 
 
-def ahrs_rotation(log: ImuLog, u: np.ndarray, bias: np.ndarray, ref_slice: tuple[int, int],
-                  ref_theta: float = 0.0, gain: float = 0.5,
-                  acceleration_rejection_deg: float = 10.0) -> np.ndarray:
+def ahrs_rotation(
+    log: ImuLog,
+    u: np.ndarray,
+    bias: np.ndarray,
+    ref_slice: tuple[int, int],
+    ref_theta: float = 0.0,
+    gain: float = 0.5,
+    acceleration_rejection_deg: float = 10.0,
+) -> np.ndarray:
     """imufusion AHRS estimate of the rotation about ``u``, rad (n,).
 
     The AHRS quaternion is made relative to its mean over ``ref_slice`` and

@@ -30,8 +30,17 @@ from ._plausible import check_rate, check_span, check_up, up_evidence
 from ...series import TRACK3D_COLUMNS
 from ._read import PointSeries
 from ._rigidity import check_bodies_disjoint, check_rigid_body
-from ._rocking import (RockingGeometry, axis_vector, find_impacts, fit_pivots, pivot_motion, rocking_axes,
-                       rotation_sigma, segment_ids, split_rotation)
+from ._rocking import (
+    RockingGeometry,
+    axis_vector,
+    find_impacts,
+    fit_pivots,
+    pivot_motion,
+    rocking_axes,
+    rotation_sigma,
+    segment_ids,
+    split_rotation,
+)
 
 __all__ = ["Body3D", "Track3DResult", "track_points3d", "TRACK3D_COLUMNS", "TABLE_NAMES", "parse_bodies"]
 
@@ -108,23 +117,44 @@ class Body3D:
         ok = self.status == "ok"
         med = np.nanmedian(self.rms_m) if np.isfinite(self.rms_m).any() else np.nan
         quality = np.where(ok, 1.0 / (1.0 + self.rms_m / max(3.0 * med, 1e-5)) if np.isfinite(med) else 1.0, 0.0)
-        return pd.DataFrame({"frame": np.arange(n), "t_s": self.t_s, "object": self.name,
-                             "x_px": np.nan, "y_px": np.nan, "x_m": self.x_m, "y_m": self.y_m,
-                             "theta_rad": self.theta_rad, "sigma_theta_rad": self.sigma_theta_rad,
-                             "quality": quality, "status": self.status, "out_of_plane_rad": self.out_of_plane_rad,
-                             "twist_rad": self.twist_rad, "pivot_slide_m": self.pivot_slide_m,
-                             "pivot_uplift_m": self.pivot_uplift_m}, columns=list(TRACK3D_COLUMNS))
+        return pd.DataFrame(
+            {
+                "frame": np.arange(n),
+                "t_s": self.t_s,
+                "object": self.name,
+                "x_px": np.nan,
+                "y_px": np.nan,
+                "x_m": self.x_m,
+                "y_m": self.y_m,
+                "theta_rad": self.theta_rad,
+                "sigma_theta_rad": self.sigma_theta_rad,
+                "quality": quality,
+                "status": self.status,
+                "out_of_plane_rad": self.out_of_plane_rad,
+                "twist_rad": self.twist_rad,
+                "pivot_slide_m": self.pivot_slide_m,
+                "pivot_uplift_m": self.pivot_uplift_m,
+            },
+            columns=list(TRACK3D_COLUMNS),
+        )
 
     def to_dict(self) -> dict:
         """Summary numbers (SI units)."""
         ok = self.status == "ok"
-        return {"name": self.name, "points": list(self.labels), "samples": int(self.t_s.size),
-                "samples_ok": int(ok.sum()), "rest": self.rest, "is_table": self.is_table,
-                "max_abs_theta_rad": float(np.nanmax(np.abs(self.theta_rad))) if ok.any() else float("nan"),
-                "median_sigma_theta_rad": float(np.nanmedian(self.sigma_theta_rad)) if ok.any() else float("nan"),
-                "median_rms_m": float(np.nanmedian(self.rms_m)) if ok.any() else float("nan"),
-                "outliers_rejected": self.poses.n_rejected, "geometry": self.geometry.to_dict(),
-                "audit": None if self.audit is None else self.audit.to_dict()}
+        return {
+            "name": self.name,
+            "points": list(self.labels),
+            "samples": int(self.t_s.size),
+            "samples_ok": int(ok.sum()),
+            "rest": self.rest,
+            "is_table": self.is_table,
+            "max_abs_theta_rad": float(np.nanmax(np.abs(self.theta_rad))) if ok.any() else float("nan"),
+            "median_sigma_theta_rad": float(np.nanmedian(self.sigma_theta_rad)) if ok.any() else float("nan"),
+            "median_rms_m": float(np.nanmedian(self.rms_m)) if ok.any() else float("nan"),
+            "outliers_rejected": self.poses.n_rejected,
+            "geometry": self.geometry.to_dict(),
+            "audit": None if self.audit is None else self.audit.to_dict(),
+        }
 
 
 @dataclass(frozen=True)
@@ -167,13 +197,21 @@ class Track3DResult:
         audits = [(b.name, b.audit) for b in self.blocks if b.audit is not None]
         verdict = max((a.verdict for _, a in audits), key=order.__getitem__, default="valid")
         flags = [dict(f.to_dict(), object=name) for name, a in audits for f in a.flags]
-        return {"verdict": verdict, "flags": flags, "source": self.source,
-                "blocks": {name: a.to_dict() for name, a in audits}}
+        return {
+            "verdict": verdict,
+            "flags": flags,
+            "source": self.source,
+            "blocks": {name: a.to_dict() for name, a in audits},
+        }
 
     def to_dict(self) -> dict:
         """Summary of every body (no per-sample arrays)."""
-        return {"source": self.source, "up": self.up.tolist(), "notes": list(self.notes),
-                "bodies": [b.to_dict() for b in self.bodies]}
+        return {
+            "source": self.source,
+            "up": self.up.tolist(),
+            "notes": list(self.notes),
+            "bodies": [b.to_dict() for b in self.bodies],
+        }
 
 
 def parse_bodies(specs, labels, source="") -> dict:
@@ -191,8 +229,10 @@ def parse_bodies(specs, labels, source="") -> dict:
             raise InputError(f"--body {name!r} given twice; name each body once")
         missing = [p for p in plist if p not in labels]
         if missing:
-            raise InputError(f"{where(source)}--body {name}: point(s) {missing} not in the file (it has "
-                             f"{list(labels)[:12]}{' ...' if len(labels) > 12 else ''}); fix the point names")
+            raise InputError(
+                f"{where(source)}--body {name}: point(s) {missing} not in the file (it has "
+                f"{list(labels)[:12]}{' ...' if len(labels) > 12 else ''}); fix the point names"
+            )
         if len(plist) < MIN_POINTS:
             raise InputError(f"--body {name}: {len(plist)} point(s); a rigid pose needs at least {MIN_POINTS}")
         out[name] = plist
@@ -228,8 +268,10 @@ def _choose_rest(t, xyz, rest, name, source):
         t0, t1 = rest
         frames = np.flatnonzero((t >= t0) & (t <= t1))
         if frames.size < 1:
-            raise InputError(f"--rest {t0:g},{t1:g}: no samples in that time range (the record spans "
-                             f"{t[0]:.4g}-{t[-1]:.4g} s); give a range inside it")
+            raise InputError(
+                f"--rest {t0:g},{t1:g}: no samples in that time range (the record spans "
+                f"{t[0]:.4g}-{t[-1]:.4g} s); give a range inside it"
+            )
         ref = reference_shape(xyz, frames)
         return ref, f"{t0:.4g}-{t1:.4g} s", notes
     ref_first = reference_shape(xyz, first)
@@ -245,15 +287,23 @@ def _choose_rest(t, xyz, rest, name, source):
         return ref_last, "last", notes
     if q_first:
         if np.isfinite(angle) and angle > OVERTURNED_RAD:
-            notes.append(f"{name}: ends {math.degrees(angle):.4g} deg from where it started (overturned): "
-                         "the first rest is the reference")
+            notes.append(
+                f"{name}: ends {math.degrees(angle):.4g} deg from where it started (overturned): "
+                "the first rest is the reference"
+            )
             return ref_first, "first", notes
-        warn("W-3D-REST", f"{where(source)}{name} is not at rest at the end of the record; theta is measured "
-                          "from the first samples, which carry the release tilt if the block was held tilted "
-                          "(give --rest T0,T1 for an upright rest)")
+        warn(
+            "W-3D-REST",
+            f"{where(source)}{name} is not at rest at the end of the record; theta is measured "
+            "from the first samples, which carry the release tilt if the block was held tilted "
+            "(give --rest T0,T1 for an upright rest)",
+        )
         return ref_first, "first", notes
-    warn("W-3D-REST", f"{where(source)}{name} is at rest neither at the start nor at the end of the record; "
-                      "theta is measured from the last samples (give --rest T0,T1 for an upright rest)")
+    warn(
+        "W-3D-REST",
+        f"{where(source)}{name} is at rest neither at the start nor at the end of the record; "
+        "theta is measured from the last samples (give --rest T0,T1 for an upright rest)",
+    )
     return ref_last, "last", notes
 
 
@@ -286,8 +336,10 @@ def _fit_body(name, labels, t, xyz, rest, source):
     """``(reference shape, rest used, notes, BodyPoses)`` of one body: its rest, then its pose in every sample."""
     ref, rest_used, notes = _choose_rest(t, xyz, rest, name, source)
     if (~np.isfinite(ref).all(axis=1)).sum() > len(labels) - MIN_POINTS:
-        raise InputError(f"{where(source)}body {name!r}: fewer than {MIN_POINTS} of its points are placed at rest; "
-                         "give --rest T0,T1 where the points are seen, or fix the --body list")
+        raise InputError(
+            f"{where(source)}body {name!r}: fewer than {MIN_POINTS} of its points are placed at rest; "
+            "give --rest T0,T1 where the points are seen, or fix the --body list"
+        )
     poses = body_poses(xyz, ref)
     check_rigid_body(name, labels, xyz, poses, source)
     return ref, rest_used, notes, poses
@@ -301,8 +353,10 @@ def _body(name, labels, t, up, tolerances, fitted, is_table=False, axes=None):
     if axes is None:
         axis, e_r, max_rot = rocking_axes(R, up)
         if max_rot < math.radians(0.1) and not is_table:
-            notes.append(f"{name}: turns by at most {math.degrees(max_rot):.4g} deg; the rocking direction is "
-                         "the rig's first horizontal axis")
+            notes.append(
+                f"{name}: turns by at most {math.degrees(max_rot):.4g} deg; the rocking direction is "
+                "the rig's first horizontal axis"
+            )
     else:
         axis, e_r = axes
     theta, oop, twist = split_rotation(R, e_r, axis, up)
@@ -330,27 +384,66 @@ def _body(name, labels, t, up, tolerances, fitted, is_table=False, axes=None):
         ok = np.isfinite(theta)
         if np.isfinite(c_pos).all() or np.isfinite(c_neg).all():
             disp = np.full((n, 3), np.nan)
-            disp[ok] = pivot_motion(R[ok], tr[ok], theta[ok], origin,
-                                    np.where(np.isfinite(c_pos), c_pos, np.nan),
-                                    np.where(np.isfinite(c_neg), c_neg, np.nan))
+            disp[ok] = pivot_motion(
+                R[ok],
+                tr[ok],
+                theta[ok],
+                origin,
+                np.where(np.isfinite(c_pos), c_pos, np.nan),
+                np.where(np.isfinite(c_neg), c_neg, np.nan),
+            )
             slide, across, uplift = disp @ e_r, disp @ axis, disp @ up
         for side, c in (("positive", c_pos), ("negative", c_neg)):
             if not np.isfinite(c).all():
-                notes.append(f"{name}: never rocked beyond {math.degrees(min_theta):.4g} deg on the {side} side; "
-                             "its pivot is unknown and the pivot columns are empty there")
-        audit = audit_rocking(t, theta, slide_m=slide, uplift_m=uplift,
-                              twist_rad=twist, out_of_plane_rad=oop, sigma_theta_rad=sig_med,
-                              tolerances=tolerances, source="3d")
+                notes.append(
+                    f"{name}: never rocked beyond {math.degrees(min_theta):.4g} deg on the {side} side; "
+                    "its pivot is unknown and the pivot columns are empty there"
+                )
+        audit = audit_rocking(
+            t,
+            theta,
+            slide_m=slide,
+            uplift_m=uplift,
+            twist_rad=twist,
+            out_of_plane_rad=oop,
+            sigma_theta_rad=sig_med,
+            tolerances=tolerances,
+            source="3d",
+        )
     width = float((c_pos - c_neg) @ e_r) if np.isfinite(c_pos).all() and np.isfinite(c_neg).all() else float("nan")
     gap = float((c_pos - c_neg) @ up) if np.isfinite(width) else float("nan")
     geo = RockingGeometry(up, axis, e_r, origin, c_pos, c_neg, width, gap)
-    body = Body3D(name, tuple(labels), t, theta, sigma, oop, twist, x_m, y_m, slide, across, uplift,
-                  poses.rms_m, poses.status, geo, poses, rest_used, audit, is_table)
+    body = Body3D(
+        name,
+        tuple(labels),
+        t,
+        theta,
+        sigma,
+        oop,
+        twist,
+        x_m,
+        y_m,
+        slide,
+        across,
+        uplift,
+        poses.rms_m,
+        poses.status,
+        geo,
+        poses,
+        rest_used,
+        audit,
+        is_table,
+    )
     return body, notes
 
 
-def track_points3d(series: PointSeries, bodies: dict | None = None, up: str = "z", rest="auto",
-                   tolerances: AuditTolerances | None = None) -> Track3DResult:
+def track_points3d(
+    series: PointSeries,
+    bodies: dict | None = None,
+    up: str = "z",
+    rest="auto",
+    tolerances: AuditTolerances | None = None,
+) -> Track3DResult:
     """Rocking motion of every body in a 3D point record.
 
     Parameters
@@ -406,15 +499,29 @@ def track_points3d(series: PointSeries, bodies: dict | None = None, up: str = "z
             continue
         sel = series.select(labels)
         xyz = sel.xyz_m if frame_xyz is None else _in_frame(*frame_xyz, sel.xyz_m)
-        b, bnotes = _body(name, sel.labels, series.t_s, u, tolerances,
-                          _fit_body(name, sel.labels, series.t_s, xyz, rest, series.source))
+        b, bnotes = _body(
+            name,
+            sel.labels,
+            series.t_s,
+            u,
+            tolerances,
+            _fit_body(name, sel.labels, series.t_s, xyz, rest, series.source),
+        )
         notes += bnotes
         blocks.append(b)
     if tables:
         # the table's angles in the first block's rocking frame, so its x_m is the shake direction
         geo = blocks[0].geometry
-        tb, _ = _body(tables[0], tuple(bodies[tables[0]]), series.t_s, u, tolerances, table_fit, is_table=True,
-                      axes=(geo.axis, geo.e_r))
+        tb, _ = _body(
+            tables[0],
+            tuple(bodies[tables[0]]),
+            series.t_s,
+            u,
+            tolerances,
+            table_fit,
+            is_table=True,
+            axes=(geo.axis, geo.e_r),
+        )
         out.append(tb)
     out += blocks
     check_rate(series)
@@ -425,11 +532,17 @@ def track_points3d(series: PointSeries, bodies: dict | None = None, up: str = "z
     for b in out:
         lost = int((b.status != "ok").sum())
         if lost > 0.01 * b.t_s.size:
-            warn("W-3D-LOST", f"{where(series.source)}{b.name}: no pose in {lost} of {b.t_s.size} samples "
-                              f"({100.0 * lost / b.t_s.size:.4g} %): fewer than {MIN_POINTS} of its points seen")
+            warn(
+                "W-3D-LOST",
+                f"{where(series.source)}{b.name}: no pose in {lost} of {b.t_s.size} samples "
+                f"({100.0 * lost / b.t_s.size:.4g} %): fewer than {MIN_POINTS} of its points seen",
+            )
     for b in blocks:
         if b.audit is not None and b.audit.verdict != "valid":
             worst = ", ".join(sorted({f.kind for f in b.audit.flags}))
-            warn("W-AUDIT", f"{where(series.source)}{b.name}: assumption audit {b.audit.verdict} ({worst}; "
-                            f"impacts {', '.join(map(str, b.audit.excluded_impacts)) or 'none'}); see audit.json")
+            warn(
+                "W-AUDIT",
+                f"{where(series.source)}{b.name}: assumption audit {b.audit.verdict} ({worst}; "
+                f"impacts {', '.join(map(str, b.audit.excluded_impacts)) or 'none'}); see audit.json",
+            )
     return Track3DResult(tuple(out), u, series.source, tuple(notes))

@@ -31,12 +31,23 @@ from ._calib import StereoRig
 from ._epipolar import epi_distance, fundamental, undistorted
 from ._setup import check_depth_in_front, check_film_order, check_unsynchronised
 
-__all__ = ["detect_dots", "track_dots_2d", "DotTracks2D", "sync_offset_stereo", "SyncOffset", "match_tracks",
-           "triangulate_tracks", "StereoPoints", "track_dots_stereo", "check_films"]
+__all__ = [
+    "detect_dots",
+    "track_dots_2d",
+    "DotTracks2D",
+    "sync_offset_stereo",
+    "SyncOffset",
+    "match_tracks",
+    "triangulate_tracks",
+    "StereoPoints",
+    "track_dots_stereo",
+    "check_films",
+]
 
 
-def detect_dots(gray, min_area_px: int = 6, max_area_px: int = 20000, threshold: float | None = None,
-                with_area: bool = False):
+def detect_dots(
+    gray, min_area_px: int = 6, max_area_px: int = 20000, threshold: float | None = None, with_area: bool = False
+):
     """Sub-pixel centres of bright dots in a grey image.
 
     Parameters
@@ -95,7 +106,7 @@ def detect_dots(gray, min_area_px: int = 6, max_area_px: int = 20000, threshold:
             sw = patch.sum()
             if sw <= 0:
                 continue
-            yy, xx = np.mgrid[y0 + ya0:y0 + ya1, x0 + xa0:x0 + xa1]
+            yy, xx = np.mgrid[y0 + ya0 : y0 + ya1, x0 + xa0 : x0 + xa1]
             out.append(((patch * xx).sum() / sw, (patch * yy).sum() / sw))
             areas.append(float(area))
     uv = np.asarray(out, float).reshape(-1, 2)
@@ -140,8 +151,10 @@ def track_dots_2d(frames, source: str = "", gate_px: float = 25.0, progress=None
         det, det_area = detect_dots(gray, with_area=True)
         if last is None:
             if det.shape[0] < 3:
-                raise InputError(f"{where(source)}first frame: {det.shape[0]} dot(s) found; need at least 3 bright "
-                                 "targets on a dark background in view at the start")
+                raise InputError(
+                    f"{where(source)}first frame: {det.shape[0]} dot(s) found; need at least 3 bright "
+                    "targets on a dark background in view at the start"
+                )
             last, area = det, det_area
             vel = np.zeros_like(det)
             rows.append(det.copy())
@@ -216,8 +229,13 @@ class SyncOffset:
     coarse_frames: int
 
     def to_dict(self) -> dict:
-        return {"offset_frames": self.offset_frames, "offset_s": self.offset_s, "sigma_s": self.sigma_s,
-                "misfit_px": self.misfit_px, "coarse_frames": self.coarse_frames}
+        return {
+            "offset_frames": self.offset_frames,
+            "offset_s": self.offset_s,
+            "sigma_s": self.sigma_s,
+            "misfit_px": self.misfit_px,
+            "coarse_frames": self.coarse_frames,
+        }
 
 
 def _speed(uv):
@@ -229,8 +247,9 @@ def _speed(uv):
     return np.nan_to_num(s)
 
 
-def sync_offset_stereo(rig: StereoRig, tracks1: DotTracks2D, tracks2: DotTracks2D, pairs, fps: float,
-                       max_lag_frames: int = 50) -> SyncOffset:
+def sync_offset_stereo(
+    rig: StereoRig, tracks1: DotTracks2D, tracks2: DotTracks2D, pairs, fps: float, max_lag_frames: int = 50
+) -> SyncOffset:
     """The offset of camera 2's clock against camera 1's (see the module doc, step 3).
 
     ``pairs`` are matched track indices ``(i1, i2)`` (see :func:`match_tracks`).
@@ -241,7 +260,7 @@ def sync_offset_stereo(rig: StereoRig, tracks1: DotTracks2D, tracks2: DotTracks2
     n = min(s1.size, s2.size)
     a, b = s1[:n] - s1[:n].mean(), s2[:n] - s2[:n].mean()
     lags = np.arange(-max_lag_frames, max_lag_frames + 1)
-    cc = [np.dot(a[max(0, -k):n - max(0, k)], b[max(0, k):n - max(0, -k)]) for k in lags]
+    cc = [np.dot(a[max(0, -k) : n - max(0, k)], b[max(0, k) : n - max(0, -k)]) for k in lags]
     coarse = int(lags[int(np.argmax(cc))])
     i1, i2 = np.asarray(pairs, int).T
     F = fundamental(rig)
@@ -251,22 +270,20 @@ def sync_offset_stereo(rig: StereoRig, tracks1: DotTracks2D, tracks2: DotTracks2
 
     def misfit(lag):
         d = epi_distance(F, u1[moving], _shift(u2, lag)[moving])
-        return float(np.sqrt(np.nanmean(d ** 2)))
+        return float(np.sqrt(np.nanmean(d**2)))
 
-    r = minimize_scalar(misfit, bounds=(coarse - 1.5, coarse + 1.5), method="bounded",
-                        options={"xatol": 1e-4})
+    r = minimize_scalar(misfit, bounds=(coarse - 1.5, coarse + 1.5), method="bounded", options={"xatol": 1e-4})
     lag = float(r.x)
     h = 0.05
     f0, fp, fm = misfit(lag), misfit(lag + h), misfit(lag - h)
-    curv = (fp - 2 * f0 + fm) / h ** 2
+    curv = (fp - 2 * f0 + fm) / h**2
     # misfit^2 ~ noise^2 + c (lag - lag0)^2: sigma of the minimum from the noise level and the curvature
     n_obs = max(int(np.isfinite(u1[moving]).all(axis=2).sum()), 1)
     sigma = math.sqrt(max(f0, 1e-9) / max(curv * f0, 1e-12) / n_obs) if curv > 0 else float("nan")
     return SyncOffset(lag, -lag / fps, sigma / fps, f0, coarse)
 
 
-def match_tracks(rig: StereoRig, tracks1: DotTracks2D, tracks2: DotTracks2D, lag: float = 0.0,
-                 max_px: float = 2.0):
+def match_tracks(rig: StereoRig, tracks1: DotTracks2D, tracks2: DotTracks2D, lag: float = 0.0, max_px: float = 2.0):
     """Pairs ``(i1, i2)`` of tracks that are one target, by the median epipolar misfit over the film.
 
     Returns
@@ -282,7 +299,7 @@ def match_tracks(rig: StereoRig, tracks1: DotTracks2D, tracks2: DotTracks2D, lag
     u2 = undistorted(rig, 2, _shift(tracks2.uv_px, lag).reshape(-1, 2)).reshape(-1, n2, 2)
     n = min(u1.shape[0], u2.shape[0])
     step = max(1, n // 200)
-    d = epi_distance(F, u1[:n:step, :, None, :], u2[:n:step, None, :, :])      # (frames, n1, n2)
+    d = epi_distance(F, u1[:n:step, :, None, :], u2[:n:step, None, :, :])  # (frames, n1, n2)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)
         cost = np.nanmedian(d, axis=0)
@@ -344,8 +361,15 @@ class StereoPoints:
     labels: tuple | None = None
 
 
-def triangulate_tracks(rig: StereoRig, tracks1: DotTracks2D, tracks2: DotTracks2D, pairs, lag: float, fps: float,
-                       max_reproj_px: float = 1.0) -> StereoPoints:
+def triangulate_tracks(
+    rig: StereoRig,
+    tracks1: DotTracks2D,
+    tracks2: DotTracks2D,
+    pairs,
+    lag: float,
+    fps: float,
+    max_reproj_px: float = 1.0,
+) -> StereoPoints:
     """3D positions of the matched tracks, camera 2 read at ``lag`` frames (sub-frame) after camera 1."""
     import cv2
 
@@ -363,11 +387,11 @@ def triangulate_tracks(rig: StereoRig, tracks1: DotTracks2D, tracks2: DotTracks2
         h = cv2.triangulatePoints(P1, P2, a[ok].T, b[ok].T)
         Xo = (h[:3] / h[3]).T
         X[ok] = Xo
-        pa = (P1 @ np.vstack([Xo.T, np.ones(len(Xo))]))
-        pb = (P2 @ np.vstack([Xo.T, np.ones(len(Xo))]))
+        pa = P1 @ np.vstack([Xo.T, np.ones(len(Xo))])
+        pb = P2 @ np.vstack([Xo.T, np.ones(len(Xo))])
         ea = np.linalg.norm(pa[:2] / pa[2] - a[ok].T, axis=0)
         eb = np.linalg.norm(pb[:2] / pb[2] - b[ok].T, axis=0)
-        err[ok] = np.sqrt(0.5 * (ea ** 2 + eb ** 2))
+        err[ok] = np.sqrt(0.5 * (ea**2 + eb**2))
     bad = ~(err <= max_reproj_px)
     X[bad] = np.nan
     k = len(i1)
@@ -384,31 +408,42 @@ def check_films(film1, film2, rig: StereoRig, fps: float | None = None) -> float
     for info, film in ((i1, film1), (i2, film2)):
         check_mirrored(info, film)
         if (info.width_px, info.height_px) != tuple(rig.size):
-            raise InputError(f"{where(film)}frame size {info.width_px}x{info.height_px} differs from the "
-                             f"calibration's {rig.size[0]}x{rig.size[1]}; calibrate with films of this camera mode")
+            raise InputError(
+                f"{where(film)}frame size {info.width_px}x{info.height_px} differs from the "
+                f"calibration's {rig.size[0]}x{rig.size[1]}; calibrate with films of this camera mode"
+            )
         if fps is None and info.frame_times_s is not None and info.variable_rate and not info.n_dropped:
             # frames are paired by their slot on one constant clock (a dropped frame is an empty
             # slot); a variable rate has no slots
             d = np.diff(info.frame_times_s)
             at = float(info.frame_times_s[int(np.argmax(np.abs(d - np.median(d))))])
-            raise InputError(f"{where(film)}the camera has a variable frame rate (first irregular interval after "
-                             f"t = {at:.4f} s); stereo pairs the two films frame by frame at one rate: film at a "
-                             "fixed rate, or give --fps if the container's times are wrong")
+            raise InputError(
+                f"{where(film)}the camera has a variable frame rate (first irregular interval after "
+                f"t = {at:.4f} s); stereo pairs the two films frame by frame at one rate: film at a "
+                "fixed rate, or give --fps if the container's times are wrong"
+            )
     rate1 = fps or i1.fps
     rate2 = fps or i2.fps
     if not rate1:
-        raise InputError(f"{where(film1)}the film has no frame rate (an image folder has one only from its timestamps.csv); give --fps")
+        raise InputError(
+            f"{where(film1)}the film has no frame rate (an image folder has one only from its timestamps.csv); give --fps"
+        )
     if fps is None and rate2 and abs(rate1 - rate2) > 1e-3 * rate1:
-        raise InputError(f"{where(film2)}{rate2:.6g} frames/s but {film1} has {rate1:.6g}; the two cameras must run "
-                         "at one rate (give --fps if a container is wrong)")
+        raise InputError(
+            f"{where(film2)}{rate2:.6g} frames/s but {film1} has {rate1:.6g}; the two cameras must run "
+            "at one rate (give --fps if a container is wrong)"
+        )
     if abs(i1.n_frames - i2.n_frames) > max(5, 0.05 * max(i1.n_frames, i2.n_frames)):
-        raise InputError(f"{where(film2)}{i2.n_frames} frames but {film1} has {i1.n_frames}: the films must cover "
-                         "the same test (trim them to the same start and length)")
+        raise InputError(
+            f"{where(film2)}{i2.n_frames} frames but {film1} has {i1.n_frames}: the films must cover "
+            "the same test (trim them to the same start and length)"
+        )
     return float(rate1)
 
 
-def track_dots_stereo(film1, film2, rig: StereoRig, fps: float | None = None, sync: bool = True,
-                      progress: bool = False) -> StereoPoints:
+def track_dots_stereo(
+    film1, film2, rig: StereoRig, fps: float | None = None, sync: bool = True, progress: bool = False
+) -> StereoPoints:
     """Dots of two films to 3D points in camera 1's axes (the steps of the module doc).
 
     Parameters
@@ -436,21 +471,30 @@ def track_dots_stereo(film1, film2, rig: StereoRig, fps: float | None = None, sy
     if progress:
         from tqdm import tqdm
 
-        bar = tqdm(total=probe_video(film1).n_frames + probe_video(film2).n_frames, unit="frame", desc="stereo", file=__import__("sys").stderr)
+        bar = tqdm(
+            total=probe_video(film1).n_frames + probe_video(film2).n_frames,
+            unit="frame",
+            desc="stereo",
+            file=__import__("sys").stderr,
+        )
     from concurrent.futures import ThreadPoolExecutor
 
     # one film per thread: decoding and the detector's OpenCV calls release the GIL, so two cores work
     with ThreadPoolExecutor(max_workers=2) as ex:
-        jobs = [ex.submit(track_dots_2d, frames_by_index(f, lost), str(f),
-                          progress=bar.update if bar else None) for f in (film1, film2)]
+        jobs = [
+            ex.submit(track_dots_2d, frames_by_index(f, lost), str(f), progress=bar.update if bar else None)
+            for f in (film1, film2)
+        ]
         t1, t2 = (j.result() for j in jobs)
     warn_lost(lost)
     if bar:
         bar.close()
     pairs, _ = match_tracks(rig, t1, t2, 0.0, max_px=5.0)
     if len(pairs) < 3:
-        raise InputError(f"{where(film1)}only {len(pairs)} dot(s) match along epipolar lines with {film2}; check that "
-                         "the calibration belongs to these cameras and both see the targets")
+        raise InputError(
+            f"{where(film1)}only {len(pairs)} dot(s) match along epipolar lines with {film2}; check that "
+            "the calibration belongs to these cameras and both see the targets"
+        )
     check_film_order(rig, t1.uv_px[:, pairs[:, 0]], t2.uv_px[:, pairs[:, 1]], film1, film2)
     so = None
     lag = 0.0

@@ -51,8 +51,8 @@ def register(sub):
     p.add_argument(
         "--method",
         default="newmark",
-        choices=["newmark", "event"],
-        help="newmark (numba, fast) or event (scipy solve_ivp reference)",
+        help="integrator from rocklab.models.rocking.METHODS: newmark (numba, fast; default), taylor "
+        "(high order, exact impacts) or event (scipy solve_ivp with impact events, the reference)",
     )
     p.add_argument(
         "--no-stop-at-rest",

@@ -11,98 +11,31 @@ Sub-packages:
   folders of photos): one camera's lens file, and the boards the stereo calibration reads.
 
 The clock synchronisation of an IMU to a video track is here (:func:`sync_offset`,
-:func:`sync_imu_to_track`). The most used names of the sub-packages are re-exported.
+:func:`sync_imu_to_track`), and the manual corrections of a track (:func:`load_corrections`,
+:func:`apply_corrections`). Every public name of the sub-packages is also here: each
+sub-package's ``__all__`` is the one list.
 """
 
+from . import calib, imu, rigid, stereo, video
 from ._corrections import apply_corrections, load_corrections
 from ._sync import SyncResult, sync_events, sync_imu_to_track, sync_offset, track_rate
-from .calib import Board, Lens, calibrate_lens, load_lens, parse_board
-from .imu import (
-    ImuLog,
-    ImuRotation,
-    TableAcceleration,
-    ahrs_quaternions,
-    block_rotation,
-    read_imu,
-    read_ximu_registers,
-    table_acceleration,
-    ximu_rate_from_registers,
-)
-from .video import (
-    TRACK_COLUMNS,
-    BoardConfig,
-    MotionConfig,
-    ObjectConfig,
-    ObjectTrack,
-    Observation,
-    PlaneMap,
-    ReferenceConfig,
-    SimilarityFit,
-    TableMotion,
-    TargetsConfig,
-    TrackConfig,
-    TrackResult,
-    VideoConfig,
-    VideoInfo,
-    assemble_tracks,
-    calibrate_camera,
-    choose_sg_window,
-    estimate_noise,
-    fit_similarity,
-    iter_video_frames,
-    load_track_config,
-    probe_video,
-    table_motion,
-    track_frames,
-    track_video,
-)
+from .calib import *  # noqa: F403
+from .imu import *  # noqa: F403
+from .rigid import *  # noqa: F403
+from .stereo import *  # noqa: F403
+from .video import *  # noqa: F403
 
-__all__: list[str] = [
-    "load_corrections",
-    "apply_corrections",
-    "TrackConfig",
-    "VideoConfig",
-    "TargetsConfig",
-    "ReferenceConfig",
-    "BoardConfig",
-    "MotionConfig",
-    "ObjectConfig",
-    "load_track_config",
-    "track_video",
-    "track_frames",
-    "assemble_tracks",
-    "TrackResult",
-    "ObjectTrack",
-    "Observation",
-    "TRACK_COLUMNS",
-    "TableMotion",
-    "table_motion",
-    "choose_sg_window",
-    "estimate_noise",
-    "VideoInfo",
-    "probe_video",
-    "iter_video_frames",
-    "PlaneMap",
-    "SimilarityFit",
-    "fit_similarity",
-    "calibrate_camera",
-    "Board",
-    "parse_board",
-    "Lens",
-    "calibrate_lens",
-    "load_lens",
-    "ImuLog",
-    "read_imu",
-    "read_ximu_registers",
-    "ximu_rate_from_registers",
-    "ImuRotation",
-    "block_rotation",
-    "ahrs_quaternions",
-    "TableAcceleration",
-    "table_acceleration",
+__all__ = [
     "SyncResult",
-    "sync_offset",
     "sync_events",
     "sync_imu_to_track",
+    "sync_offset",
     "track_rate",
+    "load_corrections",
+    "apply_corrections",
 ]
+__all__ += video.__all__
+__all__ += imu.__all__
+__all__ += calib.__all__
+__all__ += rigid.__all__
+__all__ += stereo.__all__

@@ -17,12 +17,12 @@ from pathlib import Path
 
 CHECKS = (
     "check_output_dir",
-    "check_unknown",
+    "reject_unknown",
     "check_plausible",
     "check_imu_log",
     "_check_gyro_vs_tilt",
     "_check_still_tilt",
-    "_cut_at_gap",
+    "cut_at_gap",
     "_check_frames",
     "check_step",
     "check_memory",

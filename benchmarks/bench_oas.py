@@ -90,17 +90,17 @@ def main() -> int:
     # the same sampled runs through the OAS's batch path, one numba thread (per core)
     import numba
 
-    from rocklab.models.spectra._oas import OAS_DEFAULTS, _CRIT, _runs
+    from rocklab.models.spectra._oas import CRIT, OAS_DEFAULTS, batch_runs
 
     nt = numba.get_num_threads()
     numba.set_num_threads(1)
     sc = np.array([o.levels[i] * math.tan(alpha) * G / rec.pga_m_s2 for i, _ in sample])
     pp = np.array([o.p_rad_s[j] for _, j in sample])
-    args = (alpha, o.eta, _CRIT["angle"], 1, 0.0, OAS_DEFAULTS["max_p_dt"])
-    _runs(rec, sc, pp, args)
+    args = (alpha, o.eta, CRIT["angle"], 1, 0.0, OAS_DEFAULTS["max_p_dt"])
+    batch_runs(rec, sc, pp, args)
     t0 = time.perf_counter()
     for _ in range(5):
-        _runs(rec, sc, pp, args)
+        batch_runs(rec, sc, pp, args)
     t_b1 = (time.perf_counter() - t0) / 5 / len(sample)
     numba.set_num_threads(nt)
     print(

@@ -332,7 +332,7 @@ def judge_law(
     """
     from scipy.stats import chi2
 
-    from ._simfit import _ac_factor
+    from ._simfit import ac_factor
 
     t = np.asarray(t_s, float)
     y = np.asarray(theta_rad, float)
@@ -347,7 +347,7 @@ def judge_law(
     if inside.sum() >= 8:
         sd = np.std(ens.theta_rad[:, inside], axis=0)
         z = (y[inside] - p50[inside]) / np.sqrt(sd**2 + meas_noise_rad**2)
-        n_eff = max(1.0, z.size / _ac_factor(z))
+        n_eff = max(1.0, z.size / ac_factor(z))
         tests["inside_horizon"] = float(chi2.sf(float(np.mean(z**2)) * n_eff, n_eff))
     meas = response_statistics(t[ok], y[ok], alpha_rad, meas_noise_rad)
     members = [response_statistics(t, th, alpha_rad, 0.0) for th in ens.theta_rad]

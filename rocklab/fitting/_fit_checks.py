@@ -24,7 +24,7 @@ RESIDUAL_FACTOR = 20.0
 RESIDUAL_FLOOR_RAD = 1e-3
 
 
-def _cut_at_gap(t, y, t_release_s, sigma_rad):
+def cut_at_gap(t, y, t_release_s, sigma_rad):
     """Keep the record up to the first gap after the release that could hide an impact.
 
     Impacts inside a gap cannot be seen, so counting half-cycles across it makes every
@@ -69,7 +69,7 @@ def _cut_at_gap(t, y, t_release_s, sigma_rad):
     return t, y, None
 
 
-def _suspicion(t, y, res, rms, sigma, pie, tc, alpha):
+def suspicion(t, y, res, rms, sigma, pie, tc, alpha):
     """Symptoms of slip or jumping: structured residuals, asymmetric decay, offset rest, jumps."""
     flags = []
     if res.size >= 20 and rms > 3.0 * sigma:

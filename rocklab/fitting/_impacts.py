@@ -252,7 +252,7 @@ def _release_for(t, y, block):
     return rel
 
 
-def _crossings(t, y, rel):
+def zero_crossings(t, y, rel):
     sig = max(rel.sigma_rad, 1e-9)
     ic = find_crossings(t, y, start=rel.index if rel.found else 0, threshold=max(4.0 * sig, 1e-6))
     return np.array([_local_crossing_time(t, y, i) for i in ic])
@@ -318,7 +318,7 @@ def per_impact_eta(
         "n_after",
         "ok",
     ]
-    tc = _crossings(t, y, rel) if crossings_t_s is None else np.asarray(crossings_t_s, float)
+    tc = zero_crossings(t, y, rel) if crossings_t_s is None else np.asarray(crossings_t_s, float)
     if tc.size == 0:
         return pd.DataFrame(columns=cols)
     peaks = arch_peaks(t, y, tc, release=rel, sigma_rad=rel.sigma_rad if rel.sigma_rad > 0 else None)
@@ -418,7 +418,7 @@ def energy_loss_from_peaks(t_s, theta_rad, block=None, start: int = 0, n_avg: in
     """
     t, y, _ = check_record(t_s, theta_rad)
     rel = _release_for(t, y, block)
-    tc = _crossings(t, y, rel)
+    tc = zero_crossings(t, y, rel)
     if tc.size < 2:
         raise InputError(f"record has {tc.size} impact(s): need at least 2 for peak-to-peak energy loss")
     pk = arch_peaks(t, y, tc, release=rel).dropna(subset=["theta_rad"])

@@ -16,7 +16,7 @@ import numpy as np
 from scipy.optimize import minimize_scalar
 from scipy.stats import chi2
 
-from ._simfit import _ac_factor, _Problem
+from ._simfit import ac_factor, Problem
 
 __all__ = ["ReleaseInfo", "detect_release", "settle_release"]
 
@@ -277,7 +277,7 @@ def settle_release(t, y, block, dt_s: float, max_nodes: int = 400, p_ambiguous: 
     if nodes.size < 3:
         return rel, None
     for _ in range(2):  # θ0 enters linearly about th0; re-centre once on the profiled level
-        prob = _Problem(t, ys, block, th0, dt_s, t[k1] - t[0] + 0.1)
+        prob = Problem(t, ys, block, th0, dt_s, t[k1] - t[0] + 0.1)
         sse = np.array([prob.at_release(0.5, idx, t[i])[0] for i in nodes])
         b = int(np.argmin(sse))
         lo, hi = t[nodes[max(b - 1, 0)]], t[nodes[min(b + 1, nodes.size - 1)]]
@@ -294,7 +294,7 @@ def settle_release(t, y, block, dt_s: float, max_nodes: int = 400, p_ambiguous: 
     t_r = float(res.x)
     m0, S = prob.model(0.5, t[idx], t_r)
     resid = ys[idx] - m0 - (th_hat - prob.theta0) * S
-    thresh = float(chi2.ppf(p_ambiguous, 1)) * f_hat / max(k1 - 2, 1) * _ac_factor(resid)
+    thresh = float(chi2.ppf(p_ambiguous, 1)) * f_hat / max(k1 - 2, 1) * ac_factor(resid)
     rivals = np.flatnonzero((np.abs(nodes - nodes[b]) > 3) & (sse - f_hat < thresh))
     if b == nodes.size - 1:  # the physics wants a later release than the data allow: not the block's motion
         return rel, None

@@ -41,10 +41,10 @@ from .._diagnostics import warn
 from .._errors import InputError
 from ..blocks import is_lab_size
 from ..config import FIT_WINDOWS
-from ._impacts import _crossings, arch_peaks, check_record, per_impact_eta
+from ._impacts import zero_crossings, arch_peaks, check_record, per_impact_eta
 from ._release import settle_release
-from ._fit_checks import RESIDUAL_FACTOR, RESIDUAL_FLOOR_RAD, _cut_at_gap, _suspicion
-from ._simfit import _ac_factor, _grid_then_brent, _Problem, _profile_ci
+from ._fit_checks import RESIDUAL_FACTOR, RESIDUAL_FLOOR_RAD, cut_at_gap, suspicion
+from ._simfit import ac_factor, grid_then_brent, Problem, profile_ci
 
 __all__ = ["RestitutionFit", "fit_restitution", "WINDOWS", "OBJECTIVES"]
 
@@ -295,7 +295,7 @@ class _EtaSearch:
         """The simulation problem of window ``kind`` (built once per linearisation)."""
         if kind not in self._probs:
             b = self.window_span(kind)[1]
-            self._probs[kind] = _Problem(
+            self._probs[kind] = Problem(
                 self.t,
                 self.y,
                 self.block,
@@ -330,7 +330,7 @@ class _EtaSearch:
         lo_b, hi_b = self.lo_b, self.hi_b
         while True:
             lo, hi = max(lo_b, center - span), min(hi_b, center + span)
-            x, fx, on_edge = _grid_then_brent(f_grid, f, lo, hi)
+            x, fx, on_edge = grid_then_brent(f_grid, f, lo, hi)
             on_edge = on_edge and ((x - lo < 0.5 * span and lo > lo_b) or (hi - x < 0.5 * span and hi < hi_b))
             if not on_edge or span >= max_span:
                 return x, fx
@@ -424,7 +424,7 @@ class _EtaSearch:
 
     def suspicion(self, offset, residuals, rms, pie):
         """Slip/jump/misfit flags of the fit (:func:`~rocklab.fitting._fit_checks._suspicion`)."""
-        return _suspicion(self.t, self.y - offset, residuals, rms, self.sigma, pie, self.tc, self.block.alpha_rad)
+        return suspicion(self.t, self.y - offset, residuals, rms, self.sigma, pie, self.tc, self.block.alpha_rad)
 
     def release_fit(self, eta):
         """(SSE, release time s, θ0 rad, offset rad) from the plateau and release quarter-cycle only."""
@@ -453,7 +453,7 @@ def _prepare(t_s, theta_rad, block, window, objective, bounds, dt_s, nan, eta_gu
             )
         )
     # from the last sample at rest: a gap that swallows the release (placed between samples) still counts
-    t, y, gap_diag = _cut_at_gap(t, y, min(rel.t_s, t[max(rel.n_plateau - 1, 0)]), rel.sigma_rad)
+    t, y, gap_diag = cut_at_gap(t, y, min(rel.t_s, t[max(rel.n_plateau - 1, 0)]), rel.sigma_rad)
     if gap_diag is not None:
         diags.append(gap_diag)
     s0 = 1.0 if rel.theta0_rad > 0 else -1.0
@@ -479,7 +479,7 @@ def _prepare(t_s, theta_rad, block, window, objective, bounds, dt_s, nan, eta_gu
         )
     if undecided is not None:
         diags.append(warn("W-FIT-RELEASE", f"{name or 'block'}: {undecided}"))
-    tc = _crossings(t, y, rel)
+    tc = zero_crossings(t, y, rel)
     n_imp = int(tc.size)
     if n_imp < 3:
         return _failed(
@@ -615,8 +615,8 @@ def fit_restitution(
     rms = float(np.sqrt(np.mean(win_res**2))) if win_res.size else float("nan")
     n_par = (4 + int(fit_offset)) if objective_used == "theta" else 1
     s2 = f_hat / max(n_pts - n_par, 1)
-    thresh = float(chi2.ppf(level, 1)) * s2 * _ac_factor(win_res)
-    ci = _profile_ci(f_main, eta_hat, f_hat, thresh, lo_b, hi_b)
+    thresh = float(chi2.ppf(level, 1)) * s2 * ac_factor(win_res)
+    ci = profile_ci(f_main, eta_hat, f_hat, thresh, lo_b, hi_b)
     at_bound = search.at_bound(eta_hat, eta_first, tr_hat)
     flags = search.suspicion(offset, win_res if objective_used == "theta" else np.array([]), rms, pie)
     diags += _residual_warning(name, block, rms, search.rel.sigma_rad)

@@ -1,8 +1,8 @@
 """Simulation-backed least-squares machinery for :func:`~rocklab.fitting.fit_restitution`.
 
-``_Problem`` compares a record with free-rocking simulations of constant restitution
-(release time profiled by Brent, θ0 by linearised least squares); ``_grid_then_brent``
-and ``_profile_ci`` do the 1-D search and the profile-likelihood interval.
+``Problem`` compares a record with free-rocking simulations of constant restitution
+(release time profiled by Brent, θ0 by linearised least squares); ``grid_then_brent``
+and ``profile_ci`` do the 1-D search and the profile-likelihood interval.
 """
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ import numpy as np
 from scipy.optimize import brentq, minimize_scalar
 
 
-class _Problem:
+class Problem:
     """Simulation-backed objective for one record (θ0 > 0 after sign normalisation).
 
     For each η the release time is profiled by bounded Brent and θ0 (and optionally a
@@ -137,7 +137,7 @@ class _Problem:
         return np.asarray(res)
 
 
-def _grid_then_brent(fun_grid, fun, lo, hi, n_grid=5, xtol=1e-6):
+def grid_then_brent(fun_grid, fun, lo, hi, n_grid=5, xtol=1e-6):
     """1-D minimisation: coarse grid with a cheap objective, then bounded Brent on ``fun``
     between the neighbours of the best node. Returns (x, f(x), best node on the grid edge)."""
     xs = np.linspace(lo, hi, n_grid)
@@ -148,7 +148,7 @@ def _grid_then_brent(fun_grid, fun, lo, hi, n_grid=5, xtol=1e-6):
     return float(res.x), float(res.fun), (i == 0 or i == n_grid - 1)
 
 
-def _profile_ci(fun, x_hat, f_hat, thresh, lo, hi):
+def profile_ci(fun, x_hat, f_hat, thresh, lo, hi):
     """Interval where fun(x) − f_hat ≤ thresh, searched outward from x_hat within [lo, hi].
 
     The profile is nearly quadratic near its minimum, so each side is first solved by the
@@ -195,7 +195,7 @@ def _profile_ci(fun, x_hat, f_hat, thresh, lo, hi):
     return tuple(out)
 
 
-def _ac_factor(res):
+def ac_factor(res):
     if res.size < 8:
         return 1.0
     r = res - res.mean()

@@ -88,7 +88,7 @@ OAS_DEFAULTS = dict(
     max_p_dt=0.001,
 )
 
-_CRIT = {"angle": 0, "fall": 1}
+CRIT = {"angle": 0, "fall": 1}
 _GOLDEN = 0.5 * (math.sqrt(5.0) - 1.0)
 
 
@@ -105,7 +105,7 @@ def critical_impulse(R_m: float, alpha_rad: float, alpha_I: float = 4.0 / 3.0) -
     return math.sqrt(2 * alpha_I * R_m * G * (1 - math.cos(alpha_rad))) / math.cos(alpha_rad)
 
 
-def _free_code(free):
+def free_after_code(free):
     if isinstance(free, str):
         if free == "energy":
             return 1, 0.0
@@ -224,7 +224,7 @@ class OASResult:
 MAX_SLENDERNESS = 1000.0
 
 
-def _check_opts(slenderness, levels, sizes, R_max_m, R_min_m, level_max, alpha_I):
+def check_opts(slenderness, levels, sizes, R_max_m, R_min_m, level_max, alpha_I):
     try:
         sl = float(slenderness)
     except (TypeError, ValueError):
@@ -321,7 +321,7 @@ def overturning_spectrum(
     -------
     OASResult
     """
-    sl = _check_opts(slenderness, levels, sizes, R_max_m, R_min_m, level_max, alpha_I)
+    sl = check_opts(slenderness, levels, sizes, R_max_m, R_min_m, level_max, alpha_I)
     if not isinstance(base, BaseMotion):
         raise InputError(f"base={type(base).__name__}: expected a BaseMotion (load_base_motion)")
     from ..._errors import check_memory
@@ -335,7 +335,7 @@ def overturning_spectrum(
         f"an OAS grid of {int(levels)} x {int(sizes)} runs",
         "reduce --levels/--sizes (the defaults 80 x 120 resolve t_I)",
     )
-    if criterion not in _CRIT:
+    if criterion not in CRIT:
         raise InputError(f"criterion={criterion!r}: use 'angle' (|theta|>=alpha) or 'fall' (|theta|>=pi/2)")
     if search not in ("scan", "contiguous"):
         raise InputError(f"search={search!r}: use 'scan' or 'contiguous'")
@@ -343,7 +343,7 @@ def overturning_spectrum(
         raise InputError(f"grid={grid!r}: use 'adaptive' (refined where verdicts change), 'dense' or 'boundary'")
     if (grid == "boundary") != (guide is not None):
         raise InputError("grid='boundary' and guide=<an OAS of the same record> go together")
-    free_code, free_s = _free_code(free)
+    free_code, free_s = free_after_code(free)
     alpha = math.atan(1.0 / sl)
     eta_v = 1.0 - 2.0 * math.sin(alpha) ** 2 / alpha_I if eta is None else float(eta)
     if eta is not None and not (0.0 <= eta_v <= 1.0):
@@ -364,7 +364,7 @@ def overturning_spectrum(
     scales = lv * math.tan(alpha) * G / base.pga_m_s2  # record scaled to a_p = level g tan(alpha)
     if not (math.isfinite(max_p_dt) and 0 < max_p_dt <= 0.5):
         raise InputError(f"max_p_dt={max_p_dt!r}: step times p must be in (0, 0.5]")
-    args = (alpha, eta_v, _CRIT[criterion], free_code, free_s, float(max_p_dt))
+    args = (alpha, eta_v, CRIT[criterion], free_code, free_s, float(max_p_dt))
     opts = dict(
         levels=int(levels),
         level_max=float(level_max),
@@ -393,15 +393,15 @@ def overturning_spectrum(
             raise InputError("verdicts: the earlier OAS differs in more than search/refine; compute this one anew")
         over, evaluated = verdicts.overturned, verdicts.evaluated
     elif grid == "dense":
-        over = _runs(base, np.repeat(scales, p.size), np.tile(p, scales.size), args)
+        over = batch_runs(base, np.repeat(scales, p.size), np.tile(p, scales.size), args)
         over = over.reshape(scales.size, p.size)
         evaluated = np.ones_like(over)
     elif grid == "boundary":
         over, evaluated = boundary_verdicts(
-            lambda i, j: _runs(base, scales[i], p[j], args), lv.size, p.size, _guess_first(guide, lv, p)
+            lambda i, j: batch_runs(base, scales[i], p[j], args), lv.size, p.size, _guess_first(guide, lv, p)
         )
     else:
-        over, evaluated = adaptive_verdicts(lambda i, j: _runs(base, scales[i], p[j], args), lv.size, p.size)
+        over, evaluated = adaptive_verdicts(lambda i, j: batch_runs(base, scales[i], p[j], args), lv.size, p.size)
 
     p_hi, p_lo = _first_unsafe(over, p, search)
     p_hi, p_lo = _bisect(base, scales, p_hi, p_lo, refine, args)
@@ -471,7 +471,7 @@ def _guess_first(guide, lv, p):
     return first
 
 
-def _runs(base, scale, p, args):
+def batch_runs(base, scale, p, args):
     """Overturned flags of independent runs (``base`` times ``scale``, blocks ``p``) by ``simulate_batch``."""
     alpha, eta, crit, free_code, free_s, max_p_dt = args
     # neighbouring grid points cost alike and the parallel loop hands each thread one contiguous
@@ -508,7 +508,7 @@ def _bisect(base, scales, p_hi, p_lo, n, args):
     idx = np.flatnonzero(m)
     for _ in range(int(n)):
         pm = np.sqrt(p_hi[idx] * p_lo[idx])
-        o = _runs(base, scales[idx], pm, args)
+        o = batch_runs(base, scales[idx], pm, args)
         p_hi[idx] = np.where(o, pm, p_hi[idx])
         p_lo[idx] = np.where(o, p_lo[idx], pm)
     return p_hi, p_lo

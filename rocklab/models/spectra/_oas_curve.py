@@ -13,7 +13,7 @@ import numpy as np
 
 from ..._errors import InputError
 from ...blocks import G
-from ._oas import _CRIT, OAS_DEFAULTS, _check_opts, _free_code, _runs, normalised_critical_impulse
+from ._oas import CRIT, OAS_DEFAULTS, check_opts, free_after_code, batch_runs, normalised_critical_impulse
 from ...series import BaseMotion
 
 __all__ = ["OverturningCurve", "overturning_curve"]
@@ -80,24 +80,24 @@ def overturning_curve(
     """
     from ._pulses import pulse_duration, pulse_fullness, pulse_shape
 
-    alpha = math.atan(1.0 / _check_opts(slenderness, 2, 2, 2.0, 1.0, 2.0, alpha_I))
+    alpha = math.atan(1.0 / check_opts(slenderness, 2, 2, 2.0, 1.0, 2.0, alpha_I))
     eta_v = 1.0 - 2.0 * math.sin(alpha) ** 2 / alpha_I if eta is None else float(eta)
-    if criterion not in _CRIT:
+    if criterion not in CRIT:
         raise InputError(f"criterion={criterion!r}: use 'angle' or 'fall'")
-    fc, fs = _free_code(free)
+    fc, fs = free_after_code(free)
     x = np.atleast_1d(np.asarray(ptp, float))
     lv = np.atleast_1d(np.asarray(levels, float))
     if (x <= 0).any() or (lv <= 0).any():
         raise InputError("ptp and levels must be positive")
     over = np.zeros((lv.size, x.size), bool)
     amin = np.full(x.size, np.nan)
-    args = (alpha, eta_v, _CRIT[criterion], fc, fs, OAS_DEFAULTS["max_p_dt"])
+    args = (alpha, eta_v, CRIT[criterion], fc, fs, OAS_DEFAULTS["max_p_dt"])
     for j, tp in enumerate(x):
         # dimensionless: p = 1 rad/s, the pulse in g (record in m/s^2 times level tan(alpha))
         dt = tp / samples_per_lobe
         t = np.arange(int(round(pulse_duration(kind, tp, n) / dt)) + 2) * dt
         base = BaseMotion.from_samples(G * pulse_shape(kind, t, tp, n), dt, name=kind)
-        o = _runs(base, lv * math.tan(alpha), np.ones(lv.size), args)
+        o = batch_runs(base, lv * math.tan(alpha), np.ones(lv.size), args)
         over[:, j] = o
         hit = np.flatnonzero(o)
         if hit.size == 0:
@@ -107,7 +107,7 @@ def overturning_curve(
         lo = lv[k - 1] if k > 0 else 1.0
         for _ in range(refine if lo < hi else 0):
             mid = 0.5 * (lo + hi)
-            if _runs(base, np.array([mid * math.tan(alpha)]), np.ones(1), args)[0]:
+            if batch_runs(base, np.array([mid * math.tan(alpha)]), np.ones(1), args)[0]:
                 hi = mid
             else:
                 lo = mid

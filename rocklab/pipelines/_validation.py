@@ -232,7 +232,7 @@ def prepare_forced(cfg, block, prim, table, table_sync, msgs: list):
         None when the run cannot be validated (a note says why).
     """
     from ..fitting import fit_forced_restitution
-    from .experiment._column_run import base_from_table
+    from .experiment import base_from_table
 
     t, y = (np.asarray(v, float) for v in prim)
     ok = np.isfinite(y)

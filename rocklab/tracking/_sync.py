@@ -26,9 +26,9 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy.integrate import cumulative_trapezoid
 
 from .._errors import InputError
-from .imu._motion import cumtrapz
 
 __all__ = ["SyncResult", "sync_offset", "sync_events", "track_rate", "sync_imu_to_track"]
 
@@ -112,7 +112,7 @@ def _box(t, y, w):
 
     if w <= 0:
         return make_interp_spline(t, y, k=3)
-    Y = make_interp_spline(t, cumtrapz(t, y), k=3)
+    Y = make_interp_spline(t, cumulative_trapezoid(y, t, initial=0.0), k=3)
     return lambda x: (Y(x + 0.5 * w) - Y(x - 0.5 * w)) / w
 
 
@@ -261,12 +261,12 @@ def sync_offset(
         tt = np.asarray(t_b, float).ravel()
         ok = np.isfinite(tt) & np.isfinite(th_all)
         tB, B = tt[ok], sign * th_all[ok]
-        Aint = cumtrapz(ta, ya)
+        Aint = cumulative_trapezoid(ya, ta, initial=0.0)
     else:
         # Angles suit a noisy differentiated track (no noise amplification); two
         # gyros compare best on the rates themselves.
-        tB, B = tb, cumtrapz(tb, yb)
-        Aint = cumtrapz(ta, fa(ta))
+        tB, B = tb, cumulative_trapezoid(yb, tb, initial=0.0)
+        Aint = cumulative_trapezoid(fa(ta), ta, initial=0.0)
 
     from scipy.interpolate import make_interp_spline
 

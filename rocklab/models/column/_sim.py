@@ -458,7 +458,7 @@ def simulate_column(
         duration_s = (float(base.t_s[-1]) + 5.0) if base is not None else 10.0
     if not (math.isfinite(duration_s) and duration_s > 0):
         raise InputError(f"duration_s={duration_s!r}: must be positive (s)")
-    from ..rocking._integrators import check_step
+    from ..rocking import check_step
 
     check_step(max(b.p_rad_s for b in column.blocks), dt_s, "dt_s")
     phi0, v0, s0 = _initial_state(column, theta0_rad, omega0_rad_s)

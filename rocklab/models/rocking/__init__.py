@@ -20,6 +20,8 @@ from ._restitution import (
 )
 from ._result import BatchResult, KernelResult, RockingResult, block_energy
 from ._single import simulate
+from ._integrators import check_step
+
 
 __all__ = [
     "simulate",
@@ -42,4 +44,5 @@ __all__ = [
     "eta_modified",
     "eta_axes",
     "eta_bumps",
+    "check_step",
 ]

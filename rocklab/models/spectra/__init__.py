@@ -32,6 +32,8 @@ from ._pulses import (
 from ._record_measures import RecordMeasures, record_measures, response_spectrum
 from ...series import UNITS_TO_M_S2, BaseMotion
 from ._records import BUNDLED_RECORDS, bundled_record, load_base_motion
+from ._records import not_a_record
+
 
 __all__ = [
     "BaseMotion",
@@ -70,4 +72,5 @@ __all__ = [
     "design_check",
     "required_width",
     "required_width_slender",
+    "not_a_record",
 ]

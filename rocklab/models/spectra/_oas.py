@@ -58,7 +58,7 @@ import numpy as np
 
 from ..._errors import InputError
 from ...blocks import G, inertia_coefficient
-from ..rocking._batch import free_rocking_overturns, simulate_batch
+from ..rocking import free_rocking_overturns, simulate_batch
 from ._oas_grid import adaptive_verdicts, boundary_verdicts
 from ...series import BaseMotion
 

@@ -53,7 +53,7 @@ def _samples(video, info, window_s):
 
 def _propose(video, info, gray):
     """Objects proposed from what moves; (Proposals, window s)."""
-    from ...tracking.video._propose import propose_objects
+    from ...tracking.video import propose_objects
 
     duration = (info.n_frames or 0) / (info.fps or 50.0)
     for window in PROPOSE_WINDOWS_S:
@@ -101,7 +101,7 @@ def track_init(
         frame, is written first so the regions can be read off it).
     """
     from ..._io import write_text_atomic
-    from ...tracking.video._init import find_markers, parse_region, suggest_config
+    from ...tracking.video import find_markers, parse_region, suggest_config
     from .._plotting import save_bgr_png
 
     video, out = Path(video), Path(out)
@@ -283,8 +283,8 @@ def _draw_top_edge(out, img, cfg, table) -> None:
     use it: the line over the span followed, and its angle (or a note that the region holds no edge)."""
     import cv2
 
-    from ...tracking.video._plane import make_plane_map
-    from ...tracking.video.targets._table_edge import table_top_edge
+    from ...tracking.video import make_plane_map
+    from ...tracking.video.targets import table_top_edge
 
     gray = img if img.ndim == 2 else cv2.cvtColor(img, cv2.COLOR_BGR2GRAY)
     x, y = (int(round(v)) for v in table.roi[:2])

@@ -15,6 +15,8 @@ from ._figures import campaign_figures, experiment_figures
 from ._plots_column import plot_column_maps
 from ._rerun import read_rrd_scalars, read_rrd_summary
 from ._rerun3d import write_track3d_rrd
+from ._column_run import base_from_table
+
 
 __all__ = [
     "load_experiment",
@@ -29,4 +31,5 @@ __all__ = [
     "campaign_figures",
     "plot_column_maps",
     "write_track3d_rrd",
+    "base_from_table",
 ]

@@ -79,7 +79,7 @@ def expand_records(
     from pathlib import Path
 
     from ..._outdir import rocklab_wrote
-    from ...models.spectra._records import not_a_record
+    from ...models.spectra import not_a_record
 
     def folder(p: Path) -> list:
         found = []

@@ -28,6 +28,11 @@ from ...series import TableMotion
 from ._motion import choose_sg_window, estimate_noise, table_motion
 from ._track import TRACK_COLUMNS, ObjectTrack, Observation, TrackResult, assemble_tracks, track_frames, track_video
 from ._video import VideoInfo, iter_video_frames, probe_video
+from ._propose import propose_objects
+from ._init import parse_region
+from ._plane import make_plane_map
+from .targets import table_top_edge
+
 
 __all__ = [
     "load_calibration",
@@ -60,4 +65,8 @@ __all__ = [
     "iter_video_frames",
     "find_markers",
     "suggest_config",
+    "propose_objects",
+    "parse_region",
+    "make_plane_map",
+    "table_top_edge",
 ]

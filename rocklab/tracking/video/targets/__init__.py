@@ -14,6 +14,8 @@ from ._dots import DotDetector, dot_centroid
 from ._edges import EdgeDetector, refine_rectangle
 from ._markerless import MarkerlessDetector, MarkerlessTracker
 from ._region import RegionDetector, RegionTracker
+from ._table_edge import table_top_edge
+
 
 __all__ = [
     "Detection",
@@ -27,4 +29,5 @@ __all__ = [
     "RegionTracker",
     "MarkerlessDetector",
     "MarkerlessTracker",
+    "table_top_edge",
 ]

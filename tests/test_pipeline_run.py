@@ -178,3 +178,28 @@ def test_run_exit_status_follows_the_report(monkeypatch, tmp_path, run_cli, stat
     monkeypatch.setattr(exp, "run_experiment", lambda *a, **k: (report, True))
     rc, out, _ = run_cli("run", cfg, "--out", tmp_path / "out")
     assert rc == code and f"t: {status}" in out
+
+
+def test_free_rocking_report_gives_the_energy_loss_of_eq12(tmp_path, run_cli):
+    """Ther's Eq. 12 in report.json and summary.md: with a constant η every rocking loses 1 − η²
+    of its energy (kinetic energy scales by η² at an impact, the peaks' rise carries it)."""
+    from rocklab.fitting import catalogue_block
+    from rocklab.models import simulate
+
+    eta = 0.9
+    blk = catalogue_block("B5M")
+    theta0 = 0.8 * blk.alpha_rad
+    sim = simulate(blk, theta0_rad=theta0, duration_s=4.0, restitution="constant", eta=eta)
+    t = np.arange(0, 4.0, 1 / 200)
+    th = np.where(t < 0.3, theta0, np.interp(t - 0.3, sim.t_s, sim.theta_rad))
+    pd.DataFrame({"t_s": t, "theta_rad": th}).to_csv(tmp_path / "tracks.csv", index=False)
+    (tmp_path / "experiment.toml").write_text(
+        'name = "eq12"\n[block]\nid = "B5M"\n[sources.track]\npath = "tracks.csv"\n[output]\nrrd = false\nfigures = false\n'
+    )
+    rc, _, err = run_cli("run", tmp_path / "experiment.toml", "--out", tmp_path / "out")
+    assert rc == 0, err
+    e = json.loads((tmp_path / "out" / "report.json").read_text())["energy_loss"]
+    assert e["exact_rise"] and len(e["loss_per_rocking"]) >= 4
+    assert np.allclose(e["loss_per_rocking"][:4], 1 - eta**2, atol=0.01)
+    assert e["eta_equivalent"] == pytest.approx(eta, abs=0.005)
+    assert "Eq. 12" in (tmp_path / "out" / "summary.md").read_text()

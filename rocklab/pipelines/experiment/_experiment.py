@@ -160,11 +160,13 @@ def analyse_experiment(
     audit = audit_experiment(cfg, m.measured, m.tracked, m.track_rows)
     fit = None
     forced = m.table is not None
+    energy_loss = None
     if cfg.fit_restitution and not forced:
         fit = _fit_free(cfg, block, prim, audit, msgs, timings)
         if fit.status == "failed":
             status = "partial"
             msgs.append(f"restitution fit failed: {fit.message}")
+        energy_loss = _energy_loss(block, prim, msgs)
     prep = validation = None
     if forced:  # a free-rocking fit means nothing under a moving table: η_e from half cycles instead
         from .._validation import prepare_forced, validate_forced_run
@@ -193,7 +195,22 @@ def analyse_experiment(
         status=status,
         audit=audit,
         validation=validation,
+        energy_loss=energy_loss,
     )
+
+
+def _energy_loss(block, prim, msgs: list):
+    """Ther's Eq. 12 on the free rocking: the mean energy loss of the first four rockings after
+    release, from the peaks of θ (None, with a note, when the record has fewer than five peaks)."""
+    from ..._errors import InputError
+    from ...fitting import energy_loss_from_peaks
+
+    ok = np.isfinite(prim[1])
+    try:
+        return energy_loss_from_peaks(prim[0][ok], prim[1][ok], block)
+    except InputError as e:
+        msgs.append(f"energy loss (thesis Eq. 12) not computed: {e}")
+        return None
 
 
 def run_experiment(

@@ -103,6 +103,13 @@ def _summary_md(res, figs: dict, rrd: bool) -> str:
     ]
     if res.fit is not None:
         lines += _fit_lines(res.fit)
+    if res.energy_loss is not None:
+        e = res.energy_loss
+        lines += [
+            f"Energy loss per rocking (thesis Eq. 12, exact rise of the centre of mass): mean of the first "
+            f"four {_g(e.mean4)}, the constant η that loses as much {_g(e.eta_equivalent)}",
+            "",
+        ]
     if res.audit is not None:
         lines += _audit_lines(res.audit, res.fit)
     if res.sync is not None:

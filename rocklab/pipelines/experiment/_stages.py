@@ -19,7 +19,7 @@ from ._config import ExperimentConfig
 from ._review_video import ReviewVideo
 
 if TYPE_CHECKING:
-    from ...fitting import ForcedRestitutionFit, RestitutionFit
+    from ...fitting import EnergyLoss, ForcedRestitutionFit, RestitutionFit
     from ...tracking import SyncResult, TrackResult
     from ...tracking.rigid import AuditResult
 
@@ -308,6 +308,9 @@ class ExperimentResult:
         The assumption audit of the primary source.
     validation : rocklab.pipelines._validation.Validation or None
         Base-excited runs: the laws judged by their ensembles.
+    energy_loss : rocklab.fitting.EnergyLoss or None
+        Free rocking: the energy lost per rocking from the peaks of θ (thesis Eq. 12), the mean
+        of the first four and the constant η that loses as much.
     """
 
     name: str
@@ -331,6 +334,7 @@ class ExperimentResult:
     diagnostics: tuple = ()
     audit: AuditResult | None = None
     validation: object = None
+    energy_loss: EnergyLoss | None = None
 
     def to_dict(self) -> dict:
         """The numbers of ``report.json`` (units in keys)."""
@@ -366,6 +370,7 @@ class ExperimentResult:
                 "note": self.video.note,
             },
             "validation": None if self.validation is None else self.validation.to_dict(),
+            "energy_loss": None if self.energy_loss is None else _energy_loss_dict(self.energy_loss),
             "timings_s": self.timings_s,
             "units": {
                 "t": "s",
@@ -396,3 +401,17 @@ def _versions() -> dict:
         except md.PackageNotFoundError:
             out[pkg] = None
     return out
+
+
+def _energy_loss_dict(e) -> dict:
+    """Eq. 12's numbers for report.json (the peaks table stays in memory)."""
+    d = e.to_dict()
+    d.pop("peaks", None)
+    return {
+        "mean4": d["mean4"],
+        "eta_equivalent": d["eta_equivalent"],
+        "start": d["start"],
+        "exact_rise": d["exact"],
+        "loss_per_rocking": d["loss"],
+        "equation": "Ther thesis Eq. 12",
+    }

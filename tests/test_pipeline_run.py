@@ -203,3 +203,34 @@ def test_free_rocking_report_gives_the_energy_loss_of_eq12(tmp_path, run_cli):
     assert np.allclose(e["loss_per_rocking"][:4], 1 - eta**2, atol=0.01)
     assert e["eta_equivalent"] == pytest.approx(eta, abs=0.005)
     assert "Eq. 12" in (tmp_path / "out" / "summary.md").read_text()
+
+
+def test_the_thesis_contact_laws_are_simulated_from_experiment_toml(tmp_path, run_cli):
+    """[simulate] laws takes the thesis's App. A laws with their geometry (Eq. A3-A7)."""
+    from rocklab.fitting import catalogue_block
+    from rocklab.models import eta_axes, eta_bumps
+
+    blk = catalogue_block("B5M")
+    theta0 = 0.8 * blk.alpha_rad
+    sim = simulate(blk, theta0_rad=theta0, duration_s=3.0, restitution="constant", eta=0.9)
+    t = np.arange(0, 3.0, 1 / 200)
+    th = np.where(t < 0.3, theta0, np.interp(t - 0.3, sim.t_s, sim.theta_rad))
+    pd.DataFrame({"t_s": t, "theta_rad": th}).to_csv(tmp_path / "tracks.csv", index=False)
+    b2 = 0.4 * blk.b_m
+    text = (
+        'name = "appA"\n[block]\nid = "B5M"\n[sources.track]\npath = "tracks.csv"\n'
+        f'[simulate]\nlaws = ["housner", "cut_corner", "bumps", "axes"]\nbumps = 2\nb2_m = {b2}\n'
+        f"x1_m = {-0.5 * blk.b_m}\nx2_m = {0.25 * blk.b_m}\n[output]\nrrd = false\nfigures = false\n"
+    )
+    (tmp_path / "experiment.toml").write_text(text)
+    rc, _, err = run_cli("run", tmp_path / "experiment.toml", "--out", tmp_path / "out")
+    assert rc == 0, err
+    sims = json.loads((tmp_path / "out" / "report.json").read_text())["simulations"]
+    assert sims["cut_corner"]["eta"] == pytest.approx(eta_axes(blk, -b2, b2), rel=1e-12)
+    assert sims["bumps"]["eta"] == pytest.approx(eta_bumps(blk, 2, b2), rel=1e-12)
+    assert sims["axes"]["eta"] == pytest.approx(eta_axes(blk, -0.5 * blk.b_m, 0.25 * blk.b_m), rel=1e-12)
+    # more contact lines lose less (thesis Fig. 12): the bumps' η lies above the cut corner's
+    assert sims["housner"]["eta"] < sims["cut_corner"]["eta"] < sims["bumps"]["eta"] < 1
+    (tmp_path / "experiment.toml").write_text(text.replace("bumps = 2", "bumps = -1"))
+    rc, _, err = run_cli("run", tmp_path / "experiment.toml", "--out", tmp_path / "out2")
+    assert rc == 2 and "simulate.bumps" in err and "line 8" in err

@@ -45,7 +45,7 @@ SYNC_METHODS = ("xcorr", "none")
 #: the first is the default).
 FIT_WINDOWS = ("middle50", "all", "first")
 #: The restitution laws a run simulates against the measurement ("given": ``[simulate] eta``).
-SIMULATED_LAWS = ("housner", "eta_e", "modified", "eta_e_first", "given")
+SIMULATED_LAWS = ("housner", "eta_e", "modified", "eta_e_first", "given", "axes", "cut_corner", "bumps")
 #: ``[sources.imu] axis``: the block's rocking axis in the IMU's frame, optionally signed.
 IMU_AXIS = re.compile(r"auto|[+-]?[xyz]")
 
@@ -114,6 +114,10 @@ class ExperimentConfig:
     laws: tuple = ("housner", "eta_e", "modified")
     duration_s: float = 0.0
     eta_given: float | None = None
+    bumps_n: int = 1  # the bumps law (thesis App. A): bumps between the contact corners
+    b2_m: float | None = None  # cut_corner, bumps: half-distance of the outer contact lines (None: b/2)
+    x1_m: float | None = None  # axes: the rotation axis before an impact, m from the middle (None: -b/2)
+    x2_m: float | None = None  # axes: the axis after it (None: +b/2)
     rrd: bool = True
     video_decimation: int = 1
     figures: bool = True
@@ -195,6 +199,10 @@ _FIELDS = {
     ("simulate", "laws"): "laws",
     ("simulate", "eta"): "eta_given",
     ("simulate", "duration_s"): "duration_s",
+    ("simulate", "bumps"): "bumps_n",
+    ("simulate", "b2_m"): "b2_m",
+    ("simulate", "x1_m"): "x1_m",
+    ("simulate", "x2_m"): "x2_m",
     ("column", "objects"): "columns",
     ("column", "cut_m"): "column_cut_m",
     ("column", "impacts"): "column_impacts",
@@ -412,6 +420,10 @@ def load_experiment_config(path, block_catalogue: Callable[[], Mapping[str, dict
         laws=laws,
         duration_s=duration,
         eta_given=eta_given,
+        bumps_n=_bumps(r),
+        b2_m=r.field(("simulate", "b2_m"), float, positive=True),
+        x1_m=r.field(("simulate", "x1_m"), float),
+        x2_m=r.field(("simulate", "x2_m"), float),
         rrd=r.field(("output", "rrd"), bool),
         video_decimation=r.field(("output", "video_decimation"), int, positive=True),
         figures=r.field(("output", "figures"), bool),
@@ -529,6 +541,10 @@ window = "middle50"               # {_choices(FIT_WINDOWS)}
 laws = ["housner", "eta_e", "modified"]   # of {", ".join(SIMULATED_LAWS)} ("given" uses eta below)
 eta = 0.93                        # optional: a known constant restitution, simulated as "given"
 duration_s = 0                    # 0: as long as the measurement
+bumps = 1                         # law "bumps" (thesis App. A): bumps between the contact corners
+b2_m = 0.02                       # laws "cut_corner", "bumps": half-distance of the outer contact lines, m (default b/2)
+x1_m = -0.0225                    # law "axes" (thesis Eq. A3): rotation axis before the impact, m from the middle
+x2_m = 0.0225                     # ... and after it (defaults -b/2, +b/2: Housner)
 
 [column]                          # column experiments (thesis §4.3): tracked objects bottom to top
 objects = ["block_1", "block_2", "block_3"]
@@ -541,3 +557,13 @@ video_decimation = 1              # log every n-th frame to Rerun
 figures = true
 """
 """The commented schema of ``experiment.toml``: every key, an example value and its choices."""
+
+
+def _bumps(r) -> int:
+    """``[simulate] bumps``: a whole number of bumps, 0 or more."""
+    n = r.at(("simulate", "bumps"))
+    if n is None:
+        return default_of(ExperimentConfig, "bumps_n")
+    if isinstance(n, bool) or not isinstance(n, int) or n < 0:
+        r.fail(("simulate", "bumps"), f"= {n!r} must be a whole number of bumps, 0 or more")
+    return n

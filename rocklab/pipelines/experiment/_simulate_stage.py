@@ -20,6 +20,11 @@ def _eta_for_law(law: str, cfg, block, fit: FitStage | None, msgs: list) -> floa
         return cfg.eta_given
     if law in ("eta_e", "eta_e_first"):
         return None if fit is None else fit.law_eta(law)
+    if law in ("axes", "cut_corner", "bumps"):  # thesis App. A: the contact's geometry sets η
+        from ...models import make_restitution
+
+        params = {"axes": dict(x1_m=cfg.x1_m, x2_m=cfg.x2_m), "bumps": dict(n=cfg.bumps_n, b2_m=cfg.b2_m)}
+        return float(make_restitution(law, block, **params.get(law, dict(b2_m=cfg.b2_m))).eta)
     if law == "modified":
         from ...fitting import KRegression, edge_contact_k, eta_modified
 

@@ -51,7 +51,9 @@ FB_MIN_FRAC = 0.01
 FB_ROUNDTRIP_PX = 1.0
 #: Largest side of the grid the checks sample the patch on, and the corners registered on it.
 GRID_PX = 64
-N_FEATURES = 12
+N_FEATURES = 8
+LK_WIN = (9, 9)
+_LK_STOP = (3, 10, 0.03)  # cv2.TERM_CRITERIA_EPS + COUNT: 10 iterations or 0.03 px
 #: Verified frames between two renewals of the keyframe.
 KEY_EVERY = 25
 
@@ -158,15 +160,15 @@ class PointPoseVerifier:
 
         if self.feats is None:
             return None
-        a, b = self.ref_img, back
-        crit = (cv2.TERM_CRITERIA_EPS + cv2.TERM_CRITERIA_COUNT, 20, 0.03)
-        fwd, st1, _ = cv2.calcOpticalFlowPyrLK(a, b, self.feats, None, winSize=(11, 11), maxLevel=2, criteria=crit)
-        bwd, st2, _ = cv2.calcOpticalFlowPyrLK(b, a, fwd, None, winSize=(11, 11), maxLevel=2, criteria=crit)
-        good = (st1.ravel() == 1) & (st2.ravel() == 1)
-        good &= np.hypot(*(bwd - self.feats).reshape(-1, 2).T) < FB_ROUNDTRIP_PX / self.step
+        kw = {"winSize": LK_WIN, "maxLevel": 1, "criteria": _LK_STOP}
+        fwd, st1, _ = cv2.calcOpticalFlowPyrLK(self.ref_img, back, self.feats, None, **kw)
+        bwd, st2, _ = cv2.calcOpticalFlowPyrLK(back, self.ref_img, fwd, None, **kw)
+        e = (bwd - self.feats).reshape(-1, 2)
+        d = (fwd - self.feats).reshape(-1, 2)
+        good = (st1.ravel() * st2.ravel() == 1) & (np.einsum("ij,ij->i", e, e) < (FB_ROUNDTRIP_PX / self.step) ** 2)
         if good.sum() < 3:
             return None
-        return self.step * float(np.median(np.hypot(*(fwd - self.feats).reshape(-1, 2)[good].T)))
+        return self.step * math.sqrt(float(np.median(np.einsum("ij,ij->i", d[good], d[good]))))
 
     def fb_limit(self):
         """Largest misalignment accepted now, px: the verified frames' median plus

@@ -24,7 +24,7 @@ from ._checks import _check_frames, _check_rate, _interpolate, _look, _tee, _why
 from ._config import TrackConfig
 from ._geometry import PlaneMap, fit_similarity
 from .targets._detectors import make_detector
-from .targets._observability import angle_free_objects, angle_note
+from .targets._observability import angle_free_objects, angle_note, warn_theta
 from ._plane import make_plane_map
 from ._motion import TableMotion, table_motion
 
@@ -113,6 +113,10 @@ def track_frames(frames, config: TrackConfig, plane_map: PlaneMap | None = None)
             free = angle_free_objects(config, det)
         with one_blas_thread():
             dets = det.detect(gray, idx)
+        for o in config.objects:  # an angle found unmeasurable on the way (a round outline, once seen)
+            if o.id not in free and hasattr(det, "theta_note") and (why := det.theta_note(o.id)) is not None:
+                free[o.id] = why
+                warn_theta(config, o.id, why, idx)
         obs = []
         for o in config.objects:
             d = dets.get(o.id)
@@ -355,9 +359,11 @@ def assemble_tracks(observations, config: TrackConfig, fps: float, width_px: int
             a["scale"][i], a["q"][i] = r.scale, r.quality
             st[i] = r.status
             metric = metric or (r.status == "ok" and r.metric)
-        # An angle step no rocking block makes between frames is a misdetection, not motion.
         th = a["th"]
         okk = np.flatnonzero(st == "ok")
+        if np.isnan(th[okk]).any():  # found unmeasurable on the way: no frame's angle is measured
+            th[:], a["sig"][:] = np.nan, np.nan
+        # An angle step no rocking block makes between frames is a misdetection, not motion.
         for j0, j1 in zip(okk[:-1], okk[1:]):
             if j1 - j0 == 1 and abs(math.remainder(th[j1] - th[j0], 2 * math.pi)) > MAX_STEP_RAD:
                 st[j1] = "outlier"

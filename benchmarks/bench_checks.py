@@ -23,7 +23,7 @@ CHECKS = (
     "_check_gyro_vs_tilt",
     "_check_still_tilt",
     "cut_at_gap",
-    "_check_frames",
+    "check_frames",
     "check_step",
     "check_memory",
     "_check_block_rows",

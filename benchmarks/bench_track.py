@@ -96,6 +96,28 @@ def bench(width, height):
     return base, fps, fps_cpu, e2e
 
 
+def verify_cost(width, height, repeats=3):
+    """CPU time of the pose verification (targets/_verify_points.py) as a fraction of the
+    unverified tracker's, same process, same frames, best of ``repeats``."""
+    import rocklab.tracking.video.targets._verify_points as vp
+
+    seq = render(width, height, N_FRAMES)
+    seq = (seq + seq[::-1]) * 2
+    verified = vp.VerifiedDetector.detect
+    best = {}
+    try:
+        for _ in range(repeats):
+            for on in (False, True):
+                vp.VerifiedDetector.detect = verified if on else (lambda self, g, f: self.inner.detect(g, f))
+                c0 = time.process_time()
+                for _obs in track_frames(seq, CONFIG):
+                    pass
+                best[on] = min(best.get(on, np.inf), time.process_time() - c0)
+    finally:
+        vp.VerifiedDetector.detect = verified
+    return best[True] / best[False] - 1.0
+
+
 def main() -> int:
     print(f"cv2 {cv2.__version__}, threads {cv2.getNumThreads()}")
     ok = True
@@ -107,6 +129,9 @@ def main() -> int:
             f"(target >= {target:.0f}); full-frame baseline {base:6.1f} frames/s, ratio "
             f"{fps / base:5.1f}x; track_video incl. FFV1 decode {e2e:6.1f} frames/s"
         )
+    print(
+        f"pose verification at 1920x1080: +{100 * verify_cost(1920, 1080):.1f} % CPU time over the unverified tracker"
+    )
     load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
     print(
         f"load average {load:.1f} on {os.cpu_count()} cores"

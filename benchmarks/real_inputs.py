@@ -5,7 +5,8 @@ from boxes perturbed round it (each side +-20 %, the centre +-10 %, seeded), aga
 script that knows nothing of the tracker (``tests/_blob.py``: the ball's blue half by an HSV
 threshold). Printed per film and box: frames, frames ok, frames ok but wrong (the tracked point
 more than 1 % of the frame width off the reference, after the median offset), the status counts,
-and the swing period from x_px against the reference's.
+the swing period from x_px against the reference's, and whether the ball's angle was flagged
+unmeasurable (W-TRACK-THETA) or how many ok frames report one.
 
 Development film (tune on it): ``../shared/data/video/pendulum_film2_vga.mp4``.
 Validation films (never tuned on): the other take of the same scene at four resolutions,
@@ -65,7 +66,9 @@ def run(path, box, ref, ref_scale):
         T = swing_period_s(tr.t_s, x)
     except Exception:  # a track too broken to fit is reported as such
         T = np.nan
-    return len(tr.status), int(tr.ok.sum()), int(wrong.sum()), dict(zip(st.tolist(), cnt.tolist())), T, dt
+    # a ball's angle is not measurable (W-TRACK-THETA): finite angles on ok frames are reported as such
+    theta = "flagged" if tr.theta_note else f"{int(np.isfinite(tr.theta_rad[tr.ok]).sum())} ok frames with an angle"
+    return len(tr.status), int(tr.ok.sum()), int(wrong.sum()), dict(zip(st.tolist(), cnt.tolist())), T, dt, theta
 
 
 def main(n_boxes=5, only=""):
@@ -82,11 +85,11 @@ def main(n_boxes=5, only=""):
         print(f"{kind} {path.name} ({info.width_px}x{info.height_px}): reference period {T_ref:.5f} s")
         periods = []
         for i, b in enumerate([box, *perturbed_boxes(box, n_boxes, seed=1)]):
-            n, ok, bad, st, T, dt = run(path, b, ref, scale)
+            n, ok, bad, st, T, dt, theta = run(path, b, ref, scale)
             periods.append(T)
             print(
                 f"  box {i:2d} {b}: frames {n}, ok {ok} ({100 * ok / n:.2f} %), ok but wrong {bad}, "
-                f"period {T:.5f} s ({1e2 * (T / T_ref - 1):+.3f} %), {n / dt:.0f} frames/s, {st}"
+                f"period {T:.5f} s ({1e2 * (T / T_ref - 1):+.3f} %), theta {theta}, {n / dt:.0f} frames/s, {st}"
             )
         p = np.array(periods)
         print(f"  period spread over boxes: {1e2 * (np.nanmax(p) - np.nanmin(p)) / np.nanmedian(p):.4f} %")

@@ -164,7 +164,8 @@ WARNING_CODES: dict[str, tuple[str, str]] = {
     "W-TRACK-THETA": (
         "suspect",
         "a block's appearance does not change when it turns (a disk, a plain ball, a region with "
-        "no edge or mark off its centre): its angle is not measured; theta_rad is NaN and x, y "
+        "no edge or mark off its centre), or its outline is round and its texture leaves its first "
+        "view (a ball spinning in depth): its angle is not measured; theta_rad is NaN and x, y "
         'are tracked. Set kind = "point" for a position only, or redraw the region',
     ),
     "W-TRACK-LATCH": (

@@ -8,6 +8,7 @@ import pytest
 
 from _render import TEX, Scene
 from rocklab import InputError
+from rocklab._diagnostics import collecting
 from rocklab.tracking import TrackConfig, assemble_tracks, track_frames
 
 FPS = 50.0
@@ -122,9 +123,12 @@ def test_real_pendulum_footage(shared_data):
             "objects": [{"id": "ball", "roi": [310, 66, 70, 74]}],
         }
     )
-    obs = [o for fr in track_frames(((i, g) for i, g in iter_video_frames(path)), cfg) for o in fr]
+    with collecting() as diags:
+        obs = [o for fr in track_frames(((i, g) for i, g in iter_video_frames(path)), cfg) for o in fr]
     ok = np.array([o.status == "ok" for o in obs])
     assert ok.mean() >= 0.99, ok.mean()
+    # a ball spinning in depth: its angle is flagged, not reported
+    assert "W-TRACK-THETA" in {d.code for d in diags}
     x = np.array([o.X if o.status == "ok" else np.nan for o in obs])
     t = np.arange(x.size) / fps
 

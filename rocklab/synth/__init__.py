@@ -16,7 +16,7 @@ Everything here may use the physics (:mod:`rocklab.models`) and the measurement 
 
 from ._imu_sim import simulate_imu_log, write_ximu3_csv, write_ximu_csv
 from ._points3d import Points3DSession, synth_points3d
-from ._session import SynthSession, load_synth_session, synth_session
+from ._session import SynthSession, load_synth_session, synth_session, parse_size
 from ._stereo import StereoCamera, synth_stereo
 
 __all__ = [
@@ -30,4 +30,5 @@ __all__ = [
     "synth_points3d",
     "StereoCamera",
     "synth_stereo",
+    "parse_size",
 ]

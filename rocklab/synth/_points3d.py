@@ -76,7 +76,7 @@ class Points3DSession:
         return paths
 
 
-def _targets(block: Block, depth_m: float, side: bool = True):
+def target_points(block: Block, depth_m: float, side: bool = True):
     """Block targets in block axes (x along the width, y along the depth, z up; origin at the base centre)."""
     b, h, d = block.b_m, block.h_m, depth_m
     pts = []
@@ -221,7 +221,7 @@ def synth_points3d(
         psi[t >= t_k] = float(twist[1])
         injected["twist"] = (int(twist[0]), float(twist[1]))
 
-    body, labels = _targets(block, depth, side_targets)
+    body, labels = target_points(block, depth, side_targets)
     n = t.size
     half = block.b_m / 2.0
     c, s = np.cos(theta), np.sin(theta)

@@ -213,12 +213,12 @@ def _render_aruco_films(out, cams, sess, X1, X2, fps, size, noise, rng, paths):
 
     from ._files import VideoPair
     from ..tracking.rigid import kabsch
-    from ._points3d import _targets
+    from ._points3d import target_points
 
     ppm = 4000.0
     b, h = sess.block.b_m, sess.block.h_m
     depth = 0.6 * b
-    body_pts, _ = _targets(sess.block, depth, side=False)
+    body_pts, _ = target_points(sess.block, depth, side=False)
     nb = body_pts.shape[0]
     # the block's front face: x along the width, y down, origin at its top-left corner
     side = 0.6 * b

@@ -17,6 +17,7 @@ STATUS_COLOURS = {
     "jump": "tab:orange",
     "background": "tab:purple",
     "drift": "tab:pink",
+    "misaligned": "tab:green",
     "low_quality": "tab:gray",
     "outlier": "gold",
     "interpolated": "tab:cyan",

@@ -26,7 +26,7 @@ import numpy as np
 from ... import __version__
 from ...series import TableMotion
 from ._config import ExperimentConfig, load_experiment
-from ._measure import measure_imu, measure_video, read_track_csv, _sync, table_from_imu
+from ._measure import measure_imu, measure_video, read_track_csv, sync_clocks, table_from_imu
 from ._report import write_outputs
 from ._stages import ClockSync, ExperimentResult, FitStage
 from ._simulate_stage import compare_truth, simulate_laws
@@ -90,7 +90,7 @@ def _measure(cfg: ExperimentConfig, progress: bool, keep_video: bool | None, msg
     imu_sync = residual = None
     if "imu" in measured and ("video" in measured or "track" in measured) and cfg.sync_method == "xcorr":
         ref = measured.get("video") or measured.get("track")
-        imu_sync = s = _sync(ref, rot, cfg.max_offset_s)
+        imu_sync = s = sync_clocks(ref, rot, cfg.max_offset_s)
         ti, thi = measured["imu"]
         # invert t_imu = t_ref + offset + drift t_ref: the IMU series on the reference clock;
         # sign -1: the IMU's axis points the other way from the camera's θ convention

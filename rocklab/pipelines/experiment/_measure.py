@@ -106,7 +106,7 @@ def table_from_imu(cfg: ExperimentConfig, video_table: TableMotion | None, msgs:
     return table, s
 
 
-def _sync(ref, rot, max_offset_s):
+def sync_clocks(ref, rot, max_offset_s):
     """Clock model t_imu = t_ref + offset + drift * t_ref from the rocking rates."""
     from ...tracking import sync_imu_to_track
 

@@ -128,7 +128,7 @@ def _complete_rows(path: Path) -> int | None:
     return n_lines - 1
 
 
-def _numeric(df, col, path: Path) -> np.ndarray:
+def numeric_column(df, col, path: Path) -> np.ndarray:
     v = df[col].to_numpy()
     if v.dtype.kind not in "fiu":
         import pandas as pd
@@ -174,9 +174,9 @@ def stack(df, cols, path) -> tuple[np.ndarray, np.ndarray]:
     acc = np.empty((len(df), 3))
     for i, ax in enumerate("xyz"):
         c, f = cols["gyro_" + ax]
-        gyro[:, i] = _numeric(df, c, path) * f
+        gyro[:, i] = numeric_column(df, c, path) * f
         c, f = cols["acc_" + ax]
-        acc[:, i] = _numeric(df, c, path) * f
+        acc[:, i] = numeric_column(df, c, path) * f
     return gyro, acc
 
 

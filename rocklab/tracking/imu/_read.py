@@ -52,7 +52,7 @@ from ._csv import (
     check_increasing,
     gap_drops,
     inertial_columns,
-    _numeric,
+    numeric_column,
     read_csv,
     saturation,
     stack,
@@ -71,7 +71,7 @@ def _read_ximu3(path: Path, rate_hz: float | None, full_scale_g: float | None) -
         raise InputError(f"{where(path, 1)}missing column 'Timestamp (us)'; not an x-IMU3 Inertial.csv")
     cols = inertial_columns(df, path)
     gyro, acc = stack(df, cols, path)
-    t = _numeric(df, tcol, path) * 1e-6
+    t = numeric_column(df, tcol, path) * 1e-6
     check_increasing(t, path, tcol)
     period = 1.0 / rate_hz if rate_hz else float(np.median(np.diff(t))) if len(t) > 1 else 1.0
     dropped = gap_drops(t, period)
@@ -92,12 +92,12 @@ def _merge_high_g(hg: Path, t: np.ndarray, acc: np.ndarray, sat: np.ndarray):
         raise InputError(
             f"{where(hg, 1)}missing columns {', '.join(miss)}; expected 'Timestamp (us),X (g),Y (g),Z (g)'"
         )
-    th = _numeric(df, need[0], hg) * 1e-6
+    th = numeric_column(df, need[0], hg) * 1e-6
     check_increasing(th, hg, need[0])
     acc = acc.copy()
     idx = np.flatnonzero(sat)
     for k, c in enumerate(need[1:]):
-        acc[idx, k] = np.interp(t[idx], th, _numeric(df, c, hg) * G)
+        acc[idx, k] = np.interp(t[idx], th, numeric_column(df, c, hg) * G)
     return acc, int(idx.size)
 
 
@@ -152,7 +152,7 @@ def _read_timed(path: Path, rate_hz, full_scale_g, mapping) -> ImuLog:
     if tcol is None:
         t = np.arange(len(df)) / float(rate_hz)
     else:
-        t = _numeric(df, tcol, path) * tf
+        t = numeric_column(df, tcol, path) * tf
         check_increasing(t, path, tcol)
     period = 1.0 / rate_hz if rate_hz else float(np.median(np.diff(t))) if len(t) > 1 else 1.0
     return ImuLog(t, gyro, acc, 1.0 / period, gap_drops(t, period), saturation(acc, full_scale_g), str(path), fmt)

@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from ..._errors import InputError, where
-from ._csv import check_increasing, inertial_columns, _numeric, read_csv, saturation, stack
+from ._csv import check_increasing, inertial_columns, numeric_column, read_csv, saturation, stack
 from ._log import ImuLog
 
 __all__ = ["read_ximu_registers", "ximu_rate_from_registers"]
@@ -39,8 +39,8 @@ def read_ximu_registers(path) -> dict:
                 f"{where(path, 1)}missing column {need!r}; expected x-IMU "
                 "'Packet number,Address,Value,Fixed-point value,Name'"
             )
-    addr = _numeric(df, "Address", path).astype(int)
-    val = _numeric(df, "Value", path)
+    addr = numeric_column(df, "Address", path).astype(int)
+    val = numeric_column(df, "Value", path)
     names = df["Name"].astype(str).str.strip().tolist() if "Name" in df.columns else [""] * len(df)
     out: dict = {}
     for a, v, nm in zip(addr, val, names):
@@ -126,7 +126,7 @@ def read_ximu_gui(path: Path, rate_hz: float | None, full_scale_g: float | None)
         raise InputError(f"{where(path, 1)}missing column 'Packet number'; not an x-IMU GUI export")
     cols = inertial_columns(df, path)
     gyro, acc = stack(df, cols, path)
-    pk = _numeric(df, "Packet number", path)
+    pk = numeric_column(df, "Packet number", path)
     # 16-bit packet counters wrap; unwrap before checking order.
     wrap = np.diff(pk) < -30000
     if wrap.any():

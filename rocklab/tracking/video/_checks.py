@@ -20,7 +20,7 @@ __all__ = ["TABLE_TURN_MAX_RAD", "BLUR_RATIO", "check_mirrored"]
 BLUR_RATIO = 0.35
 
 
-def _look(gray, box):
+def look(gray, box):
     """(Laplacian variance, grey std) of the window ``box`` = (u0, v0, u1, v1)."""
     import cv2
 
@@ -31,7 +31,7 @@ def _look(gray, box):
     return float(cv2.Laplacian(crop, cv2.CV_32F).var()), float(crop.std())
 
 
-def _why_lost(now, ref):
+def why_lost(now, ref):
     """Reason for a lost target from its last window now vs at the last good detection.
 
     "blur": fine detail gone (Laplacian variance < 35 %) but the black/white
@@ -48,7 +48,7 @@ def _why_lost(now, ref):
     return "lost"
 
 
-def _check_frames(res, expected: int, path, info=None) -> None:
+def check_frames(res, expected: int, path, info=None) -> None:
     """Frames lost, counted per cause: W-VIDEO-SHORT (a note) when the header counts frames the
     file does not hold; W-VIDEO-DROPPED (a note) for slots of the container's clock without a
     frame (the camera dropped them; the times stay true); W-VIDEO-DAMAGED when frames the
@@ -108,7 +108,7 @@ def check_mirrored(info, path) -> None:
         )
 
 
-def _check_rate(given: float, info, path, where: str) -> None:
+def check_rate(given: float, info, path, where: str) -> None:
     """W-VIDEO-FPS when a frame rate given by the user contradicts the container's own clock."""
     kind = "mean" if info.variable_rate and not info.n_dropped else "constant"
     warn(
@@ -151,13 +151,13 @@ def _check_latch(res, path) -> None:
                 )
 
 
-def _tee(frames, fn):
+def tee(frames, fn):
     for i, g, img in frames:
         fn(i, g, img)
         yield i, g
 
 
-def _interpolate(arrs, status, max_gap):
+def interpolate(arrs, status, max_gap):
     """Fill runs of at most ``max_gap`` frames between two ``ok`` frames linearly, in place (each
     array of ``arrs``, shape (n,)); their ``status`` becomes ``"interpolated"``."""
     ok = status == "ok"

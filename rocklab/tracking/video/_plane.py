@@ -64,7 +64,7 @@ def _table_plane(config, pm, gray):
     elif gray is None:
         why = "needs the first frame"
     if why is None:
-        from .targets._aruco import _UNIT_CORNERS, make_cv_detector, refine_marker_corners
+        from .targets._aruco import UNIT_CORNERS, make_cv_detector, refine_marker_corners
 
         det, _ = make_cv_detector(config.targets)
         corners, ids, _ = det.detectMarkers(gray)
@@ -78,7 +78,7 @@ def _table_plane(config, pm, gray):
                 if config.targets.corner_refinement == "edges":
                     c, _ = refine_marker_corners(gray, c)
                 img.append(c)
-                obj.append(np.asarray(pos[k], float) + _UNIT_CORNERS * size)
+                obj.append(np.asarray(pos[k], float) + UNIT_CORNERS * size)
         if len(img) == len(tab.markers):
             return plane_homography_from_points(np.vstack(img), np.vstack(obj), pm)
         why = "not every table marker is visible in the first frame"

@@ -20,18 +20,27 @@ from ..._blas import one_blas_thread
 from ..._diagnostics import warn
 from ..._errors import InputError
 from .._corrections import apply_corrections, load_corrections
-from ._checks import _check_frames, _check_rate, _interpolate, _look, _tee, _why_lost
+from ._checks import check_frames, check_rate, interpolate, look, tee, why_lost
 from ._config import TrackConfig
 from ._geometry import PlaneMap, fit_similarity
-from .targets._detectors import make_detector
-from .targets._observability import angle_free_objects, angle_note
+from .targets import make_detector
+from .targets._observability import angle_free_objects, angle_note, warn_theta
 from ._plane import make_plane_map
 from ._motion import TableMotion, table_motion
 
-__all__ = ["Observation", "ObjectTrack", "TrackResult", "track_frames", "assemble_tracks",
-           "track_video", "make_plane_map", "TRACK_COLUMNS"]
+__all__ = [
+    "Observation",
+    "ObjectTrack",
+    "TrackResult",
+    "track_frames",
+    "assemble_tracks",
+    "track_video",
+    "make_plane_map",
+    "TRACK_COLUMNS",
+]
 
 from ...series import TRACK_COLUMNS  # noqa: E402 - the tracks.csv layout, defined once in rocklab.series
+
 #: Largest believable rotation between consecutive frames (rad); bigger steps are outliers.
 MAX_STEP_RAD = 0.35
 
@@ -112,6 +121,10 @@ def track_frames(frames, config: TrackConfig, plane_map: PlaneMap | None = None)
             free = angle_free_objects(config, det)
         with one_blas_thread():
             dets = det.detect(gray, idx)
+        for o in config.objects:  # an angle found unmeasurable on the way (a round outline, once seen)
+            if o.id not in free and hasattr(det, "theta_note") and (why := det.theta_note(o.id)) is not None:
+                free[o.id] = why
+                warn_theta(config, o.id, why, idx)
         obs = []
         for o in config.objects:
             d = dets.get(o.id)
@@ -126,29 +139,46 @@ def track_frames(frames, config: TrackConfig, plane_map: PlaneMap | None = None)
                 if fixed is None and len(q) == d.n_expected:
                     scales.setdefault(o.id, collections.deque(maxlen=51)).append(f.scale)
                 spread = math.sqrt(np.sum((q - q.mean(0)) ** 2) / len(q))
-                qual = (len(q) / d.n_expected) / (1.0 + f.rms / (0.002 * spread + 1e-12) if d.score is None
-                                                  else 1.0 / max(d.score, 1e-12))
+                qual = (len(q) / d.n_expected) / (
+                    1.0 + f.rms / (0.002 * spread + 1e-12) if d.score is None else 1.0 / max(d.score, 1e-12)
+                )
                 if qual < min_q:
-                    obs.append(Observation(idx, o.id, *(np.nan,) * 4, f.scale, f.rms, qual,
-                                           "low_quality", d.metric, plane_map.source))
+                    obs.append(
+                        Observation(
+                            idx, o.id, *(np.nan,) * 4, f.scale, f.rms, qual, "low_quality", d.metric, plane_map.source
+                        )
+                    )
                     continue
                 th, sig = (np.nan, np.nan) if o.id in free else (f.theta_rad, d.combined_sigma(f.sigma_theta_rad))
-                obs.append(Observation(idx, o.id, float(f.t[0]), float(f.t[1]), th, sig, f.scale, f.rms, qual,
-                                       "ok", d.metric, plane_map.source))
+                obs.append(
+                    Observation(
+                        idx,
+                        o.id,
+                        float(f.t[0]),
+                        float(f.t[1]),
+                        th,
+                        sig,
+                        f.scale,
+                        f.rms,
+                        qual,
+                        "ok",
+                        d.metric,
+                        plane_map.source,
+                    )
+                )
                 u, v = d.img_pts[:, 0], d.img_pts[:, 1]
                 box = (int(max(u.min(), 0)), int(max(v.min(), 0)), int(u.max()) + 1, int(v.max()) + 1)
                 boxes[o.id] = box
                 if o.id not in sharp_ref or k % 25 == 0:
-                    sharp_ref[o.id] = _look(gray, box)
+                    sharp_ref[o.id] = look(gray, box)
             else:
                 status = "lost"
                 why = det.lost_reason(o.id) if hasattr(det, "lost_reason") else None
                 if why is not None:
                     status = why  # the pose was fitted but does not re-explain the image
                 elif o.id in boxes:
-                    status = _why_lost(_look(gray, boxes[o.id]), sharp_ref.get(o.id))
-                obs.append(Observation(idx, o.id, *(np.nan,) * 7, status,
-                                       getattr(d, "metric", True), plane_map.source))
+                    status = why_lost(look(gray, boxes[o.id]), sharp_ref.get(o.id))
+                obs.append(Observation(idx, o.id, *(np.nan,) * 7, status, getattr(d, "metric", True), plane_map.source))
         yield obs
 
 
@@ -250,18 +280,30 @@ class TrackResult:
         """Long table with :data:`TRACK_COLUMNS` (the ``tracks.csv`` layout)."""
         import pandas as pd
 
-        parts = [pd.DataFrame({"frame": t.frame, "t_s": t.t_s, "object": t.object,
-                               "x_px": t.x_px if t.x_px is not None else np.full(t.frame.size, np.nan),
-                               "y_px": t.y_px if t.y_px is not None else np.full(t.frame.size, np.nan),
-                               "x_m": t.x_m,
-                               "y_m": t.y_m, "theta_rad": t.theta_rad,
-                               "sigma_theta_rad": t.sigma_theta_rad, "quality": t.quality,
-                               "status": t.status}) for t in self.tracks]
+        parts = [
+            pd.DataFrame(
+                {
+                    "frame": t.frame,
+                    "t_s": t.t_s,
+                    "object": t.object,
+                    "x_px": t.x_px if t.x_px is not None else np.full(t.frame.size, np.nan),
+                    "y_px": t.y_px if t.y_px is not None else np.full(t.frame.size, np.nan),
+                    "x_m": t.x_m,
+                    "y_m": t.y_m,
+                    "theta_rad": t.theta_rad,
+                    "sigma_theta_rad": t.sigma_theta_rad,
+                    "quality": t.quality,
+                    "status": t.status,
+                }
+            )
+            for t in self.tracks
+        ]
         df = pd.concat(parts, ignore_index=True)
         return df.sort_values(["frame", "object"], kind="stable").reset_index(drop=True)
 
-    def table_motion(self, object: str | None = None, window_s: float | None = None,
-                     polyorder: int | None = None) -> TableMotion:
+    def table_motion(
+        self, object: str | None = None, window_s: float | None = None, polyorder: int | None = None
+    ) -> TableMotion:
         """Table displacement/velocity/acceleration (x, m; SG derivatives; window from the noise)."""
         if object is None:
             tab = self.config.table
@@ -270,8 +312,13 @@ class TrackResult:
             object = tab.id
         tr = self[object]
         m = self.config.motion
-        return table_motion(tr.t_s, tr.x_m, window_s if window_s is not None else m.sg_window_s,
-                            polyorder if polyorder is not None else m.sg_polyorder, object)
+        return table_motion(
+            tr.t_s,
+            tr.x_m,
+            window_s if window_s is not None else m.sg_window_s,
+            polyorder if polyorder is not None else m.sg_polyorder,
+            object,
+        )
 
     def to_pixels(self, object: str, frame: int, points_m) -> np.ndarray:
         """Image pixels of points fixed to a tracked object, at one frame.
@@ -311,18 +358,41 @@ class TrackResult:
         per = {}
         for t in self.tracks:
             st, cnt = np.unique(t.status, return_counts=True)
-            per[t.object] = {"kind": t.kind, "n_ok": int(np.sum(t.ok)), "m_per_unit": t.m_per_unit,
-                             "status_counts": {str(a): int(b) for a, b in zip(st, cnt)},
-                             "median_sigma_theta_rad": float(np.nanmedian(t.sigma_theta_rad))
-                             if np.any(np.isfinite(t.sigma_theta_rad)) else np.nan, "theta_note": t.theta_note}
-        return {"source": self.source, "fps": self.fps, "n_frames": self.n_frames,
-                "width_px": self.width_px, "height_px": self.height_px, "plane": self.plane,
-                "level_rad": self.level_rad, "level_source": self.level_source,
-                "level_sigma_rad": self.level_sigma_rad, "objects": per, "corrections": list(self.corrections)}
+            per[t.object] = {
+                "kind": t.kind,
+                "n_ok": int(np.sum(t.ok)),
+                "m_per_unit": t.m_per_unit,
+                "status_counts": {str(a): int(b) for a, b in zip(st, cnt)},
+                "median_sigma_theta_rad": float(np.nanmedian(t.sigma_theta_rad))
+                if np.any(np.isfinite(t.sigma_theta_rad))
+                else np.nan,
+                "theta_note": t.theta_note,
+            }
+        return {
+            "source": self.source,
+            "fps": self.fps,
+            "n_frames": self.n_frames,
+            "width_px": self.width_px,
+            "height_px": self.height_px,
+            "plane": self.plane,
+            "level_rad": self.level_rad,
+            "level_source": self.level_source,
+            "level_sigma_rad": self.level_sigma_rad,
+            "objects": per,
+            "corrections": list(self.corrections),
+        }
 
 
-def assemble_tracks(observations, config: TrackConfig, fps: float, width_px: int, height_px: int,
-                    plane_map: PlaneMap | None = None, source=None, frame_times_s=None) -> TrackResult:
+def assemble_tracks(
+    observations,
+    config: TrackConfig,
+    fps: float,
+    width_px: int,
+    height_px: int,
+    plane_map: PlaneMap | None = None,
+    source=None,
+    frame_times_s=None,
+) -> TrackResult:
     """Convert per-frame observations (plane units) into a :class:`TrackResult` (m, levelled rad).
 
     Parameters
@@ -354,9 +424,11 @@ def assemble_tracks(observations, config: TrackConfig, fps: float, width_px: int
             a["scale"][i], a["q"][i] = r.scale, r.quality
             st[i] = r.status
             metric = metric or (r.status == "ok" and r.metric)
-        # An angle step no rocking block makes between frames is a misdetection, not motion.
         th = a["th"]
         okk = np.flatnonzero(st == "ok")
+        if np.isnan(th[okk]).any():  # found unmeasurable on the way: no frame's angle is measured
+            th[:], a["sig"][:] = np.nan, np.nan
+        # An angle step no rocking block makes between frames is a misdetection, not motion.
         for j0, j1 in zip(okk[:-1], okk[1:]):
             if j1 - j0 == 1 and abs(math.remainder(th[j1] - th[j0], 2 * math.pi)) > MAX_STEP_RAD:
                 st[j1] = "outlier"
@@ -367,14 +439,17 @@ def assemble_tracks(observations, config: TrackConfig, fps: float, width_px: int
     unseen = [o.id for o in config.objects if not np.any(raw[o.id][1] == "ok")]
     if len(unseen) == len(config.objects) or (unseen and n > 1):
         o = unseen[0]
-        raise InputError(f"{config.source or 'config'}: object {o!r} is never seen in "
-                         f"{source or 'the video'}; check its markers/dots/roi and the dictionary")
+        raise InputError(
+            f"{config.source or 'config'}: object {o!r} is never seen in "
+            f"{source or 'the video'}; check its markers/dots/roi and the dictionary"
+        )
     # Scale: metres per plane unit, per object (objects may sit at different depths).
     m_per = {}
     fallback = config.reference.m_per_px
     if fallback is None and not metric_plane:
-        metric_scales = [1.0 / np.nanmedian(raw[o.id][0]["scale"][raw[o.id][1] == "ok"])
-                         for o in config.objects if raw[o.id][2]]
+        metric_scales = [
+            1.0 / np.nanmedian(raw[o.id][0]["scale"][raw[o.id][1] == "ok"]) for o in config.objects if raw[o.id][2]
+        ]
         fallback = float(np.median(metric_scales)) if metric_scales else None
     for o in config.objects:
         a, st, metric = raw[o.id]
@@ -386,9 +461,12 @@ def assemble_tracks(observations, config: TrackConfig, fps: float, width_px: int
             m_per[o.id] = float(fallback)
         else:  # no metric scale anywhere: positions stay in pixels, never a made-up metre
             m_per[o.id] = math.nan
-            warn("W-TRACK-NOSCALE", f"{config.source or 'config'}: no metric scale for object {o.id!r}: x_m, y_m "
-                                    "left empty (x_px, y_px and theta_rad are measured); give "
-                                    "targets.marker_size_m, objects.size_m or reference.m_per_px")
+            warn(
+                "W-TRACK-NOSCALE",
+                f"{config.source or 'config'}: no metric scale for object {o.id!r}: x_m, y_m "
+                "left empty (x_px, y_px and theta_rad are measured); give "
+                "targets.marker_size_m, objects.size_m or reference.m_per_px",
+            )
     from ._level import level_from_reference, world_angle
 
     pm_px = plane_map
@@ -410,17 +488,45 @@ def assemble_tracks(observations, config: TrackConfig, fps: float, width_px: int
         else:
             u = v = np.full(n, np.nan)
         if config.motion.interpolate_max_gap_frames:
-            _interpolate([x, y, th, u, v], st, config.motion.interpolate_max_gap_frames)
-        t_s = (np.asarray(frame_times_s, float)[frames] if frame_times_s is not None
-               else frames / float(fps))
-        tracks.append(ObjectTrack(o.id, o.kind, frames.copy(), t_s, x, y, th, sig,
-                                  q, st.astype(str), m_per[o.id], u, v, angle_note(o, st, th)))
-    return TrackResult(tuple(tracks), float(fps), level, n, int(width_px), int(height_px),
-                       None if source is None else str(source), config, plane, plane_map, level_src, level_sig)
+            interpolate([x, y, th, u, v], st, config.motion.interpolate_max_gap_frames)
+        t_s = np.asarray(frame_times_s, float)[frames] if frame_times_s is not None else frames / float(fps)
+        tracks.append(
+            ObjectTrack(
+                o.id,
+                o.kind,
+                frames.copy(),
+                t_s,
+                x,
+                y,
+                th,
+                sig,
+                q,
+                st.astype(str),
+                m_per[o.id],
+                u,
+                v,
+                angle_note(o, st, th),
+            )
+        )
+    return TrackResult(
+        tuple(tracks),
+        float(fps),
+        level,
+        n,
+        int(width_px),
+        int(height_px),
+        None if source is None else str(source),
+        config,
+        plane,
+        plane_map,
+        level_src,
+        level_sig,
+    )
 
 
-def track_video(path, config: TrackConfig, fps: float | None = None, progress: bool = False,
-                on_frame=None) -> TrackResult:
+def track_video(
+    path, config: TrackConfig, fps: float | None = None, progress: bool = False, on_frame=None
+) -> TrackResult:
     """Track a video file.
 
     Parameters
@@ -452,7 +558,7 @@ def track_video(path, config: TrackConfig, fps: float | None = None, progress: b
     # the container's own frame times, unless the user overrides the rate (a clock known wrong)
     times = None if given else info.frame_times_s
     if given and info.frame_times_s is not None and info.fps and abs(given - info.fps) > 1e-3 * info.fps:
-        _check_rate(given, info, path, "the given fps" if fps else f"{config.source or 'config'}: [video] fps")
+        check_rate(given, info, path, "the given fps" if fps else f"{config.source or 'config'}: [video] fps")
     n_expected = info.n_frames
     if fields is not None:  # deinterlaced: two fields per frame, half a frame apart
         if rate is not None and not given:
@@ -462,32 +568,37 @@ def track_video(path, config: TrackConfig, fps: float | None = None, progress: b
             times = np.column_stack((times, times + half)).ravel()
         n_expected = 2 * info.n_frames
     if rate is None:
-        raise InputError(f"{path}: the film has no frame rate (an image folder has one only from its timestamps.csv); "
-                         "pass --fps N (or set [video] fps in the config)")
+        raise InputError(
+            f"{path}: the film has no frame rate (an image folder has one only from its timestamps.csv); "
+            "pass --fps N (or set [video] fps in the config)"
+        )
     v = config.video
     fixes = load_corrections(v.corrections, [o.id for o in config.objects]) if v.corrections else ()  # errors first
     start, stop = v.start_frame, v.stop_frame
     ref_frame = config.reference.board.frame if config.reference.board is not None else start
     first = None
-    for _, g in iter_video_frames(path, ref_frame, ref_frame + 1, prefetch=0, pixel_aspect=info.pixel_aspect,
-                                  fields=fields):
+    for _, g in iter_video_frames(
+        path, ref_frame, ref_frame + 1, prefetch=0, pixel_aspect=info.pixel_aspect, fields=fields
+    ):
         first = g
     if first is None:
-        raise InputError(f"{path}: frame {ref_frame} is past the end of the video "
-                         f"({info.n_frames} frames); check start_frame / reference.board.frame")
+        raise InputError(
+            f"{path}: frame {ref_frame} is past the end of the video "
+            f"({info.n_frames} frames); check start_frame / reference.board.frame"
+        )
     pm = make_plane_map(config, info.width_px, info.height_px, first)
-    frames = iter_video_frames(path, start, stop, color=on_frame is not None, pixel_aspect=info.pixel_aspect,
-                               fields=fields)
+    frames = iter_video_frames(
+        path, start, stop, color=on_frame is not None, pixel_aspect=info.pixel_aspect, fields=fields
+    )
     if on_frame is not None:
-        frames = _tee(frames, on_frame)
+        frames = tee(frames, on_frame)
     if progress:
         from tqdm import tqdm
 
         total = (min(stop, n_expected) if stop else n_expected) - start
-        frames = tqdm(frames, total=total if total > 0 else None, unit="frame", desc="track",
-                      leave=False)
+        frames = tqdm(frames, total=total if total > 0 else None, unit="frame", desc="track", leave=False)
     obs = track_frames(frames, config, pm)
     res = assemble_tracks(obs, config, rate, info.width_px, info.height_px, pm, path, frame_times_s=times)
     expected = (min(stop, n_expected) if stop else n_expected) - start
-    _check_frames(res, expected, path, info)
+    check_frames(res, expected, path, info)
     return apply_corrections(res, fixes) if fixes else res  # the config's hand fixes

@@ -209,7 +209,7 @@ def _track(args) -> int:
     from ....tracking.rigid import parse_bodies, track_points3d, write_points_csv
     from ....tracking.stereo import load_rig, stereo_point_series, track_dots_stereo
     from .._io_plan import POINTS, stereo_track_outputs
-    from ._cmd_track3d import _rest, write_track3d_outputs
+    from ._cmd_track3d import rest_spec, write_track3d_outputs
 
     if not args.calib:
         raise InputError("rocklab stereo track: give --calib stereo.json (from 'rocklab stereo calibrate')")
@@ -217,7 +217,7 @@ def _track(args) -> int:
         raise InputError(f"--fps {args.fps}: must be a positive number of frames per second")
     rig = load_rig(args.calib)
     _check_rig(rig, args.calib)
-    rest = _rest(args.rest)
+    rest = rest_spec(args.rest)
     out = Path(args.out) if args.out else Path(args.film1).parent / "tracks.csv"
     if args.targets == "aruco":
         from ....tracking.stereo import track_markers_stereo

@@ -128,7 +128,7 @@ def _run_stereo(args, out, events) -> int:
 
     from ...._outdir import publish_dir, stage_dir
     from ....synth import synth_stereo
-    from ....synth._session import parse_size
+    from ....synth import parse_size
 
     size = parse_size(args.size if args.size != "1920x1080" else "2400x1728")
     tmp = stage_dir(out)
@@ -230,7 +230,7 @@ def _run_points3d(args) -> int:
 def run(args) -> int:
     """Run ``rocklab synth`` with parsed ``args``; returns the exit status (0 ok)."""
     from ....synth import synth_session
-    from ....synth._session import parse_size
+    from ....synth import parse_size
 
     if args.points3d or args.stereo:
         return _run_points3d(args)

@@ -71,7 +71,7 @@ def register(sub):
     p.set_defaults(func=run)
 
 
-def _rest(spec: str):
+def rest_spec(spec: str):
     s = str(spec).strip().lower()
     if s in ("auto", "first", "last"):
         return s
@@ -120,7 +120,7 @@ def run(args) -> int:
         twist_rad=math.radians(positive("--twist-tol (deg)", args.twist_tol)),
         out_of_plane_rad=math.radians(args.twist_tol),
     )
-    rest = _rest(args.rest)
+    rest = rest_spec(args.rest)
     out = Path(args.out) if args.out else src.parent / "tracks.csv"
     series = read_points(src)
     bodies = parse_bodies(args.body, series.labels, series.source)

@@ -24,7 +24,7 @@ _REFINE = {
     "edges": "CORNER_REFINE_NONE",
 }
 # Object-frame corner offsets (y up) in OpenCV's order TL, TR, BR, BL, unit side.
-_UNIT_CORNERS = np.array([[-0.5, 0.5], [0.5, 0.5], [0.5, -0.5], [-0.5, -0.5]])
+UNIT_CORNERS = np.array([[-0.5, 0.5], [0.5, 0.5], [0.5, -0.5], [-0.5, -0.5]])
 
 
 def make_cv_detector(targets, win: int | None = None):
@@ -197,7 +197,7 @@ class ArucoDetector:
         fits = {}
         for m in o.markers:
             q = self.pm.to_plane(found[m])
-            fits[m] = fit_similarity(_UNIT_CORNERS * (self.size[o.id] or 1.0), q)
+            fits[m] = fit_similarity(UNIT_CORNERS * (self.size[o.id] or 1.0), q)
         f0 = fits[o.markers[0]]
         rot = np.array(
             [[np.cos(-f0.theta_rad), -np.sin(-f0.theta_rad)], [np.sin(-f0.theta_rad), np.cos(-f0.theta_rad)]]
@@ -222,7 +222,7 @@ class ArucoDetector:
                 lay = self.layout[o.id] = self._learn_layout(o, found)
             s = self.size[o.id] or 1.0
             img = np.vstack([found[m] for m in have])
-            obj = np.vstack([lay[m] + _UNIT_CORNERS * s for m in have])
+            obj = np.vstack([lay[m] + UNIT_CORNERS * s for m in have])
             sig = np.array([self.sigma.get(m, np.nan) for m in have])
             # markers are independent: the mean orientation's sigma shrinks with their number
             sig_mean = float(np.sqrt(np.nansum(sig**2)) / len(have)) if np.any(np.isfinite(sig)) else 0.0

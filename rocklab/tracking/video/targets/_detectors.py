@@ -55,6 +55,17 @@ def make_detector(config, pm, first_gray):
 
 def _make_single(config, pm, first_gray):
     style = config.targets.style
+    if style == "markerless":
+        from ._markerless import MarkerlessDetector
+
+        return MarkerlessDetector(config, pm, first_gray)
+    from ._verify_points import VerifiedDetector
+
+    return VerifiedDetector(_point_detector(config, pm, first_gray))
+
+
+def _point_detector(config, pm, first_gray):
+    style = config.targets.style
     if style in ("aruco", "apriltag"):
         from ._aruco import ArucoDetector
 
@@ -67,10 +78,6 @@ def _make_single(config, pm, first_gray):
         from ._edges import EdgeDetector
 
         return EdgeDetector(config, pm, first_gray)
-    if style == "markerless":
-        from ._markerless import MarkerlessDetector
-
-        return MarkerlessDetector(config, pm, first_gray)
     from ._region import RegionDetector
 
     return RegionDetector(config, pm, first_gray)

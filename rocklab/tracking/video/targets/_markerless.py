@@ -45,6 +45,14 @@ __all__ = ["MarkerlessTracker", "MarkerlessDetector", "MIN_CC", "REKEY_CC"]
 MIN_CC = 0.6
 #: Correlation with the first template below which the latest keyframe is used (and renewed).
 REKEY_CC = 0.9
+#: An outline at least this round (circularity of its hull: a disk 1, an ellipse of axes 3:2
+#: 0.93, 2:1 0.83, a square 0.785) tells no angle: the texture alone does, and a ball's texture turns as
+#: the ball spins in depth; its angle is not reported ...
+ROUND_MIN = 0.9
+#: ... when, over at least ROUND_MIN_FRAMES verified frames, this share of them no longer
+#: correlates with the first view to REKEY_CC (a disk with a mark turning in the plane does).
+OTHER_VIEW_SHARE = 0.25
+ROUND_MIN_FRAMES = 30
 #: Smallest grey-level standard deviation of a region worth tracking.
 MIN_TEXTURE_STD = 3.0
 #: Margin of the full-resolution ECC window round the coarse footprint, px (the half-resolution
@@ -144,6 +152,9 @@ class MarkerlessTracker:
         self.theta_note, sym = (None, None) if obj.kind == "table" else theta_unobservable(tmpl)
         self.sym0 = None if sym is None else self.origin + sym  # the centre of symmetry, first-frame px
         self.verifier.check_turn = self.theta_note is None
+        #: why the angle is not reported although the texture gives one (a round outline), or None
+        self.round_note = None
+        self.views = [0, 0]  # verified frames, and those not a turned copy of the first view
         self.reason = None  # why the last frame was lost ("mismatch", "jump", "background", "lost")
 
     # -- registration -------------------------------------------------------------
@@ -326,6 +337,22 @@ class MarkerlessTracker:
         t = new_ctr - R @ ctr
         return _euclid(th, t[0], t[1])
 
+    def _round_check(self, first_view):
+        """Sets :attr:`round_note` once the outline is known to be round and the texture is no
+        longer a turned copy of the first view on :data:`OTHER_VIEW_SHARE` of the verified frames:
+        a ball spinning in depth (a disk with a mark turning in the plane keeps its first view)."""
+        self.views[0] += 1
+        self.views[1] += not first_view
+        out = self.verifier.outline
+        if self.round_note is not None or self.theta_note is not None or out is None or out.roundness < ROUND_MIN:
+            return
+        n, other = self.views
+        if n >= ROUND_MIN_FRAMES and other >= OTHER_VIEW_SHARE * n:
+            self.round_note = (
+                f"its outline is round (circularity {out.roundness:.2f}) and its texture is not a turned "
+                f"copy of its first view on {100 * other / n:.0f} % of the frames: a ball spinning in depth"
+            )
+
     def _held(self, W):
         """``W`` turned back upright about the object's centre of symmetry when its angle is not
         observable (there the fitted angle is noise, and it would swing the template's centre)."""
@@ -371,6 +398,7 @@ class MarkerlessTracker:
             W_pred = _euclid(0.0, 0.0, 0.0)
         fit = self._ecc(self.tmpl0, gray, W_pred, direct=len(self.poses) >= 2)
         tmpl = self.tmpl0
+        first_view = fit is not None and fit[1] >= REKEY_CC  # the frame is a turned copy of the first
         if (fit is None or fit[1] < REKEY_CC) and self.key is not self.tmpl0:
             alt = self._ecc(self.key, gray, W_pred if fit is None else fit[0])
             if alt is not None and (fit is None or alt[1] > fit[1]):
@@ -408,6 +436,7 @@ class MarkerlessTracker:
             self.poses = []  # the next frame searches from the first frame's place, then the last seen
             return None
         self.verifier.confirm(gray, self.size)
+        self._round_check(first_view)
         W, cc = fit
         if cc < REKEY_CC and mask is None:
             back = self._warp_back(gray, W)
@@ -458,9 +487,10 @@ class MarkerlessDetector:
         return {oid: t.detect(gray, frame) for oid, t in self.trackers.items()}
 
     def theta_note(self, oid):
-        """Why object ``oid``'s angle cannot be measured from its appearance, or None."""
+        """Why object ``oid``'s angle cannot be measured from its appearance (from its first
+        region, or once its outline is known, a round outline), or None."""
         t = self.trackers.get(oid)
-        return None if t is None else t.theta_note
+        return None if t is None else t.theta_note or t.round_note
 
     def lost_reason(self, oid):
         """Why object ``oid`` was lost in the last frame (a status word), or None."""

@@ -23,6 +23,7 @@ __all__ = [
     "theta_unobservable",
     "angle_free_objects",
     "angle_note",
+    "warn_theta",
     "MIN_TURN_SHARE",
 ]
 
@@ -134,8 +135,6 @@ def angle_free_objects(config, detector) -> dict:
     dict
         object id -> reason (one line).
     """
-    from ...._diagnostics import warn
-
     out = {}
     for o in config.objects:
         why = detector.theta_note(o.id) if hasattr(detector, "theta_note") else None
@@ -143,13 +142,21 @@ def angle_free_objects(config, detector) -> dict:
             out[o.id] = POINT_NOTE
         elif why is not None:
             out[o.id] = why
-            warn(
-                "W-TRACK-THETA",
-                f"{config.source or 'config'}: object {o.id!r}: theta cannot be measured: {why}; "
-                'theta_rad is NaN, x and y are tracked; set kind = "point" to track a position only, '
-                "or draw the region round a part that shows the turn (an edge, a mark)",
-            )
+            warn_theta(config, o.id, why)
     return out
+
+
+def warn_theta(config, oid, why, frame=None):
+    """W-TRACK-THETA for object ``oid`` (``frame``: the frame it was found at, when not the first)."""
+    from ...._diagnostics import warn
+
+    at = "" if frame is None else f" (found at frame {frame}; theta_rad is dropped on every frame)"
+    warn(
+        "W-TRACK-THETA",
+        f"{config.source or 'config'}: object {oid!r}: theta cannot be measured: {why}{at}; "
+        'theta_rad is NaN, x and y are tracked; set kind = "point" to track a position only, '
+        "or draw the region round a part that shows the turn (an edge, a mark)",
+    )
 
 
 def angle_note(obj, status, theta_rad) -> str:

@@ -41,6 +41,7 @@ __all__ = [
     "masked_fit",
     "OutlineRef",
     "silhouette",
+    "roundness",
     "warp_grown",
 ]
 
@@ -184,6 +185,34 @@ def silhouette(patch, bg):
     return np.clip((d - lo) * (1.0 / (hi - lo)), 0.0, 1.0)
 
 
+def roundness(sil) -> float:
+    """Circularity ``4 pi A / P^2`` of the convex hull of the largest blob where the silhouette
+    ``sil`` (h, w, 0..1) stands out (above 0.2, gaps of a few pixels closed: a clear part
+    of a ball stands out less than its coloured part): 1 for a disk, 0.785 for a square, 0.59
+    for a 1:3 block; NaN without a blob of at least 20 px.
+
+    >>> yy, xx = np.mgrid[0:60, 0:60]
+    >>> round(roundness(((xx - 30) ** 2 + (yy - 28) ** 2 < 20**2).astype(np.float32)), 2) > 0.95
+    True
+    >>> sq = np.zeros((60, 60), np.float32); sq[10:50, 10:50] = 1
+    >>> 0.75 < roundness(sq) < 0.82
+    True
+    """
+    import cv2
+
+    if sil is None:
+        return float("nan")
+    b = cv2.morphologyEx(
+        (np.asarray(sil) > 0.2).astype(np.uint8), cv2.MORPH_CLOSE, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (5, 5))
+    )
+    cs, _ = cv2.findContours(b, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)
+    if not cs:
+        return float("nan")
+    hull = cv2.convexHull(max(cs, key=cv2.contourArea)).astype(np.float32)
+    area, per = cv2.contourArea(hull), cv2.arcLength(hull, True)
+    return float(4 * math.pi * area / per**2) if area >= 20 else float("nan")
+
+
 def _peak(res):
     """Sub-pixel location (x, y) of the maximum of ``res`` and its value (parabola through the
     neighbours where the maximum is inside)."""
@@ -235,6 +264,8 @@ class OutlineRef:
         if self.ref is not None and self.scale < 1.0:
             a, b = (_reduce(img[y0:y1, x0:x1], self.scale) for img in (first, bg))
             self.ref = silhouette(a, b)
+        #: the outline's roundness (:func:`roundness`), NaN without an outline
+        self.roundness = roundness(self.ref)
 
     def locate(self, tr, frame, bg, W, grown=None):
         """Register the outline round the pose ``W`` (first-frame px -> image px).

@@ -16,10 +16,22 @@ FLAGS = doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE
 
 
 def _entry_points():
+    from rocklab.fitting import fit_restitution
+    from rocklab.models import overturning_spectrum, simulate
     from rocklab.pipelines import run_experiment
+    from rocklab.tracking import track_video
     from rocklab.tracking.video.targets._observability import turn_share
+    from rocklab.tracking.video.targets._occlusion import roundness
 
-    return {"run_experiment": run_experiment, "turn_share": turn_share}
+    return {
+        "simulate": simulate,
+        "track_video": track_video,
+        "fit_restitution": fit_restitution,
+        "overturning_spectrum": overturning_spectrum,
+        "run_experiment": run_experiment,
+        "turn_share": turn_share,
+        "roundness": roundness,
+    }
 
 
 @pytest.mark.parametrize("name", sorted(_entry_points()))

@@ -320,6 +320,15 @@ def overturning_spectrum(
     Returns
     -------
     OASResult
+
+    Examples
+    --------
+    A one-cycle sine pulse (peak 0.5 m/s², period 2 s) on a coarse 20 × 30 grid, H/B = 5:
+
+    >>> from rocklab.models import overturning_spectrum, pulse_motion
+    >>> o = overturning_spectrum(pulse_motion("sine", 0.5, 2.0), 5.0, levels=20, sizes=30)
+    >>> o.n_runs, round(o.t_I_s, 2)
+    (313, 0.36)
     """
     sl = check_opts(slenderness, levels, sizes, R_max_m, R_min_m, level_max, alpha_I)
     if not isinstance(base, BaseMotion):

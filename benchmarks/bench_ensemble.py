@@ -58,7 +58,7 @@ def make_run(seed: int, acc_noise=0.049, acc_bias=0.01, sync_sd=2e-4):
     """(block, eta_true, prim, table, table_sync, truth) of one synthetic shake-table run."""
     from rocklab.fitting import catalogue_block, ceh_catalogue, half_cycle_segments
     from rocklab.models import simulate
-    from rocklab.synth._motion import record_table, sine_pulse_table
+    from rocklab.synth._scripted_motion import record_table, sine_pulse_table
 
     recs, random_record = _records()
     rng = np.random.default_rng(seed)

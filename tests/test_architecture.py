@@ -236,16 +236,7 @@ def test_no_function_over_120_lines_outside_numba_kernels():
 
 
 #: File names used by more than one module, each for a different job (issue 28: to become distinct).
-SHARED_FILE_NAMES = {
-    "_campaign.py",
-    "_config.py",
-    "_dots.py",
-    "_geometry.py",
-    "_motion.py",
-    "_plane.py",
-    "_read.py",
-    "_restitution.py",
-}
+SHARED_FILE_NAMES: set = set()
 
 
 def test_distinct_file_names_for_distinct_jobs():
@@ -306,7 +297,7 @@ PRIVATE_IMPORTS = {
     "rocklab.tracking.stereo._calib -> rocklab.tracking.video._checks": (
         "a mirrored film is refused by the one check the single-camera tracker uses"
     ),
-    "rocklab.tracking.stereo._dots -> rocklab.tracking.video._checks": "the same mirrored-film check",
+    "rocklab.tracking.stereo._dots3d -> rocklab.tracking.video._checks": "the same mirrored-film check",
     "rocklab.tracking.stereo._world -> rocklab.tracking.rigid._rigidity": (
         "triangulated points are grouped into rigid bodies by the 3D import's rule"
     ),
@@ -316,7 +307,7 @@ PRIVATE_IMPORTS = {
     "rocklab.tracking.video._plane -> rocklab.tracking.video.targets._aruco": (
         "the plane map refines marker corners with the ArUco detector's own refinement"
     ),
-    "rocklab.tracking.video._geometry -> rocklab.tracking.calib._boards": (
+    "rocklab.tracking.video._camera_model -> rocklab.tracking.calib._boards": (
         "the reference board is found with the calibration's corner window"
     ),
     "rocklab.tracking.video._propose -> rocklab.tracking.video.targets._table_edge": (

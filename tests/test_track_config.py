@@ -76,7 +76,7 @@ def test_schema_page_and_examples():
     from pathlib import Path
 
     from rocklab.tracking import load_track_config
-    from rocklab.tracking.video._config import schema_markdown
+    from rocklab.config import schema_markdown
 
     root = Path(__file__).resolve().parents[1]
     assert (root / "docs" / "track-toml.md").read_text(encoding="utf-8").endswith(schema_markdown())

@@ -18,7 +18,7 @@ def _forced_run(eta, seed, *, block_id="B5L", acc_bias=0.01):
     θ at 50 Hz with 0.4 mrad noise, the table accelerometer at 256 Hz with 0.005 g noise and a bias."""
     from rocklab.fitting import catalogue_block
     from rocklab.models import bundled_record, simulate
-    from rocklab.synth._motion import record_table
+    from rocklab.synth._scripted_motion import record_table
 
     block = catalogue_block(block_id)
     table = record_table(bundled_record("elcentro"), 0.6, 6.9, 0.01, 1.6 * block.uplift_acc_m_s2)
@@ -182,7 +182,7 @@ def test_each_half_cycle_gives_its_impact_eta():
     from rocklab.fitting import fit_forced_restitution
     from rocklab.models import bundled_record, simulate
     from rocklab.pipelines.experiment._column_run import base_from_table
-    from rocklab.synth._motion import record_table
+    from rocklab.synth._scripted_motion import record_table
 
     from rocklab import Block
 

@@ -10,7 +10,7 @@ flags), :func:`per_impact_eta` (data-only per-impact η), :func:`energy_loss_fro
 (:func:`ceh_catalogue`, :func:`catalogue_block`).
 """
 
-from ._campaign import ETA_MAT_RULES, EtaMatResult, KTableResult, fit_eta_mat, k_table, read_block_table
+from ._campaign_fits import ETA_MAT_RULES, EtaMatResult, KTableResult, fit_eta_mat, k_table, read_block_table
 from ._catalogue import catalogue_block, ceh_catalogue, ceh_full_contact, ceh_table5
 from ._ensemble import (
     BUDGET_SOURCES,
@@ -38,7 +38,7 @@ from ._impacts import (
 from ._laws import alpha_from_hb, edge_contact_k, eta_housner, eta_modified, k_from_eta
 from ._regression import CEH_EQ19, REGRESSION_FORMS, KPrediction, KRegression, fit_k_regression
 from ._repeats import RepeatSummary, campaign_table, fit_many, summarize_repeats
-from ._restitution import OBJECTIVES, WINDOWS, RestitutionFit, fit_restitution
+from ._eta_fit import OBJECTIVES, WINDOWS, RestitutionFit, fit_restitution
 
 __all__ = [
     # per experiment

@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._restitution import RestitutionFit, fit_restitution
+from ._eta_fit import RestitutionFit, fit_restitution
 
 __all__ = ["RepeatSummary", "summarize_repeats", "fit_many", "campaign_table"]
 

@@ -56,7 +56,7 @@ def _simulate(blk, *, theta0_sim, base, horizon_s, restitution, eta):
 
 
 def _table_motion(kind, seed_rng, *, record, amplitude, period, stroke, blocks, start_s, horizon_s):
-    from ._motion import record_table, sine_pulse_table, still_table
+    from ._scripted_motion import record_table, sine_pulse_table, still_table
 
     if kind == "none":
         return still_table()
@@ -616,7 +616,7 @@ def _block_info(blk) -> dict:
 
 def _single_motions(blks, xs, phi0, tbl, base, table, rest_s, sim_end_s, rng_m, restitution, eta):
     """Independent blocks side by side: one ``simulate`` run each, to ``sim_end_s`` (video time)."""
-    from ._motion import BlockMotion
+    from ._scripted_motion import BlockMotion
 
     motions, sims, ends = [], [], [tbl.end_s]
     for k, blk in enumerate(blks):

@@ -53,7 +53,7 @@ import numpy as np
 from ..._diagnostics import warn
 from ..._errors import InputError
 from ...blocks import G
-from ._motion import (
+from ._motion_windows import (
     axis_vector,
     cumtrapz,
     first_motion,

@@ -22,7 +22,7 @@ import numpy as np
 from ..._diagnostics import warn
 from ..._errors import InputError
 from ...blocks import G
-from ._motion import axis_vector, first_motion, forced_run, motion_mask, rotation_between
+from ._motion_windows import axis_vector, first_motion, forced_run, motion_mask, rotation_between
 from ._read import ImuLog
 from ._validity import TABLE_TURN_MAX_RAD, table_turn
 

@@ -27,7 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..._diagnostics import warn
-from ._motion import cumtrapz, moving_average, rownorm
+from ._motion_windows import cumtrapz, moving_average, rownorm
 
 __all__ = []
 

@@ -14,8 +14,8 @@ What lives here:
 
 from ._audit import FLAG_KINDS, AuditFlag, AuditResult, AuditTolerances, audit_rocking
 from ._pose import BodyPoses, body_poses, kabsch, reference_shape
-from ._read import PointSeries, read_c3d, read_points, read_points_csv, write_c3d, write_points_csv
-from ._plane import audit_plane_track, plane_pivot_motion
+from ._read_points import PointSeries, read_c3d, read_points, read_points_csv, write_c3d, write_points_csv
+from ._plane_audit import audit_plane_track, plane_pivot_motion
 from ._rocking import RockingGeometry, find_impacts, fit_pivots, rocking_axes, split_rotation
 from ._track3d import TRACK3D_COLUMNS, Body3D, Track3DResult, parse_bodies, track_points3d
 

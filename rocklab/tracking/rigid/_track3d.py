@@ -28,7 +28,7 @@ from ._audit import AuditResult, AuditTolerances, audit_rocking
 from ._pose import MIN_POINTS, BodyPoses, body_poses, kabsch, reference_shape
 from ._plausible import check_rate, check_span, check_up, up_evidence
 from ...series import TRACK3D_COLUMNS
-from ._read import PointSeries
+from ._read_points import PointSeries
 from ._rigidity import check_bodies_disjoint, check_rigid_body
 from ._rocking import (
     RockingGeometry,

@@ -11,7 +11,7 @@
 """
 
 from ._calib import DEFAULT_BOARD, StereoRig, calibrate_stereo, charuco_board, load_rig
-from ._dots import (
+from ._dots3d import (
     DotTracks2D,
     StereoPoints,
     SyncOffset,

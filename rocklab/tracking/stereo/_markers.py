@@ -14,7 +14,7 @@ import numpy as np
 from ..._errors import InputError, where
 from ._calib import StereoRig
 from ._setup import check_depth_in_front, check_film_order, check_unsynchronised
-from ._dots import DotTracks2D, StereoPoints, check_films, sync_offset_stereo, triangulate_tracks
+from ._dots3d import DotTracks2D, StereoPoints, check_films, sync_offset_stereo, triangulate_tracks
 
 __all__ = ["track_markers_2d", "track_markers_stereo"]
 

@@ -18,7 +18,7 @@ import numpy as np
 
 from ..rigid import PointSeries
 from ..rigid._rigidity import rigid_groups
-from ._dots import StereoPoints
+from ._dots3d import StereoPoints
 
 __all__ = ["stereo_point_series"]
 

@@ -21,11 +21,11 @@ from ...config import (
     VideoConfig,
     load_track_config,
 )
-from ._geometry import PlaneMap, SimilarityFit, calibrate_camera, fit_similarity, load_calibration
+from ._camera_model import PlaneMap, SimilarityFit, calibrate_camera, fit_similarity, load_calibration
 from ._init import find_markers, suggest_config
 from ._level import level_from_reference
 from ...series import TableMotion
-from ._motion import choose_sg_window, estimate_noise, table_motion
+from ._table_track import choose_sg_window, estimate_noise, table_motion
 from ._track import TRACK_COLUMNS, ObjectTrack, Observation, TrackResult, assemble_tracks, track_frames, track_video
 from ._video import VideoInfo, iter_video_frames, probe_video
 from ._propose import propose_objects

@@ -12,7 +12,7 @@ import numpy as np
 
 from ..._errors import InputError
 from ...config import MARKER_STYLES, TrackConfig
-from ._geometry import PlaneMap, board_homography, load_calibration, plane_homography_from_points
+from ._camera_model import PlaneMap, board_homography, load_calibration, plane_homography_from_points
 
 __all__ = ["make_plane_map"]
 

@@ -187,7 +187,7 @@ def find_table_below(first_gray, box):
     """
     import cv2
 
-    from ._geometry import PlaneMap
+    from ._camera_model import PlaneMap
     from .targets._table_edge import BLUR_PX, table_top_edge
 
     H, W = first_gray.shape[:2]

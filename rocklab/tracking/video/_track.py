@@ -21,12 +21,12 @@ from ..._diagnostics import warn
 from ..._errors import InputError
 from .._corrections import apply_corrections, load_corrections
 from ._checks import check_frames, check_rate, interpolate, look, tee, why_lost
-from ._config import TrackConfig
-from ._geometry import PlaneMap, fit_similarity
+from ...config import TrackConfig
+from ._camera_model import PlaneMap, fit_similarity
 from .targets import make_detector
 from .targets._observability import angle_free_objects, angle_note, warn_theta
 from ._plane import make_plane_map
-from ._motion import TableMotion, table_motion
+from ._table_track import TableMotion, table_motion
 
 __all__ = [
     "Observation",

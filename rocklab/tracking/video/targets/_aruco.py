@@ -12,7 +12,7 @@ import numpy as np
 from ...._errors import InputError
 from ._detection import Detection
 from ._edges import refine_rectangle
-from .._geometry import fit_similarity
+from .._camera_model import fit_similarity
 
 __all__ = ["ArucoDetector", "Detection"]
 

@@ -85,7 +85,7 @@ def test_fit_restitution_missing_columns_and_short(run_cli, tmp_path):
     assert rc == 2 and "theta_rad" in err
     p.write_text("t_s,theta_rad\n" + "".join(f"{i / 150},0.05\n" for i in range(5)))
     rc, out, err = run_cli("fit", "restitution", p, "--width", 0.045, "--height", 0.2025)
-    assert rc == 2 and "too short" in err
+    assert rc == 2 and "too short" in err and str(p) in err  # the file is named
 
 
 def test_fit_restitution_failed_status(run_cli, tmp_path):

@@ -149,3 +149,10 @@ def test_progress_bar_goes_to_stderr(session, run_cli, tmp_path):
     assert rc == 0
     json.loads(out)  # stdout stays one JSON object
     assert "track" in err and "frame" in err
+
+
+def test_a_missing_video_is_named_before_a_missing_config(tmp_path, run_cli):
+    # it said "track.toml: tracking config not found" for a mistyped film name
+    for cmd in (("track",), ("track", "preview")):
+        rc, _, err = run_cli(*cmd, tmp_path / "nothere.mp4")
+        assert rc == 2 and "nothere.mp4" in err and "not found" in err and "track.toml" not in err

@@ -84,3 +84,16 @@ def test_schema_page_and_examples():
     assert set(loaded) == {"track_aruco.toml", "track_markerless.toml", "track_mixed.toml"}
     assert loaded["track_mixed.toml"].object("table").style == "markerless"
     assert loaded["track_markerless.toml"].targets.style == "markerless"
+
+
+def test_a_region_outside_the_frames_is_refused_when_tracking(tmp_path, sine_session, run_cli):
+    """``track init`` refuses a box past the frame's edge; the same roi written into track.toml by
+    hand was tracked (and reported ok on every frame)."""
+    text = (sine_session / "track.toml").read_text()
+    cfg = tmp_path / "t.toml"
+    cfg.write_text(
+        text.replace('id = "block_1"\n', 'id = "block_1"\nstyle = "region"\nroi = [900.0, 200.0, 120.0, 100.0]\n', 1)
+    )
+    rc, _, err = run_cli("track", sine_session / "video.mkv", "--config", cfg, "-o", tmp_path / "tr.csv")
+    assert rc == 2 and "block_1" in err and "960x540" in err and "roi" in err
+    assert not (tmp_path / "tr.csv").exists()

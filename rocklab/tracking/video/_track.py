@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import collections
 import math
+import os
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -569,6 +570,7 @@ def track_video(
     from ._video import iter_video_frames, probe_video
 
     info = probe_video(path)
+    _check_regions(config, info, path)
     fields = info.field_order
     given = fps or config.video.fps
     rate = given or info.fps
@@ -619,3 +621,19 @@ def track_video(
     expected = (min(stop, n_expected) if stop else n_expected) - start
     check_frames(res, expected, path, info)
     return apply_corrections(res, fixes) if fixes else res  # the config's hand fixes
+
+
+def _check_regions(config, info, path) -> None:
+    """Every object's ``roi`` lies in the frames (a region past the edge tracks nothing real: it
+    was refused by ``track init`` but not when written by hand)."""
+    W, H = info.width_px, info.height_px
+    tol = 0.5  # px: continuous coordinates, pixel centres at integers
+    for o in config.objects:
+        if o.roi is None:
+            continue
+        u, v, w, h = (float(x) for x in o.roi)
+        if u < -tol or v < -tol or u + w > W + tol or v + h > H + tol:
+            raise InputError(
+                f"{config.source or 'track.toml'}: object {o.id!r} roi {[u, v, w, h]} leaves the {W}x{H} "
+                f"frames of {os.path.basename(str(path))}; give a region inside them (read it off 'rocklab track init')"
+            )

@@ -146,6 +146,11 @@ def _read_track(path: Path, obj: str | None, nan: str):
         raise InputError(
             f"{where(path, line)}NaN or not-ok sample ({int(bad.sum())} such rows); use --nan skip to drop them"
         )
+    if int((~bad).sum()) < 10:  # named here: the fit's own message cannot say which file
+        raise InputError(
+            f"{path}: {int((~bad).sum())} usable samples (status ok or corrected, finite θ): too short, a fit needs "
+            "at least 10 over a few rocking cycles: check the file, its object and its status column"
+        )
     return t[~bad], th[~bad], int(bad.sum())
 
 

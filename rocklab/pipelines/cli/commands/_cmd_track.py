@@ -120,6 +120,8 @@ def run(args) -> int:
     from .._io_plan import TABLE, track_outputs
 
     video = Path(args.video)
+    if not video.exists() and "%" not in video.name:  # named first: the config's absence would hide it
+        raise InputError(f"{video}: video not found (no such file, image folder or numbered pattern); check the path")
     cfg_path = Path(args.config) if args.config else video.parent / "track.toml"
     if not cfg_path.exists():
         raise InputError(f"{cfg_path}: tracking config not found; pass --config track.toml")
@@ -218,6 +220,8 @@ def _tools(args) -> int:
                 f"'rocklab track {video} --config {out}'"
             )
         return 0
+    if not video.exists() and "%" not in video.name:  # named first: the config's absence would hide it
+        raise InputError(f"{video}: video not found (no such file, image folder or numbered pattern); check the path")
     cfg_path = Path(args.config) if args.config else video.parent / "track.toml"
     if not cfg_path.exists():
         raise InputError(f"{cfg_path}: tracking config not found; pass --config track.toml")

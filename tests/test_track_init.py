@@ -74,6 +74,8 @@ def test_preview_sheet(session, tmp_path, run_cli):
         (["--object", "a=1,2,3"], "x,y,w,h"),
         (["--object", "a=100,100,200,100", "--object", "a=300,100,50,50"], "given twice"),
         (["--table", "0,0,-5,5"], "w, h > 0"),
+        # a table box past the edge is named as --table (it said "--object table")
+        (["--object", "a=100,100,50,50", "--table", "800,500,300,100"], "--table: region"),
     ],
 )
 def test_init_bad_regions(session, tmp_path, run_cli, extra, words):

@@ -147,16 +147,16 @@ def suggest_config(
     video = VideoConfig(fps=fps)
     H, W = first_gray.shape[:2]
 
-    def inside(name, roi):
+    def inside(option, roi):
         x, y, w, h = roi
         if x < 0 or y < 0 or x + w > W or y + h > H:
-            raise InputError(f"--object {name}: region {list(roi)} leaves the {W}x{H} first frame; give it inside")
+            raise InputError(f"{option}: region {list(roi)} leaves the {W}x{H} first frame; give it inside")
         return roi
 
     if regions or table_roi is not None:
-        objs = [ObjectConfig(id=n, kind="block", roi=inside(n, r)) for n, r in (regions or {}).items()]
+        objs = [ObjectConfig(id=n, kind="block", roi=inside(f"--object {n}", r)) for n, r in (regions or {}).items()]
         if table_roi is not None:
-            objs.append(ObjectConfig(id="table", kind="table", roi=inside("table", table_roi)))
+            objs.append(ObjectConfig(id="table", kind="table", roi=inside("--table", table_roi)))
         _check_overlaps(objs)
         notes.append("objects followed markerless from the regions given (px, first frame)")
         notes.append(

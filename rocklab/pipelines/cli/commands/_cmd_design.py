@@ -123,7 +123,15 @@ def _register_design(sub):
 
 
 def _register_equivalent(sub):
-    p = sub.add_parser("equivalent", help="equivalent-block parameters of a rocking mechanism")
+    p = sub.add_parser(
+        "equivalent",
+        help="equivalent-block parameters of a rocking mechanism",
+        description="Equivalent-block parameters of a rocking mechanism (DeJong & Dimitrakopoulos 2014). "
+        "What each mechanism needs: block, strut, frame, wall: --R and --alpha, or --b and --h "
+        "(frame: also --gamma; block, frame, wall: --alpha-I); asym-frame: --b --H --H1 --L --h "
+        "[--masses]; arch: --beta --thickness --radius; cone: --H --base-radius. A time history "
+        "needs --base-motion or --pulse.",
+    )
     p.add_argument(
         "mechanism",
         choices=("block", "strut", "frame", "wall", "asym-frame", "arch", "cone"),

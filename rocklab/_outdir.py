@@ -112,10 +112,23 @@ def owned_entries(path) -> set[str]:
         return set()
 
 
+#: A staging file or folder of rocklab's atomic writes: ``.<name>.tmp-<pid>-...`` / ``.<name>.old-<pid>-...``.
+_STAGING = re.compile(r"^\..+\.(?:tmp|old)-(\d+)-")
+
+
 def foreign_entries(path) -> list[str]:
-    """Entries of folder ``path`` that rocklab did not write (sorted names)."""
+    """Entries of folder ``path`` that rocklab did not write (sorted names).
+
+    A staging leftover of a rocklab writer that was killed (its process is gone) is rocklab's,
+    not the user's: the next write of that output removes it (:func:`clean_stale`).
+    """
     owned = owned_entries(path) | {MARKER}
-    return sorted(p.name for p in Path(path).iterdir() if p.name not in owned)
+
+    def ours(name: str) -> bool:
+        m = _STAGING.match(name)
+        return name in owned or (m is not None and not pid_alive(int(m.group(1))))
+
+    return sorted(p.name for p in Path(path).iterdir() if not ours(p.name))
 
 
 def _digest(path) -> bytes:

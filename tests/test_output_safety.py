@@ -308,3 +308,21 @@ def test_stamps_live_in_the_cache_folder_where_files_hold_no_extended_attributes
     link = folder / "link.json"
     link.symlink_to(out)
     assert not rocklab_wrote(link)
+
+
+def test_a_killed_writers_staging_file_is_not_the_users(tmp_path):
+    """A campaign killed while writing campaign.rrd left ``.campaign.rrd.tmp-<pid>-...``; resuming
+    refused the folder as holding "files rocklab did not write". A dead writer's staging is
+    rocklab's; a live one's (another rocklab still writing) is not taken."""
+    import os
+    import subprocess
+    import sys
+
+    from rocklab._outdir import foreign_entries
+
+    dead = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True, text=True)
+    pid = int(dead.stdout)
+    (tmp_path / f".campaign.rrd.tmp-{pid}-abc.rrd").write_bytes(b"x")
+    (tmp_path / f".report.json.tmp-{os.getpid()}-def").write_bytes(b"x")
+    (tmp_path / "notes.txt").write_text("mine")
+    assert foreign_entries(tmp_path) == sorted([f".report.json.tmp-{os.getpid()}-def", "notes.txt"])

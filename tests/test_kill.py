@@ -191,12 +191,18 @@ def test_sigterm_during_a_compiled_loop_is_one_line_and_143(tmp_path):
     )
     out = tmp_path / "sim.csv"
     argv = ["simulate", "--width", 0.2, "--height", 1.0, "--base-motion", rec, "--duration", 1500, "--dt", 2e-6]
-    for _ in range(2):
-        proc = subprocess.Popen(
-            CLI + [str(a) for a in argv] + ["--output-dt", "0.01", "-o", str(out)],
-            stdout=subprocess.DEVNULL,
-            stderr=subprocess.PIPE,
-        )
+    for blocked in (False, True):
+        # a child inherits its parent's blocked signals: the CLI unblocks SIGTERM (a test process had
+        # blocked it, and the killed run went on to publish its output, exit 0)
+        mask = signal.pthread_sigmask(signal.SIG_BLOCK if blocked else signal.SIG_UNBLOCK, {signal.SIGTERM})
+        try:
+            proc = subprocess.Popen(
+                CLI + [str(a) for a in argv] + ["--output-dt", "0.01", "-o", str(out)],
+                stdout=subprocess.DEVNULL,
+                stderr=subprocess.PIPE,
+            )
+        finally:
+            signal.pthread_sigmask(signal.SIG_SETMASK, mask)
         ps = psutil.Process(proc.pid)
         # past the imports (about 1 CPU-s): inside numba (compiling, or the ~5 CPU-s loop)
         while proc.poll() is None and sum(ps.cpu_times()[:2]) < 2.5:

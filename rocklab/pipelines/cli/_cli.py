@@ -185,6 +185,10 @@ def main(argv=None) -> int:
     cmd = args.command
     if threading.current_thread() is threading.main_thread():
         signal.signal(signal.SIGTERM, _on_sigterm)
+        if hasattr(signal, "pthread_sigmask"):
+            # a blocked signal mask is inherited from the parent (a job runner, a test process that
+            # blocked SIGTERM): blocked, a SIGTERM would wait until the run ends and publish anyway
+            signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGTERM, signal.SIGINT})
 
     try:
         with warnings.catch_warnings(), collecting(echo=stderr_echo(cmd)) as diags:

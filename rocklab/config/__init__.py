@@ -14,77 +14,11 @@ Each choice list (target styles, levelling modes, table sources, fit windows, si
 and each default (the dataclasses' fields) is defined here once.
 """
 
-from ._experiment_toml import (
-    CONTACT_TYPES,
-    EXAMPLE_TOML,
-    FIT_WINDOWS,
-    PRIMARY_SOURCES,
-    SIMULATED_LAWS,
-    SYNC_METHODS,
-    TABLE_SOURCES,
-    ExperimentConfig,
-    SourceImu,
-    SourceTable,
-    SourceTrack,
-    SourceVideo,
-    experiment_name,
-    load_experiment_config,
-)
+from ._experiment_toml import *  # noqa: F403
+from ._experiment_toml import __all__ as _experiment_names
 from ._toml import TomlDoc, dumps_toml
-from ._track_toml import (
-    BOARD_KINDS,
-    CORNER_REFINEMENTS,
-    DOT_COLORS,
-    LEVEL_MODES,
-    MARKER_STYLES,
-    OBJECT_KINDS,
-    PLANE_MODES,
-    REGION_STYLES,
-    TARGET_STYLES,
-    BoardConfig,
-    MotionConfig,
-    ObjectConfig,
-    ReferenceConfig,
-    TargetsConfig,
-    TrackConfig,
-    VideoConfig,
-    load_track_config,
-    schema_markdown,
-)
+from ._track_toml import *  # noqa: F403
+from ._track_toml import __all__ as _track_names
 
-__all__ = [
-    "TomlDoc",
-    "dumps_toml",
-    "TrackConfig",
-    "VideoConfig",
-    "TargetsConfig",
-    "ReferenceConfig",
-    "BoardConfig",
-    "MotionConfig",
-    "ObjectConfig",
-    "load_track_config",
-    "schema_markdown",
-    "TARGET_STYLES",
-    "MARKER_STYLES",
-    "REGION_STYLES",
-    "OBJECT_KINDS",
-    "LEVEL_MODES",
-    "CORNER_REFINEMENTS",
-    "DOT_COLORS",
-    "PLANE_MODES",
-    "BOARD_KINDS",
-    "ExperimentConfig",
-    "SourceVideo",
-    "SourceTrack",
-    "SourceImu",
-    "SourceTable",
-    "load_experiment_config",
-    "experiment_name",
-    "EXAMPLE_TOML",
-    "CONTACT_TYPES",
-    "PRIMARY_SOURCES",
-    "TABLE_SOURCES",
-    "SYNC_METHODS",
-    "FIT_WINDOWS",
-    "SIMULATED_LAWS",
-]
+# each schema module's __all__ is the one list of its public names
+__all__ = ["TomlDoc", "dumps_toml", *_track_names, *_experiment_names]

@@ -20,6 +20,13 @@ __all__ = ["TABLE_TURN_MAX_RAD", "BLUR_RATIO", "check_mirrored"]
 BLUR_RATIO = 0.35
 
 
+def region_leaves(roi, width_px: int, height_px: int, tol_px: float = 0.0) -> bool:
+    """Whether a region ``(u, v, w, h)`` (px) reaches past a ``width_px`` x ``height_px`` frame by
+    more than ``tol_px``."""
+    u, v, w, h = (float(x) for x in roi)
+    return u < -tol_px or v < -tol_px or u + w > width_px + tol_px or v + h > height_px + tol_px
+
+
 def look(gray, box):
     """(Laplacian variance, grey std) of the window ``box`` = (u0, v0, u1, v1)."""
     import cv2

@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..._errors import InputError
+from ._checks import region_leaves
 from ...config import ObjectConfig, ReferenceConfig, TargetsConfig, TrackConfig, VideoConfig
 
 __all__ = ["DICTIONARIES", "MarkerFinding", "find_markers", "suggest_config", "parse_region"]
@@ -148,8 +149,7 @@ def suggest_config(
     H, W = first_gray.shape[:2]
 
     def inside(option, roi):
-        x, y, w, h = roi
-        if x < 0 or y < 0 or x + w > W or y + h > H:
+        if region_leaves(roi, W, H):
             raise InputError(f"{option}: region {list(roi)} leaves the {W}x{H} first frame; give it inside")
         return roi
 

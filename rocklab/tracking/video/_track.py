@@ -21,7 +21,7 @@ from ..._blas import one_blas_thread
 from ..._diagnostics import warn
 from ..._errors import InputError
 from .._corrections import apply_corrections, load_corrections
-from ._checks import check_frames, check_rate, interpolate, look, tee, why_lost
+from ._checks import check_frames, check_rate, interpolate, look, region_leaves, tee, why_lost
 from ...config import TrackConfig
 from ._camera_model import PlaneMap, fit_similarity
 from .targets import make_detector
@@ -627,13 +627,10 @@ def _check_regions(config, info, path) -> None:
     """Every object's ``roi`` lies in the frames (a region past the edge tracks nothing real: it
     was refused by ``track init`` but not when written by hand)."""
     W, H = info.width_px, info.height_px
-    tol = 0.5  # px: continuous coordinates, pixel centres at integers
     for o in config.objects:
-        if o.roi is None:
-            continue
-        u, v, w, h = (float(x) for x in o.roi)
-        if u < -tol or v < -tol or u + w > W + tol or v + h > H + tol:
+        # half a pixel of slack: continuous coordinates, pixel centres at integers
+        if o.roi is not None and region_leaves(o.roi, W, H, tol_px=0.5):
             raise InputError(
-                f"{config.source or 'track.toml'}: object {o.id!r} roi {[u, v, w, h]} leaves the {W}x{H} "
+                f"{config.source or 'track.toml'}: object {o.id!r} roi {[float(x) for x in o.roi]} leaves the {W}x{H} "
                 f"frames of {os.path.basename(str(path))}; give a region inside them (read it off 'rocklab track init')"
             )

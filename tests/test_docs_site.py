@@ -100,4 +100,5 @@ def test_readme_figures_are_in_the_site(site):
     text = html.unescape(re.sub(r"<[^>]+>", "", (site / "measured.html").read_text(encoding="utf-8")))
     missing = [r for r in rows if re.sub(r"`", "", r) not in text]
     assert not missing, missing
-    assert "η_mat comes\nout at" in readme and "out at 0.9890" in text.replace("\n", " ").replace("  ", " ")
+    # the demo's figure from its camcorder films
+    assert "η_mat comes\nout at" in readme and "out at 0.9892" in text.replace("\n", " ").replace("  ", " ")

@@ -151,6 +151,7 @@ def test_experiment_config_round_trips_through_its_own_toml(tmp_path):
         columns=("block_1",),
         column_cut_m=0.002,
         truth=(d / "truth.csv").resolve(),
+        tags=(("config", "a"), ("repeat", 3), ("taped", True)),
     )
     text = cfg.to_toml(header=["written by a test"])
     assert text.startswith("# written by a test\n")
@@ -179,7 +180,8 @@ def test_experiment_defaults_come_from_the_dataclass(tmp_path):
 def test_example_documents_exactly_the_schema():
     def leaves(node, pre=()):
         for k, v in node.items():
-            yield from leaves(v, (*pre, k)) if isinstance(v, dict) else [(*pre, k)]
+            free_form = (*pre, k) == ("experiment", "tags")  # a user's own names
+            yield from leaves(v, (*pre, k)) if isinstance(v, dict) and not free_form else [(*pre, k)]
 
     documented = set(leaves(tomllib.loads(EXAMPLE_TOML)))
     schema = {(*t, k) for t, keys in SCHEMA.items() for k in keys if (*t, k) not in SCHEMA}
@@ -232,3 +234,21 @@ def test_corrections_toml_errors_name_the_line(tmp_path):
     p.write_text('[[corrections]]\nobject = "b"\nframe = 3\naction = "drop"\n\n[[corrections]]\nobject = "b"\n')
     with pytest.raises(InputError, match=r"fix.toml, line 6, correction 2"):
         load_corrections(p)
+
+
+@pytest.mark.parametrize(
+    "line, words",
+    [
+        ("tags = { config = 0.5 }", "config = 0.5: a tag must be a string"),
+        ('tags = "a"', "must be a table of names and values"),
+        ('tags = { "1x" = "a" }', "'1x', which is not usable"),
+        ('tag = { a = "b" }', "did you mean 'tags'"),
+    ],
+)
+def test_experiment_tags_are_checked_with_their_line(tmp_path, line, words):
+    d = _files(tmp_path)
+    p = d / "experiment.toml"
+    p.write_text(f'[block]\nb_m = 0.1\nh_m = 0.2\n[sources.video]\npath = "video.mkv"\n[experiment]\n{line}\n')
+    with pytest.raises(InputError, match="line 7") as e:
+        load_experiment_config(p)
+    assert words in str(e.value) and "\n" not in str(e.value)

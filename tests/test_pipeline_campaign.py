@@ -16,7 +16,7 @@ ETA_MAT = 0.985
 L_C = 0.0015
 
 
-def _exp(root, name, bid, contact, eta, seed):
+def _exp(root, name, bid, contact, eta, seed, extra=""):
     blk = catalogue_block(bid)
     theta0 = 0.8 * blk.alpha_rad
     sim = simulate(blk, theta0_rad=theta0, duration_s=6.0, restitution="constant", eta=eta)
@@ -28,7 +28,7 @@ def _exp(root, name, bid, contact, eta, seed):
     pd.DataFrame({"t_s": t, "theta_rad": th}).to_csv(d / "tracks.csv", index=False)
     contact_toml = f'[contact]\ntype = "edge"\nl_c_m = {L_C}\n' if contact == "edge" else ""
     (d / "experiment.toml").write_text(
-        f'name = "{name}"\n[block]\nid = "{bid}"\n{contact_toml}[sources.track]\npath = "tracks.csv"\n'
+        f'name = "{name}"\n{extra}[block]\nid = "{bid}"\n{contact_toml}[sources.track]\npath = "tracks.csv"\n'
         "[output]\nrrd = false\nfigures = false\n"
     )
 
@@ -197,3 +197,52 @@ def test_a_base_excited_runs_half_cycle_eta_is_shown_but_not_pooled():
     assert eta_mat["eta_mat"] == pytest.approx(ETA_MAT, abs=1e-9)
     text = CampaignResult(out_dir=Path("out"), runs=runs, table=table).summary_text()
     assert "0.600" in text and "hc" in text.split("B5M_table")[1].splitlines()[0]
+
+
+def test_campaign_groups_repeats_by_their_tags(tmp_path, run_cli):
+    # Ther's repeat experiments (thesis Tables 2-3): configurations tagged in experiment.toml,
+    # mean ± std per configuration. With a constant η the energy lost per rocking is exactly
+    # 1 - η² (kinetic energy scales by η² at the impact, none is lost between impacts)
+    from rocklab.pipelines.campaign import group_repeats
+    from rocklab.pipelines.campaign._groups import campaign_tags, check_group_by
+
+    root = tmp_path / "repeats"
+    truth = {"a": 0.93, "b": 0.86}
+    for i, (conf, tape) in enumerate((("a", "micropore"), ("a", "none"), ("b", "micropore"), ("b", "none"))):
+        tags = f'[experiment]\ntags = {{ config = "{conf}", tape = "{tape}" }}\n'
+        _exp(root, f"B6M_{conf}{i}", "B6M", "full", truth[conf], 20 + i, extra=tags)
+    out = tmp_path / "out"
+    args = ("--group-by", "config", "--group-by", "config,tape", "--workers", "2", "--no-progress", "--json")
+    rc, stdout, err = run_cli("campaign", root, "--out", out, *args)
+    assert rc == 0, err
+    groups = pd.read_csv(out / "groups.csv", keep_default_na=False, na_values=[""])
+    assert list(dict.fromkeys(groups["group_by"])) == ["config", "config+tape"]
+    by_conf = groups[groups["group_by"] == "config"].set_index("group")
+    for conf, eta in truth.items():
+        r = by_conf.loc[conf]
+        assert r["n"] == 2 and r["eta_e_n"] == 2
+        assert r["eta_e_mean"] == pytest.approx(eta, abs=0.003)
+        assert 0 < r["eta_e_std"] < 0.003  # two noisy repeats: a spread, and a small one
+        assert r["energy_loss_mean4_mean"] == pytest.approx(1 - eta**2, abs=0.01)
+        assert r["eta_equivalent_mean"] == pytest.approx(eta, abs=0.005)
+    combo = [g for g in json.loads(stdout)["groups"] if g["group_by"] == "config+tape"]
+    assert sorted(g["group"] for g in combo) == ["a/micropore", "a/none", "b/micropore", "b/none"]
+    assert all(g["n"] == 1 and g["eta_e_std"] is None for g in combo)  # one repeat: no spread, null in JSON
+    md = (out / "summary.md").read_text(encoding="utf-8")
+    assert "## Repeats by tag" in md and f"{by_conf.loc['a', 'eta_e_mean']:.4g}" in md
+    tab = pd.read_csv(out / "campaign.csv")
+    assert sorted(tab["tag_config"]) == ["a", "a", "b", "b"]
+    rep = json.loads((out / "experiments" / "B6M_a0" / "report.json").read_text())
+    assert rep["tags"] == {"config": "a", "tape": "micropore"}
+
+    # without --group-by: one grouping per tag name; each tape holds one repeat of each
+    # configuration, so its mean η_e lies halfway and its spread is the configurations' gap / √2
+    groupings = check_group_by((), campaign_tags(sorted(root.rglob("experiment.toml"))), root)
+    assert groupings == (("config",), ("tape",))
+    by_tape = group_repeats(tab, groupings).query("group_by == 'tape'").set_index("group")
+    assert by_tape.loc["micropore", "eta_e_mean"] == pytest.approx(np.mean(list(truth.values())), abs=0.003)
+    assert by_tape.loc["none", "eta_e_std"] == pytest.approx(abs(truth["a"] - truth["b"]) / np.sqrt(2), abs=0.004)
+    # a tag nobody carries: refused before any work, naming the tags there are
+    rc, _, err = run_cli("campaign", root, "--out", tmp_path / "out3", "--group-by", "confg")
+    assert rc == 2 and "'confg'" in err and "tags found: config, tape" in err and "Traceback" not in err
+    assert not (tmp_path / "out3").exists()

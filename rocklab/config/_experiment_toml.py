@@ -27,6 +27,7 @@ __all__ = [
     "SourceTable",
     "load_experiment_config",
     "experiment_name",
+    "load_experiment_tags",
     "EXAMPLE_TOML",
     "CONTACT_TYPES",
     "PRIMARY_SOURCES",
@@ -125,6 +126,12 @@ class ExperimentConfig:
     column_cut_m: float = 0.0
     column_impacts: int = 1
     truth: Path | None = None  # synthetic sessions: truth.csv for the report
+    tags: tuple = ()  # ``[experiment] tags``: (key, value) pairs a campaign groups repeats by
+
+    @property
+    def tag_dict(self) -> dict:
+        """``[experiment] tags`` as a dict (key: str, int or bool)."""
+        return dict(self.tags)
 
     def block(self):
         """The :class:`rocklab.Block` of this experiment."""
@@ -168,6 +175,8 @@ class ExperimentConfig:
             return {k: v for k, v in d.items() if v is not None}
 
         d: dict = {"name": self.name, "truth": p(self.truth)}
+        if self.tags:
+            d["experiment"] = {"tags": self.tag_dict}
         d["block"] = {"id": self.block_id, "b_m": self.b_m, "h_m": self.h_m, "mass_kg": self.mass_kg}
         for (table, key), name in _FIELDS.items():
             v = getattr(self, name)
@@ -183,7 +192,19 @@ class ExperimentConfig:
         table = src(self.table, ("imu", "record"))
         sources["table"] = {"from": table.pop("source"), **table}
         d["sources"] = sources
-        order = ("name", "truth", "block", "contact", "sources", "sync", "fit", "simulate", "column", "output")
+        order = (
+            "name",
+            "truth",
+            "experiment",
+            "block",
+            "contact",
+            "sources",
+            "sync",
+            "fit",
+            "simulate",
+            "column",
+            "output",
+        )
         return dumps_toml({k: d[k] for k in order if k in d}, header)
 
 
@@ -213,7 +234,8 @@ _FIELDS = {
 
 #: Every table of ``experiment.toml`` and its keys (what the unknown-key rule checks against).
 SCHEMA: dict[tuple, tuple] = {
-    (): ("name", "truth", "block", "contact", "sources", "sync", "fit", "simulate", "column", "output"),
+    (): ("name", "truth", "experiment", "block", "contact", "sources", "sync", "fit", "simulate", "column", "output"),
+    ("experiment",): ("tags",),
     ("block",): ("id", "b_m", "h_m", "mass_kg"),
     ("sources",): ("primary", "video", "track", "imu", "table"),
     ("sources", "video"): tuple(f.name for f in dataclasses.fields(SourceVideo)),
@@ -254,6 +276,17 @@ def experiment_name(path) -> str | None:
         return None
     name = doc.data.get("name", Path(path).parent.name)
     return name if isinstance(name, str) else None
+
+
+def load_experiment_tags(path) -> tuple:
+    """The ``[experiment] tags`` of an ``experiment.toml`` as (name, value) pairs, checked as
+    :func:`load_experiment_config` checks them; () when the file cannot be read (its own run
+    reports that)."""
+    try:
+        doc = TomlDoc.read(path, "experiment config")
+        return _tags(_Reader(doc.data, doc.text, Path(path)))
+    except InputError:
+        return ()
 
 
 # ---------------------------------------------------------------------- reading
@@ -431,6 +464,7 @@ def load_experiment_config(path, block_catalogue: Callable[[], Mapping[str, dict
         column_cut_m=cut,
         column_impacts=r.field(("column", "impacts"), int, positive=True),
         truth=r.file(("truth",), required=False),
+        tags=_tags(r),
     )
     for t, known in SCHEMA.items():
         if t and isinstance(r.at(t), dict):
@@ -490,6 +524,9 @@ def _choices(options) -> str:
 EXAMPLE_TOML = f"""\
 name = "B6M_full_01"              # optional; defaults to the file's folder name
 truth = "truth.csv"               # optional (synthetic sessions): the true motion, for the report
+
+[experiment]                      # optional: free-form tags; `rocklab campaign` groups repeats by them
+tags = {{ config = "a", tape = "micropore" }}   # values: strings, integers or true/false
 
 [block]                           # either a catalogue id ...
 id = "B6M"                        # Čeh et al. (2018) Table 2 (B1S..B10L)
@@ -567,3 +604,26 @@ def _bumps(r) -> int:
     if isinstance(n, bool) or not isinstance(n, int) or n < 0:
         r.fail(("simulate", "bumps"), f"= {n!r} must be a whole number of bumps, 0 or more")
     return n
+
+
+#: A tag's name: it becomes the campaign column ``tag_<name>``.
+TAG_NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]*")
+
+
+def _tags(r) -> tuple:
+    """``[experiment] tags``: (name, value) pairs in the file's order; values are strings,
+    integers or booleans (a float would group 0.1 and 0.10000001 apart)."""
+    v = r.at(("experiment", "tags"))
+    if v is None:
+        return ()
+    key = ("experiment", "tags")
+    if not isinstance(v, dict):
+        r.fail(key, f'must be a table of names and values, e.g. tags = {{ config = "a" }}, got {v!r}')
+    for name, val in v.items():
+        if not TAG_NAME.fullmatch(name):
+            r.fail(
+                key, f"has the name {name!r}, which is not usable: use letters, digits and _, starting with a letter"
+            )
+        if isinstance(val, float) or not isinstance(val, (str, int, bool)):
+            r.fail(key, f'{name} = {val!r}: a tag must be a string, an integer or true/false; e.g. {name} = "{val}"')
+    return tuple(v.items())

@@ -2,5 +2,14 @@
 
 from ._campaign import CampaignResult, find_experiments, run_campaign
 from ._demo import make_demo_campaign, run_demo
+from ._groups import GROUPED_QUANTITIES, group_repeats
 
-__all__ = ["run_campaign", "find_experiments", "CampaignResult", "run_demo", "make_demo_campaign"]
+__all__ = [
+    "run_campaign",
+    "find_experiments",
+    "CampaignResult",
+    "group_repeats",
+    "GROUPED_QUANTITIES",
+    "run_demo",
+    "make_demo_campaign",
+]

@@ -21,6 +21,7 @@ import numpy as np
 from ..._errors import InputError
 from ..._procs import dask_client, spawn_pool
 from ..._io import write_frame_atomic, write_json_atomic, write_text_atomic
+from ._groups import campaign_tags, check_group_by, group_lines_md, group_lines_text, group_repeats
 
 __all__ = ["CampaignResult", "run_campaign", "find_experiments"]
 
@@ -29,6 +30,7 @@ __all__ = ["CampaignResult", "run_campaign", "find_experiments"]
 CAMPAIGN_ENTRIES = (
     "experiments",
     "campaign.csv",
+    "groups.csv",
     "campaign.json",
     "campaign.rrd",
     "figures",
@@ -116,6 +118,11 @@ class CampaignResult:
         Edge-contact η_mat fit (:meth:`to_dict` of the fitting result).
     k_table : dict or None
         Full-contact inverse k per block and the regression.
+    messages : list[str]
+        Notes on the campaign fits (what was not fitted and why).
+    groups : pandas.DataFrame or None
+        Repeats grouped by their ``[experiment] tags``
+        (:func:`rocklab.pipelines.campaign.group_repeats`); None without tags.
     """
 
     out_dir: Path
@@ -124,6 +131,7 @@ class CampaignResult:
     eta_mat: dict | None = None
     k_table: dict | None = None
     messages: list = field(default_factory=list)
+    groups: object = None
 
     @property
     def n_ok(self) -> int:
@@ -157,6 +165,7 @@ class CampaignResult:
             "experiments": self.table.to_dict(orient="records") if self.table is not None else [],
             "eta_mat": self.eta_mat,
             "k_table": self.k_table,
+            "groups": self.groups.to_dict(orient="records") if self.groups is not None else [],
             "messages": list(self.messages),
         }
 
@@ -210,6 +219,7 @@ class CampaignResult:
                     f"R² = {g(self.k_table.get('r2'))}, RMSE = {g(self.k_table.get('rmse'))}",
                     "",
                 ]
+        lines += group_lines_md(self.groups)
         for r in self.runs:
             if not r["ok"]:
                 lines.append(f"- **FAILED** {r['config']}: {r['error']}")
@@ -272,6 +282,7 @@ class CampaignResult:
                     f"RMSE = {self.k_table.get('rmse', float('nan')):.4f} "
                     f"(Čeh: +0.0047·hb2 -0.0258·hb +1.0635 -0.0565·b_cm)"
                 )
+        lines += group_lines_text(self.groups)
         for r in self.runs:
             if not r["ok"]:
                 lines.append(f"FAILED {r['config']}: {r['error']}")
@@ -315,6 +326,7 @@ def _row(run: dict) -> dict:
     ci = fit.get("ci95_eta_e") or [np.nan, np.nan]
     sims = rep.get("simulations") or {}
     truth = rep.get("truth") or {}
+    loss = rep.get("energy_loss") or {}
     warn_codes = sorted({w["code"] for w in rep.get("warnings") or []})
     return {
         "experiment": rep["name"],
@@ -337,6 +349,9 @@ def _row(run: dict) -> dict:
         "eta_M": (sims.get("modified") or {}).get("eta", np.nan),
         "eta_true": truth.get("eta") if truth.get("eta") is not None else np.nan,
         "fit_status": fit.get("status"),
+        "energy_loss_mean4": loss.get("mean4", np.nan),
+        "eta_equivalent": loss.get("eta_equivalent", np.nan),
+        **{f"tag_{k}": v for k, v in (rep.get("tags") or {}).items()},
         "out": run["out"],
         "column": json.dumps(_column_summary(rep["column"])) if rep.get("column") else "",
     }
@@ -379,9 +394,36 @@ def _campaign_fits(table, msgs):
 
 
 def run_campaign(
-    root, out_dir, *, workers: int = 2, scheduler: str | None = None, force: bool = False, progress: bool = True
+    root,
+    out_dir,
+    *,
+    workers: int = 2,
+    scheduler: str | None = None,
+    force: bool = False,
+    progress: bool = True,
+    group_by=(),
 ) -> CampaignResult:
-    """Run every experiment under ``root`` into ``out_dir/experiments/<name>/`` and fit the campaign."""
+    """Run every experiment under ``root`` into ``out_dir/experiments/<name>/`` and fit the campaign.
+
+    Parameters
+    ----------
+    root : path
+        Folder searched recursively for ``experiment*.toml``.
+    out_dir : path
+        Output folder (``campaign.csv``, ``groups.csv``, ``campaign.json``, figures, ``summary.md``).
+    workers : int
+        Local processes.
+    scheduler : str or None
+        A Dask distributed scheduler's address: run the experiments there.
+    force : bool
+        Re-run unchanged experiments too.
+    progress : bool
+        Show a progress bar.
+    group_by : sequence of str
+        Groupings of repeats, each tag names joined by commas (``"config"``, ``"config,tape"``);
+        empty: one grouping per tag name the experiments carry. A name no experiment carries is
+        refused before any work.
+    """
     import pandas as pd
     from tqdm import tqdm
 
@@ -390,6 +432,7 @@ def run_campaign(
     root = Path(root).resolve()
     configs = find_experiments(root)
     _check_unique_names(configs, root)
+    groupings = check_group_by(group_by, campaign_tags(configs), root)
     out_dir = check_output_dir(out_dir, force=force, need_bytes=len(configs) * 30 * 1024 * 1024)
     claim_dir(out_dir, CAMPAIGN_ENTRIES, command="campaign")
     jobs = []
@@ -428,7 +471,10 @@ def run_campaign(
             eta_mat, k_tab = _campaign_fits(good, msgs)
         except InputError as e:
             msgs.append(f"campaign fits not done: {e}")
-    res = CampaignResult(out_dir=out_dir, runs=runs, table=table, eta_mat=eta_mat, k_table=k_tab, messages=msgs)
+    groups = group_repeats(table, groupings) if groupings and len(good) else None
+    res = CampaignResult(
+        out_dir=out_dir, runs=runs, table=table, eta_mat=eta_mat, k_table=k_tab, messages=msgs, groups=groups
+    )
     _write_campaign(res)
     return res
 
@@ -441,6 +487,8 @@ def _write_campaign(res: CampaignResult) -> None:
     out.mkdir(parents=True, exist_ok=True)
     if res.table is not None and len(res.table):
         write_frame_atomic(out / "campaign.csv", res.table)
+        if res.groups is not None and len(res.groups):
+            write_frame_atomic(out / "groups.csv", res.groups)
         reg = None
         from ...fitting import KRegression
 

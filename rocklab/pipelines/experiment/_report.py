@@ -97,6 +97,7 @@ def _summary_md(res, figs: dict, rrd: bool) -> str:
         "",
         f"Status: **{res.status}**",
         "",
+        *([f"Tags: {', '.join(f'{k} = {v}' for k, v in res.config.tags)}", ""] if res.config.tags else []),
         f"Block: b = {_g(res.block.b_m)} m, h = {_g(res.block.h_m)} m, α = {_g(res.block.alpha_rad)} rad, "
         f"p = {_g(res.block.p_rad_s)} rad/s, η_H = {_g(res.block.eta_H)}; contact: {res.config.contact}",
         "",

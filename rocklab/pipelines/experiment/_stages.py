@@ -340,6 +340,7 @@ class ExperimentResult:
         """The numbers of ``report.json`` (units in keys)."""
         return {
             "name": self.name,
+            "tags": self.config.tag_dict,
             "status": self.status,
             "messages": list(self.messages),
             "warnings": [d.to_dict() for d in self.diagnostics],

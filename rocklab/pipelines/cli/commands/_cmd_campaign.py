@@ -14,6 +14,13 @@ def register(sub):
     p.add_argument("--scheduler", metavar="ADDR", help="run the experiments on a Dask distributed cluster")
     p.add_argument("--force", action="store_true", help="re-run unchanged experiments too")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    p.add_argument(
+        "--group-by",
+        action="append",
+        metavar="TAGS",
+        help="group repeats by these [experiment] tags (comma-separated: one grouping; repeat the option "
+        "for more); default: one grouping per tag found. Mean ± std of eta_e and the Eq. 12 energy loss",
+    )
     p.add_argument("--json", action="store_true", help="print the campaign summary as one JSON object")
     p.set_defaults(func=run)
 
@@ -29,6 +36,7 @@ def run(args) -> int:
         scheduler=args.scheduler,
         force=args.force,
         progress=not args.no_progress,
+        group_by=args.group_by or (),
     )
     if args.json:
         from .._cli_base import emit_json

@@ -12,7 +12,15 @@ import pytest
 from rocklab._diagnostics import collecting
 from rocklab._errors import InputError
 from rocklab.series import read_tracks
-from rocklab.tracking.imports import PlanePoints, dlt_project, parse_plane_bodies, plane_tracks, read_dltdv, read_trk
+from rocklab.tracking.imports import (
+    PlanePoints,
+    dlt_project,
+    parse_plane_bodies,
+    plane_tracks,
+    read_dltdv,
+    read_kinovea,
+    read_trk,
+)
 
 TRK = Path(__file__).parent / "data" / "importers" / "diabolo_rotation.trk"
 DT_S = 0.0125
@@ -235,3 +243,105 @@ def test_dltdv_reconstruction_from_two_cameras(tmp_path, run_cli):
         len(back) == 30 * 3 - 1
         and abs(back["z_m"].mean() - np.delete(xyz_cm[..., 2].ravel(), 4 * 3 + 1).mean() / 100) < 1e-9
     )
+
+
+KINOVEA_XML = Path(__file__).parent / "data" / "importers" / "kinovea_box_jump.xml"
+#: A Kinovea Gnuplot export in a repository without a licence: read from its mirror when present.
+KINOVEA_TXT = ("/work/.mirror/ANaaim+kinovea_to_json/repo", "b0c8cc7562fdadc338617a0cf487e1db586bc20e")
+
+
+def _sheet_numbers(path: Path) -> dict:
+    """Every trajectory's x, y (cm) as the spreadsheet holds them, parsed independently."""
+    text = path.read_text(encoding="utf-8")
+    out = {}
+    for block in text.split(">Label :<")[1:]:
+        label = re.search(r'<Data ss:Type="String">([^<]+)</Data>', block).group(1)
+        nums = [float(v) for v in re.findall(r'<Data ss:Type="Number">([^<]+)</Data>', block.split(">Track<")[0])]
+        out[label] = np.array(nums).reshape(-1, 2)
+    return out
+
+
+def test_kinovea_spreadsheet_numbers_in_metres():
+    """Kinovea's spreadsheet (Coords in cm): every exported x, y comes back as m (x 0.01, exact to
+    1e-15), times from its h:mm:ss:cc codes; the one time each trajectory has twice is lost and
+    warned (W-IMPORT-TIME), never a guessed row."""
+    with collecting() as found:
+        pts = read_kinovea(KINOVEA_XML)
+    assert [d.code for d in found] == ["W-IMPORT-TIME"]
+    want = _sheet_numbers(KINOVEA_XML)
+    assert pts.labels == tuple(want) and len(pts.labels) == 9 and pts.xy_px is None
+    for j, lab in enumerate(pts.labels):
+        got = pts.xy_m[:, j]
+        seen = np.isfinite(got).all(axis=1)
+        assert seen.sum() == len(want[lab]) - 2  # the two rows sharing a time
+        exported = {tuple(np.round(r * 0.01, 12)) for r in want[lab]}
+        assert {tuple(np.round(r, 12)) for r in got[seen]} <= exported
+    assert np.allclose(pts.t_s[:6], [0, 0.04, 0.08, 0.12, 0.16, 0.21], atol=1e-12, rtol=0)
+    with collecting():
+        snapped = read_kinovea(KINOVEA_XML, fps=24)
+    assert np.array_equal(snapped.frame[:8], np.arange(8)) and abs(snapped.t_s[5] - 5 / 24) < 1e-15
+    with pytest.raises(InputError, match=r"is 1\d\.\d ms from any frame at --fps 30"), collecting():
+        read_kinovea(KINOVEA_XML, fps=30)
+    with pytest.raises(InputError, match="two different times fall on one frame at --fps 12"):
+        read_kinovea(KINOVEA_XML, fps=12)
+    with pytest.raises(InputError, match="the file says 'cm', --units says 'mm'"):
+        read_kinovea(KINOVEA_XML, units="mm")
+
+
+def test_kinovea_segment_angle_through_the_cli(tmp_path, run_cli):
+    """The thigh (hip, knee) as a body: theta is the turn of that segment (closed form from the
+    exported coordinates), written to tracks.csv through `rocklab import`."""
+    out = tmp_path / "tracks.csv"
+    rc, stdout, err = run_cli("import", KINOVEA_XML, "-o", out, "--body", "thigh=Hanche,Genou", "--rest", "first")
+    assert rc == 0 and "warning W-IMPORT-TIME" in err
+    tr = read_tracks(out).rows("thigh")
+    with collecting():
+        pts = read_kinovea(KINOVEA_XML)
+    d = pts.xy_m[:, 1] - pts.xy_m[:, 0]
+    ang = np.arctan2(d[:, 1], d[:, 0])
+    _, th = tr.theta()
+    ok = np.isfinite(th)
+    assert ok.sum() == 27  # 29 times: one shared by two rows, one only the elbow has
+    # rest "first": the first 10 frames' mean shape; theta differences are the segment's turns
+    assert np.abs(np.diff(th[ok]) - np.diff(ang[ok])).max() < 5e-9  # tracks.csv keeps 9 digits
+
+
+def test_kinovea_gnuplot_text_needs_its_unit(tmp_path):
+    import subprocess
+
+    repo, commit = KINOVEA_TXT
+    if not Path(repo).is_dir():
+        pytest.skip("the Kinovea text export (ANaaim/kinovea_to_json, no licence) is not mirrored here")
+    txt = tmp_path / "pas_camera_01.txt"
+    txt.write_bytes(
+        subprocess.run(
+            ["git", f"--git-dir={repo}", "show", f"{commit}:data_kinovea/pas_camera_01.txt"],
+            capture_output=True,
+            check=True,
+        ).stdout
+    )
+    with pytest.raises(InputError, match="names no unit; give --units"):
+        read_kinovea(txt)
+    pts = read_kinovea(txt, units="cm", fps=120)
+    assert pts.labels[1:] == ("tarse", "jarret", "hanche", "pointe dos") and pts.t_s.size == 100
+    # "77,20 -21,97" (a decimal comma) at t = 0 for the first trajectory
+    assert np.allclose(pts.xy_m[0, 0], [0.772, -0.2197], atol=1e-15, rtol=0)
+    assert np.array_equal(pts.frame, np.arange(100))
+
+
+def test_run_reads_a_tracker_project_as_its_track(tmp_path):
+    """[sources.track] given a .trk: the same rows `rocklab import` writes with its defaults (every
+    point one block, upright in its last frames); a DLTdv file there is refused with the fix."""
+    from rocklab.pipelines.experiment._measure import read_track_csv
+
+    tr = read_track_csv(TRK, None)
+    t, th = tr.theta()
+    with collecting():
+        pts = read_trk(TRK)
+    want = plane_tracks(pts, {"block_1": pts.labels})
+    assert np.array_equal(t, want["t_s"].to_numpy())
+    assert np.array_equal(th, want["theta_rad"].to_numpy(), equal_nan=True) and np.isfinite(th).sum() == 172
+    dlt = tmp_path / "run_xyzpts.txt"  # a DLTdv table kept under another suffix
+    dlt.write_text("pt1_X,pt1_Y,pt1_Z\n1,2,3\n")
+    with pytest.raises(InputError, match="convert this dltdv file with rocklab import"):
+        read_track_csv(dlt, None)

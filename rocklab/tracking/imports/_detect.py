@@ -1,4 +1,5 @@
-"""Which tool wrote a file: from its suffix, its name or its first bytes."""
+"""Which tool wrote a file (from its suffix, its name or its first bytes), and a plane tool's points
+read by that tool's reader."""
 
 from __future__ import annotations
 
@@ -6,10 +7,12 @@ from pathlib import Path
 
 from ..._errors import InputError
 
-__all__ = ["detect_tool", "IMPORT_TOOLS"]
+__all__ = ["detect_tool", "read_plane_points", "IMPORT_TOOLS", "PLANE_TOOLS"]
 
 #: Tools the importers read.
-IMPORT_TOOLS = ("tracker", "dltdv")
+IMPORT_TOOLS = ("tracker", "kinovea", "dltdv")
+#: Tools whose files hold points in one film's plane (read by :func:`read_plane_points`).
+PLANE_TOOLS = ("tracker", "kinovea")
 
 
 def detect_tool(path: Path) -> str:
@@ -28,12 +31,39 @@ def detect_tool(path: Path) -> str:
         return "dltdv"
     try:
         with open(path, "rb") as fh:
-            head = fh.read(4096).decode("utf-8", "replace")
+            head = fh.read(65536).decode("utf-8", "replace")
     except OSError:
         head = ""
     if "org.opensourcephysics.cabrillo.tracker" in head:
         return "tracker"
+    if head.startswith("#Kinovea") or ("<?xml" in head[:100] and "Coords (x,y:" in head):
+        return "kinovea"
     first = head.splitlines()[0] if head else ""
     if first.startswith("pt1_"):
         return "dltdv"
-    raise InputError(f"{path}: cannot tell which tool wrote it (not .trk/.trz, no DLTdv pt1_... header); give --tool")
+    raise InputError(
+        f"{path}: cannot tell which tool wrote it (not .trk/.trz, no Kinovea trajectory, no DLTdv pt1_... header); give --tool"
+    )
+
+
+def read_plane_points(path, tool: str | None = None, *, member=None, units=None, fps=None):
+    """The points of a plane tool's file (:data:`PLANE_TOOLS`) as :class:`PlanePoints`.
+
+    Parameters
+    ----------
+    path : str or Path
+    tool : {"tracker", "kinovea"}, optional
+        The tool; None: :func:`detect_tool`.
+    member, units, fps
+        Passed to :func:`read_trk` (``member``, ``units``) or :func:`read_kinovea` (``units``,
+        ``fps``).
+    """
+    from ._kinovea import read_kinovea
+    from ._tracker_trk import read_trk
+
+    tool = detect_tool(path) if tool is None else tool
+    if tool == "tracker":
+        return read_trk(path, member=member, units=units)
+    if tool == "kinovea":
+        return read_kinovea(path, units=units, fps=fps)
+    raise InputError(f"{path}: a {tool} file holds no plane track; import it with rocklab import")

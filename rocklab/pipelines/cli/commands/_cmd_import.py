@@ -1,11 +1,13 @@
 """``rocklab import``: another tool's tracking into rocklab's files.
 
-``rocklab import FILE [--tool auto|tracker|dltdv] [-o OUT] [--body NAME=P1,P2 ...]``
+``rocklab import FILE [--tool auto|tracker|kinovea|dltdv] [-o OUT] [--body NAME=P1,P2 ...]``
 
 - Tracker (``.trk``, or a ``.trz`` with ``--trk NAME`` when it holds several): the point-mass
   tracks become ``tracks.csv`` (the film tracker's columns): each body's angle from two or more
   points marked on it, counter-clockwise from its rest shape (``--rest``), its centroid in px
   and, when the project is calibrated, in m. Without ``--body`` every point is one block.
+- Kinovea (*Export to spreadsheet* ``.xml``, or the Gnuplot ``.txt`` with ``--units``):
+  the trajectories, in the calibration's unit (y up), become ``tracks.csv`` the same way.
 - DLTdv (``*xypts.csv`` with ``--coefs *DLTcoefs.csv``, or ``*xyzpts.csv``): 3D points,
   reconstructed from two or more cameras with the DLT coefficients, written as the long
   ``points.csv`` (``t_s, point, x_m, y_m, z_m``) that ``rocklab track3d`` reads; ``--fps``
@@ -22,17 +24,18 @@ from pathlib import Path
 from ...._errors import InputError
 
 #: Tools ``--tool`` accepts (``auto``: from the file's name and content).
-TOOLS = ("auto", "tracker", "dltdv")
+TOOLS = ("auto", "tracker", "kinovea", "dltdv")
 
 
 def register(sub):
     """Add ``import`` to the ``rocklab`` parser ``sub``."""
     p = sub.add_parser(
         "import",
-        help="another tool's tracking (Tracker .trk/.trz, DLTdv xypts/xyzpts) into tracks.csv or points.csv",
+        help="another tool's tracking (Tracker .trk/.trz, Kinovea .xml/.txt, DLTdv xypts/xyzpts) into tracks.csv "
+        "or points.csv",
         description=__doc__,
     )
-    p.add_argument("file", help="the tool's file: .trk, .trz, *xypts.csv or *xyzpts.csv")
+    p.add_argument("file", help="the tool's file: .trk, .trz, Kinovea's .xml or .txt, *xypts.csv or *xyzpts.csv")
     p.add_argument("--tool", choices=TOOLS, default="auto", help="the tool that wrote FILE (default: auto)")
     p.add_argument(
         "-o",
@@ -60,26 +63,32 @@ def register(sub):
         "--units",
         default=None,
         metavar="UNIT",
-        help="length unit of the tool's calibration when the file names none: m, cm, mm (Tracker also in, ft)",
+        help="length unit of the tool's calibration when the file names none (Kinovea .txt, DLTdv): m, cm, mm "
+        "(Tracker also in, ft)",
     )
     p.add_argument("--coefs", default=None, metavar="CSV", help="DLTdv: the DLT coefficients (*DLTcoefs.csv)")
-    p.add_argument("--fps", type=float, default=None, help="DLTdv: the cameras' frame rate, Hz (t_s = row / fps)")
+    p.add_argument(
+        "--fps",
+        type=float,
+        default=None,
+        help="DLTdv: the cameras' frame rate, Hz (t_s = row / fps); Kinovea: snap the exported times to frames",
+    )
     p.add_argument("--json", action="store_true", help="print a JSON summary on stdout")
     p.set_defaults(func=run)
 
 
-def _run_tracker(args, src: Path, out: Path) -> dict:
+def _run_plane(args, src: Path, out: Path, tool: str) -> dict:
     from ....series import write_tracks
-    from ....tracking.imports import parse_plane_bodies, plane_tracks, read_trk
+    from ....tracking.imports import parse_plane_bodies, plane_tracks, read_plane_points
     from ._cmd_track3d import rest_spec
 
-    pts = read_trk(src, member=args.trk, units=args.units)
+    pts = read_plane_points(src, tool, member=args.trk, units=args.units, fps=args.fps)
     bodies = parse_plane_bodies(args.body, pts.labels, pts.source)
     rows = plane_tracks(pts, bodies, rest=rest_spec(args.rest))
     write_tracks(out, rows, side=not args.out)
     per = {b: int((rows[rows["object"] == b]["status"] == "ok").sum()) for b in bodies}
     return {
-        "tool": "tracker",
+        "tool": tool,
         "source": pts.source,
         "points": list(pts.labels),
         "bodies": {b: list(v) for b, v in bodies.items()},
@@ -118,7 +127,7 @@ def run(args) -> int:
 
     tool = detect_tool(src) if args.tool == "auto" else args.tool
     out = Path(args.out) if args.out else import_output(src, tool)
-    summary = (_run_tracker if tool == "tracker" else _run_dltdv)(args, src, out)
+    summary = _run_dltdv(args, src, out) if tool == "dltdv" else _run_plane(args, src, out, tool)
     if args.json:
         from .._cli_base import emit_json
 
@@ -126,7 +135,7 @@ def run(args) -> int:
         return 0
     for n in summary["notes"]:
         print(f"note: {n}")
-    if tool == "tracker":
+    if tool != "dltdv":
         for b, pts in summary["bodies"].items():
             print(f"{b}: points {pts}, {summary['frames_ok'][b]}/{summary['frames']} frames with every point")
         print(f"wrote {out}" + ("" if summary["metric"] else " (x_m, y_m empty: no calibration)"))

@@ -35,10 +35,10 @@ def read_track_csv(path: Path, obj: str | None):
             f"{path}: [sources.track] takes a tracks.csv, a Tracker project or a Kinovea spreadsheet; "
             f"convert this {tool} file with rocklab import"
         )
-    if tool == "kinovea" and Path(path).suffix.lower() == ".txt":
+    if Path(path).suffix.lower() not in (".trk", ".trz", ".xml"):  # text exports name no unit
         raise InputError(
-            f"{path}: a Kinovea text export names no unit; convert it with rocklab import FILE --units cm "
-            "-o tracks.csv and give that as [sources.track] path"
+            f"{path}: a {tool} text export names no length unit; convert it with rocklab import FILE "
+            "--units cm -o tracks.csv and give that as [sources.track] path"
         )
     pts = read_plane_points(path, tool)
     rows = plane_tracks(pts, parse_plane_bodies([], pts.labels, pts.source))

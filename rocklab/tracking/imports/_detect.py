@@ -6,6 +6,9 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..._errors import InputError
+from ._kinovea import read_kinovea
+from ._tracker_table import looks_like_tracker_table, read_tracker_table
+from ._tracker_trk import read_trk
 
 __all__ = ["detect_tool", "read_plane_points", "IMPORT_TOOLS", "PLANE_TOOLS"]
 
@@ -36,13 +39,15 @@ def detect_tool(path: Path) -> str:
         head = ""
     if "org.opensourcephysics.cabrillo.tracker" in head:
         return "tracker"
+    if looks_like_tracker_table(head):
+        return "tracker"
     if head.startswith("#Kinovea") or ("<?xml" in head[:100] and "Coords (x,y:" in head):
         return "kinovea"
     first = head.splitlines()[0] if head else ""
     if first.startswith("pt1_"):
         return "dltdv"
     raise InputError(
-        f"{path}: cannot tell which tool wrote it (not .trk/.trz, no Kinovea trajectory, no DLTdv pt1_... header); give --tool"
+        f"{path}: cannot tell which tool wrote it (not .trk/.trz or Tracker's data export, no Kinovea trajectory, no DLTdv pt1_... header); give --tool"
     )
 
 
@@ -58,12 +63,11 @@ def read_plane_points(path, tool: str | None = None, *, member=None, units=None,
         Passed to :func:`read_trk` (``member``, ``units``) or :func:`read_kinovea` (``units``,
         ``fps``).
     """
-    from ._kinovea import read_kinovea
-    from ._tracker_trk import read_trk
-
     tool = detect_tool(path) if tool is None else tool
     if tool == "tracker":
-        return read_trk(path, member=member, units=units)
+        if Path(path).suffix.lower() in (".trk", ".trz"):
+            return read_trk(path, member=member, units=units)
+        return read_tracker_table(path, units=units)
     if tool == "kinovea":
         return read_kinovea(path, units=units, fps=fps)
     raise InputError(f"{path}: a {tool} file holds no plane track; import it with rocklab import")

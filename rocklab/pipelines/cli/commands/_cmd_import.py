@@ -31,11 +31,14 @@ def register(sub):
     """Add ``import`` to the ``rocklab`` parser ``sub``."""
     p = sub.add_parser(
         "import",
-        help="another tool's tracking (Tracker .trk/.trz, Kinovea .xml/.txt, DLTdv xypts/xyzpts) into tracks.csv "
+        help="another tool's tracking (Tracker .trk/.trz or data table, Kinovea .xml/.txt, DLTdv xypts/xyzpts) into tracks.csv "
         "or points.csv",
         description=__doc__,
     )
-    p.add_argument("file", help="the tool's file: .trk, .trz, Kinovea's .xml or .txt, *xypts.csv or *xyzpts.csv")
+    p.add_argument(
+        "file",
+        help="the tool's file: .trk, .trz or Tracker's data table, Kinovea's .xml or .txt, *xypts.csv or *xyzpts.csv",
+    )
     p.add_argument("--tool", choices=TOOLS, default="auto", help="the tool that wrote FILE (default: auto)")
     p.add_argument(
         "-o",
@@ -63,7 +66,8 @@ def register(sub):
         "--units",
         default=None,
         metavar="UNIT",
-        help="length unit of the tool's calibration when the file names none (Kinovea .txt, DLTdv): m, cm, mm "
+        help="length unit of the tool's calibration when the file names none (Tracker's data table, Kinovea .txt, "
+        "DLTdv): m, cm, mm "
         "(Tracker also in, ft)",
     )
     p.add_argument("--coefs", default=None, metavar="CSV", help="DLTdv: the DLT coefficients (*DLTcoefs.csv)")

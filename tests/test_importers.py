@@ -165,8 +165,12 @@ def test_cli_import_tracker_writes_tracks_read_by_fit(tmp_path, run_cli):
     t, th = tr.theta()
     assert np.isfinite(th).sum() == 172 and abs(th[0]) < 1e-9
     assert abs(t[-1] - 173 * DT_S) < 1e-12
-    rc, _, err = run_cli("import", TRK, "-o", tmp_path / "x.csv", "--body", "d=masa A")
-    assert rc == 2 and "one point; an angle needs at least two" in err and err.count("\n") == 1
+    rc, stdout, err = run_cli("import", TRK, "-o", tmp_path / "x.csv", "--body", "a=masa A", "--body", "c=nope")
+    assert rc == 2 and "--body c: point(s) ['nope'] not in the file" in err and err.count("\n") == 1
+    rc, stdout, err = run_cli("import", TRK, "-o", tmp_path / "x.csv", "--body", "a=masa A")
+    assert rc == 0 and "a is one point: its position only" in stdout
+    one = read_tracks(tmp_path / "x.csv").rows("a")
+    assert np.isnan(one.column("theta_rad")).all() and np.isfinite(one.column("x_m")).sum() == 172
     junk = tmp_path / "junk.csv"
     junk.write_text("a,b\n1,2\n")
     rc, _, err = run_cli("import", junk)

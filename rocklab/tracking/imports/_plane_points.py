@@ -63,13 +63,8 @@ class PlanePoints:
 
 def parse_plane_bodies(specs, labels, source="") -> dict:
     """``{"NAME": (P1, P2, ...)}`` from ``NAME=P1,P2,...`` strings; none: one body ``block_1`` of
-    every point. A plane pose needs two points a body."""
+    every point. A body of one point is a position only (its angle is not measured)."""
     if not specs:
-        if len(labels) < 2:
-            raise InputError(
-                f"{where(source)}only one tracked point {list(labels)}; a block's angle needs two points "
-                "on it: track a second point in the tool"
-            )
         return {"block_1": tuple(labels)}
     out: dict = {}
     for s in specs:
@@ -86,8 +81,6 @@ def parse_plane_bodies(specs, labels, source="") -> dict:
                 f"{where(source)}--body {name}: point(s) {missing} not in the file (it has {list(labels)}); "
                 "fix the point names"
             )
-        if len(plist) < 2:
-            raise InputError(f"--body {name}: one point; an angle needs at least two points on the body")
         out[name] = plist
     return out
 
@@ -119,7 +112,8 @@ def plane_tracks(points: PlanePoints, bodies: dict, rest="auto"):
     ----------
     points : PlanePoints
     bodies : dict
-        ``{name: (label, ...)}``, at least two labels a body (:func:`parse_plane_bodies`).
+        ``{name: (label, ...)}`` (:func:`parse_plane_bodies`); a body of one point gets its
+        position and ``theta_rad`` NaN, as a film's ``kind = "point"`` object.
     rest : {"auto", "last", "first"} or (t0_s, t1_s)
         Where the body stands upright: its rest shape is the mean of its centred points over
         the last (``auto``, ``last``: free rocking ends upright) or first :data:`REST_SAMPLES`
@@ -148,7 +142,8 @@ def plane_tracks(points: PlanePoints, bodies: dict, rest="auto"):
         cur = xy - xy.mean(axis=1, keepdims=True)
         cross = (ref[None, :, 0] * cur[:, :, 1] - ref[None, :, 1] * cur[:, :, 0]).sum(axis=1)
         dot = (ref[None, :, 0] * cur[:, :, 0] + ref[None, :, 1] * cur[:, :, 1]).sum(axis=1)
-        theta = np.where(seen, np.arctan2(cross, dot), np.nan)
+        # one point has a position, never an angle (as a film's kind = "point" object)
+        theta = np.where(seen & (len(labs) > 1), np.arctan2(cross, dot), np.nan)
         nan = np.full(n, np.nan)
         px = points.xy_px[:, idx, :].mean(axis=1) if points.xy_px is not None else np.full((n, 2), np.nan)
         m = points.xy_m[:, idx, :].mean(axis=1) if points.xy_m is not None else np.full((n, 2), np.nan)

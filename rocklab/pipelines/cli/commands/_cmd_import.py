@@ -52,8 +52,8 @@ def register(sub):
         action="append",
         default=[],
         metavar="NAME=P1,P2,...",
-        help="a rigid body and the names of its points (repeat; two or more points each); "
-        "default: every point is one block, block_1",
+        help="a rigid body and the names of its points (repeat; two or more for its angle, one point is a "
+        "position only); default: every point is one block, block_1",
     )
     p.add_argument(
         "--rest",
@@ -142,6 +142,9 @@ def run(args) -> int:
     if tool != "dltdv":
         for b, pts in summary["bodies"].items():
             print(f"{b}: points {pts}, {summary['frames_ok'][b]}/{summary['frames']} frames with every point")
+        for b, pts in summary["bodies"].items():
+            if len(pts) == 1:
+                print(f"note: {b} is one point: its position only (theta_rad empty); an angle needs two points")
         print(f"wrote {out}" + ("" if summary["metric"] else " (x_m, y_m empty: no calibration)"))
     else:
         print(f"{len(summary['points'])} points, {summary['samples']} samples; wrote {out}")

@@ -3,8 +3,8 @@
 A ``.trk`` keeps every point-mass track as image positions per frame (px, y down), the
 coordinate system that maps them to the world (per key frame: origin px, angle deg, scale px per
 unit; Tracker's ``ImageCoordSystem``: ``x_img = sx cos a x - sx sin a y + x0``,
-``y_img = -sy sin a x - sy cos a y + y0``), the length unit and the clip's time base (start
-time and frame duration in ms). The reader converts at this boundary: times to s, world
+``y_img = -sy sin a x - sy cos a y + y0``), the length unit and the clip's time base (Tracker's
+``VideoPlayer.getFrameTime``: start time + (frame - start frame) x frame duration, in ms). The reader converts at this boundary: times to s, world
 positions to m (y up). Model tracks (``DynamicParticle``...) are simulations, not measurements,
 and are not read.
 """

@@ -239,6 +239,13 @@ def test_dltdv_reconstruction_from_two_cameras(tmp_path, run_cli):
     bad.write_text("\n".join(lines) + "\n")
     with pytest.raises(InputError, match=r"bad_xypts.csv, line 4, 'pt1_cam1_X': not a number"):
         read_dltdv(bad, coefs=c, fps=500.0, units="cm")
+    # DLTdv's own 3D export of the same points (its xyzpts layout), read as is: the same metres
+    xyzpts = tmp_path / "trial_xyzpts.csv"
+    cols = {f"pt{i + 1}_{a}": xyz_cm[:, i, k] for i in range(3) for k, a in enumerate("XYZ")}
+    pd.DataFrame(cols).to_csv(xyzpts, index=False, float_format="%.10f")
+    direct, info3 = read_dltdv(xyzpts, fps=500.0, units="cm")
+    assert info3["reconstructed"] is False
+    assert np.nanmax(np.abs(direct.xyz_m - series.xyz_m)) < 1e-9
     out = tmp_path / "points.csv"
     rc, stdout, errs = run_cli("import", f, "--coefs", c, "--fps", 500, "--units", "cm", "-o", out)
     assert rc == 0, errs

@@ -130,6 +130,7 @@ def test_tracker_units_calibration_and_bad_files(tmp_path, diabolo):
     cm = read_trk(_with(text, '"length_unit" type="string">m<', '"length_unit" type="string">cm<', tmp_path))
     assert np.nanmax(np.abs(cm.xy_m - diabolo.xy_m * 0.01)) < 1e-15
     assert any("from cm to m" in n for n in cm.notes)
+    assert any("reference frame 'cm A' is not applied" in n for n in diabolo.notes)
     raw = _with(text, "409.8056734369308", "1.0", tmp_path)
     raw = _with(raw.read_text(), "409.8056734369308", "1.0", tmp_path)
     with collecting() as found:

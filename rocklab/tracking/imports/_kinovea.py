@@ -221,6 +221,10 @@ def _assemble(tracks, scale, unit, fps, path, resolution) -> PlanePoints:
         )
     t_s = grid / fps if fps is not None else grid * resolution
     notes = [f"coordinates converted from {unit} to m"] if scale != 1.0 else []
-    notes.append(f"times snapped to frames at {fps:g} fps" if fps else f"times as exported ({resolution:g} s steps)")
+    notes.append(
+        f"times snapped to frames at {fps:g} fps"
+        if fps
+        else f"times as exported ({resolution:g} s steps); frame is the sample's index (--fps gives the film's)"
+    )
     frame = grid if fps is not None else np.arange(grid.size)
     return PlanePoints(t_s, frame, labels, None, xy, str(path), tuple(notes))

@@ -203,6 +203,11 @@ def read_trk(path, member: str | None = None, units: str | None = None) -> Plane
             xy_px[row[f], j] = xy
     t_s = (start_ms + (frames - start_frame) * dt_ms) / 1000.0
     notes = [f"times from the clip: start {start_ms:g} ms at frame {start_frame}, {dt_ms:g} ms a frame"]
+    if "referenceframe" in panel:  # a moving origin Tracker derives for display; the marks are raw
+        notes.append(
+            f"Tracker's reference frame {_value(panel['referenceframe'])!r} is not applied: positions are "
+            "in the project's fixed axes"
+        )
     unit = _length_unit(panel, units, source)
     calibrated = any(abs(k[3] - 1.0) > 1e-12 or abs(k[4] - 1.0) > 1e-12 for k in keys.values())
     xy_m = None

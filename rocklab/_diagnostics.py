@@ -236,6 +236,12 @@ WARNING_CODES: dict[str, tuple[str, str]] = {
         "rotation or a double impact beyond tolerance): see audit.json for the impacts "
         "affected; fits through them are not trustworthy",
     ),
+    # imports from other tools
+    "W-IMPORT-TIME": (
+        "suspect",
+        "an imported trajectory has two rows at one time (a Kinovea export): that time is left out "
+        "(lost) for it, as the file does not say which row is the film's; check the trajectory there",
+    ),
     "W-STEREO-NOSYNC": (
         "suspect",
         "the films were taken as triggered together (--no-sync), but a clock offset between them "

@@ -1129,6 +1129,136 @@ many(
 )
 
 
+# -- other tools' files: `rocklab import FILE` ----------------------------------------------------------------
+IMPORTERS = Path(__file__).parent / "data" / "importers"
+
+
+def _write(path: Path, text: str) -> Path:
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+def _copy(src: Path, dst: Path) -> Path:
+    dst.write_bytes(src.read_bytes())
+    return dst
+
+
+_PANEL = '<?xml version="1.0"?>\n<object class="org.opensourcephysics.cabrillo.tracker.TrackerPanel">\n{}</object>\n'
+_KINOVEA_SHEET = (
+    '<?xml version="1.0"?><Workbook xmlns="urn:schemas-microsoft-com:office:spreadsheet" '
+    'xmlns:ss="urn:schemas-microsoft-com:office:spreadsheet"><Worksheet><Table>'
+    '<Row><Cell><Data ss:Type="String">Label :</Data></Cell><Cell><Data ss:Type="String">A</Data></Cell></Row>'
+    '<Row><Cell><Data ss:Type="String">Coords (x,y:{unit}; t:time)</Data></Cell></Row>'
+    '<Row><Cell><Data ss:Type="String">x</Data></Cell><Cell><Data ss:Type="String">y</Data></Cell>'
+    '<Cell><Data ss:Type="String">t</Data></Cell></Row>'
+    "{rows}</Table></Worksheet></Workbook>"
+)
+
+
+def _sheet_row(x, y, t):
+    return (
+        f'<Row><Cell><Data ss:Type="Number">{x}</Data></Cell><Cell><Data ss:Type="Number">{y}</Data></Cell>'
+        f'<Cell><Data ss:Type="String">{t}</Data></Cell></Row>'
+    )
+
+
+many(
+    "import",
+    [
+        ("trk-ok", lambda tmp: ["import", _copy(IMPORTERS / "diabolo_rotation.trk", tmp / "d.trk")], "ok", None),
+        ("trk-not-xml", lambda tmp: ["import", _write(tmp / "a.trk", "hello")], "error", "not valid XML"),
+        (
+            "trk-other-xml",
+            lambda tmp: ["import", _write(tmp / "a.trk", "<object class='x.Other'/>")],
+            "error",
+            "not a Tracker project",
+        ),
+        ("trz-not-zip", lambda tmp: ["import", _write(tmp / "a.trz", "PK?")], "error", "not a zip file"),
+        (
+            "trk-no-masses",
+            lambda tmp: ["import", _write(tmp / "a.trk", _PANEL.format(""))],
+            "error",
+            "delta_t|no point-mass track",
+        ),
+        (
+            "trk-o-is-input",
+            lambda tmp: ["import", _copy(IMPORTERS / "diabolo_rotation.trk", tmp / "d.trk"), "-o", tmp / "d.trk"],
+            "error",
+            SACRED,
+        ),
+        (
+            "kinovea-pixels",
+            lambda tmp: [
+                "import",
+                _write(tmp / "k.xml", _KINOVEA_SHEET.format(unit="px", rows=_sheet_row(1, 2, "0:00:00:00"))),
+            ],
+            "error",
+            "not a length",
+        ),
+        (
+            "kinovea-bad-time",
+            lambda tmp: [
+                "import",
+                _write(tmp / "k.xml", _KINOVEA_SHEET.format(unit="cm", rows=_sheet_row(1, 2, "12 ms"))),
+            ],
+            "error",
+            "time code",
+        ),
+        (
+            "kinovea-doubled-time",
+            lambda tmp: ["import", _copy(IMPORTERS / "kinovea_box_jump.xml", tmp / "k.xml")],
+            "warn",
+            "W-IMPORT-TIME",
+        ),
+        (
+            "kinovea-text-no-unit",
+            lambda tmp: [
+                "import",
+                _write(tmp / "k.txt", "#Kinovea Trajectory data export\n#T X Y\n\n# a\n0.000 1,0 2,0\n"),
+            ],
+            "error",
+            "names no unit",
+        ),
+        (
+            "dltdv-no-fps",
+            lambda tmp: ["import", _write(tmp / "t_xyzpts.csv", "pt1_X,pt1_Y,pt1_Z\n1,2,3\n"), "--units", "m"],
+            "error",
+            "--fps",
+        ),
+        (
+            "dltdv-bad-cell",
+            lambda tmp: [
+                "import",
+                _write(tmp / "t_xyzpts.csv", "pt1_X,pt1_Y,pt1_Z\n1,2,3\n1,x,3\n"),
+                "--fps",
+                100,
+                "--units",
+                "mm",
+            ],
+            "error",
+            "line 3, 'pt1_Y': not a number",
+        ),
+        (
+            "dltdv-coefs-short",
+            lambda tmp: [
+                "import",
+                _write(tmp / "t_xypts.csv", "pt1_cam1_X,pt1_cam1_Y,pt1_cam2_X,pt1_cam2_Y\n1,2,3,4\n"),
+                "--coefs",
+                _write(tmp / "c_DLTcoefs.csv", "1,2\n3,4\n"),
+                "--fps",
+                100,
+                "--units",
+                "m",
+            ],
+            "error",
+            "11 finite rows",
+        ),
+        ("unknown-tool", lambda tmp: ["import", _write(tmp / "a.csv", "a,b\n1,2\n")], "error", "cannot tell"),
+    ],
+    None,
+)
+
+
 def _trk_cmd(tmp):
     v, c = _trk_real(tmp)
     return [v, "--config", c]

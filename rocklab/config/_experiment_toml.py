@@ -64,7 +64,8 @@ class SourceVideo:
 
 @dataclass(frozen=True)
 class SourceTrack:
-    """An already tracked CSV with ``t_s, theta_rad`` (and optionally ``object``)."""
+    """An already tracked CSV with ``t_s, theta_rad`` (and optionally ``object``), or a Tracker
+    project / Kinovea spreadsheet whose points are one block (``rocklab.tracking.imports``)."""
 
     path: Path
     object: str | None = None

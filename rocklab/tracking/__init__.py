@@ -7,6 +7,8 @@ Sub-packages:
 - :mod:`rocklab.tracking.rigid`: 3D point imports (CSV, C3D), rigid poses, the rocking
   decomposition and the assumption audit;
 - :mod:`rocklab.tracking.stereo`: two cameras (calibration, sync, 3D dots and markers).
+- :mod:`rocklab.tracking.imports`: other tools' tracking (Tracker, Kinovea, DLTdv) as plane
+  tracks or 3D points.
 - :mod:`rocklab.tracking.calib`: camera calibration from checkerboard and ChArUco pictures (films,
   folders of photos): one camera's lens file, and the boards the stereo calibration reads.
 
@@ -16,10 +18,11 @@ The clock synchronisation of an IMU to a video track is here (:func:`sync_offset
 sub-package's ``__all__`` is the one list.
 """
 
-from . import calib, imu, rigid, stereo, video
+from . import calib, imports, imu, rigid, stereo, video
 from ._corrections import apply_corrections, load_corrections
 from ._sync import SyncResult, sync_events, sync_imu_to_track, sync_offset, track_rate
 from .calib import *  # noqa: F403
+from .imports import *  # noqa: F403
 from .imu import *  # noqa: F403
 from .rigid import *  # noqa: F403
 from .stereo import *  # noqa: F403
@@ -39,3 +42,4 @@ __all__ += imu.__all__
 __all__ += calib.__all__
 __all__ += rigid.__all__
 __all__ += stereo.__all__
+__all__ += imports.__all__

@@ -38,6 +38,7 @@ COMMAND_MODULES = (
     "_cmd_imu",
     "_cmd_track",
     "_cmd_track3d",
+    "_cmd_import",
     "_cmd_stereo",
     "_cmd_synth",
     "_cmd_fit",

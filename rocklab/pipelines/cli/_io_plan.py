@@ -14,7 +14,16 @@ from __future__ import annotations
 
 from pathlib import Path
 
-__all__ = ["io_plan", "track_outputs", "track3d_outputs", "stereo_track_outputs", "TABLE", "AUDIT", "POINTS"]
+__all__ = [
+    "io_plan",
+    "import_output",
+    "track_outputs",
+    "track3d_outputs",
+    "stereo_track_outputs",
+    "TABLE",
+    "AUDIT",
+    "POINTS",
+]
 
 #: Labels of the side files (keys of the ``*_outputs`` dicts; they name the file in error messages).
 TABLE = "the table CSV written beside -o"
@@ -90,6 +99,25 @@ def _track3d(args):
     src = Path(args.points)
     outs = track3d_outputs(_opt(args.out) or src.parent / "tracks.csv")
     return [("points", src)], [*outs.items(), ("--rrd", _opt(args.rrd))]
+
+
+def import_output(path: Path, tool: str) -> Path:
+    """``rocklab import``'s default output beside FILE: ``points.csv`` (DLTdv) or ``tracks.csv``."""
+    return path.parent / ("points.csv" if tool == "dltdv" else "tracks.csv")
+
+
+def _import(args):
+    from ...tracking.imports import detect_tool
+
+    src = Path(args.file)
+    ins = [("file", src)] + ([("--coefs", Path(args.coefs))] if args.coefs else [])
+    if args.out:
+        return ins, [("-o", Path(args.out))]
+    try:
+        tool = detect_tool(src) if args.tool == "auto" else args.tool
+    except Exception:  # noqa: BLE001 - an unknown file is reported by the command itself
+        return ins, []
+    return ins, [("-o", import_output(src, tool))]
 
 
 def _stereo(args):
@@ -168,6 +196,7 @@ def _oas(args):
 _PLANS = {
     "track": _track,
     "track3d": _track3d,
+    "import": _import,
     "stereo": _stereo,
     "calibrate": _calibrate,
     "imu": _imu,

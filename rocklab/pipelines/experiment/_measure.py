@@ -19,8 +19,30 @@ __all__: list[str] = []
 
 
 def read_track_csv(path: Path, obj: str | None):
-    """The rows of ``obj`` in a tracked CSV (:class:`rocklab.series.Tracks`), checked."""
-    return read_tracks(path).rows(obj, fix="[sources.track] object")
+    """The rows of ``obj`` in a tracked CSV (:class:`rocklab.series.Tracks`), checked.
+
+    A Tracker project (``.trk``, ``.trz``) or a Kinovea spreadsheet is imported on the way: every
+    point it marks is one block, ``block_1``, upright in its last frames (``rocklab import``
+    groups points into several blocks and takes the other choices).
+    """
+    if Path(path).suffix.lower() in (".csv", ".parquet"):
+        return read_tracks(path).rows(obj, fix="[sources.track] object")
+    from ...tracking.imports import PLANE_TOOLS, detect_tool, parse_plane_bodies, plane_tracks, read_plane_points
+
+    tool = detect_tool(path)
+    if tool not in PLANE_TOOLS:
+        raise InputError(
+            f"{path}: [sources.track] takes a tracks.csv, a Tracker project or a Kinovea spreadsheet; "
+            f"convert this {tool} file with rocklab import"
+        )
+    if Path(path).suffix.lower() not in (".trk", ".trz", ".xml"):  # text exports name no unit
+        raise InputError(
+            f"{path}: a {tool} text export names no length unit; convert it with rocklab import FILE "
+            "--units cm -o tracks.csv and give that as [sources.track] path"
+        )
+    pts = read_plane_points(path, tool)
+    rows = plane_tracks(pts, parse_plane_bodies([], pts.labels, pts.source))
+    return Tracks.from_frame(rows, path).rows(obj, fix="[sources.track] object")
 
 
 def _probe_fps(path, given: float | None) -> float:

@@ -283,6 +283,12 @@ def simulate(
         fall_rad,
         law_params,
     )
+    return _run(meth, problem)
+
+
+def _run(meth, problem: RockingProblem) -> RockingResult:
+    """``problem`` integrated by ``meth`` (its limits and the run's cost checked first) into a read-only result,
+    resampled onto the output grid when the integrator stored every step."""
     meth.check(problem)
     _check_cost(problem)
     out = meth.run(problem)
@@ -301,20 +307,20 @@ def simulate(
         overturn_t_s=float(out.overturn_t_s),
         fall_t_s=float(out.fall_t_s),
         max_abs_theta_rad=float(out.max_abs_theta_rad),
-        block=block,
+        block=problem.block,
         restitution=problem.law,
         method=meth.name,
         dt_s=problem.dt_s,
         n_impacts=int(out.n_impacts),
-        linearized=bool(linearized),
-        base_name=base.name if base is not None else "",
+        linearized=problem.linearized,
+        base_name=problem.base.name if problem.base is not None else "",
     )
     if resample is None:
         return res
     t = out.t_s
     t2 = np.arange(int(math.floor(t[-1] / resample + 1e-9)) + 1) * resample
     th2, w2 = res.at(t2)
-    E2 = block_energy(block, th2, w2, linearized)
+    E2 = block_energy(problem.block, th2, w2, problem.linearized)
     for a in (t2, th2, w2, E2):
         a.setflags(write=False)
     return dataclasses.replace(res, t_s=t2, theta_rad=th2, omega_rad_s=w2, energy_J=E2)

@@ -88,41 +88,7 @@ def simulate_batch(
         ``t_end_s``) for verdicts beyond the simulated span (see
         :func:`free_rocking_overturns`).
     """
-    try:
-        arrs = np.broadcast_arrays(
-            *(
-                np.asarray(x, float)
-                for x in (
-                    p_rad_s,
-                    alpha_rad,
-                    scale,
-                    theta0_rad,
-                    omega0_rad_s,
-                    alpha_I,
-                    np.nan if eta is None else eta,
-                    np.nan if fall_rad is None else fall_rad,
-                )
-            )
-        )
-    except (ValueError, TypeError) as e:
-        raise InputError(
-            f"simulate_batch: array arguments do not broadcast ({e}); give equal lengths or scalars"
-        ) from None
-    p, al, sc, th0, w0, aI, et, fr = (np.array(a, dtype=float).ravel() for a in arrs)
-    for name, v in (("p_rad_s", p), ("alpha_rad", al), ("alpha_I", aI)):
-        if not np.all(np.isfinite(v) & (v > 0)):
-            raise InputError(f"simulate_batch: {name} must be finite and positive everywhere")
-    if np.any(al >= _HALF_PI):
-        raise InputError("simulate_batch: alpha_rad must be < pi/2")
-    for name, v in (("scale", sc), ("theta0_rad", th0), ("omega0_rad_s", w0)):
-        if not np.all(np.isfinite(v)):
-            raise InputError(f"simulate_batch: {name} must be finite")
-    if np.any(np.abs(th0) >= al):
-        raise InputError("simulate_batch: |theta0_rad| must be < alpha_rad for every entry")
-    et = np.where(np.isnan(et), 1.0 - 2.0 * np.sin(al) ** 2 / aI, et)
-    if np.any(np.abs(et) > 1):
-        raise InputError("simulate_batch: |eta| must be <= 1")
-    fr = np.where(np.isnan(fr), _HALF_PI, fr)
+    p, al, sc, th0, w0, et, fr = _entries(p_rad_s, alpha_rad, scale, theta0_rad, omega0_rad_s, alpha_I, eta, fall_rad)
     if not (math.isfinite(dt_s) and dt_s > 0):
         raise InputError(f"simulate_batch: dt_s={dt_s!r} must be positive (s)")
     if base is not None and not isinstance(base, BaseMotion):
@@ -160,6 +126,49 @@ def simulate_batch(
         omega_end_rad_s=w_end,
         t_end_s=steps * h,
     )
+
+
+def _entries(p_rad_s, alpha_rad, scale, theta0_rad, omega0_rad_s, alpha_I, eta, fall_rad):
+    """The per-entry arguments broadcast to one length m and checked; eta and fall_rad defaulted.
+
+    Returns (p rad/s, alpha rad, scale, theta0 rad, omega0 rad/s, eta, fall rad), each (m,) float.
+    """
+    try:
+        arrs = np.broadcast_arrays(
+            *(
+                np.asarray(x, float)
+                for x in (
+                    p_rad_s,
+                    alpha_rad,
+                    scale,
+                    theta0_rad,
+                    omega0_rad_s,
+                    alpha_I,
+                    np.nan if eta is None else eta,
+                    np.nan if fall_rad is None else fall_rad,
+                )
+            )
+        )
+    except (ValueError, TypeError) as e:
+        raise InputError(
+            f"simulate_batch: array arguments do not broadcast ({e}); give equal lengths or scalars"
+        ) from None
+    p, al, sc, th0, w0, aI, et, fr = (np.array(a, dtype=float).ravel() for a in arrs)
+    for name, v in (("p_rad_s", p), ("alpha_rad", al), ("alpha_I", aI)):
+        if not np.all(np.isfinite(v) & (v > 0)):
+            raise InputError(f"simulate_batch: {name} must be finite and positive everywhere")
+    if np.any(al >= _HALF_PI):
+        raise InputError("simulate_batch: alpha_rad must be < pi/2")
+    for name, v in (("scale", sc), ("theta0_rad", th0), ("omega0_rad_s", w0)):
+        if not np.all(np.isfinite(v)):
+            raise InputError(f"simulate_batch: {name} must be finite")
+    if np.any(np.abs(th0) >= al):
+        raise InputError("simulate_batch: |theta0_rad| must be < alpha_rad for every entry")
+    et = np.where(np.isnan(et), 1.0 - 2.0 * np.sin(al) ** 2 / aI, et)
+    if np.any(np.abs(et) > 1):
+        raise InputError("simulate_batch: |eta| must be <= 1")
+    fr = np.where(np.isnan(fr), _HALF_PI, fr)
+    return p, al, sc, th0, w0, et, fr
 
 
 def free_rocking_overturns(theta_rad, omega_rad_s, p_rad_s, alpha_rad, eta) -> np.ndarray:

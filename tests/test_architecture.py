@@ -205,22 +205,49 @@ def test_synth_names_live_in_synth_only():
 
 
 def _function_lengths():
-    """{"package.module:function": lines of code without the docstring} for every function, and the
-    numba kernels apart (their loops are long by nature: one kernel, one compiled unit)."""
+    """{"package.module:function": whole lines, from ``def`` to the last line, signature and docstring
+    included} for every function, and the numba kernels apart (their loops are long by nature: one
+    kernel, one compiled unit)."""
     out, kernels = {}, set()
     for path in PKG.rglob("*.py"):
         mod = _module_name(path).removeprefix("rocklab.")
-        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
-            if not isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
-                continue
-            first = node.body[0]
-            doc = isinstance(first, ast.Expr) and isinstance(getattr(first, "value", None), ast.Constant)
-            start = node.body[1].lineno if doc and len(node.body) > 1 else first.lineno
-            key = f"{mod}:{node.name}"
-            out[key] = max(out.get(key, 0), node.end_lineno - start + 1)
-            if any("jit" in ast.unparse(d) for d in node.decorator_list):
-                kernels.add(key)
+        _source_lengths(path.read_text(encoding="utf-8"), mod, out, kernels)
     return out, kernels
+
+
+def _source_lengths(source, mod, out, kernels):
+    """Add the functions of one module's ``source`` to ``out`` (whole lengths) and its kernels to ``kernels``."""
+    for node in ast.walk(ast.parse(source)):
+        if not isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+            continue
+        key = f"{mod}:{node.name}"
+        out[key] = max(out.get(key, 0), node.end_lineno - node.lineno + 1)
+        if any("jit" in ast.unparse(d) for d in node.decorator_list):
+            kernels.add(key)
+
+
+def test_function_length_counts_the_whole_function():
+    # issue 28 counts a function from its def to its last line: signature and docstring are part of it
+    source = (
+        "@njit(cache=True)\n"
+        "def kernel(x):\n"
+        "    return x\n"
+        "\n"
+        "def f(\n"
+        "    a,\n"
+        "    b,\n"
+        "):\n"
+        '    """Doc.\n'
+        "\n"
+        "    More doc.\n"
+        '    """\n'
+        "    c = a + b\n"
+        "    return c\n"
+    )
+    out, kernels = {}, set()
+    _source_lengths(source, "m", out, kernels)
+    assert out == {"m:kernel": 2, "m:f": 10}
+    assert kernels == {"m:kernel"}
 
 
 #: Functions still over the limit, each to be cut into steps (issue 28). The list only shrinks:

@@ -355,3 +355,44 @@ def test_private_imports_are_listed_with_their_reason():
     assert len(cross) + len(names) <= 15
     assert found - set(PRIVATE_IMPORTS) == set(), "import the name from its package's face instead"
     assert set(PRIVATE_IMPORTS) - found == set(), "these are gone: take them off PRIVATE_IMPORTS"
+
+
+def _listed_by_hand(tree) -> set:
+    """Names written as string literals in a module's ``__all__`` assignments (``=``, ``+=``, annotated)."""
+    names = set()
+    for node in tree.body:
+        if isinstance(node, ast.Assign):
+            targets = node.targets
+        elif isinstance(node, (ast.AugAssign, ast.AnnAssign)):
+            targets = [node.target]
+        else:
+            continue
+        if node.value is not None and any(isinstance(t, ast.Name) and t.id == "__all__" for t in targets):
+            names |= {e.value for e in ast.walk(node.value) if isinstance(e, ast.Constant) and isinstance(e.value, str)}
+    return names
+
+
+def test_each_public_name_is_listed_by_one_face():
+    # issue 28: a package's __all__ is its names' one list; a face that takes another face's names
+    # builds its __all__ from that face's __all__ (as rocklab.models does), never copies them by hand
+    import importlib
+
+    faces = {_module_name(p): p for p in PKG.rglob("__init__.py")}
+    copies = []
+    for face, path in faces.items():
+        tree = ast.parse(path.read_text(encoding="utf-8"))
+        by_hand = _listed_by_hand(tree)
+        for node in tree.body:
+            if not isinstance(node, ast.ImportFrom):
+                continue
+            if node.level:
+                base = face.split(".")
+                src = ".".join(base[: len(base) - (node.level - 1)] + ([node.module] if node.module else []))
+            else:
+                src = node.module or ""
+            if src not in faces:
+                continue  # a face's own modules are where its names live
+            theirs = set(getattr(importlib.import_module(src), "__all__", ()))
+            copies += [f"{face}: {a.name} (listed by {src})" for a in node.names if a.name in by_hand & theirs]
+    assert len(faces) > 20  # every package's face was read
+    assert not copies, copies

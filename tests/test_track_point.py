@@ -12,7 +12,8 @@ import numpy as np
 import pytest
 
 from rocklab._diagnostics import collecting
-from rocklab.tracking import TrackConfig, track_frames
+from rocklab.config import TrackConfig
+from rocklab.tracking import track_frames
 from rocklab.tracking.video._track import assemble_tracks
 from rocklab.tracking.video.targets._observability import MIN_TURN_SHARE, turn_share
 

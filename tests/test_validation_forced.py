@@ -53,7 +53,7 @@ def test_eta_from_half_cycles_covers_the_truth(eta):
 
 def test_too_few_half_cycles_fail_with_a_reason():
     from rocklab.fitting import fit_forced_restitution
-    from rocklab.models import BaseMotion
+    from rocklab.series import BaseMotion
 
     t = np.arange(200) / 50.0
     block = __import__("rocklab").Block(0.06, 0.225)
@@ -157,7 +157,7 @@ def test_half_cycles_stop_where_the_block_passes_alpha():
     stopped ``rocklab run``): the half cycles end before the first |θ| ≥ 0.98 α."""
     from rocklab import Block
     from rocklab.fitting import fit_forced_restitution, half_cycle_segments
-    from rocklab.models import BaseMotion
+    from rocklab.series import BaseMotion
 
     block = Block(0.06, 0.225)
     alpha = block.alpha_rad

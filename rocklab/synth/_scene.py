@@ -63,7 +63,8 @@ def _table_motion(kind, seed_rng, *, record, amplitude, period, stroke, blocks, 
         return still_table()
     if kind == "sine":
         return sine_pulse_table(start_s, period, amplitude)
-    from ..models import BaseMotion, bundled_record, load_base_motion
+    from ..series import BaseMotion
+    from ..models import bundled_record, load_base_motion
 
     if record is None:
         base, name = bundled_record("elcentro"), "elcentro"

@@ -92,7 +92,7 @@ def simulate_batch(
     if not (math.isfinite(dt_s) and dt_s > 0):
         raise InputError(f"simulate_batch: dt_s={dt_s!r} must be positive (s)")
     if base is not None and not isinstance(base, BaseMotion):
-        raise InputError("simulate_batch: base must be a rocklab.models.BaseMotion or None")
+        raise InputError("simulate_batch: base must be a rocklab.series.BaseMotion or None")
     if duration_s is None:
         if base is None:
             raise InputError("simulate_batch: give duration_s for free rocking (no base record)")

@@ -5,7 +5,7 @@ Sign convention (Čeh Eq. 1–2, Fig. 1): theta > 0 is rotation about corner A,
 with p = sqrt(m g R / I_O) (any alpha_I). A block at rest uplifts only when
 |a_g| > g tan(alpha), towards theta > 0 when a_g < 0 (the base moves away
 under it). Everything is SI; the base motion is a
-:class:`~rocklab.models.BaseMotion` in m/s^2.
+:class:`~rocklab.series.BaseMotion` in m/s^2.
 
 Rules (every integrator of :data:`~rocklab.models.rocking.METHODS`):
 
@@ -118,7 +118,7 @@ def _problem(
     law = _law(restitution, block, law_params)
     if base is not None and not isinstance(base, BaseMotion):
         raise InputError(
-            f"base={type(base).__name__}: give a rocklab.models.BaseMotion "
+            f"base={type(base).__name__}: give a rocklab.series.BaseMotion "
             "(e.g. BaseMotion.from_samples(acc, dt_s, 'g')) or None"
         )
     every, resample = 1, None

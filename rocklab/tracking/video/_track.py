@@ -570,7 +570,8 @@ def track_video(
     >>> import pathlib, tempfile
     >>> import numpy as np, pandas as pd
     >>> from rocklab.synth import synth_session
-    >>> from rocklab.tracking import load_track_config, track_video
+    >>> from rocklab.config import load_track_config
+    >>> from rocklab.tracking import track_video
     >>> d = pathlib.Path(tempfile.mkdtemp())
     >>> s = synth_session(d / "s", seed=1, size=(480, 270), duration_s=1.0, imu=False, mp4=False)
     >>> res = track_video(d / "s" / "video.mkv", load_track_config(d / "s" / "track.toml"))

@@ -4,7 +4,7 @@ import pytest
 
 from rocklab import InputError
 from rocklab._diagnostics import collecting
-from rocklab.pipelines.experiment._config import load_experiment
+from rocklab.pipelines import load_experiment
 from rocklab.config import load_track_config
 from rocklab.tracking import track_video
 

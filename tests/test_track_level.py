@@ -99,9 +99,9 @@ def test_markerless_table_edge_levels_a_camcorder_render_at_960x540(tmp_path, se
     from rocklab.synth import synth_session
     from rocklab.config import load_track_config
     from rocklab.tracking import track_video
-    from rocklab.tracking.video._plane import make_plane_map
-    from rocklab.tracking.video._video import iter_video_frames
-    from rocklab.tracking.video.targets._table_edge import table_top_edge
+    from rocklab.tracking import make_plane_map
+    from rocklab.tracking import iter_video_frames
+    from rocklab.tracking.video.targets import table_top_edge
 
     s = synth_session(
         tmp_path / "s",

@@ -102,7 +102,7 @@ def test_real_pendulum_footage(shared_data):
     swing period agrees with an independent colour-blob centroid + damped-sine fit."""
     from scipy.optimize import curve_fit
 
-    from rocklab.tracking.video._video import iter_video_frames
+    from rocklab.tracking import iter_video_frames
 
     path = shared_data / "video" / "pendulum_film2_vga.mp4"
     cap = cv2.VideoCapture(str(path))

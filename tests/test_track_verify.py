@@ -180,7 +180,7 @@ def test_outline_check_sees_a_slide_a_turn_about_a_point_off_the_object_not_a_sh
     silhouette then matches in the pose's own frame, as on a spinning ball), it fails too."""
     import cv2
 
-    from rocklab.tracking.video.targets._markerless import MarkerlessTracker
+    from rocklab.tracking.video.targets import MarkerlessTracker
     from rocklab.tracking.video.targets._occlusion import DRIFT_FRAC, OutlineRef
 
     class Stub:  # what the check needs of a tracker: the template's place and its windows

@@ -37,7 +37,7 @@ def _forced_run(eta, seed, *, block_id="B5L", acc_bias=0.01):
 @pytest.mark.parametrize("eta", [0.937, 0.89])
 def test_eta_from_half_cycles_covers_the_truth(eta):
     from rocklab.fitting import fit_forced_restitution
-    from rocklab.pipelines.experiment._column_run import base_from_table
+    from rocklab.pipelines import base_from_table
 
     block, _, t, y, tab = _forced_run(eta, seed=3)
     fit = fit_forced_restitution(t, y, block, base_from_table(tab, 0.0, "test", sign=-1.0))
@@ -105,7 +105,7 @@ def test_response_statistics_closed_form():
 def test_run_reports_validation_and_bands(tmp_path):
     """``rocklab run`` on a tracked θ and the table's record: report.json ``validation`` with the
     documented keys, series.csv bands whose coverage is the one reported."""
-    from rocklab.pipelines.experiment._experiment import run_experiment
+    from rocklab.pipelines import run_experiment
 
     eta = 0.937
     block, table, t, y, _ = _forced_run(eta, seed=5)
@@ -181,7 +181,7 @@ def test_each_half_cycle_gives_its_impact_eta():
     """Without noise every half cycle alone finds the true η (the per-impact η of a shake-table run)."""
     from rocklab.fitting import fit_forced_restitution
     from rocklab.models import bundled_record, simulate
-    from rocklab.pipelines.experiment._column_run import base_from_table
+    from rocklab.pipelines import base_from_table
     from rocklab.synth._scripted_motion import record_table
 
     from rocklab import Block

@@ -13,7 +13,7 @@ import pytest
 from rocklab._diagnostics import RocklabWarning
 from rocklab.config import TrackConfig
 from rocklab.tracking import probe_video, track_video
-from rocklab.tracking.video._video import iter_video_frames
+from rocklab.tracking import iter_video_frames
 
 av = pytest.importorskip("av")
 

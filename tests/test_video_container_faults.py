@@ -14,7 +14,7 @@ import pytest
 from rocklab._diagnostics import RocklabWarning, collecting
 from rocklab.config import TrackConfig
 from rocklab.tracking import probe_video, track_video
-from rocklab.tracking.video._video import iter_video_frames
+from rocklab.tracking import iter_video_frames
 
 from test_video_container import CFG, _marker_frame, _write
 

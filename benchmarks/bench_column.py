@@ -26,7 +26,8 @@ import time
 import numpy as np
 
 from rocklab.blocks import Block
-from rocklab.models import BaseMotion, Column, bundled_record, column_overturning_maps, simulate_column
+from rocklab.series import BaseMotion
+from rocklab.models import Column, bundled_record, column_overturning_maps, simulate_column
 
 
 def _timed(fn, repeat=1):

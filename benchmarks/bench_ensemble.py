@@ -33,7 +33,8 @@ SHARED = Path(__file__).resolve().parents[2] / "shared" / "data" / "records"
 
 
 def _records():
-    from rocklab.models import BaseMotion, bundled_record, load_base_motion
+    from rocklab.series import BaseMotion
+    from rocklab.models import bundled_record, load_base_motion
 
     recs = [("elcentro", bundled_record("elcentro"))]
     for name in ("RSN68_SFERN_PEL090.AT2", "elCentro.AT2"):
@@ -121,7 +122,8 @@ def judge_run(run, n=64):
 
 def speed(n=64, repeats=3):
     from rocklab.fitting import InputUncertainty, simulate_ensemble
-    from rocklab.models import BaseMotion, simulate
+    from rocklab.series import BaseMotion
+    from rocklab.models import simulate
 
     run = make_run(0)
     blk, (t, _), tab = run["block"], run["prim"], run["table"]

@@ -25,7 +25,8 @@ import cv2
 import numpy as np
 from threadpoolctl import threadpool_limits
 
-from rocklab.tracking import TrackConfig, track_frames
+from rocklab.config import TrackConfig
+from rocklab.tracking import track_frames
 
 W, H, N = 1920, 1080, 120
 

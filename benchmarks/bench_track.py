@@ -19,7 +19,8 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from rocklab.tracking import TrackConfig, track_frames, track_video
+from rocklab.config import TrackConfig
+from rocklab.tracking import track_frames, track_video
 from rocklab.tracking.video.targets._aruco import make_cv_detector
 
 N_FRAMES = 60

@@ -30,7 +30,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 from _blob import blob_track, perturbed_boxes, swing_period_s, wrong_ok  # noqa: E402
 
 from rocklab._diagnostics import collecting  # noqa: E402
-from rocklab.tracking import TrackConfig, track_video  # noqa: E402
+from rocklab.config import TrackConfig
+from rocklab.tracking import track_video
 from rocklab.tracking.video._video import probe_video  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -19,7 +19,8 @@ import numpy as np
 from rocklab import Block
 from rocklab.fitting import fit_restitution
 from rocklab.synth import synth_session
-from rocklab.tracking import load_track_config, track_video
+from rocklab.config import load_track_config
+from rocklab.tracking import track_video
 
 
 def main(n_seeds: int = 20, work: Path | None = None) -> None:

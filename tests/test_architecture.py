@@ -205,22 +205,49 @@ def test_synth_names_live_in_synth_only():
 
 
 def _function_lengths():
-    """{"package.module:function": lines of code without the docstring} for every function, and the
-    numba kernels apart (their loops are long by nature: one kernel, one compiled unit)."""
+    """{"package.module:function": whole lines, from ``def`` to the last line, signature and docstring
+    included} for every function, and the numba kernels apart (their loops are long by nature: one
+    kernel, one compiled unit)."""
     out, kernels = {}, set()
     for path in PKG.rglob("*.py"):
         mod = _module_name(path).removeprefix("rocklab.")
-        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
-            if not isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
-                continue
-            first = node.body[0]
-            doc = isinstance(first, ast.Expr) and isinstance(getattr(first, "value", None), ast.Constant)
-            start = node.body[1].lineno if doc and len(node.body) > 1 else first.lineno
-            key = f"{mod}:{node.name}"
-            out[key] = max(out.get(key, 0), node.end_lineno - start + 1)
-            if any("jit" in ast.unparse(d) for d in node.decorator_list):
-                kernels.add(key)
+        _source_lengths(path.read_text(encoding="utf-8"), mod, out, kernels)
     return out, kernels
+
+
+def _source_lengths(source, mod, out, kernels):
+    """Add the functions of one module's ``source`` to ``out`` (whole lengths) and its kernels to ``kernels``."""
+    for node in ast.walk(ast.parse(source)):
+        if not isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+            continue
+        key = f"{mod}:{node.name}"
+        out[key] = max(out.get(key, 0), node.end_lineno - node.lineno + 1)
+        if any("jit" in ast.unparse(d) for d in node.decorator_list):
+            kernels.add(key)
+
+
+def test_function_length_counts_the_whole_function():
+    # issue 28 counts a function from its def to its last line: signature and docstring are part of it
+    source = (
+        "@njit(cache=True)\n"
+        "def kernel(x):\n"
+        "    return x\n"
+        "\n"
+        "def f(\n"
+        "    a,\n"
+        "    b,\n"
+        "):\n"
+        '    """Doc.\n'
+        "\n"
+        "    More doc.\n"
+        '    """\n'
+        "    c = a + b\n"
+        "    return c\n"
+    )
+    out, kernels = {}, set()
+    _source_lengths(source, "m", out, kernels)
+    assert out == {"m:kernel": 2, "m:f": 10}
+    assert kernels == {"m:kernel"}
 
 
 #: Functions still over the limit, each to be cut into steps (issue 28). The list only shrinks:
@@ -328,3 +355,44 @@ def test_private_imports_are_listed_with_their_reason():
     assert len(cross) + len(names) <= 15
     assert found - set(PRIVATE_IMPORTS) == set(), "import the name from its package's face instead"
     assert set(PRIVATE_IMPORTS) - found == set(), "these are gone: take them off PRIVATE_IMPORTS"
+
+
+def _listed_by_hand(tree) -> set:
+    """Names written as string literals in a module's ``__all__`` assignments (``=``, ``+=``, annotated)."""
+    names = set()
+    for node in tree.body:
+        if isinstance(node, ast.Assign):
+            targets = node.targets
+        elif isinstance(node, (ast.AugAssign, ast.AnnAssign)):
+            targets = [node.target]
+        else:
+            continue
+        if node.value is not None and any(isinstance(t, ast.Name) and t.id == "__all__" for t in targets):
+            names |= {e.value for e in ast.walk(node.value) if isinstance(e, ast.Constant) and isinstance(e.value, str)}
+    return names
+
+
+def test_each_public_name_is_listed_by_one_face():
+    # issue 28: a package's __all__ is its names' one list; a face that takes another face's names
+    # builds its __all__ from that face's __all__ (as rocklab.models does), never copies them by hand
+    import importlib
+
+    faces = {_module_name(p): p for p in PKG.rglob("__init__.py")}
+    copies = []
+    for face, path in faces.items():
+        tree = ast.parse(path.read_text(encoding="utf-8"))
+        by_hand = _listed_by_hand(tree)
+        for node in tree.body:
+            if not isinstance(node, ast.ImportFrom):
+                continue
+            if node.level:
+                base = face.split(".")
+                src = ".".join(base[: len(base) - (node.level - 1)] + ([node.module] if node.module else []))
+            else:
+                src = node.module or ""
+            if src not in faces:
+                continue  # a face's own modules are where its names live
+            theirs = set(getattr(importlib.import_module(src), "__all__", ()))
+            copies += [f"{face}: {a.name} (listed by {src})" for a in node.names if a.name in by_hand & theirs]
+    assert len(faces) > 20  # every package's face was read
+    assert not copies, copies

@@ -229,8 +229,8 @@ def test_board_specs_and_corner_conventions():
 
 
 def test_cli_calibrate_lens_file_feeds_track_toml(tmp_path, run_cli):
-    from rocklab.tracking import TrackConfig
-    from rocklab.tracking.video._plane import make_plane_map
+    from rocklab.config import TrackConfig
+    from rocklab.tracking import make_plane_map
 
     d = DATA / "bouguet_stereo"
     out = tmp_path / "lens.json"

@@ -18,8 +18,9 @@ def test_demo_sessions_carry_the_stated_truth(tmp_path):
     import json
 
     from rocklab.fitting import catalogue_block, edge_contact_k, eta_modified
-    from rocklab.pipelines.experiment._config import load_experiment
-    from rocklab.pipelines.campaign._demo import ETA_MAT_TRUE, L_C_M, make_demo_campaign
+    from rocklab.pipelines import load_experiment
+    from rocklab.pipelines import make_demo_campaign
+    from rocklab.pipelines.campaign._demo import ETA_MAT_TRUE, L_C_M
 
     runs = (("B3M_edge", "B3M", "edge", "none"), ("B5M_full", "B5M", "full", "none"))
     cfgs = make_demo_campaign(tmp_path, size=(320, 180), progress=False, runs=runs)

@@ -9,8 +9,8 @@ import pytest
 
 from rocklab import InputError
 from rocklab.blocks import Block
+from rocklab.series import BaseMotion
 from rocklab.models import (
-    BaseMotion,
     Column,
     app_c_reduction,
     column_impact,

@@ -15,7 +15,8 @@ import pytest
 
 from rocklab import InputError
 from rocklab.blocks import Block
-from rocklab.models import BaseMotion, Column, bundled_record, column_overturning_maps, sine_pulse, simulate_column
+from rocklab.series import BaseMotion
+from rocklab.models import Column, bundled_record, column_overturning_maps, sine_pulse, simulate_column
 
 
 def _elcentro_3s():

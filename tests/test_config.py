@@ -228,7 +228,7 @@ def test_dumps_toml_is_read_back_equal():
 
 
 def test_corrections_toml_errors_name_the_line(tmp_path):
-    from rocklab.tracking._corrections import load_corrections
+    from rocklab.tracking import load_corrections
 
     p = tmp_path / "fix.toml"
     p.write_text('[[corrections]]\nobject = "b"\nframe = 3\naction = "drop"\n\n[[corrections]]\nobject = "b"\n')

@@ -13,7 +13,7 @@ import pandas as pd
 import pytest
 
 from rocklab import InputError
-from rocklab.tracking._corrections import load_corrections
+from rocklab.tracking import load_corrections
 
 BAD = range(40, 45)  # frames that show frame 10's picture: the tracker reports frame 10's pose there
 

@@ -26,7 +26,8 @@ import pytest
 from rocklab._diagnostics import collecting
 
 from rocklab import Block
-from rocklab.models import BaseMotion, simulate
+from rocklab.series import BaseMotion
+from rocklab.models import simulate
 from rocklab.tracking import block_rotation
 from rocklab.synth import simulate_imu_log
 

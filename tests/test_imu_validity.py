@@ -21,7 +21,7 @@ from rocklab.models import simulate
 from rocklab.synth import simulate_imu_log
 from rocklab.tracking import block_rotation, read_imu, table_acceleration
 from rocklab.tracking.imu import _validity
-from rocklab.tracking.imu._read import ImuLog
+from rocklab.tracking import ImuLog
 
 FS = 256.0
 _BOUNDS = ("AXIS_TILT_MAX_RAD", "AXIS_SHARE_MIN", "TURN_RANGE_MAX_RAD", "DRIFT_MAX_RAD_S", "TABLE_TURN_MAX_RAD")

@@ -7,7 +7,8 @@ import pandas as pd
 import pytest
 
 from rocklab import Block, G, InputError
-from rocklab.models import BaseMotion, pulse_motion, simulate
+from rocklab.series import BaseMotion
+from rocklab.models import pulse_motion, simulate
 from rocklab.models.mechanisms import (
     asymmetric_frame,
     block_mechanism,

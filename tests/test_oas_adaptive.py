@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 from rocklab._errors import InputError
-from rocklab.models import BaseMotion, load_base_motion, overturning_spectrum
+from rocklab.series import BaseMotion
+from rocklab.models import load_base_motion, overturning_spectrum
 from rocklab.models.spectra._oas_grid import adaptive_verdicts, boundary_verdicts
 
 FF1 = "records/fema-p695-far-field/SortedEQFile_120111.txt"

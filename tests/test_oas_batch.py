@@ -9,7 +9,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from rocklab.pipelines.spectra._spectra_batch import expand_records, table4_row, thesis_table4
+from rocklab.pipelines import expand_records, table4_row, thesis_table4
 
 
 def test_thesis_table4_transcription():

@@ -10,7 +10,7 @@ import pytest
 
 from rocklab.fitting import catalogue_block, edge_contact_k, eta_modified
 from rocklab.models import simulate
-from rocklab.pipelines.experiment._rerun import read_rrd_summary
+from rocklab.pipelines import read_rrd_summary
 
 ETA_MAT = 0.985
 L_C = 0.0015
@@ -178,7 +178,8 @@ def _report(name, bid, contact, *, fit=None, half_cycles=None):
 def test_a_base_excited_runs_half_cycle_eta_is_shown_but_not_pooled():
     # Čeh's η_mat (Eq. 16) and k (Eq. 18) are free-rocking quantities: a shake-table run's half-cycle
     # η_e is reported in its row, and the campaign fits come from the free runs alone
-    from rocklab.pipelines.campaign._campaign import CampaignResult, _campaign_fits, _row
+    from rocklab.pipelines import CampaignResult
+    from rocklab.pipelines.campaign._campaign import _campaign_fits, _row
 
     truth = {
         b: eta_modified(catalogue_block(b).alpha_rad, edge_contact_k(catalogue_block(b).b_m, L_C)) * ETA_MAT

@@ -7,12 +7,12 @@ import json
 import numpy as np
 import pytest
 
-from rocklab.pipelines.experiment._rerun import read_rrd_summary
+from rocklab.pipelines import read_rrd_summary
 
 
 @pytest.fixture(scope="module")
 def column_run(tmp_path_factory):
-    from rocklab.pipelines.experiment._experiment import run_experiment
+    from rocklab.pipelines import run_experiment
     from rocklab.synth import synth_session
 
     d = tmp_path_factory.mktemp("column")

@@ -3,7 +3,7 @@ import tomllib
 import pytest
 
 from rocklab import InputError
-from rocklab.pipelines.experiment._config import EXAMPLE_TOML, load_experiment
+from rocklab.pipelines import EXAMPLE_TOML, load_experiment
 
 
 def _write(tmp_path, text, files=("tracks.csv",)):

@@ -24,7 +24,7 @@ def sine_session(tmp_path_factory):
 
 
 def test_table_driven_simulation_matches_truth(sine_session, tmp_path):
-    from rocklab.pipelines.experiment._experiment import run_experiment
+    from rocklab.pipelines import run_experiment
 
     meta = json.loads((sine_session / "session.json").read_text())
     assert meta["blocks"][0]["eta_true"] == 0.75
@@ -55,7 +55,7 @@ def test_table_from_imu_is_synced_to_the_video(tmp_path):
     """A record-driven run takes the table acceleration from the table IMU (the camera's 50 fps
     cannot sample it); the IMU clock is found from the table acceleration itself."""
     from rocklab.pipelines.campaign._demo import _render_one
-    from rocklab.pipelines.experiment._experiment import run_experiment
+    from rocklab.pipelines import run_experiment
 
     cfg = _render_one(tmp_path / "s", 5, "B5L_elcentro", "B5L", "full", "record", (640, 360), 50.0)
     assert 'from = "imu"' in cfg.read_text()
@@ -76,10 +76,10 @@ def test_table_from_imu_is_synced_to_the_video(tmp_path):
 
 def test_streaming_without_rrd_file_still_logs_the_video(sine_session, tmp_path):
     """``rrd = false`` with --spawn/--connect: the frames are kept while tracking and logged."""
-    from rocklab.pipelines.experiment._config import load_experiment
-    from rocklab.pipelines.experiment._experiment import analyse_experiment
+    from rocklab.pipelines import load_experiment
+    from rocklab.pipelines import analyse_experiment
     from rocklab.pipelines.experiment._log_experiment import log_experiment
-    from rocklab.pipelines.experiment._rerun import read_rrd_summary
+    from rocklab.pipelines import read_rrd_summary
 
     text = (sine_session / "experiment.toml").read_text()
     assert text.count("video_decimation = 10\n") == 1

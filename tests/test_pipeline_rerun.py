@@ -3,14 +3,8 @@
 import numpy as np
 import pytest
 
-from rocklab.pipelines.experiment._rerun import (
-    experiment_blueprint,
-    log_events,
-    log_series,
-    open_recording,
-    read_rrd_scalars,
-    read_rrd_summary,
-)
+from rocklab.pipelines import read_rrd_scalars, read_rrd_summary
+from rocklab.pipelines.experiment._rerun import experiment_blueprint, log_events, log_series, open_recording
 
 
 def test_series_and_events_round_trip(tmp_path):

@@ -8,7 +8,7 @@ import pytest
 
 from rocklab import Block
 from rocklab.models import simulate
-from rocklab.pipelines.experiment._rerun import read_rrd_scalars, read_rrd_summary
+from rocklab.pipelines import read_rrd_scalars, read_rrd_summary
 
 ETA_TRUE = 0.93
 FPS = 150.0

@@ -14,7 +14,7 @@ from rocklab._diagnostics import collecting
 from rocklab.synth import synth_points3d
 from rocklab.tracking.rigid import read_points, track_points3d, write_points_csv
 from rocklab.tracking.rigid import _plausible
-from rocklab.tracking.rigid._read_points import PointSeries
+from rocklab.tracking import PointSeries
 
 
 def _codes(series, bodies, up):

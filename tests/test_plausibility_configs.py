@@ -4,8 +4,9 @@ import pytest
 
 from rocklab import InputError
 from rocklab._diagnostics import collecting
-from rocklab.pipelines.experiment._config import load_experiment
-from rocklab.tracking import load_track_config, track_video
+from rocklab.pipelines import load_experiment
+from rocklab.config import load_track_config
+from rocklab.tracking import track_video
 
 
 def _exp(tmp_path, extra_video="", extra=""):

@@ -7,8 +7,9 @@ import pytest
 
 from rocklab import G, InputError
 from rocklab._diagnostics import RocklabWarning, collecting
-from rocklab.models import BaseMotion, load_base_motion, pulse_parameters, simulate
-from rocklab.models.spectra._pulses import lobe_impulses
+from rocklab.series import BaseMotion
+from rocklab.models import load_base_motion, pulse_parameters, simulate
+from rocklab.models import lobe_impulses
 
 VALUES = [f"{v: .7E}" for v in 0.1 * np.sin(np.linspace(0, 6, 40))]
 

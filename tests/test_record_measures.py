@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 from rocklab import G, InputError
-from rocklab.models import BaseMotion, bundled_record
+from rocklab.series import BaseMotion
+from rocklab.models import bundled_record
 from rocklab.models.spectra import record_measures, response_spectrum
 
 

@@ -2,7 +2,8 @@ import numpy as np
 import pytest
 
 from rocklab import G, InputError
-from rocklab.models import BaseMotion, load_base_motion
+from rocklab.series import BaseMotion
+from rocklab.models import load_base_motion
 
 
 def test_at2_nga_west2(shared_data):

@@ -59,7 +59,8 @@ def test_h264_sessions_fit_like_the_lossless_film(tmp_path):
     # the camcorder-like video.mp4 of default free-rocking sessions: these seeds failed ("record starts
     # in motion", seed 1) or fitted a drift step as the release (seed 18: eta_e 0.662) before
     from rocklab.synth import synth_session
-    from rocklab.tracking import load_track_config, track_video
+    from rocklab.config import load_track_config
+    from rocklab.tracking import track_video
 
     for seed in (1, 18):
         out = tmp_path / f"s{seed}"

@@ -9,7 +9,7 @@ import pytest
 
 from rocklab import Block, InputError
 from rocklab.models import RESTITUTION_LAWS, Restitution, make_restitution
-from rocklab.models.rocking._restitution import eta_axes, eta_bumps, eta_housner, eta_modified
+from rocklab.models import eta_axes, eta_bumps, eta_housner, eta_modified
 
 
 def test_ceh_table1_housner():

@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 from rocklab import Block, InputError
-from rocklab.models import BaseMotion, simulate, simulate_batch
+from rocklab.series import BaseMotion
+from rocklab.models import simulate, simulate_batch
 
 
 def _sine_pulse(A_g, f_hz, dt=1e-3, T=6.0):

@@ -14,7 +14,8 @@ import numpy as np
 import pytest
 
 from rocklab import Block
-from rocklab.models import BaseMotion, simulate
+from rocklab.series import BaseMotion
+from rocklab.models import simulate
 
 B6M = Block(0.045, 0.2025, name="B6M")
 

@@ -14,7 +14,8 @@ import numpy as np
 import pytest
 
 from rocklab import Block
-from rocklab.models import BaseMotion, bundled_record
+from rocklab.series import BaseMotion
+from rocklab.models import bundled_record
 
 
 def _compare(fast, gen, th_tol=1e-10):

@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 from rocklab import Block, G, InputError
-from rocklab.models import BaseMotion, simulate
+from rocklab.series import BaseMotion
+from rocklab.models import simulate
 
 B6M = Block(0.045, 0.2025, name="B6M")
 

@@ -98,7 +98,7 @@ def test_oas_bad_input(run_cli, shared_data, tmp_path):
 
 def test_oas_many_on_a_dask_cluster(shared_data):
     distributed = pytest.importorskip("distributed")
-    from rocklab.pipelines.spectra._spectra_batch import oas_many
+    from rocklab.pipelines import oas_many
 
     recs = [shared_data / FF.format(r) for r in ("120111", "120112")]
     kw = dict(levels=8, sizes=20, refine=3)

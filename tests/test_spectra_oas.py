@@ -7,9 +7,9 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from rocklab import G, InputError
+from rocklab.series import BaseMotion
 from rocklab.models import (
     F_SINE,
-    BaseMotion,
     fit_inclined_line,
     free_rocking_overturns,
     load_base_motion,

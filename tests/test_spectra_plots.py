@@ -3,7 +3,8 @@
 import numpy as np
 
 from rocklab.models import overturning_curve, overturning_spectrum, pulse_motion
-from rocklab.pipelines.spectra._plots_spectra import plot_oas, plot_overturning_curve, plot_wall_error_maps
+from rocklab.pipelines import plot_oas, plot_overturning_curve
+from rocklab.pipelines.spectra._plots_spectra import plot_wall_error_maps
 
 
 def test_wall_error_maps_fig3_trends(tmp_path):

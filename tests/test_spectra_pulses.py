@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from rocklab import Block, G, InputError
+from rocklab.series import BaseMotion
 from rocklab.models import (
-    BaseMotion,
     design_check,
     load_base_motion,
     pulse_motion,

@@ -248,9 +248,10 @@ def test_setup_errors_are_named_before_the_audit(session, tmp_path):
 def test_no_sync_on_lagged_films_is_a_warning_and_silent_once_aligned(session):
     # --no-sync on films 2.7 ms (0.4 frame) apart skewed every moving target; the offset is
     # measured anyway and reported, and films aligned by that offset raise nothing
-    from rocklab.tracking.stereo._dots3d import _shift, match_tracks, sync_offset_stereo, track_dots_2d
+    from rocklab.tracking import match_tracks, sync_offset_stereo, track_dots_2d
+    from rocklab.tracking.stereo._dots3d import _shift
     from rocklab.tracking.stereo._setup import check_unsynchronised
-    from rocklab.tracking.video._video import iter_video_frames
+    from rocklab.tracking import iter_video_frames
 
     d, _, rig, _ = session
     with collecting() as diags:

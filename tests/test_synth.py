@@ -187,8 +187,8 @@ def test_imu_logs_read_back_with_the_x_imu_reader(free_session, shared_data):
 
 
 def test_configs_load_with_their_readers(free_session):
-    from rocklab.pipelines.experiment._config import load_experiment
-    from rocklab.tracking import load_track_config
+    from rocklab.pipelines import load_experiment
+    from rocklab.config import load_track_config
 
     s = free_session
     cfg = load_track_config(s.track_toml)

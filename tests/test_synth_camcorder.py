@@ -8,7 +8,8 @@ import pytest
 
 from _render import realistic_session
 from rocklab.synth import synth_session
-from rocklab.tracking import load_track_config, track_video
+from rocklab.config import load_track_config
+from rocklab.tracking import track_video
 
 av = pytest.importorskip("av")
 

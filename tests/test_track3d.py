@@ -28,7 +28,7 @@ from rocklab.tracking.rigid import (
     write_points_csv,
 )
 from rocklab.tracking.rigid._rigidity import rigid_groups
-from rocklab.tracking.rigid._track3d import TRACK3D_COLUMNS
+from rocklab.tracking import TRACK3D_COLUMNS
 
 C3D = Path(__file__).parent / "data" / "c3d"
 
@@ -334,7 +334,7 @@ def test_cli_track3d_c3d_then_fit_restitution(tmp_path, run_cli):
     )
     assert rc == 0, err
     # the Rerun review: every sample's targets, the pivot, the plots, one text row per impact and flag
-    from rocklab.pipelines.experiment._rerun import read_rrd_summary
+    from rocklab.pipelines import read_rrd_summary
 
     rows = read_rrd_summary(tmp_path / "t" / "review.rrd")
     n = len(pd.read_csv(tmp_path / "s" / "truth.csv"))

@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 from _render import Scene, marker_texture, write_video
-from rocklab.tracking import TrackConfig, assemble_tracks, track_frames, track_video
+from rocklab.config import TrackConfig
+from rocklab.tracking import assemble_tracks, track_frames, track_video
 
 FPS = 50.0
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 from rocklab import InputError
-from rocklab.tracking import TrackConfig, load_track_config
+from rocklab.config import TrackConfig, load_track_config
 
 EXAMPLE = """\
 [video]
@@ -75,7 +75,7 @@ def test_schema_page_and_examples():
     """docs/track-toml.md carries the generated reference; every example in examples/ loads."""
     from pathlib import Path
 
-    from rocklab.tracking import load_track_config
+    from rocklab.config import load_track_config
     from rocklab.config import schema_markdown
 
     root = Path(__file__).resolve().parents[1]

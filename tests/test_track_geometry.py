@@ -7,7 +7,8 @@ import pytest
 
 from _render import Scene, checker_texture, marker_texture
 from rocklab import InputError
-from rocklab.tracking import BoardConfig, TrackConfig, assemble_tracks, calibrate_camera, fit_similarity, track_frames
+from rocklab.config import BoardConfig, TrackConfig
+from rocklab.tracking import assemble_tracks, calibrate_camera, fit_similarity, track_frames
 
 BOARD = {"kind": "checkerboard", "squares_x": 9, "squares_y": 6, "square_m": 0.02}
 

@@ -106,7 +106,7 @@ def test_init_markerless_on_a_realistic_render_tracks_unedited(tmp_path, run_cli
     1.2 deg): theta within 0.05 deg RMS (measured 0.015), the table's pixel track a straight-line
     image of its true displacement to 0.1 px (measured 0.04)."""
     from _render import realistic_session
-    from rocklab.tracking import load_track_config
+    from rocklab.config import load_track_config
 
     s = realistic_session(tmp_path / "s", size=(960, 540))
     rois = {o.id: o.roi for o in load_track_config(s.track_toml).objects}

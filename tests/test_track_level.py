@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 from _render import Scene, marker_texture
-from rocklab.tracking import TrackConfig, assemble_tracks, track_frames
+from rocklab.config import TrackConfig
+from rocklab.tracking import assemble_tracks, track_frames
 
 ROLL = math.radians(1.2)
 FPS = 50.0
@@ -96,10 +97,11 @@ def test_markerless_table_edge_levels_a_camcorder_render_at_960x540(tmp_path, se
     frame's edge alone 0.0003-0.0073 deg off on lossless films of six scenes, against 0.006-0.036
     deg from the region alone."""
     from rocklab.synth import synth_session
-    from rocklab.tracking import load_track_config, track_video
-    from rocklab.tracking.video._plane import make_plane_map
-    from rocklab.tracking.video._video import iter_video_frames
-    from rocklab.tracking.video.targets._table_edge import table_top_edge
+    from rocklab.config import load_track_config
+    from rocklab.tracking import track_video
+    from rocklab.tracking import make_plane_map
+    from rocklab.tracking import iter_video_frames
+    from rocklab.tracking.video.targets import table_top_edge
 
     s = synth_session(
         tmp_path / "s",

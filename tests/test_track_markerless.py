@@ -9,7 +9,8 @@ import pytest
 from _render import TEX, Scene
 from rocklab import InputError
 from rocklab._diagnostics import collecting
-from rocklab.tracking import TrackConfig, assemble_tracks, track_frames
+from rocklab.config import TrackConfig
+from rocklab.tracking import assemble_tracks, track_frames
 
 FPS = 50.0
 
@@ -101,7 +102,7 @@ def test_real_pendulum_footage(shared_data):
     swing period agrees with an independent colour-blob centroid + damped-sine fit."""
     from scipy.optimize import curve_fit
 
-    from rocklab.tracking.video._video import iter_video_frames
+    from rocklab.tracking import iter_video_frames
 
     path = shared_data / "video" / "pendulum_film2_vga.mp4"
     cap = cv2.VideoCapture(str(path))
@@ -152,7 +153,8 @@ def test_mixed_styles_aruco_block_on_markerless_table(tmp_path, sine_session):
     """A block with ArUco markers on a table followed markerless (issue: mixed styles per object)."""
     import pandas as pd
 
-    from rocklab.tracking import load_track_config, track_video
+    from rocklab.config import load_track_config
+    from rocklab.tracking import track_video
 
     out = sine_session  # shared, read only: the edited config goes to tmp_path
     text = (out / "track.toml").read_text()
@@ -187,7 +189,8 @@ def test_markerless_synth_session_granite_block(tmp_path, table, size):
     textured steel table, no markers anywhere; the config synth writes tracks it."""
     import pandas as pd
 
-    from rocklab.tracking import load_track_config, track_video
+    from rocklab.config import load_track_config
+    from rocklab.tracking import track_video
     from rocklab.synth import synth_session
 
     out = tmp_path / "s"
@@ -226,7 +229,8 @@ def test_table_region_on_the_block_is_flagged(tmp_path):
     import re
 
     from rocklab._diagnostics import collecting
-    from rocklab.tracking import load_track_config, track_video
+    from rocklab.config import load_track_config
+    from rocklab.tracking import track_video
     from rocklab.synth import synth_session
 
     out = tmp_path / "s"
@@ -262,7 +266,8 @@ def test_markerless_hand_occlusion_never_reports_a_wrong_pose(tmp_path):
 
     from rocklab._diagnostics import collecting
     from rocklab.synth import synth_session
-    from rocklab.tracking import load_track_config, track_video
+    from rocklab.config import load_track_config
+    from rocklab.tracking import track_video
 
     hand = {"object": "block_1", "t0_s": 0.6, "t1_s": 1.4, "kind": "hand"}
     s = synth_session(

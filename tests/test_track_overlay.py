@@ -7,7 +7,8 @@ import pytest
 
 @pytest.mark.parametrize("calibrated", [True, False])
 def test_to_pixels_matches_true_projection(tmp_path, calibrated):
-    from rocklab.tracking import load_track_config, track_video
+    from rocklab.config import load_track_config
+    from rocklab.tracking import track_video
     from rocklab.synth import synth_session
 
     s = synth_session(
@@ -38,7 +39,8 @@ def test_pixel_columns_match_the_overlay_projection(tmp_path):
     (from the levelled metric pose, through scale, levelling and lens distortion)."""
     import numpy as np
 
-    from rocklab.tracking import load_track_config, track_video
+    from rocklab.config import load_track_config
+    from rocklab.tracking import track_video
     from rocklab.synth import synth_session
 
     if True:

@@ -12,8 +12,9 @@ import numpy as np
 import pytest
 
 from rocklab._diagnostics import collecting
-from rocklab.tracking import TrackConfig, track_frames
-from rocklab.tracking.video._track import assemble_tracks
+from rocklab.config import TrackConfig
+from rocklab.tracking import track_frames
+from rocklab.tracking import assemble_tracks
 from rocklab.tracking.video.targets._observability import MIN_TURN_SHARE, turn_share
 
 W, H, N, R = 320, 240, 90, 22.0

@@ -8,7 +8,8 @@ import pandas as pd
 import pytest
 
 from rocklab._diagnostics import RocklabWarning
-from rocklab.tracking import load_track_config, track_video
+from rocklab.config import load_track_config
+from rocklab.tracking import track_video
 
 
 @pytest.fixture(scope="module", params=["aruco", "dots", "edges"])

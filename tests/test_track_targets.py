@@ -8,8 +8,9 @@ import pytest
 
 from _render import TEX, Scene, dots_texture, plain_texture
 from rocklab._diagnostics import RocklabWarning
-from rocklab.tracking import TrackConfig, assemble_tracks, track_frames
-from rocklab.tracking.video.targets._dots import dot_centroid
+from rocklab.config import TrackConfig
+from rocklab.tracking import assemble_tracks, track_frames
+from rocklab.tracking.video.targets import dot_centroid
 
 FPS = 50.0
 ROLL = 0.01  # camera roll, rad: levelling from the table must remove it

@@ -8,7 +8,8 @@ import pytest
 
 from _blob import blob_track, perturbed_boxes, swing_period_s, wrong_ok
 from rocklab._diagnostics import collecting
-from rocklab.tracking import TrackConfig, track_video
+from rocklab.config import TrackConfig
+from rocklab.tracking import track_video
 
 # boxes drawn round the ball by eye that, unverified, reported 83 to 282 frames ok while 50 px off
 EYE_BOXES = [(310, 68, 72, 74), (312, 70, 68, 68), (305, 63, 80, 80), (308, 66, 74, 76)]
@@ -179,7 +180,7 @@ def test_outline_check_sees_a_slide_a_turn_about_a_point_off_the_object_not_a_sh
     silhouette then matches in the pose's own frame, as on a spinning ball), it fails too."""
     import cv2
 
-    from rocklab.tracking.video.targets._markerless import MarkerlessTracker
+    from rocklab.tracking.video.targets import MarkerlessTracker
     from rocklab.tracking.video.targets._occlusion import DRIFT_FRAC, OutlineRef
 
     class Stub:  # what the check needs of a tracker: the template's place and its windows

@@ -10,7 +10,8 @@ import pytest
 
 from _render import TEX, Scene, dots_texture, marker_texture, plain_texture
 from rocklab._diagnostics import collecting
-from rocklab.tracking import TrackConfig, assemble_tracks, track_frames
+from rocklab.config import TrackConfig
+from rocklab.tracking import assemble_tracks, track_frames
 
 FPS = 50.0
 W, H, K = 640, 400, 1500.0  # frame px, px per m

@@ -37,7 +37,7 @@ def _forced_run(eta, seed, *, block_id="B5L", acc_bias=0.01):
 @pytest.mark.parametrize("eta", [0.937, 0.89])
 def test_eta_from_half_cycles_covers_the_truth(eta):
     from rocklab.fitting import fit_forced_restitution
-    from rocklab.pipelines.experiment._column_run import base_from_table
+    from rocklab.pipelines import base_from_table
 
     block, _, t, y, tab = _forced_run(eta, seed=3)
     fit = fit_forced_restitution(t, y, block, base_from_table(tab, 0.0, "test", sign=-1.0))
@@ -53,7 +53,7 @@ def test_eta_from_half_cycles_covers_the_truth(eta):
 
 def test_too_few_half_cycles_fail_with_a_reason():
     from rocklab.fitting import fit_forced_restitution
-    from rocklab.models import BaseMotion
+    from rocklab.series import BaseMotion
 
     t = np.arange(200) / 50.0
     block = __import__("rocklab").Block(0.06, 0.225)
@@ -105,7 +105,7 @@ def test_response_statistics_closed_form():
 def test_run_reports_validation_and_bands(tmp_path):
     """``rocklab run`` on a tracked θ and the table's record: report.json ``validation`` with the
     documented keys, series.csv bands whose coverage is the one reported."""
-    from rocklab.pipelines.experiment._experiment import run_experiment
+    from rocklab.pipelines import run_experiment
 
     eta = 0.937
     block, table, t, y, _ = _forced_run(eta, seed=5)
@@ -157,7 +157,7 @@ def test_half_cycles_stop_where_the_block_passes_alpha():
     stopped ``rocklab run``): the half cycles end before the first |θ| ≥ 0.98 α."""
     from rocklab import Block
     from rocklab.fitting import fit_forced_restitution, half_cycle_segments
-    from rocklab.models import BaseMotion
+    from rocklab.series import BaseMotion
 
     block = Block(0.06, 0.225)
     alpha = block.alpha_rad
@@ -181,7 +181,7 @@ def test_each_half_cycle_gives_its_impact_eta():
     """Without noise every half cycle alone finds the true η (the per-impact η of a shake-table run)."""
     from rocklab.fitting import fit_forced_restitution
     from rocklab.models import bundled_record, simulate
-    from rocklab.pipelines.experiment._column_run import base_from_table
+    from rocklab.pipelines import base_from_table
     from rocklab.synth._scripted_motion import record_table
 
     from rocklab import Block

@@ -44,7 +44,8 @@ def _track(path, decimation=2, codec="jpeg"):
     """Track the clip while the review film is made; (tracking, [(index, JPEG)]) or, for AV1,
     (tracking, ReviewVideo)."""
     from rocklab.pipelines.experiment._review_video import ReviewFilm
-    from rocklab.tracking import TrackConfig, track_video
+    from rocklab.config import TrackConfig
+    from rocklab.tracking import track_video
 
     cfg = TrackConfig.from_dict(
         {

@@ -11,8 +11,9 @@ import numpy as np
 import pytest
 
 from rocklab._diagnostics import RocklabWarning
-from rocklab.tracking import TrackConfig, probe_video, track_video
-from rocklab.tracking.video._video import iter_video_frames
+from rocklab.config import TrackConfig
+from rocklab.tracking import probe_video, track_video
+from rocklab.tracking import iter_video_frames
 
 av = pytest.importorskip("av")
 

@@ -12,8 +12,9 @@ import numpy as np
 import pytest
 
 from rocklab._diagnostics import RocklabWarning, collecting
-from rocklab.tracking import TrackConfig, probe_video, track_video
-from rocklab.tracking.video._video import iter_video_frames
+from rocklab.config import TrackConfig
+from rocklab.tracking import probe_video, track_video
+from rocklab.tracking import iter_video_frames
 
 from test_video_container import CFG, _marker_frame, _write
 

@@ -164,7 +164,8 @@ def simulate_ensemble(
     import time
 
     from ..blocks import Block
-    from ..models import BaseMotion, simulate
+    from ..series import BaseMotion
+    from ..models import simulate
 
     rng = np.random.default_rng(seed)
     tt = np.asarray(table_t_s, float)

@@ -538,6 +538,27 @@ def _bound_warnings(name, at_bound, ci, lo_b, hi_b):
     return []
 
 
+def _check_options(window, objective, eta_bounds):
+    """The fit's choices are known ones and its search interval lies in (0, 1); returns (lo, hi)."""
+    if window not in WINDOWS:
+        raise InputError(f"window={window!r}: use one of {WINDOWS}")
+    if objective not in OBJECTIVES:
+        raise InputError(f"objective={objective!r}: use one of {OBJECTIVES}")
+    lo_b, hi_b = (float(x) for x in eta_bounds)
+    if not (0 < lo_b < hi_b < 1):
+        raise InputError(f"eta_bounds={eta_bounds}: need 0 < lo < hi < 1 (a restitution >= 1 gains energy)")
+    return lo_b, hi_b
+
+
+def _interval(f_main, eta_hat, f_hat, dof, win_res, level, bounds):
+    """Profile-likelihood confidence interval of eta at ``level``: the cost ``f_main(eta)`` rises by the
+    chi-square quantile times the residual variance (``f_hat`` over ``dof`` degrees of freedom),
+    inflated for the window residuals' autocorrelation."""
+    s2 = f_hat / max(dof, 1)
+    thresh = float(chi2.ppf(level, 1)) * s2 * ac_factor(win_res)
+    return profile_ci(f_main, eta_hat, f_hat, thresh, *bounds)
+
+
 def fit_restitution(
     t_s,
     theta_rad,
@@ -609,13 +630,7 @@ def fit_restitution(
     >>> fit.status, round(fit.eta_e, 4)
     ('ok', 0.9)
     """
-    if window not in WINDOWS:
-        raise InputError(f"window={window!r}: use one of {WINDOWS}")
-    if objective not in OBJECTIVES:
-        raise InputError(f"objective={objective!r}: use one of {OBJECTIVES}")
-    lo_b, hi_b = (float(x) for x in eta_bounds)
-    if not (0 < lo_b < hi_b < 1):
-        raise InputError(f"eta_bounds={eta_bounds}: need 0 < lo < hi < 1 (a restitution >= 1 gains energy)")
+    lo_b, hi_b = _check_options(window, objective, eta_bounds)
     prep = _prepare(
         t_s, theta_rad, block, window, objective, (lo_b, hi_b), dt_s, nan, eta_guess, theta0_rad, fit_offset
     )
@@ -630,9 +645,7 @@ def fit_restitution(
     n_pts = int(res.size)
     rms = float(np.sqrt(np.mean(win_res**2))) if win_res.size else float("nan")
     n_par = (4 + int(fit_offset)) if objective_used == "theta" else 1
-    s2 = f_hat / max(n_pts - n_par, 1)
-    thresh = float(chi2.ppf(level, 1)) * s2 * ac_factor(win_res)
-    ci = profile_ci(f_main, eta_hat, f_hat, thresh, lo_b, hi_b)
+    ci = _interval(f_main, eta_hat, f_hat, n_pts - n_par, win_res, level, (lo_b, hi_b))
     at_bound = search.at_bound(eta_hat, eta_first, tr_hat)
     flags = search.suspicion(offset, win_res if objective_used == "theta" else np.array([]), rms, pie)
     diags += _residual_warning(name, block, rms, search.rel.sigma_rad)

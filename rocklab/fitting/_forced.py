@@ -175,7 +175,8 @@ _BIAS_STEP = 0.01
 def _segment_stats(seg, eta, t, y, block, base_ts, dt_s):
     """(e, a, c) of one half cycle at ``eta``: with P the projection off its start-state columns,
     r its residual and g its sensitivity to a table bias, e = |P r|², a = (P g)·(P r), c = |P g|²."""
-    from ..models import BaseMotion, simulate
+    from ..series import BaseMotion
+    from ..models import simulate
 
     tp, thp, idx = seg
     bt, ba = base_ts
@@ -271,7 +272,7 @@ def fit_forced_restitution(
         Measured θ(t) on the base's clock, s and rad, in the simulator's sense of θ
         (the caller mirrors the base when the measurement's sense differs).
     block : rocklab.Block
-    base : rocklab.models.BaseMotion
+    base : rocklab.series.BaseMotion
         The measured table acceleration (m/s²), t = 0 at the measurement's t = 0.
     eta_bounds : (float, float)
         Range searched for η.

@@ -12,35 +12,21 @@ importing it stays light).
 - :func:`run_campaign` runs every experiment under a folder, then the campaign fits
   (``rocklab campaign``, :class:`CampaignResult`);
 - :func:`run_demo` / :func:`make_demo_campaign`: the synthetic demo campaign (``rocklab demo``);
-- :func:`read_rrd_summary` / :func:`read_rrd_scalars` read a written ``.rrd`` back with Rerun's reader.
+- :func:`read_rrd_summary` / :func:`read_rrd_scalars` read a written ``.rrd`` back with Rerun's reader;
+- :func:`oas_many` / :func:`oas_table` and the record-study figures (:mod:`.spectra`).
+
+Every public name of these sub-packages is also here: each sub-package's ``__all__`` is the one list.
 """
 
-from .campaign import CampaignResult, find_experiments, make_demo_campaign, run_campaign, run_demo
-from .cli import main
-from .experiment import (
-    EXAMPLE_TOML,
-    ExperimentConfig,
-    ExperimentResult,
-    analyse_experiment,
-    load_experiment,
-    read_rrd_scalars,
-    read_rrd_summary,
-    run_experiment,
-)
+from . import campaign, cli, experiment, spectra
+from .campaign import *  # noqa: F403
+from .cli import *  # noqa: F403
+from .experiment import *  # noqa: F403
+from .spectra import *  # noqa: F403
 
-__all__ = [
-    "main",
-    "load_experiment",
-    "ExperimentConfig",
-    "EXAMPLE_TOML",
-    "run_experiment",
-    "analyse_experiment",
-    "ExperimentResult",
-    "run_campaign",
-    "find_experiments",
-    "CampaignResult",
-    "run_demo",
-    "make_demo_campaign",
-    "read_rrd_summary",
-    "read_rrd_scalars",
-]
+# each sub-package's __all__ is the one list of its public names (a name added there is exported here too)
+__all__: list[str] = []
+__all__ += experiment.__all__
+__all__ += campaign.__all__
+__all__ += spectra.__all__
+__all__ += cli.__all__

@@ -142,6 +142,38 @@ def simulate_imu_log(
     n = int(math.floor((t1 - t0) * rate_hz)) + 1
     tk = t0 + np.arange(n) * dt
 
+    f_block, w_block = _block_kinematics(tk, dt, (t_tr, th_tr, om_tr), b2, mount, base)
+    S = np.eye(3) if sensor_rotation is None else np.asarray(sensor_rotation, float)
+    gb = np.asarray(gyro_bias_deg_s, float)
+    if gb.ndim == 0:
+        gb = gb * rng.choice([-1.0, 1.0], 3)
+    gyro = w_block @ S.T + np.deg2rad(gb) + rng.normal(0.0, np.deg2rad(gyro_noise_deg_s), (n, 3))
+    acc = (
+        f_block @ S.T
+        + np.broadcast_to(np.asarray(acc_bias_g, float), (3,)) * G
+        + rng.normal(0.0, acc_noise_g * G, (n, 3))
+    )
+    keep = np.ones(n, dtype=bool)
+    for _ in range(int(drop_bursts)):
+        length = int(rng.integers(3, max(4, drop_max + 1)))
+        start = int(rng.integers(int(0.2 * n), max(int(0.2 * n) + 1, n - length - int(0.2 * n))))
+        keep[start : start + length] = False
+    t_dev = tk * (1.0 + clock_drift) + clock_offset_s
+    return ImuLog(
+        t_dev[keep], gyro[keep], acc[keep], float(rate_hz), int(n - keep.sum()), None, "simulated", "simulated"
+    )
+
+
+def _block_kinematics(tk, dt, truth, b2, mount, base):
+    """Specific force (n, 3) m/s² and rate (n, 3) rad/s in the block frame at the sample times ``tk`` (s).
+
+    ``truth`` = (t s, theta rad, omega rad/s) of the block rocking on its edges at ±``b2`` m with the sensor
+    at ``mount`` = (x, z) m in the block frame; ``base`` moves the table along world x. Rates and
+    accelerations are central differences over one sample interval ``dt`` (s), as a sampling IMU sees them.
+    """
+    t_tr, th_tr, om_tr = truth
+    n = tk.size
+
     def theta_at(t):
         return np.interp(t, t_tr, th_tr)
 
@@ -166,25 +198,7 @@ def simulate_imu_log(
     f_block = np.einsum("nji,nj->ni", R, f_world)
     w_block = np.zeros((n, 3))
     w_block[:, 1] = (theta_at(tk + 0.5 * dt) - theta_at(tk - 0.5 * dt)) / dt
-    S = np.eye(3) if sensor_rotation is None else np.asarray(sensor_rotation, float)
-    gb = np.asarray(gyro_bias_deg_s, float)
-    if gb.ndim == 0:
-        gb = gb * rng.choice([-1.0, 1.0], 3)
-    gyro = w_block @ S.T + np.deg2rad(gb) + rng.normal(0.0, np.deg2rad(gyro_noise_deg_s), (n, 3))
-    acc = (
-        f_block @ S.T
-        + np.broadcast_to(np.asarray(acc_bias_g, float), (3,)) * G
-        + rng.normal(0.0, acc_noise_g * G, (n, 3))
-    )
-    keep = np.ones(n, dtype=bool)
-    for _ in range(int(drop_bursts)):
-        length = int(rng.integers(3, max(4, drop_max + 1)))
-        start = int(rng.integers(int(0.2 * n), max(int(0.2 * n) + 1, n - length - int(0.2 * n))))
-        keep[start : start + length] = False
-    t_dev = tk * (1.0 + clock_drift) + clock_offset_s
-    return ImuLog(
-        t_dev[keep], gyro[keep], acc[keep], float(rate_hz), int(n - keep.sum()), None, "simulated", "simulated"
-    )
+    return f_block, w_block
 
 
 def _sample_index(log: ImuLog) -> np.ndarray:

@@ -187,6 +187,48 @@ def synth_points3d(
     tm = t - hold_s
     theta = np.where(tm < 0, th0, np.interp(tm, motion_t, res.theta_rad, right=0.0))
     impacts = hold_s + np.asarray(res.impacts["t_s"], float)
+    theta, impacts, (slide_x, uplift, psi), injected = _inject(t, theta, impacts, double_impact, slide, jump, twist)
+    body, labels = target_points(block, depth, side_targets)
+    n = t.size
+    half = block.b_m / 2.0
+    world = _block_points(body, half, theta, psi, slide_x, uplift)
+    all_labels = list(labels)
+    if table:
+        tpts = np.array(
+            [[-2.5 * half, -depth, 0.0], [2.5 * half, -depth, 0.0], [2.5 * half, depth, 0.0], [-2.5 * half, depth, 0.0]]
+        )
+        world = np.concatenate([world, np.broadcast_to(tpts, (n, 4, 3))], axis=1)
+        all_labels += [f"T{i + 1}" for i in range(4)]
+    Q = _rig(up, math.radians(yaw_deg))
+    rig = np.einsum("ij,npj->npi", Q, world) + np.asarray(offset_m, float)
+    rng = np.random.default_rng(seed)
+    rig = rig + rng.normal(0.0, noise_m, rig.shape)
+    series = PointSeries(t, tuple(all_labels), rig, f"synth3d(seed={seed})")
+    # theta about the rocking axis from the truth's body frame: the tracker's e_r is +-Q x; keep its sign rule
+    e_r = Q @ np.array([1.0, 0.0, 0.0])
+    axis = Q @ np.array([0.0, 1.0, 0.0])
+    truth = pd.DataFrame(
+        {
+            "t_s": t,
+            "theta_rad": theta,
+            "twist_rad": psi,
+            "out_of_plane_rad": np.zeros(n),
+            "slide_m": slide_x,
+            "uplift_m": uplift,
+            "table_x_m": np.zeros(n),
+        }
+    )
+    bodies = {"block": tuple(labels)}
+    if table:
+        bodies["table"] = tuple(all_labels[len(labels) :])
+    return Points3DSession(series, truth, impacts, block, bodies, e_r, axis, Q @ np.array([0.0, 0.0, 1.0]), injected)
+
+
+def _inject(t, theta, impacts, double_impact, slide, jump, twist):
+    """The faults asked for, injected at their impacts (1-based) into the rocking history ``theta`` (rad).
+
+    Returns (theta rad, impact times s, (slide m, uplift m, twist rad) each like ``t``, {fault: (impact, value)}).
+    """
     injected = {}
 
     def at(k, what):
@@ -220,10 +262,13 @@ def synth_points3d(
         t_k = at(twist[0], "twist")
         psi[t >= t_k] = float(twist[1])
         injected["twist"] = (int(twist[0]), float(twist[1]))
+    return theta, impacts, (slide_x, uplift, psi), injected
 
-    body, labels = target_points(block, depth, side_targets)
-    n = t.size
-    half = block.b_m / 2.0
+
+def _block_points(body, half, theta, psi, slide_x, uplift):
+    """World positions (n, points, 3) m of the body points (points, 3) of a block rocking by ``theta`` about its
+    edges at ±``half`` m, turned by ``psi`` rad about the vertical, slid by ``slide_x`` m, lifted by ``uplift`` m."""
+    n = theta.size
     c, s = np.cos(theta), np.sin(theta)
     px = np.where(theta >= 0, half, -half)  # the edge it turns about
     q = body[None, :, :] - np.stack([px, np.zeros(n), np.zeros(n)], axis=1)[:, None, :]
@@ -234,34 +279,4 @@ def synth_points3d(
     xw = cp * x - sp * y + slide_x[:, None]
     yw = sp * x + cp * y
     zw = z + uplift[:, None]
-    world = np.stack([xw, yw, zw], axis=2)
-    all_labels = list(labels)
-    if table:
-        tpts = np.array(
-            [[-2.5 * half, -depth, 0.0], [2.5 * half, -depth, 0.0], [2.5 * half, depth, 0.0], [-2.5 * half, depth, 0.0]]
-        )
-        world = np.concatenate([world, np.broadcast_to(tpts, (n, 4, 3))], axis=1)
-        all_labels += [f"T{i + 1}" for i in range(4)]
-    Q = _rig(up, math.radians(yaw_deg))
-    rig = np.einsum("ij,npj->npi", Q, world) + np.asarray(offset_m, float)
-    rng = np.random.default_rng(seed)
-    rig = rig + rng.normal(0.0, noise_m, rig.shape)
-    series = PointSeries(t, tuple(all_labels), rig, f"synth3d(seed={seed})")
-    # theta about the rocking axis from the truth's body frame: the tracker's e_r is +-Q x; keep its sign rule
-    e_r = Q @ np.array([1.0, 0.0, 0.0])
-    axis = Q @ np.array([0.0, 1.0, 0.0])
-    truth = pd.DataFrame(
-        {
-            "t_s": t,
-            "theta_rad": theta,
-            "twist_rad": psi,
-            "out_of_plane_rad": np.zeros(n),
-            "slide_m": slide_x,
-            "uplift_m": uplift,
-            "table_x_m": np.zeros(n),
-        }
-    )
-    bodies = {"block": tuple(labels)}
-    if table:
-        bodies["table"] = tuple(all_labels[len(labels) :])
-    return Points3DSession(series, truth, impacts, block, bodies, e_r, axis, Q @ np.array([0.0, 0.0, 1.0]), injected)
+    return np.stack([xw, yw, zw], axis=2)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import inspect
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -62,7 +63,8 @@ def _table_motion(kind, seed_rng, *, record, amplitude, period, stroke, blocks, 
         return still_table()
     if kind == "sine":
         return sine_pulse_table(start_s, period, amplitude)
-    from ..models import BaseMotion, bundled_record, load_base_motion
+    from ..series import BaseMotion
+    from ..models import bundled_record, load_base_motion
 
     if record is None:
         base, name = bundled_record("elcentro"), "elcentro"
@@ -355,8 +357,6 @@ def build_scene(
     layout=None,
     texture="procedural",
 ) -> Scene:
-    from ._camera import make_camera
-
     ss = np.random.SeedSequence(seed)
     s_cam, s_motion, s_tex, s_noise, s_imu, s_bg = ss.spawn(6)
     rng_m = np.random.default_rng(s_motion)
@@ -388,43 +388,19 @@ def build_scene(
         horizon_s=max(horizon, 3.0),
     )
     base = tbl.base_motion(sim_end)
-    spacing = 0.35
-    xs = [0.0] if n == 1 else [-spacing, 0.0, spacing]
-    if theta0_rad is None:
-        phi0 = [s * 0.5 * b.alpha_rad for s, b in zip((1, -1, 1), blks)]
-    else:
-        phi0 = list(np.broadcast_to(np.asarray(theta0_rad, float), (n,)))
-        for p, b in zip(phi0, blks):
-            if not abs(p) < b.alpha_rad:
-                raise InputError(f"theta0_rad={p!r}: must be within ±alpha = ±{b.alpha_rad:.4f} rad")
-    if layout == "column":
-        motions, sims, ends = _column_motions(
-            blks,
-            tbl,
-            base,
-            table,
-            rest_s,
-            sim_end,
-            rng_m,
-            None if theta0_rad is None else float(np.ravel(theta0_rad)[0]),
-        )
-    else:
-        motions, sims, ends = _single_motions(
-            blks, xs, phi0, tbl, base, table, rest_s, sim_end, rng_m, restitution, eta
-        )
+    phi0 = _release_angles(theta0_rad, blks)
+    motions, sims, ends = _block_motions(
+        layout, blks, phi0, theta0_rad, tbl, base, table, (rest_s, sim_end), rng_m, (restitution, eta)
+    )
     if duration_s is None:
         duration_s = float(np.clip(max(ends) + 0.6, 2.0, 12.0))
     n_frames = max(2, int(round(duration_s * fps)))
     _check_motions_cover(motions, sims, n_frames / fps + IMU_TAIL_S)
-    W, H = size
-    h_max = max(b.h_m for b in blks)
-    stack = sum(b.h_m for b in blks) if layout == "column" else h_max
     table_w = 1.2 if layout == "side" else 0.8
     stroke = {"none": 0.0, "sine": table_amplitude_m, "record": table_stroke_m}[table]
-    view_h = max(3.0 * h_max, 1.4 * stack, (table_w + 2 * stroke + 0.1) * H / W)
-    cam = make_camera(size, (0.0, 0.4 * stack), view_h, np.random.default_rng(s_cam), distortion=distortion)
+    cam = _framed_camera(size, blks, layout, table_w + 2 * stroke, np.random.default_rng(s_cam), distortion)
     maps = cam.plane_maps()
-    mpp = cam.m_per_px((0.0, 0.5 * h_max))
+    mpp = cam.m_per_px((0.0, 0.5 * max(b.h_m for b in blks)))
     texel, psf_m = mpp / 4.0, 0.5 * mpp
     objects, feats = _textured_objects(
         blks, motions, tbl, table, targets, table_w, texel, psf_m, np.random.default_rng(s_tex), texture
@@ -474,6 +450,53 @@ def build_scene(
         table_w,
         layout=layout,
     )
+
+
+#: build_scene's options, which ``synth_session`` forwards as it was given them
+SCENE_OPTIONS = frozenset(inspect.signature(build_scene).parameters)
+
+
+def _release_angles(theta0_rad, blks) -> list:
+    """Initial tilts of blocks rocking side by side, rad (default: ±0.5 alpha, alternating)."""
+    if theta0_rad is None:
+        return [s * 0.5 * b.alpha_rad for s, b in zip((1, -1, 1), blks)]
+    phi0 = list(np.broadcast_to(np.asarray(theta0_rad, float), (len(blks),)))
+    for p, b in zip(phi0, blks):
+        if not abs(p) < b.alpha_rad:
+            raise InputError(f"theta0_rad={p!r}: must be within ±alpha = ±{b.alpha_rad:.4f} rad")
+    return phi0
+
+
+def _block_motions(layout, blks, phi0, theta0_rad, tbl, base, table, times_s, rng_m, law):
+    """(motions, simulation summaries, end times s) of the blocks: a column, or blocks side by side.
+
+    ``times_s`` = (release or table start, end of the simulation), ``law`` = (restitution, eta).
+    """
+    rest_s, sim_end = times_s
+    if layout == "column":
+        return _column_motions(
+            blks,
+            tbl,
+            base,
+            table,
+            rest_s,
+            sim_end,
+            rng_m,
+            None if theta0_rad is None else float(np.ravel(theta0_rad)[0]),
+        )
+    xs = [0.0] if len(blks) == 1 else [-0.35, 0.0, 0.35]  # blocks side by side, 0.35 m apart
+    return _single_motions(blks, xs, phi0, tbl, base, table, rest_s, sim_end, rng_m, *law)
+
+
+def _framed_camera(size, blks, layout, table_span_m, rng, distortion):
+    """The session camera, framed so the blocks (stacked or not) and the table's span (m) fit the view."""
+    from ._camera import make_camera
+
+    W, H = size
+    h_max = max(b.h_m for b in blks)
+    stack = sum(b.h_m for b in blks) if layout == "column" else h_max
+    view_h = max(3.0 * h_max, 1.4 * stack, (table_span_m + 0.1) * H / W)
+    return make_camera(size, (0.0, 0.4 * stack), view_h, rng, distortion=distortion)
 
 
 def _check_motions_cover(motions, sims, t_end_s: float) -> None:

@@ -260,48 +260,45 @@ def synth_session(
     InputError
         Bad parameter values, non-empty ``out_dir`` without ``force``, an unreadable record.
     """
-    from ._scene import build_scene
+    from ._scene import SCENE_OPTIONS
 
     size = parse_size(size)
     fps = float(fps) if isinstance(fps, (int, float, np.number)) and not isinstance(fps, bool) else fps
     _check(seed, blocks, table, fps, targets, duration_s, exposure_s, noise_dn)
+    _check_look(flicker, texture)
+    seed = int(seed)
+    # the scene's options (build_scene's parameters) go on as given: size parsed, fps a float, seed an int
+    scene_options = {name: value for name, value in locals().items() if name in SCENE_OPTIONS}
+    files = dict(imu=imu, imu_rate_hz=imu_rate_hz, calibrated=calibrated)
+    out_dir = Path(out_dir)
+    render_s = _render_session(scene_options, float(flicker), files, out_dir, force, mp4, progress)
+    return load_synth_session(out_dir, render_s=render_s)
+
+
+def _check_look(flicker, texture):
+    """The frames' exposure flicker and surface textures are among the known ones."""
     if not (isinstance(flicker, (int, float)) and not isinstance(flicker, bool) and 0 <= flicker <= 0.5):
         raise InputError(f"flicker={flicker!r}: exposure flicker must be a relative amplitude from 0 to 0.5")
     if texture not in ("procedural", "photo"):
         raise InputError(f"texture={texture!r}: use 'procedural' (synthetic noise) or 'photo' (photographs)")
-    out_dir = Path(out_dir)
+
+
+def _render_session(scene_options, flicker, files, out_dir: Path, force: bool, mp4: bool, progress: bool) -> float:
+    """Build the scene, render it and write its files into a staged folder published as ``out_dir``.
+
+    Returns the rendering time, s. Nothing is left behind when any step fails.
+    """
+    from ._scene import build_scene
+
     tmp = _prepare_out(out_dir, force)
     t_start = time.perf_counter()
     try:
-        scene = build_scene(
-            seed=int(seed),
-            blocks=blocks,
-            table=table,
-            fps=fps,
-            size=size,
-            targets=targets,
-            duration_s=duration_s,
-            occlusion=occlusion,
-            rolling_shutter=rolling_shutter,
-            block=block,
-            restitution=restitution,
-            eta=eta,
-            theta0_rad=theta0_rad,
-            record=record,
-            table_amplitude_m=table_amplitude_m,
-            table_period_s=table_period_s,
-            table_stroke_m=table_stroke_m,
-            exposure_s=exposure_s,
-            noise_dn=noise_dn,
-            distortion=distortion,
-            layout=layout,
-            texture=texture,
-        )
-        scene.flicker = float(flicker)
+        scene = build_scene(**scene_options)
+        scene.flicker = flicker
         _render_video(scene, tmp, mp4, progress)
-        meta = scene.write_files(tmp, imu=imu, imu_rate_hz=imu_rate_hz, calibrated=calibrated)
-        meta["flicker"] = float(flicker)
-        meta["texture"] = texture
+        meta = scene.write_files(tmp, **files)
+        meta["flicker"] = flicker
+        meta["texture"] = scene_options["texture"]
         render_s = time.perf_counter() - t_start
         meta["render_s"] = render_s
         from .._io import write_json_atomic
@@ -313,7 +310,7 @@ def synth_session(
     except BaseException:
         shutil.rmtree(tmp, ignore_errors=True)
         raise
-    return load_synth_session(out_dir, render_s=render_s)
+    return render_s
 
 
 def _render_video(scene, folder: Path, mp4: bool, progress: bool):

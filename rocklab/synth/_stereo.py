@@ -336,9 +336,6 @@ def synth_stereo(
         ``paths`` (name -> Path), ``cameras`` (two StereoCamera), ``session`` (the
         :class:`~rocklab.synth.Points3DSession` at camera 1's frame times), ``offset_s``.
     """
-    import cv2
-    import pandas as pd
-
     from ._files import VideoPair
     from ._points3d import synth_points3d
 
@@ -346,22 +343,7 @@ def synth_stereo(
     out.mkdir(parents=True, exist_ok=True)
     rng = np.random.default_rng(seed)
     cams = _cameras(tuple(size), f_px)
-    # the calibration film
-    board = charuco_board(CHARUCO)
-    ppm = 4000.0
-    bw = int(round(CHARUCO["squares"][0] * CHARUCO["square_m"] * ppm))
-    bh = int(round(CHARUCO["squares"][1] * CHARUCO["square_m"] * ppm))
-    texture = board.generateImage((bw, bh), marginSize=0)
-    texture = (40 + texture.astype(np.float32) * (200 / 255)).astype(np.uint8)
-    texture = cv2.GaussianBlur(texture, (0, 0), 0.5 * ppm * 0.9 / f_px)  # band-limited (see the markers)
-    poses = _board_poses(n_board, rng)
-    paths = {}
-    for k, cam in enumerate(cams, start=1):
-        vp = VideoPair(out, fps, size, mp4=False, stem=f"calib_cam{k}")
-        for R_b, t_b in poses:
-            vp.write(_render_board(cam, R_b, t_b, texture, ppm, noise_dn, rng))
-        vp.close()
-        paths[f"calib_cam{k}"] = vp.paths["mkv"]
+    paths = _calibration_films(out, cams, fps, size, f_px, n_board, noise_dn, rng)
     # the rocking film: the motion sampled finely, then read at each camera's frame times
     fine = 20
     sess = synth_points3d(
@@ -399,6 +381,39 @@ def synth_stereo(
             paths[f"cam{k}"] = vp.paths["mkv"]
     else:
         raise ValueError(f"targets={targets!r}: must be 'dots' or 'aruco'")
+    paths.update(_write_truth(out, sess, t1, X1, labels, cams, offset_s, fps))
+    return {"paths": paths, "cameras": cams, "session": sess, "offset_s": offset_s, "t_s": t1, "X1": X1}
+
+
+def _calibration_films(out: Path, cams, fps, size, f_px, n_board, noise_dn, rng) -> dict:
+    """Film the ChArUco board in ``n_board`` poses with both cameras; returns {"calib_cam<k>": mkv path}."""
+    import cv2
+
+    from ._files import VideoPair
+
+    board = charuco_board(CHARUCO)
+    ppm = 4000.0
+    bw = int(round(CHARUCO["squares"][0] * CHARUCO["square_m"] * ppm))
+    bh = int(round(CHARUCO["squares"][1] * CHARUCO["square_m"] * ppm))
+    texture = board.generateImage((bw, bh), marginSize=0)
+    texture = (40 + texture.astype(np.float32) * (200 / 255)).astype(np.uint8)
+    texture = cv2.GaussianBlur(texture, (0, 0), 0.5 * ppm * 0.9 / f_px)  # band-limited (see the markers)
+    poses = _board_poses(n_board, rng)
+    paths = {}
+    for k, cam in enumerate(cams, start=1):
+        vp = VideoPair(out, fps, size, mp4=False, stem=f"calib_cam{k}")
+        for R_b, t_b in poses:
+            vp.write(_render_board(cam, R_b, t_b, texture, ppm, noise_dn, rng))
+        vp.close()
+        paths[f"calib_cam{k}"] = vp.paths["mkv"]
+    return paths
+
+
+def _write_truth(out: Path, sess, t1, X1, labels, cams, offset_s, fps) -> dict:
+    """Write truth.csv (motion at camera 1's frame times ``t1``, s), points_truth.csv (``X1``, m, (frames,
+    points, 3)) and rig.json (cameras, clock offset, board, bodies, injected faults); returns their paths."""
+    import pandas as pd
+
     truth = sess.truth
     tr = pd.DataFrame({c: np.interp(t1, truth["t_s"], truth[c]) for c in truth.columns})
     tr["t_s"] = t1
@@ -424,5 +439,4 @@ def synth_stereo(
         "injected": {k: list(v) for k, v in sess.injected.items()},
     }
     (out / "rig.json").write_text(json.dumps(rig, indent=2))
-    paths.update(truth_csv=truth_path, points_truth_csv=out / "points_truth.csv", rig_json=out / "rig.json")
-    return {"paths": paths, "cameras": cams, "session": sess, "offset_s": offset_s, "t_s": t1, "X1": X1}
+    return dict(truth_csv=truth_path, points_truth_csv=out / "points_truth.csv", rig_json=out / "rig.json")

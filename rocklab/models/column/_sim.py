@@ -446,6 +446,51 @@ def simulate_column(
     """
     from ._core import run_core, run_core_jit
 
+    duration_s, (phi0, v0, s0) = _checked_start(column, base, theta0_rad, omega0_rad_s, duration_s, dt_s, n_impacts)
+    accb, t0b, dtb = _base_samples(base)
+    n_float = duration_s / dt_s
+    n_steps = int(math.ceil(n_float - 1e-9))
+    stride = _stride(output_dt_s, dt_s, n_steps)
+    n_rows = n_steps // stride + 2
+    _check_cost(column.n, duration_s, dt_s, n_float, n_rows)
+    par = np.array(
+        [g_m_s2, column.mu, t0b, dtb, 1.0 if velocity_terms else 0.0, 1e-14, _quiet_time(column, base, g_m_s2), 0.0]
+    )
+    ovt = float(overturn_angle_rad) if overturn_angle_rad else -1.0
+    head = (
+        phi0,
+        v0,
+        s0,
+        column.block_array(),
+        par,
+        accb,
+        n_steps,
+        float(dt_s),
+        int(max_enum_closed),
+        int(n_impacts),
+        float(rest_omega_rad_s),
+        bool(stop_at_rest),
+        ovt,
+        stride,
+    )
+    run = _run_kernel(run_core_jit if jit else run_core, head, n_rows, column.n, stride, dt_s)
+    params = dict(
+        dt_s=dt_s,
+        output_dt_s=float(dt_s if output_dt_s is None else output_dt_s),
+        duration_s=float(duration_s),
+        n_impacts=int(n_impacts),
+        velocity_terms=bool(velocity_terms),
+        max_enum_closed=int(max_enum_closed),
+        overturn_angle_rad=overturn_angle_rad,
+        g_m_s2=g_m_s2,
+        rest_omega_rad_s=rest_omega_rad_s,
+        base=None if base is None else base.name,
+    )
+    return _column_result(column, run, params)
+
+
+def _checked_start(column, base, theta0_rad, omega0_rad_s, duration_s, dt_s, n_impacts):
+    """(duration s, (joint angles, rates, signs)) of a run whose inputs are checked; InputError otherwise."""
     if not isinstance(column, Column):
         raise InputError("column: must be a rocklab.models.Column")
     if not (math.isfinite(dt_s) and dt_s > 0):
@@ -469,24 +514,35 @@ def simulate_column(
                 f"below, not < its alpha = {b.alpha_rad:.4g} rad (it would fall at release); "
                 "give smaller initial angles"
             )
-    blk = column.block_array()
-    if base is not None:
-        accb = np.array(base.acc_m_s2, dtype=float)  # writable: numba types read-only arrays apart
-        t0b, dtb = float(base.t_s[0]), base.dt_s
-    else:
-        accb, t0b, dtb = np.zeros(0), 0.0, 1.0
-    n = column.n
-    n_float = duration_s / dt_s
-    n_steps = int(math.ceil(n_float - 1e-9))
-    stride = _stride(output_dt_s, dt_s, n_steps)
-    n_rows = n_steps // stride + 2
-    _check_cost(n, duration_s, dt_s, n_float, n_rows)
-    par = np.array(
-        [g_m_s2, column.mu, t0b, dtb, 1.0 if velocity_terms else 0.0, 1e-14, _quiet_time(column, base, g_m_s2), 0.0]
-    )
+    return duration_s, (phi0, v0, s0)
+
+
+def _base_samples(base):
+    """(acceleration m/s², first time s, step s) of the base record as the kernel reads them."""
+    if base is None:
+        return np.zeros(0), 0.0, 1.0
+    # writable: numba types read-only arrays apart
+    return np.array(base.acc_m_s2, dtype=float), float(base.t_s[0]), base.dt_s
+
+
+@dataclass(frozen=True)
+class _KernelRun:
+    """What the column loop returned, cut to its counts, in the clockwise-positive convention."""
+
+    t_s: np.ndarray  # (rows,) s
+    phi: np.ndarray  # (rows, n) joint angles, rad
+    om: np.ndarray  # (rows, n) joint rates, rad/s
+    en: np.ndarray  # (rows, 2) kinetic and potential energy, J
+    conf: object  # configuration changes (DataFrame)
+    imp: object  # impacts (DataFrame)
+    code: int
+    t_status_s: float
+    peak: np.ndarray  # (2, n) max |theta| and |phi|, rad
+
+
+def _run_kernel(fn, head, n_rows, n, stride, dt_s):
+    """Run the compiled loop ``fn(*head, ...)``, growing the event tables tenfold while they overflow."""
     ecap = 20000
-    fn = run_core_jit if jit else run_core
-    ovt = float(overturn_angle_rad) if overturn_angle_rad else -1.0
     PHI = np.empty((n_rows, n))
     VEL = np.empty((n_rows, n))
     EN = np.empty((n_rows, 2))
@@ -495,64 +551,33 @@ def simulate_column(
         EVT = np.empty(ecap)
         EVI = np.empty((ecap, 3), np.int64)
         IMP = np.empty((ecap, 6))
-        nr, ne, ni, st, t_st, k_last = fn(
-            phi0,
-            v0,
-            s0,
-            blk,
-            par,
-            accb,
-            n_steps,
-            float(dt_s),
-            int(max_enum_closed),
-            int(n_impacts),
-            float(rest_omega_rad_s),
-            bool(stop_at_rest),
-            ovt,
-            stride,
-            PHI,
-            VEL,
-            EN,
-            EVT,
-            EVI,
-            IMP,
-            PEAK,
-        )
+        nr, ne, ni, st, t_st, k_last = fn(*head, PHI, VEL, EN, EVT, EVI, IMP, PEAK)
         if st != 5 or ecap >= 5_000_000:
             break
         ecap *= 10
-    phi = -PHI[:nr]
-    om = -VEL[:nr]
     conf, imp = _event_tables(EVT[:ne], EVI[:ne], IMP[:ni])
-    status, t_st, msg = _final_status(int(st), t_st, phi, om, ne == 0)
-    params = dict(
-        dt_s=dt_s,
-        output_dt_s=float(dt_s if output_dt_s is None else output_dt_s),
-        duration_s=float(duration_s),
-        n_impacts=int(n_impacts),
-        velocity_terms=bool(velocity_terms),
-        max_enum_closed=int(max_enum_closed),
-        overturn_angle_rad=overturn_angle_rad,
-        g_m_s2=g_m_s2,
-        rest_omega_rad_s=rest_omega_rad_s,
-        base=None if base is None else base.name,
-    )
     t = (np.arange(nr) * stride) * dt_s  # the full history's k * dt_s, bit for bit
     t[nr - 1 :] = k_last * dt_s
+    return _KernelRun(t, -PHI[:nr], -VEL[:nr], EN[:nr], conf, imp, int(st), t_st, PEAK)
+
+
+def _column_result(column, run, params):
+    """The ColumnResult of a kernel run: its history, events and final status (``params``: the run's options)."""
+    status, t_st, msg = _final_status(run.code, run.t_status_s, run.phi, run.om, len(run.conf) == 0)
     return ColumnResult(
         column=column,
-        t_s=t,
-        phi_rad=phi,
-        omega_rad_s=om,
-        theta_rad=np.cumsum(phi, axis=1),
-        energy_J=EN[:nr].sum(axis=1),
-        kinetic_J=EN[:nr, 0].copy(),
-        configurations=conf,
-        impacts=imp,
+        t_s=run.t_s,
+        phi_rad=run.phi,
+        omega_rad_s=run.om,
+        theta_rad=np.cumsum(run.phi, axis=1),
+        energy_J=run.en.sum(axis=1),
+        kinetic_J=run.en[:, 0].copy(),
+        configurations=run.conf,
+        impacts=run.imp,
         status=status,
         t_status_s=float(t_st),
         message=msg,
         params=params,
-        max_abs_theta_rad=PEAK[0].copy(),
-        max_abs_phi_rad=PEAK[1].copy(),
+        max_abs_theta_rad=run.peak[0].copy(),
+        max_abs_phi_rad=run.peak[1].copy(),
     )

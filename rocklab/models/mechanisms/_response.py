@@ -260,16 +260,7 @@ def mechanism_response(
     eta = float(eta)
     if not (0.0 < eta <= 1.0):
         raise InputError(f"eta={eta!r}: a restitution must be in (0, 1]; give the coefficient of Eq. 6")
-    mechs = {1: positive, -1: negative if negative is not None else positive}
-    kappa = {1: float(scale[0]), -1: float(scale[1])}
-    limit = {
-        s: float(phi_limit_rad[0 if s == 1 else 1])
-        if phi_limit_rad is not None
-        else float(mechs[s].phi_max) - KINEMATIC_MARGIN_RAD
-        for s in (1, -1)
-    }
-    lam = {s: _uplift(mechs[s]) for s in (1, -1)}
-    eoms = {s: (_tabulated(mechs[s], limit[s]) if tabulate else mechs[s]._eom) for s in (1, -1)}
+    mechs, kappa, limit, lam, eoms = _directions(positive, negative, scale, phi_limit_rad, tabulate)
     tb = np.asarray(base.t_s, float)
     ab = np.asarray(base.acc_m_s2, float)
     t_out = tb if t_out_s is None else np.asarray(t_out_s, float)
@@ -291,22 +282,11 @@ def mechanism_response(
     while t < t_end:
         if resting:
             # at rest until the base exceeds one direction's uplift acceleration (Eq. 10)
-            k0 = int(np.searchsorted(tb, t, side="left"))
-            up_pos = -ab[k0:] > lam[1] * G
-            up_neg = ab[k0:] > lam[-1] * G
-            hit = np.flatnonzero(up_pos | up_neg)
-            if hit.size == 0:
+            lift = _next_uplift(tb, ab, t, lam)
+            if lift is None:
                 fill(t, t_end, lambda tt: (np.zeros_like(tt), np.zeros_like(tt)))
                 break
-            side = 1 if up_pos[hit[0]] else -1
-            j = k0 + int(hit[0])
-            t_next = float(tb[j])
-            if j > k0:  # the crossing of the uplift level, between samples (the base is piecewise linear)
-                lev = -side * lam[side] * G
-                a0, a1 = ab[j - 1], ab[j]
-                if a1 != a0:
-                    t_next = float(tb[j - 1] + (tb[j] - tb[j - 1]) * np.clip((lev - a0) / (a1 - a0), 0.0, 1.0))
-            t_next = max(t_next, t)
+            t_next, side = lift
             fill(t, t_next, lambda tt: (np.zeros_like(tt), np.zeros_like(tt)))
             t, y, resting = t_next, np.array([0.0, 0.0]), False
         if y[0] <= 0.0:
@@ -332,15 +312,8 @@ def mechanism_response(
             continue
         break
     phi_cr = tuple(float(mechs[s].phi_cr() * kappa[s]) for s in (1, -1))
-    status, msg = ("overturned", f"overturned at {t_over:.4g} s") if overturned else ("ok", "")
-    if not overturned and not resting and _falls(mechs[side], float(y[0]), float(y[1])):
-        status = "falling"
-        msg = (
-            f"the record ends at {t_end:.4g} s with the mechanism at {kappa[side] * y[0]:.4g} rad, "
-            f"moving at {kappa[side] * y[1]:.4g} rad/s: without more base motion it passes or stays past "
-            f"its critical rotation ({phi_cr[0 if side == 1 else 1]:.4g} rad) and falls; give a longer record "
-            "(pad it with zeros) to see the outcome"
-        )
+    end = (t_over if overturned else None, t_end, resting)
+    status, msg = _end_status(mechs[side], kappa[side], phi_cr[0 if side == 1 else 1], y, end)
     return MechanismResponse(
         t_s=t_out,
         phi_rad=phi_out,
@@ -355,6 +328,60 @@ def mechanism_response(
         status=status,
         message=msg,
         meta={"uplift_over_g": (lam[1], lam[-1])},
+    )
+
+
+def _directions(positive, negative, scale, phi_limit_rad, tabulate):
+    """Per direction (1, -1): mechanism, scale, overturning limit rad, uplift acceleration / g, equation of motion."""
+    mechs = {1: positive, -1: negative if negative is not None else positive}
+    kappa = {1: float(scale[0]), -1: float(scale[1])}
+    limit = {
+        s: float(phi_limit_rad[0 if s == 1 else 1])
+        if phi_limit_rad is not None
+        else float(mechs[s].phi_max) - KINEMATIC_MARGIN_RAD
+        for s in (1, -1)
+    }
+    lam = {s: _uplift(mechs[s]) for s in (1, -1)}
+    eoms = {s: (_tabulated(mechs[s], limit[s]) if tabulate else mechs[s]._eom) for s in (1, -1)}
+    return mechs, kappa, limit, lam, eoms
+
+
+def _next_uplift(tb, ab, t, lam):
+    """(time s, direction) at which the base, from ``t`` on, first exceeds a direction's uplift
+    acceleration ``lam[side] g`` (Eq. 10); None if it never does."""
+    k0 = int(np.searchsorted(tb, t, side="left"))
+    up_pos = -ab[k0:] > lam[1] * G
+    up_neg = ab[k0:] > lam[-1] * G
+    hit = np.flatnonzero(up_pos | up_neg)
+    if hit.size == 0:
+        return None
+    side = 1 if up_pos[hit[0]] else -1
+    j = k0 + int(hit[0])
+    t_next = float(tb[j])
+    if j > k0:  # the crossing of the uplift level, between samples (the base is piecewise linear)
+        lev = -side * lam[side] * G
+        a0, a1 = ab[j - 1], ab[j]
+        if a1 != a0:
+            t_next = float(tb[j - 1] + (tb[j] - tb[j - 1]) * np.clip((lev - a0) / (a1 - a0), 0.0, 1.0))
+    return max(t_next, t), side
+
+
+def _end_status(mech, kappa, phi_cr, y, end):
+    """(status, message) at the end of a run, ``end`` = (overturning time s or None, record's end s, at rest?).
+
+    ``falling``: the state y = (phi rad, rate rad/s) at the record's end carries the mechanism past its
+    critical rotation ``phi_cr`` (rad, reported).
+    """
+    t_over, t_end, resting = end
+    if t_over is not None:
+        return "overturned", f"overturned at {t_over:.4g} s"
+    if resting or not _falls(mech, float(y[0]), float(y[1])):
+        return "ok", ""
+    return "falling", (
+        f"the record ends at {t_end:.4g} s with the mechanism at {kappa * y[0]:.4g} rad, "
+        f"moving at {kappa * y[1]:.4g} rad/s: without more base motion it passes or stays past "
+        f"its critical rotation ({phi_cr:.4g} rad) and falls; give a longer record "
+        "(pad it with zeros) to see the outcome"
     )
 
 

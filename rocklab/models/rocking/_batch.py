@@ -88,6 +88,51 @@ def simulate_batch(
         ``t_end_s``) for verdicts beyond the simulated span (see
         :func:`free_rocking_overturns`).
     """
+    p, al, sc, th0, w0, et, fr = _entries(p_rad_s, alpha_rad, scale, theta0_rad, omega0_rad_s, alpha_I, eta, fall_rad)
+    if not (math.isfinite(dt_s) and dt_s > 0):
+        raise InputError(f"simulate_batch: dt_s={dt_s!r} must be positive (s)")
+    if base is not None and not isinstance(base, BaseMotion):
+        raise InputError("simulate_batch: base must be a rocklab.series.BaseMotion or None")
+    if duration_s is None:
+        if base is None:
+            raise InputError("simulate_batch: give duration_s for free rocking (no base record)")
+        duration_s = float(base.t_s[-1]) + float(free_after_s)
+    if not (math.isfinite(duration_s) and duration_s > 0):
+        raise InputError(f"simulate_batch: duration_s={duration_s!r} must be positive (s)")
+    n_sub = np.maximum(1, np.ceil(p * dt_s / max_p_dt - 1e-12)).astype(np.int64)
+    h = dt_s / n_sub
+    n_steps = np.ceil(duration_s / h - 1e-9).astype(np.int64)
+    if base is None:
+        acc, t0, dta = np.zeros(0), 0.0, 1.0
+        acc.setflags(write=False)  # same numba type as a BaseMotion array: one compile
+    else:
+        acc, t0, dta = np.ascontiguousarray(base.acc_m_s2, float), float(base.t_s[0]), base.dt_s
+    over, t_over, mx, nimp, status, steps, th_end, w_end = run_batch(
+        p, al, th0, w0, et, h, n_steps, acc, t0, dta, sc, float(rest_tol), fr, bool(stop_on_overturn)
+    )
+    return BatchResult(
+        overturned=over,
+        overturn_t_s=t_over,
+        max_abs_theta_over_alpha=mx,
+        n_impacts=nimp,
+        status=status,
+        p_rad_s=p,
+        alpha_rad=al,
+        scale=sc,
+        eta=et,
+        dt_s=h,
+        n_steps=int(steps.sum()),
+        theta_end_rad=th_end,
+        omega_end_rad_s=w_end,
+        t_end_s=steps * h,
+    )
+
+
+def _entries(p_rad_s, alpha_rad, scale, theta0_rad, omega0_rad_s, alpha_I, eta, fall_rad):
+    """The per-entry arguments broadcast to one length m and checked; eta and fall_rad defaulted.
+
+    Returns (p rad/s, alpha rad, scale, theta0 rad, omega0 rad/s, eta, fall rad), each (m,) float.
+    """
     try:
         arrs = np.broadcast_arrays(
             *(
@@ -123,43 +168,7 @@ def simulate_batch(
     if np.any(np.abs(et) > 1):
         raise InputError("simulate_batch: |eta| must be <= 1")
     fr = np.where(np.isnan(fr), _HALF_PI, fr)
-    if not (math.isfinite(dt_s) and dt_s > 0):
-        raise InputError(f"simulate_batch: dt_s={dt_s!r} must be positive (s)")
-    if base is not None and not isinstance(base, BaseMotion):
-        raise InputError("simulate_batch: base must be a rocklab.models.BaseMotion or None")
-    if duration_s is None:
-        if base is None:
-            raise InputError("simulate_batch: give duration_s for free rocking (no base record)")
-        duration_s = float(base.t_s[-1]) + float(free_after_s)
-    if not (math.isfinite(duration_s) and duration_s > 0):
-        raise InputError(f"simulate_batch: duration_s={duration_s!r} must be positive (s)")
-    n_sub = np.maximum(1, np.ceil(p * dt_s / max_p_dt - 1e-12)).astype(np.int64)
-    h = dt_s / n_sub
-    n_steps = np.ceil(duration_s / h - 1e-9).astype(np.int64)
-    if base is None:
-        acc, t0, dta = np.zeros(0), 0.0, 1.0
-        acc.setflags(write=False)  # same numba type as a BaseMotion array: one compile
-    else:
-        acc, t0, dta = np.ascontiguousarray(base.acc_m_s2, float), float(base.t_s[0]), base.dt_s
-    over, t_over, mx, nimp, status, steps, th_end, w_end = run_batch(
-        p, al, th0, w0, et, h, n_steps, acc, t0, dta, sc, float(rest_tol), fr, bool(stop_on_overturn)
-    )
-    return BatchResult(
-        overturned=over,
-        overturn_t_s=t_over,
-        max_abs_theta_over_alpha=mx,
-        n_impacts=nimp,
-        status=status,
-        p_rad_s=p,
-        alpha_rad=al,
-        scale=sc,
-        eta=et,
-        dt_s=h,
-        n_steps=int(steps.sum()),
-        theta_end_rad=th_end,
-        omega_end_rad_s=w_end,
-        t_end_s=steps * h,
-    )
+    return p, al, sc, th0, w0, et, fr
 
 
 def free_rocking_overturns(theta_rad, omega_rad_s, p_rad_s, alpha_rad, eta) -> np.ndarray:

@@ -80,7 +80,7 @@ class RockingProblem(NamedTuple):
     output spacing that is not a whole multiple of ``dt_s`` (a camera frame interval):
     integrators with :attr:`Integrator.any_output_grid` sample it directly, the others
     store every step and :func:`~rocklab.models.simulate` resamples. ``law`` is a
-    :class:`~rocklab.models.Restitution`, ``base`` a :class:`~rocklab.models.BaseMotion` or
+    :class:`~rocklab.models.Restitution`, ``base`` a :class:`~rocklab.series.BaseMotion` or
     None; ``rtol`` and ``ode_method`` concern the ``event`` integrator only.
     """
 

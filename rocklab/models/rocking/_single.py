@@ -5,7 +5,7 @@ Sign convention (Čeh Eq. 1–2, Fig. 1): theta > 0 is rotation about corner A,
 with p = sqrt(m g R / I_O) (any alpha_I). A block at rest uplifts only when
 |a_g| > g tan(alpha), towards theta > 0 when a_g < 0 (the base moves away
 under it). Everything is SI; the base motion is a
-:class:`~rocklab.models.BaseMotion` in m/s^2.
+:class:`~rocklab.series.BaseMotion` in m/s^2.
 
 Rules (every integrator of :data:`~rocklab.models.rocking.METHODS`):
 
@@ -118,7 +118,7 @@ def _problem(
     law = _law(restitution, block, law_params)
     if base is not None and not isinstance(base, BaseMotion):
         raise InputError(
-            f"base={type(base).__name__}: give a rocklab.models.BaseMotion "
+            f"base={type(base).__name__}: give a rocklab.series.BaseMotion "
             "(e.g. BaseMotion.from_samples(acc, dt_s, 'g')) or None"
         )
     every, resample = 1, None
@@ -283,6 +283,12 @@ def simulate(
         fall_rad,
         law_params,
     )
+    return _run(meth, problem)
+
+
+def _run(meth, problem: RockingProblem) -> RockingResult:
+    """``problem`` integrated by ``meth`` (its limits and the run's cost checked first) into a read-only result,
+    resampled onto the output grid when the integrator stored every step."""
     meth.check(problem)
     _check_cost(problem)
     out = meth.run(problem)
@@ -301,20 +307,20 @@ def simulate(
         overturn_t_s=float(out.overturn_t_s),
         fall_t_s=float(out.fall_t_s),
         max_abs_theta_rad=float(out.max_abs_theta_rad),
-        block=block,
+        block=problem.block,
         restitution=problem.law,
         method=meth.name,
         dt_s=problem.dt_s,
         n_impacts=int(out.n_impacts),
-        linearized=bool(linearized),
-        base_name=base.name if base is not None else "",
+        linearized=problem.linearized,
+        base_name=problem.base.name if problem.base is not None else "",
     )
     if resample is None:
         return res
     t = out.t_s
     t2 = np.arange(int(math.floor(t[-1] / resample + 1e-9)) + 1) * resample
     th2, w2 = res.at(t2)
-    E2 = block_energy(block, th2, w2, linearized)
+    E2 = block_energy(problem.block, th2, w2, problem.linearized)
     for a in (t2, th2, w2, E2):
         a.setflags(write=False)
     return dataclasses.replace(res, t_s=t2, theta_rad=th2, omega_rad_s=w2, energy_J=E2)

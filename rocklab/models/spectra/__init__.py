@@ -30,18 +30,15 @@ from ._pulses import (
     pulse_shape,
 )
 from ._record_measures import RecordMeasures, record_measures, response_spectrum
-from ...series import UNITS_TO_M_S2, BaseMotion
 from ._records import BUNDLED_RECORDS, bundled_record, load_base_motion
 from ._records import not_a_record
 
 
 __all__ = [
-    "BaseMotion",
     "load_base_motion",
     "RecordMeasures",
     "record_measures",
     "response_spectrum",
-    "UNITS_TO_M_S2",
     "bundled_record",
     "BUNDLED_RECORDS",
     "PulseParameters",

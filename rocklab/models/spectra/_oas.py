@@ -331,49 +331,14 @@ def overturning_spectrum(
     (313, 0.36)
     """
     sl = check_opts(slenderness, levels, sizes, R_max_m, R_min_m, level_max, alpha_I)
-    if not isinstance(base, BaseMotion):
-        raise InputError(f"base={type(base).__name__}: expected a BaseMotion (load_base_motion)")
-    from ..._errors import check_memory
-    from ._pulses import check_record
-
-    base = check_record(base)  # enough samples, not all zeros
-    if int(levels) < 1 or int(sizes) < 2:
-        raise InputError(f"levels={levels!r}, sizes={sizes!r}: need at least 1 level and 2 sizes")
-    check_memory(
-        80.0 * int(levels) * int(sizes),
-        f"an OAS grid of {int(levels)} x {int(sizes)} runs",
-        "reduce --levels/--sizes (the defaults 80 x 120 resolve t_I)",
-    )
-    if criterion not in CRIT:
-        raise InputError(f"criterion={criterion!r}: use 'angle' (|theta|>=alpha) or 'fall' (|theta|>=pi/2)")
-    if search not in ("scan", "contiguous"):
-        raise InputError(f"search={search!r}: use 'scan' or 'contiguous'")
-    if grid not in ("adaptive", "dense", "boundary"):
-        raise InputError(f"grid={grid!r}: use 'adaptive' (refined where verdicts change), 'dense' or 'boundary'")
-    if (grid == "boundary") != (guide is not None):
-        raise InputError("grid='boundary' and guide=<an OAS of the same record> go together")
+    base = _checked_record(base, levels, sizes)
+    _check_choices(criterion, search, grid, guide)
     free_code, free_s = free_after_code(free)
-    alpha = math.atan(1.0 / sl)
-    eta_v = 1.0 - 2.0 * math.sin(alpha) ** 2 / alpha_I if eta is None else float(eta)
-    if eta is not None and not (0.0 <= eta_v <= 1.0):
-        raise InputError(f"eta={eta!r}: restitution omega+/omega- must be in [0, 1] (1: no energy lost); fix it")
-    if eta is None and sl < 1.0:
-        raise InputError(
-            f"slenderness={sl:g}: Housner's restitution 1 - 2 sin^2(alpha)/alpha_I = {eta_v:.3g} "
-            "holds for slender blocks (h/b >= 1); give h/b >= 1, or the block's restitution eta"
-        )
+    alpha, eta_v = _block_restitution(sl, alpha_I, eta)
     if not (0.0 <= float(level_offset) < 1.0 and 0.0 <= float(size_offset) < 1.0):
         raise InputError(f"level_offset={level_offset!r}, size_offset={size_offset!r}: fractions of a step in [0, 1)")
-    step = (float(level_max) - 1.0) / (int(levels) - 1)
-    lv = 1.0 + (np.arange(int(levels)) + float(level_offset)) * step
-    R = float(R_max_m) * (float(R_min_m) / float(R_max_m)) ** (
-        (np.arange(int(sizes)) + float(size_offset)) / (int(sizes) - 1)
-    )
-    p = np.sqrt(G / (alpha_I * R))
-    scales = lv * math.tan(alpha) * G / base.pga_m_s2  # record scaled to a_p = level g tan(alpha)
     if not (math.isfinite(max_p_dt) and 0 < max_p_dt <= 0.5):
         raise InputError(f"max_p_dt={max_p_dt!r}: step times p must be in (0, 0.5]")
-    args = (alpha, eta_v, CRIT[criterion], free_code, free_s, float(max_p_dt))
     opts = dict(
         levels=int(levels),
         level_max=float(level_max),
@@ -389,32 +354,103 @@ def overturning_spectrum(
         size_offset=float(size_offset),
         grid=grid,
     )
+    lv, R, p = _grid_axes(opts, alpha_I)
+    scales = lv * math.tan(alpha) * G / base.pga_m_s2  # record scaled to a_p = level g tan(alpha)
+    args = (alpha, eta_v, CRIT[criterion], free_code, free_s, float(max_p_dt))
     if verdicts is not None:
-
-        def grid_of(o):
-            return {k: v for k, v in o.items() if k not in ("search", "refine")}
-
-        if (
-            grid_of(verdicts.options) != grid_of(opts)
-            or (verdicts.eta, verdicts.alpha_rad, verdicts.alpha_I) != (eta_v, alpha, float(alpha_I))
-            or verdicts.name != base.name
-        ):
-            raise InputError("verdicts: the earlier OAS differs in more than search/refine; compute this one anew")
-        over, evaluated = verdicts.overturned, verdicts.evaluated
-    elif grid == "dense":
-        over = batch_runs(base, np.repeat(scales, p.size), np.tile(p, scales.size), args)
-        over = over.reshape(scales.size, p.size)
-        evaluated = np.ones_like(over)
-    elif grid == "boundary":
-        over, evaluated = boundary_verdicts(
-            lambda i, j: batch_runs(base, scales[i], p[j], args), lv.size, p.size, _guess_first(guide, lv, p)
-        )
+        over, evaluated = _reused_verdicts(verdicts, opts, (eta_v, alpha, float(alpha_I)), base.name)
     else:
-        over, evaluated = adaptive_verdicts(lambda i, j: batch_runs(base, scales[i], p[j], args), lv.size, p.size)
+        over, evaluated = _grid_verdicts(grid, lambda i, j: batch_runs(base, scales[i], p[j], args), lv, p, guide)
 
     p_hi, p_lo = _first_unsafe(over, p, search)
     p_hi, p_lo = _bisect(base, scales, p_hi, p_lo, refine, args)
+    return _oas_result(base.name, lv, R, p, over, evaluated, p_hi, (alpha, float(alpha_I), eta_v), opts)
 
+
+def _checked_record(base, levels, sizes):
+    """The record checked (enough samples, not all zeros), and the grid's size checked against memory."""
+    if not isinstance(base, BaseMotion):
+        raise InputError(f"base={type(base).__name__}: expected a BaseMotion (load_base_motion)")
+    from ..._errors import check_memory
+    from ._pulses import check_record
+
+    base = check_record(base)
+    if int(levels) < 1 or int(sizes) < 2:
+        raise InputError(f"levels={levels!r}, sizes={sizes!r}: need at least 1 level and 2 sizes")
+    check_memory(
+        80.0 * int(levels) * int(sizes),
+        f"an OAS grid of {int(levels)} x {int(sizes)} runs",
+        "reduce --levels/--sizes (the defaults 80 x 120 resolve t_I)",
+    )
+    return base
+
+
+def _check_choices(criterion, search, grid, guide):
+    """The OAS's definition choices are among the known ones (module docstring)."""
+    if criterion not in CRIT:
+        raise InputError(f"criterion={criterion!r}: use 'angle' (|theta|>=alpha) or 'fall' (|theta|>=pi/2)")
+    if search not in ("scan", "contiguous"):
+        raise InputError(f"search={search!r}: use 'scan' or 'contiguous'")
+    if grid not in ("adaptive", "dense", "boundary"):
+        raise InputError(f"grid={grid!r}: use 'adaptive' (refined where verdicts change), 'dense' or 'boundary'")
+    if (grid == "boundary") != (guide is not None):
+        raise InputError("grid='boundary' and guide=<an OAS of the same record> go together")
+
+
+def _block_restitution(sl, alpha_I, eta):
+    """(alpha rad, eta): the block's angle and its restitution, Housner's when ``eta`` is None."""
+    alpha = math.atan(1.0 / sl)
+    eta_v = 1.0 - 2.0 * math.sin(alpha) ** 2 / alpha_I if eta is None else float(eta)
+    if eta is not None and not (0.0 <= eta_v <= 1.0):
+        raise InputError(f"eta={eta!r}: restitution omega+/omega- must be in [0, 1] (1: no energy lost); fix it")
+    if eta is None and sl < 1.0:
+        raise InputError(
+            f"slenderness={sl:g}: Housner's restitution 1 - 2 sin^2(alpha)/alpha_I = {eta_v:.3g} "
+            "holds for slender blocks (h/b >= 1); give h/b >= 1, or the block's restitution eta"
+        )
+    return alpha, eta_v
+
+
+def _grid_axes(opts, alpha_I):
+    """(levels a_p/a_p,min, R m, p rad/s) of the grid ``opts`` describes, each shifted by its offset."""
+    step = (opts["level_max"] - 1.0) / (opts["levels"] - 1)
+    lv = 1.0 + (np.arange(opts["levels"]) + opts["level_offset"]) * step
+    R = opts["R_max_m"] * (opts["R_min_m"] / opts["R_max_m"]) ** (
+        (np.arange(opts["sizes"]) + opts["size_offset"]) / (opts["sizes"] - 1)
+    )
+    return lv, R, np.sqrt(G / (alpha_I * R))
+
+
+def _reused_verdicts(verdicts, opts, block, name):
+    """(overturned, evaluated) of an earlier OAS on the same grid, runs and block (alpha, eta, alpha_I)."""
+
+    def grid_of(o):
+        return {k: v for k, v in o.items() if k not in ("search", "refine")}
+
+    eta_v, alpha, alpha_I = block
+    if (
+        grid_of(verdicts.options) != grid_of(opts)
+        or (verdicts.eta, verdicts.alpha_rad, verdicts.alpha_I) != (eta_v, alpha, alpha_I)
+        or verdicts.name != name
+    ):
+        raise InputError("verdicts: the earlier OAS differs in more than search/refine; compute this one anew")
+    return verdicts.overturned, verdicts.evaluated
+
+
+def _grid_verdicts(grid, run, lv, p, guide):
+    """(overturned, evaluated), each (levels, sizes): ``run(i, j)`` simulated where ``grid`` says."""
+    if grid == "dense":
+        i, j = np.repeat(np.arange(lv.size), p.size), np.tile(np.arange(p.size), lv.size)
+        over = run(i, j).reshape(lv.size, p.size)
+        return over, np.ones_like(over)
+    if grid == "boundary":
+        return boundary_verdicts(run, lv.size, p.size, _guess_first(guide, lv, p))
+    return adaptive_verdicts(run, lv.size, p.size)
+
+
+def _oas_result(name, lv, R, p, over, evaluated, p_hi, block, opts):
+    """The OASResult of a grid's verdicts and boundary ``p_hi`` (rad/s), block = (alpha rad, alpha_I, eta)."""
+    alpha, alpha_I, eta_v = block
     f = lv * p_hi
     icr = normalised_critical_impulse(alpha)
     f_min = float(np.nanmin(f)) if np.isfinite(f).any() else float("nan")
@@ -434,9 +470,9 @@ def overturning_spectrum(
         beta=beta,
         i_cr=icr,
         alpha_rad=alpha,
-        alpha_I=float(alpha_I),
+        alpha_I=alpha_I,
         eta=eta_v,
-        name=base.name,
+        name=name,
         options=opts,
         evaluated=evaluated,
     )

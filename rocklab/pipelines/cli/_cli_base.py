@@ -48,7 +48,7 @@ def add_base_motion_args(p) -> None:
 
 
 def pulse_from_spec(spec: str, option: str = "--pulse"):
-    """The :class:`~rocklab.models.BaseMotion` of ``KIND,PEAK,T_P[,N]`` (peak ``0.3g`` or ``2.94m/s2``).
+    """The :class:`~rocklab.series.BaseMotion` of ``KIND,PEAK,T_P[,N]`` (peak ``0.3g`` or ``2.94m/s2``).
 
     The pulse is sampled at t_p/200 and followed by one t_p of zeros (the commands integrate on
     past the record as free rocking).

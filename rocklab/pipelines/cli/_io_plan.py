@@ -60,7 +60,7 @@ def _track_config_inputs(cfg_path: Path) -> tuple[list, object]:
     """The config and the calibration file it names; the parsed config (None when missing)."""
     if not cfg_path.is_file():
         return [], None
-    from ...tracking import load_track_config
+    from ...config import load_track_config
 
     cfg = load_track_config(cfg_path)
     return [("config", cfg_path)] + [("[video] calibration of the config", p) for p in cfg.named_files], cfg

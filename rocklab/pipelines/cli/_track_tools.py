@@ -328,7 +328,8 @@ def track_preview(
     """
     from dataclasses import replace
 
-    from ...tracking import load_track_config, track_video
+    from ...config import load_track_config
+    from ...tracking import track_video
 
     video = Path(video)
     if not 1 <= int(n_frames) <= 48:

@@ -29,7 +29,7 @@ def base_from_table(table: TableMotion, t0_s: float, where: str, *, sign: float 
     """
     from scipy.interpolate import CubicSpline
 
-    from ...models import BaseMotion
+    from ...series import BaseMotion
 
     tt = np.asarray(table.t_s, float)
     aa = np.asarray(table.ax_m_s2, float)

@@ -58,7 +58,8 @@ def _probe_fps(path, given: float | None) -> float:
 
 
 def measure_video(cfg: ExperimentConfig, progress: bool, keep_film: bool):
-    from ...tracking import load_track_config, track_video
+    from ...config import load_track_config
+    from ...tracking import track_video
 
     tcfg = load_track_config(cfg.video.track_config) if cfg.video.track_config else None
     if tcfg is not None and cfg.video.corrections is not None:  # the experiment's hand fixes win

@@ -201,7 +201,8 @@ def fig9(ctx) -> Built:
     import pandas as pd
 
     from ...blocks import Block
-    from ...models import BaseMotion, critical_impulse, simulate
+    from ...series import BaseMotion
+    from ...models import critical_impulse, simulate
 
     # a short rectangular pulse of impulse I = a t_p: below, near and above the critical impulse (Eq. 17)
     blk = Block(0.25, 1.0)

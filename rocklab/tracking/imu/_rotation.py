@@ -270,24 +270,7 @@ def block_rotation(
             f"release={release!r}: use 'auto', 'thread' (thread-burn release) or 'none' (forced run on a shake table)"
         )
     t, gyro, acc, fs = log.t_s, log.gyro_rad_s, log.acc_m_s2, float(log.rate_hz)
-    moving = motion_mask(t, gyro, acc, fs, np.deg2rad(still_gyro_deg_s), still_acc_g * G)
-    min_run = max(2, int(round(0.1 * fs)))
-    forced, i_carry, i_carry_end = forced_run(t, gyro, acc, fs, np.deg2rad(still_gyro_deg_s), still_acc_g * G, min_run)
-    if release != "auto":
-        forced = release == "none"
-    i_move = first_motion(moving, min_run)
-    if forced and i_carry is not None:
-        i_move = i_carry if i_move is None else min(i_move, i_carry)
-    status, msg = "ok", ""
-    if i_move is None:
-        i_move, i_end = n, n
-        status, msg = "no_motion", "no motion found above the stillness thresholds"
-        _check_still_tilt(log, fs)
-    else:
-        # Decaying rocking fragments the motion mask; the last moving sample ends it.
-        i_end = last_motion_end(moving, 1) or i_move
-        if forced and i_carry_end is not None:
-            i_end = max(i_end, i_carry_end)
+    moving, forced, (i_move, i_end), status, msg = _motion_span(log, release, still_gyro_deg_s, still_acc_g)
     s0, s1, e0, e1, has_end, min_rest, status, msg = _rest_windows(n, fs, i_move, i_end, min_rest_s, status, msg)
     bias = gyro[s0:s1].mean(axis=0)
     w = gyro - bias
@@ -307,31 +290,13 @@ def block_rotation(
                     status, msg = "no_rest_after", "table still moving at the end: drift not anchored"
     f_start = acc[s0:s1].mean(axis=0)
     f_end = acc[e0:e1].mean(axis=0) if has_end else None
-    f_ref = f_end if has_end else _vertical_axis(f_start)
-    if forced:
-        # Shake table: the block starts upright; the end rest is measured, not assumed.
-        f_ref = f_start
-    elif has_end and abs(float(tilt_about(u, _vertical_axis(f_start), f_end))) > np.deg2rad(20.0):
-        # Ended far from upright (overturned, or stopped leaning on something):
-        # upright is then the sensor axis nearest to gravity at the start
-        # (square mounting); both windows still anchor the drift.
-        f_ref = _vertical_axis(f_start)
-        msg = "ended > 20 deg from upright: upright = sensor axis nearest gravity at start"
-    integ = cumtrapz(t, omega)
-    th_start = float(tilt_about(u, f_ref, f_start))
-    ts_mid, is_mean = t[s0:s1].mean(), integ[s0:s1].mean()
-    drift = 0.0
-    if has_end:
-        th_end = float(tilt_about(u, f_ref, f_end))
-        te_mid, ie_mean = t[e0:e1].mean(), integ[e0:e1].mean()
-        drift = ((ie_mean - is_mean) - (th_end - th_start)) / (te_mid - ts_mid)
-    theta = th_start + (integ - is_mean) - drift * (t - ts_mid)
-    omega = omega - drift
+    f_ref, msg = _upright(u, f_start, f_end, forced, msg)
+    theta, omega, drift, th_start, changes = _anchored(t, omega, u, (f_ref, f_start, f_end), (s0, s1), (e0, e1))
     # rocking: one axis carries the rate and the block turns by less than 90 deg; other motion
     # (a hand-held sensor) has no single tilt to compare the gyro with
     planar = float(np.sum(omega[moving] ** 2)) >= 0.9 * float(np.sum(w[moving] ** 2)) if moving.any() else False
     if has_end and planar and float(np.max(np.abs(theta))) < 0.5 * np.pi:
-        status, msg = _check_gyro_vs_tilt(log.source, ie_mean - is_mean, th_end - th_start, status, msg)
+        status, msg = _check_gyro_vs_tilt(log.source, *changes, status, msg)
     # without a rest before, the bias came from moving samples: the drift then corrects it
     judge = status != "no_rest_before"
     rocking = check_rocking(t, w, u, f_start, fs, drift, judge) if status != "no_motion" else None
@@ -376,6 +341,76 @@ def block_rotation(
         "forced" if forced else "thread",
         rocking,
     )
+
+
+def _motion_span(log: ImuLog, release, still_gyro_deg_s, still_acc_g):
+    """(moving mask, forced run?, (first moving sample, end of the motion), status, message) of a block's log.
+
+    A forced run (shake table) is recognised from the log unless ``release`` says which kind of run it is;
+    its carried motion then counts as motion. No motion: status ``no_motion``, both indices ``n``.
+    """
+    n, t, gyro, acc, fs = log.n, log.t_s, log.gyro_rad_s, log.acc_m_s2, float(log.rate_hz)
+    moving = motion_mask(t, gyro, acc, fs, np.deg2rad(still_gyro_deg_s), still_acc_g * G)
+    min_run = max(2, int(round(0.1 * fs)))
+    forced, i_carry, i_carry_end = forced_run(t, gyro, acc, fs, np.deg2rad(still_gyro_deg_s), still_acc_g * G, min_run)
+    if release != "auto":
+        forced = release == "none"
+    i_move = first_motion(moving, min_run)
+    if forced and i_carry is not None:
+        i_move = i_carry if i_move is None else min(i_move, i_carry)
+    status, msg = "ok", ""
+    if i_move is None:
+        i_move, i_end = n, n
+        status, msg = "no_motion", "no motion found above the stillness thresholds"
+        _check_still_tilt(log, fs)
+    else:
+        # Decaying rocking fragments the motion mask; the last moving sample ends it.
+        i_end = last_motion_end(moving, 1) or i_move
+        if forced and i_carry_end is not None:
+            i_end = max(i_end, i_carry_end)
+    return moving, forced, (i_move, i_end), status, msg
+
+
+def _upright(u, f_start, f_end, forced, msg):
+    """(specific force of the upright block, message): the reference tilts about ``u`` are measured from.
+
+    ``f_start``, ``f_end``: mean accelerometer vectors (3,) of the rests before and after (None: no rest after).
+    """
+    has_end = f_end is not None
+    f_ref = f_end if has_end else _vertical_axis(f_start)
+    if forced:
+        # Shake table: the block starts upright; the end rest is measured, not assumed.
+        f_ref = f_start
+    elif has_end and abs(float(tilt_about(u, _vertical_axis(f_start), f_end))) > np.deg2rad(20.0):
+        # Ended far from upright (overturned, or stopped leaning on something):
+        # upright is then the sensor axis nearest to gravity at the start
+        # (square mounting); both windows still anchor the drift.
+        f_ref = _vertical_axis(f_start)
+        msg = "ended > 20 deg from upright: upright = sensor axis nearest gravity at start"
+    return f_ref, msg
+
+
+def _anchored(t, omega, u, forces, rest_before, rest_after):
+    """The rate integrated into a tilt about ``u`` anchored on the rests' accelerometer tilts.
+
+    ``forces`` = (upright, rest before, rest after or None) specific forces (3,); the rests are sample
+    windows. With a rest after, the gyro's drift (rad/s) makes the integral meet both tilts.
+    Returns (theta rad, omega rad/s, drift rad/s, tilt at the start rad, (gyro change, tilt change) rad
+    between the rests or None).
+    """
+    f_ref, f_start, f_end = forces
+    (s0, s1), (e0, e1) = rest_before, rest_after
+    integ = cumtrapz(t, omega)
+    th_start = float(tilt_about(u, f_ref, f_start))
+    ts_mid, is_mean = t[s0:s1].mean(), integ[s0:s1].mean()
+    drift, changes = 0.0, None
+    if f_end is not None:
+        th_end = float(tilt_about(u, f_ref, f_end))
+        te_mid, ie_mean = t[e0:e1].mean(), integ[e0:e1].mean()
+        drift = ((ie_mean - is_mean) - (th_end - th_start)) / (te_mid - ts_mid)
+        changes = (ie_mean - is_mean, th_end - th_start)
+    theta = th_start + (integ - is_mean) - drift * (t - ts_mid)
+    return theta, omega - drift, drift, th_start, changes
 
 
 def _rest_windows(n, fs, i_move, i_end, min_rest_s, status, msg):

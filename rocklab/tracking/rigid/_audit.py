@@ -304,98 +304,145 @@ def audit_rocking(
     t = np.asarray(t_s, float)
     th = np.asarray(theta_rad, float)
     sig = float(sigma_theta_rad) if sigma_theta_rad is not None and np.isfinite(sigma_theta_rad) else 0.0
-    hyst = max(5.0 * sig, math.radians(0.05))
-    impacts = find_impacts(t, th, hyst)
-    seg = segment_ids(t, impacts)
-    n_seg = impacts.size + 1
-    flags: list[AuditFlag] = []
-    checked = []
-    maxima: dict = {}
-    noise: dict = {}
-    notes: list[str] = []
-    k_sigma = 4.0  # a flag needs the departure beyond the tolerance by 4 sigma of its noise
+    audit = _Audit(t, th, max(5.0 * sig, math.radians(0.05)), noise_floor or {})
+    if slide_m is not None:
+        audit.stepwise("slide", slide_m, tol.slide_m)
+    if uplift_m is not None:
+        audit.flights(uplift_m, tol.jump_m)
+    if twist_rad is not None:
+        audit.stepwise("twist", twist_rad, tol.twist_rad)
+    if out_of_plane_rad is not None:
+        audit.stepwise("out_of_plane", out_of_plane_rad, tol.out_of_plane_rad)
+    audit.double_impacts(tol.double_impact_ratio)
+    return audit.result(tol, source)
 
-    floor = noise_floor or {}
 
-    def resolvable(kind, sigma, limit, margin):
-        noise[kind] = sigma
+#: A flag needs the departure beyond the tolerance by this many sigma of its noise.
+K_SIGMA = 4.0
+
+
+class _Audit:
+    """One run's audit as it is built: the half-cycles between impacts, and the checks made, their flags,
+    largest departures, noise and notes so far."""
+
+    def __init__(self, t, th, hyst, floor):
+        self.t, self.th, self.hyst, self.floor = t, th, hyst, floor
+        self.impacts = find_impacts(t, th, hyst)
+        self.seg = segment_ids(t, self.impacts)
+        self.n_seg = self.impacts.size + 1
+        self.flags: list[AuditFlag] = []
+        self.checked: list[str] = []
+        self.maxima: dict = {}
+        self.noise: dict = {}
+        self.notes: list[str] = []
+
+    def resolvable(self, kind, sigma, limit, margin):
+        """Record the noise of ``kind`` and note when it hides departures at the tolerance ``limit``."""
+        self.noise[kind] = sigma
         if np.isfinite(sigma) and margin > limit:
-            notes.append(
+            self.notes.append(
                 f"{kind}: measurement noise {sigma:.3g} (SI) per sample; departures below "
                 f"{limit + margin:.3g} cannot be told from noise"
             )
 
+    @staticmethod
     def impact_of(j):
         return int(j) if j >= 1 else None
 
-    def stepwise(kind, values, limit):
+    def stepwise(self, kind, values, limit):
+        """Flag steps of ``values`` (n,) or (n, k) across impacts and spreads within half-cycles above ``limit``."""
         values = np.asarray(values, float)
         if values.ndim == 1:
             values = values[:, None]
         if not np.isfinite(values).any():
             return
-        checked.append(kind)
-        med, spread, worst, count = _segment_stats(values, seg, n_seg)
+        self.checked.append(kind)
+        med, spread, worst, count = _segment_stats(values, self.seg, self.n_seg)
         ok = np.isfinite(med).all(axis=1)
-        sigma = np.nanmax([_noise(values), floor.get(kind, np.nan), 0.0])
+        sigma = np.nanmax([_noise(values), self.floor.get(kind, np.nan), 0.0])
         sg = sigma if np.isfinite(sigma) else 0.0
-        resolvable(kind, sigma, limit, k_sigma * sg)
+        self.resolvable(kind, sigma, limit, K_SIGMA * sg)
         dev = np.linalg.norm(values - np.nanmedian(values, axis=0), axis=1)
-        maxima[kind] = float(np.nanmax(dev)) if np.isfinite(dev).any() else float("nan")
+        self.maxima[kind] = float(np.nanmax(dev)) if np.isfinite(dev).any() else float("nan")
         prev = None
-        for j in range(n_seg):
+        for j in range(self.n_seg):
             if not ok[j]:
                 continue
             if prev is not None:
                 step = float(np.linalg.norm(med[j] - med[prev]))
                 s_step = 1.25 * sg * math.sqrt(1.0 / count[j] + 1.0 / count[prev])
-                if step > limit + k_sigma * s_step:
-                    flags.append(AuditFlag(kind, float(impacts[j - 1]), step, limit, impact_of(j), "step"))
-            if spread[j] > limit + k_sigma * sg:
-                flags.append(AuditFlag(kind, float(t[worst[j]]), float(spread[j]), limit, impact_of(j), "within"))
+                if step > limit + K_SIGMA * s_step:
+                    self.flags.append(
+                        AuditFlag(kind, float(self.impacts[j - 1]), step, limit, self.impact_of(j), "step")
+                    )
+            if spread[j] > limit + K_SIGMA * sg:
+                self.flags.append(
+                    AuditFlag(kind, float(self.t[worst[j]]), float(spread[j]), limit, self.impact_of(j), "within")
+                )
             prev = j
 
-    if slide_m is not None:
-        stepwise("slide", slide_m, tol.slide_m)
-    if uplift_m is not None:
+    def flights(self, uplift_m, limit):
+        """Flag each flight phase of the pivot's uplift (n,) above ``limit`` m, at its highest sample."""
         up = np.asarray(uplift_m, float)
-        if np.isfinite(up).any():
-            checked.append("jump")
-            maxima["jump"] = float(np.nanmax(up))
-            s_up = float(np.nanmax([_noise(up), floor.get("jump", np.nan), 0.0]))
-            resolvable("jump", s_up, tol.jump_m, k_sigma * (s_up if np.isfinite(s_up) else 0.0))
-            above = np.isfinite(up) & (up > tol.jump_m + k_sigma * (s_up if np.isfinite(s_up) else 0.0))
-            # one flag per flight phase (a run of samples above the tolerance), at its highest sample
-            edges = np.flatnonzero(np.diff(np.r_[0, above.astype(int), 0]))
-            for a, b in zip(edges[::2], edges[1::2]):
-                k = a + int(np.argmax(up[a:b]))
-                flags.append(AuditFlag("jump", float(t[k]), float(up[k]), tol.jump_m, impact_of(seg[k]), "flight"))
-    if twist_rad is not None:
-        stepwise("twist", twist_rad, tol.twist_rad)
-    if out_of_plane_rad is not None:
-        stepwise("out_of_plane", out_of_plane_rad, tol.out_of_plane_rad)
-    checked.append("double_impact")
-    for k, h in _touches(t, th, seg, hyst):
-        # the block came down to the table and went back up on the same edge: the next impact was doubled
-        flags.append(AuditFlag("double_impact", float(t[k]), float(h), 2.0 * hyst, int(seg[k]) + 1, "bounce"))
-    if impacts.size >= 3:
-        dur = np.diff(impacts)  # half-cycle j (impact j -> j+1) lasts dur[j-1]
-        for i in range(1, dur.size - 1):
-            shortest = tol.double_impact_ratio * min(dur[i - 1], dur[i + 1])
-            if dur[i] < shortest:
-                flags.append(
-                    AuditFlag(
-                        "double_impact", float(impacts[i]), float(dur[i]), float(shortest), i + 1, "short half-cycle"
+        if not np.isfinite(up).any():
+            return
+        self.checked.append("jump")
+        self.maxima["jump"] = float(np.nanmax(up))
+        s_up = float(np.nanmax([_noise(up), self.floor.get("jump", np.nan), 0.0]))
+        self.resolvable("jump", s_up, limit, K_SIGMA * (s_up if np.isfinite(s_up) else 0.0))
+        above = np.isfinite(up) & (up > limit + K_SIGMA * (s_up if np.isfinite(s_up) else 0.0))
+        # one flag per flight phase (a run of samples above the tolerance), at its highest sample
+        edges = np.flatnonzero(np.diff(np.r_[0, above.astype(int), 0]))
+        for a, b in zip(edges[::2], edges[1::2]):
+            k = a + int(np.argmax(up[a:b]))
+            self.flags.append(
+                AuditFlag("jump", float(self.t[k]), float(up[k]), limit, self.impact_of(self.seg[k]), "flight")
+            )
+
+    def double_impacts(self, ratio):
+        """Flag bounces, and half-cycles shorter than ``ratio`` times both their neighbours."""
+        self.checked.append("double_impact")
+        t, seg, impacts = self.t, self.seg, self.impacts
+        for k, h in _touches(t, self.th, seg, self.hyst):
+            # the block came down to the table and went back up on the same edge: the next impact was doubled
+            self.flags.append(
+                AuditFlag("double_impact", float(t[k]), float(h), 2.0 * self.hyst, int(seg[k]) + 1, "bounce")
+            )
+        if impacts.size >= 3:
+            dur = np.diff(impacts)  # half-cycle j (impact j -> j+1) lasts dur[j-1]
+            for i in range(1, dur.size - 1):
+                shortest = ratio * min(dur[i - 1], dur[i + 1])
+                if dur[i] < shortest:
+                    self.flags.append(
+                        AuditFlag(
+                            "double_impact",
+                            float(impacts[i]),
+                            float(dur[i]),
+                            float(shortest),
+                            i + 1,
+                            "short half-cycle",
+                        )
                     )
-                )
-    flags.sort(key=lambda f: (f.t_s, FLAG_KINDS.index(f.kind)))
-    if not flags:
-        verdict = "valid"
-    elif any(f.kind != "double_impact" and f.value > tol.invalid_factor * f.tolerance for f in flags):
-        verdict = "invalid"
-    else:
-        verdict = "suspect"
-    excluded = tuple(sorted({f.impact for f in flags if f.impact is not None}))
-    return AuditResult(
-        verdict, tuple(flags), impacts, excluded, tuple(checked), maxima, tol, source, tuple(notes), noise
-    )
+
+    def result(self, tol, source) -> AuditResult:
+        """The verdict over the flags, and the impacts a fit should exclude."""
+        flags = sorted(self.flags, key=lambda f: (f.t_s, FLAG_KINDS.index(f.kind)))
+        if not flags:
+            verdict = "valid"
+        elif any(f.kind != "double_impact" and f.value > tol.invalid_factor * f.tolerance for f in flags):
+            verdict = "invalid"
+        else:
+            verdict = "suspect"
+        excluded = tuple(sorted({f.impact for f in flags if f.impact is not None}))
+        return AuditResult(
+            verdict,
+            tuple(flags),
+            self.impacts,
+            excluded,
+            tuple(self.checked),
+            self.maxima,
+            tol,
+            source,
+            tuple(self.notes),
+            self.noise,
+        )

@@ -414,29 +414,7 @@ def assemble_tracks(
     frames = np.array(sorted({r.frame for r in rows}), int)
     pos = {f: i for i, f in enumerate(frames)}
     n = len(frames)
-    raw = {}
-    for o in config.objects:
-        a = {k: np.full(n, np.nan) for k in ("X", "Y", "th", "sig", "scale", "q")}
-        st = np.full(n, "lost", dtype=object)
-        metric = False  # metres only where a measured frame says so: a lost frame's flag is a default
-        for r in by[o.id]:
-            i = pos[r.frame]
-            a["X"][i], a["Y"][i], a["th"][i], a["sig"][i] = r.X, r.Y, r.theta_rad, r.sigma_theta_rad
-            a["scale"][i], a["q"][i] = r.scale, r.quality
-            st[i] = r.status
-            metric = metric or (r.status == "ok" and r.metric)
-        th = a["th"]
-        okk = np.flatnonzero(st == "ok")
-        if np.isnan(th[okk]).any():  # found unmeasurable on the way: no frame's angle is measured
-            th[:], a["sig"][:] = np.nan, np.nan
-        # An angle step no rocking block makes between frames is a misdetection, not motion.
-        for j0, j1 in zip(okk[:-1], okk[1:]):
-            if j1 - j0 == 1 and abs(math.remainder(th[j1] - th[j0], 2 * math.pi)) > MAX_STEP_RAD:
-                st[j1] = "outlier"
-        bad = st != "ok"
-        for k in ("X", "Y", "th", "sig"):
-            a[k][bad] = np.nan
-        raw[o.id] = (a, st, metric)
+    raw = {o.id: _object_series(by[o.id], pos, n) for o in config.objects}
     unseen = [o.id for o in config.objects if not np.any(raw[o.id][1] == "ok")]
     if len(unseen) == len(config.objects) or (unseen and n > 1):
         o = unseen[0]
@@ -444,30 +422,7 @@ def assemble_tracks(
             f"{config.source or 'config'}: object {o!r} is never seen in "
             f"{source or 'the video'}; check its markers/dots/roi and the dictionary"
         )
-    # Scale: metres per plane unit, per object (objects may sit at different depths).
-    m_per = {}
-    fallback = config.reference.m_per_px
-    if fallback is None and not metric_plane:
-        metric_scales = [
-            1.0 / np.nanmedian(raw[o.id][0]["scale"][raw[o.id][1] == "ok"]) for o in config.objects if raw[o.id][2]
-        ]
-        fallback = float(np.median(metric_scales)) if metric_scales else None
-    for o in config.objects:
-        a, st, metric = raw[o.id]
-        if metric_plane:
-            m_per[o.id] = 1.0
-        elif metric and config.reference.m_per_px is None:
-            m_per[o.id] = 1.0 / float(np.nanmedian(a["scale"][st == "ok"]))
-        elif fallback is not None:
-            m_per[o.id] = float(fallback)
-        else:  # no metric scale anywhere: positions stay in pixels, never a made-up metre
-            m_per[o.id] = math.nan
-            warn(
-                "W-TRACK-NOSCALE",
-                f"{config.source or 'config'}: no metric scale for object {o.id!r}: x_m, y_m "
-                "left empty (x_px, y_px and theta_rad are measured); give "
-                "targets.marker_size_m, objects.size_m or reference.m_per_px",
-            )
+    m_per = _metres_per_unit(config, raw, metric_plane)
     from ._level import level_from_reference, world_angle
 
     pm_px = plane_map
@@ -525,6 +480,64 @@ def assemble_tracks(
     )
 
 
+def _object_series(rows, pos, n):
+    """One object's observations laid on the frames (``pos``: frame -> row of ``n``).
+
+    Returns ({"X", "Y", "th", "sig", "scale", "q"}: arrays (n,), NaN where not measured; statuses (n,);
+    whether a measured frame is in metres). An angle step no rocking block makes marks an outlier.
+    """
+    a = {k: np.full(n, np.nan) for k in ("X", "Y", "th", "sig", "scale", "q")}
+    st = np.full(n, "lost", dtype=object)
+    metric = False  # metres only where a measured frame says so: a lost frame's flag is a default
+    for r in rows:
+        i = pos[r.frame]
+        a["X"][i], a["Y"][i], a["th"][i], a["sig"][i] = r.X, r.Y, r.theta_rad, r.sigma_theta_rad
+        a["scale"][i], a["q"][i] = r.scale, r.quality
+        st[i] = r.status
+        metric = metric or (r.status == "ok" and r.metric)
+    th = a["th"]
+    okk = np.flatnonzero(st == "ok")
+    if np.isnan(th[okk]).any():  # found unmeasurable on the way: no frame's angle is measured
+        th[:], a["sig"][:] = np.nan, np.nan
+    # An angle step no rocking block makes between frames is a misdetection, not motion.
+    for j0, j1 in zip(okk[:-1], okk[1:]):
+        if j1 - j0 == 1 and abs(math.remainder(th[j1] - th[j0], 2 * math.pi)) > MAX_STEP_RAD:
+            st[j1] = "outlier"
+    bad = st != "ok"
+    for k in ("X", "Y", "th", "sig"):
+        a[k][bad] = np.nan
+    return a, st, metric
+
+
+def _metres_per_unit(config, raw, metric_plane) -> dict:
+    """Metres per plane unit per object (objects may sit at different depths); NaN, with a coded
+    warning, where no metric scale is known."""
+    m_per = {}
+    fallback = config.reference.m_per_px
+    if fallback is None and not metric_plane:
+        metric_scales = [
+            1.0 / np.nanmedian(raw[o.id][0]["scale"][raw[o.id][1] == "ok"]) for o in config.objects if raw[o.id][2]
+        ]
+        fallback = float(np.median(metric_scales)) if metric_scales else None
+    for o in config.objects:
+        a, st, metric = raw[o.id]
+        if metric_plane:
+            m_per[o.id] = 1.0
+        elif metric and config.reference.m_per_px is None:
+            m_per[o.id] = 1.0 / float(np.nanmedian(a["scale"][st == "ok"]))
+        elif fallback is not None:
+            m_per[o.id] = float(fallback)
+        else:  # no metric scale anywhere: positions stay in pixels, never a made-up metre
+            m_per[o.id] = math.nan
+            warn(
+                "W-TRACK-NOSCALE",
+                f"{config.source or 'config'}: no metric scale for object {o.id!r}: x_m, y_m "
+                "left empty (x_px, y_px and theta_rad are measured); give "
+                "targets.marker_size_m, objects.size_m or reference.m_per_px",
+            )
+    return m_per
+
+
 def track_video(
     path, config: TrackConfig, fps: float | None = None, progress: bool = False, on_frame=None
 ) -> TrackResult:
@@ -557,7 +570,8 @@ def track_video(
     >>> import pathlib, tempfile
     >>> import numpy as np, pandas as pd
     >>> from rocklab.synth import synth_session
-    >>> from rocklab.tracking import load_track_config, track_video
+    >>> from rocklab.config import load_track_config
+    >>> from rocklab.tracking import track_video
     >>> d = pathlib.Path(tempfile.mkdtemp())
     >>> s = synth_session(d / "s", seed=1, size=(480, 270), duration_s=1.0, imu=False, mp4=False)
     >>> res = track_video(d / "s" / "video.mkv", load_track_config(d / "s" / "track.toml"))

@@ -406,23 +406,8 @@ def iter_video_frames(
         Only with ``color``: the frame as decoded (a grey source decodes to three equal
         channels; ``gray`` itself when the reader returns one channel).
     """
-    import cv2
-
     first = start // 2 if fields else start
-    if fields:
-        # OpenCV's FFmpeg reader cannot convert interlaced pictures ("Cannot convert interlaced to
-        # progressive frames") and returns the previous picture again, silently: decode with PyAV
-        cap = _PyAVReader(path, first, gray=not color)
-    elif (store := frame_store(_open_checked(path))) is not None:
-        cap = FrameStoreReader(store, first, gray=not color)
-    else:
-        # PyAV for every film it opens (grey from the luma plane: no YUV -> BGR -> grey), so grey
-        # and colour frames are the same frames, upright and at the same indices
-        cap = _pyav_reader(_open_checked(path), first, gray=not color)
-        if cap is None:
-            cap = _open(path)
-            if first:
-                cap.set(cv2.CAP_PROP_POS_FRAMES, first)
+    cap = _capture(path, first, fields, color)
 
     def read():
         i = first
@@ -453,6 +438,37 @@ def iter_video_frames(
     if prefetch <= 0:
         yield from read()
         return
+
+    yield from _prefetched(read, prefetch)
+
+
+def _capture(path, first: int, fields, color: bool):
+    """A reader of ``path`` placed on frame ``first``: PyAV, a frame store, or OpenCV's as a last resort."""
+    import cv2
+
+    if fields:
+        # OpenCV's FFmpeg reader cannot convert interlaced pictures ("Cannot convert interlaced to
+        # progressive frames") and returns the previous picture again, silently: decode with PyAV
+        cap = _PyAVReader(path, first, gray=not color)
+    elif (store := frame_store(_open_checked(path))) is not None:
+        cap = FrameStoreReader(store, first, gray=not color)
+    else:
+        # PyAV for every film it opens (grey from the luma plane: no YUV -> BGR -> grey), so grey
+        # and colour frames are the same frames, upright and at the same indices
+        cap = _pyav_reader(_open_checked(path), first, gray=not color)
+        if cap is None:
+            cap = _open(path)
+            if first:
+                cap.set(cv2.CAP_PROP_POS_FRAMES, first)
+    return cap
+
+
+def _prefetched(read, prefetch: int):
+    """Yield the items of the generator ``read()``, decoded up to ``prefetch`` ahead in a background thread.
+
+    An InputError raised while reading is raised here, in the consumer; stopping early stops the thread
+    and releases the reader.
+    """
 
     def produce(put):
         frames = read()

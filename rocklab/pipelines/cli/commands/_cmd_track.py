@@ -116,7 +116,8 @@ def run(args) -> int:
 
     from ...._io import write_frame_atomic
     from ....series import write_tracks
-    from ....tracking import load_track_config, track_video
+    from ....config import load_track_config
+    from ....tracking import track_video
     from .._io_plan import TABLE, track_outputs
 
     video = Path(args.video)

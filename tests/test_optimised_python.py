@@ -16,7 +16,7 @@ def test_cli_help_under_OO(args):
 def test_example_toml_is_not_a_docstring():
     # the example config must survive -OO: it is a constant, not a slice of the module docstring
     p = subprocess.run(
-        [sys.executable, "-OO", "-c", "from rocklab.pipelines import EXAMPLE_TOML; print(len(EXAMPLE_TOML))"],
+        [sys.executable, "-OO", "-c", "from rocklab.config import EXAMPLE_TOML; print(len(EXAMPLE_TOML))"],
         capture_output=True,
         text=True,
         timeout=120,

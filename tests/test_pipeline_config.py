@@ -3,7 +3,8 @@ import tomllib
 import pytest
 
 from rocklab import InputError
-from rocklab.pipelines import EXAMPLE_TOML, load_experiment
+from rocklab.config import EXAMPLE_TOML
+from rocklab.pipelines import load_experiment
 
 
 def _write(tmp_path, text, files=("tracks.csv",)):

@@ -6,7 +6,7 @@ Sub-packages: :mod:`.experiment` (one experiment), :mod:`.campaign` (many, and t
 The only subpackage that imports rerun or matplotlib (always inside functions, so
 importing it stays light).
 
-- :func:`load_experiment` reads an ``experiment.toml`` (:class:`ExperimentConfig`);
+- :func:`load_experiment` reads an ``experiment.toml`` (:class:`rocklab.config.ExperimentConfig`);
 - :func:`run_experiment` runs one experiment into a folder (``rocklab run``);
   :func:`analyse_experiment` does the same in memory (:class:`ExperimentResult`);
 - :func:`run_campaign` runs every experiment under a folder, then the campaign fits

@@ -1,6 +1,6 @@
 """One experiment, end to end: its config, the stages, the outputs and the Rerun review.
 
-- ``experiment.toml`` (:func:`load_experiment`, :class:`ExperimentConfig`);
+- ``experiment.toml`` (:func:`load_experiment`; the schema is :class:`rocklab.config.ExperimentConfig`);
 - the stages: tracking, IMU, sync, the assumption audit, the restitution fit, the simulations
   (:func:`analyse_experiment`, :class:`ExperimentResult`), and a column experiment's own stage;
 - the outputs, written atomically into a staged folder (:func:`run_experiment`):
@@ -9,7 +9,7 @@
   (:func:`read_rrd_summary`, :func:`read_rrd_scalars`).
 """
 
-from ._config import EXAMPLE_TOML, ExperimentConfig, load_experiment
+from ._config import load_experiment
 from ._experiment import ExperimentResult, analyse_experiment, run_experiment
 from ._figures import campaign_figures, experiment_figures
 from ._plots_column import plot_column_maps
@@ -20,8 +20,6 @@ from ._column_run import base_from_table
 
 __all__ = [
     "load_experiment",
-    "ExperimentConfig",
-    "EXAMPLE_TOML",
     "run_experiment",
     "analyse_experiment",
     "ExperimentResult",

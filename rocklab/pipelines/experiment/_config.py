@@ -1,15 +1,15 @@
 """``experiment.toml`` for ``rocklab run``: the reader of :mod:`rocklab.config` with the block
 catalogue (Čeh et al. 2018, Table 2), so ``[block] id = "B6M"`` needs no dimensions.
 
-The schema, with every key and its default, is :data:`EXAMPLE_TOML` (all lengths in m, times in
-s, angles in rad).
+The schema, with every key and its default, is :data:`rocklab.config.EXAMPLE_TOML` (all lengths
+in m, times in s, angles in rad).
 """
 
 from __future__ import annotations
 
-from ...config import EXAMPLE_TOML, ExperimentConfig, load_experiment_config
+from ...config import ExperimentConfig, load_experiment_config
 
-__all__ = ["ExperimentConfig", "load_experiment", "EXAMPLE_TOML"]
+__all__ = ["load_experiment"]
 
 
 def load_experiment(path) -> ExperimentConfig:

@@ -25,7 +25,8 @@ import numpy as np
 
 from ... import __version__
 from ...series import TableMotion
-from ._config import ExperimentConfig, load_experiment
+from ...config import ExperimentConfig
+from ._config import load_experiment
 from ._measure import measure_imu, measure_video, read_track_csv, sync_clocks, table_from_imu
 from ._report import write_outputs
 from ._stages import ClockSync, ExperimentResult, FitStage

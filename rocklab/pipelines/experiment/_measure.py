@@ -12,7 +12,7 @@ import numpy as np
 
 from ..._errors import InputError
 from ...series import TableMotion, Tracks, read_tracks
-from ._config import ExperimentConfig
+from ...config import ExperimentConfig
 from ._review_video import ReviewFilm
 
 __all__: list[str] = []

@@ -15,7 +15,7 @@ import numpy as np
 from ... import __version__
 from ...blocks import Block
 from ...series import TableMotion
-from ._config import ExperimentConfig
+from ...config import ExperimentConfig
 from ._review_video import ReviewVideo
 
 if TYPE_CHECKING:

@@ -79,6 +79,7 @@ def test_table_from_imu_is_synced_to_the_video(tmp_path):
     # each sample's sigma: the error's scale (not a constant, not zero)
     sig = ser["table_sigma_acc_m_s2"].to_numpy()[m]
     assert 0.005 < np.median(sig) < 0.05 and np.sqrt(np.mean((a[m] - a_true[m]) ** 2)) < 3 * np.median(sig)
+    assert "Table motion: fused from the table IMU" in (tmp_path / "out" / "summary.md").read_text()
 
 
 def test_streaming_without_rrd_file_still_logs_the_video(sine_session, tmp_path):

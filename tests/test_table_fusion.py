@@ -27,13 +27,13 @@ def _tables():
 TABLES = _tables()
 
 
-def _measure(table, seed, T, *, bias_g=0.0, scale=1.0):
+def _measure(table, seed, T, *, bias_g=0.0, scale=1.0, lead_s=None):
     """(video TableMotion, IMU t on its own clock, IMU acceleration) of one synthetic run."""
     from rocklab.synth._imu_sim import simulate_imu_log
     from rocklab.tracking import table_acceleration, table_motion
 
     rng = np.random.default_rng(seed)
-    t0 = -rng.uniform(0.5, 1.5)  # the IMU log starts before the film, as rocklab synth's do
+    t0 = -rng.uniform(0.5, 1.5) if lead_s is None else -lead_s  # the IMU log starts before the film
     tg = np.arange(t0 - 0.1, T + 0.1, 1e-3)
     log = simulate_imu_log(
         np.array([t0, T]), np.zeros(2), None, rate_hz=256.0, t_start_s=t0, base=(tg, scale * table.a(tg)),
@@ -156,3 +156,18 @@ def test_gravity_leak_of_a_pitching_table_is_taken_out():
     assert err(lev) < 1.01 * noise  # measured within 0.1 % of the noise (seeds 0-2)
     # a level table is not made worse by the gyro (its noise integrates to 0.02 deg)
     assert err(table_acceleration(still, axis="x", level=True)) < 1.01 * noise
+
+
+def test_a_long_log_is_fused_over_the_film_and_two_seconds():
+    """An IMU logging 6 s before the film: the fusion covers the film's span and 2 s either side
+    (memory stays bounded for long logs), and is as good as with a short lead."""
+    from rocklab.pipelines.experiment._measure import fuse_with_video
+    from rocklab.tracking import MARGIN_S
+
+    table, T = TABLES["sine"]
+    video, ti, ai = _measure(table, 1, T, lead_s=6.0)
+    with collecting():
+        motion, _, fusion = fuse_with_video(ti, ai, video, max_offset_s=8.0)
+    assert motion.t_s[0] == pytest.approx(video.t_s[0] - MARGIN_S, abs=1 / 256)
+    assert motion.t_s[-1] <= video.t_s[-1] + MARGIN_S
+    assert _rel_rms(motion.t_s, motion.ax_m_s2, table, T) <= 0.0105 and fusion.status == "ok"

@@ -19,7 +19,7 @@ sub-package's ``__all__`` is the one list.
 
 from . import calib, imu, rigid, stereo, video
 from ._corrections import apply_corrections, load_corrections
-from ._table_fusion import BIAS_MAX_M_S2, BIAS_WALK_M_S2, DISAGREE_NIS, TableFusion, fuse_table_motion
+from ._table_fusion import BIAS_MAX_M_S2, BIAS_WALK_M_S2, DISAGREE_NIS, MARGIN_S, TableFusion, fuse_table_motion
 from ._sync import SyncResult, sync_events, sync_imu_to_track, sync_offset, track_rate
 from .calib import *  # noqa: F403
 from .imu import *  # noqa: F403
@@ -40,6 +40,7 @@ __all__ = [
     "BIAS_MAX_M_S2",
     "BIAS_WALK_M_S2",
     "DISAGREE_NIS",
+    "MARGIN_S",
 ]
 __all__ += video.__all__
 __all__ += imu.__all__

@@ -20,6 +20,7 @@ def _tables():
     up = catalogue_block("B5L").uplift_acc_m_s2
     return {
         "sine": (sine_pulse_table(1.0, 0.6, 0.045), 3.0),  # thesis Fig. 31's pulse
+        "sine_slow": (sine_pulse_table(1.0, 0.8, 0.045), 3.0),
         "elcentro": (record_table(bundled_record("elcentro"), 0.6, 6.9, 0.01, 1.6 * up), 8.0),  # the demo's B5L
     }
 
@@ -61,27 +62,28 @@ def _fuse(name, seed, **kw):
     return table, T, video, (ti - sync.offset_s) / (1 + sync.drift), ai, motion, fusion, diags
 
 
-@pytest.mark.parametrize("seed", [0, 1, 2])
-def test_fused_sine_pulse_table_within_one_percent(seed):
-    table, T, video, ti, ai, motion, fusion, diags = _fuse("sine", seed)
+@pytest.mark.parametrize("name, seed", [("sine", 0), ("sine", 1), ("sine", 2), ("sine_slow", 0)])
+def test_fused_sine_pulse_table_within_one_percent(name, seed):
+    table, T, video, ti, ai, motion, fusion, diags = _fuse(name, seed)
     e_f = _rel_rms(motion.t_s, motion.ax_m_s2, table, T)
-    # measured 0.91 / 0.91 / 1.01 % (IMU alone 1.8 %, film alone 3.0-3.5 %)
-    assert e_f <= 0.0105
-    assert e_f < 0.6 * _rel_rms(ti, ai, table, T)
+    # measured 0.69 / 0.66 / 0.67 % (IMU alone 1.8 %, film alone 3.0-3.5 %); the 0.8 s pulse 0.91 %
+    # (IMU 2.8 %, film 2.5 %)
+    assert e_f <= 0.01
+    assert e_f < 0.5 * _rel_rms(ti, ai, table, T)
     assert e_f < 0.4 * _rel_rms(video.t_s, video.ax_m_s2, table, T)
     assert motion.source == "fused" and fusion.status == "ok" and not diags
 
 
 #: record -> (bound on the fused error, on its ratio to the IMU's alone, to the film's alone)
-RECORD_BOUNDS = {"elcentro": (0.025, 0.45, 0.3), "sfern": (0.033, 0.65, 0.3)}
+RECORD_BOUNDS = {"elcentro": (0.024, 0.4, 0.3), "sfern": (0.03, 0.6, 0.25)}
 
 
 @pytest.mark.parametrize("name, seed", [("elcentro", 0), ("elcentro", 1), ("sfern", 2)])
 def test_fused_record_table_beats_each_source_and_its_sigma_holds(name, seed, request):
     """Records on the demo's sensors. El Centro: the Wiener bound with the true spectrum is 2.0 % (the
-    IMU's 5 mg per sample over the record's 2-15 Hz), so 1 % is out of reach; the fusion gets 2.0-2.2 %
-    (IMU alone 6.1-6.5 %, film alone 8.3-9.4 %). San Fernando (Pacoima, ../shared): 2.8-2.9 % (IMU
-    4.8 %, film 12.5-12.8 %)."""
+    IMU's 5 mg per sample over the record's 2-15 Hz, for a stationary signal), so 1 % is out of reach;
+    the fusion gets 2.0-2.1 % (IMU alone 6.1-6.5 %, film alone 8.3-9.4 %). San Fernando (Pacoima,
+    ../shared): 2.5 % (IMU 4.8 %, film 12.5 %)."""
     from rocklab.pipelines.experiment._measure import fuse_with_video
 
     if name == "sfern":
@@ -104,7 +106,7 @@ def test_fused_record_table_beats_each_source_and_its_sigma_holds(name, seed, re
     assert e_f < vs_film * _rel_rms(video.t_s, video.ax_m_s2, table, T)
     m = (motion.t_s > 0) & (motion.t_s < T - 0.1)
     z = (motion.ax_m_s2 - table.a(motion.t_s))[m] / motion.sigma_ax_m_s2[m]
-    assert 0.5 < np.sqrt(np.mean(z**2)) < 1.3  # the smoother's sigma is the error's scale
+    assert 0.5 < np.sqrt(np.mean(z**2)) < 1.3  # the smoother's sigma is the error's scale (0.64-0.78)
     assert fusion.status == "ok" and not diags
     # the table's displacement within a few film noise levels of the truth
     x_true = table.u(motion.t_s[m]) - table.u(0.0)

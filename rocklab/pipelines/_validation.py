@@ -5,7 +5,8 @@ What the run measured sets the ensemble's input uncertainty
 
 - table acceleration noise: the robust standard deviation of the table acceleration in its
   rest before the shaking (the samples before it first leaves ±6 σ of its start level; a
-  table fused from an IMU and the film: at least the IMU's white noise), sampled at :data:`INPUT_SAFETY` (2) times that;
+  table fused from an IMU and the film: at least the IMU's white noise), sampled at
+  :data:`INPUT_SAFETY` (2) times that;
   the bias the half-cycle fit of η_e finds is taken out, and a constant bias of its standard
   error and σ/√n (the rest gives gravity's level) sampled; a scale error of
   :data:`ACC_SCALE_SD` (1 %);

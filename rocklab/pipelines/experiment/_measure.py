@@ -73,11 +73,11 @@ def table_from_imu(cfg: ExperimentConfig, video_table: TableMotion | None, msgs:
 
     A 50 fps camera cannot measure a record's table acceleration (content above 25 Hz is lost;
     on a synthetic El Centro run the 50 Hz samples turned a surviving block into an overturning
-    one), and a table IMU's is noisy (5 mg) and offset by any tilt: with a video table, gravity's
-    leak through the table's tilt is taken out by the IMU's gyro (``level=True``), the IMU's clock is found by cross-correlating its acceleration with the video's
-    (t_imu = t_video + offset + drift t_video) and the two are fused
-    (:func:`rocklab.tracking.fuse_table_motion`: the film's displacement below a few hertz, the
-    IMU's acceleration above, each sample's σ).
+    one), and a table IMU's is noisy (5 mg) and offset by any tilt. With a video table, gravity's
+    leak through the table's tilt is taken out by the IMU's gyro (``level=True``), the IMU's clock
+    is found by cross-correlating its acceleration with the video's (t_imu = t_video + offset +
+    drift t_video) and the two are fused (:func:`rocklab.tracking.fuse_table_motion`: the film's
+    displacement below a few hertz, the IMU's acceleration above, each sample's σ).
 
     Returns
     -------

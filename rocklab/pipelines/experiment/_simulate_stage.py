@@ -149,12 +149,15 @@ def compare_truth(cfg, prim, table=None) -> TruthComparison:
 
 def _table_error(df, table) -> float | None:
     """RMS of the measured table acceleration minus the truth's, over the truth's RMS, where both
-    exist (the truth's frames), -; None without a table in either. The measurement is read at the
-    frames by a cubic spline, as :func:`base_from_table` resamples it for the simulations (linear
-    interpolation of a 256 Hz record adds 0.7 % of El Centro's RMS)."""
+    exist (the truth's frames), -; None without a table in either, or for a table not on the film's
+    clock (an IMU alone, a record). The measurement is read at the frames by a cubic spline, as
+    :func:`base_from_table` resamples it for the simulations (linear interpolation of a 256 Hz
+    record adds 0.7 % of El Centro's RMS)."""
     from scipy.interpolate import CubicSpline
 
-    if table is None or "object" not in df.columns or "ax_m_s2" not in df.columns:
+    if table is None or table.source not in ("fused", "video") or "object" not in df.columns:
+        return None
+    if "ax_m_s2" not in df.columns:
         return None
     tb = df[df["object"] == table.object]
     ta, aa = np.asarray(table.t_s, float), np.asarray(table.ax_m_s2, float)

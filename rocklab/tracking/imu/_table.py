@@ -14,8 +14,9 @@ rests are measured (``turn_rad``); above 3 deg the gravity leak
 
 ``level=True`` takes out gravity's leak through a table that tilts while it shakes (a pitching
 platform): each sample is turned back by the gyro's rotation since the rest (bias from the rest,
-small angles: ``f_rest = f + phi x f``). Its drift (the rest's bias error, 0.01 deg/s, is 0.002 m/s2
-of offset after 10 s) is left for a film to pin (:func:`rocklab.tracking.fuse_table_motion`).
+small angles: ``f_rest = f + phi x f``). Its drift (a bias error of 0.01 deg/s left by the rest is
+0.1 deg, 0.017 m/s2 of offset, after 10 s) is left for a film to pin
+(:func:`rocklab.tracking.fuse_table_motion`, whose offset state takes it out).
 """
 
 from __future__ import annotations

@@ -138,6 +138,13 @@ WARNING_CODES: dict[str, tuple[str, str]] = {
         "rests): gravity, removed in the orientation at the first rest, leaks into the table "
         "acceleration by 2 g sin(turn/2); check that the sensor is fixed to the table",
     ),
+    "W-TABLE-FUSION": (
+        "suspect",
+        "the table IMU and the film's table disagree beyond their noise: the film's displacement departs "
+        "from the IMU's twice-integrated acceleration, or the IMU reads an offset larger than a level table "
+        "gives (0.05 m/s2, 0.3 deg of tilt); the fused table follows the film at low frequencies. Check the "
+        "table IMU's scale and mounting, the sync and the film's metric scale",
+    ),
     # video tracking
     "W-TRACK-NOSCALE": (
         "note",

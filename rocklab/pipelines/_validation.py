@@ -4,8 +4,9 @@ What the run measured sets the ensemble's input uncertainty
 (:class:`rocklab.fitting.InputUncertainty`):
 
 - table acceleration noise: the robust standard deviation of the table acceleration in its
-  rest before the shaking (the samples before it first leaves ±6 σ of its start level),
-  sampled at :data:`INPUT_SAFETY` (2) times that;
+  rest before the shaking (the samples before it first leaves ±6 σ of its start level; a
+  table fused from an IMU and the film: at least the IMU's white noise), sampled at
+  :data:`INPUT_SAFETY` (2) times that;
   the bias the half-cycle fit of η_e finds is taken out, and a constant bias of its standard
   error and σ/√n (the rest gives gravity's level) sampled; a scale error of
   :data:`ACC_SCALE_SD` (1 %);
@@ -172,6 +173,10 @@ def _uncertainty(cfg, table, table_sync, y, msgs):
             rest = aa[fin][w]
             sa = _robust_sd(rest)
             sb = sa / np.sqrt(rest.size)
+        if table.source == "fused" and np.isfinite(table.acc_noise_m_s2):
+            # the fused table is smooth at rest; its error in the band that rocks a block is the
+            # IMU's white noise there (the film takes over only below a few hertz)
+            sa = max(sa, float(table.acc_noise_m_s2))
         if table_sync is not None:
             st = max(float(table_sync.residual_ms or 0.0) / 1000.0, 0.25 * dt_tab)
         else:

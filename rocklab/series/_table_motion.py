@@ -42,7 +42,14 @@ class TableMotion:
     object : str
         The tracked table's id.
     source : str
-        Where the motion comes from: ``"video"``, ``"imu"`` or ``"record"``.
+        Where the motion comes from: ``"video"``, ``"imu"``, ``"record"`` or ``"fused"`` (the
+        table IMU's acceleration and the video's displacement, :func:`rocklab.tracking.fuse_table_motion`).
+    sigma_ax_m_s2 : ndarray, shape (n,), or None
+        Standard deviation of each acceleration sample, m/s^2 (the fusion's smoother); None when
+        the source does not give one.
+    acc_noise_m_s2 : float
+        White-noise level of the acceleration as measured, before any smoothing, m/s^2 (a fused
+        table's IMU); NaN when unknown.
     """
 
     t_s: np.ndarray
@@ -54,6 +61,8 @@ class TableMotion:
     noise_m: float = math.nan
     object: str = "table"
     source: str = "video"
+    sigma_ax_m_s2: np.ndarray | None = None
+    acc_noise_m_s2: float = math.nan
 
     @classmethod
     def from_acceleration(cls, t_s, acc_m_s2, source: str, object: str = "table") -> "TableMotion":
@@ -68,16 +77,24 @@ class TableMotion:
         return self.window * float(np.median(np.diff(self.t_s)))
 
     def columns(self) -> dict:
-        """The measured series by their report names: ``disp_m``, ``vel_m_s``, ``acc_m_s2``
-        (the ones this source has), each an ndarray on ``t_s``."""
-        out = {"disp_m": self.x_m, "vel_m_s": self.vx_m_s, "acc_m_s2": self.ax_m_s2}
+        """The measured series by their report names: ``disp_m``, ``vel_m_s``, ``acc_m_s2``,
+        ``sigma_acc_m_s2`` (the ones this source has), each an ndarray on ``t_s``."""
+        out = {
+            "disp_m": self.x_m,
+            "vel_m_s": self.vx_m_s,
+            "acc_m_s2": self.ax_m_s2,
+            "sigma_acc_m_s2": self.sigma_ax_m_s2,
+        }
         return {k: np.asarray(v, float) for k, v in out.items() if v is not None}
 
     def to_frame(self):
         """The result as a pandas DataFrame (SI units in the column names)."""
         import pandas as pd
 
-        cols = {"t_s": self.t_s, "x_m": self.x_m, "vx_m_s": self.vx_m_s, "ax_m_s2": self.ax_m_s2}
+        cols = {
+            "t_s": self.t_s, "x_m": self.x_m, "vx_m_s": self.vx_m_s, "ax_m_s2": self.ax_m_s2,
+            "sigma_ax_m_s2": self.sigma_ax_m_s2,
+        }  # fmt: skip
         return pd.DataFrame({k: v for k, v in cols.items() if v is not None})
 
     def to_base_motion(self, name: str | None = None):
@@ -92,6 +109,7 @@ class TableMotion:
         """Plain dict of the fields, JSON-ready (SI units in the keys)."""
         return {
             "object": self.object,
+            "source": self.source,
             "window": self.window,
             "window_s": self.window_s,
             "polyorder": self.polyorder,

@@ -12,6 +12,7 @@ Sub-packages:
 - :mod:`rocklab.tracking.calib`: camera calibration from checkerboard and ChArUco pictures (films,
   folders of photos): one camera's lens file, and the boards the stereo calibration reads.
 
+The table motion fused from the table IMU and the film (:func:`fuse_table_motion`) is here too.
 The clock synchronisation of an IMU to a video track is here (:func:`sync_offset`,
 :func:`sync_imu_to_track`), and the manual corrections of a track (:func:`load_corrections`,
 :func:`apply_corrections`). Every public name of the sub-packages is also here: each
@@ -20,6 +21,7 @@ sub-package's ``__all__`` is the one list.
 
 from . import calib, imports, imu, rigid, stereo, video
 from ._corrections import apply_corrections, load_corrections
+from ._table_fusion import BIAS_MAX_M_S2, BIAS_WALK_M_S2, DISAGREE_NIS, MARGIN_S, TableFusion, fuse_table_motion
 from ._sync import SyncResult, sync_events, sync_imu_to_track, sync_offset, track_rate
 from .calib import *  # noqa: F403
 from .imports import *  # noqa: F403
@@ -36,6 +38,12 @@ __all__ = [
     "track_rate",
     "load_corrections",
     "apply_corrections",
+    "TableFusion",
+    "fuse_table_motion",
+    "BIAS_MAX_M_S2",
+    "BIAS_WALK_M_S2",
+    "DISAGREE_NIS",
+    "MARGIN_S",
 ]
 __all__ += video.__all__
 __all__ += imu.__all__

@@ -58,6 +58,7 @@ class _Measured:
     sync: ClockSync | None
     residual: tuple | None
     table_sync: object  # rocklab.tracking.SyncResult of the table IMU, or None
+    table_fusion: object = None  # rocklab.tracking.TableFusion (table IMU and film), or None
 
 
 def _measure(cfg: ExperimentConfig, progress: bool, keep_video: bool | None, msgs: list, timings: dict) -> _Measured:
@@ -79,9 +80,9 @@ def _measure(cfg: ExperimentConfig, progress: bool, keep_video: bool | None, msg
         t1 = time.perf_counter()
         measured["imu"], rot = measure_imu(cfg)
         timings["imu_s"] = time.perf_counter() - t1
-    table_sync = None
+    table_sync = fusion = None
     if cfg.table.source == "imu":
-        table, table_sync = table_from_imu(cfg, table, msgs)
+        table, table_sync, fusion = table_from_imu(cfg, table, msgs)
     elif cfg.table.source == "record":
         from ...models import load_base_motion
 
@@ -101,7 +102,7 @@ def _measure(cfg: ExperimentConfig, progress: bool, keep_video: bool | None, msg
         thi_on_v = np.interp(tv, measured["imu"][0], thi, left=np.nan, right=np.nan)
         residual = (tv, thv - thi_on_v)
     sync = ClockSync(imu_sync, table_sync) if imu_sync is not None or table_sync is not None else None
-    return _Measured(measured, table, tr, film, track_rows, sync, residual, table_sync)
+    return _Measured(measured, table, tr, film, track_rows, sync, residual, table_sync, fusion)
 
 
 def _fit_free(cfg, block, prim, audit, msgs: list, timings: dict) -> FitStage:
@@ -142,6 +143,7 @@ def analyse_experiment(
         sync=m.sync,
         video_imu_residual=m.residual,
         table=m.table,
+        table_fusion=m.table_fusion,
         messages=msgs,
         timings_s=timings,
         frames=m.tracked,
@@ -186,7 +188,7 @@ def analyse_experiment(
         t4 = time.perf_counter()
         validation = validate_forced_run(prep, block, {law: s.eta for law, s in sims.items()})
         timings["validation_s"] = time.perf_counter() - t4
-    truth = compare_truth(cfg, prim) if cfg.truth is not None else None
+    truth = compare_truth(cfg, prim, m.table) if cfg.truth is not None else None
     return ExperimentResult(
         **shared,
         fit=fit,

@@ -155,7 +155,7 @@ def _column_figure(plt, res, out: Path) -> Path:
 
 
 def _table_figure(plt, res, out: Path) -> Path:
-    """The table's displacement, velocity and acceleration."""
+    """The table's displacement, velocity and acceleration (with its ±2σ band when fused)."""
     fig, axs = plt.subplots(3, 1, figsize=(10, 6), sharex=True)
     tt = res.table.t_s
     cols = res.table.columns()
@@ -164,10 +164,14 @@ def _table_figure(plt, res, out: Path) -> Path:
     ):
         if key in cols:
             ax.plot(tt, cols[key], lw=0.9)
+        if key == "acc_m_s2" and "sigma_acc_m_s2" in cols:  # a fused table: each sample's ±2σ
+            a, s2 = cols[key], 2 * cols["sigma_acc_m_s2"]
+            ax.fill_between(tt, a - s2, a + s2, alpha=0.3, lw=0, label="±2σ")
+            ax.legend(loc="upper right")
         ax.set_ylabel(lab)
         ax.grid(alpha=0.3)
     axs[-1].set_xlabel("t (s)")
-    axs[0].set_title("table motion")
+    axs[0].set_title(f"table motion ({res.table.source})")
     return save_png(fig, out / "table.png")
 
 

@@ -92,41 +92,47 @@ def measure_imu(cfg: ExperimentConfig):
 
 
 def table_from_imu(cfg: ExperimentConfig, video_table: TableMotion | None, msgs: list):
-    """Table acceleration from the table IMU, on the video clock when the video tracked the table.
+    """Table motion from the table IMU, fused with the video's when the video tracked the table.
 
     A 50 fps camera cannot measure a record's table acceleration (content above 25 Hz is lost;
     on a synthetic El Centro run the 50 Hz samples turned a surviving block into an overturning
-    one), so the IMU (~256 Hz) drives the simulation; its clock is found by cross-correlating its
-    acceleration with the video's (t_imu = t_video + offset + drift t_video).
+    one), and a table IMU's is noisy (5 mg) and offset by any tilt. With a video table, gravity's
+    leak through the table's tilt is taken out by the IMU's gyro (``level=True``), the IMU's clock
+    is found by cross-correlating its acceleration with the video's (t_imu = t_video + offset +
+    drift t_video) and the two are fused (:func:`rocklab.tracking.fuse_table_motion`: the film's
+    displacement below a few hertz, the IMU's acceleration above, each sample's σ).
 
     Returns
     -------
     table : TableMotion
-        The IMU's acceleration; with a video table, on its clock and sense, with the video's
-        displacement and velocity interpolated onto the IMU's times.
+        ``source="fused"`` on the video's clock and sense; ``"imu"`` on the IMU's clock without a
+        video table.
     sync : rocklab.tracking.SyncResult or None
         The table IMU's clock (None without a video table).
+    fusion : rocklab.tracking.TableFusion or None
+        The fusion's noises, the IMU's offset and the sources' agreement (None without a video table).
     """
-    from ...tracking import read_imu, sync_offset, table_acceleration
+    from ...tracking import read_imu, table_acceleration
 
     log = read_imu(cfg.table.imu)
-    ta = table_acceleration(log, axis=None)
+    # with a film to pin its drift, the gyro takes gravity's leak through a pitching table out
+    ta = table_acceleration(log, axis=None, level=video_table is not None)
     t, a = np.asarray(ta.t_s, float), np.asarray(ta.acc_m_s2, float)
     if video_table is None:
         msgs.append("table IMU used on its own clock: no tracked table on video to sync it with")
-        return TableMotion.from_acceleration(t, a, source="imu", object=cfg.table.object), None
-    s = sync_offset(t, a, video_table.t_s, video_table.ax_m_s2, max_offset_s=cfg.max_offset_s)
-    # the video's sense of x is the reference: a_video = sign * a_imu
-    t_v = (t - s.offset_s) / (1.0 + s.drift)
+        return TableMotion.from_acceleration(t, a, source="imu", object=cfg.table.object), None, None
+    return fuse_with_video(t, a, video_table, cfg.max_offset_s, label=f"{cfg.path}: table")
 
-    def on_imu_times(y):  # displacement and velocity stay the video's
-        return np.interp(t_v, video_table.t_s, y, left=np.nan, right=np.nan)
 
-    table = TableMotion(
-        t_v, on_imu_times(video_table.x_m), on_imu_times(video_table.vx_m_s), s.sign * a,
-        object=video_table.object, source="imu",
-    )  # fmt: skip
-    return table, s
+def fuse_with_video(t_imu_s, acc_m_s2, video_table: TableMotion, max_offset_s: float, label: str = "table"):
+    """Sync a table IMU's acceleration to the video's table (``t_imu = t_video + offset + drift
+    t_video``, the video's sense of x) and fuse the two: ``(TableMotion, SyncResult, TableFusion)``."""
+    from ...tracking import fuse_table_motion, sync_offset
+
+    s = sync_offset(t_imu_s, acc_m_s2, video_table.t_s, video_table.ax_m_s2, max_offset_s=max_offset_s)
+    t_v = (np.asarray(t_imu_s, float) - s.offset_s) / (1.0 + s.drift)
+    fusion = fuse_table_motion(video_table, t_v, s.sign * np.asarray(acc_m_s2, float), label=label)
+    return fusion.motion, s, fusion
 
 
 def sync_clocks(ref, rot, max_offset_s):

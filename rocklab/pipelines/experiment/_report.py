@@ -91,6 +91,23 @@ def _audit_lines(audit, fit) -> list:
     return lines
 
 
+def _table_lines(res) -> list:
+    """The table motion the simulations were driven by, and for a fused one its two sources."""
+    if res.table is None:
+        return []
+    f = res.table_fusion
+    if f is None:
+        return [f"Table motion: from the {res.table.source}", ""]
+    return [
+        f"Table motion: fused from the table IMU (noise {_g(f.sigma_a_m_s2)} m/s²) and the film "
+        f"(noise {_g(1000 * f.sigma_x_m)} mm): median σ of the acceleration "
+        f"{_g(float(np.nanmedian(f.motion.sigma_ax_m_s2)))} m/s², the IMU's offset up to "
+        f"{_g(float(np.max(np.abs(f.imu_bias_m_s2))))} m/s², the film's normalised innovations "
+        f"{_g(f.video_nis)} (1 when the two agree)",
+        "",
+    ]
+
+
 def _summary_md(res, figs: dict, rrd: bool) -> str:
     lines = [
         f"# {res.name}",
@@ -121,6 +138,7 @@ def _summary_md(res, figs: dict, rrd: bool) -> str:
             f"residual {_g(None if imu is None else imu.residual_ms)} ms",
             "",
         ]
+    lines += _table_lines(res)
     lines += ["| simulation | η | RMS vs measured (rad) | impacts |", "|---|---|---|---|"]
     for law, s in res.simulations.items():
         rms = s.rms_vs_measured_rad
@@ -132,7 +150,12 @@ def _summary_md(res, figs: dict, rrd: bool) -> str:
         lines += summary_lines(res.validation, res.block.alpha_rad)
     if res.truth is not None:
         lines += [
-            f"Synthetic truth: η = {_g(res.truth.eta)}, measured θ RMS error {_g(res.truth.theta_rms_error_rad)} rad",
+            f"Synthetic truth: η = {_g(res.truth.eta)}, measured θ RMS error {_g(res.truth.theta_rms_error_rad)} rad"
+            + (
+                ""
+                if res.truth.table_acc_rms_error_rel is None
+                else f", table acceleration RMS error {100 * res.truth.table_acc_rms_error_rel:.3g} % of its RMS"
+            ),
             "",
         ]
     if res.column is not None:

@@ -173,15 +173,23 @@ class TruthComparison:
         The true η (``session.json``), when known.
     theta_rms_error_rad : float or None
         RMS of measured − true θ where both exist.
+    table_acc_rms_error_rel : float or None
+        RMS of the measured minus the true table acceleration over the true one's RMS, at the
+        truth's frames, - (None without a table).
     """
 
     t_s: np.ndarray
     theta_rad: np.ndarray
     eta: float | None
     theta_rms_error_rad: float | None
+    table_acc_rms_error_rel: float | None = None
 
     def to_dict(self) -> dict:
-        return {"eta": self.eta, "theta_rms_error_rad": self.theta_rms_error_rad}
+        return {
+            "eta": self.eta,
+            "theta_rms_error_rad": self.theta_rms_error_rad,
+            "table_acc_rms_error_rel": self.table_acc_rms_error_rel,
+        }
 
 
 @dataclass(frozen=True)
@@ -288,6 +296,8 @@ class ExperimentResult:
     simulations : dict[str, LawSimulation]
         Law → its simulation.
     table : rocklab.series.TableMotion or None
+        The table motion the simulations are driven by (``table.source``: ``fused``, ``imu``,
+        ``video`` or ``record``).
     truth : TruthComparison or None
         When the session has a synthetic truth.
     status : str
@@ -311,6 +321,8 @@ class ExperimentResult:
     energy_loss : rocklab.fitting.EnergyLoss or None
         Free rocking: the energy lost per rocking from the peaks of θ (thesis Eq. 12), the mean
         of the first four and the constant η that loses as much.
+    table_fusion : rocklab.tracking.TableFusion or None
+        The table IMU fused with the film's table (their noises, the IMU's offset, agreement).
     """
 
     name: str
@@ -335,6 +347,7 @@ class ExperimentResult:
     audit: AuditResult | None = None
     validation: object = None
     energy_loss: EnergyLoss | None = None
+    table_fusion: object = None
 
     def to_dict(self) -> dict:
         """The numbers of ``report.json`` (units in keys)."""
@@ -359,7 +372,8 @@ class ExperimentResult:
             "audit": None if self.audit is None else self.audit.to_dict(),
             "per_impact_eta": [float(x) for x in self.per_impact_eta],
             "simulations": {law: s.to_dict() for law, s in self.simulations.items()},
-            "table": None if self.table is None else _table_peaks(self.table),
+            "table_source": None if self.table is None else self.table.source,
+            "table": None if self.table is None else _table_peaks(self.table, self.table_fusion),
             "truth": None if self.truth is None else self.truth.to_dict(),
             "column": None if self.column is None else self.column.to_dict(),
             "review_video": None
@@ -385,11 +399,15 @@ class ExperimentResult:
         }
 
 
-def _table_peaks(table: TableMotion) -> dict:
-    return {
+def _table_peaks(table: TableMotion, fusion=None) -> dict:
+    d = {
+        "source": table.source,
         "peak_disp_m": None if table.x_m is None else float(np.nanmax(np.abs(table.x_m))),
         "peak_acc_m_s2": float(np.nanmax(np.abs(table.ax_m_s2))),
     }
+    if fusion is not None:
+        d["fusion"] = fusion.to_dict()
+    return d
 
 
 def _versions() -> dict:

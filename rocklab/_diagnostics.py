@@ -123,8 +123,10 @@ WARNING_CODES: dict[str, tuple[str, str]] = {
         "suspect",
         "the log is not a rocking block: its rotation axis is far from horizontal (a spin "
         "about the vertical), the rotation is spread over several axes (a hand-held sensor), "
-        "it turns through more than a half turn, or holding the rests needs a large gyro "
-        "drift; theta, release and impacts mean nothing. Check the file and the mounting",
+        "it turns through more than a half turn, holding the rests needs a large gyro "
+        "drift, or, released from rest, its half swings grow (a foot while walking; a released "
+        "block only loses energy); theta, release and impacts mean nothing. Check the file and "
+        "the mounting (a shake-table run read as a release: --release none)",
     ),
     "W-IMU-NO-REST": (
         "suspect",

@@ -85,8 +85,12 @@ def test_forced_run_rests_upright(forced):
     # The thread-release reading of the same log (the old behaviour) is clearly worse:
     # its initial-rest reference holds table acceleration (measured 0.26 deg RMS,
     # -0.43 deg at the initial rest).
-    old = block_rotation(_log(forced), "y", release="thread")
-    assert old.run_kind == "thread"
+    # It is also no free rocking: the table grows the half swings from the ~0 deg start (W-IMU-NOT-ROCKING).
+    with collecting() as found:
+        old = block_rotation(_log(forced), "y", release="thread")
+    assert old.run_kind == "thread" and old.status == "suspect"
+    assert [d.code for d in found] == ["W-IMU-NOT-ROCKING"] and "half swing" in found[0].message
+    assert np.rad2deg(old.rocking.swing_peaks_rad[1]) > 5.0  # the 8.6 deg peak after a < 2 deg start
     rms_old, _, rest0_old = _errors(old, res, res.t_s[-1])
     assert rms_old > 3 * rms and abs(rest0_old) > np.deg2rad(0.2)
 
@@ -112,8 +116,10 @@ def test_forced_log_ends_tilted(forced):
     # measured 0.045 deg.  0.1 deg is ~4 standard deviations.
     assert np.mean(rot.theta_rad[rot.t_s > t_cut + 0.3]) == pytest.approx(res.theta_rad[k], abs=np.deg2rad(0.1))
     # Anchoring on the end as upright (thread reading) shifts everything by the end tilt.
-    old = block_rotation(log, "y", release="thread")
+    with collecting() as found:  # and is flagged: a table's half swings grow (W-IMU-NOT-ROCKING)
+        old = block_rotation(log, "y", release="thread")
     assert _errors(old, res, t_cut)[0] > np.deg2rad(2.0)
+    assert [d.code for d in found] == ["W-IMU-NOT-ROCKING"] and old.status == "suspect"
 
 
 def test_forced_log_ends_moving(forced):

@@ -190,9 +190,9 @@ def forced_run(t, gyro, acc, fs, gyro_thr, acc_thr, min_run):
         return False, None, i_carry_end
     w = max(1, int(round(0.05 * fs)))
     g0 = np.median(gyro[:n0], axis=0)
-    rot = moving_average(rownorm(gyro - g0), w) > gyro_thr
-    i_rot = first_motion(rot, min_run)
-    forced = i_rot is None or t[i_rot] - t[i_carry] > 0.1
+    rate = moving_average(rownorm(gyro - g0), w)
+    i_rot = first_motion(rate > gyro_thr, min_run)
+    forced = i_rot is None or _ramp_start(t, rate, i_rot, fs) - t[i_carry] > 0.1
     ws = max(2, int(round(0.1 * fs)))
     sm = moving_average(acc, ws)
     thr = max(5.0 * float(np.linalg.norm(np.std(acc[:n0], axis=0))) / np.sqrt(ws), _FINE_ACC)
@@ -203,6 +203,23 @@ def forced_run(t, gyro, acc, fs, gyro_thr, acc_thr, min_run):
         quiet = np.flatnonzero(rownorm(sm[i_carry_end:] - f1) <= thr)
         i_carry_end = min(n, i_carry_end + (int(quiet[0]) if quiet.size else n) + ws // 2)
     return bool(forced), i_carry, i_carry_end
+
+
+def _ramp_start(t, rate, i_rot, fs) -> float:
+    """When the rotation that crosses the threshold at ``i_rot`` started, s: its rate ramp over the
+    next 50 ms extrapolated back to zero (at most 0.5 s back).
+
+    A block released near its overturning tilt speeds up slowly (its rate reaches 2 deg/s
+    0.1-0.15 s after the release) while the accelerometer sees the release at once; the
+    threshold crossing alone made such releases "forced" runs (upright = the held tilt).
+    """
+    j = min(len(t), i_rot + max(4, int(round(0.05 * fs))))
+    if j - i_rot < 3:
+        return float(t[i_rot])
+    slope = float(np.polyfit(t[i_rot:j] - t[i_rot], rate[i_rot:j], 1)[0])
+    if slope <= 0:
+        return float(t[i_rot])
+    return float(t[i_rot] - min(rate[i_rot] / slope, 0.5))
 
 
 def still_acc_start(acc, e0, e1, sigma, fs, min_rest) -> int:

@@ -31,9 +31,10 @@ Method (``block_rotation``)
    shake table (``"none"``: block upright at rest, the table moves, the block
    may rock and ends wherever it ends).  ``"auto"`` calls a run forced when
    the accelerometer *vector* leaves its initial level (by 0.03 g, 50 ms
-   means, >= 0.1 s) more than 0.1 s before the gyro shows rotation: the table
+   means, >= 0.1 s) more than 0.1 s before the gyro's rotation starts (its
+   rate ramp, once above 2 deg/s, extrapolated back to zero): the table
    carries the block before it uplifts, whereas a released block rotates at
-   once.  In a forced run the upright reference is the *initial* rest
+   once (slowly, when released near its overturning tilt).  In a forced run the upright reference is the *initial* rest
    (theta = 0 there), the rest windows end where the table starts / begin
    where it has stopped (accelerometer vector, not only its norm), the end
    rest's tilt is measured by the accelerometer, and ``release_t_s`` is NaN.
@@ -68,7 +69,7 @@ from ._motion_windows import (
     twist_angle,
 )
 from ._read import ImuLog
-from ._validity import RockingCheck, check_rocking, warn_no_rest, warn_not_rocking
+from ._validity import RockingCheck, check_rocking, half_swing_peaks, warn_no_rest, warn_not_rocking
 
 __all__ = ["ImuRotation", "block_rotation", "ahrs_rotation", "ahrs_quaternions"]
 
@@ -299,12 +300,16 @@ def block_rotation(
         status, msg = _check_gyro_vs_tilt(log.source, *changes, status, msg)
     # without a rest before, the bias came from moving samples: the drift then corrects it
     judge = status != "no_rest_before"
-    rocking = check_rocking(t, w, u, f_start, fs, drift, judge) if status != "no_motion" else None
+    rocking = None
+    if status != "no_motion":
+        # a released block only loses energy: its half swings shrink (a table feeds energy in)
+        peaks = None if forced else half_swing_peaks(theta, i_move, i_end, th_start if judge else None)
+        rocking = check_rocking(t, w, u, f_start, fs, drift, judge, peaks, has_end)
     if rocking is not None and rocking.reasons:
         # a spinning or hand-held sensor: worse than any rest-window status
         status, msg = "suspect", warn_not_rocking(log.source, rocking) + ("; " + msg if msg else "")
     elif status in ("no_rest_before", "no_rest_after"):  # theta unanchored: a coded warning (run shows it)
-        msg = warn_no_rest(log.source, status, t, i_move, i_end, min_rest_s)
+        msg = warn_no_rest(log.source, status, t, i_move, i_end, min_rest_s, omega)
     if axis is None:
         ref = th_start if abs(th_start) > np.deg2rad(1.0) else theta[np.argmax(np.abs(theta))]
         if ref < 0:

@@ -8,6 +8,20 @@ turn (a block that overturns lies on a side, ~90 deg).  A sensor turned about
 its vertical, moved by hand or spun shows none of this; integrating it about
 its principal axis gives angles that mean nothing (``W-IMU-NOT-ROCKING``).
 
+A block released from rest (a thread-burn release) only loses energy: each half
+swing's |theta| peak is at most the one before, the first at most the release
+tilt ``|theta0|``.  A foot-mounted sensor while walking pitches about one
+horizontal axis too (all the tests above pass), but swings by tens of degrees
+after resting level: a half swing that outgrows the largest earlier one on its
+side (``|theta0|`` on the release side) by more than ``SWING_GROWTH_MAX_RAD +
+SWING_GROWTH_REL * earlier`` is not free rocking.  An error of the upright
+reference (the anchoring's rests) shifts both sides' peaks in opposite senses,
+so the first peak on a side is compared with the other side's only when upright
+was measured at a final rest.  A
+forced run (a shake table feeds energy in) is not judged by this; nor is a
+last half swing that topples the block (it ends > 20 deg from upright without
+coming back).
+
 A table sensor is meant not to turn at all: gravity is removed in the
 orientation measured at the rest before shaking, so any later turn of the
 sensor leaks ``2 g sin(turn / 2)`` into the "table acceleration"
@@ -43,6 +57,13 @@ TURN_RANGE_MAX_RAD = np.pi
 #: Largest residual gyro bias the two-rest anchoring may remove, rad/s (a still MEMS
 #: gyro's bias wanders by hundredths of a deg/s over a test).
 DRIFT_MAX_RAD_S = np.deg2rad(1.0)
+#: Largest growth of a half swing's |theta| peak over the previous one (the first over
+#: |theta0|) in a thread-release run, rad, plus ``SWING_GROWTH_REL`` times the previous peak.
+#: The upright reference's error (a mis-mount, a sloping table: < 0.3 deg) enters twice.
+SWING_GROWTH_MAX_RAD = np.deg2rad(3.0)
+SWING_GROWTH_REL = 0.25
+#: |theta| past which a last half swing that does not come back is a toppled block, rad.
+_TOPPLED_RAD = np.deg2rad(20.0)
 #: Largest turn of a table sensor over the log, rad.
 TABLE_TURN_MAX_RAD = np.deg2rad(3.0)
 #: Rate above which a sample counts as rotating (50 ms means), rad/s.
@@ -63,6 +84,10 @@ class RockingCheck:
         samples, 0..1 (NaN when fewer than 0.1 s rotate).
     turn_range_rad : float
         Range of the gyro angle about the axis (bias and anchoring drift removed), rad.
+    swing_peaks_rad : tuple of float
+        |theta| peaks, rad, of the half swing that grew most beyond the bound (module
+        doc) and of the largest earlier one it is compared with: (earlier, later);
+        empty when none did or the run is forced.
     reasons : tuple of str
         The bounds broken (empty: a rocking block).
     """
@@ -71,15 +96,60 @@ class RockingCheck:
     axis_share: float
     turn_range_rad: float
     reasons: tuple = ()
+    swing_peaks_rad: tuple = ()
 
 
-def check_rocking(t, w, u, f_rest, fs, drift_rad_s, judge_drift=True) -> RockingCheck:
+def half_swing_peaks(theta, i_move: int, i_end: int, theta0_rad: float | None = None) -> np.ndarray:
+    """Signed peak of each half swing (between zero crossings of theta) over samples ``[i_move, i_end)``, rad.
+
+    ``theta0_rad`` (the release tilt measured at rest) is put first when given; a last
+    half swing that does not come back and ends past 20 deg (a toppled block) is left out.
+    """
+    th = np.asarray(theta[i_move:i_end], float)
+    peaks = [] if theta0_rad is None else [float(theta0_rad)]
+    if th.size < 2:
+        return np.asarray(peaks)
+    cut = np.flatnonzero(np.signbit(th[1:]) != np.signbit(th[:-1])) + 1
+    segs = np.split(th, cut)
+    if abs(th[-1]) > _TOPPLED_RAD and float(np.max(np.abs(segs[-1]))) <= abs(th[-1]) + np.deg2rad(1.0):
+        segs = segs[:-1]
+    return np.asarray(peaks + [float(s[np.argmax(np.abs(s))]) for s in segs if s.size])
+
+
+def _worst_growth(peaks: np.ndarray, cross_side: bool) -> tuple:
+    """The (earlier, later) |peak| pair that most exceeds the growth bound, or () if none does.
+
+    A peak is compared with the largest earlier peak on its side: an error of the upright
+    reference moves both alike. With ``cross_side`` (the upright reference was measured at a
+    final rest) the first peak on a side is compared with the largest on the other side.
+    """
+    best, pair = 0.0, ()
+    top = {True: np.nan, False: np.nan}  # largest |peak| so far per side (True: theta > 0)
+    for p in peaks:
+        side = bool(p > 0)
+        ref = top[side]
+        if np.isnan(ref) and cross_side:
+            ref = top[not side]
+        if not np.isnan(ref):
+            excess = abs(p) - ref * (1.0 + SWING_GROWTH_REL) - SWING_GROWTH_MAX_RAD
+            if excess > best:
+                best, pair = excess, (float(ref), float(abs(p)))
+        top[side] = abs(p) if np.isnan(top[side]) else max(top[side], abs(p))
+    return pair
+
+
+def check_rocking(
+    t, w, u, f_rest, fs, drift_rad_s, judge_drift=True, swing_peaks=None, upright_measured=True
+) -> RockingCheck:
     """Measure the rocking evidence (module doc) of bias-free rates ``w`` (n, 3) rad/s about ``u``.
 
     ``f_rest`` is the accelerometer mean over the rest before the motion (m/s^2,
     sensor frame); ``drift_rad_s`` the residual bias the anchoring removed (also
     removed before the turn range is taken); ``judge_drift`` False when the bias
     came from moving samples (no rest before), which the drift then rightly corrects.
+    ``swing_peaks`` (rad, from :func:`half_swing_peaks`) for a thread-release run; None
+    for a forced run, whose table feeds energy in. ``upright_measured`` False when upright
+    was not measured at a final rest (the two sides' peaks are then not compared).
     """
     w_avg = max(1, int(round(0.05 * fs)))
     rot = moving_average(rownorm(w), w_avg) > _ROT_THR_RAD_S
@@ -111,7 +181,14 @@ def check_rocking(t, w, u, f_rest, fs, drift_rad_s, judge_drift=True) -> Rocking
             f"holding the rests needs a {np.rad2deg(drift_rad_s):.3g} deg/s gyro drift "
             f"(a still gyro drifts < {np.rad2deg(DRIFT_MAX_RAD_S):.3g} deg/s)"
         )
-    return RockingCheck(tilt, share, turn, tuple(reasons))
+    grown = _worst_growth(np.asarray(swing_peaks, float), upright_measured) if swing_peaks is not None else ()
+    if grown:
+        reasons.append(
+            f"a half swing reaches {np.rad2deg(grown[1]):.3g} deg after one of {np.rad2deg(grown[0]):.3g} deg "
+            f"(a released block only loses energy: bound + {np.rad2deg(SWING_GROWTH_MAX_RAD):.2g} deg "
+            f"+ {100 * SWING_GROWTH_REL:.3g} %; a shake-table run: --release none)"
+        )
+    return RockingCheck(tilt, share, turn, tuple(reasons), grown)
 
 
 def warn_not_rocking(source: str, chk: RockingCheck) -> str:
@@ -148,22 +225,33 @@ def table_turn(t, gyro, bias, acc, f_rest, fs, min_rest) -> float:
 NO_REST_DRIFT_RAD_S = np.deg2rad(0.1)
 
 
-def warn_no_rest(source: str, status: str, t, i_move: int, i_end: int, min_rest_s: float) -> str:
+def warn_no_rest(source: str, status: str, t, i_move: int, i_end: int, min_rest_s: float, omega=None) -> str:
     """Emit ``W-IMU-NO-REST`` for a log without a rest before its first motion (``status``
-    ``"no_rest_before"``) or after its last (``"no_rest_after"``); returns its message."""
+    ``"no_rest_before"``) or after its last (``"no_rest_after"``); returns its message.
+
+    ``omega`` (rad/s, the rate about the axis) names the rate still seen at the end of a log
+    whose motion runs to its last sample."""
     if status == "no_rest_before":
         what = (
             f"motion starts {t[min(i_move, len(t) - 1)] - t[0]:.3g} s into the log, before a {min_rest_s:g} s "
             "rest: the gyro bias and the starting tilt come from the first 0.5 s, which move; theta0 and the "
             "release are not measured (start the logger before the release)"
         )
+        return warn("W-IMU-NO-REST", f"{source}: {what}").message
+    span = float(t[-1] - t[0])
+    if i_end >= len(t) - 1:
+        tail = t >= t[-1] - 0.5
+        rate = "" if omega is None else f", {np.rad2deg(np.max(np.abs(omega[tail]))):.3g} deg/s in its last 0.5 s"
+        where = f"the block still moves when the log ends (motion up to the last sample{rate})"
     else:
-        span = float(t[-1] - t[0])
-        what = (
-            f"the log ends {t[-1] - t[min(i_end, len(t) - 1)]:.3g} s after the last motion, short of a "
-            f"{min_rest_s:g} s rest: the gyro drift is not held by a final rest, so theta is integrated "
-            f"from the start alone; a drift of {np.rad2deg(NO_REST_DRIFT_RAD_S):.2g} deg/s puts it "
-            f"{np.rad2deg(NO_REST_DRIFT_RAD_S) * span:.3g} deg off by the end ({span:.4g} s; keep logging "
-            "until the block has rested)"
+        where = (
+            f"the log ends {t[-1] - t[i_end]:.2g} s after the last motion, short of the {min_rest_s:g} s rest "
+            "that anchors the drift"
         )
+    what = (
+        f"{where}: the residual gyro drift is not measured, so theta is the gyro integral from the start "
+        f"rest alone; a residual drift of {np.rad2deg(NO_REST_DRIFT_RAD_S):.2g} deg/s (a MEMS gyro's bias "
+        f"wander) puts it {np.rad2deg(NO_REST_DRIFT_RAD_S) * span:.3g} deg off by the end ({span:.4g} s "
+        "after the start; keep logging until the block has rested)"
+    )
     return warn("W-IMU-NO-REST", f"{source}: {what}").message

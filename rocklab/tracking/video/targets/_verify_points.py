@@ -259,8 +259,12 @@ class VerifiedDetector:
         return out
 
     def lost_reason(self, oid):
-        """Why object ``oid``'s last detection was refused, or None (not found at all)."""
-        return self.reasons.get(oid)
+        """Why object ``oid``'s last detection was refused (by the verifier, or by the detector
+        itself), or None (not found at all)."""
+        why = self.reasons.get(oid)
+        if why is None and hasattr(self.inner, "lost_reason"):
+            why = self.inner.lost_reason(oid)
+        return why
 
     def theta_note(self, oid):
         return self.inner.theta_note(oid) if hasattr(self.inner, "theta_note") else None

@@ -362,7 +362,7 @@ def fig43(ctx) -> Built:
 
     base = bundled_record("elcentro")
     plt = _plt()
-    fig, ax = plt.subplots(1, 3, figsize=(12, 3.8), constrained_layout=True, sharey=True)
+    fig, ax = plt.subplots(1, 3, figsize=(12, 3.8), constrained_layout=True, sharex=True, sharey=True)
     frames, nums, size = [], {}, {}
     for a_, n in zip(ax, (1, 2, 3)):
         for k in (1, 2, 10):
@@ -375,6 +375,9 @@ def fig43(ctx) -> Built:
             nums[f"mean_unsafe_R_m_{n}_blocks_{k}_impacts"] = number(None, size[n, k], "m")
         a_.set(xscale="log", xlabel="p [1/s] (whole column)", title=f"{n} block{'s' if n > 1 else ''}, H/B = 12")
         a_.legend(fontsize=7)
+    ticks = [0.7, 1.0, 1.5, 2.0]
+    ax[0].set_xticks(ticks, [f"{t:g}" for t in ticks], minor=False)
+    ax[0].set_xticks([], minor=True)
     ax[0].set_ylabel("a_p / a_p,min")
     _save(fig, ctx.png("ther:Fig. 43"))
     less = all(size[n, 10] >= size[n, 1] for n in (1, 2, 3))

@@ -53,8 +53,17 @@ def test_cli_oas_column(run_cli, tmp_path):
     rc, out, err = run_cli(*args, "--column", "1", "--refine", "5", "--json", "-o", tmp_path / "c.csv")
     assert rc == 0, err
     d = json.loads(out)
-    blk = overturning_spectrum(pulse_motion("sine", 2.0, 1.0), 6.0, levels=4, sizes=12, refine=5, R_max_m=100.0)
+    blk = overturning_spectrum(pulse_motion("sine", 2.0, 1.0), 6.0, levels=4, sizes=12, refine=5)
     assert d["options"]["n_blocks"] == 1 and d["t_I_s"] == pytest.approx(blk.t_I_s, rel=1e-6)
     assert (tmp_path / "c.csv").read_text().startswith("level,p_min_rad_s")
     rc, _, err = run_cli(*args, "--column", "2", "--eta", "0.9")
     assert rc == 2 and "--eta" in err and "Traceback" not in err
+
+
+def test_a_column_coming_apart_counts_unsafe(sine):
+    # stocky blocks (three of h/b = 2) under 4 a_p,min: a joint would take tension (thesis §3.3: the
+    # calculation stops, the column may disintegrate); such runs are unsafe and counted
+    o = column_overturning_spectrum(sine, 6.0, 3, levels=2, level_max=4.0, sizes=2, R_max_m=1000.0, R_min_m=100.0)
+    assert o.options["n_terminated"] >= 1
+    assert o.overturned[1, 0]  # R = 1000 m at a_p = 4 a_p,min: tension, not a safe block
+    assert not o.overturned[0].any()  # at a_p,min nothing lifts far enough

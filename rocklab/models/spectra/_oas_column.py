@@ -110,8 +110,8 @@ def column_overturning_spectrum(
     n_impacts: int = 1,
     levels: int = 19,
     level_max: float = 10.0,
-    sizes: int = 41,
-    R_max_m: float = 100.0,
+    sizes: int = 49,
+    R_max_m: float = 1000.0,
     R_min_m: float = 0.1,
     refine: int = 6,
     max_p_dt: float = 0.003,
@@ -134,8 +134,10 @@ def column_overturning_spectrum(
     n_impacts : int
         Consecutive impacts per closing (1 Housner; 2 the thesis's model; 10 "rolling").
     levels, level_max, sizes, R_max_m, R_min_m, refine, search :
-        As :func:`~rocklab.models.overturning_spectrum` (R the column's half-diagonal, m); a
-        coarser default grid, each point being a column run.
+        As :func:`~rocklab.models.overturning_spectrum` (R the column's half-diagonal, m; the same
+        size range, 1000 m to 0.1 m), on a coarser default grid, each point being a column run.
+        A level whose largest size already overturns has its boundary beyond the grid (no
+        bisection there): give a larger ``R_max_m``.
     max_p_dt : float
         Step times the largest block p of the run (the top block's).
     free_pt : float

@@ -70,12 +70,7 @@ def _register_oas(sub):
     p.add_argument("--slenderness", type=float, default=12.0, help="block h/b (default 12)")
     p.add_argument("--levels", type=int, default=None, help="a_p/a_p,min levels 1..level-max (80; with --column 19)")
     p.add_argument("--level-max", type=float, default=10.0, help="largest a_p/a_p,min level (default 10)")
-    p.add_argument(
-        "--sizes",
-        type=int,
-        default=None,
-        help="log-spaced R from 1000 m to 0.1 m (120; with --column 41 sizes from 100 m to 0.1 m)",
-    )
+    p.add_argument("--sizes", type=int, default=None, help="log-spaced R from 1000 m to 0.1 m (120; with --column 49)")
     p.add_argument(
         "--column",
         type=count(1),

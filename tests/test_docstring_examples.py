@@ -17,7 +17,7 @@ FLAGS = doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE
 
 def _entry_points():
     from rocklab.fitting import fit_restitution
-    from rocklab.models import overturning_spectrum, simulate
+    from rocklab.models import column_overturning_spectrum, overturning_spectrum, simulate
     from rocklab.pipelines import run_experiment
     from rocklab.tracking import track_video
     from rocklab.tracking.video.targets._observability import turn_share
@@ -28,6 +28,7 @@ def _entry_points():
         "track_video": track_video,
         "fit_restitution": fit_restitution,
         "overturning_spectrum": overturning_spectrum,
+        "column_overturning_spectrum": column_overturning_spectrum,
         "run_experiment": run_experiment,
         "turn_share": turn_share,
         "roundness": roundness,

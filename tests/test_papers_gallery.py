@@ -5,6 +5,13 @@ import re
 
 import pytest
 
+import numpy as np
+import pandas as pd
+from scipy.optimize import brentq
+
+from rocklab.blocks import Block
+from rocklab.models import eta_axes, eta_bumps
+from rocklab.models.spectra import normalised_critical_impulse
 from rocklab.pipelines.papers import ENTRIES, regenerate
 
 
@@ -19,7 +26,8 @@ def test_every_figure_and_table_has_one_row():
         assert tabs == set(range(1, n_tab + 1)), paper
     # a row is regenerated or says why not: never silently empty
     assert all((e.build is not None) != bool(e.why_not) for e in ENTRIES)
-    assert sum(e.build is not None for e in ENTRIES) >= 45
+    assert sum(e.build is not None for e in ENTRIES) >= 49
+    assert not [e.key for e in ENTRIES if "open" in e.why_not]  # every row regenerated or says the true reason
 
 
 def _run(tmp_path, only, records=None):
@@ -75,8 +83,15 @@ def test_thesis_fig14_needs_records_then_matches(tmp_path, shared_data):
 
 
 def test_thesis_record_figures(tmp_path, shared_data):
-    _, numbers = _run(tmp_path, "ther:Fig. 52,ther:Fig. 55,ther:Fig. 53", records=shared_data / "records")
+    _, numbers = _run(tmp_path, "ther:Fig. 52,ther:Fig. 55,ther:Fig. 53,ther:Fig. 47", records=shared_data / "records")
     assert -1 <= numbers["ther:Fig. 53"]["r"]["rocklab"] <= 1
+    # Fig. 47: t_I of the characteristic OAS is i_cr over the leftmost point of its transform (Eq. 20)
+    char = pd.read_csv(tmp_path / "ther_fig47.csv")
+    f_min = (char.level * char.p_min_rad_s).min()
+    assert char.f_rad_s.min() == pytest.approx(f_min, rel=1e-12)
+    t_I = numbers["ther:Fig. 47"]["t_I_s"]["rocklab"]
+    assert t_I == pytest.approx(normalised_critical_impulse(np.arctan(1 / 12)) / f_min, rel=1e-12)
+    assert 0.1 < t_I < 1.0  # the records' own t_I lie between 0.2 and 0.5 s
     assert numbers["ther:Fig. 52"]["t_p_s"]["rocklab"] == pytest.approx(0.405, abs=0.0005)  # Table 4: 0.405 s
     n55 = numbers["ther:Fig. 55"]
     assert n55["t_I_s"]["paper"] == 0.27  # Fig. 55's own printed value, not Table 4's 0.266
@@ -105,3 +120,32 @@ def test_cli_papers(run_cli, tmp_path):
     assert d["n_rows"] == len(ENTRIES) and d["n_regenerated"] == 1 and d["failed"] == []
     rc, out, err = run_cli("papers", "--out", tmp_path / "h", "--records", tmp_path / "nowhere")
     assert rc == 2 and "not a folder" in err
+
+
+def test_ceh_table1_and_fig5(tmp_path):
+    _, numbers = _run(tmp_path, "ceh2018:Table 1,ceh2018:Fig. 5")
+    for q in numbers["ceh2018:Table 1"].values():  # alpha, R, eta_H rounded as printed, and "rocking"
+        assert q["rocklab"] == q["paper"]
+    for q in numbers["ceh2018:Fig. 5"].values():  # the simulated omega jumps are eta_H's (0.9294, 0.5385)
+        assert q["rocklab"] == pytest.approx(q["paper"], abs=5e-5)
+
+
+def test_thesis_tables2_3_agree_through_the_implied_widths():
+    # Fig. 23 (the blocks' widths) is not held; Table 2's printed cut-corner losses (5 mm cuts, Eq. A3)
+    # fix b, and with it rocklab's laws give Table 3's printed model losses: config b (one middle
+    # bump, Eq. A7) within 0.1 point, c (wires 7 mm in) and d (c and a middle wire) within 0.8: c's
+    # 27.3 % against the printed 26.5 % (h/b 2.79) and 17.0 % against 17.2 % (h/b 3.70) are the
+    # largest gaps, of opposite sign, so no single width explains them (docs/discrepancies.md)
+    from rocklab.pipelines.papers._ther import TABLE23_IMPLIED_B_MM
+
+    def loss(eta):
+        return 1 - eta**2
+
+    printed = {2.79: (0.284, 0.148, 0.265, 0.138), 3.70: (0.177, 0.090, 0.172, 0.086)}
+    for (hb, (a, b_, c, d)), b_mm in zip(printed.items(), TABLE23_IMPLIED_B_MM):
+        b = brentq(lambda w: loss(eta_axes(Block(w, hb * w), 0.005 - w / 2, w / 2 - 0.005)) - a, 0.02, 2.0)
+        assert b * 1e3 == pytest.approx(b_mm, abs=0.1)  # the row's text quotes these
+        blk = Block(b, hb * b)
+        assert loss(eta_bumps(blk, 1, b / 2 - 0.005)) == pytest.approx(b_, abs=0.001)
+        assert loss(eta_axes(blk, 0.007 - b / 2, b / 2 - 0.007)) == pytest.approx(c, abs=0.008)
+        assert loss(eta_bumps(blk, 1, b / 2 - 0.007)) == pytest.approx(d, abs=0.005)

@@ -1,7 +1,8 @@
 """The papers' regenerated figures in the site: ``rocklab papers`` runs at build time.
 
 The figures are computed, not stored: at each build the gallery is regenerated into a temporary
-folder (the figures that need no record files, about 35 s on one core) and added to the site as
+folder (the figures that need no record files, about 70 s on one core, half of it the nine
+column OAS of thesis Fig. 43) and added to the site as
 ``gallery/figures/index.md`` with every PNG beside it. The page is the gallery's own index (one
 row per figure and table of the three papers) followed by the images themselves, so a reader sees
 each figure with its comparison. A figure that fails to regenerate fails the build.

@@ -16,6 +16,7 @@ from ._oas import (
     overturning_spectrum,
     simplified_oas,
 )
+from ._oas_column import column_overturning_spectrum
 from ._oas_curve import OverturningCurve, overturning_curve
 from ._oas_sets import CharacteristicOAS, TItpRegression, characteristic_oas, oas_convex_hull, tI_tp_regression
 from ._oas_band import BAND_ENSEMBLE, TIBand, t_I_band
@@ -51,6 +52,7 @@ __all__ = [
     "F_SINE",
     "OASResult",
     "overturning_spectrum",
+    "column_overturning_spectrum",
     "OverturningCurve",
     "overturning_curve",
     "CharacteristicOAS",

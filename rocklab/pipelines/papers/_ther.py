@@ -85,10 +85,17 @@ TABLES = {
 }
 DRAWING = "a drawing or photograph: no data to regenerate"
 EXPERIMENT = "measured data the thesis shows only as a plot (not given as numbers): not invented"
-OPEN = "open: not regenerated yet (issue 30)"
+NF37 = (
+    "needs the near-field record NF-37 (1994 Northridge, Rinaldi Receiving Station 228, FEMA P695), which "
+    "neither rocklab nor ../shared/data/records holds; "
+)
 WHY = {
     **{k: DRAWING for k in (1, 2, 5, 6, 7, 10, 11, 15, 16, 17, 18, 19, 20, 21, 22, 23, 24, 28, 30, 38, 51, 54, 59)},
     **{k: EXPERIMENT for k in (25, 26, 27, 31, 32)},
+    57: NF37 + "with it, `rocklab oas NF37.AT2 --slenderness 12` and Voyagaki's triangular pulse of T_p/2 = 0.6 s "
+    "(`rocklab oas --pulse`) give the two curves",
+    58: NF37 + "and the two replacement signals' durations were read off the record's OAS and are drawn, not "
+    "printed (Fig. 58b's Erzincan NF-26 is not held either)",
 }
 
 
@@ -249,6 +256,10 @@ def fig14(ctx) -> Built:
     return Built(df, nums, note)
 
 
+#: The widths (mm) at which Eq. A3 with 5 mm cut corners gives Table 2's printed 28.4 % and 17.7 %
+#: for h/b = 2.79 and 3.70 (tests/test_papers_gallery.py solves for them again).
+TABLE23_IMPLIED_B_MM = (181.1, 204.2)
+
 BUILDERS = {4: fig4, 12: fig12, 29: fig29, 14: fig14, **_SPECTRA, **_SETS}
 NEEDS_RECORDS = {14, *_SPECTRA_RECORDS, *_SETS_RECORDS}
 
@@ -264,17 +275,23 @@ def _entries():
         elif n in BUILDERS:
             out.append(Entry(key, cap, BUILDERS[n], needs_records=n in NEEDS_RECORDS))
         else:
-            out.append(Entry(key, cap, why_not=WHY.get(n, OPEN)))
+            out.append(Entry(key, cap, why_not=WHY[n]))
     for n, cap in TABLES.items():
         why = {
             1: "measured data of other authors (quoted, not computed)",
-            2: "the model column (Housner with the 5 mm cut corners, Eq. A3) needs the blocks' widths, given in "
-            "Fig. 23 only; from h/b alone Housner loses 31.2 % and 19.4 % (printed 28.4 % and 17.7 %); the "
-            "experiment columns are the thesis's measurements",
-            3: "as Table 2: the wires' and cut corners' model losses need the blocks' widths (Fig. 23 only)",
+            2: "the model column (Housner with the 5 mm cut corners, Eq. A3) needs the blocks' widths, drawn in "
+            "Fig. 23 only, and the thesis is held as a text extraction without its figures (../shared/papers); "
+            "from h/b alone Housner loses 31.2 % and 19.4 % (printed 28.4 % and 17.7 %). The printed values "
+            f"imply b = {TABLE23_IMPLIED_B_MM[0]:.0f} mm and {TABLE23_IMPLIED_B_MM[1]:.0f} mm (a reading to check "
+            "against Fig. 23, not used as data); the experiment columns are the thesis's measurements",
+            3: "as Table 2: the model losses need the blocks' widths (Fig. 23 only). With the widths Table 2's "
+            "printed values imply, Eq. A3/A7 give configuration b (a middle wire) 14.8 % and 9.1 % (printed "
+            "14.8 %, 9.0 %), c (wires 7 mm in) 27.3 % and 17.0 % (26.5 %, 17.2 %), d (c and a middle wire) "
+            "14.2 % and 8.7 % (13.8 %, 8.6 %): the thesis's two tables agree with each other and with rocklab's "
+            "laws to 0.8 points (tests/test_papers_gallery.py)",
             4: "needs the 44 FEMA far-field records (not shipped): `python benchmarks/oas_fema44.py` computes it where they are",
             5: "needs the near-field records (not shipped)",
-        }.get(n, OPEN)
+        }[n]
         out.append(Entry(f"ther:Table {n}", cap, why_not=why))
     return out
 

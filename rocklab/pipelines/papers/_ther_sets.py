@@ -61,6 +61,40 @@ def fig44(ctx) -> Built:
     return Built(c.to_frame(), {"n_records": number(None, len(sp), "")}, note)
 
 
+def fig47(ctx) -> Built:
+    import pandas as pd
+
+    from ...models.spectra import characteristic_oas, normalised_critical_impulse, simplified_oas
+
+    sp = _spectra(ctx)
+    c = characteristic_oas([o for _, o, _ in sp], 0.16)
+    f = c.levels * c.p_min_rad_s
+    icr = normalised_critical_impulse(float(sp[0][1].alpha_rad))
+    f_min = float(np.nanmin(f))
+    t_I = icr / f_min  # Eq. 20: the vertical line of the simplified transformed OAS
+    p = np.geomspace(np.nanmin(c.p_min_rad_s) / 2, np.nanmax(c.p_min_rad_s) * 2, 200)
+    simple = simplified_oas(p, t_I, i_cr=icr)
+    plt = _plt()
+    fig, ax = plt.subplots(1, 2, figsize=(10, 3.8), constrained_layout=True, sharey=True)
+    ax[0].plot(c.p_min_rad_s, c.levels, "k.-", label="characteristic OAS (16 % exceedance)")
+    ax[0].plot(p, simple, "k--", label=f"simplified (Eq. 21), t_I = {t_I:.3g} s")
+    ax[1].plot(f, c.levels, "k.-", label="transformed characteristic OAS")
+    ax[1].axvline(f_min, color="k", ls="--", label=f"f_min = i_cr / t_I = {f_min:.3g} 1/s")
+    ax[0].set(xscale="log", xlabel="p [1/s]", ylabel="a_p / a_p,min", ylim=(0, float(c.levels.max()) * 1.05))
+    ax[1].set(xlabel="f = p a_p/a_p,min [1/s]")
+    for a_ in ax:
+        a_.legend(fontsize=7)
+    _save(fig, ctx.png("ther:Fig. 47"))
+    df = pd.DataFrame({"level": c.levels, "p_min_rad_s": c.p_min_rad_s, "f_rad_s": f})
+    nums = {"t_I_s": number(None, t_I, "s"), "f_min_rad_s": number(None, f_min, "1/s")}
+    note = (
+        f"the characteristic OAS of Fig. 44 transformed (f = p a_p/a_p,min) and its simplified form, the vertical "
+        f"line at f_min (t_I = {t_I:.3g} s, Eq. 20-21); the thesis's curve is an example without printed values; "
+        + _scope(len(sp))
+    )
+    return Built(df, nums, note)
+
+
 def fig48(ctx) -> Built:
     import pandas as pd
 
@@ -154,5 +188,5 @@ def fig53(ctx) -> Built:
     return Built(df, nums, note)
 
 
-BUILDERS = {44: fig44, 48: fig48, 49: fig49, 50: fig50, 53: fig53}
+BUILDERS = {44: fig44, 47: fig47, 48: fig48, 49: fig49, 50: fig50, 53: fig53}
 NEEDS_RECORDS = set(BUILDERS)

@@ -2,7 +2,8 @@
 
 - ``rocklab pulse RECORD [--units g]`` → a_max_m_s2, I_max_m_s, t_p_s (thesis Eq. 16, 25)
 - ``rocklab oas RECORD... --slenderness 12 [--levels 80] [--sizes 120] [-o oas.csv] [--plot oas.png]``
-  → t_I_s, t_I_prime_s, beta, f_min (thesis §5.1.3, §5.3); several records run in
+  → t_I_s, t_I_prime_s, beta, f_min (thesis §5.1.3, §5.3); ``--column N [--impacts K]`` the OAS of a
+  column of N blocks (thesis Fig. 43, one record or --pulse); several records run in
   parallel (``--workers``, or ``--scheduler ADDR`` for Dask) and ``-o`` is then the
   summary table ``record, t_p_s, t_I_s, t_I_prime_s, beta, f_min, error``.
 - ``rocklab design --height 12 --ag 0.14 --tI 0.7 [--mass-at-top]`` → width_m (Eq. 21/23)
@@ -67,9 +68,22 @@ def _register_oas(sub):
         "and one record stating other units is an error",
     )
     p.add_argument("--slenderness", type=float, default=12.0, help="block h/b (default 12)")
-    p.add_argument("--levels", type=int, default=80, help="a_p/a_p,min levels 1..level-max (80)")
+    p.add_argument("--levels", type=int, default=None, help="a_p/a_p,min levels 1..level-max (80; with --column 19)")
     p.add_argument("--level-max", type=float, default=10.0, help="largest a_p/a_p,min level (default 10)")
-    p.add_argument("--sizes", type=int, default=120, help="log-spaced R from 1000 m to 0.1 m (120)")
+    p.add_argument("--sizes", type=int, default=None, help="log-spaced R from 1000 m to 0.1 m (120; with --column 49)")
+    p.add_argument(
+        "--column",
+        type=count(1),
+        default=None,
+        metavar="N",
+        help="the OAS of a column of N equal blocks stacked to --slenderness (thesis Fig. 43; one record or --pulse)",
+    )
+    p.add_argument(
+        "--impacts",
+        type=count(1),
+        default=1,
+        help="with --column: consecutive impacts per closing (1 Housner, 2 the thesis's model, 10 'rolling')",
+    )
     p.add_argument("--refine", type=count(0), default=10, help="bisection steps on the boundary (10)")
     p.add_argument(
         "--criterion",
@@ -220,10 +234,12 @@ def _free(v):
 def run_oas(args) -> int:
     from ...._io import write_frame_atomic
 
+    if args.column is not None:
+        return _run_oas_column(args)
     kw = dict(
-        levels=args.levels,
+        levels=80 if args.levels is None else args.levels,
         level_max=args.level_max,
-        sizes=args.sizes,
+        sizes=120 if args.sizes is None else args.sizes,
         refine=args.refine,
         criterion=args.criterion,
         free=_free(args.free),
@@ -260,6 +276,62 @@ def run_oas(args) -> int:
             f"{rec.name}: t_I = {o.t_I_s:.4f} s, t'_I = {o.t_I_prime_s:.4f} s, beta = {o.beta:.3f}, "
             f"f_min = {o.f_min_rad_s:.4f} 1/s at a_p/a_p,min = {lv:.3f}, R = {R:.3f} m "
             f"(H/B = {args.slenderness:g})"
+        )
+    return 0
+
+
+def _run_oas_column(args) -> int:
+    """``rocklab oas REC --column N [--impacts K]``: the OAS of a column (thesis Fig. 43)."""
+    from pathlib import Path
+
+    from ...._io import write_frame_atomic
+    from ....models import column_overturning_spectrum, load_base_motion
+
+    fixed = {
+        "--band": args.band,
+        "--list": args.list,
+        "--eta": args.eta is not None,
+        "--criterion": args.criterion != "angle",
+        "--free": args.free != "energy",
+    }
+    bad = [k for k, v in fixed.items() if v]
+    if bad:
+        raise InputError(
+            f"rocklab oas --column: {', '.join(bad)} apply to a single block (a column's restitution follows "
+            "from --impacts, it overturns when a joint's centre of mass passes its pivot); leave them out"
+        )
+    if args.pulse is not None and args.record:
+        raise InputError("rocklab oas --column: give one record or --pulse, not both")
+    if args.pulse is None and (len(args.record) != 1 or Path(args.record[0]).is_dir()):
+        raise InputError("rocklab oas --column: give one record file (or --pulse KIND,PEAK,T_P)")
+    rec = pulse_from_spec(args.pulse) if args.pulse is not None else load_base_motion(args.record[0], units=args.units)
+    kw = {k: v for k, v in (("levels", args.levels), ("sizes", args.sizes)) if v is not None}
+    o = column_overturning_spectrum(
+        rec,
+        args.slenderness,
+        args.column,
+        n_impacts=args.impacts,
+        level_max=args.level_max,
+        refine=args.refine,
+        search=args.search,
+        **kw,
+    )
+    if args.out:
+        write_frame_atomic(args.out, o.to_frame())
+    if args.plot:
+        from ...spectra import plot_oas
+
+        plot_oas(o, args.plot)
+    d = o.to_dict()
+    if args.json:
+        _emit(d)
+    else:
+        lv, R = o.f_min_at
+        print(
+            f"{rec.name}: column of {args.column} block(s), {args.impacts} impact(s) per closing, "
+            f"H/B = {args.slenderness:g}: t_I = {o.t_I_s:.4f} s, f_min = {o.f_min_rad_s:.4f} 1/s at "
+            f"a_p/a_p,min = {lv:.3f}, R = {R:.3f} m (the whole column's p and R); "
+            f"{o.options['n_terminated']} run(s) ended by tension or sliding (counted unsafe)"
         )
     return 0
 

@@ -102,6 +102,68 @@ def _boundary(over, p, search):
     return p_hi, p_lo
 
 
+def _check_column_options(n_blocks, n_impacts, max_p_dt, rest_pt, free_pt, search, grid) -> tuple[int, int]:
+    """The column-specific options of :func:`column_overturning_spectrum`, checked (one-line
+    :class:`InputError` naming the option); returns (n_blocks, n_impacts) as integers."""
+    if int(n_blocks) != n_blocks or int(n_blocks) < 1:
+        raise InputError(f"n_blocks={n_blocks!r}: a column has a whole number of blocks >= 1 (e.g. 2)")
+    if int(n_impacts) != n_impacts or int(n_impacts) < 1:
+        raise InputError(f"n_impacts={n_impacts!r}: consecutive impacts per closing must be a whole number >= 1")
+    if not (math.isfinite(max_p_dt) and 0 < max_p_dt <= 0.01):
+        raise InputError(f"max_p_dt={max_p_dt!r}: step times p must be in (0, 0.01] (converged impacts)")
+    if not (math.isfinite(rest_pt) and 0 < rest_pt <= 0.01):
+        raise InputError(f"rest_pt={rest_pt!r}: the rest threshold, in units of p, must be in (0, 0.01]")
+    if not (math.isfinite(free_pt) and free_pt >= 0):
+        raise InputError(f"free_pt={free_pt!r}: free rocking after the record, in units of 1/p, must be >= 0")
+    if search not in ("scan", "contiguous"):
+        raise InputError(f"search={search!r}: use 'scan' or 'contiguous'")
+    if grid not in ("top-down", "adaptive", "dense"):
+        raise InputError(f"grid={grid!r}: use 'top-down', 'adaptive' (refined where verdicts change) or 'dense'")
+    if grid == "top-down" and search != "scan":
+        raise InputError("grid='top-down' finds the scan boundary only; give search='scan' or another grid")
+    return int(n_blocks), int(n_impacts)
+
+
+def _bisect(p_hi, p_lo, unsafe, refine: int) -> None:
+    """Geometric bisection of each level's boundary between ``p_lo`` (safe) and ``p_hi``
+    (unsafe), in place, ``refine`` halvings; ``unsafe(level index, p)`` runs one column."""
+    for i in np.flatnonzero(np.isfinite(p_hi) & np.isfinite(p_lo)):
+        for _ in range(refine):
+            pm = math.sqrt(p_hi[i] * p_lo[i])
+            if unsafe(i, pm):
+                p_hi[i] = pm
+            else:
+                p_lo[i] = pm
+
+
+def _oas_result(base, alpha, lv, R, p, over, evaluated, p_hi, opts) -> OASResult:
+    """The :class:`OASResult` of a column's verdict grid and boundary (``p_hi`` per level)."""
+    f = lv * p_hi
+    icr = normalised_critical_impulse(alpha)
+    f_min = float(np.nanmin(f)) if np.isfinite(f).any() else float("nan")
+    tIp, beta = fit_inclined_line(f, lv)
+    return OASResult(
+        levels=lv,
+        R_m=R,
+        p_rad_s=p,
+        overturned=over,
+        p_min_rad_s=p_hi,
+        R_unsafe_max_m=G / (ALPHA_I_SOLID * p_hi**2),
+        f_rad_s=f,
+        f_min_rad_s=f_min,
+        t_I_s=icr / f_min if math.isfinite(f_min) else float("nan"),
+        t_I_prime_s=tIp,
+        beta=beta,
+        i_cr=icr,
+        alpha_rad=alpha,
+        alpha_I=ALPHA_I_SOLID,
+        eta=float("nan"),
+        name=base.name,
+        options=opts,
+        evaluated=evaluated,
+    )
+
+
 def column_overturning_spectrum(
     base: BaseMotion,
     slenderness: float = 12.0,
@@ -175,36 +237,19 @@ def column_overturning_spectrum(
     from ._pulses import check_record
 
     base = check_record(base)
-    if int(n_blocks) != n_blocks or int(n_blocks) < 1:
-        raise InputError(f"n_blocks={n_blocks!r}: a column has a whole number of blocks >= 1 (e.g. 2)")
-    if int(n_impacts) != n_impacts or int(n_impacts) < 1:
-        raise InputError(f"n_impacts={n_impacts!r}: consecutive impacts per closing must be a whole number >= 1")
-    if not (math.isfinite(max_p_dt) and 0 < max_p_dt <= 0.01):
-        raise InputError(f"max_p_dt={max_p_dt!r}: step times p must be in (0, 0.01] (converged impacts)")
-    if not (math.isfinite(rest_pt) and 0 < rest_pt <= 0.01):
-        raise InputError(f"rest_pt={rest_pt!r}: the rest threshold, in units of p, must be in (0, 0.01]")
-    if not (math.isfinite(free_pt) and free_pt >= 0):
-        raise InputError(f"free_pt={free_pt!r}: free rocking after the record, in units of 1/p, must be >= 0")
-    if search not in ("scan", "contiguous"):
-        raise InputError(f"search={search!r}: use 'scan' or 'contiguous'")
-    if grid not in ("top-down", "adaptive", "dense"):
-        raise InputError(f"grid={grid!r}: use 'top-down', 'adaptive' (refined where verdicts change) or 'dense'")
-    if grid == "top-down" and search != "scan":
-        raise InputError("grid='top-down' finds the scan boundary only; give search='scan' or another grid")
-    n_blocks, n_impacts = int(n_blocks), int(n_impacts)
+    n_blocks, n_impacts = _check_column_options(n_blocks, n_impacts, max_p_dt, rest_pt, free_pt, search, grid)
     alpha = math.atan(1.0 / sl)
     lv = np.linspace(1.0, float(level_max), int(levels))
     R = float(R_max_m) * (float(R_min_m) / float(R_max_m)) ** (np.arange(int(sizes)) / (int(sizes) - 1))
     p = np.sqrt(G / (ALPHA_I_SOLID * R))
     scales = lv * math.tan(alpha) * G / base.pga_m_s2
 
-    terminated = []
+    terminated = []  # runs stopped by tension or sliding at a joint: counted unsafe
 
     def one(scale, p_rad_s):
-        R_m = G / (ALPHA_I_SOLID * p_rad_s**2)
+        R_m = G / (ALPHA_I_SOLID * p_rad_s**2)  # the column's half-diagonal at this p
         status = _overturns(base, scale, R_m, alpha, n_blocks, n_impacts, max_p_dt, free_pt, rest_pt, velocity_terms)
-        if status in ("tension", "sliding"):
-            terminated.append(status)
+        terminated.extend([status] if status in ("tension", "sliding") else [])
         return status in ("overturned", "tension", "sliding")
 
     def run(rows, cols):
@@ -219,17 +264,7 @@ def column_overturning_spectrum(
     else:
         over, evaluated = _top_down(run, lv.size, p.size)
     p_hi, p_lo = _boundary(over, p, search)
-    for i in np.flatnonzero(np.isfinite(p_hi) & np.isfinite(p_lo)):  # geometric bisection per level
-        for _ in range(int(refine)):
-            pm = math.sqrt(p_hi[i] * p_lo[i])
-            if one(scales[i], pm):
-                p_hi[i] = pm
-            else:
-                p_lo[i] = pm
-    f = lv * p_hi
-    icr = normalised_critical_impulse(alpha)
-    f_min = float(np.nanmin(f)) if np.isfinite(f).any() else float("nan")
-    tIp, beta = fit_inclined_line(f, lv)
+    _bisect(p_hi, p_lo, lambda i, pm: one(scales[i], pm), int(refine))
     opts = dict(
         n_blocks=n_blocks,
         n_impacts=n_impacts,
@@ -248,23 +283,4 @@ def column_overturning_spectrum(
         grid=grid,
         n_terminated=len(terminated),
     )
-    return OASResult(
-        levels=lv,
-        R_m=R,
-        p_rad_s=p,
-        overturned=over,
-        p_min_rad_s=p_hi,
-        R_unsafe_max_m=G / (ALPHA_I_SOLID * p_hi**2),
-        f_rad_s=f,
-        f_min_rad_s=f_min,
-        t_I_s=icr / f_min if math.isfinite(f_min) else float("nan"),
-        t_I_prime_s=tIp,
-        beta=beta,
-        i_cr=icr,
-        alpha_rad=alpha,
-        alpha_I=ALPHA_I_SOLID,
-        eta=float("nan"),
-        name=base.name,
-        options=opts,
-        evaluated=evaluated,
-    )
+    return _oas_result(base, alpha, lv, R, p, over, evaluated, p_hi, opts)

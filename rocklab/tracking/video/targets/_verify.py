@@ -232,25 +232,25 @@ class PoseVerifier:
         if self.filled or self.first_known or frame == self._sampled_at:
             return
         self._sampled_at = frame
-        u0, v0, u1, v1 = self.outer
-        self.lost_crops.append(np.array(gray[v0:v1, u0:u1]))
-        self.n_lost += 1
-        if self.n_lost % LOST_SAMPLES[0]:  # tried every few frames: a median costs
-            return
         import cv2
 
+        u0, v0, u1, v1 = self.outer
+        crop = np.array(gray[v0:v1, u0:u1])
         f = min(1.0, 40.0 / max(self.size))
 
         def small(img):
             return img if f == 1.0 else cv2.resize(img, None, fx=f, fy=f, interpolation=cv2.INTER_AREA)
 
-        med = np.median(np.stack([small(c) for c in self.lost_crops]), axis=0).astype(np.float32)
-        first = small(self.first_outer)
-        if float(np.mean(np.abs(med - first) >= BG_TOL)) < BG_CHANGED:
+        self.lost_crops.append((crop, small(crop)))
+        self.n_lost += 1
+        if self.n_lost % LOST_SAMPLES[0]:  # tried every few frames: a median costs
+            return
+        med = np.median(np.stack([c[1] for c in self.lost_crops]), axis=0).astype(np.float32)
+        if float(np.mean(np.abs(med - small(self.first_outer)) >= BG_TOL)) < BG_CHANGED:
             return  # the first view is still there: the object did not leave (or was lost in place)
         if best_turned_match(med, small(self.tmpl0), 0.0, MEDIAN_TURNS_DEG, min_cc) is not None:
             return  # the object, or an object like it, stands there
-        self.bg[v0:v1, u0:u1] = np.median(np.stack(self.lost_crops), axis=0)
+        self.bg[v0:v1, u0:u1] = np.median(np.stack([c[0] for c in self.lost_crops]), axis=0)
         self.first_known = True
 
     def learn_outline(self):

@@ -13,6 +13,9 @@ Validation films (never tuned on): the other take of the same scene at four reso
 ``film1_{vga,sd,hd,fhd}.mp4`` of the public repository bartekpacia/pendulum (no licence stated,
 so not shipped: put them in ``$ROCKLAB_FILMS``, default ``/tmp/verify-films``; skipped when absent).
 
+TrackLab's ``pendulumDrag.mp4`` (AGPL-3.0, not shipped; in ``$ROCKLAB_FILMS`` too) is checked
+against a bright blob on its black cloth instead (``tests/_blob.py``'s ``bright_blob_track``).
+
 Run: ``python benchmarks/real_inputs.py [n_boxes [part of a file name]]``.
 """
 
@@ -27,7 +30,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 
-from _blob import blob_track, perturbed_boxes, swing_period_s, wrong_ok  # noqa: E402
+from _blob import blob_track, bright_blob_track, perturbed_boxes, swing_period_s, wrong_ok  # noqa: E402
 
 from rocklab._diagnostics import collecting  # noqa: E402
 from rocklab.config import TrackConfig
@@ -44,6 +47,10 @@ FILMS = [
         for r, s in (("vga", 310 / 1080), ("sd", 480 / 1080), ("hd", 720 / 1080), ("fhd", 1.0))
     ],
 ]
+#: Films whose object is not the blue ball: (set, path, box, the object's centre in the first frame
+#: for :func:`bright_blob_track`). TrackLab's pendulumDrag.mp4 (github.com/OpenPhysics/TrackLab,
+#: AGPL-3.0, not shipped): a bob hanging still for a second, then shot into a fast swing.
+BRIGHT_FILMS = [("validation", FILMS_DIR / "pendulumDrag.mp4", (313, 316, 20, 18), (323.0, 325.0))]
 
 
 def run(path, box, ref, ref_scale):
@@ -73,7 +80,7 @@ def run(path, box, ref, ref_scale):
 
 
 def main(n_boxes=5, only=""):
-    for kind, path, box in FILMS:
+    for kind, path, box, *start in FILMS + BRIGHT_FILMS:
         if only not in path.name:
             continue
         if not path.exists():
@@ -81,6 +88,8 @@ def main(n_boxes=5, only=""):
             continue
         info = probe_video(path)
         ref, fps, w_cv = blob_track(path)
+        if start:  # not the blue ball: the bright blob against the film's median
+            ref = bright_blob_track(path, start[0])
         scale = np.array([info.width_px / w_cv, 1.0])  # non-square pixels: the tracker resamples
         T_ref = swing_period_s(np.arange(len(ref)) / fps, ref[:, 0])
         print(f"{kind} {path.name} ({info.width_px}x{info.height_px}): reference period {T_ref:.5f} s")

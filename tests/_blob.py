@@ -102,3 +102,40 @@ def perturbed_boxes(box, n, seed=0, size_frac=0.2, pos_frac=0.1):
         ux, uy = cx + rng.uniform(-pos_frac, pos_frac) * w, cy + rng.uniform(-pos_frac, pos_frac) * h
         out.append((int(round(ux - sw / 2)), int(round(uy - sh / 2)), int(round(sw)), int(round(sh))))
     return out
+
+
+def bright_blob_track(path, start_uv, thr=50, area_px=(12, 400), max_step_px=80.0):
+    """A small bright object on a dark background (a bob in front of black cloth), px (u, v) per
+    frame; NaN where none is found.
+
+    Independent of the tracker: per frame, the pixels brighter or darker than the film's temporal
+    median (every second frame) by more than ``thr`` grey levels, their compact blobs of
+    ``area_px`` pixels, and of those the one nearest the last found (from ``start_uv`` in the first
+    frame, within ``max_step_px``). The median is the background where the object moves most of
+    the film.
+    """
+    cap = cv2.VideoCapture(str(path))
+    frames = []
+    while True:
+        ok, img = cap.read()
+        if not ok:
+            break
+        frames.append(cv2.cvtColor(img, cv2.COLOR_BGR2GRAY))
+    cap.release()
+    g = np.asarray(frames, np.int16)
+    med = np.median(g[::2], axis=0).astype(np.int16)
+    last, out = np.asarray(start_uv, float), []
+    for f in g:
+        n, _, st, cen = cv2.connectedComponentsWithStats((np.abs(f - med) > thr).astype(np.uint8))
+        best = None
+        for i in range(1, n):
+            w, h = st[i, 2], st[i, 3]
+            if not area_px[0] <= st[i, cv2.CC_STAT_AREA] <= area_px[1] or max(w, h) > 3 * min(w, h) + 3:
+                continue
+            d = float(np.hypot(*(cen[i] - last)))
+            if d <= max_step_px and (best is None or d < best[0]):
+                best = (d, cen[i])
+        out.append((np.nan, np.nan) if best is None else tuple(best[1]))
+        if best is not None:
+            last = best[1]
+    return np.array(out, float).reshape(-1, 2)

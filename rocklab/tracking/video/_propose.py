@@ -7,6 +7,9 @@ frame in at least half of the samples in which anything moves (the object has le
 texture has turned over it). The frames' common brightness change is taken out first, so
 exposure hunting does not count as motion. Connected regions of that mask, closed over the
 texture's gaps and merged when they touch, are the proposals: boxes in first-frame pixels.
+Parts thinner than :data:`THIN_PX` (a pendulum's string sweeping the wall) are dropped first,
+a merge that would cover most of the frame leaves its parts apart, and a box narrower than the
+markerless tracker's smallest region is no proposal.
 
 The table is the long straight horizontal edge a block stands on: searched just below each
 proposal's bottom, on either side of it, and accepted only when
@@ -51,6 +54,11 @@ EDGE_CONTRAST = 20.0
 MIN_EDGE = 16.0
 #: Gaps closed inside a region, and regions merged, within this fraction of the frame's short side.
 CLOSE_FRACTION = 0.02
+#: Moving parts thinner than this (px at the working width, after the 1 px blur and the closing
+#: of gaps) are not objects.
+THIN_PX = 5
+#: Smallest side of a proposal, px of the full frame: the markerless tracker's smallest region.
+MIN_SIDE_PX = 8
 
 
 @dataclass(frozen=True)
@@ -157,6 +165,10 @@ def moving_boxes(first_gray, samples, masks: bool = False) -> tuple[list, int]:
     k = max(3, int(round(CLOSE_FRACTION * min(f0.shape))) | 1)
     mask = cv2.morphologyEx(mask, cv2.MORPH_OPEN, np.ones((3, 3), np.uint8))
     mask = cv2.morphologyEx(mask, cv2.MORPH_CLOSE, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (k, k)))
+    # what is thinner than THIN_PX once the texture's gaps are closed is no object to track: a
+    # pendulum's string (it sweeps the wall, and merged with its bob it made the proposal a box
+    # from the pivot to the bob, mostly still wall)
+    mask = cv2.morphologyEx(mask, cv2.MORPH_OPEN, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (THIN_PX, THIN_PX)))
     n, labels, stats, _ = cv2.connectedComponentsWithStats(mask, connectivity=8)
     grad = cv2.magnitude(cv2.Sobel(f0, cv2.CV_32F, 1, 0), cv2.Sobel(f0, cv2.CV_32F, 0, 1))
     floor = MIN_STRUCTURE * (float(np.median(grad)) + 1e-3)
@@ -165,14 +177,19 @@ def moving_boxes(first_gray, samples, masks: bool = False) -> tuple[list, int]:
         for i in range(1, n)
         if stats[i, 4] >= MIN_FRACTION * n_px and np.percentile(grad[labels == i], 95) >= floor
     ]
-    boxes = _merge(boxes, gap=k)
+    merged = []
+    for m in _merge(boxes, gap=k):
+        if m[2] * m[3] <= MAX_FRACTION * n_px:
+            merged.append(m)
+        else:  # neighbours merged into most of the frame: each part is a proposal of its own
+            merged += [b for b in boxes if _box_gap(b, m) == 0.0 and b[2] * b[3] <= MAX_FRACTION * n_px]
     out = []
-    for x, y, w, h in boxes:
-        if w * h > MAX_FRACTION * n_px:
-            continue
+    for x, y, w, h in merged:
         # back to full-frame pixels, out to the outer edge of the last pixel, inside the frame
         x0, y0 = max(0.0, x / scale), max(0.0, y / scale)
         x1, y1 = min(float(W), (x + w) / scale), min(float(H), (y + h) / scale)
+        if min(x1 - x0, y1 - y0) < MIN_SIDE_PX:
+            continue
         out.append(tuple(float(round(v)) for v in (x0, y0, x1 - x0, y1 - y0)))
     return sorted(out), len(moving)
 
@@ -246,9 +263,10 @@ def propose_objects(first_gray, samples) -> Proposals:
         kept = []
         for x, y, w, h in boxes:
             v_top = max(top_at(x), top_at(x + w))
-            if y >= v_top - 2:
+            h = float(min(y + h, math.ceil(v_top + 2)) - y)
+            if y >= v_top - 2 or h < MIN_SIDE_PX:
                 continue
-            kept.append((x, y, w, float(min(y + h, math.ceil(v_top + 2)) - y)))
+            kept.append((x, y, w, h))
         boxes = kept
         # a shake table moves and comes back: changed in any sample, not in most
         changed, scale = moving_boxes(first_gray, samples, masks=True)

@@ -156,6 +156,7 @@ class MarkerlessTracker:
         self.round_note = None
         self.views = [0, 0]  # verified frames, and those not a turned copy of the first view
         self.reason = None  # why the last frame was lost ("mismatch", "jump", "background", "lost")
+        self.min_cc = MIN_CC
 
     # -- registration -------------------------------------------------------------
     def _window(self, gray, W, margin):
@@ -431,6 +432,7 @@ class MarkerlessTracker:
             self.reason = self.reason or (None if fit is not None and fit[1] >= MIN_CC else "lost")
         if self.reason is not None:
             self.key = self.tmpl0 if self.reason == "drift" else self.key  # the keyframe learned the slide
+            self.verifier.lost_frame(gray, frame, MIN_CC)
             if self.poses:
                 self.last = self.poses[-1]
             self.poses = []  # the next frame searches from the first frame's place, then the last seen

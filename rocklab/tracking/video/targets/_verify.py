@@ -15,7 +15,12 @@ and, for the outline, its own first frame:
   :data:`MAX_STEP_RAD` a frame since the last verified pose;
 * **background** (``background``): the warped patch must not match the still background
   (the first frame, with the object's first region filled in once the object has left it)
-  on nearly all of its pixels: a pose frozen on a patch of wall is a lost lock;
+  on nearly all of its pixels: a pose frozen on a patch of wall is a lost lock. The first
+  frame shows the object in its first region, so that region's background is learned apart:
+  from a verified frame in which the object has left it, or, sooner, from the median of the
+  frames in which the object was lost (:data:`LOST_SAMPLES`), once the object's template
+  registers nowhere in that median (the object has gone from its first place: a bob hanging
+  still before it was shot off would otherwise make its own empty place look like the object);
 * **outline** (``drift``): once the background behind the object's first region is known, the
   object's silhouette against it, registered round the pose (:mod:`._occlusion`), must lie where
   the pose puts it, within :data:`._occlusion.DRIFT_FRAC` of the template: a spinning object's
@@ -68,6 +73,14 @@ BG_FRACTION = 0.9
 HINT_STEPS = 3
 #: Fraction of the patch whose background must be known for the background check to apply.
 BG_KNOWN = 0.5
+#: Share of the first region that must have changed from the first frame in that median.
+BG_CHANGED = 0.05
+#: Frames since the object was first lost whose first region's median is tried as the
+#: background there: every first number of them, the last second number kept.
+LOST_SAMPLES = (3, 15)
+#: Turns of the template tried in that median (degrees): a median that holds the object turned
+#: (a block lost while it rocked) is not its background.
+MEDIAN_TURNS_DEG = (0.0, -5.0, 5.0, -10.0, 10.0)
 
 
 class PoseVerifier:
@@ -96,6 +109,12 @@ class PoseVerifier:
         m = self.margin
         self.outer = (max(box[0] - m, 0), max(box[1] - m, 0), min(box[2] + m, W), min(box[3] + m, H))
         self.filled = False  # the first region's background seen (the object has left it)
+        #: the first region's background taken from the median of lost frames (the check applies
+        #: there; the outline is learned only from a verified frame)
+        self.first_known = False
+        self.lost_crops: collections.deque = collections.deque(maxlen=LOST_SAMPLES[1])
+        self.n_lost, self._sampled_at, self.since_lost = 0, -1, False
+        self.first_outer = first_gray[self.outer[1] : self.outer[3], self.outer[0] : self.outer[2]].astype(np.float32)
         self.tmpl0 = first_gray[box[1] : box[3], box[0] : box[2]].astype(np.float32)
         self.size = size
         self.scores = collections.deque(maxlen=300)
@@ -199,6 +218,41 @@ class PoseVerifier:
                 self.bg[v0:v1, u0:u1] = gray[v0:v1, u0:u1]
                 self.filled = True
 
+    def lost_frame(self, gray, frame, min_cc):
+        """Learn from a frame in which the object was lost: from then on every frame's first
+        region is a sample of what stands there (:meth:`_sample`)."""
+        self.since_lost = True
+        self._sample(gray, frame, min_cc)
+
+    def _sample(self, gray, frame, min_cc):
+        """Keep ``gray``'s first region (once per frame) and, every first number of :data:`LOST_SAMPLES`
+        samples, take their median as the background there when the object's template registers
+        in it nowhere at ``min_cc`` and it differs from the first view (the object has left its
+        place). Decided on copies reduced until the template is about 40 px across."""
+        if self.filled or self.first_known or frame == self._sampled_at:
+            return
+        self._sampled_at = frame
+        import cv2
+
+        u0, v0, u1, v1 = self.outer
+        crop = np.array(gray[v0:v1, u0:u1])
+        f = min(1.0, 40.0 / max(self.size))
+
+        def small(img):
+            return img if f == 1.0 else cv2.resize(img, None, fx=f, fy=f, interpolation=cv2.INTER_AREA)
+
+        self.lost_crops.append((crop, small(crop)))
+        self.n_lost += 1
+        if self.n_lost % LOST_SAMPLES[0]:  # tried every few frames: a median costs
+            return
+        med = np.median(np.stack([c[1] for c in self.lost_crops]), axis=0).astype(np.float32)
+        if float(np.mean(np.abs(med - small(self.first_outer)) >= BG_TOL)) < BG_CHANGED:
+            return  # the first view is still there: the object did not leave (or was lost in place)
+        if best_turned_match(med, small(self.tmpl0), 0.0, MEDIAN_TURNS_DEG, min_cc) is not None:
+            return  # the object, or an object like it, stands there
+        self.bg[v0:v1, u0:u1] = np.median(np.stack([c[0] for c in self.lost_crops]), axis=0)
+        self.first_known = True
+
     def learn_outline(self):
         """Once the background is known: the object's outline in the user's region."""
         if self.filled and self.outline is None:
@@ -228,11 +282,13 @@ class PoseVerifier:
         if len(self.recent) == 2 and self.recent[1][2] - self.recent[0][2] == 1:
             (c0, t0, _), (c1, t1, _) = self.recent
             pred = (2 * c1 - c0, 2 * t1 - t0)
+        if self.since_lost:  # what stands in the first region now, the frame checked included
+            self._sample(gray, frame, tr.min_cc)
         bg = back = known = bg_g = back_g = None
         self.hint = None
         # the background is known where the first frame did not show the object, and everywhere
         # once the object has left its first region: only then is the check worth its two warps
-        if self.filled or self._clear(centre):
+        if self.filled or self.first_known or self._clear(centre):
             m = 2 * self.margin
             bg_g, back_g = warp_grown(tr, self.bg, W, m), warp_grown(tr, gray, W, m)
             if bg_g is not None and back_g is not None:

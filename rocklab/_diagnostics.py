@@ -58,6 +58,12 @@ WARNING_CODES: dict[str, tuple[str, str]] = {
         "check the record's sampling and zero padding",
     ),
     # simulation
+    "W-COLUMN-APART": (
+        "note",
+        "column runs stopped with a joint in tension or sliding (the column comes apart, which the "
+        "rocking model cannot follow): counted as unsafe in overturning maps and spectra; see their "
+        "stopped / n_terminated counts",
+    ),
     "W-SIM-DT": (
         "suspect",
         "time step dt is large against the block's 1/p (p dt > 0.01): "

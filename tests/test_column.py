@@ -435,3 +435,24 @@ def test_events_converge_with_the_time_step():
     np.testing.assert_allclose(r1.impacts.t_s[:8], r2.impacts.t_s[:8], atol=1e-6)
     assert r1.impacts.joint[:8].tolist() == r2.impacts.joint[:8].tolist()
     np.testing.assert_allclose(r1.theta_rad, r2.theta_rad[::2], atol=1e-6)
+
+
+def test_maps_count_a_column_that_comes_apart_as_unsafe_and_say_so():
+    # a strong, short pulse sends a joint into tension: the rocking model cannot follow the column
+    # apart, so the map must neither call that cell safe nor hide it (W-COLUMN-APART, `stopped`)
+    from rocklab._diagnostics import collecting
+    from rocklab.models import column_overturning_maps, sine_pulse
+
+    ap, tp = np.array([8.44, 53.56]), np.array([0.05, 0.132, 1.511])
+    with collecting() as diags:
+        m = column_overturning_maps(12.0, 1.0, n_blocks=(2,), ap_m_s2=ap, tp_s=tp)
+    col = Column.uniform(1.0, 12.0, 2, mass_kg=1.0)
+    for i, a in enumerate(ap):
+        for j, t in enumerate(tp):
+            r = simulate_column(col, sine_pulse(a, t, dt_s=min(2e-3, t / 50)), duration_s=t + 10.0, dt_s=2e-3)
+            assert m.stopped[0, i, j] == (r.status in ("tension", "sliding"))
+            assert m.overturned[0, i, j] == (r.overturned or m.stopped[0, i, j])
+    assert 0 < m.stopped.sum() < m.stopped.size  # the grid holds both kinds
+    (d,) = [d for d in diags if d.code == "W-COLUMN-APART"]
+    assert f"{int(m.stopped.sum())} of {m.stopped.size}" in d.message
+    assert m.to_frame()["stopped"].sum() == m.stopped.sum()

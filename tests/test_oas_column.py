@@ -63,7 +63,12 @@ def test_cli_oas_column(run_cli, tmp_path):
 def test_a_column_coming_apart_counts_unsafe(sine):
     # stocky blocks (three of h/b = 2) under 4 a_p,min: a joint would take tension (thesis §3.3: the
     # calculation stops, the column may disintegrate); such runs are unsafe and counted
-    o = column_overturning_spectrum(sine, 6.0, 3, levels=2, level_max=4.0, sizes=2, R_max_m=1000.0, R_min_m=100.0)
+    from rocklab._diagnostics import collecting
+
+    with collecting() as diags:
+        o = column_overturning_spectrum(sine, 6.0, 3, levels=2, level_max=4.0, sizes=2, R_max_m=1000.0, R_min_m=100.0)
     assert o.options["n_terminated"] >= 1
+    (d,) = [d for d in diags if d.code == "W-COLUMN-APART"]  # said, not only counted
+    assert d.message.startswith(f"{o.options['n_terminated']} column runs")
     assert o.overturned[1, 0]  # R = 1000 m at a_p = 4 a_p,min: tension, not a safe block
     assert not o.overturned[0].any()  # at a_p,min nothing lifts far enough

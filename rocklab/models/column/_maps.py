@@ -42,10 +42,15 @@ class ColumnMaps:
     tp_s : ndarray (nt,)
         Pulse periods, s.
     overturned : ndarray (k, na, nt) bool
+        Unsafe: overturned, or stopped (below).
     max_theta_over_alpha : ndarray (k, na, nt)
         Peak |block angle| over the column's slenderness angle atan(B/H).
     H_m, B_m : float
     params : dict
+    stopped : ndarray (k, na, nt) bool
+        Runs the model stopped because a joint went into tension or slid (the column comes
+        apart; :func:`simulate_column` status ``tension``/``sliding``): counted unsafe, as the
+        thesis's model stops there too, and reported by W-COLUMN-APART.
     """
 
     n_blocks: np.ndarray
@@ -56,6 +61,7 @@ class ColumnMaps:
     H_m: float
     B_m: float
     params: dict = field(default_factory=dict)
+    stopped: np.ndarray | None = None
 
     @property
     def overturned_fraction(self) -> np.ndarray:
@@ -74,6 +80,7 @@ class ColumnMaps:
                 "ap_m_s2": ap.ravel(),
                 "tp_s": tp.ravel(),
                 "overturned": self.overturned.ravel(),
+                "stopped": (np.zeros_like(self.overturned) if self.stopped is None else self.stopped).ravel(),
                 "max_theta_over_alpha": self.max_theta_over_alpha.ravel(),
             }
         )
@@ -88,6 +95,7 @@ class ColumnMaps:
             "tp_s": self.tp_s.tolist(),
             "overturned": self.overturned.tolist(),
             "overturned_fraction": self.overturned_fraction.tolist(),
+            "stopped": None if self.stopped is None else self.stopped.tolist(),
             "params": dict(self.params),
         }
 
@@ -134,6 +142,7 @@ def column_overturning_maps(
     if (nb < 1).any() or ap.ndim != 1 or tp.ndim != 1 or (tp <= 0).any():
         raise InputError("column_overturning_maps: n_blocks >= 1, 1-D grids and positive t_p required")
     over = np.zeros((nb.size, ap.size, tp.size), bool)
+    stopped = np.zeros_like(over)
     peak = np.zeros_like(over, dtype=float)
     alpha = math.atan2(B_m, H_m)
     done = 0
@@ -150,11 +159,20 @@ def column_overturning_maps(
                     n_impacts=n_impacts,
                     **run_kwargs,
                 )
-                over[k, i, j] = r.overturned
+                stopped[k, i, j] = r.status in ("tension", "sliding")
+                over[k, i, j] = r.overturned or stopped[k, i, j]
                 peak[k, i, j] = float(np.max(np.asarray(r.max_abs_theta_rad))) / alpha
                 done += 1
                 if progress is not None:
                     progress(done)
+    if stopped.any():
+        from ..._diagnostics import warn
+
+        warn(
+            "W-COLUMN-APART",
+            f"{int(stopped.sum())} of {stopped.size} column runs stopped with a joint in tension or sliding "
+            "(the column comes apart): counted as unsafe; see ColumnMaps.stopped",
+        )
     return ColumnMaps(
         nb,
         ap,
@@ -164,4 +182,5 @@ def column_overturning_maps(
         float(H_m),
         float(B_m),
         dict(n_impacts=n_impacts, dt_s=dt_s, free_s=free_s, pulse="full sine", **sim_kwargs),
+        stopped,
     )

@@ -138,6 +138,14 @@ def _bisect(p_hi, p_lo, unsafe, refine: int) -> None:
 
 def _oas_result(base, alpha, lv, R, p, over, evaluated, p_hi, opts) -> OASResult:
     """The :class:`OASResult` of a column's verdict grid and boundary (``p_hi`` per level)."""
+    if opts["n_terminated"]:
+        from ..._diagnostics import warn
+
+        warn(
+            "W-COLUMN-APART",
+            f"{opts['n_terminated']} column runs stopped with a joint in tension or sliding "
+            "(the column comes apart): counted as unsafe (options['n_terminated'])",
+        )
     f = lv * p_hi
     icr = normalised_critical_impulse(alpha)
     f_min = float(np.nanmin(f)) if np.isfinite(f).any() else float("nan")

@@ -129,8 +129,8 @@ def parse_size(text) -> tuple[int, int]:
 def _check(seed, blocks, table, fps, targets, duration_s, exposure_s, noise_dn):
     if not isinstance(seed, (int, np.integer)) or isinstance(seed, bool) or seed < 0:
         raise InputError(f"seed={seed!r}: must be a non-negative integer")
-    if blocks not in (1, 3):
-        raise InputError(f"blocks={blocks!r}: must be 1 or 3")
+    if blocks not in (1, 2, 3):
+        raise InputError(f"blocks={blocks!r}: must be 1, 2 or 3")
     if table not in TABLES:
         raise InputError(f"table={table!r}: unknown table motion; use one of {', '.join(TABLES)}")
     if targets not in TARGETS:
@@ -189,6 +189,9 @@ def synth_session(
     progress: bool = False,
     flicker: float = 0.0,
     texture: str = "procedural",
+    column_cut_m: float = 0.0,
+    column_impacts: int = 1,
+    video: bool = True,
 ) -> SynthSession:
     """Render a synthetic lab session into ``out_dir`` (see the module doc for the layout).
 
@@ -200,8 +203,8 @@ def synth_session(
     seed : int
         Everything random (camera pose and lens, release times, textures,
         noise, IMU errors) derives from it: same seed, identical files.
-    blocks : {1, 3}
-        One block, or three blocks: a stacked column (thesis §4.3: three
+    blocks : {1, 2, 3}
+        One block, or two or three blocks: a stacked column (thesis §4.3: three
         0.1 x 0.2 m granite blocks, ``rocklab.models.simulate_column``) when
         the column model is available, else independent blocks side by side
         (``layout`` forces one: ``"column"`` or ``"side"``).
@@ -233,7 +236,15 @@ def synth_session(
     restitution, eta :
         Impact law for :func:`rocklab.models.simulate` (default constant eta = 0.75: a 0.1 x 0.2 m block survives the sine pulse).
     theta0_rad : float or sequence, optional
-        Initial counter-clockwise tilt(s) for free rocking (default ±0.5 alpha).
+        Initial counter-clockwise tilt(s) for free rocking (default ±0.5 alpha). A column: one
+        angle tilts it as one body, one per level gives each block's own angle (thesis §4.2:
+        ``[0, -0.153]``, the upper block alone tilted).
+    column_cut_m, column_impacts : float, int
+        A column's cut edge at every joint (m) and impacts per closing (the true model, written
+        to ``experiment.toml``'s ``[column]``).
+    video : bool
+        Render the film (``video.mkv``/``.mp4``, ``track.toml``). False: only the IMU logs, the
+        truth and an ``experiment.toml`` that measures every block with its IMU (needs ``imu``).
     exposure_s : float, optional
         Shutter time, s (default half a frame period); motion blur integrates over it.
     noise_dn : float
@@ -269,6 +280,8 @@ def synth_session(
         raise InputError(f"flicker={flicker!r}: exposure flicker must be a relative amplitude from 0 to 0.5")
     if texture not in ("procedural", "photo"):
         raise InputError(f"texture={texture!r}: use 'procedural' (synthetic noise) or 'photo' (photographs)")
+    if not video and not imu:
+        raise InputError("video=False needs imu=True: a session without a film is measured by its IMUs")
     out_dir = Path(out_dir)
     tmp = _prepare_out(out_dir, force)
     t_start = time.perf_counter()
@@ -296,10 +309,13 @@ def synth_session(
             distortion=distortion,
             layout=layout,
             texture=texture,
+            column_cut_m=column_cut_m,
+            column_impacts=column_impacts,
         )
         scene.flicker = float(flicker)
-        _render_video(scene, tmp, mp4, progress)
-        meta = scene.write_files(tmp, imu=imu, imu_rate_hz=imu_rate_hz, calibrated=calibrated)
+        if video:
+            _render_video(scene, tmp, mp4, progress)
+        meta = scene.write_files(tmp, imu=imu, imu_rate_hz=imu_rate_hz, calibrated=calibrated, video=video)
         meta["flicker"] = float(flicker)
         meta["texture"] = texture
         render_s = time.perf_counter() - t_start

@@ -6,6 +6,7 @@ Each returns ``(t_s, theta_rad)`` on its own clock (and what else the stage meas
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -111,3 +112,90 @@ def sync_clocks(ref, rot, max_offset_s):
     from ...tracking import sync_imu_to_track
 
     return sync_imu_to_track(rot, ref[0], ref[1], max_offset_s=max_offset_s)
+
+
+#: A level IMU whose impact spikes correlate less than this with the reference level's is flagged.
+COLUMN_SYNC_MIN_CORRELATION = 0.5
+
+
+@dataclass(frozen=True)
+class ColumnImus:
+    """A column's levels measured by their IMUs, on one clock.
+
+    Attributes
+    ----------
+    t_s : ndarray, (m,)
+        The reference clock's samples (the video's clock with a film, else the released level's IMU).
+    theta_rad : ndarray, (m, L)
+        Each level's angle, counter-clockwise positive (the camera's sense), rad; NaN outside its log.
+    release_t_s : float
+        The release seen by the level that starts farthest from upright (NaN: none, a forced run), s.
+    theta_start_rad : ndarray, (L,)
+        Each level's angle in its rest before the motion, rad.
+    clocks : list of dict
+        Per level: ``offset_s`` (its log's time minus the reference's), ``drift``, ``correlation``,
+        ``how`` (``video``, ``reference`` or ``impacts``).
+    """
+
+    t_s: np.ndarray
+    theta_rad: np.ndarray
+    release_t_s: float
+    theta_start_rad: np.ndarray
+    clocks: list
+
+
+def _impact_signal(rot):
+    """``|‖specific force‖ - g|`` of a level's IMU: its impacts' spikes, shared by every level."""
+    from ...blocks import G
+
+    return np.asarray(rot.t_s, float), np.abs(np.linalg.norm(np.asarray(rot.acc_m_s2, float), axis=1) - G)
+
+
+def measure_column_imus(cfg: ExperimentConfig, video=None) -> ColumnImus:
+    """Each ``[column] imu`` log as its level's angle, all on one clock.
+
+    With a film (``video`` = ``(t_s, theta_rad (m, L))`` tracked, counter-clockwise), each IMU is put
+    on the video clock by its own block's rocking rates (:func:`sync_clocks`). Without one, the IMU of
+    the level that starts farthest from upright (the released one) is the clock, and the others are
+    put on it by cross-correlating the acceleration spikes of the impacts, which every level feels
+    at the same instants (a column's impact changes the velocity of every block); a weak correlation
+    is a coded warning (``W-IMU-COLUMN-SYNC``).
+    """
+    from ..._diagnostics import warn
+    from ...tracking import block_rotation, read_imu, sync_offset
+
+    rots = [block_rotation(read_imu(p), axis=cfg.column_imu_axis) for p in cfg.column_imus]
+    starts = np.array([float(r.theta0_rad) for r in rots])
+    clocks: list = []
+    series = []
+    if video is not None:
+        tv, thv = video
+        for i, r in enumerate(rots):
+            s = sync_clocks((tv, thv[:, i]), r, cfg.max_offset_s)
+            series.append(((np.asarray(r.t_s) - s.offset_s) / (1.0 + s.drift), s.sign * np.asarray(r.theta_rad)))
+            clocks.append({"offset_s": s.offset_s, "drift": s.drift, "correlation": s.correlation, "how": "video"})
+        t_ref = np.asarray(tv, float)
+        ref = int(np.argmax(np.abs(starts)))
+        t_rel = (float(rots[ref].release_t_s) - clocks[ref]["offset_s"]) / (1.0 + clocks[ref]["drift"])
+    else:
+        ref = int(np.argmax(np.abs(starts)))
+        ta, ya = _impact_signal(rots[ref])
+        for i, r in enumerate(rots):
+            if i == ref:
+                series.append((np.asarray(r.t_s, float), np.asarray(r.theta_rad, float)))
+                clocks.append({"offset_s": 0.0, "drift": 0.0, "correlation": 1.0, "how": "reference"})
+                continue
+            s = sync_offset(ta, ya, *_impact_signal(r), max_offset_s=cfg.max_offset_s, drift=False)
+            # t_ref = t_level + offset: the level's samples on the reference clock
+            series.append((np.asarray(r.t_s, float) + s.offset_s, np.asarray(r.theta_rad, float)))
+            clocks.append({"offset_s": -s.offset_s, "drift": 0.0, "correlation": s.correlation, "how": "impacts"})
+            if not s.correlation >= COLUMN_SYNC_MIN_CORRELATION:
+                warn(
+                    "W-IMU-COLUMN-SYNC",
+                    f"{cfg.path}: [column] imu {cfg.column_imus[i]} correlates {s.correlation:.2f} with level "
+                    f"{ref + 1}'s impacts (< {COLUMN_SYNC_MIN_CORRELATION}); its clock offset is uncertain",
+                )
+        t_ref = series[ref][0]
+        t_rel = float(rots[ref].release_t_s)
+    th = np.column_stack([np.interp(t_ref, tt, yy, left=np.nan, right=np.nan) for tt, yy in series])
+    return ColumnImus(t_ref, th, t_rel, starts, clocks)

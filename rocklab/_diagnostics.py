@@ -117,7 +117,7 @@ WARNING_CODES: dict[str, tuple[str, str]] = {
     "W-IMU-COLUMN-SYNC": (
         "suspect",
         "a column's level IMUs were put on one clock by cross-correlating the acceleration spikes of "
-        "their impacts, and a level correlates weakly (peak below 0.5): its events may be shifted "
+        "their impacts, and a level correlates weakly (peak below 0.4): its events may be shifted "
         "against the others'; record a film (each IMU is then synced to its tracked block) or start "
         "the loggers together",
     ),

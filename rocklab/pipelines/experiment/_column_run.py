@@ -191,8 +191,9 @@ JOINT_CLOSED_RAD = 0.0025
 COLUMN_ENSEMBLE_SPAN_S = 1.5
 #: Members of each column ensemble (a 2-block, 10 s free release: 32 runs take ~2 s on one core).
 COLUMN_ENSEMBLE_SIZE = 32
-#: Smallest start-angle uncertainty of a level, rad (a tilt read at rest, by accelerometer or camera).
-THETA0_MIN_SD_RAD = 1e-3
+#: Smallest start-angle uncertainty of a level, rad (a tilt read at rest, by accelerometer or camera);
+#: also the constant offset of each level's measured angle the ensembles' sequences are read with.
+THETA0_MIN_SD_RAD = 2e-3
 
 
 @dataclass(frozen=True)
@@ -302,7 +303,7 @@ def validate_column(cfg, col, t, th, t0, th0, table, source, *, n=COLUMN_ENSEMBL
     for k in sorted({1, 2, int(cfg.column_impacts)}):
         ens = simulate_column_ensemble(
             col, tg, theta0_rad=-np.asarray(th0, float), t_start_s=t0, unc=unc, table_t_s=tab[0],
-            table_acc_m_s2=tab[1], n_impacts=k, n=n, seed=seed,
+            table_acc_m_s2=tab[1], n_impacts=k, n=n, meas_offset_rad=THETA0_MIN_SD_RAD, seed=seed,
         )  # fmt: skip
         secs += ens.seconds
         law = f"impacts_{k}"

@@ -185,7 +185,7 @@ def _with_truth(out, truth_path, objs, t, th, t0):
 #: A measured joint opened by less than this at rest starts closed, rad (half the opening threshold
 #: the sequences are read with, :data:`rocklab.fitting.EVENT_THRESHOLD_RAD`).
 JOINT_CLOSED_RAD = 0.0025
-#: The ensembles simulate this long after the start, s: a column's predictability horizon comes
+#: The ensembles simulate this long after the release (or the table's first motion), s: a column's predictability horizon comes
 #: within its first rockings (0.3 s on the thesis §4.2 release) and its impacts make every
 #: simulated second costly (a 2-block, 9 s free release: 0.5 s per run).
 COLUMN_ENSEMBLE_SPAN_S = 1.5
@@ -248,6 +248,17 @@ def _rest_noise(th, ok, t, t0):
     return float(np.max(1.4826 * np.median(np.abs(d - np.median(d, axis=0)), axis=0) / np.sqrt(2.0)))
 
 
+def _table_starts(table) -> float:
+    """When the table starts moving: its acceleration first leaves its starting level by 5 % of the
+    peak, s (its first sample when it never rests)."""
+    ta, aa = np.asarray(table.t_s, float), np.asarray(table.ax_m_s2, float)
+    fin = np.isfinite(aa)
+    ta, aa = ta[fin], aa[fin]
+    lev = float(np.median(aa[:10]))
+    away = np.flatnonzero(np.abs(aa - lev) > 0.05 * float(np.max(np.abs(aa - lev))))
+    return float(ta[away[0]]) if away.size else float(ta[0])
+
+
 def _column_uncertainty(cfg, t, th, t0, table):
     from .._validation import ACC_SCALE_SD, INPUT_SAFETY, LENGTH_SD_M, MIN_NOISE_RAD
     from ...fitting import InputUncertainty
@@ -259,7 +270,7 @@ def _column_uncertainty(cfg, t, th, t0, table):
     if table is not None:
         aa = np.asarray(table.ax_m_s2, float)
         ta = np.asarray(table.t_s, float)
-        rest = aa[np.isfinite(aa) & (ta < t0)]
+        rest = aa[np.isfinite(aa) & (ta < _table_starts(table))]
         if rest.size >= 10:
             sa = float(1.4826 * np.median(np.abs(np.diff(rest) - np.median(np.diff(rest)))) / np.sqrt(2.0))
             sb = sa / np.sqrt(rest.size)
@@ -295,7 +306,9 @@ def validate_column(cfg, col, t, th, t0, th0, table, source, *, n=COLUMN_ENSEMBL
     from ...fitting import judge_column, simulate_column_ensemble
 
     unc = _column_uncertainty(cfg, t, th, t0, table)
-    keep = (t >= t0 - 0.05) & (t <= t0 + COLUMN_ENSEMBLE_SPAN_S) & np.isfinite(th).all(axis=1)
+    # the span counts from the release, or from when the table starts moving
+    t_go = t0 if table is None else max(t0, _table_starts(table))
+    keep = (t >= t0 - 0.05) & (t <= t_go + COLUMN_ENSEMBLE_SPAN_S) & np.isfinite(th).all(axis=1)
     tg, yg = t[keep], th[keep]
     tab = (None, None) if table is None else (np.asarray(table.t_s, float), np.asarray(table.ax_m_s2, float))
     alphas = np.array([b.alpha_rad for b in col.blocks])

@@ -63,7 +63,7 @@ def test_fig29_true_model_consistent_bump_model_not(fig29_run):
     val = rep["validation"]
     assert val["reference_law"] == "impacts_1" and set(val["laws"]) == {"impacts_1", "impacts_2"}
     true, bump = val["laws"]["impacts_1"], val["laws"]["impacts_2"]
-    assert true["verdict"] == "consistent" and true["n_events_inside"] >= 5
+    assert true["verdict"] == "consistent" and true["n_events_inside"] >= 4  # measured 6
     assert true["n_matched_inside"] == true["n_events_inside"]
     assert true["band_coverage"] > bump["band_coverage"] + 0.3  # measured 1.0 against 0.29
     # one mid-joint bump per closing loses less energy: its later openings come at other times
@@ -94,9 +94,9 @@ def test_different_blocks_true_model_consistent(mixed_run):
     assert abs(col["imu_clocks"][0]["offset_s"] - true_offset) < 2e-3  # measured 0.7 ms
     laws = rep["validation"]["laws"]
     true, bump = laws["impacts_1"], laws["impacts_2"]
-    assert true["verdict"] == "consistent" and true["n_events_inside"] >= 5  # measured 15 of 15
+    assert true["verdict"] == "consistent" and true["n_events_inside"] >= 4  # measured 6 of 6
     assert true["n_matched_inside"] == true["n_events_inside"]
-    assert bump["verdict"] == "inconsistent"  # measured 3 of 15 matched
+    assert bump["verdict"] == "inconsistent"  # measured 1 of 8 matched
     # the nominal model's events are the truth's (same model, the measured start angles)
     t_rel = meta["blocks"][0]["release_s"]
     truth = [(e["t_s"] - t_rel, e["joint"], e["event"]) for e in meta["blocks"][0]["column_events"]][:3]

@@ -9,7 +9,8 @@ from its block angles exactly as the measured one is read (:func:`rocklab.models
 same threshold, same samples) and compares:
 
 - each measured event's probability: the fraction of members with the same joint turning the
-  same way within ``±tol_s`` (matched in order, :func:`rocklab.models.compare_sequences`); an
+  same way within ``±tol_s`` (a ``closed`` state the joint leaves again within ``tol_s``, a pass
+  through closed at an impact, is not an event) (matched in order, :func:`rocklab.models.compare_sequences`); an
   event is *matched* when at least half the members have it;
 - the predictability horizon: the first time the members' 5–95 % spread of any level's angle
   passes :data:`HORIZON_FRACTION` of that block's α, or, when earlier, the time by which a quarter
@@ -284,6 +285,20 @@ def _rank_p(x, sample):
     return float(min(1.0, 2.0 * min(below + 1, above + 1) / (s.size + 1)))
 
 
+def _through_closed(seq, tol_s: float) -> list:
+    """The sequence without the ``closed`` states a joint passes through at an impact (reopened
+    within ``tol_s``): whether a sample falls inside the closed band during a sign change of a fast
+    joint is a matter of the sampling's phase, not of the motion."""
+    out = []
+    for i, (t, j, st) in enumerate(seq):
+        if st == "closed":
+            nxt = next((e for e in seq[i + 1 :] if e[1] == j), None)
+            if nxt is not None and nxt[0] - t <= tol_s:
+                continue
+        out.append((t, j, st))
+    return out
+
+
 def _event_horizon(seqs, tol_s: float) -> float:
     """The 25th percentile over members of the time of their first event that fewer than half the
     other members share (same joint and state within ±``tol_s``), s; inf when most never diverge."""
@@ -348,13 +363,13 @@ def judge_column(
     wide = np.flatnonzero(np.any(p95 - p05 > HORIZON_FRACTION * np.asarray(alpha_rad, float), axis=1))
     horizon = float(t[wide[0]]) if wide.size else float(t[-1])
     t_first = float(t[np.flatnonzero(ok.all(axis=1))[0]])
-    horizon = min(horizon, _event_horizon([[e for e in q if e[0] > t_first] for q in ens.sequences], tol_s))
-    meas = [e for e in joint_sequence(t, y, threshold_rad) if e[0] > t_first]
+    meas = _through_closed([e for e in joint_sequence(t, y, threshold_rad) if e[0] > t_first], tol_s)
+    members = [_through_closed([e for e in q if e[0] > t_first], tol_s) for q in ens.sequences]
+    horizon = min(horizon, _event_horizon(members, tol_s))
     n = len(ens.sequences)
     hits = np.zeros(len(meas), int)
     counts = []
-    for seq in ens.sequences:
-        seq = [e for e in seq if e[0] > t_first]
+    for seq in members:
         counts.append(sum(e[0] < horizon for e in seq))
         matched = {(p[0], p[2]) for p in compare_sequences(meas, seq, tol_s=tol_s).pairs}
         hits += np.array([(e[0], e[1]) in matched for e in meas], int)

@@ -120,6 +120,13 @@ WARNING_CODES: dict[str, tuple[str, str]] = {
         "the log's clock jumps or has a gap: samples are missing or the "
         "timestamps are corrupt; impacts in the gap are lost",
     ),
+    "W-IMU-COLUMN-SYNC": (
+        "suspect",
+        "a column's level IMUs were put on one clock by cross-correlating the acceleration spikes of "
+        "their impacts, and a level correlates weakly (peak below 0.4): its events may be shifted "
+        "against the others'; record a film (each IMU is then synced to its tracked block) or start "
+        "the loggers together",
+    ),
     "W-IMU-RATE": (
         "suspect",
         "sample rate disagrees between the option, the log's register and its timestamps; the timestamps were trusted",

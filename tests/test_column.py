@@ -197,6 +197,28 @@ def test_one_block_under_base_motion_equals_single_block_simulator():
     assert t_up - 0.005 < first.t_s <= t_up
 
 
+def test_narrow_upper_block_rocks_as_a_single_block_on_a_wide_one():
+    # per-level geometry: a narrow block released on a wide, heavy one pivots on its own corners
+    # (the joint is as wide as the narrower face), so until the lower joint changes state it is the
+    # single-block motion of that narrow block alone, and its first impact is the single block's
+    top = Block(0.08, 0.25, mass_kg=2.0)
+    col = Column((Block(0.2, 0.4, mass_kg=40.0), top))
+    assert np.allclose(col.half_width_m, [0.1, 0.04])
+    r = simulate_column(col, theta0_rad=[0.0, 0.1], duration_s=1.0, dt_s=1e-4)
+    s1 = simulate(top, theta0_rad=0.1, duration_s=1.0, dt_s=1e-4)
+    low = r.configurations[(r.configurations.joint == 0) & (r.configurations.event != "start")]
+    t_end = float(low.t_s.iloc[0]) if len(low) else 1.0
+    first = float(s1.impacts.t_s.iloc[0])
+    assert first <= t_end + 1e-9  # the wide block stays closed until the narrow one's first impact
+    w = r.t_s <= first
+    np.testing.assert_allclose(r.theta_rad[w, 1], np.interp(r.t_s[w], s1.t_s, s1.theta_rad), atol=1e-6)
+    assert np.all(r.theta_rad[w, 0] == 0.0)
+    assert abs(float(r.impacts.t_s.iloc[0]) - first) < 1e-6 and int(r.impacts.joint.iloc[0]) == 1
+    # the same blocks the other way up: the pivot moves inside the wide upper block's face
+    inv = Column((top, Block(0.2, 0.4, mass_kg=40.0)))
+    assert np.allclose(inv.half_width_m, [0.04, 0.04])
+
+
 # -- invariants of the multi-block model ---------------------------------------------------------
 
 

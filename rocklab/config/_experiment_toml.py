@@ -126,6 +126,13 @@ class ExperimentConfig:
     columns: tuple = ()  # for column experiments: object ids bottom to top
     column_cut_m: float = 0.0
     column_impacts: int = 1
+    column_b_m: tuple = ()  # width of each level, m, bottom to top (empty: [block] b_m at every level)
+    column_h_m: tuple = ()  # height of each level, m (empty: [block] h_m)
+    column_mass_kg: tuple = ()  # mass of each level, kg (empty: [block] mass_kg, else granite)
+    column_theta0_rad: tuple = ()  # free release: each level's start angle, measured sense (empty: measured)
+    column_imus: tuple = ()  # one IMU log (folder or CSV) per level, bottom to top
+    column_imu_axis: str | None = None  # the levels' IMUs' rocking axis, signed for the camera's sense
+    column_event_tol_s: float = 0.02  # a simulated event matches a measured one within this, s
     truth: Path | None = None  # synthetic sessions: truth.csv for the report
     tags: tuple = ()  # ``[experiment] tags``: (key, value) pairs a campaign groups repeats by
 
@@ -140,6 +147,19 @@ class ExperimentConfig:
 
         return Block(self.b_m, self.h_m, mass_kg=self.mass_kg, name=self.block_id or self.name)
 
+    def column_blocks(self) -> list:
+        """The :class:`rocklab.Block` of each column level, bottom to top: ``[column] b_m, h_m,
+        mass_kg`` where given, else the ``[block]`` values (identical blocks)."""
+        from ..blocks import Block
+
+        out = []
+        for i, oid in enumerate(self.columns):
+            b = self.column_b_m[i] if self.column_b_m else self.b_m
+            h = self.column_h_m[i] if self.column_h_m else self.h_m
+            m = self.column_mass_kg[i] if self.column_mass_kg else self.mass_kg
+            out.append(Block(b, h, mass_kg=m, name=oid))
+        return out
+
     def input_files(self) -> list[Path]:
         """Every input file the run reads (for the unchanged-inputs check)."""
         out = [self.path]
@@ -150,6 +170,7 @@ class ExperimentConfig:
             if self.video.track_config:
                 out += [self.video.track_config, *_track_config_files(self.video.track_config)]
         out += [src.path for src in (self.track, self.imu) if src is not None]
+        out += list(self.column_imus)
         for p in (self.table.imu, self.table.record, self.truth):
             if p:
                 out.append(p)
@@ -193,6 +214,8 @@ class ExperimentConfig:
         table = src(self.table, ("imu", "record"))
         sources["table"] = {"from": table.pop("source"), **table}
         d["sources"] = sources
+        if self.column_imus:
+            d.setdefault("column", {})["imu"] = [p(v) for v in self.column_imus]
         order = (
             "name",
             "truth",
@@ -228,6 +251,12 @@ _FIELDS = {
     ("column", "objects"): "columns",
     ("column", "cut_m"): "column_cut_m",
     ("column", "impacts"): "column_impacts",
+    ("column", "b_m"): "column_b_m",
+    ("column", "h_m"): "column_h_m",
+    ("column", "mass_kg"): "column_mass_kg",
+    ("column", "theta0_rad"): "column_theta0_rad",
+    ("column", "imu_axis"): "column_imu_axis",
+    ("column", "event_tol_s"): "column_event_tol_s",
     ("output", "rrd"): "rrd",
     ("output", "video_decimation"): "video_decimation",
     ("output", "figures"): "figures",
@@ -245,6 +274,7 @@ SCHEMA: dict[tuple, tuple] = {
     ("sources", "table"): ("from", "object", "imu", "record", "units"),
     **{(t,): tuple(k for (tt, k) in _FIELDS if tt == t) for t, _ in _FIELDS},
 }
+SCHEMA[("column",)] += ("imu",)  # paths, read by _column_keys (relative to the file's folder)
 
 
 def _track_config_files(path: Path) -> list[Path]:
@@ -347,6 +377,12 @@ class _Reader(TomlDoc):
             if required:
                 self.fail(key, "is required")
             return None
+        return self.existing(key, v, allow_dir)
+
+    def existing(self, key, v, allow_dir=False) -> Path:
+        """The existing file (or folder) the string ``v`` at ``key`` names, relative to the config's folder."""
+        if not isinstance(v, str):
+            self.fail(key, f"must be a path (a string), got {v!r}")
         p = (self.source.parent / v).resolve()
         if not (p.is_file() or (allow_dir and p.is_dir())):
             self.fail(key, f"names {v!r}, which does not exist (looked in {p.parent}); fix the path")
@@ -410,7 +446,7 @@ def load_experiment_config(path, block_catalogue: Callable[[], Mapping[str, dict
     k = r.field(("contact", "k"), float, positive=True)
 
     # -- sources --------------------------------------------------------------
-    video, track, imu, table, primary = _sources(r, path, sources)
+    video, track, imu, table, primary = _sources(r, path, sources, column_imus="imu" in data.get("column", {}))
 
     laws = r.field(("simulate", "laws"), list)
     for law in laws:
@@ -424,11 +460,7 @@ def load_experiment_config(path, block_catalogue: Callable[[], Mapping[str, dict
     if "given" in laws and eta_given is None:
         r.fail(("simulate", "laws"), "contains 'given' but [simulate] eta is not set")
     columns = r.field(("column", "objects"), list)
-    if columns and video is None:
-        r.fail(("column", "objects"), "needs a [sources.video] section (the blocks are tracked on video)")
-    cut = r.field(("column", "cut_m"), float)
-    if cut < 0 or cut >= (b or 1) / 2:
-        r.fail(("column", "cut_m"), f"= {cut} m must be in [0, b/2)")
+    col = _column_keys(r, columns, video, b)
     duration = r.field(("simulate", "duration_s"), float)
     if not (math.isfinite(duration) and duration >= 0):
         r.fail(("simulate", "duration_s"), f"= {duration} must be >= 0 s (0: as long as the measurement)")
@@ -462,8 +494,8 @@ def load_experiment_config(path, block_catalogue: Callable[[], Mapping[str, dict
         video_decimation=r.field(("output", "video_decimation"), int, positive=True),
         figures=r.field(("output", "figures"), bool),
         columns=columns,
-        column_cut_m=cut,
         column_impacts=r.field(("column", "impacts"), int, positive=True),
+        **col,
         truth=r.file(("truth",), required=False),
         tags=_tags(r),
     )
@@ -473,8 +505,45 @@ def load_experiment_config(path, block_catalogue: Callable[[], Mapping[str, dict
     return cfg
 
 
-def _sources(r: _Reader, path: Path, sources: dict):
-    """``[sources]``: (video, track, imu, table, primary)."""
+def _column_keys(r: _Reader, columns: tuple, video, b_block: float) -> dict:
+    """``[column]``'s per-level keys, checked: one value per object, a signed axis with IMUs, every
+    level measured (video or its IMU), cuts narrower than half the narrowest joint."""
+    n = len(columns)
+    out = {}
+    for key in ("b_m", "h_m", "mass_kg", "theta0_rad"):
+        v = r.vector(("column", key), r.at(("column", key)))
+        if v is not None and len(v) != n:
+            r.fail(("column", key), f"has {len(v)} values for {n} [column] objects; give one per level, bottom to top")
+        if v is not None and key != "theta0_rad" and not all(x > 0 for x in v):
+            r.fail(("column", key), f"= {list(v)} must all be positive")
+        out[f"column_{key}"] = tuple(v or ())
+    imus = r.at(("column", "imu"))
+    paths: tuple = ()
+    if imus is not None:
+        if not isinstance(imus, list) or len(imus) != n:
+            r.fail(("column", "imu"), f"must be an array of {n} IMU log paths (one per [column] object, bottom to top)")
+        paths = tuple(r.existing(("column", "imu"), v, allow_dir=True) for v in imus)
+    axis = r.get(("column", "imu_axis"), str)
+    if paths and (axis is None or not re.fullmatch(r"[+-]?[xyz]", axis)):
+        r.fail(
+            ("column", "imu_axis"),
+            f"= {axis!r}: the levels' IMUs need their rocking axis with the sign that turns "
+            "counter-clockwise as the camera sees it positive (e.g. '-y'); 'auto' cannot tell the levels' senses apart",
+        )
+    if columns and video is None and not paths:
+        r.fail(("column", "objects"), "needs a [sources.video] section or [column] imu (one IMU log per level)")
+    widths = out["column_b_m"] or (b_block,) * n
+    cut = r.field(("column", "cut_m"), float)
+    narrow = min((min(widths[j], widths[j - 1]) if j else widths[j]) for j in range(n)) if n else b_block
+    if cut < 0 or cut >= narrow / 2:
+        r.fail(("column", "cut_m"), f"= {cut} m must be in [0, {narrow / 2:g}) (half the narrowest joint)")
+    tol = r.field(("column", "event_tol_s"), float, positive=True)
+    return dict(out, column_cut_m=cut, column_imus=paths, column_imu_axis=axis, column_event_tol_s=tol)
+
+
+def _sources(r: _Reader, path: Path, sources: dict, column_imus: bool = False):
+    """``[sources]``: (video, track, imu, table, primary); a column measured by its levels' IMUs
+    needs no other source."""
     video = track = imu = None
     s = "sources"
     if "video" in sources:
@@ -496,13 +565,13 @@ def _sources(r: _Reader, path: Path, sources: dict):
         )
         if not IMU_AXIS.fullmatch(imu.axis):
             r.fail((s, "imu", "axis"), f"= {imu.axis!r} must be x, y, z (optionally signed, e.g. -y) or auto")
-    if video is None and track is None and imu is None:
+    if video is None and track is None and imu is None and not column_imus:
         raise InputError(f"{path}: [sources] needs at least one of [sources.video], [sources.track], [sources.imu]")
     given = {"video": video, "track": track, "imu": imu}
     primary = r.get((s, "primary"), str, choices=PRIMARY_SOURCES)
     if primary is None:
-        primary = next(p for p in PRIMARY_SOURCES if given[p] is not None)
-    if given[primary] is None:
+        primary = next((p for p in PRIMARY_SOURCES if given[p] is not None), "imu")
+    if given[primary] is None and not (column_imus and primary == "imu"):
         r.fail((s, "primary"), f"= {primary!r} but there is no [sources.{primary}] section")
     T = SourceTable
     tsrc = r.get((s, "table", "from"), str, default_of(T, "source"), choices=TABLE_SOURCES)
@@ -584,10 +653,18 @@ b2_m = 0.02                       # laws "cut_corner", "bumps": half-distance of
 x1_m = -0.0225                    # law "axes" (thesis Eq. A3): rotation axis before the impact, m from the middle
 x2_m = 0.0225                     # ... and after it (defaults -b/2, +b/2: Housner)
 
-[column]                          # column experiments (thesis §4.3): tracked objects bottom to top
-objects = ["block_1", "block_2", "block_3"]
+[column]                          # column experiments (thesis §4.2-4.3): levels bottom to top
+objects = ["block_1", "block_2", "block_3"]   # their ids (the tracked objects when there is a video)
 cut_m = 0.002                     # cut edge at every joint, m
 impacts = 1                       # consecutive impacts per joint closing (thesis: 2)
+b_m = [0.12, 0.1, 0.08]           # optional: each level's width, m (default: [block] b_m at every level)
+h_m = [0.3, 0.2, 0.2]             # optional: each level's height, m (default: [block] h_m)
+mass_kg = [9.7, 5.4, 3.5]         # optional: each level's mass, kg (default: [block] mass_kg)
+theta0_rad = [0.0, 0.0, -0.1]     # optional, free release: each level's start angle, counter-clockwise
+                                  # as the camera sees it (default: measured in the rest before the release)
+imu = ["imu/block_1", "imu/block_2", "imu/block_3"]  # optional: one IMU log per level (video optional then)
+imu_axis = "-y"                   # with imu: the rocking axis, signed so that counter-clockwise is positive
+event_tol_s = 0.02                # a simulated opening or impact matches a measured one within ± this, s
 
 [output]
 rrd = true

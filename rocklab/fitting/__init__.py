@@ -11,6 +11,7 @@ flags), :func:`per_impact_eta` (data-only per-impact η), :func:`energy_loss_fro
 """
 
 from ._campaign_fits import ETA_MAT_RULES, EtaMatResult, KTableResult, fit_eta_mat, k_table, read_block_table
+from ._column_ensemble import EVENT_THRESHOLD_RAD, ColumnEnsemble, ColumnVerdict, judge_column, simulate_column_ensemble
 from ._catalogue import catalogue_block, ceh_catalogue, ceh_full_contact, ceh_table5
 from ._ensemble import (
     BUDGET_SOURCES,
@@ -64,6 +65,11 @@ __all__ = [
     "BUDGET_SOURCES",
     "judge_law",
     "response_statistics",
+    "simulate_column_ensemble",
+    "judge_column",
+    "ColumnEnsemble",
+    "ColumnVerdict",
+    "EVENT_THRESHOLD_RAD",
     "InputUncertainty",
     "Ensemble",
     "LawVerdict",

@@ -12,6 +12,8 @@ from pathlib import Path
 
 import numpy as np
 
+from .._errors import InputError
+
 __all__ = ["VideoPair", "write_track_toml", "write_experiment_toml"]
 
 
@@ -172,12 +174,14 @@ def write_track_toml(path: Path, *, style, camera, objects, marker_size_m, dot_d
     return text
 
 
-def write_experiment_toml(path: Path, *, name, block, table_kind, imu_objects, column=None) -> str:
+def write_experiment_toml(path: Path, *, name, block, table_kind, imu_objects, column=None, video=True) -> str:
     """``experiment.toml`` for ``rocklab run``, through its schema (:class:`rocklab.config.ExperimentConfig`).
 
     ``block``: dict with ``id, b_m, h_m, mass_kg`` of the block the run fits;
-    ``imu_objects``: object ids that have ``imu/<id>/`` logs; ``column``: object
-    ids bottom to top for a stacked column (or None).
+    ``imu_objects``: object ids that have ``imu/<id>/`` logs; ``column``: a stacked column's
+    ``objects`` (ids bottom to top), ``blocks`` (dicts with ``b_m, h_m, mass_kg``, written per
+    level when they differ), ``cut_m`` and ``impacts`` (or None); ``video``: whether the session
+    has a film (without one, every level is measured by its IMU).
     """
     from .._io import write_text_atomic
     from ..config import ExperimentConfig, SourceImu, SourceTable, SourceVideo
@@ -185,6 +189,21 @@ def write_experiment_toml(path: Path, *, name, block, table_kind, imu_objects, c
     path = Path(path)
     folder = path.parent
     bid = block["id"]
+    col: dict = {}
+    if column is not None:
+        col = {"columns": tuple(column["objects"]), "column_cut_m": float(column["cut_m"])}
+        col["column_impacts"] = int(column["impacts"])
+        per = {k: tuple(float(b[k]) for b in column["blocks"]) for k in ("b_m", "h_m", "mass_kg")}
+        if any(len(set(v)) > 1 for v in per.values()):
+            col.update({f"column_{k}": v for k, v in per.items()})
+        if not video:
+            # the synthetic IMUs' y axis points away from the camera: -y turns counter-clockwise positive
+            col.update(column_imus=tuple(folder / "imu" / o for o in column["objects"]), column_imu_axis="-y")
+    if not video and table_kind != "none":
+        raise InputError(
+            "video=False with a moving table: the table IMU's clock can only be put on the blocks' through "
+            "a film; render the video or use table='none'"
+        )
     cfg = ExperimentConfig(
         path=path,
         name=name,
@@ -192,12 +211,14 @@ def write_experiment_toml(path: Path, *, name, block, table_kind, imu_objects, c
         h_m=float(block["h_m"]),
         mass_kg=float(block["mass_kg"]),
         block_id=None,
-        primary="video",
-        video=SourceVideo(path=folder / "video.mkv", track_config=folder / "track.toml", object=bid),
-        imu=SourceImu(path=folder / "imu" / bid, axis="y") if bid in imu_objects else None,
+        primary="video" if video else "imu",
+        video=SourceVideo(path=folder / "video.mkv", track_config=folder / "track.toml", object=bid) if video else None,
+        imu=SourceImu(path=folder / "imu" / bid, axis="y")
+        if bid in imu_objects and (video or column is None)
+        else None,
         table=SourceTable() if table_kind == "none" else SourceTable(source="video", object="table"),
-        columns=tuple(column or ()),
         truth=folder / "truth.csv",
+        **col,
     )
     text = cfg.to_toml(header=("Experiment config written by 'rocklab synth' (schema: docs/experiment-toml.md).",))
     write_text_atomic(path, text, stamp=False)  # an input of `rocklab run`, not an output

@@ -217,31 +217,42 @@ class Scene:
         centre = to_world(np.array([[0.0, c]]), ox, oy, phi).reshape(-1, 2)[0]
         return centre + np.array([[-k * a, -k * c], [k * a, k * c]])
 
-    def write_files(self, folder: Path, *, imu: bool, imu_rate_hz: float, calibrated: bool) -> dict:
-        """Write truth.csv, track.toml, experiment.toml, imu/ and return session.json's content."""
+    def write_files(self, folder: Path, *, imu: bool, imu_rate_hz: float, calibrated: bool, video: bool = True) -> dict:
+        """Write truth.csv, track.toml (with a film), experiment.toml, imu/ and return session.json's content."""
         from .._io import write_frame_atomic
         from ._files import write_experiment_toml, write_track_toml
 
         write_frame_atomic(folder / "truth.csv", self.truth_frame())
         f1 = self.features[self.block_motions[0].id]
-        write_track_toml(
-            folder / "track.toml",
-            style=self.targets,
-            camera=self.camera,
-            objects=self._track_objects(),
-            marker_size_m=f1.get("marker_size_m"),
-            dot_diameter_m=f1.get("dot_diameter_m"),
-            calibrated=calibrated,
-        )
+        if video:
+            write_track_toml(
+                folder / "track.toml",
+                style=self.targets,
+                camera=self.camera,
+                objects=self._track_objects(),
+                marker_size_m=f1.get("marker_size_m"),
+                dot_diameter_m=f1.get("dot_diameter_m"),
+                calibrated=calibrated,
+            )
         b0 = self.sims[0]["block"]
         imu_info = self._write_imu(folder, imu_rate_hz) if imu else {}
+        column = None
+        if self.layout == "column":
+            s0 = self.sims[0]
+            column = {
+                "objects": [m.id for m in self.block_motions],
+                "blocks": [s["block"] for s in self.sims],
+                "cut_m": s0["column_cut_m"],
+                "impacts": s0["column_impacts"],
+            }
         write_experiment_toml(
             folder / "experiment.toml",
             name=f"synth-seed{self.seed}",
             block={"id": self.block_motions[0].id, "b_m": b0["b_m"], "h_m": b0["h_m"], "mass_kg": b0["mass_kg"]},
             table_kind=self.table.kind,
             imu_objects=set(imu_info),
-            column=[m.id for m in self.block_motions] if self.layout == "column" else None,
+            column=column,
+            video=video,
         )
         return self._meta(imu_info)
 
@@ -356,6 +367,8 @@ def build_scene(
     distortion,
     layout=None,
     texture="procedural",
+    column_cut_m=0.0,
+    column_impacts=1,
 ) -> Scene:
     ss = np.random.SeedSequence(seed)
     s_cam, s_motion, s_tex, s_noise, s_imu, s_bg = ss.spawn(6)
@@ -390,7 +403,17 @@ def build_scene(
     base = tbl.base_motion(sim_end)
     phi0 = _release_angles(theta0_rad, blks)
     motions, sims, ends = _block_motions(
-        layout, blks, phi0, theta0_rad, tbl, base, table, (rest_s, sim_end), rng_m, (restitution, eta)
+        layout,
+        blks,
+        phi0,
+        theta0_rad,
+        tbl,
+        base,
+        table,
+        (rest_s, sim_end),
+        rng_m,
+        (restitution, eta),
+        column=(column_cut_m, column_impacts),
     )
     if duration_s is None:
         duration_s = float(np.clip(max(ends) + 0.6, 2.0, 12.0))
@@ -467,23 +490,19 @@ def _release_angles(theta0_rad, blks) -> list:
     return phi0
 
 
-def _block_motions(layout, blks, phi0, theta0_rad, tbl, base, table, times_s, rng_m, law):
+def _block_motions(layout, blks, phi0, theta0_rad, tbl, base, table, times_s, rng_m, law, column=(0.0, 1)):
     """(motions, simulation summaries, end times s) of the blocks: a column, or blocks side by side.
 
-    ``times_s`` = (release or table start, end of the simulation), ``law`` = (restitution, eta).
+    ``times_s`` = (release or table start, end of the simulation), ``law`` = (restitution, eta),
+    ``column`` = (cut at every joint m, impacts per closing).
     """
     rest_s, sim_end = times_s
     if layout == "column":
-        return _column_motions(
-            blks,
-            tbl,
-            base,
-            table,
-            rest_s,
-            sim_end,
-            rng_m,
-            None if theta0_rad is None else float(np.ravel(theta0_rad)[0]),
-        )
+        th0 = None if theta0_rad is None else np.ravel(np.asarray(theta0_rad, float))
+        # one angle: the column tilted as one body; one per level: each block's own angle
+        th0 = None if th0 is None else (float(th0[0]) if th0.size == 1 else th0)
+        cut_m, impacts = column
+        return _column_motions(blks, tbl, base, table, rest_s, sim_end, rng_m, th0, cut_m=cut_m, impacts=impacts)
     xs = [0.0] if len(blks) == 1 else [-0.35, 0.0, 0.35]  # blocks side by side, 0.35 m apart
     return _single_motions(blks, xs, phi0, tbl, base, table, rest_s, sim_end, rng_m, *law)
 
@@ -685,34 +704,40 @@ def _single_motions(blks, xs, phi0, tbl, base, table, rest_s, sim_end_s, rng_m, 
     return motions, sims, ends
 
 
-def _column_motions(blks, tbl, base, table, rest_s, sim_end_s, rng_m, phi0=None):
-    """A stacked column (``rocklab.models.simulate_column``): free rocking after a
-    thread-burn release of the whole column tilted by half its slenderness angle,
-    or standing on the moving table; simulated to ``sim_end_s`` (video time)."""
+def _column_motions(blks, tbl, base, table, rest_s, sim_end_s, rng_m, phi0=None, *, cut_m=0.0, impacts=1):
+    """A stacked column (``rocklab.models.simulate_column``, ``cut_m`` at every joint, ``impacts``
+    per closing): free rocking after a thread-burn release of the whole column tilted by half its
+    slenderness angle (``phi0`` one angle: the whole column; an array: each level's own
+    counter-clockwise angle), or standing on the moving table; simulated to ``sim_end_s`` (video time)."""
     from ._column import ColumnBlockView, ColumnMotion, column_api
 
     Column, simulate_column = column_api()
-    col = Column(tuple(blks))
+    col = Column(tuple(blks), cut_m=cut_m)
     n = len(blks)
     H = sum(b.h_m for b in blks)
     if table == "none":
         alpha_col = float(np.arctan(min(b.b_m for b in blks) / H))
         if phi0 is None:
             phi0 = 0.5 * alpha_col
-        elif not abs(phi0) < alpha_col:
+        elif np.ndim(phi0) == 0 and not abs(phi0) < alpha_col:
             raise InputError(
                 f"theta0_rad={phi0!r}: the column tips as one body; give |theta0| < "
                 f"{alpha_col:.4f} rad (its slenderness angle)"
             )
+        if np.ndim(phi0) and np.size(phi0) != n:
+            raise InputError(f"theta0_rad={list(phi0)!r}: give one angle or one per level ({n})")
+        levels = np.broadcast_to(np.asarray(phi0, float), (n,))
         release = round(rest_s + float(rng_m.uniform(0.0, 0.1)), 4)
-        res = simulate_column(col, None, theta0_rad=[-phi0] * n, duration_s=max(sim_end_s - release, 0.5))
-        psi0 = np.zeros((1, n))
-        psi0[0, 0] = phi0
+        res = simulate_column(
+            col, None, theta0_rad=-levels, duration_s=max(sim_end_s - release, 0.5), n_impacts=impacts
+        )
+        psi0 = np.diff(np.concatenate([[0.0], levels]))[None, :]  # held by the thread until the release
         t = np.concatenate(([0.0], release + res.t_s))
         psi = np.vstack([psi0, -res.phi_rad])
+        phi0 = [float(v) for v in levels]
     else:
-        phi0, release = 0.0, None
-        res = simulate_column(col, base, duration_s=sim_end_s)
+        phi0, release = [0.0] * n, None
+        res = simulate_column(col, base, duration_s=sim_end_s, n_impacts=impacts)
         t, psi = res.t_s, -res.phi_rad
     cm = ColumnMotion(
         np.array([b.b_m for b in blks]),
@@ -737,12 +762,19 @@ def _column_motions(blks, tbl, base, table, rest_s, sim_end_s, rng_m, phi0=None)
         "impact_t_s": [float(v) + (release or 0.0) for v in imp["t_s"]] if len(imp) else [],
         "impact_joint": [int(v) for v in imp["joint"]] if len(imp) else [],
         "column_status_t_s": float(res.t_status_s),
+        "column_cut_m": float(cut_m),
+        "column_impacts": int(impacts),
+        "column_events": [
+            {"t_s": float(r.t_s) + (release or 0.0), "joint": int(r.joint), "state": r.state, "event": r.event}
+            for r in res.configurations.itertuples()
+            if r.event != "start"
+        ],
     }
     sims = [
         {
             "id": m.id,
             "block": _block_info(b),
-            "theta0_rad": phi0,
+            "theta0_rad": phi0[k],
             "layout": "column",
             "max_abs_theta_rad": float(res.max_abs_theta_rad[k]),
         }

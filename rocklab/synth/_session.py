@@ -129,8 +129,8 @@ def parse_size(text) -> tuple[int, int]:
 def _check(seed, blocks, table, fps, targets, duration_s, exposure_s, noise_dn):
     if not isinstance(seed, (int, np.integer)) or isinstance(seed, bool) or seed < 0:
         raise InputError(f"seed={seed!r}: must be a non-negative integer")
-    if blocks not in (1, 3):
-        raise InputError(f"blocks={blocks!r}: must be 1 or 3")
+    if blocks not in (1, 2, 3):
+        raise InputError(f"blocks={blocks!r}: must be 1, 2 or 3")
     if table not in TABLES:
         raise InputError(f"table={table!r}: unknown table motion; use one of {', '.join(TABLES)}")
     if targets not in TARGETS:
@@ -189,6 +189,9 @@ def synth_session(
     progress: bool = False,
     flicker: float = 0.0,
     texture: str = "procedural",
+    column_cut_m: float = 0.0,
+    column_impacts: int = 1,
+    video: bool = True,
 ) -> SynthSession:
     """Render a synthetic lab session into ``out_dir`` (see the module doc for the layout).
 
@@ -200,8 +203,8 @@ def synth_session(
     seed : int
         Everything random (camera pose and lens, release times, textures,
         noise, IMU errors) derives from it: same seed, identical files.
-    blocks : {1, 3}
-        One block, or three blocks: a stacked column (thesis §4.3: three
+    blocks : {1, 2, 3}
+        One block, or two or three blocks: a stacked column (thesis §4.3: three
         0.1 x 0.2 m granite blocks, ``rocklab.models.simulate_column``) when
         the column model is available, else independent blocks side by side
         (``layout`` forces one: ``"column"`` or ``"side"``).
@@ -233,7 +236,15 @@ def synth_session(
     restitution, eta :
         Impact law for :func:`rocklab.models.simulate` (default constant eta = 0.75: a 0.1 x 0.2 m block survives the sine pulse).
     theta0_rad : float or sequence, optional
-        Initial counter-clockwise tilt(s) for free rocking (default ±0.5 alpha).
+        Initial counter-clockwise tilt(s) for free rocking (default ±0.5 alpha). A column: one
+        angle tilts it as one body, one per level gives each block's own angle (thesis §4.2:
+        ``[0, -0.153]``, the upper block alone tilted).
+    column_cut_m, column_impacts : float, int
+        A column's cut edge at every joint (m) and impacts per closing (the true model, written
+        to ``experiment.toml``'s ``[column]``).
+    video : bool
+        Render the film (``video.mkv``/``.mp4``, ``track.toml``). False: only the IMU logs, the
+        truth and an ``experiment.toml`` that measures every block with its IMU (needs ``imu``).
     exposure_s : float, optional
         Shutter time, s (default half a frame period); motion blur integrates over it.
     noise_dn : float
@@ -266,10 +277,12 @@ def synth_session(
     fps = float(fps) if isinstance(fps, (int, float, np.number)) and not isinstance(fps, bool) else fps
     _check(seed, blocks, table, fps, targets, duration_s, exposure_s, noise_dn)
     _check_look(flicker, texture)
+    if not video and not imu:
+        raise InputError("video=False needs imu=True: a session without a film is measured by its IMUs")
     seed = int(seed)
     # the scene's options (build_scene's parameters) go on as given: size parsed, fps a float, seed an int
     scene_options = {name: value for name, value in locals().items() if name in SCENE_OPTIONS}
-    files = dict(imu=imu, imu_rate_hz=imu_rate_hz, calibrated=calibrated)
+    files = dict(imu=imu, imu_rate_hz=imu_rate_hz, calibrated=calibrated, video=video)
     out_dir = Path(out_dir)
     render_s = _render_session(scene_options, float(flicker), files, out_dir, force, mp4, progress)
     return load_synth_session(out_dir, render_s=render_s)
@@ -295,7 +308,8 @@ def _render_session(scene_options, flicker, files, out_dir: Path, force: bool, m
     try:
         scene = build_scene(**scene_options)
         scene.flicker = flicker
-        _render_video(scene, tmp, mp4, progress)
+        if files["video"]:
+            _render_video(scene, tmp, mp4, progress)
         meta = scene.write_files(tmp, **files)
         meta["flicker"] = flicker
         meta["texture"] = scene_options["texture"]

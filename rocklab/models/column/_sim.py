@@ -6,6 +6,16 @@ the formulation. Mass matrix and load vector follow the App. C reduction for
 the current geometry (plus the velocity terms ``BᵀMḂφ̇`` the thesis drops,
 switchable); openings and impacts by the enumeration models of §3.2.2–3.2.3.
 
+Blocks of different sizes
+-------------------------
+Every level has its own width, height, mass and inertia: the App. C reduction (Eq. C1–C8: three
+mass points per block, ``B`` from the current geometry, ``M̃ = BᵀMB``, ``p̃ = Bᵀp``) and the
+opening and impact models (Eq. 4–9) are written per block and per joint and assume nothing of the
+kind. The thesis's worked examples do use identical blocks (App. C's two 1 × 4 m blocks, Eq.
+C9–C16; Psycharis's two-block impact, Eq. 10–11; §4.2 and §4.3), and it says nothing of a joint
+between faces of different widths: here a joint pivots ``cut_m`` inside the NARROWER of its two
+faces (:attr:`Column.half_width_m`), the corner of the narrower block on the wider one.
+
 Sign convention (public)
 ------------------------
 x to the right, base acceleration positive to the right. Block angles

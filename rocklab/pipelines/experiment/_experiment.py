@@ -132,7 +132,6 @@ def analyse_experiment(
     timings: dict[str, float] = {}
     m = _measure(cfg, progress, keep_video, msgs, timings)
     block = cfg.block()
-    prim = m.measured[cfg.primary]
     status = "ok"
     shared = dict(
         name=cfg.name,
@@ -153,11 +152,14 @@ def analyse_experiment(
         from ._column_run import analyse_column
 
         t3 = time.perf_counter()
-        column = analyse_column(cfg, m.tracked, m.table, cfg.truth)
+        column = analyse_column(cfg, m.tracked, m.table, cfg.truth, msgs)
         timings["column_s"] = time.perf_counter() - t3
+        if cfg.primary not in m.measured:  # levels measured by their IMUs alone: the bottom level's clock
+            shared["measured"] = {cfg.primary: (column.t_s, column.theta_measured_rad[:, 0]), **m.measured}
         return ExperimentResult(
             **shared, fit=None, per_impact_eta=np.empty(0), simulations={}, truth=None, status=status, column=column
         )
+    prim = m.measured[cfg.primary]
     from ._audit_stage import audit_experiment
 
     audit = audit_experiment(cfg, m.measured, m.tracked, m.track_rows)

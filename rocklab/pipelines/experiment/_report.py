@@ -36,11 +36,18 @@ def series_frame(res):
             cols[f"table_{k}"] = np.interp(t, res.table.t_s, v, left=np.nan, right=np.nan)
     if res.column is not None:
         c = res.column
+        v = c.validation
+        band = None if v is None else v.bands[v.reference_law]
         for i, o in enumerate(c.objects):
-            cols[f"theta_{o}_video_rad"] = np.interp(t, c.t_s, c.theta_measured_rad[:, i], left=np.nan, right=np.nan)
+            cols[f"theta_{o}_{c.source}_rad"] = np.interp(
+                t, c.t_s, c.theta_measured_rad[:, i], left=np.nan, right=np.nan
+            )
             cols[f"theta_{o}_sim_column_rad"] = np.interp(
                 t, c.sim_t_s, c.theta_sim_rad[:, i], left=np.nan, right=np.nan
             )
+            if band is not None:  # the reference law's 5–95 % band (predicted measurement)
+                for q, b in (("p05", band[1]), ("p95", band[2])):
+                    cols[f"theta_{o}_sim_column_{q}_rad"] = np.interp(t, band[0], b[:, i], left=np.nan, right=np.nan)
             if c.theta_truth is not None:
                 tt, th = c.theta_truth
                 cols[f"theta_{o}_truth_rad"] = np.interp(t, tt, th[:, i], left=np.nan, right=np.nan)
@@ -177,6 +184,7 @@ def _summary_md(res, figs: dict, rrd: bool) -> str:
             f"{sq.n_measured} measured / {sq.n_simulated} simulated events matched "
             f"(median timing error {_g(sq.timing_error_s)} s)",
         ]
+        lines += _column_validation_lines(c)
         if c.sequence_vs_truth is not None:
             st = c.sequence_vs_truth
             lines += [
@@ -192,6 +200,35 @@ def _summary_md(res, figs: dict, rrd: bool) -> str:
     if rrd:
         lines += ["", "Visual review: `rerun session.rrd`"]
     return "\n".join(lines) + "\n"
+
+
+def _column_validation_lines(c) -> list:
+    """The event-sequence verdicts of a column run (``summary.md``)."""
+    v = c.validation
+    if v is None:
+        return []
+    lines = [
+        "",
+        f"Event-sequence validation ({v.n_members} simulations per model, measured by {c.source}; "
+        f"start {_g(c.start_t_s)} s, start angles {', '.join(_g(x) for x in c.theta0_rad)} rad): "
+        f"predictability horizon ({v.reference_law}) {_g(v.horizon_s)} s",
+        "",
+        "| model | verdict | score | events inside the horizon matched | band coverage |",
+        "|---|---|---|---|---|",
+    ]
+    for law, lv in v.laws.items():
+        lines.append(
+            f"| {law} | **{lv.verdict}** | {_g(lv.score)} | {lv.n_matched_inside} of {lv.n_events_inside} "
+            f"(±{_g(lv.tol_s)} s) | {_g(lv.band_coverage)} |"
+        )
+    ev = c.model_events()[:3]
+    if ev:
+        lines += [
+            "",
+            "First model events after the start: "
+            + ", ".join(f"{_g(e['t_from_start_s'])} s joint {e['joint']} {e['event']} ({e['state']})" for e in ev),
+        ]
+    return lines
 
 
 def write_outputs(res, out_dir: Path, fp: str, *, spawn=False, connect=None, progress=False) -> dict:

@@ -237,6 +237,19 @@ class ColumnStage:
     cut_m : float
         The joints' cut, m.
     impacts_per_closing : int
+    source : str
+        What measured the levels: ``video`` or ``imu`` (each level's IMU, on one clock).
+    start_t_s : float
+        The release (free rocking) or the first sample the levels are measured together, s.
+    theta0_rad : tuple of float
+        Each level's start angle, counter-clockwise, rad.
+    blocks : tuple of dict
+        Each level's block (:meth:`rocklab.Block.to_dict`), bottom to top.
+    imu_clocks : list of dict or None
+        Per level IMU: how its clock was put on the run's (``offset_s``, ``correlation``, ``how``).
+    validation : ColumnValidation or None
+        The event-sequence verdicts of the model's ensembles
+        (:func:`rocklab.pipelines.experiment._column_run.validate_column`).
     theta_truth : (t_s, theta_rad (m', n)) or None
         A synthetic session's true angles.
     sequence_vs_truth : rocklab.models.SequenceComparison or None
@@ -255,19 +268,47 @@ class ColumnStage:
     comparison: object
     cut_m: float
     impacts_per_closing: int
+    source: str = "video"
+    start_t_s: float = 0.0
+    theta0_rad: tuple = ()
+    blocks: tuple = ()
+    imu_clocks: list | None = None
+    validation: object = None
     theta_truth: tuple | None = None
     sequence_vs_truth: object = None
     theta_rms_error_rad: list | None = None
+
+    def model_events(self) -> list:
+        """The model's openings and impacts: ``t_s`` (measured clock), ``t_from_start_s``, ``joint``,
+        ``state`` (after it), ``event``."""
+        c = self.configurations
+        return [
+            {
+                "t_s": float(r.t_s),
+                "t_from_start_s": float(r.t_s - self.start_t_s),
+                "joint": int(r.joint),
+                "state": r.state,
+                "event": r.event,
+            }
+            for r in c[c.event != "start"].itertuples()
+        ]
 
     def to_dict(self) -> dict:
         """``report.json``'s ``column``."""
         d = {
             "objects": list(self.objects),
             "status": self.status,
+            "source": self.source,
+            "start_t_s": float(self.start_t_s),
+            "theta0_rad": list(self.theta0_rad),
+            "blocks": list(self.blocks),
             "comparison": self.comparison.to_dict(),
             "cut_m": self.cut_m,
             "impacts_per_closing": self.impacts_per_closing,
+            "model_events": self.model_events()[:50],
         }
+        if self.imu_clocks is not None:
+            d["imu_clocks"] = self.imu_clocks
         if self.sequence_vs_truth is not None:
             d["sequence_vs_truth"] = self.sequence_vs_truth.to_dict()
         if self.theta_rms_error_rad is not None:
@@ -384,7 +425,9 @@ class ExperimentResult:
                 "bytes": self.video.n_bytes,
                 "note": self.video.note,
             },
-            "validation": None if self.validation is None else self.validation.to_dict(),
+            "validation": self.validation.to_dict()
+            if self.validation is not None
+            else (None if self.column is None or self.column.validation is None else self.column.validation.to_dict()),
             "energy_loss": None if self.energy_loss is None else _energy_loss_dict(self.energy_loss),
             "timings_s": self.timings_s,
             "units": {

@@ -93,7 +93,7 @@ def _member_base(table_t_s, table_acc_m_s2, unc, rng, t_start_s):
     """One draw of the measured table acceleration as a BaseMotion on 1 ms (None without a table)."""
     from scipy.interpolate import CubicSpline
 
-    from ..models import BaseMotion
+    from ..series import BaseMotion
 
     if table_t_s is None:
         return None

@@ -401,19 +401,9 @@ def build_scene(
         horizon_s=max(horizon, 3.0),
     )
     base = tbl.base_motion(sim_end)
-    phi0 = _release_angles(theta0_rad, blks)
+    law, column = (restitution, eta), (column_cut_m, column_impacts)
     motions, sims, ends = _block_motions(
-        layout,
-        blks,
-        phi0,
-        theta0_rad,
-        tbl,
-        base,
-        table,
-        (rest_s, sim_end),
-        rng_m,
-        (restitution, eta),
-        column=(column_cut_m, column_impacts),
+        layout, blks, theta0_rad, tbl, base, table, (rest_s, sim_end), rng_m, law, column=column
     )
     if duration_s is None:
         duration_s = float(np.clip(max(ends) + 0.6, 2.0, 12.0))
@@ -490,13 +480,14 @@ def _release_angles(theta0_rad, blks) -> list:
     return phi0
 
 
-def _block_motions(layout, blks, phi0, theta0_rad, tbl, base, table, times_s, rng_m, law, column=(0.0, 1)):
+def _block_motions(layout, blks, theta0_rad, tbl, base, table, times_s, rng_m, law, column=(0.0, 1)):
     """(motions, simulation summaries, end times s) of the blocks: a column, or blocks side by side.
 
     ``times_s`` = (release or table start, end of the simulation), ``law`` = (restitution, eta),
     ``column`` = (cut at every joint m, impacts per closing).
     """
     rest_s, sim_end = times_s
+    phi0 = _release_angles(theta0_rad, blks)  # each block within its own ±alpha, whatever the layout
     if layout == "column":
         th0 = None if theta0_rad is None else np.ravel(np.asarray(theta0_rad, float))
         # one angle: the column tilted as one body; one per level: each block's own angle

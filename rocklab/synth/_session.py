@@ -198,33 +198,28 @@ def synth_session(
     Parameters
     ----------
     out_dir : path
-        New (or empty) folder; written atomically (rendered into a temporary
-        sibling folder, then renamed). ``force=True`` replaces a non-empty one.
+        New (or empty) folder; written atomically (rendered into a temporary sibling folder, then renamed).
+        ``force=True`` replaces a non-empty one.
     seed : int
-        Everything random (camera pose and lens, release times, textures,
-        noise, IMU errors) derives from it: same seed, identical files.
+        Everything random (camera pose and lens, release times, textures, noise, IMU errors) derives from it:
+        same seed, identical files.
     blocks : {1, 2, 3}
-        One block, or two or three blocks: a stacked column (thesis §4.3: three
-        0.1 x 0.2 m granite blocks, ``rocklab.models.simulate_column``) when
-        the column model is available, else independent blocks side by side
-        (``layout`` forces one: ``"column"`` or ``"side"``).
+        One block, or two or three blocks: a stacked column (thesis §4.3: three 0.1 x 0.2 m granite blocks,
+        ``rocklab.models.simulate_column``) when the column model is available, else independent blocks side by
+        side (``layout`` forces one: ``"column"`` or ``"side"``).
     table : {"none", "sine", "record"}
-        ``none``: free rocking after a thread-burn release from ``theta0_rad``
-        at a known time; ``sine``: blocks at rest on a table doing one smooth
-        sine cycle (``table_period_s``, ``table_amplitude_m``, default 45 mm
-        as thesis Fig. 31, 20 mm for the column which overturns at 45 mm);
-        ``record``: ``record`` (path of an .AT2/CSV record or a BaseMotion;
-        default the bundled El Centro 1940) scaled and high-passed to the
-        table stroke ``table_stroke_m``.
+        ``none``: free rocking after a thread-burn release from ``theta0_rad`` at a known time; ``sine``: blocks
+        at rest on a table doing one smooth sine cycle (``table_period_s``, ``table_amplitude_m``, default 45 mm
+        as thesis Fig. 31, 20 mm for the column which overturns at 45 mm); ``record``: ``record`` (path of an
+        .AT2/CSV record or a BaseMotion; default the bundled El Centro 1940) scaled and high-passed to the table
+        stroke ``table_stroke_m``.
     fps : float
         Frame rate, Hz.
     size : (W, H) or "WxH"
-        Frame size, px. The framing scales with it (a 0.2 m block fills a
-        third of the frame height).
+        Frame size, px. The framing scales with it (a 0.2 m block fills a third of the frame height).
     targets : {"aruco", "dots", "edges", "markerless"}
-        Two ArUco markers (DICT_4X4_50) per block and two on the table; four
-        black dots per block and three on the table; or plain light blocks on
-        a dark background.
+        Two ArUco markers (DICT_4X4_50) per block and two on the table; four black dots per block and three on
+        the table; or plain light blocks on a dark background.
     duration_s : float, optional
         Video length, s (default: until the blocks are at rest plus 0.6 s, at most 12 s).
     occlusion : (t0_s, t1_s) or dict, optional
@@ -234,33 +229,32 @@ def synth_session(
     block : Block or list of Block, optional
         Block geometry (default 0.1 m x 0.2 m x 0.3 m granite, the thesis §4.3 column element).
     restitution, eta :
-        Impact law for :func:`rocklab.models.simulate` (default constant eta = 0.75: a 0.1 x 0.2 m block survives the sine pulse).
+        Impact law for :func:`rocklab.models.simulate` (default constant eta = 0.75: a 0.1 x 0.2 m block
+        survives the sine pulse).
     theta0_rad : float or sequence, optional
-        Initial counter-clockwise tilt(s) for free rocking (default ±0.5 alpha). A column: one
-        angle tilts it as one body, one per level gives each block's own angle (thesis §4.2:
-        ``[0, -0.153]``, the upper block alone tilted).
+        Initial counter-clockwise tilt(s) for free rocking (default ±0.5 alpha). A column: one angle tilts it as
+        one body, one per level gives each block's own angle (thesis §4.2: ``[0, -0.153]``, the upper block
+        alone tilted).
     column_cut_m, column_impacts : float, int
-        A column's cut edge at every joint (m) and impacts per closing (the true model, written
-        to ``experiment.toml``'s ``[column]``).
+        A column's cut edge at every joint (m) and impacts per closing (the true model, written to
+        ``experiment.toml``'s ``[column]``).
     video : bool
-        Render the film (``video.mkv``/``.mp4``, ``track.toml``). False: only the IMU logs, the
-        truth and an ``experiment.toml`` that measures every block with its IMU (needs ``imu``).
+        Render the film (``video.mkv``/``.mp4``, ``track.toml``). False: only the IMU logs, the truth and an
+        ``experiment.toml`` that measures every block with its IMU (needs ``imu``).
     exposure_s : float, optional
         Shutter time, s (default half a frame period); motion blur integrates over it.
     noise_dn : float
         Sensor noise, grey levels (sigma).
     flicker : float
-        Exposure flicker, relative amplitude (0 to 0.5): a camcorder's automatic exposure
-        hunting under mains light (``Renderer.exposure_gain``); the frames' brightness follows it.
+        Exposure flicker, relative amplitude (0 to 0.5): a camcorder's automatic exposure hunting under mains
+        light (``Renderer.exposure_gain``); the frames' brightness follows it.
     texture : {"procedural", "photo"}
-        Surfaces from synthetic noise, or from photographs (CC0, shipped in
-        ``rocklab/data/textures``): the wall is a brick wall and a markerless block's
-        face is gravel-like stone.
+        Surfaces from synthetic noise, or from photographs (CC0, shipped in ``rocklab/data/textures``): the wall
+        is a brick wall and a markerless block's face is gravel-like stone.
     imu : bool
-        Write IMU logs (one per block and one on the table), x-IMU GUI format. They
-        start 0.5..1.5 s before the video and run on 0.5 s after its last frame (the
-        camera is stopped first); the blocks and the table are simulated to the end
-        of the logs, while ``truth.csv`` covers the video frames.
+        Write IMU logs (one per block and one on the table), x-IMU GUI format. They start 0.5..1.5 s before the
+        video and run on 0.5 s after its last frame (the camera is stopped first); the blocks and the table are
+        simulated to the end of the logs, while ``truth.csv`` covers the video frames.
 
     Returns
     -------
@@ -276,20 +270,20 @@ def synth_session(
     size = parse_size(size)
     fps = float(fps) if isinstance(fps, (int, float, np.number)) and not isinstance(fps, bool) else fps
     _check(seed, blocks, table, fps, targets, duration_s, exposure_s, noise_dn)
-    _check_look(flicker, texture)
-    if not video and not imu:
-        raise InputError("video=False needs imu=True: a session without a film is measured by its IMUs")
+    _check_look(flicker, texture, video, imu)
     seed = int(seed)
     # the scene's options (build_scene's parameters) go on as given: size parsed, fps a float, seed an int
     scene_options = {name: value for name, value in locals().items() if name in SCENE_OPTIONS}
     files = dict(imu=imu, imu_rate_hz=imu_rate_hz, calibrated=calibrated, video=video)
-    out_dir = Path(out_dir)
-    render_s = _render_session(scene_options, float(flicker), files, out_dir, force, mp4, progress)
-    return load_synth_session(out_dir, render_s=render_s)
+    render_s = _render_session(scene_options, float(flicker), files, Path(out_dir), force, mp4, progress)
+    return load_synth_session(Path(out_dir), render_s=render_s)
 
 
-def _check_look(flicker, texture):
-    """The frames' exposure flicker and surface textures are among the known ones."""
+def _check_look(flicker, texture, video=True, imu=True):
+    """The frames' exposure flicker and surface textures are among the known ones; a session
+    without a film has IMUs."""
+    if not video and not imu:
+        raise InputError("video=False needs imu=True: a session without a film is measured by its IMUs")
     if not (isinstance(flicker, (int, float)) and not isinstance(flicker, bool) and 0 <= flicker <= 0.5):
         raise InputError(f"flicker={flicker!r}: exposure flicker must be a relative amplitude from 0 to 0.5")
     if texture not in ("procedural", "photo"):

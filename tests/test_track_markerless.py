@@ -97,58 +97,6 @@ def test_markerless_region_without_texture_is_an_error():
     assert "\n" not in str(e.value)
 
 
-def test_real_pendulum_footage(shared_data):
-    """Real camera footage (a spinning ball on a string): >= 99 % of frames followed, and the
-    swing period agrees with an independent colour-blob centroid + damped-sine fit."""
-    from scipy.optimize import curve_fit
-
-    from rocklab.tracking import iter_video_frames
-
-    path = shared_data / "video" / "pendulum_film2_vga.mp4"
-    cap = cv2.VideoCapture(str(path))
-    fps = cap.get(cv2.CAP_PROP_FPS)
-    blob_x = []
-    while True:  # independent method: centroid of the blue half of the ball (HSV threshold)
-        ok, img = cap.read()
-        if not ok:
-            break
-        hsv = cv2.cvtColor(img, cv2.COLOR_BGR2HSV)
-        m = cv2.inRange(hsv, (95, 80, 40), (130, 255, 255))
-        ys, xs = np.nonzero(m)
-        blob_x.append(xs.mean() if xs.size > 30 else np.nan)
-    blob_x = np.array(blob_x)
-    cfg = TrackConfig.from_dict(
-        {
-            "targets": {"style": "markerless"},
-            "reference": {"level": "none"},
-            "objects": [{"id": "ball", "roi": [310, 66, 70, 74]}],
-        }
-    )
-    with collecting() as diags:
-        obs = [o for fr in track_frames(((i, g) for i, g in iter_video_frames(path)), cfg) for o in fr]
-    ok = np.array([o.status == "ok" for o in obs])
-    assert ok.mean() >= 0.99, ok.mean()
-    # a ball spinning in depth: its angle is flagged, not reported
-    assert "W-TRACK-THETA" in {d.code for d in diags}
-    x = np.array([o.X if o.status == "ok" else np.nan for o in obs])
-    t = np.arange(x.size) / fps
-
-    def damped(t, a, tau, T, ph, c):
-        return a * np.exp(-t / tau) * np.cos(2 * np.pi * t / T + ph) + c
-
-    def period(sig):
-        m = np.isfinite(sig)
-        s = sig[m] - np.nanmean(sig)
-        f = np.fft.rfftfreq(m.sum(), 1 / fps)[1:]
-        T0 = 1 / f[np.argmax(np.abs(np.fft.rfft(s))[1:])]
-        p0 = (np.nanstd(s) * 1.4, 30.0, T0, 0.0, 0.0)
-        popt, _ = curve_fit(damped, t[m], s, p0=p0, maxfev=20000)
-        return popt[2]
-
-    T_track, T_blob = period(x), period(blob_x)
-    assert abs(T_track / T_blob - 1) <= 5e-4, (T_track, T_blob)
-
-
 def test_mixed_styles_aruco_block_on_markerless_table(tmp_path, sine_session):
     """A block with ArUco markers on a table followed markerless (issue: mixed styles per object)."""
     import pandas as pd
@@ -228,7 +176,6 @@ def test_table_region_on_the_block_is_flagged(tmp_path):
     """A table's region drawn on the rocking block: the 'table' turns with the block (W-TRACK-LATCH)."""
     import re
 
-    from rocklab._diagnostics import collecting
     from rocklab.config import load_track_config
     from rocklab.tracking import track_video
     from rocklab.synth import synth_session
@@ -264,7 +211,6 @@ def test_markerless_hand_occlusion_never_reports_a_wrong_pose(tmp_path):
     """
     import pandas as pd
 
-    from rocklab._diagnostics import collecting
     from rocklab.synth import synth_session
     from rocklab.config import load_track_config
     from rocklab.tracking import track_video
@@ -343,7 +289,6 @@ def test_markerless_block_without_theta0_takes_its_start_from_the_final_rest(tmp
 
     import pandas as pd
 
-    from rocklab._diagnostics import collecting
     from rocklab.synth import synth_session
     from rocklab.tracking import track_video
 

@@ -303,7 +303,7 @@ def _event_horizon(seqs, tol_s: float) -> float:
     """The 25th percentile over members of the time of their first event that fewer than half the
     other members share (same joint and state within ±``tol_s``), s; inf when most never diverge."""
     n = len(seqs)
-    keyed = [{} for _ in seqs]
+    keyed: list[dict] = [{} for _ in seqs]
     for d, seq in zip(keyed, seqs):
         for t, j, st in seq:
             d.setdefault((j, st), []).append(t)

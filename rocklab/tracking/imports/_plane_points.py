@@ -63,26 +63,11 @@ class PlanePoints:
 
 def parse_plane_bodies(specs, labels, source="") -> dict:
     """``{"NAME": (P1, P2, ...)}`` from ``NAME=P1,P2,...`` strings; none: one body ``block_1`` of
-    every point. A body of one point is a position only (its angle is not measured)."""
-    if not specs:
-        return {"block_1": tuple(labels)}
-    out: dict = {}
-    for s in specs:
-        name, sep, pts = str(s).partition("=")
-        name = name.strip()
-        plist = tuple(p.strip() for p in pts.split(",") if p.strip())
-        if not sep or not name or not plist:
-            raise InputError(f"--body {s!r}: expected NAME=P1,P2 (a body name and its point names)")
-        if name in out:
-            raise InputError(f"--body {name!r} given twice; name each body once")
-        missing = [p for p in plist if p not in labels]
-        if missing:
-            raise InputError(
-                f"{where(source)}--body {name}: point(s) {missing} not in the file (it has {list(labels)}); "
-                "fix the point names"
-            )
-        out[name] = plist
-    return out
+    every point. A body of one point is a position only (its angle is not measured). The rules
+    and messages are :func:`rocklab.tracking.rigid.parse_bodies`'s."""
+    from ..rigid import parse_bodies
+
+    return parse_bodies(specs, labels, source, default_name="block_1", min_points=1)
 
 
 def _rest_shape(xy, seen, t, rest, name, source):

@@ -214,17 +214,34 @@ class Track3DResult:
         }
 
 
-def parse_bodies(specs, labels, source="") -> dict:
-    """``{"NAME": (P1, P2, ...)}`` from ``NAME=P1,P2,...`` strings; none: one body ``block`` of every point."""
+def parse_bodies(specs, labels, source="", *, default_name: str = "block", min_points: int = MIN_POINTS) -> dict:
+    """``{"NAME": (P1, P2, ...)}`` from ``NAME=P1,P2,...`` strings; none: one body ``default_name``
+    of every point.
+
+    Parameters
+    ----------
+    specs : sequence of str or None
+        ``--body`` values.
+    labels : sequence of str
+        The point names the file has.
+    source : str
+        The file, for the error messages.
+    default_name : str
+        The one body's name when no ``specs`` are given.
+    min_points : int
+        The fewest points a body may have (3 for a rigid pose in 3D; 1 for a plane import, where
+        a one-point body is a position only).
+    """
     if not specs:
-        return {"block": tuple(labels)}
+        return {default_name: tuple(labels)}
+    example = ",".join(f"P{i}" for i in range(1, max(min_points, 2) + 1))
     out: dict = {}
     for s in specs:
         name, sep, pts = str(s).partition("=")
         name = name.strip()
         plist = tuple(p.strip() for p in pts.split(",") if p.strip())
         if not sep or not name or not plist:
-            raise InputError(f"--body {s!r}: expected NAME=P1,P2,P3 (a body name and its point labels)")
+            raise InputError(f"--body {s!r}: expected NAME={example} (a body name and its point labels)")
         if name in out:
             raise InputError(f"--body {name!r} given twice; name each body once")
         missing = [p for p in plist if p not in labels]
@@ -233,8 +250,8 @@ def parse_bodies(specs, labels, source="") -> dict:
                 f"{where(source)}--body {name}: point(s) {missing} not in the file (it has "
                 f"{list(labels)[:12]}{' ...' if len(labels) > 12 else ''}); fix the point names"
             )
-        if len(plist) < MIN_POINTS:
-            raise InputError(f"--body {name}: {len(plist)} point(s); a rigid pose needs at least {MIN_POINTS}")
+        if len(plist) < min_points:
+            raise InputError(f"--body {name}: {len(plist)} point(s); a rigid pose needs at least {min_points}")
         out[name] = plist
     return out
 

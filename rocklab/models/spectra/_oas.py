@@ -362,9 +362,9 @@ def overturning_spectrum(
     else:
         over, evaluated = _grid_verdicts(grid, lambda i, j: batch_runs(base, scales[i], p[j], args), lv, p, guide)
 
-    p_hi, p_lo = _first_unsafe(over, p, search)
+    p_hi, p_lo = first_unsafe(over, p, search)
     p_hi, p_lo = _bisect(base, scales, p_hi, p_lo, refine, args)
-    return _oas_result(base.name, lv, R, p, over, evaluated, p_hi, (alpha, float(alpha_I), eta_v), opts)
+    return oas_result(base.name, lv, R, p, over, evaluated, p_hi, (alpha, float(alpha_I), eta_v), opts)
 
 
 def _checked_record(base, levels, sizes):
@@ -448,7 +448,7 @@ def _grid_verdicts(grid, run, lv, p, guide):
     return adaptive_verdicts(run, lv.size, p.size)
 
 
-def _oas_result(name, lv, R, p, over, evaluated, p_hi, block, opts):
+def oas_result(name, lv, R, p, over, evaluated, p_hi, block, opts):
     """The OASResult of a grid's verdicts and boundary ``p_hi`` (rad/s), block = (alpha rad, alpha_I, eta)."""
     alpha, alpha_I, eta_v = block
     f = lv * p_hi
@@ -478,7 +478,7 @@ def _oas_result(name, lv, R, p, over, evaluated, p_hi, block, opts):
     )
 
 
-def _first_unsafe(over, p, search):
+def first_unsafe(over, p, search):
     """Per level, p (rad/s) of the largest unsafe grid size and of its safe neighbour (NaN if none).
 
     ``search="scan"``: the first overturning size from the largest block down; ``"contiguous"``:

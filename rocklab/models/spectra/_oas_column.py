@@ -35,7 +35,7 @@ from ..._errors import InputError
 from ...blocks import G
 from ...series import BaseMotion
 from ..column import Column, simulate_column
-from ._oas import OASResult, check_opts, fit_inclined_line, normalised_critical_impulse
+from ._oas import OASResult, check_opts, first_unsafe, oas_result
 from ._oas_grid import adaptive_verdicts
 
 __all__ = ["column_overturning_spectrum"]
@@ -88,20 +88,6 @@ def _top_down(run, n_rows, n_cols):
     return over, evaluated
 
 
-def _boundary(over, p, search):
-    """Per level, p of the largest unsafe grid size and of its safe larger neighbour (NaN if none)."""
-    p_hi, p_lo = np.full(over.shape[0], np.nan), np.full(over.shape[0], np.nan)
-    for i, row in enumerate(over):
-        hit = np.flatnonzero(row)
-        if search == "contiguous":  # the run of unsafe sizes that reaches the smallest block
-            safe = np.flatnonzero(~row)
-            hit = np.arange(safe[-1] + 1 if safe.size else 0, row.size) if row[-1] else hit[:0]
-        if hit.size:
-            p_hi[i] = p[hit[0]]
-            p_lo[i] = p[hit[0] - 1] if hit[0] > 0 else np.nan
-    return p_hi, p_lo
-
-
 def _check_column_options(n_blocks, n_impacts, max_p_dt, rest_pt, free_pt, search, grid) -> tuple[int, int]:
     """The column-specific options of :func:`column_overturning_spectrum`, checked (one-line
     :class:`InputError` naming the option); returns (n_blocks, n_impacts) as integers."""
@@ -136,8 +122,10 @@ def _bisect(p_hi, p_lo, unsafe, refine: int) -> None:
                 p_lo[i] = pm
 
 
-def _oas_result(base, alpha, lv, R, p, over, evaluated, p_hi, opts) -> OASResult:
-    """The :class:`OASResult` of a column's verdict grid and boundary (``p_hi`` per level)."""
+def _column_result(base, alpha, lv, R, p, over, evaluated, p_hi, opts) -> OASResult:
+    """The :class:`OASResult` of a column's verdict grid and boundary (``p_hi`` per level), read
+    as a monolithic block's (alpha_I 4/3, eta NaN); runs stopped with the column coming apart
+    are said (W-COLUMN-APART)."""
     if opts["n_terminated"]:
         from ..._diagnostics import warn
 
@@ -146,30 +134,7 @@ def _oas_result(base, alpha, lv, R, p, over, evaluated, p_hi, opts) -> OASResult
             f"{opts['n_terminated']} column runs stopped with a joint in tension or sliding "
             "(the column comes apart): counted as unsafe (options['n_terminated'])",
         )
-    f = lv * p_hi
-    icr = normalised_critical_impulse(alpha)
-    f_min = float(np.nanmin(f)) if np.isfinite(f).any() else float("nan")
-    tIp, beta = fit_inclined_line(f, lv)
-    return OASResult(
-        levels=lv,
-        R_m=R,
-        p_rad_s=p,
-        overturned=over,
-        p_min_rad_s=p_hi,
-        R_unsafe_max_m=G / (ALPHA_I_SOLID * p_hi**2),
-        f_rad_s=f,
-        f_min_rad_s=f_min,
-        t_I_s=icr / f_min if math.isfinite(f_min) else float("nan"),
-        t_I_prime_s=tIp,
-        beta=beta,
-        i_cr=icr,
-        alpha_rad=alpha,
-        alpha_I=ALPHA_I_SOLID,
-        eta=float("nan"),
-        name=base.name,
-        options=opts,
-        evaluated=evaluated,
-    )
+    return oas_result(base.name, lv, R, p, over, evaluated, p_hi, (alpha, ALPHA_I_SOLID, float("nan")), opts)
 
 
 def column_overturning_spectrum(
@@ -271,7 +236,7 @@ def column_overturning_spectrum(
         over, evaluated = adaptive_verdicts(run, lv.size, p.size)
     else:
         over, evaluated = _top_down(run, lv.size, p.size)
-    p_hi, p_lo = _boundary(over, p, search)
+    p_hi, p_lo = first_unsafe(over, p, search)
     _bisect(p_hi, p_lo, lambda i, pm: one(scales[i], pm), int(refine))
     opts = dict(
         n_blocks=n_blocks,
@@ -291,4 +256,4 @@ def column_overturning_spectrum(
         grid=grid,
         n_terminated=len(terminated),
     )
-    return _oas_result(base, alpha, lv, R, p, over, evaluated, p_hi, opts)
+    return _column_result(base, alpha, lv, R, p, over, evaluated, p_hi, opts)

@@ -39,7 +39,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ._ensemble import DEFAULT_ENSEMBLE_SIZE, HORIZON_FRACTION, InputUncertainty
+from ._ensemble import DEFAULT_ENSEMBLE_SIZE, HORIZON_FRACTION, InputUncertainty, table_draw
 
 __all__ = [
     "ColumnEnsemble",
@@ -91,22 +91,12 @@ class ColumnEnsemble:
 
 def _member_base(table_t_s, table_acc_m_s2, unc, rng, t_start_s):
     """One draw of the measured table acceleration as a BaseMotion on 1 ms (None without a table)."""
-    from scipy.interpolate import CubicSpline
-
-    from ..series import BaseMotion
-
     if table_t_s is None:
         return None
     tt = np.asarray(table_t_s, float)
     aa = np.asarray(table_acc_m_s2, float)
     fin = np.isfinite(tt) & np.isfinite(aa)
-    tt, aa = tt[fin], aa[fin]
-    a = aa * (1.0 + unc.acc_scale * rng.standard_normal())
-    a = a + unc.acc_noise_m_s2 * rng.standard_normal(aa.size) + unc.acc_bias_m_s2 * rng.standard_normal()
-    ts = tt + unc.sync_s * rng.standard_normal()
-    tf = np.arange(ts[0], ts[-1], 1e-3)
-    af = CubicSpline(ts, a)(tf)
-    return BaseMotion.from_samples(af, 1e-3, t0_s=float(tf[0]) - t_start_s, units="m/s2", name="table")
+    return table_draw(tt[fin], aa[fin], unc, rng, t_start_s)
 
 
 def _member_column(column, unc, rng):

@@ -111,11 +111,36 @@ class Ensemble:
     seconds: float = 0.0
 
 
-def _spline_base(t, a, dt_s):
+def table_draw(tt, aa, unc, rng, t_start_s: float, sign: float = 1.0):
+    """One draw of a measured table acceleration within its uncertainty, as the simulator's input.
+
+    Parameters
+    ----------
+    tt, aa : ndarray (n,)
+        The measured table's times (s) and acceleration (m/s²), finite.
+    unc : InputUncertainty
+        Scale, white noise, bias and sync errors drawn, in that order, from ``rng``.
+    rng : numpy.random.Generator
+    t_start_s : float
+        The simulation's start on the measurement's clock, s.
+    sign : float
+        -1 mirrors the table (the measurement's θ counter-clockwise, the simulator's clockwise).
+
+    Returns
+    -------
+    rocklab.series.BaseMotion
+        The draw splined onto 1 ms samples, its time from ``t_start_s``.
+    """
     from scipy.interpolate import CubicSpline
 
-    tf = np.arange(t[0], t[-1], dt_s)
-    return tf, CubicSpline(t, a)(tf)
+    from ..series import BaseMotion
+
+    a = aa * (1.0 + unc.acc_scale * rng.standard_normal())
+    a += unc.acc_noise_m_s2 * rng.standard_normal(aa.size) + unc.acc_bias_m_s2 * rng.standard_normal()
+    ts = tt + unc.sync_s * rng.standard_normal()
+    tf = np.arange(ts[0], ts[-1], 1e-3)
+    af = CubicSpline(ts, a)(tf)
+    return BaseMotion.from_samples(sign * af, 1e-3, t0_s=float(tf[0]) - t_start_s, units="m/s2", name="table")
 
 
 def simulate_ensemble(
@@ -164,7 +189,6 @@ def simulate_ensemble(
     import time
 
     from ..blocks import Block
-    from ..series import BaseMotion
     from ..models import simulate
 
     rng = np.random.default_rng(seed)
@@ -179,10 +203,7 @@ def simulate_ensemble(
     t0 = time.perf_counter()
     span = float(t_out[-1] - t_start_s)
     for i in range(n):
-        a = aa * (1.0 + unc.acc_scale * rng.standard_normal())
-        a += unc.acc_noise_m_s2 * rng.standard_normal(aa.size) + unc.acc_bias_m_s2 * rng.standard_normal()
-        tf, af = _spline_base(tt + unc.sync_s * rng.standard_normal(), a, 1e-3)
-        base = BaseMotion.from_samples(sign * af, 1e-3, t0_s=float(tf[0]) - t_start_s, units="m/s2", name="table")
+        base = table_draw(tt, aa, unc, rng, t_start_s, sign)
         b = block.b_m + unc.length_m * rng.standard_normal()
         h = block.h_m + unc.length_m * rng.standard_normal()
         blk = Block(b, h, depth_m=block.depth_m, mass_kg=block.mass_kg, alpha_I=block.alpha_I)

@@ -94,9 +94,17 @@ def _rocking_log(seed, mis_deg=4.0, slope_deg=1.0):
     block = Block(b_m=rng.uniform(0.08, 0.2), h_m=rng.uniform(0.3, 0.9))
     th0 = rng.uniform(0.3, 0.9) * block.alpha_rad
     res = simulate(block, theta0_rad=th0, duration_s=8.0, dt_s=1e-4)
-    # mis-mount: a random rotation of mis_deg; a table sloping by slope_deg about x
-    # tilts gravity in the block frame (the rocking edge along y stays level only when
-    # the slope is about y: here it is about x, the worst case for the axis angle)
+    return _mounted_log(res, block, rng, seed, mis_deg, slope_deg)
+
+
+def _mounted_log(res, block, rng, seed, mis_deg, slope_deg, rest_after_s=1.5, **noise):
+    """The x-IMU log of simulated rocking ``res``, the sensor mounted askew and the table sloping.
+
+    Mis-mount: a random rotation of ``mis_deg``; a table sloping by ``slope_deg`` about x tilts
+    gravity in the block frame (the rocking edge along y stays level only when the slope is about
+    y: here it is about x, the worst case for the axis angle). ``noise``: the gyro's and the
+    accelerometer's noise options of ``simulate_imu_log``.
+    """
     S = Rotation.from_rotvec(np.deg2rad(mis_deg) * _unit(rng.normal(size=3))).as_matrix()
     slope = Rotation.from_euler("x", slope_deg, degrees=True).as_matrix()
     log = simulate_imu_log(
@@ -106,11 +114,12 @@ def _rocking_log(seed, mis_deg=4.0, slope_deg=1.0):
         omega_rad_s=res.omega_rad_s,
         rate_hz=FS,
         rest_before_s=1.0,
-        rest_after_s=1.5,
+        rest_after_s=rest_after_s,
         gyro_bias_deg_s=rng.uniform(0.2, 1.0),
         sensor_rotation=S,
         seed=seed,
         drop_bursts=1,
+        **noise,
     )
     acc = log.acc_m_s2 - S @ [0, 0, G] + (S @ slope.T @ [0, 0, G])
     return ImuLog(log.t_s, log.gyro_rad_s, acc, log.rate_hz, log.dropped_samples, None, "simulated", "sim")
@@ -351,25 +360,8 @@ def _free_log(seed, noise=1.0, rest_after_s=1.5):
     block = Block(b_m=b, h_m=b * rng.uniform(2.0, 10.0))
     th0 = rng.uniform(0.3, 0.97) * block.alpha_rad
     res = simulate(block, theta0_rad=th0, duration_s=6.0, dt_s=2e-4, restitution="constant", eta=rng.uniform(0.8, 0.98))
-    S = Rotation.from_rotvec(np.deg2rad(4.0) * _unit(rng.normal(size=3))).as_matrix()
-    slope = Rotation.from_euler("x", 1.0, degrees=True).as_matrix()
-    log = simulate_imu_log(
-        res.t_s,
-        res.theta_rad,
-        block,
-        omega_rad_s=res.omega_rad_s,
-        rate_hz=FS,
-        rest_before_s=1.0,
-        rest_after_s=rest_after_s,
-        gyro_bias_deg_s=rng.uniform(0.2, 1.0),
-        gyro_noise_deg_s=0.1 * noise,
-        acc_noise_g=0.005 * noise,
-        sensor_rotation=S,
-        seed=seed,
-        drop_bursts=1,
-    )
-    acc = log.acc_m_s2 - S @ [0, 0, G] + (S @ slope.T @ [0, 0, G])
-    return ImuLog(log.t_s, log.gyro_rad_s, acc, log.rate_hz, log.dropped_samples, None, "simulated", "sim"), th0
+    noise_kw = dict(gyro_noise_deg_s=0.1 * noise, acc_noise_g=0.005 * noise)
+    return _mounted_log(res, block, rng, seed, 4.0, 1.0, rest_after_s, **noise_kw), th0
 
 
 @pytest.mark.parametrize("seed", [1, 2, 3, 4])

@@ -127,6 +127,18 @@ class PoseVerifier:
         #: whether the angle is checked (False for an object whose appearance tells no angle)
         self.check_turn = True
 
+    def motion_context(self, frame: int):
+        """(last verified (centre, theta, frame) or None, frames since it (1 without one), the
+        constant-velocity prediction (centre, theta) from the last two verified poses when they
+        are consecutive frames, else None) for a pose at ``frame``."""
+        last = self.recent[-1] if self.recent else None
+        gap = frame - last[2] if last is not None else 1
+        pred = None
+        if len(self.recent) == 2 and self.recent[1][2] - self.recent[0][2] == 1:
+            (c0, t0, _), (c1, t1, _) = self.recent
+            pred = (2 * c1 - c0, 2 * t1 - t0)
+        return last, gap, pred
+
     # -- learned limits ------------------------------------------------------------
     def score_limit(self) -> float:
         """The lowest correlation accepted now."""
@@ -276,12 +288,7 @@ class PoseVerifier:
         Wd = np.asarray(W, float)
         centre = Wd[:, :2] @ tr.centre0 + Wd[:, 2]
         theta = math.atan2(Wd[1, 0] - Wd[0, 1], Wd[0, 0] + Wd[1, 1])
-        last = self.recent[-1] if self.recent else None
-        gap = frame - last[2] if last is not None else 1
-        pred = None
-        if len(self.recent) == 2 and self.recent[1][2] - self.recent[0][2] == 1:
-            (c0, t0, _), (c1, t1, _) = self.recent
-            pred = (2 * c1 - c0, 2 * t1 - t0)
+        last, gap, pred = self.motion_context(frame)
         if self.since_lost:  # what stands in the first region now, the frame checked included
             self._sample(gray, frame, tr.min_cc)
         bg = back = known = bg_g = back_g = None

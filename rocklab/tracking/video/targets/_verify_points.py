@@ -192,12 +192,7 @@ class PointPoseVerifier:
         c = np.array([centre.real, centre.imag])
         theta = cmath.phase(z)
         b = self.base
-        last = b.recent[-1] if b.recent else None
-        gap = frame - last[2] if last is not None else 1
-        pred = None
-        if len(b.recent) == 2 and b.recent[1][2] - b.recent[0][2] == 1:
-            (c0, t0, _), (c1, t1, _) = b.recent
-            pred = (2 * c1 - c0, 2 * t1 - t0)
+        last, gap, pred = b.motion_context(frame)
         last2 = None if last is None else last[:2]
         score, mis, back = 1.0, None, None
         if self.look:

@@ -1,4 +1,4 @@
-"""Imports from other tools: Tracker projects (a real .trk) and DLTdv points (synthetic cameras)."""
+"""Imports from other tools: Tracker projects (a real .trk), Kinovea exports and DLTdv points (synthetic cameras, and real DLTdv7 projects)."""
 
 from __future__ import annotations
 
@@ -436,3 +436,82 @@ def test_tracker_data_table_in_its_export_layout(tmp_path, diabolo, delim, comma
     sep = np.nanmin(np.linalg.norm(diabolo.xy_m[:, 1] - diabolo.xy_m[:, 0], axis=1))
     bound = 2 * 5e-7 * np.nanmax(np.abs(diabolo.xy_m)) / sep
     assert np.nanmax(np.abs(th[same] - want)) < bound < 2e-4
+
+
+#: Two real DLTdv7 projects of Project Ushichka (thermal cameras in a cave, 25 Hz, easyWand
+#: calibration in m): the repository states no licence, so they are read from its mirror when
+#: present (tests/data/importers/README.md).
+USHICHKA = ("/work/.mirror/thejasvibr+projectushichka/repo", "fdd234c47107becb05d0fc95ac689a6c66448da1")
+USHICHKA_SETS = {
+    "acoustic-tracking/2018-08-17/speaker_playbacks/DLTdv7_data_2018-08-17_P03_1000TMC": (1, 51),
+    "thermo_lidar_alignment/data/bat_trajs/DLTdv7_data_20180817-P000-15000": (15, 606),
+}
+USHICHKA_COEFS = "acoustic-tracking/2018-08-17/speaker_playbacks/2018-08-17_wand_dltCoefs_round4.csv"
+
+
+def _mirror_file(repo_commit, path: str, dest: Path) -> Path:
+    import subprocess
+
+    repo, commit = repo_commit
+    dest.write_bytes(
+        subprocess.run(["git", f"--git-dir={repo}", "show", f"{commit}:{path}"], capture_output=True, check=True).stdout
+    )
+    return dest
+
+
+def test_dltdv_reproduces_dltdv7s_own_3d_and_residuals(tmp_path, run_cli):
+    """Real DLTdv7 exports (xypts + the easyWand DLTcoefs it used + its own xyzpts and xyzres):
+    rocklab's reconstruction gives DLTdv7's 3D points to 1e-6 m (the files keep 6 decimals:
+    measured 5.1e-7 m over 657 reconstructions) and its residual to 2e-6 px (measured 1.1e-6 px), with
+    exactly DLTdv's NaN pattern. Controls: the plain RMS, two of the three cameras, or another
+    calibration of the same rig miss by orders of magnitude more."""
+    from rocklab.tracking.imports import dlt_reconstruct, dlt_residual, read_dlt_coefs
+
+    if not Path(USHICHKA[0]).is_dir():
+        pytest.skip("the DLTdv7 exports (thejasvibr/projectushichka, no licence) are not mirrored here")
+    coefs = _mirror_file(USHICHKA, USHICHKA_COEFS, tmp_path / "wand_dltCoefs.csv")
+    L = read_dlt_coefs(coefs)
+    assert L.shape == (11, 3)
+    other = tmp_path / "other_dltCoefs.csv"  # the same cameras calibrated on 2018-07-28
+    _mirror_file(
+        USHICHKA, "track-to-trajectory/2018-07-28_001/video_calibration_data/round3_2018-07-28_dltCoefs.csv", other
+    )
+    for stem, (n_pts, n_recon) in USHICHKA_SETS.items():
+        name = stem.rsplit("/", 1)[1]
+        files = {
+            k: _mirror_file(USHICHKA, f"{stem}{k}.csv", tmp_path / f"{name}{k}.csv")
+            for k in ("xypts", "xyzpts", "xyzres")
+        }
+        series, info = read_dltdv(files["xypts"], coefs=coefs, fps=25.0, units="m")
+        theirs = pd.read_csv(files["xyzpts"]).to_numpy(float).reshape(len(series.t_s), n_pts, 3)
+        res = pd.read_csv(files["xyzres"]).to_numpy(float)
+        assert series.labels == tuple(f"pt{i + 1}" for i in range(n_pts)) and info["cameras"] == 3
+        assert np.array_equal(np.isfinite(series.xyz_m), np.isfinite(theirs))
+        assert np.isfinite(theirs[..., 0]).sum() == n_recon
+        assert np.nanmax(np.abs(series.xyz_m - theirs)) < 1e-6
+        assert abs(info["median_dltres_px"] - np.nanmedian(res)) < 2e-6
+        uv = pd.read_csv(files["xypts"]).to_numpy(float).reshape(len(series.t_s), n_pts, 3, 2)
+        for p in range(n_pts):
+            xyz, rms = dlt_reconstruct(L, uv[:, p])
+            ours = dlt_residual(L, uv[:, p], xyz)
+            assert np.array_equal(np.isfinite(ours), np.isfinite(res[:, p]))
+            if np.isfinite(ours).any():
+                assert np.nanmax(np.abs(ours - res[:, p])) < 2e-6
+                # DLTdv conditions by 2k - 3 degrees of freedom: the plain RMS is not its residual
+                assert np.nanmax(np.abs(rms - res[:, p])) > 1e-3
+        # controls: drop camera 3, or use the other day's calibration
+        two = uv[:, 0].copy()
+        two[:, 2] = np.nan
+        three_cams = np.isfinite(uv[:, 0]).all(axis=2).sum(axis=1) == 3
+        if three_cams.any():
+            xyz2, _ = dlt_reconstruct(L, two)
+            assert np.nanmax(np.abs(xyz2[three_cams] - theirs[three_cams, 0])) > 1e-3
+        wrong, _ = read_dltdv(files["xypts"], coefs=other, fps=25.0, units="m")
+        assert np.nanmax(np.abs(wrong.xyz_m - theirs)) > 1e-2
+    # through the CLI: points.csv rows are DLTdv7's own numbers, 25 Hz rows
+    out = tmp_path / "points.csv"
+    rc, _, err = run_cli("import", files["xypts"], "--coefs", coefs, "--fps", 25, "--units", "m", "-o", out)
+    assert rc == 0, err
+    back = pd.read_csv(out)
+    assert len(back) == n_recon
+    assert np.abs(np.sort(back["x_m"].to_numpy()) - np.sort(theirs[..., 0][np.isfinite(theirs[..., 0])])).max() < 1e-6

@@ -11,7 +11,7 @@ fix of a file it cannot read.
 """
 
 from ._detect import IMPORT_TOOLS, PLANE_TOOLS, detect_tool, read_plane_points
-from ._dltdv import dlt_project, dlt_reconstruct, read_dlt_coefs, read_dltdv
+from ._dltdv import dlt_project, dlt_reconstruct, dlt_residual, read_dlt_coefs, read_dltdv
 from ._kinovea import KINOVEA_UNITS_M, read_kinovea
 from ._plane_points import REST_SAMPLES, PlanePoints, parse_plane_bodies, plane_tracks
 from ._tracker_table import looks_like_tracker_table, read_tracker_table
@@ -30,6 +30,7 @@ __all__ = [
     "read_dlt_coefs",
     "dlt_reconstruct",
     "dlt_project",
+    "dlt_residual",
     "detect_tool",
     "IMPORT_TOOLS",
     "PLANE_TOOLS",

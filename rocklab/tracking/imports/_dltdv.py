@@ -5,7 +5,9 @@
 - ``DLTcoefs``: 11 rows, one column per camera, no header: the 11-parameter DLT
   ``u = (L1 X + L2 Y + L3 Z + L4) / (L9 X + L10 Y + L11 Z + 1)``,
   ``v = (L5 X + L6 Y + L7 Z + L8) / (L9 X + L10 Y + L11 Z + 1)``;
-- ``xyzpts``: columns ``ptI_X, ptI_Y, ptI_Z`` in the calibration's unit.
+- ``xyzpts``: columns ``ptI_X, ptI_Y, ptI_Z`` in the calibration's unit;
+- ``xyzres``: column ``ptI_dltres``, DLTdv's reconstruction residual (px, see
+  :func:`dlt_residual`).
 
 A point seen by two or more cameras in a frame is reconstructed by linear least squares on
 the DLT equations (as DLTdv's ``dlt_reconstruct`` does); with one camera it stays NaN. Neither
@@ -23,7 +25,7 @@ import numpy as np
 from ..._errors import InputError, where
 from ..rigid import PointSeries
 
-__all__ = ["read_dltdv", "dlt_reconstruct", "dlt_project", "read_dlt_coefs"]
+__all__ = ["read_dltdv", "dlt_reconstruct", "dlt_project", "dlt_residual", "read_dlt_coefs"]
 
 _LENGTH_M = {"m": 1.0, "cm": 0.01, "mm": 0.001}
 _XY = re.compile(r"^pt(\d+)_cam(\d+)_([XY])$")
@@ -86,6 +88,37 @@ def dlt_reconstruct(coefs: np.ndarray, uv: np.ndarray) -> tuple[np.ndarray, np.n
         back = np.stack([dlt_project(L[:, j], sol) for j in cams])
         rms[i] = float(np.sqrt(np.mean((back - uv[i, cams]) ** 2)))
     return xyz, rms
+
+
+def dlt_residual(coefs: np.ndarray, uv: np.ndarray, xyz: np.ndarray) -> np.ndarray:
+    """DLTdv's residual of 3D points (its ``xyzres`` export, ``dltres``), px.
+
+    DLTdv 6 and later report the reprojection error over the ``k`` cameras that saw the point,
+    conditioned by the reconstruction's degrees of freedom: ``sqrt(sum(du^2 + dv^2) / (2k - 3))``
+    (one degree of freedom with two cameras), not the plain RMS of :func:`dlt_reconstruct`.
+
+    Parameters
+    ----------
+    coefs : ndarray, shape (11, c)
+    uv : ndarray, shape (n, c, 2)
+        Image coordinates; NaN where a camera did not see the point.
+    xyz : ndarray, shape (n, 3)
+        The points' 3D positions (NaN where not reconstructed).
+
+    Returns
+    -------
+    ndarray, shape (n,)
+        NaN where ``xyz`` is NaN.
+    """
+    L = np.asarray(coefs, float)
+    back = np.stack([dlt_project(L[:, j], xyz) for j in range(L.shape[1])], axis=1)
+    seen = np.isfinite(uv).all(axis=2)
+    sq = np.where(seen[..., None], (back - uv) ** 2, 0.0).sum(axis=(1, 2))
+    dof = 2 * seen.sum(axis=1) - 3
+    ok = np.isfinite(xyz).all(axis=1) & (dof > 0)
+    out = np.full(len(xyz), np.nan)
+    out[ok] = np.sqrt(sq[ok] / dof[ok])
+    return out
 
 
 def read_dlt_coefs(path) -> np.ndarray:
@@ -158,7 +191,9 @@ def read_dltdv(path, coefs=None, fps: float | None = None, units: str | None = N
     series : PointSeries
         Points ``pt1``, ``pt2``... in m.
     info : dict
-        ``{"cameras": c, "reconstructed": True/False, "median_rms_px": ...}``.
+        ``{"cameras": c, "reconstructed": True/False, "median_rms_px": ..., "median_dltres_px": ...}``:
+        the median over reconstructed samples of the plain reprojection RMS and of DLTdv's own
+        residual (:func:`dlt_residual`, what its ``xyzres`` holds); None for an ``xyzpts`` file.
     """
     path = Path(path)
     if not path.is_file():
@@ -177,7 +212,7 @@ def read_dltdv(path, coefs=None, fps: float | None = None, units: str | None = N
     t = np.arange(vals.shape[0]) / rate
     notes = [f"rows at {rate:g} Hz"] + ([f"coordinates converted from {units} to m"] if scale != 1.0 else [])
     series = PointSeries(t, tuple(f"pt{i}" for i in pts), xyz * scale, str(path), tuple(notes))
-    return series, {"cameras": None, "reconstructed": False, "median_rms_px": None}
+    return series, {"cameras": None, "reconstructed": False, "median_rms_px": None, "median_dltres_px": None}
 
 
 def _from_xypts(path, coefs, rate, scale, units):
@@ -198,12 +233,19 @@ def _from_xypts(path, coefs, rate, scale, units):
         uv[:, pts.index(int(i)), int(j) - 1, "XY".index(ax)] = vals[:, k]
     xyz = np.full((vals.shape[0], len(pts), 3), np.nan)
     rms = np.full((vals.shape[0], len(pts)), np.nan)
+    res = np.full((vals.shape[0], len(pts)), np.nan)
     for p in range(len(pts)):
         xyz[:, p], rms[:, p] = dlt_reconstruct(L, uv[:, p])
+        res[:, p] = dlt_residual(L, uv[:, p], xyz[:, p])
     t = np.arange(vals.shape[0]) / rate
     notes = [f"rows at {rate:g} Hz", f"3D from {L.shape[1]} cameras by the DLT coefficients of {Path(coefs).name}"]
     if scale != 1.0:
         notes.append(f"coordinates converted from {units} to m")
-    med = float(np.nanmedian(rms)) if np.isfinite(rms).any() else None
+    any_ = bool(np.isfinite(rms).any())
     series = PointSeries(t, tuple(f"pt{i}" for i in pts), xyz * scale, str(path), tuple(notes))
-    return series, {"cameras": int(L.shape[1]), "reconstructed": True, "median_rms_px": med}
+    return series, {
+        "cameras": int(L.shape[1]),
+        "reconstructed": True,
+        "median_rms_px": float(np.nanmedian(rms)) if any_ else None,
+        "median_dltres_px": float(np.nanmedian(res)) if any_ else None,
+    }

@@ -515,3 +515,26 @@ def test_dltdv_reproduces_dltdv7s_own_3d_and_residuals(tmp_path, run_cli):
     back = pd.read_csv(out)
     assert len(back) == n_recon
     assert np.abs(np.sort(back["x_m"].to_numpy()) - np.sort(theirs[..., 0][np.isfinite(theirs[..., 0])])).max() < 1e-6
+
+
+#: The same cameras and calibration filming a thrown object (thejasvibr/tproject, no licence;
+#: commit on its `restructured` branch), digitised in DLTdv7 without a 3D export.
+TPROJECT = ("/work/.mirror/thejasvibr+tproject/repo", "d489d6cd9b3d5e2fed6393b50f53b1ddcce4d129")
+
+
+def test_dltdv_thrown_object_falls_at_g(tmp_path):
+    """A real DLTdv7 digitisation of an object thrown in the cave (26 frames seen by 2-3 of the
+    thermal cameras at 25 Hz), reconstructed by rocklab in m: a parabola fit gives |g| = 10.00
+    m/s^2 (9.81 + 2 %), mostly along the calibration's -z. At a wrong frame rate (30 Hz) the same
+    fit gives 1.44 g, so the check sees the time base, not only the geometry."""
+    if not Path(TPROJECT[0]).is_dir():
+        pytest.skip("the DLTdv7 digitisation (thejasvibr/tproject, no licence) is not mirrored here")
+    xy = _mirror_file(TPROJECT, "examples/DLTdv7_data_gravityxypts.csv", tmp_path / "gravityxypts.csv")
+    coefs = _mirror_file(TPROJECT, "examples/2018-08-17_wand_dltCoefs.csv", tmp_path / "wand_dltCoefs.csv")
+    for fps, lo, hi in ((25.0, 9.3, 10.3), (30.0, 13.4, 14.9)):
+        series, info = read_dltdv(xy, coefs=coefs, fps=fps, units="m")
+        seen = np.isfinite(series.xyz_m[:, 0]).all(axis=1)
+        assert seen.sum() == 26 and info["median_dltres_px"] < 2.0
+        g = 2 * np.polyfit(series.t_s[seen], series.xyz_m[seen, 0], 2)[0]
+        assert lo < np.linalg.norm(g) < hi
+        assert -g[2] / np.linalg.norm(g) > 0.97

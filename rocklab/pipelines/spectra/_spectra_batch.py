@@ -1,10 +1,11 @@
 """OAS and t_I of many records in parallel (local processes or a Dask cluster).
 
-Each record is one task: read it, compute its pulse parameters and OAS, return
-one summary row ``record, t_p_s, t_I_s, t_I_prime_s, beta, f_min, f_min_level, f_min_R_m``. Local runs
-use :class:`concurrent.futures.ProcessPoolExecutor`; ``scheduler="tcp://host:port"``
-submits the same function to a ``dask.distributed`` cluster. A tqdm progress bar
-goes to stderr.
+Each record and block slenderness is one task: read the record, compute its pulse parameters
+and OAS, return one summary row ``record, t_p_s, t_I_s, t_I_prime_s, beta, f_min, f_min_level,
+f_min_R_m, error, h_over_b`` (the thesis's whole study is 44 records x h/b 3, 5, 8, 12). Local
+runs use :class:`concurrent.futures.ProcessPoolExecutor`; ``scheduler="tcp://host:port"``
+submits the same function to a ``dask.distributed`` cluster. A tqdm progress bar goes to
+stderr; with a :class:`~._study_journal.StudyJournal` a stopped study resumes where it was.
 """
 
 from __future__ import annotations
@@ -15,7 +16,7 @@ import sys
 
 from ..._procs import dask_client, pool_initializer
 
-__all__ = ["oas_summary_row", "oas_many", "expand_records", "thesis_table4", "table4_row"]
+__all__ = ["oas_summary_row", "oas_many", "expand_records", "thesis_table4", "table4_row", "h_over_b_values"]
 
 #: Extra columns with ``--band``: the 90 % band of each quantity and the default member's t_I.
 BAND_COLUMNS = ["t_I_p05_s", "t_I_p95_s", "t_I_prime_p05_s", "t_I_prime_p95_s", "beta_p05", "beta_p95", "t_I_default_s"]
@@ -203,17 +204,77 @@ def _one_numba_thread():
     numba.set_num_threads(1)
 
 
+def h_over_b_values(slenderness) -> list[float]:
+    """The block slendernesses of a study: one h/b or a sequence of them, each > 0, no repeats.
+
+    Raises
+    ------
+    InputError
+        An h/b that is not a positive number, or one given twice.
+    """
+    from ..._errors import InputError
+
+    vals = [slenderness] if isinstance(slenderness, (int, float)) else list(slenderness)
+    out: list[float] = []
+    for v in vals:
+        try:
+            f = float(v)
+        except (TypeError, ValueError):
+            f = math.nan
+        if not (f > 0 and math.isfinite(f)):
+            raise InputError(f"--slenderness {v!r}: each h/b must be a number > 0 (e.g. 12 or 3,5,8,12)")
+        if f in out:
+            raise InputError(f"--slenderness: h/b {f:g} is given twice; give each value once")
+        out.append(f)
+    if not out:
+        raise InputError("--slenderness: give at least one h/b (e.g. 12 or 3,5,8,12)")
+    return out
+
+
+def _run_tasks(args_list, workers, scheduler, on_done) -> None:
+    """Run :func:`oas_summary_row` on each argument tuple (in-process, local processes or Dask),
+    calling ``on_done(index, row)`` as each finishes (any order)."""
+    if not args_list:
+        return
+    if scheduler:
+        from dask.distributed import as_completed
+
+        with dask_client(scheduler) as client:
+            futs = {client.submit(oas_summary_row, *a, pure=False): i for i, a in enumerate(args_list)}
+            for f in as_completed(futs):
+                on_done(futs[f], f.result())
+    elif (workers or os.cpu_count() or 1) <= 1 or len(args_list) == 1:
+        for i, a in enumerate(args_list):
+            on_done(i, oas_summary_row(*a))
+    else:
+        import multiprocessing as mp
+        from concurrent.futures import ProcessPoolExecutor, as_completed
+
+        # spawned, not forked: a process that already ran numba's threaded kernels forks
+        # children that crash in them (the pool then breaks and the record batch fails)
+        with ProcessPoolExecutor(
+            max_workers=workers,
+            mp_context=mp.get_context("spawn"),
+            initializer=pool_initializer,
+            initargs=(os.getpid(), _one_numba_thread),
+        ) as ex:
+            futs = {ex.submit(oas_summary_row, *a): i for i, a in enumerate(args_list)}
+            for f in as_completed(futs):
+                on_done(futs[f], f.result())
+
+
 def oas_many(
     paths,
     units: str | None = None,
-    slenderness: float = 12.0,
+    slenderness=12.0,
     oas_kwargs: dict | None = None,
     workers: int | None = None,
     scheduler: str | None = None,
     progress: bool = True,
     band: bool = False,
+    journal=None,
 ):
-    """Summary table (pandas DataFrame, input order) of many records' OAS.
+    """Summary table (pandas DataFrame) of many records' OAS, a row per record and h/b.
 
     Parameters
     ----------
@@ -222,8 +283,9 @@ def oas_many(
     units : str, optional
         Units of the files that state none (``g`` for the FEMA two-column set); a
         file's own units (AT2 units field, CSV column) are kept.
-    slenderness : float
-        Block h/b.
+    slenderness : float or sequence of float
+        Block h/b, or several (the thesis's study: 3, 5, 8, 12); rows are record-major in the
+        order given, column ``h_over_b``.
     oas_kwargs : dict, optional
         Options of :func:`rocklab.models.overturning_spectrum`.
     workers : int, optional
@@ -231,100 +293,107 @@ def oas_many(
     scheduler : str, optional
         Address of a Dask distributed scheduler; local processes are not used then.
     progress : bool
-        Show a tqdm bar on stderr.
+        Show a tqdm bar on stderr (one step per record and h/b).
+    journal : StudyJournal, optional
+        Rows finished by an earlier run of the same study are taken from it and not run again;
+        each row finished here is added to it as it comes (see :mod:`._study_journal`).
     """
     import pandas as pd
     from tqdm import tqdm
 
-    paths = [str(p) for p in paths]
-    rows = [None] * len(paths)
-    if not paths:
-        return pd.DataFrame(columns=TABLE_COLUMNS[:9])
-    bar = tqdm(total=len(paths), desc="OAS", unit="record", file=sys.stderr, disable=not progress)
-    args = (units, slenderness, oas_kwargs, band)
+    from ._study_journal import file_digest, task_key
+
+    hbs = h_over_b_values(slenderness)
+    cols = ["record", "t_p_s", "t_I_s", "t_I_prime_s", "beta", "f_min", "f_min_level", "f_min_R_m", "error"]
+    cols += (BAND_COLUMNS if band else []) + ["h_over_b"]
+    tasks = [(str(p), hb) for p in paths for hb in hbs]
+    if not tasks:
+        return pd.DataFrame(columns=cols)
+    keys: list = [None] * len(tasks)
+    if journal is not None:
+        digests = {}
+        for p in {p for p, _ in tasks}:
+            try:
+                digests[p] = file_digest(p)
+            except OSError:  # the run reports it as the row's error; nothing to reuse
+                digests[p] = None
+        keys = [task_key(digests[p], hb) if digests[p] else None for p, hb in tasks]
+    rows: list = [journal.get(k) if (journal is not None and k) else None for k in keys]
+    todo = [i for i, r in enumerate(rows) if r is None]
+    bar = tqdm(
+        total=len(tasks), initial=len(tasks) - len(todo), desc="OAS", unit="run", file=sys.stderr, disable=not progress
+    )
+
+    def done(j: int, row: dict) -> None:
+        i = todo[j]
+        row["h_over_b"] = tasks[i][1]
+        rows[i] = row
+        if journal is not None and keys[i] and not row["error"]:  # an error is cheap to meet again
+            journal.add(keys[i], row)
+        bar.update()
+
     try:
-        if scheduler:
-            from dask.distributed import as_completed
-
-            with dask_client(scheduler) as client:
-                futs = {client.submit(oas_summary_row, p, *args, pure=False): i for i, p in enumerate(paths)}
-                for f in as_completed(futs):
-                    rows[futs[f]] = f.result()
-                    bar.update()
-        elif (workers or os.cpu_count() or 1) <= 1 or len(paths) == 1:
-            for i, p in enumerate(paths):
-                rows[i] = oas_summary_row(p, *args)
-                bar.update()
-        else:
-            import multiprocessing as mp
-            from concurrent.futures import ProcessPoolExecutor, as_completed
-
-            # spawned, not forked: a process that already ran numba's threaded kernels forks
-            # children that crash in them (the pool then breaks and the record batch fails)
-            with ProcessPoolExecutor(
-                max_workers=workers,
-                mp_context=mp.get_context("spawn"),
-                initializer=pool_initializer,
-                initargs=(os.getpid(), _one_numba_thread),
-            ) as ex:
-                futs = {ex.submit(oas_summary_row, p, *args): i for i, p in enumerate(paths)}
-                for f in as_completed(futs):
-                    rows[futs[f]] = f.result()
-                    bar.update()
+        _run_tasks([(tasks[i][0], units, tasks[i][1], oas_kwargs, band) for i in todo], workers, scheduler, done)
     finally:
         bar.close()
-    cols = ["record", "t_p_s", "t_I_s", "t_I_prime_s", "beta", "f_min", "f_min_level", "f_min_R_m", "error"]
-    return pd.DataFrame(rows, columns=cols + (BAND_COLUMNS if band else []))
+    for r, (p, _) in zip(rows, tasks):
+        r["record"] = p  # a resumed row names the record as this run does
+    return pd.DataFrame(rows, columns=cols)
 
 
 def oas_table(
     items,
     units: str | None = None,
-    slenderness: float = 12.0,
+    slenderness=12.0,
     oas_kwargs: dict | None = None,
     workers: int | None = None,
     scheduler: str | None = None,
     progress: bool = True,
     band: bool = False,
+    journal=None,
 ):
-    """The record table (:data:`TABLE_COLUMNS`) of :func:`expand_records` items.
+    """The record table (:data:`TABLE_COLUMNS`, then ``h_over_b``) of :func:`expand_records` items.
 
-    Records with an error from the expansion are not run; each row carries the
-    thesis's Table 4 values when the record is named by its FEMA P695 number
-    (compared only for H/B = 12, the table's slenderness).
+    A row per record and h/b (``slenderness``: one value or several), record-major. Records with
+    an error from the expansion are not run; each row carries the thesis's Table 4 values when
+    the record is named by its FEMA P695 number and h/b is 12 (the table's slenderness).
+    ``journal``: see :func:`oas_many`.
     """
     import math
 
     import pandas as pd
 
+    hbs = h_over_b_values(slenderness)
     ok = [(n, p) for n, p, e in items if not e]
     res = oas_many(
         [p for _, p in ok],
         units=units,
-        slenderness=slenderness,
+        slenderness=hbs,
         oas_kwargs=oas_kwargs,
         workers=workers,
         scheduler=scheduler,
         progress=progress,
         band=band,
+        journal=journal,
     )
-    by_path = {r["record"]: r for r in res.to_dict(orient="records")}
+    by_task = {(r["record"], r["h_over_b"]): r for r in res.to_dict(orient="records")}
     t4 = thesis_table4()
     rows = []
-    columns = TABLE_COLUMNS + (BAND_COLUMNS if band else [])
+    columns = TABLE_COLUMNS + (BAND_COLUMNS if band else []) + ["h_over_b"]
     for name, path, err in items:
-        row = {c: math.nan for c in columns}
-        row.update(name=name, record=path, thesis_id="", error=err)
-        if not err:
-            row.update({k: v for k, v in by_path[path].items() if k in row})
-        hit = table4_row(name, t4) if abs(slenderness - 12.0) < 1e-9 else None
-        if hit is not None:
-            row.update(
-                thesis_id=hit["ff_id"],
-                thesis_t_p_s=float(hit["t_p_s"]),
-                thesis_t_I_s=float(hit["t_I_s"]),
-                thesis_t_I_prime_s=float(hit["t_I_prime_s"]),
-                thesis_beta=float(hit["beta"]),
-            )
-        rows.append(row)
+        for hb in hbs:
+            row = {c: math.nan for c in columns}
+            row.update(name=name, record=path, thesis_id="", error=err, h_over_b=hb)
+            if not err:
+                row.update({k: v for k, v in by_task[(path, hb)].items() if k in row})
+            hit = table4_row(name, t4) if abs(hb - 12.0) < 1e-9 else None
+            if hit is not None:
+                row.update(
+                    thesis_id=hit["ff_id"],
+                    thesis_t_p_s=float(hit["t_p_s"]),
+                    thesis_t_I_s=float(hit["t_I_s"]),
+                    thesis_t_I_prime_s=float(hit["t_I_prime_s"]),
+                    thesis_beta=float(hit["beta"]),
+                )
+            rows.append(row)
     return pd.DataFrame(rows, columns=columns)

@@ -2,6 +2,8 @@
 
 - ``rocklab pulse RECORD [--units g]`` → a_max_m_s2, I_max_m_s, t_p_s (thesis Eq. 16, 25)
 - ``rocklab oas RECORD... --slenderness 12 [--levels 80] [--sizes 120] [-o oas.csv] [--plot oas.png]``
+- ``rocklab oas FOLDER --slenderness 3,5,8,12 --band -o study.csv [--resume] [--scheduler ADDR]``: the
+  thesis's whole record study, a row per record and h/b, resumable after a stop
   → t_I_s, t_I_prime_s, beta, f_min (thesis §5.1.3, §5.3); ``--column N [--impacts K]`` the OAS of a
   column of N blocks (thesis Fig. 43, one record or --pulse); several records run in
   parallel (``--workers``, or ``--scheduler ADDR`` for Dask) and ``-o`` is then the
@@ -67,7 +69,11 @@ def _register_oas(sub):
         help="units of records that state none (g, m/s2, cm/s2); a file's own units are kept, "
         "and one record stating other units is an error",
     )
-    p.add_argument("--slenderness", type=float, default=12.0, help="block h/b (default 12)")
+    p.add_argument(
+        "--slenderness",
+        default="12",
+        help="block h/b (default 12); several, comma-separated (3,5,8,12), make a row per record and h/b",
+    )
     p.add_argument("--levels", type=int, default=None, help="a_p/a_p,min levels 1..level-max (80; with --column 19)")
     p.add_argument("--level-max", type=float, default=10.0, help="largest a_p/a_p,min level (default 10)")
     p.add_argument("--sizes", type=int, default=None, help="log-spaced R from 1000 m to 0.1 m (120; with --column 49)")
@@ -119,6 +125,12 @@ def _register_oas(sub):
     p.add_argument("--workers", type=count(1), default=None, help="local processes for several records")
     p.add_argument("--scheduler", default=None, help="Dask distributed scheduler address")
     p.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
+    p.add_argument(
+        "--resume",
+        action="store_true",
+        help="with -o: go on from the rows an interrupted run of the same command finished "
+        "(kept in OUT.journal.json while it runs)",
+    )
     p.add_argument("--json", action="store_true", help="print one JSON object")
     return p
 
@@ -232,8 +244,21 @@ def _free(v):
 
 
 def run_oas(args) -> int:
-    from ...._io import write_frame_atomic
+    from pathlib import Path
 
+    from ...._io import write_frame_atomic
+    from ...spectra import h_over_b_values
+
+    hbs = h_over_b_values(str(args.slenderness).split(","))
+    if args.resume and not args.out:
+        raise InputError(
+            "rocklab oas --resume: give the same -o TABLE.csv as the run to resume (its journal is beside it)"
+        )
+    if len(hbs) > 1 and (args.pulse is not None or args.column is not None):
+        raise InputError(
+            "rocklab oas: several --slenderness values make a record study; give one with --pulse or --column"
+        )
+    args.slenderness = hbs if len(hbs) > 1 else hbs[0]
     if args.column is not None:
         return _run_oas_column(args)
     kw = dict(
@@ -246,15 +271,19 @@ def run_oas(args) -> int:
         search=args.search,
         eta=args.eta,
     )
-    if args.slenderness is None or not (args.slenderness > 0):
-        raise InputError(f"--slenderness {args.slenderness}: h/b must be > 0 (e.g. 12)")
-    from pathlib import Path
 
     if args.pulse is not None and (args.record or args.list or args.band):
         raise InputError("rocklab oas: --pulse is one base motion; give it without records, --list or --band")
     if not args.record and not args.list and args.pulse is None:
         raise InputError("rocklab oas: give record files, folders of records, --list FILE or --pulse KIND,PEAK,T_P")
-    if args.list or args.band or len(args.record) > 1 or any(Path(r).is_dir() for r in args.record):
+    if (
+        args.list
+        or args.band
+        or args.resume
+        or isinstance(args.slenderness, list)
+        or len(args.record) > 1
+        or any(Path(r).is_dir() for r in args.record)
+    ):
         return _run_oas_batch(args, kw)
     from ....models import load_base_motion, overturning_spectrum, pulse_parameters
 
@@ -340,8 +369,8 @@ def _run_oas_batch(args, kw) -> int:
     import sys
     from pathlib import Path
 
-    from ...._io import write_frame_atomic
-    from ...spectra import expand_records, oas_table
+    from .... import __version__
+    from ...spectra import StudyJournal, expand_records, oas_table
 
     skipped: list = []
     notes: list = []
@@ -355,52 +384,94 @@ def _run_oas_batch(args, kw) -> int:
     for _, _, err in items:
         if err:
             sys.stderr.write(f"rocklab oas: error: {err}\n")
-    tab = oas_table(
-        items,
-        units=args.units,
-        slenderness=args.slenderness,
-        oas_kwargs=kw,
-        workers=args.workers,
-        scheduler=args.scheduler,
-        progress=not args.no_progress,
-        band=args.band,
-    )
-    for (_, _, err), row_err in zip(items, tab["error"]):  # the table keeps the items' order
+    journal = None
+    if args.out:
+        opts = {"oas": kw, "units": args.units, "band": bool(args.band), "rocklab": __version__}
+        journal = StudyJournal.open(args.out, opts, resume=args.resume)
+        if args.resume:
+            sys.stderr.write(
+                f"rocklab oas: resuming from {journal.path} ({journal.resumed} finished run(s)); runs of "
+                "changed records are done again\n"
+            )
+    try:
+        tab = oas_table(
+            items,
+            units=args.units,
+            slenderness=args.slenderness,
+            oas_kwargs=kw,
+            workers=args.workers,
+            scheduler=args.scheduler,
+            progress=not args.no_progress,
+            band=args.band,
+            journal=journal,
+        )
+    except BaseException:  # Ctrl-C, SIGTERM, a lost cluster: say where the finished runs are
+        if journal is not None and journal.rows:
+            sys.stderr.write(
+                f"rocklab oas: {len(journal.rows)} finished run(s) kept in {journal.path}; run the same "
+                "command with --resume to go on\n"
+            )
+        raise
+    n_hb = len(args.slenderness) if isinstance(args.slenderness, list) else 1
+    for (_, _, err), row_err in zip([it for it in items for _ in range(n_hb)], tab["error"]):  # items' order
         if row_err and not err:  # the expansion's errors are printed above
             sys.stderr.write(f"rocklab oas: error: {row_err}\n")
     if args.out:
-        out = Path(args.out)
-        write_frame_atomic(out, tab, float_format="%.6g")
-        from ...._io import atomic_path
+        _write_study_table(tab, Path(args.out))
+        journal.close()
+    return _report_oas_batch(args, tab)
 
-        with atomic_path(out.with_suffix(".parquet"), side=True) as tmp:
-            tab.to_parquet(tmp, index=False)
-    if args.plot:
-        from ...spectra import plot_tI_vs_tp
 
-        plot_tI_vs_tp(tab, args.plot, args.slenderness)
+def _write_study_table(tab, out) -> None:
+    """The record table as CSV (the path given) and Parquet beside it, each atomically."""
+    from ...._io import atomic_path, write_frame_atomic
+
+    write_frame_atomic(out, tab, float_format="%.6g")
+    with atomic_path(out.with_suffix(".parquet"), side=True) as tmp:
+        tab.to_parquet(tmp, index=False)
+
+
+def _report_oas_batch(args, tab) -> int:
+    """Figures, the t_I-t_p regression per h/b (thesis Fig. 53) and the printed or JSON table."""
+    from pathlib import Path
+
+    from ....models.spectra import tI_tp_regression
+
+    hbs = args.slenderness if isinstance(args.slenderness, list) else [args.slenderness]
+    regs = {}
+    for hb in hbs:
+        sub = tab[tab["h_over_b"] == hb]
+        ok = sub[(sub["error"] == "") & sub["t_I_s"].notna() & sub["t_p_s"].notna()]
+        regs[hb] = tI_tp_regression(ok["t_p_s"], ok["t_I_s"]).to_dict() if len(ok) >= 3 else None
+        if args.plot:
+            from ...spectra import plot_tI_vs_tp
+
+            plot = Path(args.plot)
+            if len(hbs) > 1:  # one figure per h/b: OUT_hb12.png
+                plot = plot.with_name(f"{plot.stem}_hb{hb:g}{plot.suffix}")
+            plot_tI_vs_tp(sub, plot, hb)
     n_bad = int((tab["error"] != "").sum())
-    reg = None
-    ok = tab[(tab["error"] == "") & tab["t_I_s"].notna() & tab["t_p_s"].notna()]
-    if len(ok) >= 3:  # thesis Fig. 53: t_I against t_p across the records
-        from ....models.spectra import tI_tp_regression
-
-        reg = tI_tp_regression(ok["t_p_s"], ok["t_I_s"]).to_dict()
     if args.json:
-        _emit({"records": tab.to_dict(orient="records"), "failed": n_bad, "tI_tp_regression": reg})
-    else:
-        cols = (
-            ["name", "t_p_s", "t_I_s"]
-            + (["t_I_p05_s", "t_I_p95_s"] if args.band else [])
-            + ["t_I_prime_s", "beta", "thesis_id", "thesis_t_I_s"]
-        )
-        show = tab[cols]
-        print(show.to_string(index=False, float_format=lambda v: f"{v:.4g}"))
-        print(f"{len(tab) - n_bad}/{len(tab)} records done" + (f", {n_bad} failed (see above)" if n_bad else ""))
+        d = {"records": tab.to_dict(orient="records"), "failed": n_bad, "tI_tp_regression": regs[hbs[0]]}
+        if len(hbs) > 1:
+            d["tI_tp_regression"] = {f"{hb:g}": r for hb, r in regs.items()}
+        _emit(d)
+        return 0 if n_bad == 0 else 1
+    cols = (
+        ["name"]
+        + (["h_over_b"] if len(hbs) > 1 else [])
+        + ["t_p_s", "t_I_s"]
+        + (["t_I_p05_s", "t_I_p95_s"] if args.band else [])
+        + ["t_I_prime_s", "beta", "thesis_id", "thesis_t_I_s"]
+    )
+    print(tab[cols].to_string(index=False, float_format=lambda v: f"{v:.4g}"))
+    what = "records" if len(hbs) == 1 else "runs (record x h/b)"
+    print(f"{len(tab) - n_bad}/{len(tab)} {what} done" + (f", {n_bad} failed (see above)" if n_bad else ""))
+    for hb, reg in regs.items():
         if reg is not None:
             print(
                 f"t_I = {reg['slope']:.4g} t_p + {reg['intercept']:.4g} s over {reg['n']} records, "
-                f"correlation r = {reg['r']:.4g} (thesis Fig. 53)"
+                f"correlation r = {reg['r']:.4g} (thesis Fig. 53, H/B = {hb:g})"
             )
     return 0 if n_bad == 0 else 1
 

@@ -178,3 +178,21 @@ def test_log_ends_at_rest_so_the_drift_is_anchored(short):
         rot_cut = block_rotation(cut, axis="y")
     assert rot_cut.status == "no_rest_after"
     assert [w for w in found if "W-IMU-NO-REST" in str(w.message)]
+
+
+def test_log_end_rule():
+    """1 s after the last block or the table is still; never less than 0.5 s after the film; a block
+    still rocking when its simulation ends (the rest search's end) ends the log moving, 0.1 s short
+    of that end, whatever the other blocks do."""
+    from types import SimpleNamespace
+
+    from rocklab.synth._scene import imu_log_end
+
+    def m(end):
+        return SimpleNamespace(t_s=np.array([0.0, end]))
+
+    rest, rocking = {"sim_status": "rest"}, {"sim_status": "rocking"}
+    assert imu_log_end([m(7.7), m(3.2)], [rest, rest], 0.6, 4.0) == pytest.approx(8.7)
+    assert imu_log_end([m(2.0)], [rest], 7.5, 4.0) == pytest.approx(8.5)  # the table stops last
+    assert imu_log_end([m(1.2)], [rest], 0.6, 4.0) == pytest.approx(4.5)  # at rest before the film ends
+    assert imu_log_end([m(2.0), m(34.6)], [rest, rocking], 0.6, 4.0) == pytest.approx(34.5)

@@ -533,10 +533,8 @@ def imu_log_end(motions, sims, table_end_s: float, video_end_s: float) -> float:
     end, 0.1 s short for the IMU's interval means: its log ends moving, as a real one would.
     """
     ends = [float(m.t_s[-1]) for m in motions]
-    if any(s["sim_status"] == "rocking" for s in sims):
-        end = min(ends) - 0.1
-    else:
-        end = max([float(table_end_s), *ends]) + IMU_REST_S
+    moving = [e for e, s in zip(ends, sims) if s["sim_status"] == "rocking"]
+    end = min(moving) - 0.1 if moving else max([float(table_end_s), *ends]) + IMU_REST_S
     return max(float(video_end_s) + IMU_TAIL_S, end)
 
 

@@ -369,6 +369,62 @@ def test_joint_sequence_recovers_model_events_and_comparison(three_block_free):
     assert compare_sequences(swapped, seq).n_matched < len(seq)
 
 
+def test_events_one_frame_apart_match_a_one_frame_tolerance_anywhere_on_the_grid():
+    """Frame times i / fps differ by one frame only up to rounding (at 50 fps 0.80 - 0.78 is
+    0.020000000000000018): a one-frame tolerance matches every pair one frame apart (it used to
+    reject the pairs rounded up, about two in three), and never a pair two frames apart."""
+    t = np.arange(200) / 50.0
+    step = np.diff(t)
+    assert np.sum(step > 0.02) > 100 and np.sum(step < 0.02) > 10  # the rounding to absorb
+    for i in range(198):
+        a, b, c = [(t[i], 0, "cw")], [(t[i + 1], 0, "cw")], [(t[i + 2], 0, "cw")]
+        assert compare_sequences(a, b, tol_s=0.02).n_matched == 1
+        assert compare_sequences(b, a, tol_s=0.02).n_matched == 1
+        assert compare_sequences(a, c, tol_s=0.02).n_matched == 0
+        assert compare_sequences(a, c, tol_s=0.039).n_matched == 0
+
+
+def test_column_verdict_matches_members_one_frame_late():
+    """An ensemble whose members all open, close and reopen the joint one frame after the
+    measurement (50 fps, tolerance one frame): every measured event has probability 1, the members
+    never diverge (no event horizon), and the model is consistent. Before frame times were
+    compared up to rounding, the measured opening at 0.78 s had probability 0 against members at
+    0.80 s, and the horizon ended there."""
+    from rocklab.fitting import ColumnEnsemble, judge_column
+
+    t = np.arange(100) / 50.0
+    y = np.zeros((t.size, 1))
+    y[39:60, 0] = 0.02  # cw open from 0.78 s, closed from 1.20 s
+    y[75:90, 0] = -0.02  # ccw open from 1.50 s
+    member = np.roll(y, 1, axis=0)  # each event one frame later
+    n = 32
+    ens = ColumnEnsemble(
+        t,
+        np.repeat(member[None], n, axis=0),
+        [joint_sequence(t, member)] * n,
+        np.zeros(n, bool),
+        np.stack([member - 0.03, member + 0.03]),
+    )
+    meas = joint_sequence(t, y)
+    assert [(e[2]) for e in meas] == ["cw", "closed", "ccw", "closed"]
+    assert 0.80 - 0.78 > 0.02  # the pair the float comparison rejected
+    v = judge_column(t, y, ens, [0.46], tol_s=0.02, t_start_s=0.0)
+    assert [e["probability"] for e in v.events] == [1.0] * 4
+    assert v.horizon_s == t[-1] and v.n_events_inside == v.n_matched_inside == 4
+    assert v.verdict == "consistent"
+    # two frames late: no event is matched, every one missed: inconsistent
+    late = np.roll(y, 2, axis=0)
+    ens2 = ColumnEnsemble(
+        t,
+        np.repeat(late[None], n, axis=0),
+        [joint_sequence(t, late)] * n,
+        np.zeros(n, bool),
+        np.stack([late - 0.03, late + 0.03]),
+    )
+    v2 = judge_column(t, y, ens2, [0.46], tol_s=0.02, t_start_s=0.0)
+    assert [e["probability"] for e in v2.events] == [0.0] * 4 and v2.verdict == "inconsistent"
+
+
 # -- thesis §5.2, Fig. 40 ----------------------------------------------------------------------------
 
 

@@ -1,13 +1,18 @@
 """Synthetic IMU logs run on after the last video frame (the camera is stopped first):
-the block keeps moving there as the simulator says, in the gyro and the accelerometer."""
+the block keeps moving there as the simulator says, in the gyro and the accelerometer, and the
+logs end 1 s after the block has come to rest, as a lab logs until the block rests (the IMU
+reader anchors its drift there: no W-IMU-NO-REST on a clean synthetic log)."""
 
 from __future__ import annotations
+
+import warnings
+from dataclasses import replace
 
 import numpy as np
 import pytest
 
 from rocklab import G, Block
-from rocklab.tracking import read_imu
+from rocklab.tracking import block_rotation, read_imu
 from rocklab.synth import synth_session
 
 GYRO_NOISE = np.deg2rad(0.1)  # rad/s per sample, the synth's error model (session.json)
@@ -31,8 +36,9 @@ def short(tmp_path_factory):
     b = s.meta["blocks"][0]
     rel = b["release_s"]
     res = simulate(
-        blk, theta0_rad=-b["theta0_rad"], duration_s=3.0, dt_s=1e-4, restitution="constant", eta=b["eta_true"]
+        blk, theta0_rad=-b["theta0_rad"], duration_s=10.0, dt_s=1e-4, restitution="constant", eta=b["eta_true"]
     )
+    assert res.status == "rest"  # the run stops when the block rests: res.t_s[-1] is that time
 
     def theta_sim(t):
         t = np.asarray(t, float)
@@ -43,12 +49,17 @@ def short(tmp_path_factory):
     return s, blk, log, tv, theta_sim, res
 
 
-def _last_contiguous_tail(log, tv, t_from):
-    """Indices of the samples after ``t_from`` that follow the last lost-packet gap."""
+def _moving_tail(log, tv, t_from, t_to):
+    """Indices of the longest run of consecutive samples (no lost packet) in ``(t_from, t_to)``."""
     k = np.rint(log.t_s * log.rate_hz).astype(np.int64)
-    idx = np.flatnonzero(tv > t_from)
-    gaps = np.flatnonzero(np.diff(k[idx]) != 1)
-    return idx[gaps[-1] + 1 :] if len(gaps) else idx
+    idx = np.flatnonzero((tv > t_from) & (tv < t_to))
+    runs = np.split(idx, np.flatnonzero(np.diff(k[idx]) != 1) + 1)
+    return max(runs, key=len)
+
+
+def _rest_s(s, res):
+    """When the block comes to rest on the video clock, s (the independent run stops there)."""
+    return s.meta["blocks"][0]["release_s"] + float(res.t_s[-1])
 
 
 def test_log_outlasts_the_video_and_truth_covers_the_frames_only(short):
@@ -56,10 +67,13 @@ def test_log_outlasts_the_video_and_truth_covers_the_frames_only(short):
     t_video = s.n_frames / s.fps
     tr = s.truth[s.truth.object == "block_1"]
     assert len(tr) == s.n_frames == 50 and tr["t_s"].max() == pytest.approx((s.n_frames - 1) / s.fps)
-    # The IMU logs 0.5 s past the video (last sample within one period of it).
-    assert t_video + 0.5 - 1 / log.rate_hz < tv[-1] <= t_video + 0.5
-    # The block is still rocking when the video stops: |omega| far from zero there ...
+    # The block rests well after the video (independent run) and the IMU logs 1 s past that
+    # (last sample within one period of it; the synth's run stops at rest within its 0.1 ms step).
     rel = s.meta["blocks"][0]["release_s"]
+    t_rest = rel + float(res.t_s[-1])
+    assert t_rest > t_video + 0.3  # measured 0.49 s
+    assert t_rest + 1.0 - 1 / log.rate_hz - 2e-4 < tv[-1] <= t_rest + 1.0 + 2e-4
+    # The block is still rocking when the video stops: |omega| far from zero there ...
     w_end = np.interp(t_video - rel, res.t_s, res.omega_rad_s)
     assert abs(w_end) > 0.05
     # ... and session.json's impacts are the simulator's through the end of the log,
@@ -73,11 +87,11 @@ def test_log_outlasts_the_video_and_truth_covers_the_frames_only(short):
 
 
 def test_gyro_keeps_following_the_rotation_after_the_video(short):
-    s, _, log, tv, theta_sim, _ = short
+    s, _, log, tv, theta_sim, res = short
     info = s.meta["imu"]["block_1"]
     dt = 1.0 / log.rate_hz
-    tail = _last_contiguous_tail(log, tv, s.n_frames / s.fps)
-    assert len(tail) * dt > 0.4
+    tail = _moving_tail(log, tv, s.n_frames / s.fps, _rest_s(s, res))
+    assert len(tail) * dt > 0.25  # 0.29 s here (a lost-packet burst falls in the 0.49 s)
     # gyro_y = d(theta_sim)/dt (= -d theta_rad / dt), interval means; the bias is the synth's.
     g = log.gyro_rad_s[tail, 1] - np.deg2rad(info["gyro_bias_deg_s"][1])
     t = tv[tail]
@@ -99,9 +113,9 @@ def test_gyro_keeps_following_the_rotation_after_the_video(short):
 def test_accelerometer_keeps_following_the_rotation_after_the_video(short):
     """Specific force of the sensor point from rigid rotation about the active corner
     (positions by finite differences here, not the writer's formula), in the sensor frame."""
-    s, blk, log, tv, theta_sim, _ = short
+    s, blk, log, tv, theta_sim, res = short
     dt = 1.0 / log.rate_hz
-    tail = _last_contiguous_tail(log, tv, s.n_frames / s.fps)
+    tail = _moving_tail(log, tv, s.n_frames / s.fps, _rest_s(s, res))
     t = tv[tail]
     rx, rz = 0.0, MOUNT_FRAC * blk.h_m
     assert s.meta["imu"]["block_1"]["mount_m"] == pytest.approx([rx, rz])
@@ -132,3 +146,53 @@ def test_accelerometer_keeps_following_the_rotation_after_the_video(short):
     assert np.std(expect[far, 0]) > 20 * ACC_NOISE and np.std(got[far, 0]) > 20 * ACC_NOISE
     res = got[far] - expect[far]
     assert np.sqrt(np.mean(res**2, axis=0)).max() < 1.3 * ACC_NOISE
+
+
+def test_log_ends_at_rest_so_the_drift_is_anchored(short):
+    """The reader finds the final rest where the simulator put it and anchors theta there (status
+    ok, no W-IMU-NO-REST); the same log cut 0.5 s after the video, as the synth used to, ends
+    while the block moves and is still flagged."""
+    s, _, log, tv, _, res = short
+    t0 = s.meta["imu"]["block_1"]["t0_video_s"]
+    with warnings.catch_warnings(record=True) as found:
+        warnings.simplefilter("always")
+        rot = block_rotation(log, axis="y")
+    assert rot.status == "ok" and not [w for w in found if "W-IMU-NO-REST" in str(w.message)]
+    # the rest the reader anchors on starts where the simulated block rests (measured 0.052 s
+    # after: the reader's 50 ms trim next to the motion)
+    t_rest = _rest_s(s, res)
+    assert t_rest - 0.02 < rot.rest_t_s + t0 < t_rest + 0.15
+    # the block ends upright, as the simulator's: theta at rest within 0.02 deg of 0 (measured 4e-4)
+    assert abs(float(np.mean(rot.theta_rad[rot.t_s + t0 > t_rest + 0.2]))) < np.deg2rad(0.02)
+    keep = tv <= s.n_frames / s.fps + 0.5
+    cut = replace(
+        log,
+        t_s=log.t_s[keep],
+        gyro_rad_s=log.gyro_rad_s[keep],
+        acc_m_s2=log.acc_m_s2[keep],
+        saturated=None if log.saturated is None else log.saturated[keep],
+        packet=None if log.packet is None else log.packet[keep],
+    )
+    with warnings.catch_warnings(record=True) as found:
+        warnings.simplefilter("always")
+        rot_cut = block_rotation(cut, axis="y")
+    assert rot_cut.status == "no_rest_after"
+    assert [w for w in found if "W-IMU-NO-REST" in str(w.message)]
+
+
+def test_log_end_rule():
+    """1 s after the last block or the table is still; never less than 0.5 s after the film; a block
+    still rocking when its simulation ends (the rest search's end) ends the log moving, 0.1 s short
+    of that end, whatever the other blocks do."""
+    from types import SimpleNamespace
+
+    from rocklab.synth._scene import imu_log_end
+
+    def m(end):
+        return SimpleNamespace(t_s=np.array([0.0, end]))
+
+    rest, rocking = {"sim_status": "rest"}, {"sim_status": "rocking"}
+    assert imu_log_end([m(7.7), m(3.2)], [rest, rest], 0.6, 4.0) == pytest.approx(8.7)
+    assert imu_log_end([m(2.0)], [rest], 7.5, 4.0) == pytest.approx(8.5)  # the table stops last
+    assert imu_log_end([m(1.2)], [rest], 0.6, 4.0) == pytest.approx(4.5)  # at rest before the film ends
+    assert imu_log_end([m(2.0), m(34.6)], [rest, rocking], 0.6, 4.0) == pytest.approx(34.5)

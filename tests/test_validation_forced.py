@@ -211,3 +211,26 @@ def test_rest_before_the_shaking_survives_one_outlier():
     w = _rest_window(x)
     assert w is not None and w.stop == 301
     assert _robust_sd(x[w]) == pytest.approx(0.01, rel=0.2)
+
+
+def test_rest_of_a_smooth_fused_table_reaches_the_shaking():
+    """A fused table (IMU + film, smoothed) wanders at rest by ±0.02 m/s² while its first differences
+    are 100x smaller: the rest ended at its first samples and the validation assumed 2 % of the peak
+    as the noise (W-VALID-ASSUMED on the demo's El Centro run). With the IMU's white noise (0.05) as
+    the least σ the rest runs to the shaking, and 1 % of the peak still ends it."""
+    from rocklab.pipelines._validation import _rest_window
+
+    t = np.arange(0.0, 3.0, 1 / 256.0)
+    start = 1.3
+    rest = 0.02 * np.sin(2 * np.pi * 0.7 * t + 1.0)
+    shake = np.where(t >= start, 4.0 * np.sin(2 * np.pi * 2.0 * (t - start)), 0.0)
+    x = rest + shake
+    w0 = _rest_window(x)
+    assert w0 is None or w0.stop < 0.1 * start * 256  # the smooth rest's own differences: 2e-4 m/s2
+    w = _rest_window(x, sigma_floor=0.05)
+    assert w is not None and start - 0.05 < t[w.stop] < start + 0.05
+    # the floor is a per-sample noise: shaking below 6 of it stays rest, 0.4 m/s2 ends it within 0.1 s
+    x2 = rest + np.where(t >= start, 0.04 * np.sin(2 * np.pi * 2.0 * (t - start)), 0.0)
+    assert _rest_window(x2, sigma_floor=0.05).stop == x2.size
+    w3 = _rest_window(rest + 0.1 * shake, sigma_floor=0.05)
+    assert start < t[w3.stop] < start + 0.1

@@ -58,6 +58,10 @@ MISSED_PROBABILITY = 0.05
 #: A model whose band holds less than this fraction of the measured samples is inconsistent.
 COVERAGE_INCONSISTENT = 0.5
 _P_INCONSISTENT, _P_CONSISTENT = 0.01, 0.05
+#: Event times on the measured frame grid differ by whole frames only up to rounding (at 50 fps
+#: 0.80 - 0.78 = 0.020000000000000018 s); the tolerance allows this much more, s (as
+#: :func:`rocklab.models.compare_sequences` does).
+_ROUNDING_S = 1e-9
 
 
 @dataclass(frozen=True)
@@ -335,7 +339,8 @@ def judge_column(
     alpha_rad : array_like, (L,)
         Each block's slenderness angle, rad.
     tol_s : float
-        ±Δt within which a member's event matches a measured one, s.
+        ±Δt within which a member's event matches a measured one, s (up to float rounding: one
+        frame matches events one frame apart on the measured grid).
     t_start_s : float
         The release (or the start of the shaking), s: events at the first sample are the start
         state, not a prediction.
@@ -353,9 +358,10 @@ def judge_column(
     wide = np.flatnonzero(np.any(p95 - p05 > HORIZON_FRACTION * np.asarray(alpha_rad, float), axis=1))
     horizon = float(t[wide[0]]) if wide.size else float(t[-1])
     t_first = float(t[np.flatnonzero(ok.all(axis=1))[0]])
-    meas = _through_closed([e for e in joint_sequence(t, y, threshold_rad) if e[0] > t_first], tol_s)
-    members = [_through_closed([e for e in q if e[0] > t_first], tol_s) for q in ens.sequences]
-    horizon = min(horizon, _event_horizon(members, tol_s))
+    tol = tol_s + _ROUNDING_S
+    meas = _through_closed([e for e in joint_sequence(t, y, threshold_rad) if e[0] > t_first], tol)
+    members = [_through_closed([e for e in q if e[0] > t_first], tol) for q in ens.sequences]
+    horizon = min(horizon, _event_horizon(members, tol))
     n = len(ens.sequences)
     hits = np.zeros(len(meas), int)
     counts = []

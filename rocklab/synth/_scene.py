@@ -15,10 +15,17 @@ __all__ = ["build_scene", "Scene"]
 
 TABLE_THICK_M = 0.06
 _MOUNT_FRAC = 0.85  # IMU height on the block, fraction of h
-#: The IMUs keep logging this long after the last video frame, s (as in the lab: the
+#: The IMUs keep logging at least this long after the last video frame, s (as in the lab: the
 #: camera is stopped first). The blocks and the table are simulated to the end of the
 #: logs, so a block still rocking when the video ends keeps rocking in its IMU log.
 IMU_TAIL_S = 0.5
+#: ... and, as a lab logs until the blocks have rested, this long after the last block and the
+#: table are still, s. The IMU reader anchors the gyro drift in a final rest (at least 0.1 s,
+#: 50 ms trimmed next to the motion); a log cut while a block moves is W-IMU-NO-REST.
+IMU_REST_S = 1.0
+#: The blocks are simulated at most this long past the video to find their rest, s (Čeh's B9M
+#: released from 0.8 alpha rocks for 12 s); a block still rocking then ends its log moving.
+REST_SEARCH_S = 30.0
 
 
 def _blocks(block, n):
@@ -105,6 +112,11 @@ class Scene:
     video_info: dict = field(default_factory=dict)
     layout: str = "single"
     flicker: float = 0.0  # relative amplitude of the exposure flicker (Renderer.exposure_gain)
+
+    @property
+    def imu_end_s(self) -> float:
+        """When the IMU logs end (video clock), s: :func:`imu_log_end`."""
+        return imu_log_end(self.block_motions, self.sims, self.table.end_s, self.n_frames / self.fps)
 
     def renderer(self):
         from ._render import Renderer
@@ -261,7 +273,7 @@ class Scene:
 
         out = {}
         seqs = self.imu_seed.spawn(len(self.block_motions) + 1)
-        t_end = self.n_frames / self.fps + IMU_TAIL_S
+        t_end = self.imu_end_s
         blocks = {s["id"]: s["block"] for s in self.sims}
         for k, bm in enumerate(self.block_motions):
             bd = blocks[bm.id]
@@ -327,7 +339,10 @@ class Scene:
                 "object_frame": "origin as x_m, y_m; x right, y up when upright",
                 "simulated_span": f"truth.csv covers the video frames; the motions (and blocks' "
                 f"impact_t_s, n_impacts, sim_status, max_abs_theta_rad) run on to "
-                f"the end of the IMU logs, {IMU_TAIL_S} s after the last frame",
+                f"the end of the IMU logs, {IMU_REST_S} s after the blocks and the table are still "
+                f"(at least {IMU_TAIL_S} s after the last frame; the blocks are simulated at most "
+                f"{REST_SEARCH_S} s past the video to find their rest)",
+                "imu_end_s": self.imu_end_s,
             },
         }
 
@@ -384,11 +399,11 @@ def build_scene(
         table_amplitude_m = 0.02 if layout == "column" else 0.045
     rest_s = 0.6
     horizon = float(duration_s) if duration_s is not None else 12.0
-    # The motions run past the video to the end of the IMU logs (IMU_TAIL_S after the last
-    # frame, which rounding of n_frames puts up to half a frame past `horizon`) plus 0.1 s
-    # for the IMU's interval means. Fixed-step integration: the part under the video is the
-    # same as a run stopped at the video's end.
-    sim_end = horizon + IMU_TAIL_S + 0.5 / fps + 0.1
+    # The motions run past the video to the end of the IMU logs (IMU_TAIL_S after the last frame, up to half
+    # a frame past `horizon` by rounding, + 0.1 s for the IMU's interval means), and on until the blocks rest
+    # (the simulators stop there), REST_SEARCH_S at most. Fixed-step integration: the part under the video
+    # is the same as a run stopped at the video's end.
+    sim_end = horizon + IMU_TAIL_S + 0.5 / fps + 0.1 + REST_SEARCH_S
     tbl = _table_motion(
         table,
         rng_m,
@@ -408,7 +423,7 @@ def build_scene(
     if duration_s is None:
         duration_s = float(np.clip(max(ends) + 0.6, 2.0, 12.0))
     n_frames = max(2, int(round(duration_s * fps)))
-    _check_motions_cover(motions, sims, n_frames / fps + IMU_TAIL_S)
+    _check_motions_cover(motions, sims, imu_log_end(motions, sims, tbl.end_s, n_frames / fps))
     table_w = 1.2 if layout == "side" else 0.8
     stroke = {"none": 0.0, "sine": table_amplitude_m, "record": table_stroke_m}[table]
     cam = _framed_camera(size, blks, layout, table_w + 2 * stroke, np.random.default_rng(s_cam), distortion)
@@ -507,6 +522,20 @@ def _framed_camera(size, blks, layout, table_span_m, rng, distortion):
     stack = sum(b.h_m for b in blks) if layout == "column" else h_max
     view_h = max(3.0 * h_max, 1.4 * stack, (table_span_m + 0.1) * H / W)
     return make_camera(size, (0.0, 0.4 * stack), view_h, rng, distortion=distortion)
+
+
+def imu_log_end(motions, sims, table_end_s: float, video_end_s: float) -> float:
+    """When the IMU logs end (video clock), s: :data:`IMU_REST_S` after the blocks and the table
+    are still, at least :data:`IMU_TAIL_S` after the video.
+
+    A simulation stops when its block rests (or falls): its last time is when the block is still.
+    A block still rocking at the end of its simulation (the rest search's end) is logged to that
+    end, 0.1 s short for the IMU's interval means: its log ends moving, as a real one would.
+    """
+    ends = [float(m.t_s[-1]) for m in motions]
+    moving = [e for e, s in zip(ends, sims) if s["sim_status"] == "rocking"]
+    end = min(moving) - 0.1 if moving else max([float(table_end_s), *ends]) + IMU_REST_S
+    return max(float(video_end_s) + IMU_TAIL_S, end)
 
 
 def _check_motions_cover(motions, sims, t_end_s: float) -> None:

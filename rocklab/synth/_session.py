@@ -252,9 +252,9 @@ def synth_session(
         Surfaces from synthetic noise, or from photographs (CC0, shipped in ``rocklab/data/textures``): the wall
         is a brick wall and a markerless block's face is gravel-like stone.
     imu : bool
-        Write IMU logs (one per block and one on the table), x-IMU GUI format. They start 0.5..1.5 s before the
-        video and run on 0.5 s after its last frame (the camera is stopped first); the blocks and the table are
-        simulated to the end of the logs, while ``truth.csv`` covers the video frames.
+        Write IMU logs (one per block and one on the table), x-IMU GUI format, from 0.5..1.5 s before the video to
+        1 s after the blocks and table are still (as a lab logs; >= 0.5 s after the video, the blocks simulated up
+        to 30 s past it), ``session.json["conventions"]["imu_end_s"]``; ``truth.csv`` covers the video frames.
 
     Returns
     -------

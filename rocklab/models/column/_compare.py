@@ -19,6 +19,11 @@ from ..._errors import InputError
 
 __all__ = ["joint_sequence", "compare_sequences", "SequenceComparison", "compare_to_measurement", "ColumnComparison"]
 
+#: Event times read on a frame grid (``i / fps``) differ by whole frames only up to rounding: at 50 fps
+#: 0.80 - 0.78 = 0.020000000000000018 s. A match allows this much over the tolerance, s, so that a
+#: tolerance of one frame matches events one frame apart whatever their place on the grid.
+_ROUNDING_S = 1e-9
+
 
 def joint_sequence(
     t_s, theta_rad, threshold_rad: float = 0.005, *, base_theta_rad=None, sign: float = 1.0, min_duration_s: float = 0.0
@@ -131,24 +136,26 @@ def compare_sequences(measured, simulated, tol_s: float = 0.05, t_max_s: float |
     measured, simulated : list of (t_s, joint, state)
         E.g. from :func:`joint_sequence`.
     tol_s : float
-        Largest time difference of matched events, s.
+        Largest time difference of matched events, s (up to float rounding: events one frame
+        apart on a frame grid match a tolerance of one frame).
     t_max_s : float, optional
         Compare only events before this time, s.
     """
     if not tol_s > 0:
         raise InputError(f"tol_s={tol_s!r}: time tolerance must be positive (s)")
+    lim = tol_s + _ROUNDING_S
     a = [e for e in measured if t_max_s is None or e[0] <= t_max_s]
     b = [e for e in simulated if t_max_s is None or e[0] <= t_max_s]
     na, nb = len(a), len(b)
     L = np.zeros((na + 1, nb + 1), int)
     for i in range(na - 1, -1, -1):
         for k in range(nb - 1, -1, -1):
-            ok = a[i][1] == b[k][1] and a[i][2] == b[k][2] and abs(a[i][0] - b[k][0]) <= tol_s
+            ok = a[i][1] == b[k][1] and a[i][2] == b[k][2] and abs(a[i][0] - b[k][0]) <= lim
             L[i, k] = L[i + 1, k + 1] + 1 if ok else max(L[i + 1, k], L[i, k + 1])
     pairs = []
     i = k = 0
     while i < na and k < nb:
-        ok = a[i][1] == b[k][1] and a[i][2] == b[k][2] and abs(a[i][0] - b[k][0]) <= tol_s
+        ok = a[i][1] == b[k][1] and a[i][2] == b[k][2] and abs(a[i][0] - b[k][0]) <= lim
         if ok and L[i, k] == L[i + 1, k + 1] + 1:
             pairs.append((float(a[i][0]), float(b[k][0]), int(a[i][1]), str(a[i][2])))
             i += 1

@@ -9,7 +9,8 @@ What the run measured sets the ensemble's input uncertainty
   :data:`INPUT_SAFETY` (2) times that;
   the bias the half-cycle fit of η_e finds is taken out, and a constant bias of its standard
   error and σ/√n (the rest gives gravity's level) sampled; a scale error of
-  :data:`ACC_SCALE_SD` (1 %);
+  :data:`ACC_SCALE_SD` (1 %), or, for a table fused from its IMU and the film, the scale
+  uncertainty their agreement measured (:func:`acc_scale_sd`);
 - clock offset: the table–video synchronisation residual, at least a quarter of the table's
   sample period (same clock, video table: 0); a record given as the table motion (the
   command, not a measurement): 2 % of its peak as noise, one record step as offset;
@@ -37,6 +38,7 @@ import numpy as np
 
 __all__ = [
     "ACC_SCALE_SD",
+    "acc_scale_sd",
     "INPUT_SAFETY",
     "NOISE_SAFETY",
     "Validation",
@@ -61,8 +63,18 @@ INPUT_SAFETY = 2.0
 #: the horizon uses the estimate itself).
 NOISE_SAFETY = 1.5
 #: Relative standard deviation of the table acceleration's scale (a calibrated MEMS accelerometer's
-#: sensitivity, or the video's metric scale), -.
+#: sensitivity, or the video's metric scale) when one source alone measured it, -.
 ACC_SCALE_SD = 0.01
+
+
+def acc_scale_sd(table) -> tuple[float, str]:
+    """(relative scale sd, its source) of a measured table's acceleration: what its two sources'
+    agreement measured (a fused table, :func:`rocklab.tracking.table_scale_agreement`), else the
+    prior :data:`ACC_SCALE_SD` (one source: nothing to compare it with)."""
+    sd = float(getattr(table, "acc_scale_sd", np.nan))
+    if np.isfinite(sd) and sd > 0:
+        return sd, "measured: table IMU vs film agreement"
+    return ACC_SCALE_SD, "prior: one source"
 
 
 @dataclass(frozen=True)
@@ -89,6 +101,8 @@ class Validation:
     error_budget : dict or None
         :func:`rocklab.fitting.error_budget` of the reference law inside the horizon: each measured
         input's share of the model's spread (table noise, bias, scale, clock, sizes, θ0, η).
+    acc_scale_source : str
+        Where ``uncertainty["acc_scale"]`` comes from (:func:`acc_scale_sd`).
     """
 
     horizon_s: float
@@ -101,6 +115,7 @@ class Validation:
     rest_level_rad: float
     seconds: float
     error_budget: dict | None = None
+    acc_scale_source: str = ""
 
     def to_dict(self) -> dict:
         return {
@@ -111,6 +126,7 @@ class Validation:
             "laws": {k: v.to_dict() for k, v in self.laws.items()},
             "eta_e": self.eta_fit,
             "uncertainty": self.uncertainty,
+            "acc_scale_source": self.acc_scale_source,
             "rest_level_rad": float(self.rest_level_rad),
             "ensemble_s": float(self.seconds),
             "error_budget": self.error_budget,
@@ -203,7 +219,7 @@ def _uncertainty(cfg, table, table_sync, y, msgs):
         length_m=LENGTH_SD_M,
         theta0_rad=0.0 if wy is not None else sm,  # a block at rest on the table is flat
         meas_noise_rad=sm,
-        acc_scale=ACC_SCALE_SD,
+        acc_scale=acc_scale_sd(table)[0],
     )
     return unc, level, wy is not None
 
@@ -341,6 +357,7 @@ def validate_forced_run(prep: ForcedPrep, block, laws: dict, *, n=None, seed=0) 
         rest_level_rad=prep.level_rad,
         seconds=secs,
         error_budget=budget,
+        acc_scale_source=acc_scale_sd(prep.table)[1],
     )
 
 
@@ -373,8 +390,9 @@ def summary_lines(v: Validation, alpha_rad: float) -> list[str]:
     lines += [
         "",
         f"Inputs sampled (1 σ): table acceleration noise {_g(unc['acc_noise_m_s2'])} m/s², bias "
-        f"{_g(unc['acc_bias_m_s2'])} m/s², clock {_g(1000 * unc['sync_s'])} ms, width and height "
-        f"{_g(1000 * unc['length_m'])} mm, θ noise {_g(unc['meas_noise_rad'])} rad.",
+        f"{_g(unc['acc_bias_m_s2'])} m/s², scale {_g(100 * unc['acc_scale'])} % ({v.acc_scale_source}), clock "
+        f"{_g(1000 * unc['sync_s'])} ms, width and height {_g(1000 * unc['length_m'])} mm, θ noise "
+        f"{_g(unc['meas_noise_rad'])} rad.",
         "",
     ]
     b = v.error_budget

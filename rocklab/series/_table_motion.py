@@ -50,6 +50,10 @@ class TableMotion:
     acc_noise_m_s2 : float
         White-noise level of the acceleration as measured, before any smoothing, m/s^2 (a fused
         table's IMU); NaN when unknown.
+    acc_scale_sd : float
+        Relative standard deviation of the acceleration's scale as measured (a fused table: from
+        its two sources' agreement, :func:`rocklab.tracking.table_scale_agreement`); NaN when
+        nothing measured it.
     """
 
     t_s: np.ndarray
@@ -63,6 +67,7 @@ class TableMotion:
     source: str = "video"
     sigma_ax_m_s2: np.ndarray | None = None
     acc_noise_m_s2: float = math.nan
+    acc_scale_sd: float = math.nan
 
     @classmethod
     def from_acceleration(cls, t_s, acc_m_s2, source: str, object: str = "table") -> "TableMotion":

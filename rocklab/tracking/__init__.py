@@ -21,6 +21,7 @@ sub-package's ``__all__`` is the one list.
 
 from . import calib, imports, imu, rigid, stereo, video
 from ._corrections import apply_corrections, load_corrections
+from ._table_scale import FILM_SCALE_SD, IMU_SCALE_SD, TableScale, table_scale_agreement
 from ._table_fusion import BIAS_MAX_M_S2, BIAS_WALK_M_S2, DISAGREE_NIS, MARGIN_S, TableFusion, fuse_table_motion
 from ._sync import SyncResult, sync_events, sync_imu_to_track, sync_offset, track_rate
 from .calib import *  # noqa: F403
@@ -39,6 +40,10 @@ __all__ = [
     "load_corrections",
     "apply_corrections",
     "TableFusion",
+    "TableScale",
+    "table_scale_agreement",
+    "FILM_SCALE_SD",
+    "IMU_SCALE_SD",
     "fuse_table_motion",
     "BIAS_MAX_M_S2",
     "BIAS_WALK_M_S2",

@@ -42,6 +42,7 @@ from numba import njit
 from .._diagnostics import warn
 from .._errors import InputError
 from ..series import TableMotion
+from ._table_scale import TableScale, table_scale_agreement
 
 __all__ = ["TableFusion", "fuse_table_motion", "BIAS_WALK_M_S2", "BIAS_MAX_M_S2", "DISAGREE_NIS", "ORDERS", "MARGIN_S"]
 
@@ -90,6 +91,9 @@ class TableFusion:
     status : str
         ``"ok"``, or ``"suspect"`` when the sources disagree (``message`` says how).
     message : str
+    scale : rocklab.tracking.TableScale or None
+        The film's scale against the IMU's and the fused acceleration's scale uncertainty
+        (:func:`rocklab.tracking.table_scale_agreement`).
     """
 
     motion: TableMotion
@@ -101,6 +105,7 @@ class TableFusion:
     video_nis: float
     status: str = "ok"
     message: str = ""
+    scale: TableScale | None = None
 
     def to_dict(self) -> dict:
         """``report.json``'s ``table.fusion``: the noises, q_j, the offset and the agreement."""
@@ -118,6 +123,7 @@ class TableFusion:
             "sigma_acc_median_m_s2": float(np.nanmedian(s)) if s is not None else None,
             "status": self.status,
             "message": self.message,
+            "scale": self.scale.to_dict() if self.scale is not None else None,
         }
 
 
@@ -362,6 +368,7 @@ def fuse_table_motion(
     ss, Ps = _smooth(F, sp, Pp, sf, Pf)
     ss, Ps = ss[is_out], Ps[is_out]
     sig = np.sqrt(np.maximum(Ps[:, 2, 2], 0.0))
+    scale = table_scale_agreement(video, ti, ai, sigma_a_m_s2=sa, sigma_x_m=sx)
     motion = TableMotion(
         t_out,
         ss[:, 0],
@@ -372,11 +379,12 @@ def fuse_table_motion(
         source="fused",
         sigma_ax_m_s2=sig,
         acc_noise_m_s2=sa,
+        acc_scale_sd=scale.sd,
     )
-    return _judge(motion, ss[:, m], float(q), m, sx, sa, nis[np.isfinite(nis)], label)
+    return _judge(motion, ss[:, m], float(q), m, sx, sa, nis[np.isfinite(nis)], label, scale)
 
 
-def _judge(motion, bias, q, order, sx, sa, nis, label) -> TableFusion:
+def _judge(motion, bias, q, order, sx, sa, nis, label, scale=None) -> TableFusion:
     """The fusion with its status: the sources disagree when the video's innovations are too
     large for their variance or the IMU's offset is too large for a level table."""
     # the first innovations carry the broad prior, not a disagreement
@@ -401,4 +409,4 @@ def _judge(motion, bias, q, order, sx, sa, nis, label) -> TableFusion:
             f"{label}: the table IMU and the film disagree: {'; '.join(why)}; the fused table follows the film at low "
             "frequencies. Check the table IMU's scale and mounting, the sync and the film's metric scale",
         ).message
-    return TableFusion(motion, bias, q, order, sx, sa, nis_, status, msg)
+    return TableFusion(motion, bias, q, order, sx, sa, nis_, status, msg, scale)

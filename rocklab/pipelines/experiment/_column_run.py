@@ -214,6 +214,9 @@ class ColumnValidation:
         The :class:`rocklab.fitting.InputUncertainty` sampled, SI.
     n_members : int
     seconds : float
+    acc_scale_source : str
+        Where ``uncertainty["acc_scale"]`` comes from (:func:`rocklab.pipelines._validation.acc_scale_sd`;
+        empty without a table).
     """
 
     horizon_s: float
@@ -223,6 +226,7 @@ class ColumnValidation:
     uncertainty: dict
     n_members: int
     seconds: float
+    acc_scale_source: str = ""
 
     def to_dict(self) -> dict:
         from ...fitting import HORIZON_FRACTION
@@ -235,6 +239,7 @@ class ColumnValidation:
             "n_members": self.n_members,
             "laws": {k: v.to_dict() for k, v in self.laws.items()},
             "uncertainty": self.uncertainty,
+            "acc_scale_source": self.acc_scale_source,
             "ensemble_s": float(self.seconds),
         }
 
@@ -260,7 +265,7 @@ def _table_starts(table) -> float:
 
 
 def _column_uncertainty(cfg, t, th, t0, table):
-    from .._validation import ACC_SCALE_SD, INPUT_SAFETY, LENGTH_SD_M, MIN_NOISE_RAD
+    from .._validation import INPUT_SAFETY, LENGTH_SD_M, MIN_NOISE_RAD, acc_scale_sd
     from ...fitting import InputUncertainty
 
     ok = np.isfinite(th).all(axis=1)
@@ -284,7 +289,7 @@ def _column_uncertainty(cfg, t, th, t0, table):
         length_m=LENGTH_SD_M,
         theta0_rad=0.0 if table is not None else max(sm, THETA0_MIN_SD_RAD),
         meas_noise_rad=sm,
-        acc_scale=ACC_SCALE_SD if table is not None else 0.0,
+        acc_scale=acc_scale_sd(table)[0] if table is not None else 0.0,
     )
 
 
@@ -323,5 +328,8 @@ def validate_column(cfg, col, t, th, t0, th0, table, source, *, n=COLUMN_ENSEMBL
         laws[law] = judge_column(tg, -yg, ens, alphas, tol_s=cfg.column_event_tol_s, t_start_s=t0)
         lo, hi = ens.band_rad
         bands[law] = (tg, -hi, -lo)  # the counter-clockwise band
+    from .._validation import acc_scale_sd
+
     ref = f"impacts_{int(cfg.column_impacts)}"
-    return ColumnValidation(laws[ref].horizon_s, ref, laws, bands, unc.to_dict(), n, secs)
+    src = acc_scale_sd(table)[1] if table is not None else ""
+    return ColumnValidation(laws[ref].horizon_s, ref, laws, bands, unc.to_dict(), n, secs, src)

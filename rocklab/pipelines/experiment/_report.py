@@ -110,7 +110,13 @@ def _table_lines(res) -> list:
         f"(noise {_g(1000 * f.sigma_x_m)} mm): median σ of the acceleration "
         f"{_g(float(np.nanmedian(f.motion.sigma_ax_m_s2)))} m/s², the IMU's offset up to "
         f"{_g(float(np.max(np.abs(f.imu_bias_m_s2))))} m/s², the film's normalised innovations "
-        f"{_g(f.video_nis)} (1 when the two agree)",
+        f"{_g(f.video_nis)} (1 when the two agree)"
+        + (
+            f"; the film's scale over the IMU's {_g(1 + f.scale.ratio_minus_one)} ± {_g(f.scale.se)}, so the "
+            f"acceleration's scale is known to {_g(100 * f.scale.sd)} %"
+            if f.scale is not None and f.scale.status == "ok"
+            else ""
+        ),
         "",
     ]
 
@@ -221,6 +227,11 @@ def _column_validation_lines(c) -> list:
             f"| {law} | **{lv.verdict}** | {_g(lv.score)} | {lv.n_matched_inside} of {lv.n_events_inside} "
             f"(±{_g(lv.tol_s)} s) | {_g(lv.band_coverage)} |"
         )
+    if v.acc_scale_source:
+        lines += [
+            "",
+            f"Table acceleration scale sampled: {_g(100 * v.uncertainty['acc_scale'])} % ({v.acc_scale_source})",
+        ]
     ev = c.model_events()[:3]
     if ev:
         lines += [

@@ -78,7 +78,8 @@ def test_agreeing_sources_leave_the_shared_floor_and_disagreeing_ones_their_diff
 
 def test_validation_samples_the_measured_scale_and_keeps_the_prior_for_one_source():
     """The single-block validation's input uncertainty takes a fused table's measured scale sd; an IMU
-    table alone keeps ACC_SCALE_SD (1 %); the column's does the same."""
+    table alone keeps ACC_SCALE_SD (1 %). The column's keeps the prior for both: its ensemble does not
+    sample a fused table's own error, which the prior covers."""
     import dataclasses
     from types import SimpleNamespace
 
@@ -97,5 +98,5 @@ def test_validation_samples_the_measured_scale_and_keeps_the_prior_for_one_sourc
     assert acc_scale_sd(fused)[1].startswith("measured") and acc_scale_sd(imu)[1].startswith("prior")
     tv = np.arange(200) / 50.0
     th = y[:, None] * np.ones((1, 2))
-    assert _column_uncertainty(None, tv, th, 1.0, fused).acc_scale == 0.0031
+    assert _column_uncertainty(None, tv, th, 1.0, fused).acc_scale == 0.01
     assert _column_uncertainty(None, tv, th, 1.0, imu).acc_scale == 0.01

@@ -252,15 +252,36 @@ def _run_tasks(args_list, workers, scheduler, on_done) -> None:
 
         # spawned, not forked: a process that already ran numba's threaded kernels forks
         # children that crash in them (the pool then breaks and the record batch fails)
-        with ProcessPoolExecutor(
+        ex = ProcessPoolExecutor(
             max_workers=workers,
             mp_context=mp.get_context("spawn"),
             initializer=pool_initializer,
             initargs=(os.getpid(), _one_numba_thread),
-        ) as ex:
+        )
+        try:
             futs = {ex.submit(oas_summary_row, *a): i for i, a in enumerate(args_list)}
             for f in as_completed(futs):
                 on_done(futs[f], f.result())
+        except BaseException:
+            _stop_pool(ex)
+            raise
+        ex.shutdown(wait=True)
+
+
+def _stop_pool(ex) -> None:
+    """Stop a process pool now: queued runs cancelled, running ones ended.
+
+    Leaving the pool's ``with`` block on Ctrl-C or SIGTERM waits for every submitted run (a
+    176-run study went on for minutes after the signal, its progress bar frozen); the finished
+    rows are already in the study's journal, so the running ones are simply ended.
+    """
+    procs = list((getattr(ex, "_processes", None) or {}).values())
+    ex.shutdown(wait=False, cancel_futures=True)
+    for proc in procs:
+        if proc.is_alive():
+            proc.terminate()
+    for proc in procs:
+        proc.join(timeout=5)
 
 
 def oas_many(

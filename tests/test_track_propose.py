@@ -292,3 +292,25 @@ def test_a_pendulum_is_proposed_round_its_bob_not_its_string(size, R):
     boxes, _ = moving_boxes(frames[0], frames[1:])
     assert max(_iou(b, truth) for b in boxes) >= 0.5, (boxes, truth)
     assert all(b[2] * b[3] <= 4 * (2 * R) ** 2 for b in boxes), boxes
+
+
+def test_overlapping_proposals_become_one():
+    """Proposals whose boxes overlap beyond what track init accepts for two regions (20 % of the
+    smaller) are merged until no such pair is left; each box ends inside one proposal, and a box
+    that overlaps nothing is kept as it was (a real film, TrackLab's ballOil.mp4, had two such
+    proposals and track init refused its own config)."""
+    from rocklab.tracking.video._checks import region_overlap
+    from rocklab.tracking.video._propose import _merge
+
+    rng = np.random.default_rng(7)
+    for _ in range(200):
+        boxes = [tuple(v) for v in np.c_[rng.uniform(0, 300, (6, 2)), rng.uniform(5, 80, (6, 2))]]
+        out = _merge(boxes, lambda a, b: region_overlap(a, b)[1])
+        assert not any(region_overlap(a, b)[1] for i, a in enumerate(out) for b in out[i + 1 :])
+        for x, y, w, h in boxes:
+            assert any(
+                X <= x + 1e-9 and Y <= y + 1e-9 and x + w <= X + W + 1e-9 and y + h <= Y + H + 1e-9
+                for X, Y, W, H in out
+            )
+        if not any(region_overlap(a, b)[1] for i, a in enumerate(boxes) for b in boxes[i + 1 :]):
+            assert out == [tuple(float(v) for v in b) for b in boxes]  # nothing to merge: as they were

@@ -14,7 +14,7 @@ import numpy as np
 
 from ..._diagnostics import warn
 
-__all__ = ["TABLE_TURN_MAX_RAD", "BLUR_RATIO", "check_mirrored"]
+__all__ = ["TABLE_TURN_MAX_RAD", "BLUR_RATIO", "MAX_REGION_OVERLAP", "check_mirrored", "region_overlap"]
 
 #: A lost target whose window's sharpness fell below this fraction of the last good one is "blur".
 BLUR_RATIO = 0.35
@@ -25,6 +25,21 @@ def region_leaves(roi, width_px: int, height_px: int, tol_px: float = 0.0) -> bo
     more than ``tol_px``."""
     u, v, w, h = (float(x) for x in roi)
     return u < -tol_px or v < -tol_px or u + w > width_px + tol_px or v + h > height_px + tol_px
+
+
+#: Two objects' regions may overlap by at most this share of the smaller one: beyond it a tracker
+#: would latch onto the other object (``track init`` refuses such regions and merges such proposals).
+MAX_REGION_OVERLAP = 0.2
+
+
+def region_overlap(a, b) -> tuple[float, bool]:
+    """(overlap area px^2, whether it is more than :data:`MAX_REGION_OVERLAP` of the smaller region)
+    of two regions ``(u, v, w, h)`` (px)."""
+    ax, ay, aw, ah = (float(v) for v in a)
+    bx, by, bw, bh = (float(v) for v in b)
+    ix = max(0.0, min(ax + aw, bx + bw) - max(ax, bx))
+    iy = max(0.0, min(ay + ah, by + bh) - max(ay, by))
+    return ix * iy, ix * iy > MAX_REGION_OVERLAP * min(aw * ah, bw * bh)
 
 
 def look(gray, box):

@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..._errors import InputError
-from ._checks import region_leaves
+from ._checks import region_leaves, region_overlap
 from ...config import ObjectConfig, ReferenceConfig, TargetsConfig, TrackConfig, VideoConfig
 
 __all__ = ["DICTIONARIES", "MarkerFinding", "find_markers", "suggest_config", "parse_region"]
@@ -223,16 +223,13 @@ _REST_NOTE = (
 
 
 def _check_overlaps(objs) -> None:
-    """Two objects' regions may touch but not overlap by more than 20 % of the smaller: a tracker
-    would latch onto the other object."""
+    """Two objects' regions may touch but not overlap by more than 20 % of the smaller
+    (:func:`region_overlap`): a tracker would latch onto the other object."""
     for i, a in enumerate(objs):
         for b in objs[i + 1 :]:
-            ax, ay, aw, ah = a.roi
-            bx, by, bw, bh = b.roi
-            ix = max(0.0, min(ax + aw, bx + bw) - max(ax, bx))
-            iy = max(0.0, min(ay + ah, by + bh) - max(ay, by))
-            if ix * iy > 0.2 * min(aw * ah, bw * bh):
+            area, too_much = region_overlap(a.roi, b.roi)
+            if too_much:
                 raise InputError(
-                    f"objects {a.id!r} and {b.id!r}: their regions overlap by {ix * iy:.0f} px^2; "
+                    f"objects {a.id!r} and {b.id!r}: their regions overlap by {area:.0f} px^2; "
                     "draw each round its own object only"
                 )

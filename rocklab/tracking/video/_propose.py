@@ -28,6 +28,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ._checks import region_overlap
+
 __all__ = ["Proposals", "propose_objects", "moving_boxes", "find_table_below", "WORK_WIDTH_PX"]
 
 #: Frames are compared at this width at most (px): enough for boxes to a couple of pixels of the
@@ -102,14 +104,16 @@ def _box_gap(a, b) -> float:
     return math.hypot(dx, dy)
 
 
-def _merge(boxes, gap):
+def _merge(boxes, joined):
+    """Boxes (x, y, w, h) with every pair ``joined(a, b)`` says belongs together replaced by their
+    union, until no such pair is left."""
     boxes = [tuple(float(v) for v in b) for b in boxes]
     merged = True
     while merged:
         merged = False
         for i in range(len(boxes)):
             for j in range(i + 1, len(boxes)):
-                if _box_gap(boxes[i], boxes[j]) <= gap:
+                if joined(boxes[i], boxes[j]):
                     a, b = boxes[i], boxes.pop(j)
                     x0, y0 = min(a[0], b[0]), min(a[1], b[1])
                     x1, y1 = max(a[0] + a[2], b[0] + b[2]), max(a[1] + a[3], b[1] + b[3])
@@ -178,7 +182,7 @@ def moving_boxes(first_gray, samples, masks: bool = False) -> tuple[list, int]:
         if stats[i, 4] >= MIN_FRACTION * n_px and np.percentile(grad[labels == i], 95) >= floor
     ]
     merged = []
-    for m in _merge(boxes, gap=k):
+    for m in _merge(boxes, lambda a, b: _box_gap(a, b) <= k):
         if m[2] * m[3] <= MAX_FRACTION * n_px:
             merged.append(m)
         else:  # neighbours merged into most of the frame: each part is a proposal of its own
@@ -272,4 +276,13 @@ def propose_objects(first_gray, samples) -> Proposals:
         changed, scale = moving_boxes(first_gray, samples, masks=True)
         x, y, w, h = (int(round(v * scale)) for v in table)
         moves = any(float(m[y : y + max(h, 1), x : x + max(w, 1)].mean()) > 0.2 for m in changed)
+    # padded boxes of two moving things may overlap more than track init lets two regions: they
+    # become one proposal (the user sees it drawn and may split it), never a refused config
+    boxes = _merge(boxes, lambda a, b: region_overlap(a, b)[1])
+    if moves:  # the table is an object of its own: a block's box stops above the table's region
+        boxes = [
+            b if not region_overlap(b, table)[1] else (b[0], b[1], b[2], float(table[1] - b[1]))
+            for b in boxes
+            if not region_overlap(b, table)[1] or table[1] - b[1] >= MIN_SIDE_PX
+        ]
     return Proposals(tuple(boxes), table, edge, moves, len(samples), n_moving)

@@ -148,7 +148,7 @@ def test_bad_box_or_film_is_one_line_naming_the_object(roi, fill, words):
     assert words in str(e.value) and "\n" not in str(e.value)
 
 
-def _spinning_ball(n=180, W=320, H=240, R=22, fps=60.0, seed=0, shadow=0.25):
+def _spinning_ball(n=180, W=320, H=240, R=22, fps=60.0, seed=0, shadow=0.25, spin=0.6):
     """A ball swinging on a 300 px string while it spins about the string (0.6 turns/s): its
     lower half plain, its upper half dotted, the dots sliding across it as it turns; a soft
     shadow on the wall below it that moves against the ball as it swings. Frames (uint8) and the
@@ -169,7 +169,7 @@ def _spinning_ball(n=180, W=320, H=240, R=22, fps=60.0, seed=0, shadow=0.25):
         img = wall * (1 - shadow * cv2.GaussianBlur(shade, (0, 0), 6))
         nx, ny = (xx - cx) / R, (yy - cy) / R
         nz = np.sqrt(np.clip(1 - nx**2 - ny**2, 0, 1))
-        lon = np.arctan2(nx, nz) + 2 * np.pi * 0.6 * t
+        lon = np.arctan2(nx, nz) + 2 * np.pi * spin * t
         lat = np.arcsin(np.clip(-ny, -1, 1))
         dots = (np.sin(7 * lon) * np.sin(9 * lat + 0.5) > 0.35).astype(np.float32)
         ball = np.where(ny < -0.1, 200 - 120 * dots + 20 * np.cos(3 * lon), np.where(ny < 0.05, 235, 70 + 15 * nz))
@@ -220,18 +220,19 @@ def test_spinning_ball_is_never_ok_off_its_outline():
     assert d_unchecked.max() > 2 * lim  # the case does reproduce the slide
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("box", [(0, 0, 52), (-3, 2, 46), (4, -3, 60)])
 def test_a_spinning_ball_is_where_its_disk_is_not_where_its_texture_slid(box):
     """A ball's texture slides over it as it spins; its disk does not. Lit from the front (no
-    shadow joins its disk), boxes drawn round it off-centre and +-12 % in size: once the wall
-    behind its first region is seen, every ok frame lies within the tracker's allowance
-    (DISK_AGREE_FRAC of the box) + 1.5 px of the ball's centre, 3.1-3.6 px (2.6 px on the first two;
-    the texture point alone 3.6-4.7 px, at the outline check's limit), no frame lost."""
+    shadow joins its disk), boxes drawn round it off-centre and +-12 % in size, once the wall
+    behind its first region is seen: the disk's centre alone (no allowance for the texture) keeps
+    every ok frame within 2.5 px of the ball's centre, where the texture point alone strays more
+    than 3 px (3.6-4.7 px, at the outline check's limit); with the allowance every ok frame is
+    within DISK_AGREE_FRAC of the box + 1.5 px; no frame lost."""
     from unittest import mock
 
     from rocklab.tracking import assemble_tracks, track_frames
-    from rocklab.tracking.video.targets import _occlusion
-    from rocklab.tracking.video.targets._markerless import DISK_AGREE_FRAC
+    from rocklab.tracking.video.targets import _markerless, _occlusion
 
     frames, truth = _spinning_ball(shadow=0.0)
     dx, dy, side = box
@@ -241,19 +242,22 @@ def test_a_spinning_ball_is_where_its_disk_is_not_where_its_texture_slid(box):
         {"targets": {"style": "markerless"}, "reference": {"level": "none"}, "objects": [{"id": "ball", "roi": roi}]}
     )
 
-    def off_by(tr):
+    def off_by():
+        tr = assemble_tracks(track_frames(frames, cfg), cfg, 60.0, 320, 240)["ball"]
         p = np.column_stack((tr.x_px, tr.y_px))
         d = np.hypot(*(p - truth - np.nanmedian(p[tr.ok] - truth[tr.ok], axis=0)).T)
         known = np.arange(len(frames)) >= 0.3 * 60.0  # the wall behind the first region seen
-        return np.where(tr.ok & known, d, 0.0), tr.ok.mean()
+        return np.where(tr.ok & known, d, 0.0).max(), tr.ok.mean()
 
     with collecting():
-        d, ok = off_by(assemble_tracks(track_frames(frames, cfg), cfg, 60.0, 320, 240)["ball"])
+        d, ok = off_by()
+        with mock.patch.object(_markerless, "DISK_AGREE_FRAC", 0.0):
+            d_disk, _ = off_by()
         with mock.patch.object(_occlusion.OutlineRef, "disk_centre", lambda *a, **k: None):
-            d_texture, _ = off_by(assemble_tracks(track_frames(frames, cfg), cfg, 60.0, 320, 240)["ball"])
+            d_texture, _ = off_by()
     assert ok == 1.0
-    assert d.max() <= DISK_AGREE_FRAC * side + 1.5, d.max()
-    assert d_texture.max() > DISK_AGREE_FRAC * side + 1.5  # the texture alone does not keep to it
+    assert d_disk <= 2.5 < 3.0 < d_texture, (d_disk, d_texture)
+    assert d <= _markerless.DISK_AGREE_FRAC * side + 1.5, d
 
 
 def test_a_disk_is_found_with_its_clear_half_and_past_a_shadow_strip_joining_it():

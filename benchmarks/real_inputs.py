@@ -1,9 +1,11 @@
 """Real films, checked against an independent reference: frames ok, frames ok but wrong, boxes.
 
 For each real film: the markerless tracker (``track_video``) from a box drawn round the ball and
-from boxes perturbed round it (each side +-20 %, the centre +-10 %, seeded), against a colour
-script that knows nothing of the tracker (``tests/_blob.py``: the ball's blue half by an HSV
-threshold). Printed per film and box: frames, frames ok, frames ok but wrong (the tracked point
+from boxes perturbed round it (each side +-20 %, the centre +-10 %, seeded), against a script
+that knows nothing of the tracker (``tests/_blob.py``'s ``silhouette_track``: the ball's whole
+silhouette against the film's temporal median, in colour, and the smallest circle round it;
+checked against frames labelled by hand, see its module). ``--blue`` uses the older reference
+(the ball's blue half by an HSV threshold, 2.5-3.9 px off five of the nine hand labels). Printed per film and box: frames, frames ok, frames ok but wrong (the tracked point
 more than 1 % of the frame width off the reference, after the median offset), the status counts,
 the swing period from x_px against the reference's, and whether the ball's angle was flagged
 unmeasurable (W-TRACK-THETA) or how many ok frames report one.
@@ -16,7 +18,7 @@ so not shipped: put them in ``$ROCKLAB_FILMS``, default ``/tmp/verify-films``; s
 TrackLab's ``pendulumDrag.mp4`` (AGPL-3.0, not shipped; in ``$ROCKLAB_FILMS`` too) is checked
 against a bright blob on its black cloth instead (``tests/_blob.py``'s ``bright_blob_track``).
 
-Run: ``python benchmarks/real_inputs.py [n_boxes [part of a file name]]``.
+Run: ``python benchmarks/real_inputs.py [n_boxes [part of a file name]] [--blue]``.
 """
 
 from __future__ import annotations
@@ -30,7 +32,14 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 
-from _blob import blob_track, bright_blob_track, perturbed_boxes, swing_period_s, wrong_ok  # noqa: E402
+from _blob import (  # noqa: E402
+    blob_track,
+    bright_blob_track,
+    perturbed_boxes,
+    silhouette_track,
+    swing_period_s,
+    wrong_ok,
+)
 
 from rocklab._diagnostics import collecting  # noqa: E402
 from rocklab.config import TrackConfig
@@ -79,7 +88,7 @@ def run(path, box, ref, ref_scale):
     return len(tr.status), int(tr.ok.sum()), int(wrong.sum()), dict(zip(st.tolist(), cnt.tolist())), T, dt, theta
 
 
-def main(n_boxes=5, only=""):
+def main(n_boxes=5, only="", blue=False):
     for kind, path, box, *start in FILMS + BRIGHT_FILMS:
         if only not in path.name:
             continue
@@ -90,6 +99,8 @@ def main(n_boxes=5, only=""):
         ref, fps, w_cv = blob_track(path)
         if start:  # not the blue ball: the bright blob against the film's median
             ref = bright_blob_track(path, start[0])
+        elif not blue:  # large films are reduced to about 640 px for the median
+            ref = silhouette_track(path, scale=min(1.0, 640.0 / w_cv))[0]
         scale = np.array([info.width_px / w_cv, 1.0])  # non-square pixels: the tracker resamples
         T_ref = swing_period_s(np.arange(len(ref)) / fps, ref[:, 0])
         print(f"{kind} {path.name} ({info.width_px}x{info.height_px}): reference period {T_ref:.5f} s")
@@ -106,4 +117,5 @@ def main(n_boxes=5, only=""):
 
 
 if __name__ == "__main__":
-    main(int(sys.argv[1]) if len(sys.argv) > 1 else 5, sys.argv[2] if len(sys.argv) > 2 else "")
+    args = [a for a in sys.argv[1:] if a != "--blue"]
+    main(int(args[0]) if args else 5, args[1] if len(args) > 1 else "", "--blue" in sys.argv)

@@ -25,6 +25,10 @@ a point off the ball, and in the turned frame the ball's silhouette then matches
 that does turn, the image's frame places the pose within ``2 sin(turn / 2)`` times the distance
 from the template's centre to the silhouette's, a few percent of the object for a box drawn
 round it.)
+
+**Disk**: a round outline's centre (:func:`disk`: the smallest circle round the blob standing out
+of the background, its pale parts included; a disk of the object's radius matched to the window
+where a change of the wall joins the blob) is the position of a ball, whose texture slides.
 """
 
 from __future__ import annotations
@@ -42,6 +46,7 @@ __all__ = [
     "OutlineRef",
     "silhouette",
     "roundness",
+    "disk",
     "warp_grown",
 ]
 
@@ -164,6 +169,18 @@ OUTLINE_MARGIN_FRAC = 0.2
 #: Larger side of the template at which the outline is registered, px (a larger object is
 #: registered on a reduced copy: a pixel there is at most 1/40 of it, and sub-pixel peaks).
 OUTLINE_SIDE_PX = 40.0
+#: An outline at least this round (circularity of its hull: a disk 1, an ellipse of axes 3:2
+#: 0.93, 2:1 0.83, a square 0.785) is a disk: it tells no angle, and its centre is its position.
+ROUND_MIN = 0.9
+#: Largest change of a disk's radius from its first frame's for its centre to be taken, as a
+#: fraction of it (more, or a blob less round than :data:`ROUND_MIN`: a shadow, a hand or a
+#: change of the background joined it, and the texture's pose stands).
+DISK_RADIUS_TOL = 0.15
+#: The disk's blob (:func:`disk`) gives its centre when its circle lies within this fraction of the
+#: radius of the disk matched to the window (:func:`_disk_match`), which gives it otherwise.
+DISK_AGREE = 0.05
+#: Larger side of the window in which a disk's centre is measured, px (a larger window is reduced).
+DISK_SIDE_PX = 100.0
 #: Turns smaller than this leave the image's frame and the pose's nearly the same, rad: the
 #: silhouette's place moves by under 0.15 of its distance from the template's centre.
 TURN_SAME_RAD = 0.15
@@ -211,6 +228,79 @@ def roundness(sil) -> float:
     hull = cv2.convexHull(max(cs, key=cv2.contourArea)).astype(np.float32)
     area, per = cv2.contourArea(hull), cv2.arcLength(hull, True)
     return float(4 * math.pi * area / per**2) if area >= 20 else float("nan")
+
+
+#: A pixel is part of a round object's disk where it differs from the background by this fraction
+#: of the window's strongest differences (at least :data:`BG_TOL`): lower than :data:`FG_REL`, as a
+#: ball's clear or pale half stands out less than its coloured half; holes inside are filled.
+DISK_REL = 0.2
+#: The difference is smoothed first (px), and the mask closed (px: a clear half's pale gaps
+#: between the parts that stand out, the beads in it) and opened (px: a string or a thread
+#: hanging from the ball is no part of its disk), at the window's scale (:data:`DISK_SIDE_PX`).
+DISK_SMOOTH_PX = 1.5
+DISK_CLOSE_PX = 9
+DISK_OPEN_PX = 5
+
+
+def disk(patch, bg):
+    """The largest blob standing out of ``bg`` in ``patch`` (:data:`DISK_REL`, holes filled, thin
+    parts opened away): its smallest enclosing circle's centre (x, y) px in ``patch``, radius px,
+    and the circularity of its hull (:func:`roundness`); None when nothing stands out.
+
+    A ball's outline does not slide as its texture does: the centre of its disk is the position
+    it tells (its texture slides over it as it spins).
+
+    >>> yy, xx = np.mgrid[0:80, 0:80]
+    >>> ball = np.where((xx - 41.5) ** 2 + (yy - 37) ** 2 < 18**2, 60.0, 150.0).astype(np.float32)
+    >>> ball[30:40, 30:50] = 148.0  # a clear part that hardly stands out
+    >>> (c, r, circ) = disk(ball, np.full((80, 80), 150.0, np.float32))
+    >>> bool(np.hypot(c[0] - 41.5, c[1] - 37) < 1.0 and abs(r - 18) < 1.5 and circ > 0.9)
+    True
+    """
+    import cv2
+
+    d = cv2.GaussianBlur(cv2.absdiff(np.asarray(patch, np.float32), np.asarray(bg, np.float32)), (0, 0), DISK_SMOOTH_PX)
+    flat = d[::2, ::2].ravel()
+    k = int(0.98 * (flat.size - 1))
+    hi = float(np.partition(flat, k)[k])
+    lo = max(BG_TOL, DISK_REL * hi)
+    if hi <= lo:
+        return None
+    m = (d > lo).astype(np.uint8)
+    for op, size in ((cv2.MORPH_CLOSE, DISK_CLOSE_PX), (cv2.MORPH_OPEN, DISK_OPEN_PX)):
+        m = cv2.morphologyEx(m, op, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (size, size)))
+    cs, _ = cv2.findContours(m, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)
+    if not cs:
+        return None
+    c = max(cs, key=cv2.contourArea)
+    hull = cv2.convexHull(c).astype(np.float32)
+    area, per = cv2.contourArea(hull), cv2.arcLength(hull, True)
+    if area < 20:
+        return None
+    (x, y), r = cv2.minEnclosingCircle(c)
+    return np.array([x, y]), float(r), float(4 * math.pi * area / per**2)
+
+
+def _disk_match(patch, bg, r):
+    """Centre (x, y) px in ``patch`` of a disk of radius ``r`` px matched by normalised correlation
+    to how far each pixel stands out of ``bg`` (0 below :data:`DISK_REL` of the strongest
+    differences, 1 at them): a shadow or a change of the wall that joins the object's blob moves
+    the match little; None when nothing stands out or the window is smaller than the disk."""
+    import cv2
+
+    d = cv2.GaussianBlur(cv2.absdiff(np.asarray(patch, np.float32), np.asarray(bg, np.float32)), (0, 0), DISK_SMOOTH_PX)
+    flat = d[::2, ::2].ravel()
+    k = int(0.98 * (flat.size - 1))
+    hi = float(np.partition(flat, k)[k])
+    lo = max(BG_TOL, DISK_REL * hi)
+    R = int(round(r))
+    if hi <= lo or R < 2 or min(d.shape) <= 2 * R + 1:
+        return None
+    kern = np.zeros((2 * R + 1, 2 * R + 1), np.float32)
+    cv2.circle(kern, (R, R), R, 1.0, -1)
+    res = cv2.matchTemplate(np.clip((d - lo) * (1.0 / (hi - lo)), 0.0, 1.0), kern, cv2.TM_CCOEFF_NORMED)
+    pk, val = _peak(res)
+    return pk + R if math.isfinite(val) else None
 
 
 def _peak(res):
@@ -266,6 +356,15 @@ class OutlineRef:
             self.ref = silhouette(a, b)
         #: the outline's roundness (:func:`roundness`), NaN without an outline
         self.roundness = roundness(self.ref)
+        #: the object's disk in the first frame (:func:`disk`): centre (first-frame px), radius px;
+        #: None unless it is round (then its position is its disk's centre, not a texture point)
+        self.disk0 = None
+        d = disk(first[y0:y1, x0:x1], bg[y0:y1, x0:x1]) if self.ref is not None else None
+        if d is not None:
+            # a pale part of a ball that the outline's threshold drops is part of its disk
+            self.roundness = max(self.roundness, d[2]) if math.isfinite(self.roundness) else d[2]
+            if d[2] >= ROUND_MIN:
+                self.disk0 = (d[0] + (x0, y0), d[1])
 
     def locate(self, tr, frame, bg, W, grown=None):
         """Register the outline round the pose ``W`` (first-frame px -> image px).
@@ -328,6 +427,28 @@ class OutlineRef:
                 pose[:, 2] += Wc[:, :2] @ shift
                 worst = (slide, cc, pose.astype(np.float32))
         return worst
+
+    def disk_centre(self, tr, W, grown):
+        """The object's disk centre in the image (px, (2,)) from ``grown`` (frame, background)
+        resampled by the pose ``W`` onto the template's grid grown by twice :attr:`margin`;
+        None for an object that is not a disk, or a disk whose size changed (a shadow or a
+        hand joined it)."""
+        if self.disk0 is None:
+            return None
+        back, bgw = grown
+        f = min(1.0, DISK_SIDE_PX / max(back.shape))
+        if f < 1.0:
+            back, bgw = _reduce(back, f), _reduce(bgw, f)
+        r0 = self.disk0[1] * f
+        c = _disk_match(back, bgw, r0)
+        if c is None:
+            return None
+        d = disk(back, bgw)
+        if d is not None and abs(d[1] - r0) <= DISK_RADIUS_TOL * r0 and np.hypot(*(d[0] - c)) <= DISK_AGREE * r0:
+            c = d[0]  # the blob is the disk alone: its circle is finer than the match
+        p = c / f - 2 * self.margin + tr.origin  # first-frame px under the pose
+        Wd = np.asarray(W, float)
+        return Wd[:, :2] @ p + Wd[:, 2]
 
     def moved(self, found):
         """Whether a :meth:`locate` result says the pose has left the object."""

@@ -27,7 +27,13 @@ and, for the outline, its own first frame:
   texture, or a keyframe renewed over a still edge of the wall, lets the pose slide off the
   object while every correlation stays high. The pose moved onto the outline is where the
   object is searched for first (and verified like any other pose); the motion checks forget
-  the poses of the slide.
+  the poses of the slide. The outline is learned as soon as the template has left the user's
+  region (the first frame round it as its background: the region is drawn round the object),
+  and again once the region grown by the outline's margin is seen; a disk's centre stays where
+  it was first placed.
+* **disk** (not a check: the position a ball reports): for a round outline, the centre of the
+  object's disk against the background (:meth:`._occlusion.OutlineRef.disk_centre`), kept in
+  :attr:`PoseVerifier.disk_at` for the tracker.
 
 A frame that fails is lost with that reason; only verified frames renew the keyframe and teach
 the limits, so a wrong lock cannot teach the tracker to accept itself.
@@ -105,10 +111,13 @@ class PoseVerifier:
         self.margin = int(math.ceil(OUTLINE_MARGIN_FRAC * max(size)))
         self.outline = None  # the object's outline in the user's region, once its background is known
         self.hint = None  # a pose that failed the outline, moved onto the outline
+        #: a round object's disk centre in the last frame verified (image px), or None
+        self.disk_at = None
         H, W = first_gray.shape[:2]
         m = self.margin
         self.outer = (max(box[0] - m, 0), max(box[1] - m, 0), min(box[2] + m, W), min(box[3] + m, H))
         self.filled = False  # the first region's background seen (the object has left it)
+        self.early = False  # the user's region's background seen (the template has left it)
         #: the first region's background taken from the median of lost frames (the check applies
         #: there; the outline is learned only from a verified frame)
         self.first_known = False
@@ -214,9 +223,12 @@ class PoseVerifier:
         top = float(np.percentile(self.speeds, 99)) if self.speeds else 0.0
         return max(3.0 * top, 0.1 * max(self.size))
 
-    def accept(self, score, centre, pred, last, gap, gray=None, footprint=None):
+    def accept(self, score, centre, pred, last, gap, gray=None, footprint=None, tight=None):
         """Learn from a verified frame: its correlation, its residual, its speed, and (once the
-        object has left its first region) the background there."""
+        object has left its first region) the background there: the user's region as soon as the
+        template's footprint (``tight``: its bounding box under the pose) has left it, the region
+        grown by the outline's margin once ``footprint`` (a square that holds it at any turn)
+        has left that."""
         self.n_verified += 1
         self.scores.append(float(score))
         if pred is not None and gap == 1:
@@ -229,6 +241,12 @@ class PoseVerifier:
             if x1 < u0 or x0 > u1 or y1 < v0 or y0 > v1:  # the grown first region is uncovered now
                 self.bg[v0:v1, u0:u1] = gray[v0:v1, u0:u1]
                 self.filled = True
+        if gray is not None and tight is not None and not (self.filled or self.early):
+            x0, y0, x1, y1 = tight
+            u0, v0, u1, v1 = self.box
+            if x1 < u0 or x0 > u1 or y1 < v0 or y0 > v1:  # the user's region is: the first frame round it
+                self.bg[v0:v1, u0:u1] = gray[v0:v1, u0:u1]
+                self.early = True
 
     def lost_frame(self, gray, frame, min_cc):
         """Learn from a frame in which the object was lost: from then on every frame's first
@@ -266,9 +284,17 @@ class PoseVerifier:
         self.first_known = True
 
     def learn_outline(self):
-        """Once the background is known: the object's outline in the user's region."""
-        if self.filled and self.outline is None:
-            self.outline = OutlineRef(self.first, self.bg, self.box)
+        """Once the background is known: the object's outline in the user's region, first with
+        the first frame as the background round the region (the region drawn round the object),
+        again once the grown region is seen (a region drawn smaller than the object). A disk's
+        centre stays where it was first placed: it is the point the track reports."""
+        if self.first is None or not (self.filled or self.early) or (self.outline is not None and not self.filled):
+            return
+        ref = OutlineRef(self.first, self.bg, self.box)
+        if self.outline is not None and self.outline.disk0 is not None and ref.disk0 is not None:
+            ref.disk0 = self.outline.disk0
+        self.outline = ref
+        if self.filled:
             self.first = None  # needed no more
 
     # -- with a tracker ----------------------------------------------------------------
@@ -292,10 +318,10 @@ class PoseVerifier:
         if self.since_lost:  # what stands in the first region now, the frame checked included
             self._sample(gray, frame, tr.min_cc)
         bg = back = known = bg_g = back_g = None
-        self.hint = None
+        self.hint = self.disk_at = None
         # the background is known where the first frame did not show the object, and everywhere
         # once the object has left its first region: only then is the check worth its two warps
-        if self.filled or self.first_known or self._clear(centre):
+        if self.filled or self.early or self.first_known or self._clear(centre):
             m = 2 * self.margin
             bg_g, back_g = warp_grown(tr, self.bg, W, m), warp_grown(tr, gray, W, m)
             if bg_g is not None and back_g is not None:
@@ -312,6 +338,8 @@ class PoseVerifier:
             if found is not None and self.outline.moved(found):
                 # the poses since the last frame checked here were the slide: no anchor for motion
                 reason, self.hint, self.recent = "drift", found[2], []
+            elif found is not None:
+                self.disk_at = self.outline.disk_centre(tr, W, (back_g, bg_g))
         self._pending = (float(score), centre, theta, pred, last2, gap, frame)
         return reason
 
@@ -358,7 +386,18 @@ class PoseVerifier:
         w, h = size
         half = 0.5 * math.hypot(w, h)
         footprint = (centre[0] - half, centre[1] - half, centre[0] + half, centre[1] + half)
-        self.accept(score, centre, pred, last, gap, gray, footprint)
+        c, s = abs(math.cos(theta)), abs(math.sin(theta))
+        hx, hy = 0.5 * (c * w + s * h), 0.5 * (s * w + c * h)
+        self.accept(
+            score,
+            centre,
+            pred,
+            last,
+            gap,
+            gray,
+            footprint,
+            (centre[0] - hx, centre[1] - hy, centre[0] + hx, centre[1] + hy),
+        )
         self.recent = (self.recent + [(centre, theta, frame)])[-2:]
 
 

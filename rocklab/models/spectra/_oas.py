@@ -89,6 +89,10 @@ OAS_DEFAULTS = dict(
 )
 
 CRIT = {"angle": 0, "fall": 1}
+#: Integrators of the OAS runs (``method``).
+METHODS_OAS = ("newmark", "taylor")
+#: Largest p h of a Taylor step (``method="taylor"``): the order adapts to it.
+TAYLOR_P_H = 0.25
 _GOLDEN = 0.5 * (math.sqrt(5.0) - 1.0)
 
 
@@ -269,6 +273,7 @@ def overturning_spectrum(
     grid: str = "adaptive",
     verdicts: OASResult | None = None,
     guide: OASResult | None = None,
+    method: str = "newmark",
 ) -> OASResult:
     """OAS, transformed OAS, t_I, t'_I and beta of a record for one block slenderness.
 
@@ -316,6 +321,10 @@ def overturning_spectrum(
     guide : OASResult, optional
         For ``grid="boundary"``: an OAS of the same record whose boundary is
         close to this one's (e.g. the default grid for a shifted or coarser one).
+    method : {"newmark", "taylor"}
+        Integrator of the runs (:func:`~rocklab.models.simulate_batch`): ``"newmark"`` steps of
+        ``p h <= max_p_dt``; ``"taylor"`` a Taylor step per record interval (``p h <= 0.25``, order
+        from ``p h``, truncation below 1e-16; no ``max_p_dt``), events as roots of the series.
 
     Returns
     -------
@@ -332,13 +341,10 @@ def overturning_spectrum(
     """
     sl = check_opts(slenderness, levels, sizes, R_max_m, R_min_m, level_max, alpha_I)
     base = _checked_record(base, levels, sizes)
-    _check_choices(criterion, search, grid, guide)
+    _check_choices(criterion, search, grid, guide, method)
+    _check_steps(level_offset, size_offset, max_p_dt)
     free_code, free_s = free_after_code(free)
     alpha, eta_v = _block_restitution(sl, alpha_I, eta)
-    if not (0.0 <= float(level_offset) < 1.0 and 0.0 <= float(size_offset) < 1.0):
-        raise InputError(f"level_offset={level_offset!r}, size_offset={size_offset!r}: fractions of a step in [0, 1)")
-    if not (math.isfinite(max_p_dt) and 0 < max_p_dt <= 0.5):
-        raise InputError(f"max_p_dt={max_p_dt!r}: step times p must be in (0, 0.5]")
     opts = dict(
         levels=int(levels),
         level_max=float(level_max),
@@ -353,10 +359,11 @@ def overturning_spectrum(
         level_offset=float(level_offset),
         size_offset=float(size_offset),
         grid=grid,
+        **({} if method == "newmark" else {"method": method}),  # earlier results' options stay comparable
     )
     lv, R, p = _grid_axes(opts, alpha_I)
     scales = lv * math.tan(alpha) * G / base.pga_m_s2  # record scaled to a_p = level g tan(alpha)
-    args = (alpha, eta_v, CRIT[criterion], free_code, free_s, float(max_p_dt))
+    args = (alpha, eta_v, CRIT[criterion], free_code, free_s, max_p_dt if method == "newmark" else TAYLOR_P_H, method)
     if verdicts is not None:
         over, evaluated = _reused_verdicts(verdicts, opts, (eta_v, alpha, float(alpha_I)), base.name)
     else:
@@ -385,8 +392,20 @@ def _checked_record(base, levels, sizes):
     return base
 
 
-def _check_choices(criterion, search, grid, guide):
+def _check_steps(level_offset, size_offset, max_p_dt):
+    """Grid offsets are fractions of a step and the Newmark step is in range."""
+    if not (0.0 <= float(level_offset) < 1.0 and 0.0 <= float(size_offset) < 1.0):
+        raise InputError(f"level_offset={level_offset!r}, size_offset={size_offset!r}: fractions of a step in [0, 1)")
+    if not (math.isfinite(max_p_dt) and 0 < max_p_dt <= 0.5):
+        raise InputError(f"max_p_dt={max_p_dt!r}: step times p must be in (0, 0.5]")
+
+
+def _check_choices(criterion, search, grid, guide, method="newmark"):
     """The OAS's definition choices are among the known ones (module docstring)."""
+    if method not in METHODS_OAS:
+        raise InputError(
+            f"method={method!r}: use 'newmark' (trapezoidal steps) or 'taylor' (series per record interval)"
+        )
     if criterion not in CRIT:
         raise InputError(f"criterion={criterion!r}: use 'angle' (|theta|>=alpha) or 'fall' (|theta|>=pi/2)")
     if search not in ("scan", "contiguous"):
@@ -517,8 +536,13 @@ def _guess_first(guide, lv, p):
 
 
 def batch_runs(base, scale, p, args):
-    """Overturned flags of independent runs (``base`` times ``scale``, blocks ``p``) by ``simulate_batch``."""
-    alpha, eta, crit, free_code, free_s, max_p_dt = args
+    """Overturned flags of independent runs (``base`` times ``scale``, blocks ``p``) by ``simulate_batch``.
+
+    ``args`` = (alpha rad, eta, criterion code, free code, free s, max p h[, method[, taylor_tol]]).
+    """
+    alpha, eta, crit, free_code, free_s, max_p_dt = args[:6]
+    method = args[6] if len(args) > 6 else "newmark"
+    tol = args[7] if len(args) > 7 else 1e-16
     # neighbouring grid points cost alike and the parallel loop hands each thread one contiguous
     # chunk: a golden-ratio interleave spreads the long runs over both (1.6x -> 1.9x on 2 cores)
     p = np.broadcast_to(np.asarray(p, float), np.shape(scale))
@@ -533,6 +557,8 @@ def batch_runs(base, scale, p, args):
         free_after_s=free_s if free_code == 2 else 0.0,
         fall_rad=alpha if crit == 0 else None,
         max_p_dt=max_p_dt,
+        method=method,
+        taylor_tol=tol,
     )
     over = np.asarray(b.overturned, bool)
     if free_code == 1:

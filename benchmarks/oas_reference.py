@@ -12,7 +12,8 @@ measured against it on the decided (neither chaotic nor unresolved) cells:
 
 Prints per record: cells, chaotic fraction, unresolved cells, agreement of each path
 (target >= 99.5 %), t_I of the reference and of each path (s), and the wall time of each
-(the machine may be loaded: compare within a row only).
+(the machine may be loaded: compare within a row only); under a record, for each path whose
+t_I differs from the reference's by more than 0.5 %, the differing cells behind it.
 
 Records: the five in ``../shared/data/records`` (FEMA P695 FF-1, FF-2 and three AT2 files);
 pass a folder of the 44 ``SortedEQFile_1xxxxx.txt`` FEMA far-field records (see
@@ -75,6 +76,30 @@ def _reference(rid, b):
     return out
 
 
+def _why(o, over, decided, t_I_ref):
+    """Where a path's t_I differs from the reference's by more than 0.5 %: the cells behind it.
+
+    t_I rests on one boundary point; at the levels whose first unsafe size sets the path's or the
+    reference's leftmost f, the cells where the two verdict maps differ are named with their kind:
+    chaotic/unresolved in the reference, decided (an integrator error), or filled by the adaptive grid.
+    """
+    if not (np.isfinite(o.t_I_s) and np.isfinite(t_I_ref)) or abs(o.t_I_s / t_I_ref - 1) < 0.005:
+        return ""
+    first = np.where(over.any(axis=1), over.argmax(axis=1), over.shape[1] - 1)
+    f_ref = o.levels * o.p_rad_s[first]
+    rows = {int(np.nanargmin(o.f_rad_s)), int(np.argmin(f_ref))}
+    out = []
+    for i in sorted(rows):
+        for j in np.flatnonzero(o.overturned[i] != over[i]):
+            if j > max(first[i], np.argmax(o.overturned[i])):
+                continue  # beyond both boundaries: not behind t_I
+            kind = "chaotic" if not decided[i, j] else "decided"
+            if o.evaluated is not None and not o.evaluated[i, j]:
+                kind += ", filled"
+            out.append(f"L{o.levels[i]:.2f}/R{o.R_m[j]:.3g}:{kind}")
+    return " ".join(out) if out else "bisection inside the boundary cell"
+
+
 def main(folder: Path | None) -> int:
     recs = _records(folder)
     if not recs:
@@ -87,7 +112,7 @@ def main(folder: Path | None) -> int:
     worst = {k: 1.0 for k in PATHS}
     for rid, b in recs:
         over, decided, chaos, unres, t_I_ref, t_ref = _reference(rid, b)
-        cells = []
+        cells, whys = [], []
         for k, kw in PATHS.items():
             t0 = time.perf_counter()
             o = overturning_spectrum(b, 12, **kw)
@@ -95,13 +120,20 @@ def main(folder: Path | None) -> int:
             a = float(np.mean(o.overturned[decided] == over[decided]))
             worst[k] = min(worst[k], a)
             cells.append(f" {'':>8} {100 * a:6.2f} {o.t_I_s:6.4f} {dt:6.2f}")
+            why = _why(o, over, decided, t_I_ref)
+            if why:
+                whys.append(f"    {k}: t_I {o.t_I_s:.4f} vs {t_I_ref:.4f}: {why}")
         print(
             f"{rid:<10} {b.duration_s:6.1f} {over.size:6d} {100 * chaos:7.2f} "
             f"{unres:5d} {t_I_ref:8.4f} {t_ref:6.1f}" + "".join(cells),
             flush=True,
         )
+        for w in whys:
+            print(w)
     print("worst agreement on decided cells: " + ", ".join(f"{k} {100 * v:.2f} %" for k, v in worst.items()))
-    print("(agree: % of the cells neither chaotic nor unresolved; times in s on a possibly loaded machine)")
+    print("(agree: % of the cells neither chaotic nor unresolved; times in s on a possibly loaded machine;")
+    print(" indented: where a path's t_I differs from the reference's by > 0.5 %, the cells at the levels behind it")
+    print(" whose verdicts differ, by level a_p/a_p,min and size R m: chaotic/decided in the reference, filled)")
     return 0
 
 

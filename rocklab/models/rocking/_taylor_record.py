@@ -14,8 +14,9 @@ fall like ``(p h)^k / k!``), so the truncation error is below a tolerance chosen
 caller. Events are roots of the step's polynomial, not of a discretisation:
 
 - impact: ``theta(tau) = 0`` (Newton, bracketed), then the restitution;
-- overturning: ``|theta| = fall_rad`` outward, also at an apex between the samples
-  where the sign of ``theta`` is checked (``omega = 0`` found as a root);
+- overturning: ``|theta| = fall_rad`` outward, also at an apex inside the step (where omega
+  changes sign over a step, its root is the turning point, and a trough at the corner is an
+  impact inside the step);
 - uplift from rest: ``|ug| = tan(alpha)`` on the linear interval, in closed form.
 
 Same rest and overturning rules as the Newmark batch kernel
@@ -34,13 +35,12 @@ import numpy as np
 from numba import njit, prange
 
 from ...blocks import G
+from ._newmark_lean import sdcd
 
-__all__ = ["run_taylor_record", "order_for", "MAX_ORDER", "N_SAMPLES"]
+__all__ = ["run_taylor_record", "order_for", "MAX_ORDER"]
 
 #: Highest order a step may use.
 MAX_ORDER = 40
-#: Points per step where the side of ``theta`` is checked (a root is searched between them).
-N_SAMPLES = 4
 
 _ROCKING, _REST, _OVERTURNED, _NO_UPLIFT = 0, 1, 2, 3
 
@@ -87,25 +87,31 @@ def _dpoly(a, n, x):
     return v
 
 
-@njit(cache=True, fastmath={"contract"})
-def _coefficients(a, S, C, th, w, s, p2, alpha, u0, du, n):
-    """Taylor coefficients a[0..n] of theta about (th, w) on side s with ug = u0 + du tau."""
+#: 1/k and 1/((k+1)(k+2)): multiplications instead of divisions in the recurrence's dependency chain.
+_INV_K = np.array([0.0] + [1.0 / k for k in range(1, MAX_ORDER + 1)])
+_INV_K12 = np.array([1.0 / ((k + 1) * (k + 2)) for k in range(MAX_ORDER + 1)])
+
+
+@njit(cache=True, fastmath={"contract"}, error_model="numpy")
+def _coefficients(a, S, C, th, w, p2, sc0, cc0, u0, du, n):
+    """Taylor coefficients a[0..n] of theta about (th, w) with ug = u0 + du tau; sc0, cc0 = sin, cos of
+    c = alpha s - th."""
     a[0] = th
     a[1] = w
-    c0 = alpha * s - th
-    S[0] = math.sin(c0)
-    C[0] = math.cos(c0)
-    a[2] = -0.5 * p2 * (S[0] + u0 * C[0])
+    S[0] = sc0
+    C[0] = cc0
+    a[2] = -0.5 * p2 * (sc0 + u0 * cc0)
     for k in range(1, n - 1):
         ss = 0.0
         cc = 0.0
         for j in range(1, k + 1):
-            jc = -j * a[j]  # c_j = -theta_j for j >= 1
-            ss += jc * C[k - j]
-            cc -= jc * S[k - j]
-        S[k] = ss / k
-        C[k] = cc / k
-        a[k + 2] = -p2 * (S[k] + u0 * C[k] + du * C[k - 1]) / ((k + 1) * (k + 2))
+            jc = j * a[j]  # c_j = -theta_j for j >= 1
+            ss -= jc * C[k - j]
+            cc += jc * S[k - j]
+        ik = _INV_K[k]
+        S[k] = ss * ik
+        C[k] = cc * ik
+        a[k + 2] = -p2 * _INV_K12[k] * (S[k] + u0 * C[k] + du * C[k - 1])
 
 
 @njit(cache=True, fastmath={"contract"})
@@ -132,44 +138,48 @@ def _root(a, n, lo, hi, target, s):
 
 
 @njit(cache=True, fastmath={"contract"})
-def _step_event(a, da, n, h, th, w, s, fall_rad):
+def _turn(a, da, n, lo, hi, s):
+    """Where omega = 0 between lo and hi (s*omega > 0 at lo, <= 0 at hi; or the reverse): the root of
+    the derivative series ``da`` (filled here from ``a``)."""
+    for j in range(n):
+        da[j] = (j + 1) * a[j + 1]
+    if s * _poly(da, n - 1, lo) > 0.0:
+        return _root(da, n - 1, lo, hi, 0.0, s)
+    return _root(da, n - 1, lo, hi, 0.0, -s)
+
+
+@njit(cache=True, fastmath={"contract"})
+def _step_event(a, da, n, h, th, w, s, fall_rad, y_h, w_h):
     """First event of one step's polynomial on (0, h]: (kind, tau); kind 0 none, 1 impact, 2 fall.
 
-    ``s*theta`` is checked at N_SAMPLES points; a fall at an apex between two of them is found
-    through the root of omega (``da``: the derivative's coefficients).
+    ``y_h``, ``w_h``: s*theta and s*omega at h. Where omega keeps its sign over the step theta is
+    monotone and only the ends matter; where it changes sign, the turning point (a root of omega)
+    is checked too: an apex beyond ``fall_rad``, or a trough at or below 0 (an impact inside the step).
     """
-    t_prev = 0.0
-    y_prev = s * th
-    w_prev = s * w
-    for i in range(1, N_SAMPLES + 1):
-        t_i = h * i / N_SAMPLES
-        y = s * _poly(a, n, t_i)
-        w_i = s * _dpoly(a, n, t_i)
-        if y >= fall_rad:
-            return 2, _root(a, n, t_prev, t_i, -fall_rad, -s)
-        if w_prev > 0.0 and w_i < 0.0 and y > 0.0:
-            t_top = _root(da, n - 1, t_prev, t_i, 0.0, s)
-            if s * _poly(a, n, t_top) >= fall_rad:
-                return 2, _root(a, n, t_prev, t_top, -fall_rad, -s)
-        if y <= 0.0:
-            lo = t_prev
-            if y_prev <= 0.0:
-                # leaving the corner (theta = 0 at the start): find where s*theta is positive
-                lo = t_i
-                found = False
-                for _ in range(80):
-                    lo *= 0.5
-                    if s * _poly(a, n, lo) > 0.0:
-                        found = True
-                        break
-                if not found:
-                    return 1, 0.0
-                # s*theta may dip below zero earlier than lo: it rose from 0 at tau = 0, so the
-                # first root after lo is the impact
-            return 1, _root(a, n, lo, t_i, 0.0, s)
-        t_prev = t_i
-        y_prev = y
-        w_prev = w_i
+    w0 = s * w
+    if y_h >= fall_rad:
+        return 2, _root(a, n, 0.0, h, -fall_rad, -s)
+    if y_h <= 0.0:
+        if w0 > 0.0:
+            # up and back down within the step: the apex may pass fall_rad, the impact lies after it
+            top = _turn(a, da, n, 0.0, h, s)
+            y_top = s * _poly(a, n, top)
+            if y_top >= fall_rad:
+                return 2, _root(a, n, 0.0, top, -fall_rad, -s)
+            if y_top <= 0.0:
+                return 1, 0.0  # never left the corner
+            return 1, _root(a, n, top, h, 0.0, s)
+        if th == 0.0:
+            return 1, 0.0  # at the corner and not leaving it
+        return 1, _root(a, n, 0.0, h, 0.0, s)
+    if w0 > 0.0 and w_h < 0.0:
+        top = _turn(a, da, n, 0.0, h, s)
+        if s * _poly(a, n, top) >= fall_rad:
+            return 2, _root(a, n, 0.0, top, -fall_rad, -s)
+    elif w0 < 0.0 and w_h > 0.0:
+        low = _turn(a, da, n, 0.0, h, s)
+        if s * _poly(a, n, low) <= 0.0:
+            return 1, _root(a, n, 0.0, low, 0.0, s)
     return 0, h
 
 
@@ -232,6 +242,11 @@ def run_one(p, alpha, eta, scale, th0, w0, acc, t0, dta, duration, order, max_p_
     max_abs = abs(th)
     t = 0.0
     n_acc = acc.shape[0]
+    sin_a = math.sin(alpha)
+    cos_a = math.cos(alpha)
+    sc = math.sin(alpha * s - th)
+    cc = math.cos(alpha * s - th)
+    n_steps = 0
     for k in range(-1, n_acc):
         ta, L, u_a, du = _segment(k, acc, t0, dta, duration, fac)
         if L <= 0.0:
@@ -265,23 +280,40 @@ def run_one(p, alpha, eta, scale, th0, w0, acc, t0, dta, duration, order, max_p_
                 s = -1.0 if ud > 0.0 else 1.0
                 th = 0.0
                 w = 0.0
+                sc = s * sin_a
+                cc = cos_a
                 stall += 1
                 if stall > 50:  # grazing the uplift level without leaving: stay at rest this segment
                     resting = True
                     tl = L
                 continue
             h = min(h_sub * (1.0 + 1e-12), L - tl)
-            _coefficients(a, S, C, th, w, s, p2, alpha, u0, du, n)
-            for j in range(n):
-                da[j] = (j + 1) * a[j + 1]
-            kind, tau = _step_event(a, da, n, h, th, w, s, fall_rad)
+            n_steps += 1
+            if (n_steps & 31) == 0:  # re-anchor the carried sin/cos against rounding drift
+                sc = math.sin(alpha * s - th)
+                cc = math.cos(alpha * s - th)
+            _coefficients(a, S, C, th, w, p2, sc, cc, u0, du, n)
+            y_h = s * _poly(a, n, h)
+            w_h = s * _dpoly(a, n, h)
+            kind, tau = _step_event(a, da, n, h, th, w, s, fall_rad, y_h, w_h)
             if t_over != t_over and fall_rad > alpha:
-                kind_a, tau_a = _step_event(a, da, n, h, th, w, s, alpha)
+                kind_a, tau_a = _step_event(a, da, n, h, th, w, s, alpha, y_h, w_h)
                 if kind_a == 2:
                     t_over = ta + tl + tau_a
-            th_n = _poly(a, n, tau)
-            w_n = _dpoly(a, n, tau)
             if kind == 0:
+                th_n = s * y_h
+                w_n = s * w_h
+            else:
+                th_n = _poly(a, n, tau)
+                w_n = _dpoly(a, n, tau)
+            if kind == 0:
+                d = th_n - th
+                if abs(d) < 0.2:
+                    sd, cd = sdcd(d)  # c = alpha s - theta falls by d
+                    sc, cc = sc * cd - cc * sd, cc * cd + sc * sd
+                else:
+                    sc = math.sin(alpha * s - th_n)
+                    cc = math.cos(alpha * s - th_n)
                 th = th_n
                 w = w_n
                 tl += tau
@@ -317,9 +349,13 @@ def run_one(p, alpha, eta, scale, th0, w0, acc, t0, dta, duration, order, max_p_
                     w_p = 0.0
                 s = s_base
                 w = w_p
+                sc = s * sin_a
+                cc = cos_a
                 continue
             s = 1.0 if w_p > 0.0 else -1.0
             w = w_p
+            sc = s * sin_a
+            cc = cos_a
         if status != _ROCKING:
             break
     if status == _OVERTURNED:

@@ -341,7 +341,9 @@ def run_one(p, alpha, eta, scale, th0, w0, acc, t0, dta, duration, order, max_p_
             u_i = u_a + du * tl
             s_base = (-1.0 if u_i > 0.0 else 1.0) if abs(u_i) > tan_a else 0.0
             if w_p * w_p <= rest_w2 or stall > 50:
-                if s_base == 0.0:
+                if s_base == 0.0 or stall > 50:
+                    # at rest; or held at the uplift level without leaving the corner (the base
+                    # grazes tan(alpha)): at rest too, and the resting branch ends the segment
                     resting = True
                     w = 0.0
                     continue

@@ -116,3 +116,20 @@ def test_agreement_needs_the_same_grid_and_batch_method_is_checked(shaking, ref)
         ref.agreement(overturning_spectrum(shaking, 5.0, levels=4, sizes=5))
     with pytest.raises(InputError, match="method"):
         simulate_batch(1.0, 0.2, theta0_rad=0.1, duration_s=1.0, method="rk4")
+
+
+@pytest.mark.parametrize("eps", [1e-12, 1e-6, 1e-3])
+def test_taylor_batch_grazing_uplift_comes_to_rest_like_newmark(eps):
+    # two 1 g spikes scaled to tan(alpha) (1 + eps): the base barely lifts the block at each, so a
+    # run sits at the uplift level without leaving the corner; it must end at rest, as Newmark's
+    al = math.atan(1 / 12)
+    a = np.zeros(50)
+    a[10], a[30] = 1.0, -1.0
+    base = BaseMotion.from_samples(a, 0.01, "g")
+    p = np.array([0.5, 2.0, 8.0])
+    kw = dict(base=base, scale=math.tan(al) * (1 + eps), fall_rad=al)
+    tay = simulate_batch(p, al, method="taylor", **kw)
+    nm = simulate_batch(p, al, dt_s=0.01, max_p_dt=1e-4, **kw)
+    assert tay.status.tolist() == nm.status.tolist() == [1, 1, 1]
+    assert tay.n_impacts.tolist() == nm.n_impacts.tolist() == [2, 2, 2]
+    assert np.all(tay.max_abs_theta_over_alpha < 1e-10)

@@ -32,8 +32,9 @@ VARIANTS = [
     ("refine=0", {"refine": 0}),
     ("levels=160", {"levels": 160}),
     ("sizes=240", {"sizes": 240}),
-    ("max_p_dt=0.02", {"max_p_dt": 0.02}),
-    ("max_p_dt=0.005", {"max_p_dt": 0.005}),
+    ("newmark p h 0.001", {"method": "newmark"}),
+    ("newmark p h 0.02", {"method": "newmark", "max_p_dt": 0.02}),
+    ("newmark p h 0.005", {"method": "newmark", "max_p_dt": 0.005}),
     ("eta=0.95", {"eta": 0.95}),
 ]
 

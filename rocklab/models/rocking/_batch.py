@@ -14,6 +14,7 @@ import numpy as np
 
 from ..._errors import InputError
 from ._newmark import run_batch
+from ._taylor_record import order_for, run_taylor_record
 from ...series import BaseMotion
 from ._result import BatchResult
 
@@ -39,6 +40,8 @@ def simulate_batch(
     fall_rad=None,
     max_p_dt: float = 0.02,
     rest_tol: float = 1e-6,
+    method: str = "newmark",
+    taylor_tol: float = 1e-16,
 ) -> BatchResult:
     """Run m independent blocks (broadcast arrays) in parallel; summaries only.
 
@@ -78,6 +81,15 @@ def simulate_batch(
         Largest p * h allowed (sub-stepping of small blocks).
     rest_tol : float
         Rest threshold as a fraction of alpha (see :func:`simulate`).
+    method : {"newmark", "taylor"}
+        ``"newmark"``: trapezoidal steps of ``dt_s`` sub-stepped to ``p h <= max_p_dt``, exact
+        contact (Čeh §3). ``"taylor"``: one Taylor-series step per record interval (split so
+        that ``p h <= max_p_dt``; 0.25 suffices, the order adapts), impacts, uplift and
+        overturning as roots of the series (:mod:`~rocklab.models.rocking._taylor_record`);
+        ``dt_s`` is not used: the record's own interval sets the steps.
+    taylor_tol : float
+        For ``"taylor"``: the order of each entry is the smallest with ``(p h)^(n+1)/(n+1)!``
+        below this (1e-16: truncation below rounding).
 
     Returns
     -------
@@ -99,6 +111,10 @@ def simulate_batch(
         duration_s = float(base.t_s[-1]) + float(free_after_s)
     if not (math.isfinite(duration_s) and duration_s > 0):
         raise InputError(f"simulate_batch: duration_s={duration_s!r} must be positive (s)")
+    if method == "taylor":
+        return _taylor_batch(base, (p, al, sc, th0, w0, et, fr), duration_s, max_p_dt, taylor_tol, rest_tol)
+    if method != "newmark":
+        raise InputError(f"simulate_batch: method={method!r}: use 'newmark' or 'taylor'")
     n_sub = np.maximum(1, np.ceil(p * dt_s / max_p_dt - 1e-12)).astype(np.int64)
     h = dt_s / n_sub
     n_steps = np.ceil(duration_s / h - 1e-9).astype(np.int64)
@@ -125,6 +141,41 @@ def simulate_batch(
         theta_end_rad=th_end,
         omega_end_rad_s=w_end,
         t_end_s=steps * h,
+    )
+
+
+def _taylor_batch(base, entries, duration_s, max_p_h, tol, rest_tol) -> BatchResult:
+    """``simulate_batch(method="taylor")``: the entries (p, alpha, scale, theta0, omega0, eta, fall) run
+    by :func:`~rocklab.models.rocking._taylor_record.run_taylor_record`."""
+    p, al, sc, th0, w0, et, fr = entries
+    if not (math.isfinite(max_p_h) and 0 < max_p_h <= 1.0):
+        raise InputError(f"simulate_batch: max_p_dt={max_p_h!r}: for method='taylor' give p h in (0, 1]")
+    if not (math.isfinite(tol) and 0 < tol < 1):
+        raise InputError(f"simulate_batch: taylor_tol={tol!r}: give a relative truncation bound in (0, 1)")
+    if base is None:
+        acc, t0, dta = np.zeros(1), 0.0, float(duration_s)
+    else:
+        acc, t0, dta = np.ascontiguousarray(base.acc_m_s2, float), float(base.t_s[0]), float(base.dt_s)
+    h = np.minimum(dta, max_p_h / p)  # longest step of each entry
+    order = order_for(p * h, tol)
+    status, t_over, th_end, w_end, t_end, nimp, mx = run_taylor_record(
+        p, al, et, sc, th0, w0, acc, t0, dta, float(duration_s), order, float(max_p_h), float(rest_tol), fr
+    )
+    return BatchResult(
+        overturned=status == 2,
+        overturn_t_s=t_over,
+        max_abs_theta_over_alpha=mx / al,
+        n_impacts=nimp,
+        status=status,
+        p_rad_s=p,
+        alpha_rad=al,
+        scale=sc,
+        eta=et,
+        dt_s=h,
+        n_steps=int(np.sum(np.ceil(t_end / h))),
+        theta_end_rad=th_end,
+        omega_end_rad_s=w_end,
+        t_end_s=t_end,
     )
 
 

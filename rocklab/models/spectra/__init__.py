@@ -3,7 +3,8 @@
 Ground-motion records (AT2, two-column, CSV; :func:`load_base_motion`), pulse parameters
 and t_p (:func:`pulse_parameters`), overturning curves and the Overturning Acceleration
 Spectrum with t_I, t'_I and beta (:func:`overturning_spectrum`, Eq. 13-20, 28) and t_I's band
-over the open choices (:func:`t_I_band`), and the design check and required pier width
+over the open choices (:func:`t_I_band`), converged reference verdicts with the chaotic cells
+of a grid (:func:`oas_reference`), and the design check and required pier width
 (:func:`design_check`, :func:`required_width`, Eq. 21-31).
 """
 
@@ -17,6 +18,7 @@ from ._oas import (
     simplified_oas,
 )
 from ._oas_column import column_overturning_spectrum
+from ._oas_reference import OASReference, oas_reference
 from ._oas_curve import OverturningCurve, overturning_curve
 from ._oas_sets import CharacteristicOAS, TItpRegression, characteristic_oas, oas_convex_hull, tI_tp_regression
 from ._oas_band import BAND_ENSEMBLE, TIBand, t_I_band
@@ -53,6 +55,8 @@ __all__ = [
     "OASResult",
     "overturning_spectrum",
     "column_overturning_spectrum",
+    "OASReference",
+    "oas_reference",
     "OverturningCurve",
     "overturning_curve",
     "CharacteristicOAS",

@@ -22,10 +22,13 @@ Definition choices the thesis leaves open are options (defaults first):
   search from small blocks upward would find it).
 - ``levels``, ``sizes``, ``refine``: grid density and bisection steps.
 - ``eta``: restitution; ``None`` = Housner's 1 - 2 sin^2(alpha)/alpha_I.
-- ``max_p_dt``: integration step times p of the runs (``simulate_batch``).
+- ``method``: the runs' integrator, ``"taylor"`` (a Taylor series per record interval, exact
+  events: converged verdicts, see :func:`~rocklab.models.oas_reference`) or ``"newmark"``
+  (trapezoidal steps of ``p h <= max_p_dt``, the default before session 13).
 
-How much each choice moves t_I (H/B = 12; output of ``benchmarks/oas_sensitivity.py``;
-thesis Table 4: FF-1 0.266 s, FF-2 0.360 s, FF-41 0.503 s)::
+How much each choice moves t_I (H/B = 12; output of ``benchmarks/oas_sensitivity.py`` with the
+Newmark runs at p h <= 0.001 that were the default before session 13; the Taylor default gives
+FF-1 0.336, FF-2 0.334, FF-41 0.474; thesis Table 4: FF-1 0.266 s, FF-2 0.360 s, FF-41 0.503 s)::
 
     variant              FF-1            FF-2            FF-41 (NGA-West2 file)
     defaults             0.336 (+26 %)   0.333 ( -7 %)   0.470 ( -7 %)
@@ -86,9 +89,14 @@ OAS_DEFAULTS = dict(
     alpha_I=4.0 / 3.0,
     eta=None,
     max_p_dt=0.001,
+    method="taylor",
 )
 
 CRIT = {"angle": 0, "fall": 1}
+#: Integrators of the OAS runs (``method``).
+METHODS_OAS = ("newmark", "taylor")
+#: Largest p h of a Taylor step (``method="taylor"``): the order adapts to it.
+TAYLOR_P_H = 0.25
 _GOLDEN = 0.5 * (math.sqrt(5.0) - 1.0)
 
 
@@ -269,6 +277,7 @@ def overturning_spectrum(
     grid: str = "adaptive",
     verdicts: OASResult | None = None,
     guide: OASResult | None = None,
+    method: str = "taylor",
 ) -> OASResult:
     """OAS, transformed OAS, t_I, t'_I and beta of a record for one block slenderness.
 
@@ -289,15 +298,9 @@ def overturning_spectrum(
     alpha_I : float
         Inertia coefficient I_O/(m R^2) (thesis Eq. 22).
     max_p_dt : float
-        Largest integration step times p (the runs are :func:`simulate_batch`'s
-        Newmark steps with exact impacts). Verdicts near the boundary are chaotic:
-        on FEMA FF-1, 0.02 / 0.005 / 0.002 / 0.001 disagree with 0.0005 on
-        1.1 / 0.55 / 0.35 / 0.18 % of the 9600 grid runs; 0.001 is the default.
-        Long records do not converge at all: against p h = 0.00025, the grid at
-        0.001 / 0.0005 keeps 99.82 / 99.92 % of the verdicts on FF-1 (30 s), 98.06 /
-        98.57 % on FF-30 (46 s) and 96.02 / 96.51 % on FF-9 (100 s): runs rocking for
-        a long time near the boundary are chaotic, so any other integrator (or step)
-        moves a few per cent of those verdicts; t_I's band is the honest answer.
+        For ``method="newmark"``: largest step times p. Against p h = 0.00025 the grid at
+        0.001 keeps 99.82 % of the verdicts on FF-1 (30 s), 98.06 % on FF-30 (46 s) and
+        96.02 % on FF-9 (100 s): long rocking near the boundary amplifies step errors.
     level_offset, size_offset : float
         Shift of the level grid and of the (log) size grid by this fraction of one
         step, in [0, 1): the same resolution placed elsewhere, to see how much t_I
@@ -316,6 +319,14 @@ def overturning_spectrum(
     guide : OASResult, optional
         For ``grid="boundary"``: an OAS of the same record whose boundary is
         close to this one's (e.g. the default grid for a shifted or coarser one).
+    method : {"taylor", "newmark"}
+        Integrator of the runs (:func:`~rocklab.models.simulate_batch`): ``"taylor"`` a Taylor
+        step per record interval (``p h <= 0.25``, order from ``p h``, truncation below 1e-16),
+        impacts and overturning as roots of the series: converged verdicts, the reference's own
+        (:func:`~rocklab.models.oas_reference`; on the 44 FEMA far-field records the adaptive grid
+        agrees with it on >= 99.9 % of the cells that are not chaotic, the Newmark grid at p h =
+        0.001 on 98.8 %); ``"newmark"`` trapezoidal steps of ``p h <= max_p_dt`` (the default
+        before session 13).
 
     Returns
     -------
@@ -332,13 +343,10 @@ def overturning_spectrum(
     """
     sl = check_opts(slenderness, levels, sizes, R_max_m, R_min_m, level_max, alpha_I)
     base = _checked_record(base, levels, sizes)
-    _check_choices(criterion, search, grid, guide)
+    _check_choices(criterion, search, grid, guide, method)
+    _check_steps(level_offset, size_offset, max_p_dt)
     free_code, free_s = free_after_code(free)
     alpha, eta_v = _block_restitution(sl, alpha_I, eta)
-    if not (0.0 <= float(level_offset) < 1.0 and 0.0 <= float(size_offset) < 1.0):
-        raise InputError(f"level_offset={level_offset!r}, size_offset={size_offset!r}: fractions of a step in [0, 1)")
-    if not (math.isfinite(max_p_dt) and 0 < max_p_dt <= 0.5):
-        raise InputError(f"max_p_dt={max_p_dt!r}: step times p must be in (0, 0.5]")
     opts = dict(
         levels=int(levels),
         level_max=float(level_max),
@@ -353,10 +361,11 @@ def overturning_spectrum(
         level_offset=float(level_offset),
         size_offset=float(size_offset),
         grid=grid,
+        method=method,
     )
     lv, R, p = _grid_axes(opts, alpha_I)
     scales = lv * math.tan(alpha) * G / base.pga_m_s2  # record scaled to a_p = level g tan(alpha)
-    args = (alpha, eta_v, CRIT[criterion], free_code, free_s, float(max_p_dt))
+    args = (alpha, eta_v, CRIT[criterion], free_code, free_s, max_p_dt if method == "newmark" else TAYLOR_P_H, method)
     if verdicts is not None:
         over, evaluated = _reused_verdicts(verdicts, opts, (eta_v, alpha, float(alpha_I)), base.name)
     else:
@@ -385,8 +394,20 @@ def _checked_record(base, levels, sizes):
     return base
 
 
-def _check_choices(criterion, search, grid, guide):
+def _check_steps(level_offset, size_offset, max_p_dt):
+    """Grid offsets are fractions of a step and the Newmark step is in range."""
+    if not (0.0 <= float(level_offset) < 1.0 and 0.0 <= float(size_offset) < 1.0):
+        raise InputError(f"level_offset={level_offset!r}, size_offset={size_offset!r}: fractions of a step in [0, 1)")
+    if not (math.isfinite(max_p_dt) and 0 < max_p_dt <= 0.5):
+        raise InputError(f"max_p_dt={max_p_dt!r}: step times p must be in (0, 0.5]")
+
+
+def _check_choices(criterion, search, grid, guide, method="newmark"):
     """The OAS's definition choices are among the known ones (module docstring)."""
+    if method not in METHODS_OAS:
+        raise InputError(
+            f"method={method!r}: use 'newmark' (trapezoidal steps) or 'taylor' (series per record interval)"
+        )
     if criterion not in CRIT:
         raise InputError(f"criterion={criterion!r}: use 'angle' (|theta|>=alpha) or 'fall' (|theta|>=pi/2)")
     if search not in ("scan", "contiguous"):
@@ -517,8 +538,13 @@ def _guess_first(guide, lv, p):
 
 
 def batch_runs(base, scale, p, args):
-    """Overturned flags of independent runs (``base`` times ``scale``, blocks ``p``) by ``simulate_batch``."""
-    alpha, eta, crit, free_code, free_s, max_p_dt = args
+    """Overturned flags of independent runs (``base`` times ``scale``, blocks ``p``) by ``simulate_batch``.
+
+    ``args`` = (alpha rad, eta, criterion code, free code, free s, max p h[, method[, taylor_tol]]).
+    """
+    alpha, eta, crit, free_code, free_s, max_p_dt = args[:6]
+    method = args[6] if len(args) > 6 else "newmark"
+    tol = args[7] if len(args) > 7 else 1e-16
     # neighbouring grid points cost alike and the parallel loop hands each thread one contiguous
     # chunk: a golden-ratio interleave spreads the long runs over both (1.6x -> 1.9x on 2 cores)
     p = np.broadcast_to(np.asarray(p, float), np.shape(scale))
@@ -533,6 +559,8 @@ def batch_runs(base, scale, p, args):
         free_after_s=free_s if free_code == 2 else 0.0,
         fall_rad=alpha if crit == 0 else None,
         max_p_dt=max_p_dt,
+        method=method,
+        taylor_tol=tol,
     )
     over = np.asarray(b.overturned, bool)
     if free_code == 1:

@@ -10,7 +10,7 @@ boundary, not the area of the grid. Each row's first unsafe size (which sets
 the boundary, hence t_I) gets a last check of the ``frontier`` sizes before it.
 
 Measured against the dense grid (every point simulated) on the 44 FEMA P695
-far-field records at H/B = 12, defaults (``benchmarks/oas_fema44.py``):
+far-field records at H/B = 12, Newmark runs (the default before session 13; ``benchmarks/oas_fema44.py``):
 99.93 % of the 422 400 verdicts identical (worst record 99.78 %), t_I
 identical on 44/44 records and t'_I on 42/44, 19.9 % of the grid simulated,
 25 s against 63 s for the 44 OAS on 2 cores. What it can miss: islands smaller

@@ -91,6 +91,11 @@ def main() -> int:
             f"{n} worker(s): {t[n]:.2f} s, {n_runs / t[n]:.3f} runs/s, {n_runs / t[n] / n:.3f} runs/s per worker"
             + (" (baseline)" if n == 1 else "")
         )
+    errors = {n: int((tab["error"] != "").sum()) for n, tab in tabs.items()}
+    if any(errors.values()):  # a run that failed takes no time: its figures would mean nothing
+        first = next(e for tab in tabs.values() for e in tab["error"] if e)
+        print(f"FAILED runs {errors}: {first}")
+        return 1
     same = (tabs[1]["t_I_s"].fillna(-1).to_numpy() == tabs[2]["t_I_s"].fillna(-1).to_numpy()).all()
     eff = t[1] / (2 * t[2])
     print(f"parallel efficiency 1 -> 2 workers: {eff:.1%} (target >= 80 %); t_I identical on both: {same}")

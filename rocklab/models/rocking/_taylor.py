@@ -43,7 +43,8 @@ _ROCKING, _REST, _OVERTURNED, _NO_UPLIFT = 0, 1, 2, 3
 
 
 @njit(cache=True, inline="always", fastmath={"contract"})
-def _poly(a, n, x):
+def series_value(a, n, x):
+    """The series ``a[0..n]`` at ``x`` (Horner)."""
     v = a[n]
     for k in range(n - 1, -1, -1):
         v = v * x + a[k]
@@ -51,7 +52,8 @@ def _poly(a, n, x):
 
 
 @njit(cache=True, inline="always", fastmath={"contract"})
-def _dpoly(a, n, x):
+def series_slope(a, n, x):
+    """The derivative of the series ``a[0..n]`` at ``x`` (Horner)."""
     v = n * a[n]
     for k in range(n - 1, 0, -1):
         v = v * x + k * a[k]
@@ -109,8 +111,8 @@ def _dense(a, out_th, out_w, out_e, k0, k1, out_dt, t, energy):
         i += 4
     while i < k1:
         x = i * out_dt - t
-        out_th[i] = _poly(a, n, x)
-        out_w[i] = _dpoly(a, n, x)
+        out_th[i] = series_value(a, n, x)
+        out_w[i] = series_slope(a, n, x)
         out_e[i] = energy
         i += 1
 
@@ -141,26 +143,34 @@ def _coefficients(a, S, C, c, th, w, s, p2, alpha, n):
 
 
 @njit(cache=True, fastmath={"contract"})
-def _root(a, n, lo, hi, target, s):
-    """tau in (lo, hi] where s*theta(tau) = target, with s*theta(lo) > target >= s*theta(hi)."""
-    f_lo = s * _poly(a, n, lo) - target
-    f_hi = s * _poly(a, n, hi) - target
+def series_root(a, n, lo, hi, target, s, rel_tol, max_iter):
+    """tau in (lo, hi] where s*P(tau) = target (P: the series ``a[0..n]``), with s*P(lo) > target >=
+    s*P(hi): Newton steps kept inside a shrinking bracket, to ``rel_tol`` of tau or of the bracket,
+    ``max_iter`` steps at most."""
+    f_lo = s * series_value(a, n, lo) - target
+    f_hi = s * series_value(a, n, hi) - target
     x = lo + (hi - lo) * f_lo / (f_lo - f_hi) if f_lo != f_hi else hi
-    for _ in range(100):
-        f = s * _poly(a, n, x) - target
+    for _ in range(max_iter):
+        f = s * series_value(a, n, x) - target
         if f > 0.0:
             lo = x
         else:
             hi = x
-        d = s * _dpoly(a, n, x)
+        d = s * series_slope(a, n, x)
         xn = x - f / d if d != 0.0 else 0.5 * (lo + hi)
         if not (lo < xn < hi):
             xn = 0.5 * (lo + hi)
-        if abs(xn - x) <= 1e-15 * max(abs(x), 1e-300) or hi - lo <= 1e-15 * hi:
+        if abs(xn - x) <= rel_tol * max(abs(x), 1e-300) or hi - lo <= rel_tol * hi:
             x = xn
             break
         x = xn
     return x
+
+
+@njit(cache=True, inline="always")
+def _root(a, n, lo, hi, target, s):
+    """tau in (lo, hi] where s*theta(tau) = target, with s*theta(lo) > target >= s*theta(hi)."""
+    return series_root(a, n, lo, hi, target, s, 1e-15, 100)
 
 
 @njit(cache=True, fastmath={"contract"})
@@ -207,7 +217,7 @@ def run_taylor(
         h = min(h_max, t_end - t) if t < t_end else h_max
         if h <= 0.0:
             h = h_max
-        th_h = _poly(a, n, h)
+        th_h = series_value(a, n, h)
         event = 0  # 1 impact, 2 fall
         tau = h
         if s * th_h >= fall_rad:
@@ -221,10 +231,10 @@ def run_taylor(
                 lo = h
                 for _ in range(60):
                     lo *= 0.5
-                    if s * _poly(a, n, lo) > 0.0:
+                    if s * series_value(a, n, lo) > 0.0:
                         break
             tau = _root(a, n, lo, h, 0.0, s)
-        if t_over != t_over and (event == 2 or s * _poly(a, n, tau) >= alpha):
+        if t_over != t_over and (event == 2 or s * series_value(a, n, tau) >= alpha):
             t_over = t + _root(a, n, 0.0, tau, -alpha, -s)
         # output samples in (t, t + tau]: a counted loop of independent evaluations (vectorised)
         k_end = min(n_out, int(math.floor((t + tau) / out_dt)) + 1)
@@ -237,13 +247,13 @@ def run_taylor(
             k = k_end
         # the turning point inside the step (omega = 0) sets max |theta|: there the (conserved)
         # energy is all potential, p^2 (cos(alpha - |theta|) - cos(alpha))
-        w_tau = _dpoly(a, n, tau)
+        w_tau = series_slope(a, n, tau)
         if s * w >= 0.0 and s * w_tau < 0.0:
             q = min(1.0, cos_a + energy / (e_scale * p2))
             m = alpha - math.acos(q)
             if m > max_abs:
                 max_abs = m
-        th = _poly(a, n, tau)
+        th = series_value(a, n, tau)
         w = w_tau
         t = t + tau
         if abs(th) > max_abs and event != 1:

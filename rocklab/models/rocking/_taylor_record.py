@@ -36,6 +36,7 @@ from numba import njit, prange
 
 from ...blocks import G
 from ._newmark_lean import sdcd
+from ._taylor import series_root, series_slope, series_value
 
 __all__ = ["run_taylor_record", "order_for", "MAX_ORDER"]
 
@@ -71,22 +72,6 @@ def order_for(p_h, tol: float) -> np.ndarray:
     return out
 
 
-@njit(cache=True, inline="always", fastmath={"contract"})
-def _poly(a, n, x):
-    v = a[n]
-    for k in range(n - 1, -1, -1):
-        v = v * x + a[k]
-    return v
-
-
-@njit(cache=True, inline="always", fastmath={"contract"})
-def _dpoly(a, n, x):
-    v = n * a[n]
-    for k in range(n - 1, 0, -1):
-        v = v * x + k * a[k]
-    return v
-
-
 #: 1/k and 1/((k+1)(k+2)): multiplications instead of divisions in the recurrence's dependency chain.
 _INV_K = np.array([0.0] + [1.0 / k for k in range(1, MAX_ORDER + 1)])
 _INV_K12 = np.array([1.0 / ((k + 1) * (k + 2)) for k in range(MAX_ORDER + 1)])
@@ -114,27 +99,11 @@ def _coefficients(a, S, C, th, w, p2, sc0, cc0, u0, du, n):
         a[k + 2] = -p2 * _INV_K12[k] * (S[k] + u0 * C[k] + du * C[k - 1])
 
 
-@njit(cache=True, fastmath={"contract"})
+@njit(cache=True, inline="always")
 def _root(a, n, lo, hi, target, s):
-    """tau in [lo, hi] where s*P(tau) = target, with s*P(lo) > target >= s*P(hi) (P: series ``a``)."""
-    f_lo = s * _poly(a, n, lo) - target
-    f_hi = s * _poly(a, n, hi) - target
-    x = lo + (hi - lo) * f_lo / (f_lo - f_hi) if f_lo != f_hi else hi
-    for _ in range(200):
-        f = s * _poly(a, n, x) - target
-        if f > 0.0:
-            lo = x
-        else:
-            hi = x
-        d = s * _dpoly(a, n, x)
-        xn = x - f / d if d != 0.0 else 0.5 * (lo + hi)
-        if not (lo < xn < hi):
-            xn = 0.5 * (lo + hi)
-        if abs(xn - x) <= 2e-16 * max(abs(x), 1e-300) or hi - lo <= 2e-16 * hi:
-            x = xn
-            break
-        x = xn
-    return x
+    """tau in [lo, hi] where s*P(tau) = target, with s*P(lo) > target >= s*P(hi) (P: series ``a``);
+    to 2e-16 relative (the reference's exact impacts), 200 steps at most."""
+    return series_root(a, n, lo, hi, target, s, 2e-16, 200)
 
 
 @njit(cache=True, fastmath={"contract"})
@@ -143,7 +112,7 @@ def _turn(a, da, n, lo, hi, s):
     the derivative series ``da`` (filled here from ``a``)."""
     for j in range(n):
         da[j] = (j + 1) * a[j + 1]
-    if s * _poly(da, n - 1, lo) > 0.0:
+    if s * series_value(da, n - 1, lo) > 0.0:
         return _root(da, n - 1, lo, hi, 0.0, s)
     return _root(da, n - 1, lo, hi, 0.0, -s)
 
@@ -163,7 +132,7 @@ def _step_event(a, da, n, h, th, w, s, fall_rad, y_h, w_h):
         if w0 > 0.0:
             # up and back down within the step: the apex may pass fall_rad, the impact lies after it
             top = _turn(a, da, n, 0.0, h, s)
-            y_top = s * _poly(a, n, top)
+            y_top = s * series_value(a, n, top)
             if y_top >= fall_rad:
                 return 2, _root(a, n, 0.0, top, -fall_rad, -s)
             if y_top <= 0.0:
@@ -174,11 +143,11 @@ def _step_event(a, da, n, h, th, w, s, fall_rad, y_h, w_h):
         return 1, _root(a, n, 0.0, h, 0.0, s)
     if w0 > 0.0 and w_h < 0.0:
         top = _turn(a, da, n, 0.0, h, s)
-        if s * _poly(a, n, top) >= fall_rad:
+        if s * series_value(a, n, top) >= fall_rad:
             return 2, _root(a, n, 0.0, top, -fall_rad, -s)
     elif w0 < 0.0 and w_h > 0.0:
         low = _turn(a, da, n, 0.0, h, s)
-        if s * _poly(a, n, low) <= 0.0:
+        if s * series_value(a, n, low) <= 0.0:
             return 1, _root(a, n, 0.0, low, 0.0, s)
     return 0, h
 
@@ -293,8 +262,8 @@ def run_one(p, alpha, eta, scale, th0, w0, acc, t0, dta, duration, order, max_p_
                 sc = math.sin(alpha * s - th)
                 cc = math.cos(alpha * s - th)
             _coefficients(a, S, C, th, w, p2, sc, cc, u0, du, n)
-            y_h = s * _poly(a, n, h)
-            w_h = s * _dpoly(a, n, h)
+            y_h = s * series_value(a, n, h)
+            w_h = s * series_slope(a, n, h)
             kind, tau = _step_event(a, da, n, h, th, w, s, fall_rad, y_h, w_h)
             if t_over != t_over and fall_rad > alpha:
                 kind_a, tau_a = _step_event(a, da, n, h, th, w, s, alpha, y_h, w_h)
@@ -304,8 +273,8 @@ def run_one(p, alpha, eta, scale, th0, w0, acc, t0, dta, duration, order, max_p_
                 th_n = s * y_h
                 w_n = s * w_h
             else:
-                th_n = _poly(a, n, tau)
-                w_n = _dpoly(a, n, tau)
+                th_n = series_value(a, n, tau)
+                w_n = series_slope(a, n, tau)
             if kind == 0:
                 d = th_n - th
                 if abs(d) < 0.2:

@@ -91,14 +91,10 @@ def silhouette_track(path, scale=1.0):
     radius_px : float
         The median radius.
     """
-    cap = cv2.VideoCapture(str(path))
-    frames = []
-    while True:
-        ok, img = cap.read()
-        if not ok:
-            break
-        frames.append(img if scale == 1.0 else cv2.resize(img, None, fx=scale, fy=scale, interpolation=cv2.INTER_AREA))
-    cap.release()
+    frames = _read_frames(
+        path,
+        lambda img: img if scale == 1.0 else cv2.resize(img, None, fx=scale, fy=scale, interpolation=cv2.INTER_AREA),
+    )
     med = np.median(np.asarray(frames[::4]), axis=0).astype(np.int16)
     first = np.array([_silhouette_circle(f, med, SIL_THRESHOLDS[0]) for f in frames])
     r0 = float(np.nanmedian(first[:, 2]))
@@ -191,14 +187,7 @@ def bright_blob_track(path, start_uv, thr=50, area_px=(12, 400), max_step_px=80.
     frame, within ``max_step_px``). The median is the background where the object moves most of
     the film.
     """
-    cap = cv2.VideoCapture(str(path))
-    frames = []
-    while True:
-        ok, img = cap.read()
-        if not ok:
-            break
-        frames.append(cv2.cvtColor(img, cv2.COLOR_BGR2GRAY))
-    cap.release()
+    frames = _read_frames(path, lambda img: cv2.cvtColor(img, cv2.COLOR_BGR2GRAY))
     g = np.asarray(frames, np.int16)
     med = np.median(g[::2], axis=0).astype(np.int16)
     last, out = np.asarray(start_uv, float), []
@@ -216,3 +205,16 @@ def bright_blob_track(path, start_uv, thr=50, area_px=(12, 400), max_step_px=80.
         if best is not None:
             last = best[1]
     return np.array(out, float).reshape(-1, 2)
+
+
+def _read_frames(path, each) -> list:
+    """Every frame of a film (OpenCV BGR), each passed through ``each``."""
+    cap = cv2.VideoCapture(str(path))
+    frames = []
+    while True:
+        ok, img = cap.read()
+        if not ok:
+            break
+        frames.append(each(img))
+    cap.release()
+    return frames

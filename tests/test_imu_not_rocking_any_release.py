@@ -12,7 +12,8 @@
 - A table pulse that uplifts a block within 0.1 s of its start (the synthetic sessions' 0.6 s
   pulse on a squat block, three stacked blocks) was read as a thread release from upright whose
   swings "grow": W-IMU-NOT-ROCKING on rocking blocks. A block resting upright and pushed by its
-  table before it turns is a forced run.
+  table before it turns is a forced run; read as a forced run, a block that turns unpushed (the
+  tests' strides, a release) is flagged.
 """
 
 from __future__ import annotations
@@ -168,3 +169,31 @@ def test_a_table_pulse_that_uplifts_at_once_is_a_forced_run_not_a_growing_releas
     m = (rot.t_s >= 0.0) & (rot.t_s <= res.t_s[-1])
     # the sign of theta is the data's (axis found): compare magnitudes of the history
     assert np.rad2deg(np.sqrt(np.mean((np.abs(rot.theta_rad[m]) - np.abs(th[m])) ** 2))) < 0.5
+
+
+def test_strides_and_a_release_read_as_forced_runs_are_flagged_by_the_missing_push():
+    """A forced run's block rides its table until the table uplifts it: the accelerometer leaves its
+    rest before the rotation starts (>= 3.1 times its stillness on the simulated table runs above
+    and in the synthetic sessions). The tests' planar strides (no sideways motion: the lateral test
+    passes them) and a block released from a held tilt start to turn unpushed (<= 1.06): read with
+    --release none they are flagged, and the message sends them to --release auto, which flags the
+    strides (growing half swings) and reads the release clean."""
+    import test_imu_validity as v
+
+    for log, auto_codes in ((v._gait_log(), ["W-IMU-NOT-ROCKING"]), (v._free_log(2)[0], [])):
+        with collecting() as found:
+            rot = block_rotation(log, release="none")
+        assert [d.code for d in found] == ["W-IMU-NOT-ROCKING"] and rot.status == "suspect"
+        push = float(re.search(r"left its rest by ([\d.]+) times", found[0].message).group(1))
+        assert push < 1.2 and "--release auto, which keeps every test" in found[0].message
+        with collecting() as found:
+            block_rotation(log, release="auto")
+        assert [d.code for d in found] == auto_codes
+    # a table run read as one: pushed
+    for h_m, seed in ((0.22, 1), (0.2, 3)):
+        with collecting() as found:
+            rot = block_rotation(_pulse_log(h_m, seed)[0], release="none")
+        assert found == [] and rot.status == "ok"
+    with collecting() as found:
+        block_rotation(_forced(0.0)[0], release="none")
+    assert found == []

@@ -74,7 +74,7 @@ from ._motion_windows import (
     twist_angle,
 )
 from ._read import ImuLog
-from ._validity import RockingCheck, check_rocking, half_swing_peaks, warn_no_rest, warn_not_rocking
+from ._validity import FORCED_PUSH_MIN, RockingCheck, check_rocking, half_swing_peaks, warn_no_rest, warn_not_rocking
 
 __all__ = ["ImuRotation", "block_rotation", "ahrs_rotation", "ahrs_quaternions"]
 
@@ -300,9 +300,11 @@ def block_rotation(
     f_end = acc[e0:e1].mean(axis=0) if has_end else None
     f_ref, msg = _upright(u, f_start, f_end, forced, msg)
     theta, omega, drift, th_start, changes = _anchored(t, omega, u, (f_ref, f_start, f_end), (s0, s1), (e0, e1))
-    upright_start = release == "auto" and not forced and has_end and abs(th_start) < UPRIGHT_START_RAD
+    at_rest = status not in ("no_rest_before", "no_motion")
     min_run = max(2, int(round(0.1 * fs)))
-    if upright_start and table_push(t, gyro, acc, fs, np.deg2rad(still_gyro_deg_s), min_run) >= PUSH_MIN:
+    push = table_push(t, gyro, acc, fs, np.deg2rad(still_gyro_deg_s), min_run) if at_rest else None
+    upright_start = release == "auto" and not forced and has_end and abs(th_start) < UPRIGHT_START_RAD
+    if upright_start and push is not None and push >= FORCED_PUSH_MIN:
         # it rested upright and the support pushed it before it started to turn: a table pulse
         # that uplifts the block within 0.1 s (a released block is held tilted), not a release
         return block_rotation(
@@ -311,7 +313,7 @@ def block_rotation(
         )  # fmt: skip
     rocking, status, msg = _judge(
         log, (w, u, theta, omega, moving), forced, (i_move, i_end, has_end), (f_start, th_start, drift, changes),
-        (status, msg), min_rest_s,
+        (status, msg), min_rest_s, push,
     )  # fmt: skip
     if axis is None:
         ref = th_start if abs(th_start) > np.deg2rad(1.0) else theta[np.argmax(np.abs(theta))]
@@ -354,18 +356,16 @@ def block_rotation(
 #: Largest tilt at the start rest, rad, of a block that rested upright (the upright reference's
 #: error, a mis-mount or a sloping table, is < 0.3 deg; a thread holds a block at >= 1 deg).
 UPRIGHT_START_RAD = np.deg2rad(1.0)
-#: Smallest push of the table before the rotation starts (:func:`table_push`, in units of the
-#: accelerometer's stillness at the start) that makes an upright start a forced run.
-PUSH_MIN = 2.0
 
 
-def _judge(log, motion, forced, span, anchoring, state, min_rest_s):
+def _judge(log, motion, forced, span, anchoring, state, min_rest_s, push):
     """(rocking evidence, status, message) of a block's rotation, with its warnings.
 
     ``motion`` = (bias-free rates (n, 3), axis, theta, omega, moving mask); ``span`` = (first
     moving sample, end of the motion, a rest after?);
     ``anchoring`` = (accelerometer mean at the start rest (3,), tilt there, drift, (gyro change,
-    tilt change) between the rests or None); ``state`` = (status, message).
+    tilt change) between the rests or None); ``state`` = (status, message); ``push`` the table's
+    push before the rotation (:func:`table_push`; None without a rest before), judged for a forced run.
     """
     w, u, theta, omega, moving = motion
     i_move, i_end, has_end = span
@@ -383,7 +383,7 @@ def _judge(log, motion, forced, span, anchoring, state, min_rest_s):
     if status != "no_motion":
         # a released block only loses energy: its half swings shrink (a table feeds energy in)
         peaks = None if forced else half_swing_peaks(theta, i_move, i_end, th_start if judge else None)
-        rocking = check_rocking(t, w, u, f_start, fs, drift, judge, peaks, has_end, acc)
+        rocking = check_rocking(t, w, u, f_start, fs, drift, judge, peaks, has_end, acc, push if forced else None)
     if rocking is not None and rocking.reasons:
         # a spinning or hand-held sensor: worse than any rest-window status
         status, msg = "suspect", warn_not_rocking(log.source, rocking) + ("; " + msg if msg else "")

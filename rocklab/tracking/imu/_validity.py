@@ -67,6 +67,11 @@ AXIS_SHARE_MIN = 0.8
 #: value at rest, m/s^2 (module doc): a table's cross-axis motion (a few % of its shaking)
 #: and the accelerometer's cross-axis sensitivity at impacts stay well below it.
 LATERAL_ACC_MAX_M_S2 = 0.15 * G
+#: Smallest push of the table just before a forced run's block starts to turn, in units of the
+#: accelerometer's stillness at the start (``_motion_windows.table_push``): a block rides its
+#: table until the table's acceleration uplifts it. Measured <= 1.06 on simulated releases and
+#: strides, >= 3.1 on simulated table runs.
+FORCED_PUSH_MIN = 2.0
 #: Largest range (max - min) of the gyro angle about the axis, rad: a rocking or
 #: overturning block stays within a half turn.
 TURN_RANGE_MAX_RAD = np.pi
@@ -169,7 +174,7 @@ def _worst_growth(peaks: np.ndarray, cross_side: bool) -> tuple:
 
 
 def check_rocking(
-    t, w, u, f_rest, fs, drift_rad_s, judge_drift=True, swing_peaks=None, upright_measured=True, acc=None
+    t, w, u, f_rest, fs, drift_rad_s, judge_drift=True, swing_peaks=None, upright_measured=True, acc=None, push=None
 ) -> RockingCheck:
     """Measure the rocking evidence (module doc) of bias-free rates ``w`` (n, 3) rad/s about ``u``.
 
@@ -181,6 +186,8 @@ def check_rocking(
     for a forced run, whose table feeds energy in. ``upright_measured`` False when upright
     was not measured at a final rest (the two sides' peaks are then not compared).
     ``acc`` (n, 3) m/s^2, the accelerometer, for the specific force along the axis (None: not judged).
+    ``push``: for a forced run that starts at rest, the table's push before the block turned
+    (``_motion_windows.table_push``; None: not judged).
     """
     w_avg = max(1, int(round(0.05 * fs)))
     rot = moving_average(rownorm(w), w_avg) > _ROT_THR_RAD_S
@@ -213,6 +220,13 @@ def check_rocking(
             f"while it turns the sensor accelerates along that axis by {lateral / G:.3g} g RMS "
             f"(a rocking edge stays put along itself, whether released or on a shake table: "
             f"< {LATERAL_ACC_MAX_M_S2 / G:.2g} g)"
+        )
+    if push is not None and push < FORCED_PUSH_MIN:
+        reasons.append(
+            f"read as a forced run, it started to turn from rest with no push from a table (the accelerometer "
+            f"left its rest by {push:.2g} times its own stillness in the 0.1 s before; a table uplifts a block "
+            f"by accelerating it: >= {FORCED_PUSH_MIN:g}); a block released from a held tilt is read with "
+            "--release auto, which keeps every test"
         )
     if judge_drift and abs(drift_rad_s) > DRIFT_MAX_RAD_S:
         reasons.append(

@@ -197,3 +197,27 @@ def test_strides_and_a_release_read_as_forced_runs_are_flagged_by_the_missing_pu
     with collecting() as found:
         block_rotation(_forced(0.0)[0], release="none")
     assert found == []
+
+
+def test_cli_text_names_the_kind_of_run_the_impacts_and_the_checks(run_cli, tmp_path):
+    from rocklab.synth import write_ximu3_csv
+
+    log, _ = _pulse_log(0.22, 1)
+    write_ximu3_csv(log, tmp_path / "log")
+    rot = block_rotation(read_imu(tmp_path / "log"))  # the file as the command reads it
+    rc, out, err = run_cli("--strict", "imu", tmp_path / "log")
+    assert rc == 0 and err == ""
+    # the data, not the option, made it a forced run (it used to say "the table moved before the
+    # block turned" also when --release none said so)
+    assert "forced run, no release (the table moved the block from rest upright)" in out
+    n = len(rot.impact_t_s)
+    assert n >= 3
+    listed = f"{n} impacts (theta crosses 0 with a spike or a rate step), " + (
+        "at " + ", ".join(f"{x:.4f}" for x in rot.impact_t_s) if n <= 6 else f"first {rot.impact_t_s[0]:.4f}"
+    )
+    assert listed in out and "meaningless" not in out
+    lateral = float(re.search(r"([\d.e-]+) g RMS along it while turning \(< 0\.15 g\)", out).group(1))
+    assert lateral == pytest.approx(rot.rocking.lateral_acc_m_s2 / G, rel=1e-3) and lateral < 0.01
+    assert "status ok: rests found before and after, gyro and accelerometer agree, the rocking checks pass" in out
+    rc, out, err = run_cli("imu", tmp_path / "log", "--release", "none")
+    assert rc == 0 and err == "" and "forced run, no release (as --release none says)" in out

@@ -37,8 +37,9 @@ Method (``block_rotation``)
    once (slowly, when released near its overturning tilt).  A run read as a
    release is read again as forced when the block rested upright (within
    1 deg of its end rest) and the accelerometer left its rest (by twice its
-   stillness at the start) in the 0.1 s before the rotation's start: a sharp table pulse uplifts a block
-   at once, and a thread holds a block tilted.  In a forced run the upright reference is the *initial* rest
+   stillness at the start) in the 0.1 s before the rotation's start: a
+   sharp table pulse uplifts a block at once, and a thread holds a block
+   tilted.  In a forced run the upright reference is the *initial* rest
    (theta = 0 there), the rest windows end where the table starts / begin
    where it has stopped (accelerometer vector, not only its norm), the end
    rest's tilt is measured by the accelerometer, and ``release_t_s`` is NaN.
@@ -77,6 +78,10 @@ from ._read import ImuLog
 from ._validity import FORCED_PUSH_MIN, RockingCheck, check_rocking, half_swing_peaks, warn_no_rest, warn_not_rocking
 
 __all__ = ["ImuRotation", "block_rotation", "ahrs_rotation", "ahrs_quaternions"]
+
+#: Largest tilt at the start rest, rad, of a block that rested upright (the upright reference's
+#: error, a mis-mount or a sloping table, is < 0.3 deg; a thread holds a block at >= 1 deg).
+UPRIGHT_START_RAD = np.deg2rad(1.0)
 
 
 @dataclass(frozen=True)
@@ -351,11 +356,6 @@ def block_rotation(
         "forced" if forced else "thread",
         rocking,
     )
-
-
-#: Largest tilt at the start rest, rad, of a block that rested upright (the upright reference's
-#: error, a mis-mount or a sloping table, is < 0.3 deg; a thread holds a block at >= 1 deg).
-UPRIGHT_START_RAD = np.deg2rad(1.0)
 
 
 def _judge(log, motion, forced, span, anchoring, state, min_rest_s, push):

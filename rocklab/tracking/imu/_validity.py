@@ -19,6 +19,12 @@ with the leg and rolls: 0.4-0.5 g RMS along its pitch axis in x-io's gait logs,
 against the accelerometer noise (5-15 mg) for simulated rocking. This holds for
 a forced run as for a release (``LATERAL_ACC_MAX_M_S2``).
 
+A forced run's block rests upright and rides its table until the table's
+acceleration uplifts it: the accelerometer leaves its rest before the
+rotation starts. A log read as a forced run whose block starts to turn from
+rest unpushed (a release, a foot) is not one (``FORCED_PUSH_MIN``); the
+message sends it to ``--release auto``, under which every test applies.
+
 A block released from rest (a thread-burn release) only loses energy: each half
 swing's |theta| peak is at most the one before, the first at most the release
 tilt ``|theta0|``.  A foot-mounted sensor while walking pitches about one

@@ -215,7 +215,7 @@ class ColumnValidation:
     n_members : int
     seconds : float
     acc_scale_source : str
-        Where ``uncertainty["acc_scale"]`` comes from (:func:`rocklab.pipelines._validation.acc_scale_sd`)
+        Where ``uncertainty["acc_scale"]`` comes from (the validation's ``acc_scale_sd``)
         and whether a fused table's own error is drawn; empty without a table.
     """
 

@@ -217,8 +217,8 @@ def test_spinning_ball_is_never_ok_off_its_outline():
     lim = _occlusion.DRIFT_FRAC * side + 1.0
     assert d.max() <= lim, (d.max(), lim)
     assert ok >= 0.95
-    # the case does reproduce the slide past the outline's limit (9.8 px while the prediction
-    # dropped an affine fit's scale; 5.9 px since it keeps the template's centre)
+    # the case does reproduce the slide past the outline's limit (9.8 px before the prediction
+    # kept the template's centre and a failed pose was searched round it, 5.9 px after)
     assert d_unchecked.max() > lim
 
 

@@ -37,7 +37,7 @@ import numpy as np
 from ...._errors import InputError
 from ._detection import Detection
 from ._ic import ICAffine, ICRigid
-from ._observability import sigma_theta, theta_unobservable, theta_unverifiable
+from ._observability import sigma_theta, theta_unobservable
 from ._occlusion import ROUND_MIN, cell_correlations, masked_fit, partly_covered
 from ._verify import PoseVerifier, best_turned_match
 
@@ -160,9 +160,8 @@ class MarkerlessTracker:
         self.theta_note, sym = (None, None) if obj.kind == "table" else theta_unobservable(tmpl)
         self.sym0 = None if sym is None else self.origin + sym  # the centre of symmetry, first-frame px
         self.verifier.check_turn = self.theta_note is None
-        #: why the angle is not reported although the texture gives one (a round outline, or a
-        #: region too small or plain for the verification to tell a turned pose), or None
-        self.round_note = None if obj.kind == "table" or self.theta_note else theta_unverifiable(tmpl)
+        #: why the angle is not reported although the texture gives one (a round outline), or None
+        self.round_note = None
         self.views = [0, 0]  # verified frames, and those not a turned copy of the first view
         self.reason = None  # why the last frame was lost ("mismatch", "jump", "background", "lost")
         self.min_cc = MIN_CC

@@ -10,29 +10,17 @@ alike, so its information is the whole gradient. Their ratio,
 is 1/2 for an isotropic texture, about 1/4 for a plain square (its corners), and 0 for a disk,
 a ring or anything rotationally symmetric about the centre: there the registration's angle is
 fixed by noise alone and is not a measurement.
-
-That share is local (the registration's curvature at the right angle). An angle is measured only
-if the verification can also tell a wrong one: a region whose copy turned by the largest turn
-a frame may make (:data:`._verify.MAX_STEP_RAD`) still correlates with it as well as the
-appearance check accepts at best (``1 - APPEARANCE_MADS * MIN_DEVIATION``) is registered at a
-wrong angle as readily as at the right one (a small bob, a few pixels of its string the only cue).
 """
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
-
-from ._verify import APPEARANCE_MADS, MAX_STEP_RAD, MIN_DEVIATION
 
 __all__ = [
     "sigma_theta",
     "turn_share",
-    "turn_ambiguity",
     "symmetry_centre",
     "theta_unobservable",
-    "theta_unverifiable",
     "angle_free_objects",
     "angle_note",
     "warn_theta",
@@ -136,41 +124,6 @@ def theta_unobservable(region):
             f"{100 * share:.3g} %, under {100 * MIN_TURN_SHARE:.3g} %: symmetric or textureless)"
         ), c
     return None, None
-
-
-def theta_unverifiable(region):
-    """Why the angle the registration gives ``region`` (h, w) cannot be verified, or None: turned
-    by the largest step a frame may make it still correlates with itself as well as the
-    verification accepts (the pose is still tracked, its angle not reported)."""
-    same = turn_ambiguity(region, MAX_STEP_RAD)
-    if same < AMBIGUOUS_CC:
-        return None
-    return (
-        f"its appearance barely changes when it turns (turned by {MAX_STEP_RAD:.2g} rad it still "
-        f"correlates {same:.2f} with itself, at least the {AMBIGUOUS_CC:.2g} the verification "
-        "accepts: too small or too plain to tell its angle)"
-    )
-
-
-#: Correlation of a region with its turned copy from which the two cannot be told apart: the
-#: highest appearance limit the verification ever sets (:mod:`._verify`).
-AMBIGUOUS_CC = 1.0 - APPEARANCE_MADS * MIN_DEVIATION
-
-
-def turn_ambiguity(region, turn_rad) -> float:
-    """The lower correlation of ``region`` (h, w) with its copies turned by ``+-turn_rad`` (rad)
-    about its centre (borders replicated): near 1 when a turn of that size does not show."""
-    import cv2
-
-    t = np.asarray(region, np.float32)
-    h, w = t.shape
-    out = 1.0
-    for sign in (-1.0, 1.0):
-        R = cv2.getRotationMatrix2D(((w - 1) / 2, (h - 1) / 2), math.degrees(sign * turn_rad), 1.0)
-        r = cv2.warpAffine(t, R, (w, h), flags=cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)
-        a, b = t - t.mean(), r - r.mean()
-        out = min(out, float((a * b).sum() / (math.sqrt(float((a * a).sum()) * float((b * b).sum())) + 1e-12)))
-    return out
 
 
 def angle_free_objects(config, detector) -> dict:

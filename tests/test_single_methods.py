@@ -62,3 +62,43 @@ def test_output_grid_contract():
     assert np.max(np.abs(steps.theta_rad - direct.theta_rad)) <= 1e-8
     assert np.any(steps.theta_rad != direct.theta_rad)  # really resampled, not the direct samples
     assert steps.n_impacts == direct.n_impacts >= 3
+
+
+@pytest.mark.parametrize("eps", [0.0, 1e-12, 1e-6])
+def test_event_method_ends_when_the_base_only_touches_the_uplift_level(eps):
+    # a record scaled to a_p/a_p,min = 1 (eps = 0: the peak above g tan(alpha) by the least float) lifts
+    # the block at an instant and drops it back at once; method='event' restarted that phase forever.
+    # Reference: the Newmark kernel (rest, theta ~ 0); the event method's impacts all at the two spikes
+    import math
+    import signal
+
+    from rocklab import G
+    from rocklab.series import BaseMotion
+
+    alpha = math.atan(1 / 12)
+    blk = Block.general(0.2, alpha, 4.0 / 3.0)
+    a = np.zeros(50)
+    a[10], a[30] = 1.0, -1.0
+    x = math.tan(blk.alpha_rad) * (1.0 + eps)
+    while True:  # the least scale whose samples exceed tan(alpha) once divided by g, as the kernels test it
+        base = BaseMotion.from_samples(a * x, 0.01, "g")
+        if np.max(np.abs(base.acc_m_s2 / G)) > math.tan(blk.alpha_rad):
+            break
+        x = np.nextafter(x, 2.0)
+
+    def stop(*_):
+        raise TimeoutError("simulate(method='event') did not end within 20 s")
+
+    old = signal.signal(signal.SIGALRM, stop)
+    signal.alarm(20)
+    try:
+        ev = simulate(blk, base=base, duration_s=0.5, method="event", fall_rad=alpha)
+    finally:
+        signal.alarm(0)
+        signal.signal(signal.SIGALRM, old)
+    nm = simulate(blk, base=base, duration_s=0.5, dt_s=1e-4, fall_rad=alpha)
+    assert ev.status == nm.status == "rest"
+    assert nm.n_impacts == 2 and ev.max_abs_theta_rad < 1e-10 and nm.max_abs_theta_rad < 1e-10
+    t_imp = ev.impacts["t_s"].to_numpy()
+    near = np.abs(t_imp[:, None] - np.array([0.1, 0.3])[None, :]) < 1e-6
+    assert near.any(axis=1).all() and near.any(axis=0).all()  # at the spikes only, and at both

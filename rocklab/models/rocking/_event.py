@@ -20,12 +20,17 @@ from ._result import KernelResult, block_energy
 __all__ = ["run_event"]
 
 
-def _next_uplift(t_now, rec_t, rec_a, thr, t_stop):
-    """First time >= t_now where |a| exceeds thr (linear interpolation); None if none."""
+def _next_uplift(t_now, rec_t, rec_a, thr, t_stop, after=False):
+    """First time >= t_now where |a| exceeds thr (linear interpolation); None if none.
+
+    ``after``: the block just failed to leave the corner at ``t_now`` (the base only touched the
+    uplift level there), so the time returned is later than ``t_now``: the crossing after it, or
+    at the latest the next sample above ``thr``.
+    """
     if rec_t is None:
         return None
     a_now = np.interp(t_now, rec_t, rec_a, left=0.0, right=0.0)
-    if abs(a_now) > thr:
+    if abs(a_now) > thr and not after:
         return t_now
     k = np.flatnonzero((rec_t > t_now) & (np.abs(rec_a) > thr) & (rec_t <= t_stop))
     if k.size == 0:
@@ -39,7 +44,8 @@ def _next_uplift(t_now, rec_t, rec_a, thr, t_stop):
         a0 = a_now
     lvl = thr if a1 > 0 else -thr
     fr = (lvl - a0) / (a1 - a0) if a1 != a0 else 0.0
-    return float(t0 + min(max(fr, 0.0), 1.0) * (rec_t[k] - t0))
+    tu = float(t0 + min(max(fr, 0.0), 1.0) * (rec_t[k] - t0))
+    return float(rec_t[k]) if after and tu <= t_now else tu
 
 
 def _phase(t, th, w, s, duration_s, ug, p2, alpha, linearized, fall_rad, ode_method, rtol, atol, max_step):
@@ -136,9 +142,11 @@ def run_event(
     max_abs = abs(th)
     status = "rocking"
     t_end = duration_s
+    after = False  # the last uplift did not leave the corner: look for the next one after it
     while t < duration_s:
         if resting:
-            tu = _next_uplift(t, rec_t, rec_a, tan_a, duration_s)
+            tu = _next_uplift(t, rec_t, rec_a, tan_a, duration_s, after)
+            after = False
             if tu is None or tu >= duration_s or (stop_at_rest and t >= t_last_up):
                 m = t_out >= t - 1e-12
                 th_out[m] = 0.0
@@ -174,14 +182,18 @@ def run_event(
         if sol.t_events[0].size:
             ti = float(sol.t_events[0][0])
             w_m = float(sol.y_events[0][0][1])
+            # lifted from rest and back at the same instant: the base only touched tan(alpha) (e.g. a
+            # record scaled to a_p = a_p,min exactly); without this the same phase restarts forever
+            stuck = ti <= t and th == 0.0 and w == 0.0
             e = law(w_m, len(imps))
             w_p = e * w_m
             imps.append((ti, w_m, w_p, e))
             t, th = ti, 0.0
             u = ug(ti)
             s_base = (-1.0 if u > 0 else 1.0) if abs(u) > tan_a else 0.0
-            if w_p * w_p <= rest_w2 and s_base == 0.0:
+            if w_p * w_p <= rest_w2 and (s_base == 0.0 or stuck):
                 resting = True
+                after = stuck
                 w = 0.0
                 continue
             w = w_p

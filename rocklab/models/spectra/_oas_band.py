@@ -23,11 +23,11 @@ grid reuse its verdicts, the others search each level's first unsafe size near
 its boundary only (``grid="boundary"``; on 12 FEMA records x 5 members t_I,
 t'_I and beta equal their own full adaptive grid's in 60/60).
 
-Measured (with the Newmark runs that were the default before session 13) on the 44 FEMA P695
-far-field records at H/B = 12 against Table 4
-(``benchmarks/oas_fema44.py``): Table 4's t_I lies inside the 5-95 % band for
-29/44, median half-width 8.8 %, 136 s on 2 cores. More members do not close
-the gap honestly: 18 members (adding grid-only and contiguous grid-only search,
+Measured with the Taylor runs (the default since session 13) on the 44 FEMA P695 far-field
+records at H/B = 12 against Table 4 (``benchmarks/oas_fema44.py --bands``): Table 4's t_I lies
+inside the 5-95 % band for 30/44, median half-width 9.3 % (with the Newmark runs before: 29/44,
+8.8 %, 136 s on 2 idle cores; the Taylor time is not yet measured on an idle machine). More
+members do not close the gap honestly (measured with the Newmark runs): 18 members (adding grid-only and contiguous grid-only search,
 eta -2/-3/-5 %, quarter-step level offsets, p h <= 0.005/0.01/0.02) cover at most
 33/44; FF-11, -17, -20 and -37 sit 3-41 % below every member and FF-21, -26, -27,
 -29, -42 and -43 1-43 % above, so those Table 4 rows were computed some way

@@ -10,10 +10,12 @@ boundary, not the area of the grid. Each row's first unsafe size (which sets
 the boundary, hence t_I) gets a last check of the ``frontier`` sizes before it.
 
 Measured against the dense grid (every point simulated) on the 44 FEMA P695
-far-field records at H/B = 12, Newmark runs (the default before session 13; ``benchmarks/oas_fema44.py``):
-99.93 % of the 422 400 verdicts identical (worst record 99.78 %), t_I
-identical on 44/44 records and t'_I on 42/44, 19.9 % of the grid simulated,
-25 s against 63 s for the 44 OAS on 2 cores. What it can miss: islands smaller
+far-field records at H/B = 12 with the Taylor runs (the default since session 13;
+``benchmarks/oas_fema44.py --grid``): 99.92 % of the 422 400 verdicts identical (worst
+record 99.77 %), t_I identical on 43/44 records and t'_I on 42/44, 19.8 % of the grid
+simulated, 3.47x less time than the dense grid (191.6 s against 665.1 s on one thread of a
+machine loaded by other work). With the Newmark runs before: 99.93 % (worst 99.78 %), t_I
+44/44, t'_I 42/44, 25 s against 63 s on 2 idle cores. What it can miss: islands smaller
 than a coarse cell that touch no coarse point and lie away from the boundary.
 """
 

@@ -37,7 +37,6 @@ from numba import njit, prange
 from ...blocks import G
 from ._newmark_lean import sdcd
 from ._taylor import series_root, series_slope, series_value
-from ._taylor_unrolled import coefficients_unrolled
 
 __all__ = ["run_taylor_record", "order_for", "MAX_ORDER"]
 
@@ -262,8 +261,7 @@ def run_one(p, alpha, eta, scale, th0, w0, acc, t0, dta, duration, order, max_p_
             if (n_steps & 31) == 0:  # re-anchor the carried sin/cos against rounding drift
                 sc = math.sin(alpha * s - th)
                 cc = math.cos(alpha * s - th)
-            if not coefficients_unrolled(a, S, C, th, w, p2, sc, cc, u0, du, n):
-                _coefficients(a, S, C, th, w, p2, sc, cc, u0, du, n)
+            _coefficients(a, S, C, th, w, p2, sc, cc, u0, du, n)
             y_h = s * series_value(a, n, h)
             w_h = s * series_slope(a, n, h)
             kind, tau = _step_event(a, da, n, h, th, w, s, fall_rad, y_h, w_h)

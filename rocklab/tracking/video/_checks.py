@@ -54,7 +54,8 @@ def look(gray, box):
 
 
 def why_lost(now, ref):
-    """Reason for a lost target from its last window now vs at the last good detection.
+    """Reason for a lost target from its last window now vs at the last good detection (asked only
+    while the object cannot have left that window: :func:`may_have_left`).
 
     "blur": fine detail gone (Laplacian variance < 35 %) but the black/white
     contrast still there (grey std > 25 %); "occluded": the contrast itself is
@@ -68,6 +69,69 @@ def why_lost(now, ref):
     if sharp < BLUR_RATIO * ref[0]:
         return "blur"
     return "lost"
+
+
+#: A cut to another shot (a title card, a lead-in, an edit): the mean grey change to the next
+#: frame, at :data:`CUT_WIDTH_PX` wide, more than ``CUT_FACTOR`` times the film's median change
+#: and at least ``CUT_MIN_DN`` (the real films: 24.8 and 29.0 DN at the title cards of a film
+#: whose frames change by 2.5 DN, 100.8 DN where a black lead-in ends).
+CUT_FACTOR = 6.0
+CUT_MIN_DN = 12.0
+CUT_WIDTH_PX = 160.0
+
+
+def small_grey(gray) -> np.ndarray:
+    """``gray`` at most :data:`CUT_WIDTH_PX` wide, float32, for comparing whole frames."""
+    import cv2
+
+    s = min(1.0, CUT_WIDTH_PX / gray.shape[1])
+    g = gray if s == 1.0 else cv2.resize(gray, None, fx=s, fy=s, interpolation=cv2.INTER_AREA)
+    return g.astype(np.float32)
+
+
+def cut_limit(steps) -> float:
+    """The change between two frames (DN, :func:`small_grey`) above which it is a cut, from the
+    film's own changes ``steps``; inf while fewer than 3 are known."""
+    return max(CUT_FACTOR * float(np.median(steps)), CUT_MIN_DN) if len(steps) >= 3 else math.inf
+
+
+def check_cuts(steps, frames, path) -> None:
+    """W-VIDEO-CUT when the tracked frames cut to another shot: ``steps[i]`` is the change (DN)
+    from frame ``frames[i]`` to ``frames[i + 1]``."""
+    steps = np.asarray(steps, float)
+    limit = cut_limit(steps)
+    at = [int(frames[i + 1]) for i in np.flatnonzero(steps > limit)]
+    if not at:
+        return
+    first = (
+        f"; the first frame tracked, {frames[0]}, is another shot (a title card, a lead-in): the objects' "
+        f"templates and the background come from it, so set [video] start_frame = {at[0]}"
+        if at[0] == frames[1]
+        else "; the frames after a cut show another scene: track a span without one ([video] start_frame, stop_frame)"
+    )
+    warn(
+        "W-VIDEO-CUT",
+        f"{path}: the film cuts to another shot at frame(s) {', '.join(map(str, at[:5]))} (the picture "
+        f"changes by {steps.max():.3g} grey levels against {float(np.median(steps)):.3g} a frame){first}",
+    )
+
+
+def last_seen(prev, frame: int, centre_px) -> tuple:
+    """An object's last ok frame, its centre (px) and its speed (px/frame, from the ok frame
+    before: 0 for the first), given ``prev``, the same for the ok frame before (or None)."""
+    c = np.asarray(centre_px, float)
+    if prev is None or frame <= prev[0]:
+        return frame, c, 0.0
+    return frame, c, float(np.hypot(*(c - prev[1]))) / (frame - prev[0])
+
+
+def may_have_left(seen, frame: int, box) -> bool:
+    """Whether an object last seen at ``seen`` (:func:`last_seen`) may have moved out of its last
+    window ``box`` (u0, v0, u1, v1 px) by ``frame``: at its last speed, farther than a quarter of
+    the window's smaller side. Then how that window looks says nothing about the object (it left
+    it: lost, not occluded nor blurred)."""
+    f, _, speed = seen
+    return speed * (frame - f) > 0.25 * min(box[2] - box[0], box[3] - box[1])
 
 
 def check_frames(res, expected: int, path, info=None) -> None:

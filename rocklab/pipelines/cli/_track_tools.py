@@ -164,26 +164,9 @@ def track_init(
     if not regions and troi is None:
         found = find_markers(gray)
         if found is None:
-            props, window = _propose(video, info, gray, start)
-            if not props.blocks:
-                if preview is not None:
-                    save_bgr_png(Path(preview), draw_grid(img), side=side[1])
-                what = "nothing moves" if not props.still else _still_text(props.still) + ", and nothing else moves"
-                raise InputError(
-                    f"{video}: no ArUco/AprilTag marker in frame {start} and {what} in the "
-                    f"{window:.3g} s from it{' (' + lead_note + ')' if lead_note else ''}; give the objects as "
-                    "--object NAME=x,y,w,h (and --table x,y,w,h)"
-                    + (f", read off the pixel grid in {preview}" if preview is not None else "")
-                    + ", or --start-frame N where the motion starts"
-                )
-            regions = {f"block_{k}": b for k, b in enumerate(props.blocks, start=1)}
-            troi = props.table if props.table_moves else None
-            if props.table_edge is not None and not props.table_moves:
-                line = tuple(tuple(round(float(v), 1) for v in p) for p in props.table_edge.ends_px)
-            proposed = tuple(f"--object {n}={_box_text(b)}" for n, b in regions.items())
-            if troi is not None:
-                proposed += (f"--table {_box_text(troi)}",)
-            pnotes = _proposal_notes(props, window, gray.size)
+            regions, troi, line, proposed, pnotes = _from_motion(
+                video, info, gray, img, start, lead_note, preview, side
+            )
     lens_rel = None
     if lens is not None:
         import os
@@ -220,6 +203,36 @@ def track_init(
     if preview is not None:
         save_bgr_png(Path(preview), draw_init_preview(img, cfg, found, grid=found is None), side=side[1])
     return cfg, notes, proposed
+
+
+def _from_motion(video, info, gray, img, start, lead_note, preview, side):
+    """Objects proposed from what moves after frame ``start`` (film without markers or regions):
+    (regions, table region, level line, proposals as options, notes); an InputError, after the
+    pixel grid is written to ``preview``, when nothing trackable moves."""
+    from .._plotting import save_bgr_png
+
+    line = None
+    props, window = _propose(video, info, gray, start)
+    if not props.blocks:
+        if preview is not None:
+            save_bgr_png(Path(preview), draw_grid(img), side=side[1])
+        what = "nothing moves" if not props.still else _still_text(props.still) + ", and nothing else moves"
+        raise InputError(
+            f"{video}: no ArUco/AprilTag marker in frame {start} and {what} in the "
+            f"{window:.3g} s from it{' (' + lead_note + ')' if lead_note else ''}; give the objects as "
+            "--object NAME=x,y,w,h (and --table x,y,w,h)"
+            + (f", read off the pixel grid in {preview}" if preview is not None else "")
+            + ", or --start-frame N where the motion starts"
+        )
+    regions = {f"block_{k}": b for k, b in enumerate(props.blocks, start=1)}
+    troi = props.table if props.table_moves else None
+    if props.table_edge is not None and not props.table_moves:
+        line = tuple(tuple(round(float(v), 1) for v in p) for p in props.table_edge.ends_px)
+    proposed = tuple(f"--object {n}={_box_text(b)}" for n, b in regions.items())
+    if troi is not None:
+        proposed += (f"--table {_box_text(troi)}",)
+    pnotes = _proposal_notes(props, window, gray.size)
+    return regions, troi, line, proposed, pnotes
 
 
 def _box_text(b) -> str:

@@ -22,18 +22,18 @@ from ..._diagnostics import warn
 from ..._errors import InputError
 from .._corrections import apply_corrections, load_corrections
 from ._checks import (
+    CUT_MIN_DN,
     check_cuts,
     check_frames,
     check_rate,
-    cut_limit,
     interpolate,
     last_seen,
     look,
-    may_have_left,
+    lost_status,
     region_leaves,
+    ring_look,
     small_grey,
     tee,
-    why_lost,
 )
 from ...config import TrackConfig
 from ._camera_model import PlaneMap, fit_similarity
@@ -123,8 +123,8 @@ def track_frames(frames, config: TrackConfig, plane_map: PlaneMap | None = None)
     det = None
     min_q = config.targets.min_quality
     boxes, sharp_ref = {}, {}
-    seen = {}  # object -> (frame, centre px, speed px/frame) at its last ok frame
-    prev, steps, indices = None, [], []  # the whole frame's changes: cuts to another shot
+    rings, seen = {}, {}  # object -> at its last ok frame: the ring round its window; (frame, centre, speed)
+    prev, steps, cuts, indices = None, [], [], []  # the whole frame's changes, cuts to another shot
     scales = {}  # object -> recent scales of complete detections
     for k, item in enumerate(frames):
         idx, gray = item if isinstance(item, tuple) else (k, item)
@@ -136,9 +136,13 @@ def track_frames(frames, config: TrackConfig, plane_map: PlaneMap | None = None)
             det = make_detector(config, plane_map, gray)
             free = angle_free_objects(config, det)
         small = small_grey(gray)
-        cut = prev is not None and (step := float(np.mean(np.abs(small - prev)))) > cut_limit(steps)
+        cut = False
         if prev is not None:
-            steps.append(step)
+            change = np.abs(small - prev)
+            steps.append(float(change.mean()))
+            cut = float(np.median(change)) >= CUT_MIN_DN  # most of the picture changed
+            if cut:
+                cuts.append(idx)
         prev = small
         indices.append(idx)
         with one_blas_thread():
@@ -191,6 +195,7 @@ def track_frames(frames, config: TrackConfig, plane_map: PlaneMap | None = None)
                 u, v = d.img_pts[:, 0], d.img_pts[:, 1]
                 box = (int(max(u.min(), 0)), int(max(v.min(), 0)), int(u.max()) + 1, int(v.max()) + 1)
                 boxes[o.id] = box
+                rings[o.id] = ring_look(gray, box)
                 seen[o.id] = last_seen(seen.get(o.id), idx, d.img_pts.mean(axis=0))
                 if o.id not in sharp_ref or k % 25 == 0:
                     sharp_ref[o.id] = look(gray, box)
@@ -199,11 +204,11 @@ def track_frames(frames, config: TrackConfig, plane_map: PlaneMap | None = None)
                 why = det.lost_reason(o.id) if hasattr(det, "lost_reason") else None
                 if why is not None:
                     status = why  # the pose was fitted but does not re-explain the image
-                elif o.id in boxes and not cut and not may_have_left(seen[o.id], idx, boxes[o.id]):
-                    status = why_lost(look(gray, boxes[o.id]), sharp_ref.get(o.id))
+                elif o.id in boxes and not cut:  # a cut shows another scene: only "lost" is true
+                    status = lost_status(gray, boxes[o.id], sharp_ref.get(o.id), rings[o.id], seen[o.id], idx)
                 obs.append(Observation(idx, o.id, *(np.nan,) * 7, status, getattr(d, "metric", True), plane_map.source))
         yield obs
-    check_cuts(steps, indices, config.source or "the film")
+    check_cuts(steps, cuts, indices, config.source or "the film")
 
 
 @dataclass(frozen=True)

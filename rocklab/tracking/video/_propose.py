@@ -9,7 +9,11 @@ exposure hunting does not count as motion. Connected regions of that mask, close
 texture's gaps and merged when they touch, are the proposals: boxes in first-frame pixels.
 Parts thinner than :data:`THIN_PX` (a pendulum's string sweeping the wall) are dropped first,
 a merge that would cover most of the frame leaves its parts apart, and a box narrower than the
-markerless tracker's smallest region is no proposal.
+markerless tracker's smallest region is no proposal. Nor is a box whose own first-frame content stays in
+place in the samples (:func:`stays_in_place`): it is mostly still things round a moving part
+(a stand round the stick sliding off it), and a tracker would follow the still things. The
+first frame is the first of the film's scene: :func:`lead_in` finds blank, fading-in or title
+frames before it.
 
 The table is the long straight horizontal edge a block stands on: searched just below each
 proposal's bottom, on either side of it, and accepted only when

@@ -98,6 +98,24 @@ def cut_limit(steps) -> float:
     return max(CUT_FACTOR * float(np.median(steps)), CUT_MIN_DN) if len(steps) >= 3 else math.inf
 
 
+#: ... from a picture with texture to another: the grey levels of the changed pixels spread by
+#: at least this on both sides (a grey card over two thirds of a rendered film, put in front and
+#: taken away: 1.5 DN on its side; a cover is an occluder, not a cut).
+CUT_TEXTURE_DN = 5.0
+
+
+def is_cut(before, after) -> bool:
+    """Whether frame ``after`` follows ``before`` (both :func:`small_grey`) by a cut to another
+    shot: most of the picture changed (the median pixel by :data:`CUT_MIN_DN`), from texture to
+    texture (:data:`CUT_TEXTURE_DN`): a flat cover put in front or taken away (a hand, a card)
+    is an occluder, and a lead-in from black is found by ``track init``."""
+    change = np.abs(after - before)
+    if float(np.median(change)) < CUT_MIN_DN:
+        return False
+    moved = change >= CUT_MIN_DN
+    return min(float(before[moved].std()), float(after[moved].std())) >= CUT_TEXTURE_DN
+
+
 def check_cuts(steps, cuts, frames, path) -> None:
     """W-VIDEO-CUT when the tracked frames cut to another shot: ``cuts``, the frames at which most
     of the picture changed (the median pixel by :data:`CUT_MIN_DN`), or a first frame tracked that

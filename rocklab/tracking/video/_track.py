@@ -22,8 +22,8 @@ from ..._diagnostics import warn
 from ..._errors import InputError
 from .._corrections import apply_corrections, load_corrections
 from ._checks import (
-    CUT_MIN_DN,
     check_cuts,
+    is_cut,
     check_frames,
     check_rate,
     interpolate,
@@ -138,9 +138,8 @@ def track_frames(frames, config: TrackConfig, plane_map: PlaneMap | None = None)
         small = small_grey(gray)
         cut = False
         if prev is not None:
-            change = np.abs(small - prev)
-            steps.append(float(change.mean()))
-            cut = float(np.median(change)) >= CUT_MIN_DN  # most of the picture changed
+            steps.append(float(np.mean(np.abs(small - prev))))
+            cut = is_cut(prev, small)
             if cut:
                 cuts.append(idx)
         prev = small

@@ -14,9 +14,11 @@ $(STAMP): pyproject.toml
 	$(PY) -m pip install --quiet -e ".[test]"
 	@touch $(STAMP)
 
-# pytest exit code 5 (no tests collected) is a failure too.
+# pytest exit code 5 (no tests collected) is a failure too. One worker per core (pytest-xdist), a
+# test file to one worker so its module fixtures are built once; TEST_WORKERS=0 runs in this process.
+TEST_WORKERS ?= auto
 test: $(STAMP)
-	$(PY) -m pytest -q
+	$(PY) -m pytest -q $(if $(filter 0,$(TEST_WORKERS)),,-n $(TEST_WORKERS) --dist loadfile)
 
 # real-browser tests: Debian's Chromium (installed here when root and apt allow) driven by
 # Playwright from PyPI, pointed at that Chromium (no browser download). Skips, saying why,

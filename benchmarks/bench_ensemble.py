@@ -21,7 +21,9 @@ with the true η, η ± 5 % and Housner's η; η_e is fitted from its half cycle
 IMU fused with the film, as ``rocklab run`` makes it; the IMU's scale is off by a draw of
 ``IMU_SCALE_SD`` (1 %) and the film's by one of ``FILM_SCALE_SD`` (0.3 %), and the ensembles
 sample the scale uncertainty the two sources' agreement measured (``--scale-prior``: the 1 %
-prior instead, as before it was measured).
+prior instead, as before it was measured) and the fused table's own error
+(``rocklab.fitting.fused_error_draw``: its smoother's σ, with the spectrum measured on rendered
+synthetic sessions).
 """
 
 from __future__ import annotations

@@ -137,9 +137,12 @@ WARNING_CODES: dict[str, tuple[str, str]] = {
         "the log is not a rocking block: its rotation axis is far from horizontal (a spin "
         "about the vertical), the rotation is spread over several axes (a hand-held sensor), "
         "it turns through more than a half turn, holding the rests needs a large gyro "
-        "drift, or, released from rest, its half swings grow (a foot while walking; a released "
-        "block only loses energy); theta, release and impacts mean nothing. Check the file and "
-        "the mounting (a shake-table run read as a release: --release none)",
+        "drift, it accelerates along the rocking axis while it turns (a foot while walking, "
+        "whatever --release says: a rocking edge stays put along itself), released from rest "
+        "its half swings grow (a released block only loses energy), or, read as a forced run, "
+        "it starts to turn with no push from a table; theta, release and impacts mean nothing. "
+        "Check the file and the mounting (a shake-table run read as a release: --release none; "
+        "a release read as a forced run: --release auto; each keeps every other test)",
     ),
     "W-IMU-NO-REST": (
         "suspect",

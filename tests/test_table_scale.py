@@ -77,9 +77,9 @@ def test_agreeing_sources_leave_the_shared_floor_and_disagreeing_ones_their_diff
 
 
 def test_validation_samples_the_measured_scale_and_keeps_the_prior_for_one_source():
-    """The single-block validation's input uncertainty takes a fused table's measured scale sd; an IMU
-    table alone keeps ACC_SCALE_SD (1 %). The column's keeps the prior for both: its ensemble does not
-    sample a fused table's own error, which the prior covers."""
+    """The single-block and the column validations' input uncertainty take a fused table's measured
+    scale sd and draw its own error (acc_fused 1, from its smoother's σ); an IMU table alone keeps
+    ACC_SCALE_SD (1 %) and draws no fused error."""
     import dataclasses
     from types import SimpleNamespace
 
@@ -90,7 +90,9 @@ def test_validation_samples_the_measured_scale_and_keeps_the_prior_for_one_sourc
     t = np.arange(0, 4, 1 / 256.0)
     a = np.where(t > 1.0, np.sin(2 * np.pi * (t - 1.0)), 0.0) + 0.01 * np.random.default_rng(0).standard_normal(t.size)
     imu = TableMotion.from_acceleration(t, a, "imu")
-    fused = dataclasses.replace(imu, source="fused", acc_noise_m_s2=0.01, acc_scale_sd=0.0031)
+    fused = dataclasses.replace(
+        imu, source="fused", acc_noise_m_s2=0.01, acc_scale_sd=0.0031, sigma_ax_m_s2=np.full(t.size, 0.02)
+    )
     cfg = SimpleNamespace(table=SimpleNamespace(source="imu"), path="synthetic")
     y = np.r_[np.zeros(50), 0.01 * np.sin(np.arange(150) / 5.0)] + 1e-4 * np.random.default_rng(1).standard_normal(200)
     assert _uncertainty(cfg, imu, None, y, [])[0].acc_scale == ACC_SCALE_SD == 0.01
@@ -98,5 +100,8 @@ def test_validation_samples_the_measured_scale_and_keeps_the_prior_for_one_sourc
     assert acc_scale_sd(fused)[1].startswith("measured") and acc_scale_sd(imu)[1].startswith("prior")
     tv = np.arange(200) / 50.0
     th = y[:, None] * np.ones((1, 2))
-    assert _column_uncertainty(None, tv, th, 1.0, fused).acc_scale == 0.01
-    assert _column_uncertainty(None, tv, th, 1.0, imu).acc_scale == 0.01
+    assert _uncertainty(cfg, fused, None, y, [])[0].acc_fused == 1.0
+    assert _uncertainty(cfg, imu, None, y, [])[0].acc_fused == 0.0
+    col_fused, col_imu = (_column_uncertainty(None, tv, th, 1.0, tab) for tab in (fused, imu))
+    assert col_fused.acc_scale == 0.0031 and col_fused.acc_fused == 1.0
+    assert col_imu.acc_scale == 0.01 and col_imu.acc_fused == 0.0

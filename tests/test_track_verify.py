@@ -217,7 +217,9 @@ def test_spinning_ball_is_never_ok_off_its_outline():
     lim = _occlusion.DRIFT_FRAC * side + 1.0
     assert d.max() <= lim, (d.max(), lim)
     assert ok >= 0.95
-    assert d_unchecked.max() > 2 * lim  # the case does reproduce the slide
+    # the case does reproduce the slide past the outline's limit (9.8 px before the prediction
+    # kept the template's centre and a failed pose was searched round it, 5.9 px after)
+    assert d_unchecked.max() > lim
 
 
 @pytest.mark.slow

@@ -36,6 +36,7 @@ from ._impacts import (
     find_crossings,
     per_impact_eta,
 )
+from ._table_error import FUSED_ERROR_BANDS_HZ, FUSED_ERROR_Z_VAR, fused_error_draw
 from ._laws import alpha_from_hb, edge_contact_k, eta_housner, eta_modified, k_from_eta
 from ._regression import CEH_EQ19, REGRESSION_FORMS, KPrediction, KRegression, fit_k_regression
 from ._repeats import RepeatSummary, campaign_table, fit_many, summarize_repeats
@@ -63,6 +64,9 @@ __all__ = [
     "simulate_ensemble",
     "error_budget",
     "BUDGET_SOURCES",
+    "fused_error_draw",
+    "FUSED_ERROR_BANDS_HZ",
+    "FUSED_ERROR_Z_VAR",
     "judge_law",
     "response_statistics",
     "simulate_column_ensemble",

@@ -4,7 +4,7 @@ A column's response is judged by what the thesis compares (§4.2–4.3, Figs. 29
 joint opens or closes, in which direction, and when. :func:`simulate_column_ensemble` runs ``n``
 column simulations sampling what the run does not know exactly (:class:`InputUncertainty`: each
 level's width and height, the start angle of each joint that starts open, and under a moving table its acceleration's
-noise, bias, scale and clock); :func:`judge_column` reads every member's opening/closing sequence
+noise, bias, scale and clock, and a fused table's own error, :func:`rocklab.fitting.fused_error_draw`); :func:`judge_column` reads every member's opening/closing sequence
 from its block angles exactly as the measured one is read (:func:`rocklab.models.joint_sequence`,
 same threshold, same samples) and compares:
 
@@ -25,8 +25,10 @@ same threshold, same samples) and compares:
   horizon are missed, the count's p-value is below 0.01 (one missed event alone may be a
   measurement's glitch), or fewer than :data:`COVERAGE_INCONSISTENT` of the measured samples lie
   inside the band (the true model held 0.89–1.0 on synthetic columns, a wrong impact count 0.19–0.65); ``consistent`` when every event inside the horizon is matched, at least
-  two are (fewer decide nothing) and the count's p-value is at least 0.05; otherwise
-  ``undecided``.
+  two are (fewer decide nothing), the count's p-value is at least 0.05 and at least
+  :data:`COVERAGE_CONSISTENT` of the measured samples lie inside the band (as for a single block:
+  a model whose band misses the measurement has not been shown to agree with it, whatever its
+  events); otherwise ``undecided``.
   ``band_coverage`` is the fraction of measured samples (every level) inside the 5–95 % band of
   the predicted measurement (member plus measurement noise); it is reported beside the verdict:
   after the horizon a chaotic column's band is a statement about statistics, not about θ(t).
@@ -39,7 +41,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ._ensemble import DEFAULT_ENSEMBLE_SIZE, HORIZON_FRACTION, InputUncertainty, table_draw
+from ._ensemble import DEFAULT_ENSEMBLE_SIZE, HORIZON_FRACTION, InputUncertainty, finite_table, table_draw
 
 __all__ = [
     "ColumnEnsemble",
@@ -49,6 +51,7 @@ __all__ = [
     "EVENT_THRESHOLD_RAD",
     "MISSED_PROBABILITY",
     "COVERAGE_INCONSISTENT",
+    "COVERAGE_CONSISTENT",
 ]
 
 #: A joint counts as open when its relative rotation passes this (rad; closed again below half).
@@ -57,6 +60,8 @@ EVENT_THRESHOLD_RAD = 0.005
 MISSED_PROBABILITY = 0.05
 #: A model whose band holds less than this fraction of the measured samples is inconsistent.
 COVERAGE_INCONSISTENT = 0.5
+#: A model is only called consistent when its band holds at least this fraction of the measured samples.
+COVERAGE_CONSISTENT = 0.9
 _P_INCONSISTENT, _P_CONSISTENT = 0.01, 0.05
 #: Event times on the measured frame grid differ by whole frames only up to rounding (at 50 fps
 #: 0.80 - 0.78 = 0.020000000000000018 s); the tolerance allows this much more, s (as
@@ -93,14 +98,12 @@ class ColumnEnsemble:
     seconds: float = 0.0
 
 
-def _member_base(table_t_s, table_acc_m_s2, unc, rng, t_start_s):
+def _member_base(table_t_s, table_acc_m_s2, unc, rng, t_start_s, table_sigma_m_s2=None):
     """One draw of the measured table acceleration as a BaseMotion on 1 ms (None without a table)."""
     if table_t_s is None:
         return None
-    tt = np.asarray(table_t_s, float)
-    aa = np.asarray(table_acc_m_s2, float)
-    fin = np.isfinite(tt) & np.isfinite(aa)
-    return table_draw(tt[fin], aa[fin], unc, rng, t_start_s)
+    tt, aa, sg = finite_table(table_t_s, table_acc_m_s2, table_sigma_m_s2)
+    return table_draw(tt, aa, unc, rng, t_start_s, sigma_m_s2=sg)
 
 
 def _member_column(column, unc, rng):
@@ -139,6 +142,7 @@ def simulate_column_ensemble(
     threshold_rad: float = EVENT_THRESHOLD_RAD,
     meas_offset_rad: float = 0.0,
     seed: int = 0,
+    table_sigma_m_s2=None,
 ) -> ColumnEnsemble:
     """Simulate ``n`` members of a column run, sampling :class:`InputUncertainty`.
 
@@ -173,6 +177,9 @@ def simulate_column_ensemble(
         plus one offset per level plus ``unc.meas_noise_rad`` white noise), as the measured one is.
     seed : int
         Same seed, same members.
+    table_sigma_m_s2 : array_like, (k,), optional
+        A fused table's per-sample σ (m/s²): its own error is drawn at ``unc.acc_fused`` times it
+        (:func:`rocklab.fitting.fused_error_draw`).
 
     Returns
     -------
@@ -188,7 +195,7 @@ def simulate_column_ensemble(
     span = float(t_out[-1] - t_start_s)
     t0 = time.perf_counter()
     for i in range(n):
-        base = _member_base(table_t_s, table_acc_m_s2, unc, rng, t_start_s)
+        base = _member_base(table_t_s, table_acc_m_s2, unc, rng, t_start_s, table_sigma_m_s2)
         col = _member_column(column, unc, rng)
         th0 = _member_theta0(col, theta0_rad, unc, rng)
         r = simulate_column(
@@ -389,7 +396,9 @@ def judge_column(
     score = float(np.mean([ev["probability"] for ev in inside])) if inside else 1.0
     if n_missed >= 2 or tests["n_events_inside"] < _P_INCONSISTENT or coverage < COVERAGE_INCONSISTENT:
         verdict = "inconsistent"
-    elif n_in >= 2 and n_match == n_in and tests["n_events_inside"] >= _P_CONSISTENT:
+    elif (
+        n_in >= 2 and n_match == n_in and tests["n_events_inside"] >= _P_CONSISTENT and coverage >= COVERAGE_CONSISTENT
+    ):
         verdict = "consistent"
     else:
         verdict = "undecided"

@@ -5,7 +5,9 @@ chaotic, so an error of a few per mil in the measured table motion moves it by a
 fraction of α within a few impacts. :func:`simulate_ensemble` runs ``n`` simulations
 (default :data:`DEFAULT_ENSEMBLE_SIZE` = 64) that sample what the run does not know
 exactly (:class:`InputUncertainty`): white noise on every table acceleration sample, a
-constant bias and a scale error of the table acceleration, the clock offset between table and block, the block's width and
+constant bias and a scale error of the table acceleration, the clock offset between table and block, a
+table fused from its IMU and the film's own error (its smoother's σ per sample, with the spectrum measured
+on synthetic sessions: :func:`rocklab.fitting.fused_error_draw`), the block's width and
 height, the start angle and the law's η. :func:`judge_law` compares the measured θ(t)
 with it:
 
@@ -72,6 +74,9 @@ class InputUncertainty:
         Noise of the measured θ, rad (widens the predicted-measurement band).
     acc_scale : float
         Relative error of the table acceleration's scale (an accelerometer's sensitivity), -.
+    acc_fused : float
+        Multiple of a fused table's own error drawn (:func:`rocklab.fitting.fused_error_draw`, from
+        the per-sample σ given to the ensemble): 1 as measured, 0 none, -.
     """
 
     acc_noise_m_s2: float
@@ -81,6 +86,7 @@ class InputUncertainty:
     theta0_rad: float
     meas_noise_rad: float
     acc_scale: float = 0.0
+    acc_fused: float = 0.0
 
     def to_dict(self) -> dict:
         return {k: float(v) for k, v in self.__dict__.items()}
@@ -111,7 +117,7 @@ class Ensemble:
     seconds: float = 0.0
 
 
-def table_draw(tt, aa, unc, rng, t_start_s: float, sign: float = 1.0):
+def table_draw(tt, aa, unc, rng, t_start_s: float, sign: float = 1.0, sigma_m_s2=None):
     """One draw of a measured table acceleration within its uncertainty, as the simulator's input.
 
     Parameters
@@ -119,12 +125,15 @@ def table_draw(tt, aa, unc, rng, t_start_s: float, sign: float = 1.0):
     tt, aa : ndarray (n,)
         The measured table's times (s) and acceleration (m/s²), finite.
     unc : InputUncertainty
-        Scale, white noise, bias and sync errors drawn, in that order, from ``rng``.
+        Scale, white noise, bias and sync errors drawn, in that order, from ``rng``; then, with
+        ``sigma_m_s2`` and ``unc.acc_fused`` > 0, the fused table's own error.
     rng : numpy.random.Generator
     t_start_s : float
         The simulation's start on the measurement's clock, s.
     sign : float
         -1 mirrors the table (the measurement's θ counter-clockwise, the simulator's clockwise).
+    sigma_m_s2 : ndarray (n,), optional
+        A fused table's per-sample standard deviation (``TableMotion.sigma_ax_m_s2``), m/s².
 
     Returns
     -------
@@ -134,13 +143,28 @@ def table_draw(tt, aa, unc, rng, t_start_s: float, sign: float = 1.0):
     from scipy.interpolate import CubicSpline
 
     from ..series import BaseMotion
+    from ._table_error import fused_error_draw
 
     a = aa * (1.0 + unc.acc_scale * rng.standard_normal())
     a += unc.acc_noise_m_s2 * rng.standard_normal(aa.size) + unc.acc_bias_m_s2 * rng.standard_normal()
     ts = tt + unc.sync_s * rng.standard_normal()
+    if sigma_m_s2 is not None and unc.acc_fused > 0:
+        a += fused_error_draw(tt, sigma_m_s2, rng, unc.acc_fused)
     tf = np.arange(ts[0], ts[-1], 1e-3)
     af = CubicSpline(ts, a)(tf)
     return BaseMotion.from_samples(sign * af, 1e-3, t0_s=float(tf[0]) - t_start_s, units="m/s2", name="table")
+
+
+def finite_table(table_t_s, table_acc_m_s2, table_sigma_m_s2):
+    """(t, a, σ or None) of a measured table at the samples where all given are finite."""
+    tt = np.asarray(table_t_s, float)
+    aa = np.asarray(table_acc_m_s2, float)
+    fin = np.isfinite(tt) & np.isfinite(aa)
+    if table_sigma_m_s2 is None:
+        return tt[fin], aa[fin], None
+    sg = np.asarray(table_sigma_m_s2, float)
+    fin &= np.isfinite(sg)
+    return tt[fin], aa[fin], sg[fin]
 
 
 def simulate_ensemble(
@@ -158,6 +182,7 @@ def simulate_ensemble(
     sign: float = -1.0,
     dt_s: float = 1e-4,
     seed: int = 0,
+    table_sigma_m_s2=None,
 ) -> Ensemble:
     """Simulate ``n`` members of a base-excited run, sampling :class:`InputUncertainty`.
 
@@ -181,6 +206,8 @@ def simulate_ensemble(
         Simulator step, s.
     seed : int
         Same seed, same members.
+    table_sigma_m_s2 : array_like, (k,), optional
+        A fused table's per-sample σ (m/s²): its own error is drawn at ``unc.acc_fused`` times it.
 
     Returns
     -------
@@ -192,10 +219,7 @@ def simulate_ensemble(
     from ..models import simulate
 
     rng = np.random.default_rng(seed)
-    tt = np.asarray(table_t_s, float)
-    aa = np.asarray(table_acc_m_s2, float)
-    fin = np.isfinite(tt) & np.isfinite(aa)
-    tt, aa = tt[fin], aa[fin]
+    tt, aa, sg = finite_table(table_t_s, table_acc_m_s2, table_sigma_m_s2)
     t_out = np.asarray(t_out_s, float)
     out = np.empty((n, t_out.size))
     etas = np.clip(eta + eta_sd * rng.standard_normal(n), -1.0, 1.0)
@@ -203,7 +227,7 @@ def simulate_ensemble(
     t0 = time.perf_counter()
     span = float(t_out[-1] - t_start_s)
     for i in range(n):
-        base = table_draw(tt, aa, unc, rng, t_start_s, sign)
+        base = table_draw(tt, aa, unc, rng, t_start_s, sign, sg)
         b = block.b_m + unc.length_m * rng.standard_normal()
         h = block.h_m + unc.length_m * rng.standard_normal()
         blk = Block(b, h, depth_m=block.depth_m, mass_kg=block.mass_kg, alpha_I=block.alpha_I)
@@ -417,7 +441,9 @@ def judge_law(
 
 
 #: The sources an error budget separates: a field of :class:`InputUncertainty`, or ``eta``.
-BUDGET_SOURCES = ("acc_noise_m_s2", "acc_bias_m_s2", "acc_scale", "sync_s", "length_m", "theta0_rad", "eta")
+BUDGET_SOURCES = (
+    "acc_noise_m_s2", "acc_bias_m_s2", "acc_scale", "acc_fused", "sync_s", "length_m", "theta0_rad", "eta",
+)  # fmt: skip
 
 
 def error_budget(
@@ -434,6 +460,7 @@ def error_budget(
     t_end_s: float | None = None,
     n: int = 32,
     seed: int = 0,
+    table_sigma_m_s2=None,
 ) -> dict:
     """How much of the model's spread each measured input causes (issue: the input error budget).
 
@@ -441,6 +468,8 @@ def error_budget(
     the spread is the RMS over ``t_out_s`` up to ``t_end_s`` (default the whole run) of the
     ensemble's standard deviation of θ. The shares are each source's variance over their sum (the
     sources interact, so the sum need not equal the all-sources variance, which is reported beside).
+    ``table_sigma_m_s2`` is a fused table's per-sample σ (its own error, ``acc_fused``; without it
+    that source is 0).
 
     Returns
     -------
@@ -456,7 +485,7 @@ def error_budget(
     def spread(u, sd):
         e = simulate_ensemble(
             block, table_t_s, table_acc_m_s2, t, eta=eta, eta_sd=sd, theta0_rad=theta0_rad,
-            t_start_s=t_start_s, unc=u, n=n, seed=seed,
+            t_start_s=t_start_s, unc=u, n=n, seed=seed, table_sigma_m_s2=table_sigma_m_s2,
         )  # fmt: skip
         return float(np.sqrt(np.mean(np.std(e.theta_rad[:, w], axis=0) ** 2)))
 
@@ -466,7 +495,8 @@ def error_budget(
             sd[src] = spread(zero, eta_sd) if eta_sd > 0 else 0.0
         else:
             v = getattr(unc, src)
-            sd[src] = spread(replace(zero, **{src: v}), 0.0) if v > 0 else 0.0
+            off = src == "acc_fused" and table_sigma_m_s2 is None
+            sd[src] = spread(replace(zero, **{src: v}), 0.0) if v > 0 and not off else 0.0
     total = sum(s * s for s in sd.values())
     return {
         "sources": {k: {"sd_rad": v, "share": (v * v / total) if total > 0 else 0.0} for k, v in sd.items()},

@@ -10,7 +10,9 @@ What the run measured sets the ensemble's input uncertainty
   the bias the half-cycle fit of η_e finds is taken out, and a constant bias of its standard
   error and σ/√n (the rest gives gravity's level) sampled; a scale error of
   :data:`ACC_SCALE_SD` (1 %), or, for a table fused from its IMU and the film, the scale
-  uncertainty their agreement measured (:func:`acc_scale_sd`);
+  uncertainty their agreement measured (:func:`acc_scale_sd`); a fused table's own error is drawn
+  too, from its smoother's σ per sample with the spectrum measured on synthetic sessions
+  (:func:`rocklab.fitting.fused_error_draw`);
 - clock offset: the table–video synchronisation residual, at least a quarter of the table's
   sample period (same clock, video table: 0); a record given as the table motion (the
   command, not a measurement): 2 % of its peak as noise, one record step as offset;
@@ -39,6 +41,7 @@ import numpy as np
 __all__ = [
     "ACC_SCALE_SD",
     "acc_scale_sd",
+    "fused_sigma",
     "INPUT_SAFETY",
     "NOISE_SAFETY",
     "Validation",
@@ -220,8 +223,16 @@ def _uncertainty(cfg, table, table_sync, y, msgs):
         theta0_rad=0.0 if wy is not None else sm,  # a block at rest on the table is flat
         meas_noise_rad=sm,
         acc_scale=acc_scale_sd(table)[0],
+        acc_fused=1.0 if fused_sigma(table) is not None else 0.0,
     )
     return unc, level, wy is not None
+
+
+def fused_sigma(table):
+    """A fused table's per-sample σ of its acceleration (m/s², ``TableMotion.sigma_ax_m_s2``), else None."""
+    if table is None or getattr(table, "source", "") != "fused" or getattr(table, "sigma_ax_m_s2", None) is None:
+        return None
+    return np.asarray(table.sigma_ax_m_s2, float)
 
 
 @dataclass(frozen=True)
@@ -325,6 +336,7 @@ def validate_forced_run(prep: ForcedPrep, block, laws: dict, *, n=None, seed=0) 
             unc=band_unc,
             n=n,
             seed=seed,
+            table_sigma_m_s2=fused_sigma(prep.table),
         )
         secs += ens.seconds
         verdicts[law] = judge_law(
@@ -345,6 +357,7 @@ def validate_forced_run(prep: ForcedPrep, block, laws: dict, *, n=None, seed=0) 
         block, prep.table.t_s, prep.table.ax_m_s2, t, eta=float(todo[ref]),
         eta_sd=fit.se if ref == "eta_e" and good else 0.0, theta0_rad=prep.theta0_rad, t_start_s=float(t[0]),
         unc=unc, t_end_s=float(h) if h is not None and np.isfinite(h) else None, n=max(8, n // 2), seed=seed,
+        table_sigma_m_s2=fused_sigma(prep.table),
     )  # fmt: skip
     return Validation(
         horizon_s=verdicts[ref].horizon_s,
@@ -392,7 +405,12 @@ def summary_lines(v: Validation, alpha_rad: float) -> list[str]:
         f"Inputs sampled (1 σ): table acceleration noise {_g(unc['acc_noise_m_s2'])} m/s², bias "
         f"{_g(unc['acc_bias_m_s2'])} m/s², scale {_g(100 * unc['acc_scale'])} % ({v.acc_scale_source}), clock "
         f"{_g(1000 * unc['sync_s'])} ms, width and height {_g(1000 * unc['length_m'])} mm, θ noise "
-        f"{_g(unc['meas_noise_rad'])} rad.",
+        f"{_g(unc['meas_noise_rad'])} rad"
+        + (
+            ", the fused table's own error (its smoother's σ, the spectrum measured on synthetic sessions)."
+            if unc.get("acc_fused")
+            else "."
+        ),
         "",
     ]
     b = v.error_budget
@@ -400,6 +418,7 @@ def summary_lines(v: Validation, alpha_rad: float) -> list[str]:
         names = {
             "acc_noise_m_s2": "table noise", "acc_bias_m_s2": "table bias", "acc_scale": "table scale",
             "sync_s": "clock offset", "length_m": "block size", "theta0_rad": "θ0", "eta": "η",
+            "acc_fused": "fused table's own error",
         }  # fmt: skip
         parts = sorted(b["sources"].items(), key=lambda kv: -kv[1]["share"])
         lines += [

@@ -215,8 +215,8 @@ class ColumnValidation:
     n_members : int
     seconds : float
     acc_scale_source : str
-        Where ``uncertainty["acc_scale"]`` comes from: the 1 % prior for a column (its ensemble does
-        not sample a fused table's own error, which the prior covers); empty without a table.
+        Where ``uncertainty["acc_scale"]`` comes from (the validation's ``acc_scale_sd``)
+        and whether a fused table's own error is drawn; empty without a table.
     """
 
     horizon_s: float
@@ -265,7 +265,7 @@ def _table_starts(table) -> float:
 
 
 def _column_uncertainty(cfg, t, th, t0, table):
-    from .._validation import ACC_SCALE_SD, INPUT_SAFETY, LENGTH_SD_M, MIN_NOISE_RAD
+    from .._validation import INPUT_SAFETY, LENGTH_SD_M, MIN_NOISE_RAD, acc_scale_sd, fused_sigma
     from ...fitting import InputUncertainty
 
     ok = np.isfinite(th).all(axis=1)
@@ -289,12 +289,21 @@ def _column_uncertainty(cfg, t, th, t0, table):
         length_m=LENGTH_SD_M,
         theta0_rad=0.0 if table is not None else max(sm, THETA0_MIN_SD_RAD),
         meas_noise_rad=sm,
-        # the 1 % prior even where the film and the table IMU agree better (table.fusion.scale): the
-        # column ensemble does not sample a fused table's own error (1.9 % RMS on the demo's column),
-        # and the prior is what covers it there; with the measured 0.29 % the demo column's true
-        # model was `consistent` with only 66 % of its samples inside the band
-        acc_scale=ACC_SCALE_SD if table is not None else 0.0,
+        # a fused table: the scale its IMU's agreement with the film measured, and its own error (the
+        # smoother's σ, with the spectrum measured on synthetic sessions); one source: the 1 % prior
+        acc_scale=acc_scale_sd(table)[0] if table is not None else 0.0,
+        acc_fused=1.0 if fused_sigma(table) is not None else 0.0,
     )
+
+
+def _scale_source(table) -> str:
+    """Where the sampled scale sd comes from, and whether the fused table's own error is drawn."""
+    from .._validation import acc_scale_sd, fused_sigma
+
+    if table is None:
+        return ""
+    src = acc_scale_sd(table)[1]
+    return src + "; the fused table's own error drawn" if fused_sigma(table) is not None else src
 
 
 def validate_column(cfg, col, t, th, t0, th0, table, source, *, n=COLUMN_ENSEMBLE_SIZE, seed=0):
@@ -312,6 +321,7 @@ def validate_column(cfg, col, t, th, t0, th0, table, source, *, n=COLUMN_ENSEMBL
         Start angles, counter-clockwise, rad.
     table : rocklab.series.TableMotion or None
     """
+    from .._validation import fused_sigma
     from ...fitting import judge_column, simulate_column_ensemble
 
     unc = _column_uncertainty(cfg, t, th, t0, table)
@@ -326,6 +336,7 @@ def validate_column(cfg, col, t, th, t0, th0, table, source, *, n=COLUMN_ENSEMBL
         ens = simulate_column_ensemble(
             col, tg, theta0_rad=-np.asarray(th0, float), t_start_s=t0, unc=unc, table_t_s=tab[0],
             table_acc_m_s2=tab[1], n_impacts=k, n=n, meas_offset_rad=THETA0_MIN_SD_RAD, seed=seed,
+            table_sigma_m_s2=fused_sigma(table),
         )  # fmt: skip
         secs += ens.seconds
         law = f"impacts_{k}"
@@ -333,5 +344,5 @@ def validate_column(cfg, col, t, th, t0, th0, table, source, *, n=COLUMN_ENSEMBL
         lo, hi = ens.band_rad
         bands[law] = (tg, -hi, -lo)  # the counter-clockwise band
     ref = f"impacts_{int(cfg.column_impacts)}"
-    src = "prior: the column ensemble does not sample a fused table's own error" if table is not None else ""
+    src = _scale_source(table)
     return ColumnValidation(laws[ref].horizon_s, ref, laws, bands, unc.to_dict(), n, secs, src)

@@ -11,6 +11,7 @@ and are not read.
 
 from __future__ import annotations
 
+import re
 import zipfile
 from pathlib import Path
 
@@ -80,17 +81,66 @@ def _xml_text(path: Path, member: str | None) -> tuple[bytes, str]:
         return z.read(names[0]), f"{path}:{names[0]}"
 
 
+_DECLARATION = re.compile(r"^\s*<\?xml[^>]*\?>")
+_DECLARED = re.compile(rb"""^\s*<\?xml[^>]*?encoding\s*=\s*["']([A-Za-z0-9._-]+)["']""")
+
+
+def _encoding(raw: bytes, source: str) -> tuple[str, str | None]:
+    """(the encoding to parse ``raw`` with, a note when it is not the one the file declares).
+
+    The XML declaration's encoding (UTF-8 when it names none) is used when the bytes are valid in
+    it. Tracker writes the declaration ``encoding="UTF-8"`` but, on some systems, the text in the
+    platform's 8-bit encoding (an author ``Jal\xf3n`` as one Latin-1 byte): such a file is read as
+    Windows-1252 (Java's default on Windows; ISO-8859-1 where Windows-1252 leaves a byte undefined),
+    and the note says so. Only text (names, author, notes) depends on it, never a number.
+    """
+    import codecs
+
+    if raw.startswith((codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)):
+        return "utf-16", None
+    m = _DECLARED.match(raw[:400])
+    declared = m.group(1).decode("ascii") if m else "utf-8"
+    try:
+        codecs.lookup(declared)
+    except LookupError:
+        raise InputError(
+            f"{where(source)}the XML declaration names the encoding {declared!r}, which Python does not know; "
+            "save the project again in Tracker"
+        ) from None
+    try:
+        raw.decode(declared)
+        return declared, None
+    except UnicodeDecodeError as exc:
+        bad, line = raw[exc.start], raw.count(b"\n", 0, exc.start) + 1
+    for fallback in ("cp1252", "latin-1"):
+        try:
+            raw.decode(fallback)
+            break
+        except UnicodeDecodeError:
+            continue
+    note = (
+        f"the project declares {declared} but byte 0x{bad:02x} at line {line} is not {declared}: its text read "
+        f"as {'Windows-1252' if fallback == 'cp1252' else 'ISO-8859-1'} (Tracker saved it in the platform's "
+        "encoding); names and notes with accented letters depend on this, positions and times do not"
+    )
+    return fallback, note
+
+
 def _parse(raw: bytes, source: str):
+    """The root element of a Tracker project and the encoding note of :func:`_encoding` (or None)."""
     import xml.etree.ElementTree as ET
 
+    encoding, note = _encoding(raw, source)
     try:
-        root = ET.fromstring(raw)
+        # decoded here (the declaration, which would override the encoding, dropped) only when the
+        # bytes are not in the declared encoding: expat reads every other file as it always did
+        root = ET.fromstring(_DECLARATION.sub("", raw.decode(encoding), count=1) if note else raw)
     except ET.ParseError as exc:
         line = exc.position[0] if exc.position else None
         raise InputError(f"{where(source, line)}not valid XML ({exc.msg}); save the project again in Tracker") from None
     if root.tag != "object" or not str(root.get("class", "")).endswith("TrackerPanel"):
         raise InputError(f"{where(source)}not a Tracker project (root {root.get('class')!r}); give a .trk or .trz")
-    return root
+    return root, note
 
 
 def _time_base(panel: dict, source: str) -> tuple[float, float, int]:
@@ -145,10 +195,13 @@ def _to_world(xy_px, frames, keys):
 def _point_masses(panel: dict, source: str) -> dict:
     """``{name: {frame: (x_px, y_px)}}`` of every point-mass track."""
     out: dict = {}
+    others: list = []
     tracks = panel.get("tracks")
     for item in tracks.findall("property") if tracks is not None else ():
         obj = item.find("object")
         if obj is None or obj.get("class") != _POINT_MASS:
+            if obj is not None:
+                others.append(str(obj.get("class", "")).rsplit(".", 1)[-1])
             continue
         p = _props(obj)
         name = str(_value(p["name"])) if "name" in p else f"track {len(out) + 1}"
@@ -162,7 +215,8 @@ def _point_masses(panel: dict, source: str) -> dict:
         if marks:
             out[name] = marks
     if not out:
-        raise InputError(f"{where(source)}no point-mass track with marked frames; mark the points in Tracker")
+        held = f" (its tracks: {', '.join(others)}; a model track is Tracker's simulation, not marks)" if others else ""
+        raise InputError(f"{where(source)}no point-mass track with marked frames{held}; mark the points in Tracker")
     return out
 
 
@@ -189,8 +243,11 @@ def read_trk(path, member: str | None = None, units: str | None = None) -> Plane
     path = Path(path)
     if not path.is_file():
         raise InputError(f"{where(path)}not found; give a Tracker .trk or .trz file")
+    if path.stat().st_size == 0:
+        raise InputError(f"{where(path)}empty file (0 bytes); a Tracker project is a .trk (XML) or a .trz (zip)")
     raw, source = _xml_text(path, member)
-    panel = _props(_parse(raw, source))
+    root, encoding_note = _parse(raw, source)
+    panel = _props(root)
     start_ms, dt_ms, start_frame = _time_base(panel, source)
     keys = _coords(panel, source)
     masses = _point_masses(panel, source)
@@ -203,6 +260,8 @@ def read_trk(path, member: str | None = None, units: str | None = None) -> Plane
             xy_px[row[f], j] = xy
     t_s = (start_ms + (frames - start_frame) * dt_ms) / 1000.0
     notes = [f"times from the clip: start {start_ms:g} ms at frame {start_frame}, {dt_ms:g} ms a frame"]
+    if encoding_note:
+        notes.append(encoding_note)
     if "referenceframe" in panel:  # a moving origin Tracker derives for display; the marks are raw
         notes.append(
             f"Tracker's reference frame {_value(panel['referenceframe'])!r} is not applied: positions are "

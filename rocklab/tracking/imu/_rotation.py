@@ -34,7 +34,12 @@ Method (``block_rotation``)
    means, >= 0.1 s) more than 0.1 s before the gyro's rotation starts (its
    rate ramp, once above 2 deg/s, extrapolated back to zero): the table
    carries the block before it uplifts, whereas a released block rotates at
-   once (slowly, when released near its overturning tilt).  In a forced run the upright reference is the *initial* rest
+   once (slowly, when released near its overturning tilt).  A run read as a
+   release is read again as forced when the block rested upright (within
+   1 deg of its end rest) and the accelerometer left its rest (by twice its
+   stillness at the start) in the 0.1 s before the rotation's start: a
+   sharp table pulse uplifts a block at once, and a thread holds a block
+   tilted.  In a forced run the upright reference is the *initial* rest
    (theta = 0 there), the rest windows end where the table starts / begin
    where it has stopped (accelerometer vector, not only its norm), the end
    rest's tilt is measured by the accelerometer, and ``release_t_s`` is NaN.
@@ -65,13 +70,18 @@ from ._motion_windows import (
     quat_mul,
     rownorm,
     still_acc_start,
+    table_push,
     tilt_about,
     twist_angle,
 )
 from ._read import ImuLog
-from ._validity import RockingCheck, check_rocking, half_swing_peaks, warn_no_rest, warn_not_rocking
+from ._validity import FORCED_PUSH_MIN, RockingCheck, check_rocking, half_swing_peaks, warn_no_rest, warn_not_rocking
 
 __all__ = ["ImuRotation", "block_rotation", "ahrs_rotation", "ahrs_quaternions"]
+
+#: Largest tilt at the start rest, rad, of a block that rested upright (the upright reference's
+#: error, a mis-mount or a sloping table, is < 0.3 deg; a thread holds a block at >= 1 deg).
+UPRIGHT_START_RAD = np.deg2rad(1.0)
 
 
 @dataclass(frozen=True)
@@ -183,6 +193,8 @@ class ImuRotation:
             "run_kind": self.run_kind,
             "axis_tilt_rad": float(self.rocking.axis_tilt_rad) if self.rocking else float("nan"),
             "axis_share": float(self.rocking.axis_share) if self.rocking else float("nan"),
+            "lateral_acc_m_s2": float(self.rocking.lateral_acc_m_s2) if self.rocking else float("nan"),
+            "not_rocking_reasons": list(self.rocking.reasons) if self.rocking else [],
             "source": self.source,
         }
 
@@ -293,23 +305,21 @@ def block_rotation(
     f_end = acc[e0:e1].mean(axis=0) if has_end else None
     f_ref, msg = _upright(u, f_start, f_end, forced, msg)
     theta, omega, drift, th_start, changes = _anchored(t, omega, u, (f_ref, f_start, f_end), (s0, s1), (e0, e1))
-    # rocking: one axis carries the rate and the block turns by less than 90 deg; other motion
-    # (a hand-held sensor) has no single tilt to compare the gyro with
-    planar = float(np.sum(omega[moving] ** 2)) >= 0.9 * float(np.sum(w[moving] ** 2)) if moving.any() else False
-    if has_end and planar and float(np.max(np.abs(theta))) < 0.5 * np.pi:
-        status, msg = _check_gyro_vs_tilt(log.source, *changes, status, msg)
-    # without a rest before, the bias came from moving samples: the drift then corrects it
-    judge = status != "no_rest_before"
-    rocking = None
-    if status != "no_motion":
-        # a released block only loses energy: its half swings shrink (a table feeds energy in)
-        peaks = None if forced else half_swing_peaks(theta, i_move, i_end, th_start if judge else None)
-        rocking = check_rocking(t, w, u, f_start, fs, drift, judge, peaks, has_end)
-    if rocking is not None and rocking.reasons:
-        # a spinning or hand-held sensor: worse than any rest-window status
-        status, msg = "suspect", warn_not_rocking(log.source, rocking) + ("; " + msg if msg else "")
-    elif status in ("no_rest_before", "no_rest_after"):  # theta unanchored: a coded warning (run shows it)
-        msg = warn_no_rest(log.source, status, t, i_move, i_end, min_rest_s, omega)
+    at_rest = status not in ("no_rest_before", "no_motion")
+    min_run = max(2, int(round(0.1 * fs)))
+    push = table_push(t, gyro, acc, fs, np.deg2rad(still_gyro_deg_s), min_run) if at_rest else None
+    upright_start = release == "auto" and not forced and has_end and abs(th_start) < UPRIGHT_START_RAD
+    if upright_start and push is not None and push >= FORCED_PUSH_MIN:
+        # it rested upright and the support pushed it before it started to turn: a table pulse
+        # that uplifts the block within 0.1 s (a released block is held tilted), not a release
+        return block_rotation(
+            log, axis, release="none", ahrs=ahrs, still_gyro_deg_s=still_gyro_deg_s, still_acc_g=still_acc_g,
+            min_rest_s=min_rest_s,
+        )  # fmt: skip
+    rocking, status, msg = _judge(
+        log, (w, u, theta, omega, moving), forced, (i_move, i_end, has_end), (f_start, th_start, drift, changes),
+        (status, msg), min_rest_s, push,
+    )  # fmt: skip
     if axis is None:
         ref = th_start if abs(th_start) > np.deg2rad(1.0) else theta[np.argmax(np.abs(theta))]
         if ref < 0:
@@ -346,6 +356,40 @@ def block_rotation(
         "forced" if forced else "thread",
         rocking,
     )
+
+
+def _judge(log, motion, forced, span, anchoring, state, min_rest_s, push):
+    """(rocking evidence, status, message) of a block's rotation, with its warnings.
+
+    ``motion`` = (bias-free rates (n, 3), axis, theta, omega, moving mask); ``span`` = (first
+    moving sample, end of the motion, a rest after?);
+    ``anchoring`` = (accelerometer mean at the start rest (3,), tilt there, drift, (gyro change,
+    tilt change) between the rests or None); ``state`` = (status, message); ``push`` the table's
+    push before the rotation (:func:`table_push`; None without a rest before), judged for a forced run.
+    """
+    w, u, theta, omega, moving = motion
+    i_move, i_end, has_end = span
+    f_start, th_start, drift, changes = anchoring
+    status, msg = state
+    t, acc, fs = log.t_s, log.acc_m_s2, float(log.rate_hz)
+    # rocking: one axis carries the rate and the block turns by less than 90 deg; other motion
+    # (a hand-held sensor) has no single tilt to compare the gyro with
+    planar = float(np.sum(omega[moving] ** 2)) >= 0.9 * float(np.sum(w[moving] ** 2)) if moving.any() else False
+    if has_end and planar and float(np.max(np.abs(theta))) < 0.5 * np.pi:
+        status, msg = _check_gyro_vs_tilt(log.source, *changes, status, msg)
+    # without a rest before, the bias came from moving samples: the drift then corrects it
+    judge = status != "no_rest_before"
+    rocking = None
+    if status != "no_motion":
+        # a released block only loses energy: its half swings shrink (a table feeds energy in)
+        peaks = None if forced else half_swing_peaks(theta, i_move, i_end, th_start if judge else None)
+        rocking = check_rocking(t, w, u, f_start, fs, drift, judge, peaks, has_end, acc, push if forced else None)
+    if rocking is not None and rocking.reasons:
+        # a spinning or hand-held sensor: worse than any rest-window status
+        status, msg = "suspect", warn_not_rocking(log.source, rocking) + ("; " + msg if msg else "")
+    elif status in ("no_rest_before", "no_rest_after"):  # theta unanchored: a coded warning (run shows it)
+        msg = warn_no_rest(log.source, status, t, i_move, i_end, min_rest_s, omega)
+    return rocking, status, msg
 
 
 def _motion_span(log: ImuLog, release, still_gyro_deg_s, still_acc_g):

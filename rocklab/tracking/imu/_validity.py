@@ -8,6 +8,23 @@ turn (a block that overturns lies on a side, ~90 deg).  A sensor turned about
 its vertical, moved by hand or spun shows none of this; integrating it about
 its principal axis gives angles that mean nothing (``W-IMU-NOT-ROCKING``).
 
+The rocking edge also stays put along itself: gravity's share along a horizontal
+axis fixed in the world is constant, and the block's rotation about the edge
+accelerates the sensor (``alpha x r``, ``omega x (omega x r)``, with ``omega``
+along the axis) only across it, wherever the sensor sits. So while the block
+turns, the accelerometer's component along the axis keeps its value at rest but
+for a table moving along the edge (a lab table shakes across it). A
+foot-mounted sensor pitches about a horizontal axis too, but swings sideways
+with the leg and rolls: 0.4-0.5 g RMS along its pitch axis in x-io's gait logs,
+against the accelerometer noise (5-15 mg) for simulated rocking. This holds for
+a forced run as for a release (``LATERAL_ACC_MAX_M_S2``).
+
+A forced run's block rests upright and rides its table until the table's
+acceleration uplifts it: the accelerometer leaves its rest before the
+rotation starts. A log read as a forced run whose block starts to turn from
+rest unpushed (a release, a foot) is not one (``FORCED_PUSH_MIN``); the
+message sends it to ``--release auto``, under which every test applies.
+
 A block released from rest (a thread-burn release) only loses energy: each half
 swing's |theta| peak is at most the one before, the first at most the release
 tilt ``|theta0|``.  A foot-mounted sensor while walking pitches about one
@@ -41,6 +58,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..._diagnostics import warn
+from ...blocks import G
 from ._motion_windows import cumtrapz, moving_average, rownorm
 
 __all__ = []
@@ -51,6 +69,15 @@ AXIS_TILT_MAX_RAD = np.deg2rad(20.0)
 #: Smallest share of the mean-square rate (while rotating) about the rocking axis.
 #: Planar rocking with 0.1 deg/s of gyro noise gives > 0.99.
 AXIS_SHARE_MIN = 0.8
+#: Largest RMS, over the rotating samples, of the specific force along the rocking axis less its
+#: value at rest, m/s^2 (module doc): a table's cross-axis motion (a few % of its shaking)
+#: and the accelerometer's cross-axis sensitivity at impacts stay well below it.
+LATERAL_ACC_MAX_M_S2 = 0.15 * G
+#: Smallest push of the table just before a forced run's block starts to turn, in units of the
+#: accelerometer's stillness at the start (``_motion_windows.table_push``): a block rides its
+#: table until the table's acceleration uplifts it. Measured <= 1.06 on simulated releases and
+#: strides, >= 3.1 on simulated table runs.
+FORCED_PUSH_MIN = 2.0
 #: Largest range (max - min) of the gyro angle about the axis, rad: a rocking or
 #: overturning block stays within a half turn.
 TURN_RANGE_MAX_RAD = np.pi
@@ -90,6 +117,9 @@ class RockingCheck:
         empty when none did or the run is forced.
     reasons : tuple of str
         The bounds broken (empty: a rocking block).
+    lateral_acc_m_s2 : float
+        RMS over the rotating samples of the specific force along the axis less its value at rest,
+        m/s^2 (NaN when fewer than 0.1 s rotate or no accelerometer was given).
     """
 
     axis_tilt_rad: float
@@ -97,6 +127,17 @@ class RockingCheck:
     turn_range_rad: float
     reasons: tuple = ()
     swing_peaks_rad: tuple = ()
+    lateral_acc_m_s2: float = float("nan")
+
+    @staticmethod
+    def bounds() -> dict:
+        """The bounds in force (this module's constants): ``axis_tilt_max_rad``, ``axis_share_min``,
+        ``lateral_acc_max_m_s2``."""
+        return {
+            "axis_tilt_max_rad": AXIS_TILT_MAX_RAD,
+            "axis_share_min": AXIS_SHARE_MIN,
+            "lateral_acc_max_m_s2": LATERAL_ACC_MAX_M_S2,
+        }
 
 
 def half_swing_peaks(theta, i_move: int, i_end: int, theta0_rad: float | None = None) -> np.ndarray:
@@ -139,7 +180,7 @@ def _worst_growth(peaks: np.ndarray, cross_side: bool) -> tuple:
 
 
 def check_rocking(
-    t, w, u, f_rest, fs, drift_rad_s, judge_drift=True, swing_peaks=None, upright_measured=True
+    t, w, u, f_rest, fs, drift_rad_s, judge_drift=True, swing_peaks=None, upright_measured=True, acc=None, push=None
 ) -> RockingCheck:
     """Measure the rocking evidence (module doc) of bias-free rates ``w`` (n, 3) rad/s about ``u``.
 
@@ -150,6 +191,9 @@ def check_rocking(
     ``swing_peaks`` (rad, from :func:`half_swing_peaks`) for a thread-release run; None
     for a forced run, whose table feeds energy in. ``upright_measured`` False when upright
     was not measured at a final rest (the two sides' peaks are then not compared).
+    ``acc`` (n, 3) m/s^2, the accelerometer, for the specific force along the axis (None: not judged).
+    ``push``: for a forced run that starts at rest, the table's push before the block turned
+    (``_motion_windows.table_push``; None: not judged).
     """
     w_avg = max(1, int(round(0.05 * fs)))
     rot = moving_average(rownorm(w), w_avg) > _ROT_THR_RAD_S
@@ -161,6 +205,7 @@ def check_rocking(
     share = float(np.sum((wr @ u) ** 2) / max(float(np.sum(wr * wr)), 1e-300))
     ang = cumtrapz(t, w @ u - drift_rad_s)
     turn = float(np.max(ang) - np.min(ang))
+    lateral = float("nan") if acc is None else float(np.sqrt(np.mean((acc[rot] @ u - float(f_rest @ u)) ** 2)))
     reasons = []
     if tilt > AXIS_TILT_MAX_RAD:
         reasons.append(
@@ -176,6 +221,19 @@ def check_rocking(
             f"the gyro turns through {np.rad2deg(turn):.4g} deg about it "
             f"(rocking stays within {np.rad2deg(TURN_RANGE_MAX_RAD):.3g} deg)"
         )
+    if lateral > LATERAL_ACC_MAX_M_S2:
+        reasons.append(
+            f"while it turns the sensor accelerates along that axis by {lateral / G:.3g} g RMS "
+            f"(a rocking edge stays put along itself, whether released or on a shake table: "
+            f"< {LATERAL_ACC_MAX_M_S2 / G:.2g} g)"
+        )
+    if push is not None and push < FORCED_PUSH_MIN:
+        reasons.append(
+            f"read as a forced run, it started to turn from rest with no push from a table (the accelerometer "
+            f"left its rest by {push:.2g} times its own stillness in the 0.1 s before; a table uplifts a block "
+            f"by accelerating it: >= {FORCED_PUSH_MIN:g}); a block released from a held tilt is read with "
+            "--release auto, which keeps every test"
+        )
     if judge_drift and abs(drift_rad_s) > DRIFT_MAX_RAD_S:
         reasons.append(
             f"holding the rests needs a {np.rad2deg(drift_rad_s):.3g} deg/s gyro drift "
@@ -186,9 +244,9 @@ def check_rocking(
         reasons.append(
             f"a half swing reaches {np.rad2deg(grown[1]):.3g} deg after one of {np.rad2deg(grown[0]):.3g} deg "
             f"(a released block only loses energy: bound + {np.rad2deg(SWING_GROWTH_MAX_RAD):.2g} deg "
-            f"+ {100 * SWING_GROWTH_REL:.3g} %; a shake-table run: --release none)"
+            f"+ {100 * SWING_GROWTH_REL:.3g} %; only a shake table feeds energy in)"
         )
-    return RockingCheck(tilt, share, turn, tuple(reasons), grown)
+    return RockingCheck(tilt, share, turn, tuple(reasons), grown, lateral)
 
 
 def warn_not_rocking(source: str, chk: RockingCheck) -> str:

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import sys
 
+from ....blocks import G
 from ...reports import sig
 
 
@@ -104,8 +105,8 @@ def run(args) -> int:
             f"{sig(math.degrees(summary['turn_rad']))} deg\n"
         )
     else:
-        out.write(_block_text(res))
-    out.write(f"status {status}: {_STATUS_MEANING.get(status, '')}\n")
+        out.write(_block_text(res, args.release))
+    out.write(f"status {status}: {_status_meaning(status, diags)}\n")
     msg = res.message
     for d in diags:  # a warning's text is on stderr with its code: named here, not repeated
         msg = msg.replace(d.message, f"{d.code} (above)")
@@ -120,7 +121,7 @@ def run(args) -> int:
 
 
 _STATUS_MEANING = {
-    "ok": "rests found before and after, gyro and accelerometer agree, no warning",
+    "ok": "rests found before and after, gyro and accelerometer agree, the rocking checks pass, no warning",
     "suspect": "a warning above: the numbers may be wrong; check before using them",
     "no_rest_before": "no rest before the first motion: the gyro bias came from the first 0.5 s",
     "no_rest_after": "still moving at the end: the gyro drift is not held by a final rest",
@@ -128,12 +129,22 @@ _STATUS_MEANING = {
 }
 
 
+def _status_meaning(status: str, diags) -> str:
+    """What ``status`` means; a suspect one names the warnings that made it so."""
+    text = _STATUS_MEANING.get(status, "")
+    codes = sorted({d.code for d in diags if d.severity == "suspect"})
+    if status == "suspect" and codes:
+        text = text.replace("a warning above", f"a warning above ({', '.join(codes)})", 1)
+    return text
+
+
 def _vec(v) -> str:
     """A unit vector as ``(+0.2012, -0.3614, 0)`` (4 significant digits, signed, never -0)."""
     return "(" + ", ".join(("+" if float(sig(x)) > 0 else "") + sig(x) for x in v) + ")"
 
 
-def _block_text(res) -> str:
+def _axis_text(res) -> str:
+    """The rocking axis and the rocking checks' measured values with their bounds."""
     import math
 
     import numpy as np
@@ -144,10 +155,33 @@ def _block_text(res) -> str:
     line = f"rocking axis ~{name} {_vec(a)} in the sensor frame"
     rk = res.rocking
     if rk is not None and math.isfinite(rk.axis_tilt_rad):
+        bound = rk.bounds()
         line += (
-            f", {sig(math.degrees(rk.axis_tilt_rad))} deg above the horizontal, "
-            f"{sig(100 * rk.axis_share)} % of the rotation about it"
+            f", {sig(math.degrees(rk.axis_tilt_rad))} deg above the horizontal at rest "
+            f"(a rocking edge: < {sig(math.degrees(bound['axis_tilt_max_rad']))} deg), "
+            f"{sig(100 * rk.axis_share)} % of the rotation about it (> {sig(100 * bound['axis_share_min'])} %)"
         )
+        if math.isfinite(rk.lateral_acc_m_s2):
+            line += (
+                f", {sig(rk.lateral_acc_m_s2 / G)} g RMS along it while turning "
+                f"(< {sig(bound['lateral_acc_max_m_s2'] / G)} g)"
+            )
+    return line
+
+
+def _block_text(res, release: str = "auto") -> str:
+    """The text report of a block's rotation: axis, bias, kind of run and release, theta, impacts.
+
+    ``release`` is the ``--release`` option: a kind of run the user named is said to be so, not
+    measured. A log that is not a rocking block (``W-IMU-NOT-ROCKING``) has its release, theta and
+    impacts marked as meaningless where they are printed.
+    """
+    import math
+
+    import numpy as np
+
+    line = _axis_text(res)
+    bogus = " (meaningless: not a rocking block)" if res.rocking is not None and res.rocking.reasons else ""
     b = ", ".join(sig(math.degrees(v)) for v in res.gyro_bias_rad_s)
     # the drift is anchored by the final rest; without one none is estimated (not a drift of 0)
     drift = (
@@ -158,16 +192,17 @@ def _block_text(res) -> str:
     line += f"\ngyro bias [{b}] deg/s, residual drift {drift}\n"
     th = np.rad2deg(res.theta_rad)
     if res.run_kind == "forced":
-        line += "forced run (table moved before the block turned): upright = the rest at the start"
+        why = "as --release none says" if release == "none" else "the table moved the block from rest upright"
+        line += f"forced run, no release ({why}): upright = the rest at the start"
     elif math.isfinite(res.release_t_s):
-        line += f"release at {res.release_t_s:.4f} s from theta0 {sig(math.degrees(res.theta0_rad))} deg"
+        said = " (--release thread)" if release == "thread" else ""
+        line += f"release{said} at {res.release_t_s:.4f} s from theta0 {sig(math.degrees(res.theta0_rad))} deg"
     else:
         line += "no release found"
-    line += f"; theta from {sig(th.min())} to {sig(th.max())} deg"
+    line += f"; theta from {sig(th.min())} to {sig(th.max())} deg{bogus}"
     line += f"; final rest from {res.rest_t_s:.3f} s\n" if math.isfinite(res.rest_t_s) else "; no final rest\n"
     imp = res.impact_t_s
-    if len(imp):
-        line += f"{len(imp)} impacts, first {imp[0]:.4f} s, last {imp[-1]:.4f} s\n"
-    else:
-        line += "no impacts\n"
-    return line
+    if len(imp) == 0:
+        return line + "no impacts (theta never crosses 0 with an acceleration spike or a rate step)\n"
+    at = "at " + ", ".join(f"{x:.4f}" for x in imp) if len(imp) <= 6 else f"first {imp[0]:.4f}, last {imp[-1]:.4f}"
+    return line + f"{len(imp)} impacts (theta crosses 0 with a spike or a rate step), {at} s{bogus}\n"

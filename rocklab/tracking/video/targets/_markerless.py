@@ -346,6 +346,25 @@ class MarkerlessTracker:
         t = new_ctr - R @ ctr
         return _euclid(th, t[0], t[1])
 
+    def _centred(self, W):
+        """(θ, tx, ty) of the rigid pose that puts the template's centre where ``W`` does: an
+        affine fit's scale (up to 5 %) would otherwise move the prediction by that share of the
+        centre's distance from the image's origin."""
+        th = _params(W)[0]
+        c = W[:, :2].astype(float) @ self.centre0 + W[:, 2].astype(float)
+        t = c - np.array([[math.cos(th), -math.sin(th)], [math.sin(th), math.cos(th)]]) @ self.centre0
+        return th, float(t[0]), float(t[1])
+
+    def _search_near(self, gray, W_pred, frame):
+        """The keyframe searched round the prediction ``W_pred`` (:meth:`_search`), fitted and
+        verified: (W, cc), or None."""
+        W_s = self._search(self.key, gray, W_pred)
+        alt = None if W_s is None else self._ecc(self.key, gray, W_s)
+        if alt is None or alt[1] < MIN_CC:
+            return None
+        alt = (self._held(alt[0]), alt[1])
+        return alt if self.verifier.verify(self, gray, alt[0], frame, alt[1]) is None else None
+
     def _round_check(self, first_view):
         """Sets :attr:`round_note` once the outline is known to be round and the texture is no
         longer a turned copy of the first view on :data:`OTHER_VIEW_SHARE` of the verified frames:
@@ -432,6 +451,12 @@ class MarkerlessTracker:
         if fit is not None and fit[1] >= MIN_CC:
             fit = (self._held(fit[0]), fit[1])
             self.reason = self.verifier.verify(self, gray, fit[0], frame, fit[1])
+        if self.reason is not None and self.poses:
+            # the fit converged on something else (a blurred fast frame): the template searched
+            # round the prediction first, then anywhere in the frame
+            near = self._search_near(gray, W_pred, frame)
+            if near is not None:
+                fit, tmpl, mask, visible, self.reason = near, self.key, None, 1.0, None
         if fit is None or fit[1] < MIN_CC or self.reason is not None:
             # converged on something else, or nowhere: the template anywhere in the frame
             alt = self.verifier.reacquire(self, gray, frame, MIN_CC)
@@ -458,7 +483,7 @@ class MarkerlessTracker:
                     (W, cc), mask, visible = part[:2], part[2], part[3]
             elif back is not None:  # appearance drifted from the first frame: renew the keyframe here
                 self.key = back
-        self.poses = (self.poses + [_params(W)])[-2:]
+        self.poses = (self.poses + [self._centred(W)])[-2:]
         sig = math.hypot(self._sigma_theta(tmpl, gray, W, mask), self.theta0_sigma_rad)
         pts = (self.grid + self.origin) @ W[:, :2].T.astype(float) + W[:, 2]
         at = self.verifier.disk_at

@@ -11,11 +11,14 @@ and, for the outline, its own first frame:
   :data:`MIN_SCORE`);
 * **motion** (``jump``): the pose may leave the constant-velocity prediction by no more than
   the verified frames' residuals allow (:data:`MOTION_FACTOR` times their 99th percentile, at
-  least :data:`MIN_RESIDUAL_FRAC` of the template), nor turn by more than
-  :data:`MAX_STEP_RAD` a frame since the last verified pose;
+  least :data:`MIN_RESIDUAL_FRAC` of the template; after ``g`` lost frames the prediction is
+  carried over them and the allowance is ``g (g + 1) / 2`` times that: a change of velocity each
+  frame), nor turn by more than :data:`MAX_STEP_RAD` a frame since the last verified pose;
 * **background** (``background``): the warped patch must not match the still background
   (the first frame, with the object's first region filled in once the object has left it)
-  on nearly all of its pixels: a pose frozen on a patch of wall is a lost lock. The first
+  on nearly all of its pixels, nor correlate with it as well as with the object's template:
+  a pose frozen on a patch of wall, or on a detail of the scene that looks like the object,
+  is a lost lock. The first
   frame shows the object in its first region, so that region's background is learned apart:
   from a verified frame in which the object has left it, or, sooner, from the median of the
   frames in which the object was lost (:data:`LOST_SAMPLES`), once the object's template
@@ -148,8 +151,10 @@ class PoseVerifier:
         gap = frame - last[2] if last is not None else 1
         pred = None
         if len(self.recent) == 2 and self.recent[1][2] - self.recent[0][2] == 1:
+            # extrapolated over the gap: after lost frames the object is still where its own
+            # motion carries it (a lock that jumped to something else near it is not)
             (c0, t0, _), (c1, t1, _) = self.recent
-            pred = (2 * c1 - c0, 2 * t1 - t0)
+            pred = (c1 + gap * (c1 - c0), t1 + gap * (t1 - t0))
         return last, gap, pred
 
     # -- learned limits ------------------------------------------------------------
@@ -175,7 +180,7 @@ class PoseVerifier:
         if (
             self._limits is None
             or self.n_verified >= self._learned_at + RELEARN_FRAMES
-            or self.n_verified < WARMUP_FRAMES
+            or self._learned_at <= WARMUP_FRAMES
         ):
             self._limits = (self.score_limit(), self.residual_limit(), self.speed_limit())
             self._learned_at = self.n_verified
@@ -208,16 +213,20 @@ class PoseVerifier:
             turn = abs(math.remainder(theta - last[1], 2 * math.pi))
             if self.check_turn and turn > min(MAX_STEP_RAD * gap, MAX_TURN_RAD):
                 return "jump"
-            ref = pred if pred is not None and gap == 1 else None
-            if ref is not None:
-                if float(np.hypot(*(centre - ref[0]))) > lim:
-                    return "jump"
-            else:  # after lost frames: no farther than the fastest verified motion allows
-                if float(np.hypot(*(centre - last[0]))) > (lim + speed_lim) * gap:
-                    return "jump"
+            if pred is not None and float(np.hypot(*(centre - pred[0]))) > lim * gap * (gap + 1) / 2:
+                # off the constant-velocity prediction by more than the largest change of
+                # velocity the verified frames allow in each frame since (its sum over the gap)
+                return "jump"
+            if (pred is None or gap > 1) and float(np.hypot(*(centre - last[0]))) > (lim + speed_lim) * gap:
+                return "jump"  # no farther than the fastest verified motion allows
         if bg_back is not None and known_back is not None:
             k = known_back > 0.5
-            if k.mean() >= BG_KNOWN and float(np.mean(np.abs(back[k] - bg_back[k]) < BG_TOL)) >= BG_FRACTION:
+            if k.mean() >= BG_KNOWN and (
+                float(np.mean(np.abs(back[k] - bg_back[k]) < BG_TOL)) >= BG_FRACTION
+                # the still background explains the patch at least as well as the object does (a
+                # detail of the scene that looks like a small object, under compression noise)
+                or _ncc(back[k], bg_back[k]) >= score
+            ):
                 return "background"
         return None
 

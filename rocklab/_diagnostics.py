@@ -208,6 +208,12 @@ WARNING_CODES: dict[str, tuple[str, str]] = {
         "the camera dropped frames: slots of the container's constant clock hold no frame; every "
         "frame keeps its own time, the gaps are in t_s",
     ),
+    "W-VIDEO-CUT": (
+        "suspect",
+        "the tracked frames cut to another shot (a title card, a lead-in, an edit): frames after "
+        "the cut show another scene, and a first frame from another shot gives the objects' "
+        "templates and background; set [video] start_frame (and stop_frame) to a span of one shot",
+    ),
     "W-VIDEO-DAMAGED": (
         "suspect",
         "frames the container holds did not decode (damaged packets): the frames around them are "

@@ -133,12 +133,48 @@ def test_markerless_table_edge_levels_a_camcorder_render_at_960x540(tmp_path, se
 def test_final_rest_in_tracking_noise(seed):
     """A decaying rocking then 1.5 s of rest with white tracking noise (0.002 deg, a markerless
     block's) is a rest of at least 1.4 s; the same film still rocking at the end has none."""
-    from rocklab.tracking.video._level import _final_rest
+    from rocklab.tracking.video._level import final_rest
 
     rng = np.random.default_rng(seed)
     t = np.arange(150) / FPS
     rocking = 0.2 * np.exp(-t) * np.cos(2 * np.pi * t / 0.4)
     noise = rng.normal(0.0, math.radians(0.002), t.size)
-    rest = _final_rest(np.where(t < 1.5, rocking, 0.0) + noise, FPS)
+    rest = final_rest(np.where(t < 1.5, rocking, 0.0) + noise, FPS)
     assert rest is not None and rest.size >= 0.9 * 75 and rest[-1] == t.size - 1
-    assert _final_rest(rocking + noise, FPS) is None
+    assert final_rest(rocking + noise, FPS) is None
+
+
+@pytest.mark.parametrize("still_s", [0.6, 1.4])
+def test_level_rest_and_theta0_rest_give_one_answer(still_s):
+    """A markerless block rocks, then stays still at -0.85 deg for ``still_s`` (noise 0.002 deg,
+    sigma 0.05 deg a frame). Whether it comes to rest is decided once: at 0.6 s (short of the 1 s
+    a rest needs) level = "rest" says W-LEVEL-NONE and nothing takes a starting angle from a rest
+    (main said both W-LEVEL-NONE and W-THETA0-REST "comes to rest at -0.85 deg", as on ballOil.mp4
+    from frame 45); at 1.4 s the rest levels the angles and is not taken a second time."""
+    from rocklab._diagnostics import collecting
+    from rocklab.tracking.video._level import level_from_reference, world_angle
+
+    fps = 30.0
+    rng = np.random.default_rng(3)
+    t = np.arange(int(round((2.0 + still_s) * fps))) / fps
+    off = math.radians(-0.85)
+    th = np.where(t < 2.0, 0.1 * np.cos(2 * np.pi * t / 0.7) * (2.0 - t) + off, off)
+    th = th + rng.normal(0.0, math.radians(0.002), t.size)
+    sig = np.full(t.size, math.radians(0.05))
+    cfg = TrackConfig.from_dict(
+        {
+            "targets": {"style": "markerless"},
+            "reference": {"level": "rest"},
+            "objects": [{"id": "b", "roi": [0, 0, 40, 40]}],
+        }
+    )
+    raw = {"b": ({"th": th, "sig": sig}, np.full(t.size, "ok"), None)}
+    with collecting() as got:
+        level, src, _ = level_from_reference(cfg, raw, fps, False, None)
+        out = world_angle(cfg.objects[0], cfg, th, sig, fps, level, src)
+    codes = [d.code for d in got]
+    if still_s < 1.0:
+        assert codes == ["W-LEVEL-NONE"] and src == "none" and np.array_equal(out, th)
+    else:
+        assert codes == [] and src == "rest of b" and abs(level - off) < math.radians(0.01)
+        assert abs(np.median(out[-int(fps) :])) < math.radians(0.01)

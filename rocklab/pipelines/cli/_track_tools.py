@@ -16,17 +16,45 @@ __all__ = ["track_init", "track_preview", "draw_init_preview", "contact_sheet"]
 _COLOURS = [(0, 200, 255), (255, 120, 0), (0, 220, 0), (220, 0, 220), (0, 0, 255), (255, 255, 0)]
 
 
-def _first_frame(video: Path):
-    from ...tracking.video import iter_video_frames, probe_video
+def _first_frame(video: Path, start_frame=None):
+    """(info, grey, BGR, start frame, note) of the first frame tracked: ``start_frame`` when given,
+    else the first frame after a lead-in of blank, fading-in or cut-away frames (a note says so)."""
+    from ...tracking.video import iter_video_frames, lead_in, probe_video
 
     if not video.exists():
         raise InputError(f"{video}: video not found; check the path")
     info = probe_video(video)
+    per = 2 if info.field_order is not None else 1  # a deinterlaced film yields two fields a frame
+    n = per * (info.n_frames or 0)
+    if start_frame is not None and n and not 0 <= start_frame < n:
+        raise InputError(f"--start-frame {start_frame}: {video} holds frames 0-{n - 1}; give one of them")
+    note = ""
+    if start_frame is None:
+        n_lead = max(int(round(LEAD_IN_S * per * (info.fps or 50.0))), 3)
+        grays = [
+            g for _, g in iter_video_frames(video, 0, n_lead, pixel_aspect=info.pixel_aspect, fields=info.field_order)
+        ]
+        start_frame, what = lead_in(grays, per * (info.fps or 50.0))
+        if start_frame:
+            note = (
+                (f"frames 0-{start_frame - 1} are" if start_frame > 1 else "frame 0 is")
+                + f" a lead-in ({_LEAD_IN[what]}): tracking starts at frame "
+                f"{start_frame} ([video] start_frame; regions in its pixels); give --start-frame N to choose"
+            )
     for _, gray, img in iter_video_frames(
-        video, 0, 1, color=True, pixel_aspect=info.pixel_aspect, fields=info.field_order
+        video, start_frame, start_frame + 1, color=True, pixel_aspect=info.pixel_aspect, fields=info.field_order
     ):
-        return info, gray, img
-    raise InputError(f"{video}: no frame could be decoded; check the file")
+        return info, gray, img, start_frame, note
+    raise InputError(f"{video}: frame {start_frame} could not be decoded; check the file (or --start-frame)")
+
+
+#: The first seconds of a film searched for a lead-in before its scene.
+LEAD_IN_S = 2.0
+_LEAD_IN = {
+    "blank": "blank frames, one grey level",
+    "fade-in": "the picture fading in",
+    "cut": "a title card or another shot, then a cut",
+}
 
 
 #: ``track init`` without markers compares frames over the first seconds (then, when nothing moves
@@ -35,36 +63,47 @@ PROPOSE_WINDOWS_S = (3.0, 12.0)
 PROPOSE_SAMPLES = 30
 
 
-def _samples(video, info, window_s):
-    """Grey frames spread over the first ``window_s`` seconds after the first (decoded in one pass)."""
+def _samples(video, info, window_s, start=0):
+    """Grey frames spread over the ``window_s`` seconds after frame ``start`` (decoded in one pass)."""
     from ...tracking.video import iter_video_frames
 
     per = 2 if info.field_order is not None else 1  # a deinterlaced film yields two fields a frame
     n = per * (info.n_frames or 0)
-    stop = int(round(window_s * per * (info.fps or 50.0)))
+    stop = start + int(round(window_s * per * (info.fps or 50.0)))
     stop = min(stop, n) if n else stop
-    step = max(1, (stop - 1) // PROPOSE_SAMPLES)
+    step = max(1, (stop - start - 1) // PROPOSE_SAMPLES)
     return [
         g
-        for i, g in iter_video_frames(video, 1, stop, pixel_aspect=info.pixel_aspect, fields=info.field_order)
-        if i % step == 0
+        for i, g in iter_video_frames(video, start + 1, stop, pixel_aspect=info.pixel_aspect, fields=info.field_order)
+        if (i - start) % step == 0
     ]
 
 
-def _propose(video, info, gray):
-    """Objects proposed from what moves; (Proposals, window s)."""
+def _propose(video, info, gray, start=0):
+    """Objects proposed from what moves after frame ``start``; (Proposals, window s)."""
     from ...tracking.video import propose_objects
 
-    duration = (info.n_frames or 0) / (info.fps or 50.0)
+    per = 2 if info.field_order is not None else 1
+    duration = max((per * (info.n_frames or 0) - start) / (per * (info.fps or 50.0)), 0.0)
     for window in PROPOSE_WINDOWS_S:
-        props = propose_objects(gray, _samples(video, info, window))
+        props = propose_objects(gray, _samples(video, info, window, start))
         if props.blocks or duration <= window:
             break
     return props, min(window, duration) if duration else window
 
 
 def track_init(
-    video, out, *, objects=(), table=None, marker_size_m=None, preview=None, side=(False, False), fps=None, lens=None
+    video,
+    out,
+    *,
+    objects=(),
+    table=None,
+    marker_size_m=None,
+    preview=None,
+    side=(False, False),
+    fps=None,
+    lens=None,
+    start_frame=None,
 ):
     """Write a commented ``track.toml`` for ``video`` (and a preview PNG); returns (config, notes).
 
@@ -87,6 +126,10 @@ def track_init(
     lens : path or None
         A lens file (``rocklab calibrate``) written as ``[video] calibration`` (relative to the
         config's folder); refused when calibrated at another picture size than the film's.
+    start_frame : int or None
+        The first frame tracked (``[video] start_frame``; regions are in its pixels). Not given:
+        frame 0, or the first frame after a lead-in (blank frames, a fade-in, a title card cut
+        away from: :func:`~rocklab.tracking.video.lead_in`), with a note.
 
     Returns
     -------
@@ -105,7 +148,7 @@ def track_init(
     from .._plotting import save_bgr_png
 
     video, out = Path(video), Path(out)
-    info, gray, img = _first_frame(video)
+    info, gray, img, start, lead_note = _first_frame(video, start_frame)
     regions = {}
     for spec in objects:
         name, sep, box = str(spec).partition("=")
@@ -121,23 +164,9 @@ def track_init(
     if not regions and troi is None:
         found = find_markers(gray)
         if found is None:
-            props, window = _propose(video, info, gray)
-            if not props.blocks:
-                if preview is not None:
-                    save_bgr_png(Path(preview), draw_grid(img), side=side[1])
-                raise InputError(
-                    f"{video}: no ArUco/AprilTag marker in the first frame and nothing moves in its first "
-                    f"{window:.3g} s; give the objects as --object NAME=x,y,w,h (and --table x,y,w,h)"
-                    + (f", read off the pixel grid in {preview}" if preview is not None else "")
-                )
-            regions = {f"block_{k}": b for k, b in enumerate(props.blocks, start=1)}
-            troi = props.table if props.table_moves else None
-            if props.table_edge is not None and not props.table_moves:
-                line = tuple(tuple(round(float(v), 1) for v in p) for p in props.table_edge.ends_px)
-            proposed = tuple(f"--object {n}={_box_text(b)}" for n, b in regions.items())
-            if troi is not None:
-                proposed += (f"--table {_box_text(troi)}",)
-            pnotes = _proposal_notes(props, window, gray.size)
+            regions, troi, line, proposed, pnotes = _from_motion(
+                video, info, gray, img, start, lead_note, preview, side
+            )
     lens_rel = None
     if lens is not None:
         import os
@@ -154,8 +183,9 @@ def track_init(
         marker_size_m=marker_size_m,
         found=found,
         level_line_px=line,
+        start_frame=start,
     )
-    notes = pnotes + notes
+    notes = ([lead_note] if lead_note else []) + pnotes + notes
     if lens_rel is not None:
         import dataclasses
 
@@ -165,7 +195,7 @@ def track_init(
         notes.append("the film has no frame rate: fps = 50 written; correct it (or give --fps)")
     head = [
         f"track.toml written by 'rocklab track init' from {video.name} ({info.width_px}x{info.height_px}, "
-        f"{info.n_frames} frames, {info.fps or 'unknown'} fps)",
+        f"{info.n_frames} frames, {info.fps or 'unknown'} fps)" + (f", from frame {start}" if start else ""),
         "Schema: docs/track-toml.md",
         *notes,
     ]
@@ -173,6 +203,36 @@ def track_init(
     if preview is not None:
         save_bgr_png(Path(preview), draw_init_preview(img, cfg, found, grid=found is None), side=side[1])
     return cfg, notes, proposed
+
+
+def _from_motion(video, info, gray, img, start, lead_note, preview, side):
+    """Objects proposed from what moves after frame ``start`` (film without markers or regions):
+    (regions, table region, level line, proposals as options, notes); an InputError, after the
+    pixel grid is written to ``preview``, when nothing trackable moves."""
+    from .._plotting import save_bgr_png
+
+    line = None
+    props, window = _propose(video, info, gray, start)
+    if not props.blocks:
+        if preview is not None:
+            save_bgr_png(Path(preview), draw_grid(img), side=side[1])
+        what = "nothing moves" if not props.still else _still_text(props.still) + ", and nothing else moves"
+        raise InputError(
+            f"{video}: no ArUco/AprilTag marker in frame {start} and {what} in the "
+            f"{window:.3g} s from it{' (' + lead_note + ')' if lead_note else ''}; give the objects as "
+            "--object NAME=x,y,w,h (and --table x,y,w,h)"
+            + (f", read off the pixel grid in {preview}" if preview is not None else "")
+            + ", or --start-frame N where the motion starts"
+        )
+    regions = {f"block_{k}": b for k, b in enumerate(props.blocks, start=1)}
+    troi = props.table if props.table_moves else None
+    if props.table_edge is not None and not props.table_moves:
+        line = tuple(tuple(round(float(v), 1) for v in p) for p in props.table_edge.ends_px)
+    proposed = tuple(f"--object {n}={_box_text(b)}" for n, b in regions.items())
+    if troi is not None:
+        proposed += (f"--table {_box_text(troi)}",)
+    pnotes = _proposal_notes(props, window, gray.size)
+    return regions, troi, line, proposed, pnotes
 
 
 def _box_text(b) -> str:
@@ -183,12 +243,23 @@ def _box_text(b) -> str:
 LARGE_PROPOSAL = 0.1
 
 
+def _still_text(still) -> str:
+    return "; ".join(
+        f"something moves at {_box_text(b)}, but that box is mostly still things (its content stays in place in "
+        f"{100 * share:.0f} % of the frames compared, correlation {cc:.2f}): a tracker would follow them, so it is "
+        "not proposed"
+        for b, share, cc in still
+    )
+
+
 def _proposal_notes(props, window_s, frame_px) -> list:
     notes = [
         f"PROPOSED, check before tracking: no marker found, so the objects are what moves in the first "
         f"{window_s:.3g} s ({props.n_moving} of {props.n_samples} frames compared with the first moved); "
         "see the preview, and re-run with --object NAME=x,y,w,h (and --table x,y,w,h) to correct them"
     ]
+    if props.still:
+        notes.append(_still_text(props.still) + "; draw the moving thing's own box with --object")
     for k, (x, y, w, h) in enumerate(props.blocks, start=1):
         if w * h > LARGE_PROPOSAL * frame_px:
             notes.append(

@@ -17,7 +17,7 @@ from ._level import level_from_reference
 from ._table_track import choose_sg_window, estimate_noise, table_motion
 from ._track import TRACK_COLUMNS, ObjectTrack, Observation, TrackResult, assemble_tracks, track_frames, track_video
 from ._video import VideoInfo, iter_video_frames, probe_video
-from ._propose import propose_objects
+from ._propose import lead_in, propose_objects
 from ._init import parse_region
 from ._plane import make_plane_map
 
@@ -45,6 +45,7 @@ __all__ = [
     "find_markers",
     "suggest_config",
     "propose_objects",
+    "lead_in",
     "parse_region",
     "make_plane_map",
 ]

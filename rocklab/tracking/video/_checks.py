@@ -54,7 +54,8 @@ def look(gray, box):
 
 
 def why_lost(now, ref):
-    """Reason for a lost target from its last window now vs at the last good detection.
+    """Reason for a lost target from its last window now vs at the last good detection (how the
+    window looks; :func:`lost_status` says whether that is true of the object).
 
     "blur": fine detail gone (Laplacian variance < 35 %) but the black/white
     contrast still there (grey std > 25 %); "occluded": the contrast itself is
@@ -68,6 +69,134 @@ def why_lost(now, ref):
     if sharp < BLUR_RATIO * ref[0]:
         return "blur"
     return "lost"
+
+
+#: A cut to another shot (a title card, a lead-in, an edit): the mean grey change to the next
+#: frame, at :data:`CUT_WIDTH_PX` wide, more than ``CUT_FACTOR`` times the film's median change
+#: and at least ``CUT_MIN_DN`` (the real films: 24.4 and 28.7 DN at the title cards of a film
+#: whose frames change by 2.1 DN, 100.8 DN where a black lead-in ends). Inside a film, where a
+#: hand passing the camera changes as much as a title card, a cut is a change of most of the
+#: picture: its median pixel changes by ``CUT_MIN_DN`` (96 DN at the black lead-in's end, 1 DN
+#: at a title card over a fifth of the picture).
+CUT_FACTOR = 6.0
+CUT_MIN_DN = 12.0
+CUT_WIDTH_PX = 160.0
+
+
+def small_grey(gray) -> np.ndarray:
+    """``gray`` at most :data:`CUT_WIDTH_PX` wide, float32, for comparing whole frames."""
+    import cv2
+
+    s = min(1.0, CUT_WIDTH_PX / gray.shape[1])
+    g = gray if s == 1.0 else cv2.resize(gray, None, fx=s, fy=s, interpolation=cv2.INTER_AREA)
+    return g.astype(np.float32)
+
+
+def cut_limit(steps) -> float:
+    """The change between two frames (DN, :func:`small_grey`) above which it is a cut, from the
+    film's own changes ``steps``; inf while fewer than 3 are known."""
+    return max(CUT_FACTOR * float(np.median(steps)), CUT_MIN_DN) if len(steps) >= 3 else math.inf
+
+
+#: ... from a picture with texture to another: the grey levels of the changed pixels spread by
+#: at least this on both sides (a grey card over two thirds of a rendered film, put in front and
+#: taken away: 1.5 DN on its side; a cover is an occluder, not a cut).
+CUT_TEXTURE_DN = 5.0
+
+
+def is_cut(before, after) -> bool:
+    """Whether frame ``after`` follows ``before`` (both :func:`small_grey`) by a cut to another
+    shot: most of the picture changed (the median pixel by :data:`CUT_MIN_DN`), from texture to
+    texture (:data:`CUT_TEXTURE_DN`): a flat cover put in front or taken away (a hand, a card)
+    is an occluder, and a lead-in from black is found by ``track init``."""
+    change = np.abs(after - before)
+    if float(np.median(change)) < CUT_MIN_DN:
+        return False
+    moved = change >= CUT_MIN_DN
+    return min(float(before[moved].std()), float(after[moved].std())) >= CUT_TEXTURE_DN
+
+
+def check_cuts(steps, cuts, frames, path) -> None:
+    """W-VIDEO-CUT when the tracked frames cut to another shot: ``cuts``, the frames at which most
+    of the picture changed (the median pixel by :data:`CUT_MIN_DN`), or a first frame tracked that
+    differs from the next as no other pair does (``steps[0]`` beyond :func:`cut_limit` of the
+    others: a title card over the scene, a lead-in); ``steps[i]`` is the mean change (DN) from
+    ``frames[i]`` to ``frames[i + 1]``."""
+    first = len(steps) >= 4 and steps[0] > cut_limit(steps[1:])
+    if not cuts and not first:
+        return
+    at = sorted(set(cuts) | ({int(frames[1])} if first else set()))
+    why = (
+        f"; the first frame tracked, {frames[0]}, differs from the next as no other pair does (a title card, "
+        f"a lead-in): the objects' templates and the background come from it, so set [video] start_frame = "
+        f"{frames[1]}"
+        if first
+        else "; the frames after a cut show another scene: track a span without one ([video] start_frame, stop_frame)"
+    )
+    warn(
+        "W-VIDEO-CUT",
+        f"{path}: the film cuts to another shot at frame(s) {', '.join(map(str, at[:5]))} (the picture "
+        f"changes by up to {max(steps):.3g} grey levels against {float(np.median(steps)):.3g} a frame){why}",
+    )
+
+
+def ring_look(gray, box):
+    """(mean, std) grey of the ring round the window ``box`` = (u0, v0, u1, v1): the window grown
+    by half its size on each side, less the window; None when the ring is under 64 px."""
+    u0, v0, u1, v1 = box
+    H, W = gray.shape[:2]
+    du, dv = (u1 - u0) // 2, (v1 - v0) // 2
+    x0, y0, x1, y1 = max(u0 - du, 0), max(v0 - dv, 0), min(u1 + du, W), min(v1 + dv, H)
+    outer = gray[y0:y1, x0:x1].astype(np.float32)
+    keep = np.ones(outer.shape, bool)
+    keep[max(v0 - y0, 0) : v1 - y0, max(u0 - x0, 0) : u1 - x0] = False
+    ring = outer[keep]
+    return (float(ring.mean()), float(ring.std())) if ring.size >= 64 else None
+
+
+def shows_background(gray, box, ring) -> bool:
+    """Whether the window ``box`` now looks like the ring round it did at the object's last good
+    frame (``ring``, :func:`ring_look`): mean within half the ring's spread (and 3 grey levels),
+    spread at most 1.5 times it (and 2). Then the object has left the window, and what stands
+    there is the scene behind it: the window says nothing about the object (lost, neither
+    occluded nor blurred)."""
+    if ring is None:
+        return False
+    u0, v0, u1, v1 = box
+    crop = gray[v0:v1, u0:u1].astype(np.float32)
+    if crop.size < 64:
+        return False
+    mean, std = ring
+    return abs(float(crop.mean()) - mean) <= 0.5 * std + 3.0 and float(crop.std()) <= 1.5 * std + 2.0
+
+
+def last_seen(prev, frame: int, centre_px) -> tuple:
+    """An object's last ok frame, its centre (px) and its speed (px/frame, from the ok frame
+    before: 0 for the first), given ``prev``, the same for the ok frame before (or None)."""
+    c = np.asarray(centre_px, float)
+    if prev is None or frame <= prev[0]:
+        return frame, c, 0.0
+    return frame, c, float(np.hypot(*(c - prev[1]))) / (frame - prev[0])
+
+
+def may_have_left(seen, frame: int, box) -> bool:
+    """Whether an object last seen at ``seen`` (:func:`last_seen`) may have moved out of its last
+    window ``box`` (u0, v0, u1, v1 px) by ``frame``: at its last speed, farther than a quarter of
+    the window's smaller side."""
+    f, _, speed = seen
+    return speed * (frame - f) > 0.25 * min(box[2] - box[0], box[3] - box[1])
+
+
+def lost_status(gray, box, sharp_ref, ring, seen, frame) -> str:
+    """Why an object is lost, from its last window ``box`` in ``gray`` (:func:`why_lost`), said
+    only when true of the object: "occluded" when the window does not show the scene that stood
+    round it (:func:`shows_background`: the object left, the scene behind it shows), "blur" while
+    the object cannot have left the window (:func:`may_have_left`: a window the object is leaving
+    loses its fine detail too); else "lost"."""
+    why = why_lost(look(gray, box), sharp_ref)
+    if (why == "occluded" and shows_background(gray, box, ring)) or (why == "blur" and may_have_left(seen, frame, box)):
+        return "lost"
+    return why
 
 
 def check_frames(res, expected: int, path, info=None) -> None:

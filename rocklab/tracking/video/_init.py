@@ -120,6 +120,7 @@ def suggest_config(
     marker_size_m: float | None = None,
     found: MarkerFinding | None = None,
     level_line_px=None,
+    start_frame: int = 0,
 ) -> tuple[TrackConfig, list[str], MarkerFinding | None]:
     """A tracking config for a video from its first frame.
 
@@ -138,6 +139,8 @@ def suggest_config(
         The markers already found in ``first_gray`` (the search is not repeated).
     level_line_px : ((u0, v0), (u1, v1)), optional
         Without a table: a horizontal line of the first frame (px) that levels the angles.
+    start_frame : int
+        The frame ``first_gray`` is (``[video] start_frame``: tracking starts there).
 
     Returns
     -------
@@ -145,7 +148,7 @@ def suggest_config(
         ``notes``: one line each, written as comments into the TOML.
     """
     notes: list[str] = []
-    video = VideoConfig(fps=fps)
+    video = VideoConfig(fps=fps, start_frame=int(start_frame))
     H, W = first_gray.shape[:2]
 
     def inside(option, roi):

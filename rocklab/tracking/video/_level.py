@@ -15,7 +15,7 @@ import numpy as np
 from ..._diagnostics import warn
 from ..._errors import InputError
 
-__all__ = ["level_from_reference", "anchored", "world_angle"]
+__all__ = ["level_from_reference", "anchored", "world_angle", "final_rest"]
 
 
 def _robust_sem(x) -> float:
@@ -65,7 +65,7 @@ def level_from_reference(config, raw, fps, metric_plane, plane_map):
             return 0.0, "none", math.nan
         a, st, _ = raw[oid]
         th = np.where(st == "ok", a["th"], np.nan)
-        rest = _final_rest(th, fps)
+        rest = final_rest(th, fps)
         if rest is None:
             warn(
                 "W-LEVEL-NONE",
@@ -95,8 +95,8 @@ def level_from_reference(config, raw, fps, metric_plane, plane_map):
     return 0.0, "none", math.nan
 
 
-def _final_rest(th, fps, min_s=1.0):
-    """Indices of the last still stretch of ``th`` (>= ``min_s`` long, ending at the last sample
+def final_rest(th, fps, min_s=1.0):
+    """Whether a track comes to rest at its end, the one test of it: indices of the last still stretch of ``th`` (>= ``min_s`` long, ending at the last sample
     seen), or None. Still: frame-to-frame steps within 4 sigma of the measurement noise, its scale
     from the smallest fifth of the steps (the 20 % quantile of |N(0, s)| is 0.253 s), and a spread
     within 5 % of the whole track's."""
@@ -134,7 +134,8 @@ def world_angle(o, config, th, sig, fps, level, level_src, src="config"):
     Measured objects lose the camera's roll (``level``). An anchored object (:func:`anchored`)
     carries none: its angle is its rotation plus ``theta0_rad``, an angle in the levelled frame.
     Without ``theta0_rad`` it is assumed upright at the first frame, unless it ends at rest
-    (its last 0.5 s within 10 per-frame sigmas) at an angle that differs from upright by more than 3 sigma and less than 45 deg:
+    (:func:`final_rest`, the test ``level = "rest"`` makes) at an angle that differs from upright
+    by more than 3 sigma and less than 45 deg:
     free rocking ends upright, so the rest sets the starting angle (warning W-THETA0-REST). With
     ``level = "rest"`` of the object itself, that rest is the level and is taken off as before.
     """
@@ -142,14 +143,10 @@ def world_angle(o, config, th, sig, fps, level, level_src, src="config"):
         return th - level
     if o.theta0_rad is not None:
         return th
-    # still at the end: the last 0.5 s within 10 per-frame sigmas (a block still rocking by a
-    # tenth of a degree is not at rest)
-    n = max(int(round(0.5 * fps)), 5)
-    rest = np.arange(max(th.size - n, 0), th.size)
-    tail = th[rest]
-    if rest.size < n or np.isfinite(tail).mean() < 0.8:
-        return th
-    if not np.nanmax(tail) - np.nanmin(tail) <= 10.0 * float(np.nanmedian(sig[rest])):
+    # the same decision as level = "rest" (one answer to "does it come to rest" per run: the
+    # level's W-LEVEL-NONE and this W-THETA0-REST cannot both be said of one track)
+    rest = final_rest(th, fps)
+    if rest is None:
         return th
     off = float(np.nanmedian(th[rest]))
     unc = max(_robust_sem(th[rest]), float(np.nanmedian(sig[rest])))

@@ -9,7 +9,11 @@ exposure hunting does not count as motion. Connected regions of that mask, close
 texture's gaps and merged when they touch, are the proposals: boxes in first-frame pixels.
 Parts thinner than :data:`THIN_PX` (a pendulum's string sweeping the wall) are dropped first,
 a merge that would cover most of the frame leaves its parts apart, and a box narrower than the
-markerless tracker's smallest region is no proposal.
+markerless tracker's smallest region is no proposal. Nor is a box whose own first-frame content stays in
+place in the samples (:func:`stays_in_place`): it is mostly still things round a moving part
+(a stand round the stick sliding off it), and a tracker would follow the still things. The
+first frame is the first of the film's scene: :func:`lead_in` finds blank, fading-in or title
+frames before it.
 
 The table is the long straight horizontal edge a block stands on: searched just below each
 proposal's bottom, on either side of it, and accepted only when
@@ -28,9 +32,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._checks import region_overlap
+from ._checks import cut_limit, region_overlap, small_grey
 
-__all__ = ["Proposals", "propose_objects", "moving_boxes", "find_table_below", "WORK_WIDTH_PX"]
+__all__ = ["Proposals", "propose_objects", "moving_boxes", "find_table_below", "lead_in", "WORK_WIDTH_PX"]
 
 #: Frames are compared at this width at most (px): enough for boxes to a couple of pixels of the
 #: full frame, and a 1080p film costs no more than a VGA one.
@@ -63,6 +67,54 @@ THIN_PX = 5
 MIN_SIDE_PX = 8
 
 
+#: Lead-in frames before the film's own scene: a frame whose grey levels spread by less than
+#: ``BLANK_STD_DN`` is blank (black, white, one colour); one whose spread is under ``FADE_RATIO``
+#: of the scene's is still fading in; a cut (:func:`~._checks.cut_limit`) within ``CUT_WINDOW_S``
+#: of the start ends a title card or another shot.
+BLANK_STD_DN = 2.0
+FADE_RATIO = 0.5
+CUT_WINDOW_S = 1.0
+
+
+def lead_in(grays, fps: float) -> tuple[int, str]:
+    """Frames at the start of a film that are not its scene: ``(n, what)``, the index of the first
+    frame of the scene in ``grays`` and what comes before it (``""`` when nothing does).
+
+    Parameters
+    ----------
+    grays : sequence of ndarray (H, W) uint8
+        The film's first frames, consecutive (a couple of seconds).
+    fps : float
+        Their rate, frames/s (a cut is looked for in the first :data:`CUT_WINDOW_S`).
+
+    Returns
+    -------
+    (int, str)
+        ``what`` is ``"blank"`` (frames of one grey level: black, white), ``"fade-in"`` (frames
+        whose contrast is still rising to the scene's) or ``"cut"`` (a title card or another
+        shot, ended by a cut).
+    """
+    small = [small_grey(g) for g in grays]
+    if len(small) < 3:
+        return 0, ""
+    std = np.array([float(s.std()) for s in small])
+    if np.all(std < BLANK_STD_DN):
+        return 0, ""  # a film of one colour is refused elsewhere; there is no scene to start at
+    k = int(np.argmax(std >= BLANK_STD_DN))
+    what = "blank" if k else ""
+    scene = float(np.median(std[k:]))
+    while k < len(small) - 1 and std[k] < FADE_RATIO * scene:
+        k, what = k + 1, "fade-in"
+    step = np.array([float(np.mean(np.abs(a - b))) for a, b in zip(small[k:-1], small[k + 1 :])])
+    if step.size >= 3:
+        limit = cut_limit(step)
+        n_win = max(1, int(round(CUT_WINDOW_S * fps)))
+        cuts = np.flatnonzero(step[:n_win] > limit)
+        if cuts.size:
+            k, what = k + int(cuts[-1]) + 1, what or "cut"
+    return k, what
+
+
 @dataclass(frozen=True)
 class Proposals:
     """What :func:`propose_objects` found.
@@ -80,6 +132,10 @@ class Proposals:
         The edge found there (angle, 1-sigma, the span followed).
     n_samples, n_moving : int
         Frames compared with the first, and those in which something moved.
+    still : tuple of ((x, y, w, h), float, float)
+        Boxes round something that moves whose own content stays in place (:func:`stays_in_place`):
+        the box, the share of the samples in which it did, its median correlation there. Not
+        proposed: a tracker would follow the still things in them.
     """
 
     blocks: tuple
@@ -88,6 +144,7 @@ class Proposals:
     table_moves: bool
     n_samples: int
     n_moving: int
+    still: tuple = ()
 
 
 def _prepare(gray, scale):
@@ -198,6 +255,42 @@ def moving_boxes(first_gray, samples, masks: bool = False) -> tuple[list, int]:
     return sorted(out), len(moving)
 
 
+#: A box "stays in place" when the first frame's content of it matches a sample best within
+#: ``IN_PLACE_PX`` (working pixels) of where it was in at least ``IN_PLACE_SHARE`` of the samples,
+#: with a median correlation of at least ``IN_PLACE_CC``: the still things in it outweigh what
+#: moves (a launcher's stand round the stick that slides off it; measured on the real films: 0.87
+#: for that stand, 0.06-0.34 of the samples in place for a pendulum's ball, pucks, carts and the
+#: rendered rocking blocks).
+IN_PLACE_PX = 1.5
+IN_PLACE_SHARE = 0.9
+IN_PLACE_CC = 0.7
+
+
+def stays_in_place(first_gray, samples, box) -> tuple[bool, float, float]:
+    """Whether the first frame's content of ``box`` (x, y, w, h px) stays where it is in the
+    ``samples``: (verdict, share of samples with the best match in place, median correlation of
+    the best matches). Searched within half the box's larger side round it, at the working width."""
+    import cv2
+
+    scale = min(1.0, WORK_WIDTH_PX / first_gray.shape[1])
+    f0 = _prepare(first_gray, scale)
+    x, y, w, h = (int(round(v * scale)) for v in box)
+    tmpl = f0[y : y + h, x : x + w]
+    if not samples or min(tmpl.shape) < 3 or float(tmpl.std()) < 1e-3:
+        return False, 0.0, 0.0
+    m = max(w, h) // 2
+    u0, v0 = max(x - m, 0), max(y - m, 0)
+    shifts, ccs = [], []
+    for smp in samples:
+        area = _prepare(smp, scale)[v0 : y + h + m, u0 : x + w + m]
+        _, cc, _, at = cv2.minMaxLoc(cv2.matchTemplate(area, tmpl, cv2.TM_CCOEFF_NORMED))
+        shifts.append(math.hypot(at[0] + u0 - x, at[1] + v0 - y))
+        ccs.append(cc)
+    share = float(np.mean(np.asarray(shifts) <= IN_PLACE_PX))
+    cc = float(np.median(ccs))
+    return share >= IN_PLACE_SHARE and cc >= IN_PLACE_CC, share, cc
+
+
 def find_table_below(first_gray, box):
     """A table's top edge just below the block ``box`` (x, y, w, h px): ``(roi, TopEdge)`` or None.
 
@@ -249,6 +342,11 @@ def propose_objects(first_gray, samples) -> Proposals:
     Proposals
     """
     boxes, n_moving = moving_boxes(first_gray, samples)
+    # a box round something that moves but mostly of still things is no object to track: the
+    # tracker follows the still things (a stand, the wall), and reports a still "object" as ok
+    verdicts = [stays_in_place(first_gray, samples, b) for b in boxes]
+    still = tuple((b, share, cc) for b, (yes, share, cc) in zip(boxes, verdicts) if yes)
+    boxes = [b for b, v in zip(boxes, verdicts) if not v[0]]
     table = edge = None
     moves = False
     for b in boxes:
@@ -285,4 +383,4 @@ def propose_objects(first_gray, samples) -> Proposals:
             for b in boxes
             if not region_overlap(b, table)[1] or table[1] - b[1] >= MIN_SIDE_PX
         ]
-    return Proposals(tuple(boxes), table, edge, moves, len(samples), n_moving)
+    return Proposals(tuple(boxes), table, edge, moves, len(samples), n_moving, still)

@@ -21,7 +21,20 @@ from ..._blas import one_blas_thread
 from ..._diagnostics import warn
 from ..._errors import InputError
 from .._corrections import apply_corrections, load_corrections
-from ._checks import check_frames, check_rate, interpolate, look, region_leaves, tee, why_lost
+from ._checks import (
+    check_cuts,
+    is_cut,
+    check_frames,
+    check_rate,
+    interpolate,
+    last_seen,
+    look,
+    lost_status,
+    region_leaves,
+    ring_look,
+    small_grey,
+    tee,
+)
 from ...config import TrackConfig
 from ._camera_model import PlaneMap, fit_similarity
 from .targets import make_detector
@@ -110,6 +123,8 @@ def track_frames(frames, config: TrackConfig, plane_map: PlaneMap | None = None)
     det = None
     min_q = config.targets.min_quality
     boxes, sharp_ref = {}, {}
+    rings, seen = {}, {}  # object -> at its last ok frame: the ring round its window; (frame, centre, speed)
+    prev, steps, cuts, indices = None, [], [], []  # the whole frame's changes, cuts to another shot
     scales = {}  # object -> recent scales of complete detections
     for k, item in enumerate(frames):
         idx, gray = item if isinstance(item, tuple) else (k, item)
@@ -120,6 +135,15 @@ def track_frames(frames, config: TrackConfig, plane_map: PlaneMap | None = None)
                 plane_map = make_plane_map(config, gray.shape[1], gray.shape[0], gray)
             det = make_detector(config, plane_map, gray)
             free = angle_free_objects(config, det)
+        small = small_grey(gray)
+        cut = False
+        if prev is not None:
+            steps.append(float(np.mean(np.abs(small - prev))))
+            cut = is_cut(prev, small)
+            if cut:
+                cuts.append(idx)
+        prev = small
+        indices.append(idx)
         with one_blas_thread():
             dets = det.detect(gray, idx)
         for o in config.objects:  # an angle found unmeasurable on the way (a round outline, once seen)
@@ -170,6 +194,8 @@ def track_frames(frames, config: TrackConfig, plane_map: PlaneMap | None = None)
                 u, v = d.img_pts[:, 0], d.img_pts[:, 1]
                 box = (int(max(u.min(), 0)), int(max(v.min(), 0)), int(u.max()) + 1, int(v.max()) + 1)
                 boxes[o.id] = box
+                rings[o.id] = ring_look(gray, box)
+                seen[o.id] = last_seen(seen.get(o.id), idx, d.img_pts.mean(axis=0))
                 if o.id not in sharp_ref or k % 25 == 0:
                     sharp_ref[o.id] = look(gray, box)
             else:
@@ -177,10 +203,11 @@ def track_frames(frames, config: TrackConfig, plane_map: PlaneMap | None = None)
                 why = det.lost_reason(o.id) if hasattr(det, "lost_reason") else None
                 if why is not None:
                     status = why  # the pose was fitted but does not re-explain the image
-                elif o.id in boxes:
-                    status = why_lost(look(gray, boxes[o.id]), sharp_ref.get(o.id))
+                elif o.id in boxes and not cut:  # a cut shows another scene: only "lost" is true
+                    status = lost_status(gray, boxes[o.id], sharp_ref.get(o.id), rings[o.id], seen[o.id], idx)
                 obs.append(Observation(idx, o.id, *(np.nan,) * 7, status, getattr(d, "metric", True), plane_map.source))
         yield obs
+    check_cuts(steps, cuts, indices, config.source or "the film")
 
 
 @dataclass(frozen=True)

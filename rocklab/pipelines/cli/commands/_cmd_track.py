@@ -7,7 +7,9 @@
   object's theta (with its 1-sigma band), image position and quality, every frame that is not
   ``ok`` marked by its status.
 - ``rocklab track init VIDEO [--object NAME=x,y,w,h ...] [--table x,y,w,h]
-  [--marker-size M] [--lens lens.json] -o track.toml``: a config from the first frame (markers found by
+  [--marker-size M] [--lens lens.json] [--start-frame N] -o track.toml``: a config from the first
+  frame tracked (frame N, written as ``[video] start_frame``; without it frame 0, or the first after
+  a lead-in of blank, fading-in or title frames, said in a note) (markers found by
   trying the common dictionaries, or the named regions followed markerless), commented,
   plus ``track_init.png`` with every detection, region and the level line drawn; ``--lens``
   (from ``rocklab calibrate``) is written as ``[video] calibration``.
@@ -62,6 +64,14 @@ def register(sub):
         help="init: a lens file from 'rocklab calibrate', written as [video] calibration (points undistorted)",
     )
     p.add_argument("--preview", default=None, help="init: preview PNG (default: <config stem>_init.png)")
+    p.add_argument(
+        "--start-frame",
+        type=int,
+        default=None,
+        metavar="N",
+        help="init: the first frame tracked, written as [video] start_frame (regions are in its pixels; "
+        "default: 0, or the first frame after blank, fading-in or title frames)",
+    )
     p.add_argument("--frames", type=int, default=6, help="preview: frames on the contact sheet (default 6)")
     p.add_argument("--config", default=None, help="track.toml (default: track.toml next to the video)")
     p.add_argument("-o", "--out", default=None, help="output CSV (default: tracks.csv next to the video)")
@@ -104,6 +114,10 @@ def run(args) -> int:
         raise InputError("--at T_S: shows the frames around a time in 'rocklab track preview VIDEO --at T_S' only")
     if args.lens is not None and args.video != "init":
         raise InputError("--lens: applies to 'rocklab track init'; a config names its lens in [video] calibration")
+    if args.start_frame is not None and args.video != "init":
+        raise InputError("--start-frame N: applies to 'rocklab track init'; a config sets [video] start_frame")
+    if args.start_frame is not None and args.start_frame < 0:
+        raise InputError(f"--start-frame {args.start_frame}: give a frame number >= 0")
     if args.corrections is not None and args.video == "init":
         raise InputError("--corrections: applies to 'rocklab track' and 'track preview', not to 'track init'")
     if args.video in ("init", "preview"):
@@ -194,6 +208,7 @@ def _tools(args) -> int:
             side=(not args.out, not args.preview),
             fps=args.fps,
             lens=args.lens,
+            start_frame=args.start_frame,
         )
         if args.json:
             from .._cli_base import emit_json
@@ -205,6 +220,7 @@ def _tools(args) -> int:
                     "objects": [o.id for o in cfg.objects],
                     "style": cfg.targets.style,
                     "level": cfg.reference.level,
+                    "start_frame": cfg.video.start_frame,
                     "proposed": list(proposed),
                     "notes": notes,
                 }
@@ -214,8 +230,9 @@ def _tools(args) -> int:
                 print(f"note: {n}")
             for p in proposed:
                 print(f"proposed: {p}")
+            start = f" --start-frame {cfg.video.start_frame}" if cfg.video.start_frame else ""
             if proposed:
-                print(f"to correct them: rocklab track init {video} {' '.join(proposed)} -o {out}")
+                print(f"to correct them: rocklab track init {video}{start} {' '.join(proposed)} -o {out}")
             print(
                 f"wrote {out} ({', '.join(o.id for o in cfg.objects)}) and {preview}; check the preview, then "
                 f"'rocklab track {video} --config {out}'"

@@ -78,6 +78,10 @@ MAX_TURN_RAD = 1.0
 #: fraction of the pixels whose background is known is background.
 BG_TOL = 10.0
 BG_FRACTION = 0.9
+#: A pose whose template correlation beats the outline's pose's by more than this is not said to
+#: have slid off the outline (collisionOne.webm's red cart: 0.97 against 0.36 where the first
+#: frame's background held the other cart).
+OUTLINE_CC_GAP = 0.3
 #: Steps towards the outline tried when a pose has slid off it.
 HINT_STEPS = 3
 #: Fraction of the patch whose background must be known for the background check to apply.
@@ -344,13 +348,27 @@ class PoseVerifier:
             # pose slid off the object (a spinning object's texture, a keyframe that learned a
             # still edge of the wall)
             found = self.outline.locate(tr, gray, self.bg, W, (back_g, bg_g))
-            if found is not None and self.outline.moved(found):
+            if (
+                found is not None
+                and self.outline.moved(found)
+                and not self._texture_outweighs(tr, gray, found[2], score)
+            ):
                 # the poses since the last frame checked here were the slide: no anchor for motion
                 reason, self.hint, self.recent = "drift", found[2], []
             elif found is not None:
                 self.disk_at = self.outline.disk_centre(tr, W, (back_g, bg_g))
         self._pending = (float(score), centre, theta, pred, last2, gap, frame)
         return reason
+
+    @staticmethod
+    def _texture_outweighs(tr, gray, at, score) -> bool:
+        """Whether the pose's texture match ``score`` beats the outline's pose ``at`` by more than
+        :data:`OUTLINE_CC_GAP`: then the outline is the one that is off (the background behind it
+        is stale: another object stood there in the first frame, as the second cart of a
+        collision film), not the pose."""
+        back = tr._warp_back(gray, at)
+        cc = -1.0 if back is None else max(_ncc(back, tr.tmpl0), _ncc(back, tr.key))
+        return score - cc > OUTLINE_CC_GAP
 
     def _in_frame(self, tr, W, shape):
         """Whether the grown template grid under the pose ``W`` lies inside a frame of ``shape``

@@ -134,3 +134,26 @@ def test_init_markerless_on_a_realistic_render_tracks_unedited(tmp_path, run_cli
     t, tt = (d[d.object == "table"].sort_values("frame") for d in (tr, truth))
     k = np.polyfit(tt.x_m.to_numpy(), t.x_px.to_numpy(), 1)
     assert np.sqrt(np.mean((t.x_px.to_numpy() - np.polyval(k, tt.x_m.to_numpy())) ** 2)) <= 0.1
+
+
+@pytest.mark.parametrize("box", ["10,20,40,40", "5,5,70,100", "30,60,25,30"])
+def test_init_refuses_a_box_on_a_flat_wall_as_the_tracker_would(tmp_path, run_cli, box):
+    """A box on the film's flat half is refused by init with the tracker's own rule (it wrote a config
+    that `rocklab track` then refused); the same box on the textured half is accepted."""
+    import cv2
+
+    v = tmp_path / "half.avi"
+    w = cv2.VideoWriter(str(v), cv2.VideoWriter_fourcc(*"MJPG"), 25.0, (160, 120))
+    rng = np.random.default_rng(1)
+    for _ in range(5):
+        img = np.full((120, 160, 3), 128, np.uint8)
+        img[:, 80:] = (rng.random((120, 80, 3)) * 255).astype(np.uint8)
+        w.write(img)
+    w.release()
+    rc, out, err = run_cli("track", "init", v, "--object", f"wall={box}", "-o", tmp_path / "t.toml")
+    assert rc == 2 and err.count("\n") == 1 and "--object wall" in err and "no texture" in err, err
+    assert not (tmp_path / "t.toml").exists()
+    x, y, bw, bh = (int(s) for s in box.split(","))
+    moved = f"{x + 82},{y},{min(bw, 160 - x - 82)},{bh}"
+    rc, out, err = run_cli("track", "init", v, "--object", f"block={moved}", "-o", tmp_path / "t.toml")
+    assert rc == 0, err

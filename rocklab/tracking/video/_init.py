@@ -13,6 +13,7 @@ import numpy as np
 
 from ..._errors import InputError
 from ._checks import region_leaves, region_overlap
+from .targets._markerless import MIN_TEXTURE_STD
 from ...config import ObjectConfig, ReferenceConfig, TargetsConfig, TrackConfig, VideoConfig
 
 __all__ = ["DICTIONARIES", "MarkerFinding", "find_markers", "suggest_config", "parse_region"]
@@ -161,6 +162,8 @@ def suggest_config(
         if table_roi is not None:
             objs.append(ObjectConfig(id="table", kind="table", roi=inside("--table", table_roi)))
         _check_overlaps(objs)
+        for o in objs:
+            _check_texture(first_gray, "--table" if o.kind == "table" else f"--object {o.id}", o.roi)
         notes.append("objects followed markerless from the regions given (px, first frame)")
         notes.append(
             "a block's theta starts at its theta0_rad (not given: upright in the first frame, or "
@@ -223,6 +226,18 @@ _REST_NOTE = (
     "ends upright; W-LEVEL-NONE when it does not come to rest in the film: then set reference.level "
     '= "line", "value" or "none")'
 )
+
+
+def _check_texture(first_gray, option: str, roi) -> None:
+    """A one-line :class:`InputError` for a region the markerless tracker would refuse at its first
+    frame (grey std below :data:`MIN_TEXTURE_STD`), before a config is written."""
+    u, v, w, h = (int(round(x)) for x in roi)
+    std = float(first_gray[max(v, 0) : v + h, max(u, 0) : u + w].astype(np.float32).std()) if w > 0 and h > 0 else 0.0
+    if not std >= MIN_TEXTURE_STD:
+        raise InputError(
+            f"{option}: region {list(roi)} holds no texture (grey std {std:.3g} < {MIN_TEXTURE_STD:g}); "
+            "draw it round the object's edges or surface detail"
+        )
 
 
 def _check_overlaps(objs) -> None:

@@ -340,6 +340,9 @@ PRIVATE_IMPORTS = {
     "rocklab.tracking.video._propose -> rocklab.tracking.video.targets._table_edge": (
         "proposals look for the table's top edge with the edge target's finder and blur"
     ),
+    "rocklab.tracking.video._init -> rocklab.tracking.video.targets._markerless": (
+        "init refuses a region with the markerless tracker's own texture floor, before writing a config"
+    ),
     "rocklab.tracking.calib._views -> rocklab.tracking.video.sequences._imageseq": (
         "calibration photos are read as 8-bit frames by the image-sequence reader"
     ),

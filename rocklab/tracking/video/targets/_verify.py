@@ -180,7 +180,8 @@ class PoseVerifier:
         if (
             self._limits is None
             or self.n_verified >= self._learned_at + RELEARN_FRAMES
-            or self._learned_at <= WARMUP_FRAMES
+            # until warm, every frame: limits learned from fewer samples fall back to cold floors
+            or min(len(self.scores), len(self.residuals)) <= WARMUP_FRAMES
         ):
             self._limits = (self.score_limit(), self.residual_limit(), self.speed_limit())
             self._learned_at = self.n_verified

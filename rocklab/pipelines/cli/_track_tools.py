@@ -3,6 +3,7 @@ contact sheet to check the set-up before a long run."""
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from pathlib import Path
 
@@ -187,8 +188,6 @@ def track_init(
     )
     notes = ([lead_note] if lead_note else []) + pnotes + notes
     if lens_rel is not None:
-        import dataclasses
-
         cfg = dataclasses.replace(cfg, video=dataclasses.replace(cfg.video, calibration=lens_rel))
         notes.append(f"lens {lens_rel}: detected points are undistorted with it before any geometry")
     if not info.fps and not fps:
@@ -211,12 +210,21 @@ def _from_motion(video, info, gray, img, start, lead_note, preview, side):
     pixel grid is written to ``preview``, when nothing trackable moves."""
     from .._plotting import save_bgr_png
 
+    from ...tracking.video import MIN_TEXTURE_STD, texture_std
+
     line = None
     props, window = _propose(video, info, gray, start)
+    # a proposal the tracker could not register (a flat patch) is dropped here, not refused later
+    # under an --object name the user never gave
+    flat = [b for b in props.blocks if texture_std(gray, b) < MIN_TEXTURE_STD]
+    if flat:
+        props = dataclasses.replace(props, blocks=tuple(b for b in props.blocks if b not in flat))
     if not props.blocks:
         if preview is not None:
             save_bgr_png(Path(preview), draw_grid(img), side=side[1])
         what = "nothing moves" if not props.still else _still_text(props.still) + ", and nothing else moves"
+        if flat:
+            what = f"what moves holds no texture to track ({', '.join(_box_text(b) for b in flat)})"
         raise InputError(
             f"{video}: no ArUco/AprilTag marker in frame {start} and {what} in the "
             f"{window:.3g} s from it{' (' + lead_note + ')' if lead_note else ''}; give the objects as "
@@ -232,6 +240,11 @@ def _from_motion(video, info, gray, img, start, lead_note, preview, side):
     if troi is not None:
         proposed += (f"--table {_box_text(troi)}",)
     pnotes = _proposal_notes(props, window, gray.size)
+    pnotes += [
+        f"a moving region at {_box_text(b)} not proposed: it holds no texture to track "
+        f"(grey std {texture_std(gray, b):.3g} < {MIN_TEXTURE_STD:g})"
+        for b in flat
+    ]
     return regions, troi, line, proposed, pnotes
 
 

@@ -18,7 +18,7 @@ from ._table_track import choose_sg_window, estimate_noise, table_motion
 from ._track import TRACK_COLUMNS, ObjectTrack, Observation, TrackResult, assemble_tracks, track_frames, track_video
 from ._video import VideoInfo, iter_video_frames, probe_video
 from ._propose import lead_in, propose_objects
-from ._init import parse_region
+from ._init import MIN_TEXTURE_STD, parse_region, texture_std
 from ._plane import make_plane_map
 
 
@@ -47,5 +47,7 @@ __all__ = [
     "propose_objects",
     "lead_in",
     "parse_region",
+    "texture_std",
+    "MIN_TEXTURE_STD",
     "make_plane_map",
 ]

@@ -16,7 +16,15 @@ from ._checks import region_leaves, region_overlap
 from .targets._markerless import MIN_TEXTURE_STD
 from ...config import ObjectConfig, ReferenceConfig, TargetsConfig, TrackConfig, VideoConfig
 
-__all__ = ["DICTIONARIES", "MarkerFinding", "find_markers", "suggest_config", "parse_region"]
+__all__ = [
+    "DICTIONARIES",
+    "MarkerFinding",
+    "find_markers",
+    "suggest_config",
+    "parse_region",
+    "texture_std",
+    "MIN_TEXTURE_STD",
+]
 
 #: Dictionaries tried, most common first (ArUco 4x4..6x6, AprilTag 36h11, original ArUco).
 DICTIONARIES = (
@@ -228,11 +236,19 @@ _REST_NOTE = (
 )
 
 
+def texture_std(first_gray, roi) -> float:
+    """Grey standard deviation of a region ``(u, v, w, h)`` (px) of ``first_gray``: the markerless
+    tracker needs at least :data:`MIN_TEXTURE_STD` to register it."""
+    u, v, w, h = (int(round(x)) for x in roi)
+    if w <= 0 or h <= 0:
+        return 0.0
+    return float(first_gray[max(v, 0) : v + h, max(u, 0) : u + w].astype(np.float32).std())
+
+
 def _check_texture(first_gray, option: str, roi) -> None:
     """A one-line :class:`InputError` for a region the markerless tracker would refuse at its first
     frame (grey std below :data:`MIN_TEXTURE_STD`), before a config is written."""
-    u, v, w, h = (int(round(x)) for x in roi)
-    std = float(first_gray[max(v, 0) : v + h, max(u, 0) : u + w].astype(np.float32).std()) if w > 0 and h > 0 else 0.0
+    std = texture_std(first_gray, roi)
     if not std >= MIN_TEXTURE_STD:
         raise InputError(
             f"{option}: region {list(roi)} holds no texture (grey std {std:.3g} < {MIN_TEXTURE_STD:g}); "

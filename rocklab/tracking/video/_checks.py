@@ -199,7 +199,7 @@ def lost_status(gray, box, sharp_ref, ring, seen, frame) -> str:
     return why
 
 
-def check_frames(res, expected: int, path, info=None) -> None:
+def check_frames(res, expected: int, path, info=None, config=None) -> None:
     """Frames lost, counted per cause: W-VIDEO-SHORT (a note) when the header counts frames the
     file does not hold; W-VIDEO-DROPPED (a note) for slots of the container's clock without a
     frame (the camera dropped them; the times stay true); W-VIDEO-DAMAGED when frames the
@@ -231,7 +231,7 @@ def check_frames(res, expected: int, path, info=None) -> None:
             "the gaps are in t_s",
         )
     check_mirrored(info, path)
-    _check_latch(res, path)
+    _check_latch(res, path, config)
     for t in res.tracks:
         lost = int(np.sum(~np.isin(t.status, ("ok", "interpolated"))))
         if lost > 0.01 * len(t.status):
@@ -274,9 +274,11 @@ def check_rate(given: float, info, path, where: str) -> None:
 TABLE_TURN_MAX_RAD = math.radians(1.0)
 
 
-def _check_latch(res, path) -> None:
+def _check_latch(res, path, config=None) -> None:
     """W-TRACK-LATCH when a tracker has latched onto another object: a table that turns (tables
-    translate), or two objects whose reference points coincide on more than 10 % of the frames."""
+    translate), or two objects whose reference points coincide on more than 10 % of the frames
+    both are ``ok`` (closer than 3 px, or than half the smaller side of the smaller of their first
+    regions: two objects side by side keep about a size apart)."""
     for t in res.tracks:
         th = t.theta_rad[t.ok]
         if t.kind == "table" and th.size >= 5:
@@ -287,18 +289,25 @@ def _check_latch(res, path) -> None:
                     f"{path}: table {t.object!r} turns by {math.degrees(turn):.4g} deg over the video; "
                     "a table translates: its region or markers probably follow another object",
                 )
+    sides = {
+        o.id: min(float(o.roi[2]), float(o.roi[3]))
+        for o in (getattr(config, "objects", None) or ())
+        if getattr(o, "roi", None) is not None
+    }
     tr = [t for t in res.tracks if t.x_px is not None]
     for i, a in enumerate(tr):
         for b in tr[i + 1 :]:
             both = a.ok & b.ok
             if both.sum() < 5:
                 continue
+            near = max(3.0, 0.5 * min(sides.get(a.object, 0.0), sides.get(b.object, 0.0)))
             d = np.hypot(a.x_px[both] - b.x_px[both], a.y_px[both] - b.y_px[both])
-            if np.mean(d < 3.0) > 0.1:
+            if np.mean(d < near) > 0.1:
                 warn(
                     "W-TRACK-LATCH",
-                    f"{path}: objects {a.object!r} and {b.object!r} sit on the same pixels on "
-                    f"{100 * np.mean(d < 3.0):.3g} % of the frames; one follows the other's target",
+                    f"{path}: objects {a.object!r} and {b.object!r} sit within {near:.3g} px of each other "
+                    f"on {100 * np.mean(d < near):.3g} % of the frames both are ok; one follows the "
+                    "other's target",
                 )
 
 

@@ -660,7 +660,7 @@ def track_video(
     obs = track_frames(frames, config, pm)
     res = assemble_tracks(obs, config, rate, info.width_px, info.height_px, pm, path, frame_times_s=times)
     expected = (min(stop, n_expected) if stop else n_expected) - start
-    check_frames(res, expected, path, info)
+    check_frames(res, expected, path, info, config)
     return apply_corrections(res, fixes) if fixes else res  # the config's hand fixes
 
 

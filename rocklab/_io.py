@@ -28,7 +28,14 @@ def atomic_path(path, suffix: str | None = None, *, side: bool = False, stamp: b
     ``rocklab synth``).
     """
     from ._errors import InputError
-    from ._outdir import claim_side_file, clean_stale, set_aside_user_file, stale_prefix, stamp_output
+    from ._outdir import (
+        claim_side_file,
+        clean_stale,
+        raise_pending_stop,
+        set_aside_user_file,
+        stale_prefix,
+        stamp_output,
+    )
 
     path = Path(path)
     if path.is_dir():
@@ -49,6 +56,7 @@ def atomic_path(path, suffix: str | None = None, *, side: bool = False, stamp: b
         # the final path, and made only once the file it replaces has been judged
         stamped = stamp and stamp_output(tmp, registry=False)
         kept = set_aside_user_file(path) if side else None
+        raise_pending_stop()
         os.replace(tmp, path)
         if stamp and not stamped:
             stamp_output(path)

@@ -56,6 +56,24 @@ STAMP_XATTR = "user.rocklab.output"
 _MB = 1024 * 1024
 
 
+#: A stop asked for while it could not be raised (a SIGTERM during a compiled loop: the CLI's
+#: handler leaves it here): raised before any output is published, so a stopped run never
+#: publishes even when it finishes before the signal can be delivered again.
+_PENDING_STOP: list = []
+
+
+def defer_stop(exc: BaseException | None) -> None:
+    """Raise ``exc`` at the next publication of an output (:func:`raise_pending_stop`); None
+    forgets a deferred stop (it was raised another way)."""
+    _PENDING_STOP[:] = [] if exc is None else [exc]
+
+
+def raise_pending_stop() -> None:
+    """Raise the stop left by :func:`defer_stop`, if any (before an output is renamed into place)."""
+    if _PENDING_STOP:
+        raise _PENDING_STOP.pop()
+
+
 def pid_alive(pid: int) -> bool:
     """Whether process ``pid`` exists on this machine."""
     if pid <= 0:
@@ -385,6 +403,7 @@ def publish_dir(stage, out_dir, command: str = "") -> Path:
     of the same name is kept under ``NAME.user-<time>``; nothing of the user's is
     deleted.
     """
+    raise_pending_stop()
     stage, out_dir = Path(stage), Path(out_dir)
     umask = os.umask(0)
     os.umask(umask)

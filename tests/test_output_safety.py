@@ -333,3 +333,24 @@ def test_a_killed_writers_staging_file_is_not_the_users(tmp_path):
     (tmp_path / f".report.json.tmp-{os.getpid()}-def").write_bytes(b"x")
     (tmp_path / "notes.txt").write_text("mine")
     assert foreign_entries(tmp_path) == sorted([f".report.json.tmp-{os.getpid()}-def", "notes.txt"])
+
+
+def test_a_stop_deferred_by_a_compiled_loop_stops_the_next_publication(tmp_path):
+    """A SIGTERM that came while numba's loop ran is left to be raised before any output is renamed
+    into place: the run that finishes before the signal is sent again publishes nothing (the CLI
+    test of this, tests/test_kill.py, lost that race under load: exit 0, output written)."""
+    from rocklab._io import write_text_atomic
+    from rocklab._outdir import defer_stop, raise_pending_stop
+
+    class Stop(SystemExit):
+        pass
+
+    defer_stop(Stop(143))
+    with pytest.raises(Stop):
+        write_text_atomic(tmp_path / "out.txt", "x")
+    assert not (tmp_path / "out.txt").exists() and not list(tmp_path.glob(".*"))
+    raise_pending_stop()  # raised once only
+    assert write_text_atomic(tmp_path / "out.txt", "x").read_text() == "x"
+    defer_stop(Stop(143))
+    defer_stop(None)  # forgotten when the stop was raised another way
+    assert write_text_atomic(tmp_path / "out2.txt", "y").read_text() == "y"

@@ -132,10 +132,17 @@ def _on_sigterm(signum, frame):  # a killed run removes its staged outputs on th
         # the signal is sent again a moment later, once the call has returned.
         import os
 
+        from ..._outdir import defer_stop
+
+        # and if the run finishes before that, it stops before publishing any output
+        defer_stop(_Terminated(143))
         again = threading.Timer(0.05, os.kill, (os.getpid(), signum))
         again.daemon = True
         again.start()
         return
+    from ..._outdir import defer_stop
+
+    defer_stop(None)
     raise _Terminated(143)
 
 
@@ -197,6 +204,9 @@ def main(argv=None) -> int:
                 warnings.simplefilter("ignore", RuntimeWarning)
             _check_file_outputs(args)
             rc = int(args.func(args) or 0)
+            from ..._outdir import raise_pending_stop
+
+            raise_pending_stop()  # a stop deferred by a compiled loop, for a command that published nothing
     except InputError as e:
         sys.stderr.write(f"rocklab {cmd}: error: {e}\n")
         return 2

@@ -125,6 +125,8 @@ class _Terminated(SystemExit):
 
 
 def _on_sigterm(signum, frame):  # a killed run removes its staged outputs on the way out
+    from ..._outdir import defer_stop
+
     if _inside_numba(frame):
         # A compiled loop cannot be interrupted; Python runs this handler when numba boxes the
         # loop's results, inside numba's own callback (it unpickles types). An exception raised
@@ -132,16 +134,12 @@ def _on_sigterm(signum, frame):  # a killed run removes its staged outputs on th
         # the signal is sent again a moment later, once the call has returned.
         import os
 
-        from ..._outdir import defer_stop
-
         # and if the run finishes before that, it stops before publishing any output
         defer_stop(_Terminated(143))
         again = threading.Timer(0.05, os.kill, (os.getpid(), signum))
         again.daemon = True
         again.start()
         return
-    from ..._outdir import defer_stop
-
     defer_stop(None)
     raise _Terminated(143)
 

@@ -17,6 +17,11 @@ __all__ = ["track_init", "track_preview", "draw_init_preview", "contact_sheet"]
 _COLOURS = [(0, 200, 255), (255, 120, 0), (0, 220, 0), (220, 0, 220), (0, 0, 255), (255, 255, 0)]
 
 
+def _per_frame(info) -> int:
+    """Images a frame of the film yields: 2 when it is deinterlaced into fields, else 1."""
+    return 2 if info.field_order is not None else 1
+
+
 def _first_frame(video: Path, start_frame=None):
     """(info, grey, BGR, start frame, note) of the first frame tracked: ``start_frame`` when given,
     else the first frame after a lead-in of blank, fading-in or cut-away frames (a note says so)."""
@@ -25,7 +30,7 @@ def _first_frame(video: Path, start_frame=None):
     if not video.exists():
         raise InputError(f"{video}: video not found; check the path")
     info = probe_video(video)
-    per = 2 if info.field_order is not None else 1  # a deinterlaced film yields two fields a frame
+    per = _per_frame(info)
     n = per * (info.n_frames or 0)
     if start_frame is not None and n and not 0 <= start_frame < n:
         raise InputError(f"--start-frame {start_frame}: {video} holds frames 0-{n - 1}; give one of them")
@@ -68,7 +73,7 @@ def _samples(video, info, window_s, start=0):
     """Grey frames spread over the ``window_s`` seconds after frame ``start`` (decoded in one pass)."""
     from ...tracking.video import iter_video_frames
 
-    per = 2 if info.field_order is not None else 1  # a deinterlaced film yields two fields a frame
+    per = _per_frame(info)
     n = per * (info.n_frames or 0)
     stop = start + int(round(window_s * per * (info.fps or 50.0)))
     stop = min(stop, n) if n else stop
@@ -84,7 +89,7 @@ def _propose(video, info, gray, start=0):
     """Objects proposed from what moves after frame ``start``; (Proposals, window s)."""
     from ...tracking.video import propose_objects
 
-    per = 2 if info.field_order is not None else 1
+    per = _per_frame(info)
     duration = max((per * (info.n_frames or 0) - start) / (per * (info.fps or 50.0)), 0.0)
     for window in PROPOSE_WINDOWS_S:
         props = propose_objects(gray, _samples(video, info, window, start))

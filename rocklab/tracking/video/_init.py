@@ -13,7 +13,7 @@ import numpy as np
 
 from ..._errors import InputError
 from ._checks import region_leaves, region_overlap
-from .targets._markerless import MIN_TEXTURE_STD
+from .targets._markerless import MIN_TEXTURE_STD, texture_std
 from ...config import ObjectConfig, ReferenceConfig, TargetsConfig, TrackConfig, VideoConfig
 
 __all__ = [
@@ -234,15 +234,6 @@ _REST_NOTE = (
     "ends upright; W-LEVEL-NONE when it does not come to rest in the film: then set reference.level "
     '= "line", "value" or "none")'
 )
-
-
-def texture_std(first_gray, roi) -> float:
-    """Grey standard deviation of a region ``(u, v, w, h)`` (px) of ``first_gray``: the markerless
-    tracker needs at least :data:`MIN_TEXTURE_STD` to register it."""
-    u, v, w, h = (int(round(x)) for x in roi)
-    if w <= 0 or h <= 0:
-        return 0.0
-    return float(first_gray[max(v, 0) : v + h, max(u, 0) : u + w].astype(np.float32).std())
 
 
 def _check_texture(first_gray, option: str, roi) -> None:

@@ -77,6 +77,15 @@ SEARCH_TURNS_DEG = (0.0, -2.0, 2.0, -4.0, 4.0, -6.0, 6.0, -8.0, 8.0)
 ECC_CRITERIA = (3, 60, 1e-5)  # cv2.TERM_CRITERIA_EPS | cv2.TERM_CRITERIA_COUNT
 
 
+def texture_std(first_gray, roi) -> float:
+    """Grey standard deviation of a region ``(u, v, w, h)`` (px) of ``first_gray``: the markerless
+    tracker needs at least :data:`MIN_TEXTURE_STD` to register it."""
+    u, v, w, h = (int(round(x)) for x in roi)
+    if w <= 0 or h <= 0:
+        return 0.0
+    return float(first_gray[max(v, 0) : v + h, max(u, 0) : u + w].astype(np.float32).std())
+
+
 def _euclid(theta, tx, ty):
     c, s = math.cos(theta), math.sin(theta)
     return np.array([[c, -s, tx], [s, c, ty]], np.float32)
@@ -129,10 +138,11 @@ class MarkerlessTracker:
                 "than it, or is smaller than 8x8 px; draw the region round the object in the first frame"
             )
         tmpl = first_gray[v0:v1, u0:u1].astype(np.float32)
-        if float(tmpl.std()) < MIN_TEXTURE_STD:
+        std = texture_std(first_gray, obj.roi)
+        if std < MIN_TEXTURE_STD:
             raise InputError(
                 f"object {obj.id!r}: roi {list(obj.roi)} holds no texture (grey std "
-                f"{float(tmpl.std()):.3g}); draw it round the object's edges or surface detail"
+                f"{std:.3g}); draw it round the object's edges or surface detail"
             )
         self.origin = np.array([u0, v0], float)  # template pixel (0, 0) in the first frame
         self.tmpl0 = tmpl

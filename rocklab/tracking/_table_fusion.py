@@ -19,7 +19,7 @@ derivative (the driving noise's integral), squared per second and averaged over
 :data:`ADAPT_WINDOW_S`, set ``scale``, ``q`` is searched again, and this :data:`ADAPT_PASSES`
 times. A moving table blurs on the film: where the film's normalised innovations run above 1
 (averaged over :data:`FILM_WINDOW_S`), its frames' variance is raised by as much (at most
-:data:`FILM_MAX_INFLATE`), and ``q`` and ``scale`` are found again. All from the data: the two noise
+:data:`FILM_MAX_INFLATE`), and one more pass finds ``q`` and ``scale``. All from the data: the two noise
 floors, the film's local variance, ``q`` and ``scale``. This for each model order of
 :data:`ORDERS`; the likelier order is kept. ``q_b`` lets the offset move by
 :data:`BIAS_WALK_M_S2` in a second (a slow tilt: gravity's leak through it is taken out with the
@@ -286,16 +286,15 @@ def _ml_q(run, scale):
     return -float(res.fun), 10.0 ** float(res.x)
 
 
-def _adapted(run, m: int, q: float, dt):
-    """The driving noise's density made local, in :data:`ADAPT_PASSES` passes: smooth, read the
+def _adapted(run, m: int, q: float, dt, scale=None, passes: int = ADAPT_PASSES):
+    """The driving noise's density made local, in ``passes`` passes from ``scale``: smooth, read the
     driving noise's local power from the smoothed increments of the model's last derivative
     (their squares per second, averaged over :data:`ADAPT_WINDOW_S`, relative to their mean, at
     least :data:`ADAPT_FLOOR`), find ``q`` by maximum likelihood again. Returns (log-likelihood,
     q, scale per step)."""
-    scale = None
     ll = math.nan
     w = max(3, int(round(ADAPT_WINDOW_S / float(np.median(dt[dt > 0])))))
-    for _ in range(ADAPT_PASSES):
+    for _ in range(passes):
         F, (_, _, sp, Pp, sf, Pf) = run(q, True, scale)
         ss, _ = _smooth(F, sp, Pp, sf, Pf)
         last = ss[:, m - 1]
@@ -424,7 +423,7 @@ def fuse_table_motion(
     if adapt:
         r2 = _film_variance(r, kind, nis, t)
         run = _model(m, dt, z, kind, r2, x0)
-        _, q, scale = _adapted(run, m, q, dt)
+        _, q, scale = _adapted(run, m, q, dt, scale, passes=1)  # from the density found
         F, (_, _, sp, Pp, sf, Pf) = run(q, True, scale)
     ss, Ps = _smooth(F, sp, Pp, sf, Pf)
     ss, Ps = ss[is_out], Ps[is_out]

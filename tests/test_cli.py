@@ -44,7 +44,7 @@ def test_demo_sessions_carry_the_stated_truth(tmp_path):
 
 def test_demo_column_is_driven_by_its_table_imu(tmp_path):
     """The demo's column reads its table from the table IMU (fused with the film's table: 5.0 % ->
-    1.9 % RMS error on the demo), not from a block's IMU, and that log runs until the column is at
+    1.3 % RMS error on the demo), not from a block's IMU, and that log runs until the column is at
     rest (plus 1 s) so that the IMU's drift is anchored."""
     import json
 

@@ -69,8 +69,8 @@ def test_other_draws_unchanged_and_the_error_added_only_for_a_fused_table():
 def test_drawn_error_covers_a_fused_synthetic_pulse(seed):
     """A 45 mm / 0.6 s sine pulse filmed at 50 fps (0.02 mm white noise) and logged by a 256 Hz, 5 mg
     IMU, fused: its true error over σ while the table moves has at most the drawn variance in all
-    (measured 0.85-1.31 against 2.78) and below 5 Hz, the band a rocking block feels (0.017-0.062
-    against 0.078)."""
+    (measured 0.68-1.08 against 1.43) and below 5 Hz, the band a rocking block feels (0.018-0.087
+    against 0.120)."""
     from test_table_scale import _sources
 
     from rocklab.synth._scripted_motion import sine_pulse_table

@@ -66,7 +66,7 @@ def _fuse(name, seed, **kw):
 def test_fused_sine_pulse_table_within_one_percent(name, seed):
     table, T, video, ti, ai, motion, fusion, diags = _fuse(name, seed)
     e_f = _rel_rms(motion.t_s, motion.ax_m_s2, table, T)
-    # measured 0.69 / 0.66 / 0.67 % (IMU alone 1.8 %, film alone 3.0-3.5 %); the 0.8 s pulse 0.91 %
+    # measured 0.51 / 0.51 / 0.49 % (IMU alone 1.8 %, film alone 3.0-3.5 %); the 0.8 s pulse 0.69 %
     # (IMU 2.8 %, film 2.5 %)
     assert e_f <= 0.01
     assert e_f < 0.5 * _rel_rms(ti, ai, table, T)
@@ -106,7 +106,7 @@ def test_fused_record_table_beats_each_source_and_its_sigma_holds(name, seed, re
     assert e_f < vs_film * _rel_rms(video.t_s, video.ax_m_s2, table, T)
     m = (motion.t_s > 0) & (motion.t_s < T - 0.1)
     z = (motion.ax_m_s2 - table.a(motion.t_s))[m] / motion.sigma_ax_m_s2[m]
-    assert 0.5 < np.sqrt(np.mean(z**2)) < 1.3  # the smoother's sigma is the error's scale (0.64-0.78)
+    assert 0.5 < np.sqrt(np.mean(z**2)) < 1.3  # the smoother's sigma is the error's scale (El Centro 0.82-0.86)
     assert fusion.status == "ok" and not diags
     # the table's displacement within a few film noise levels of the truth
     x_true = table.u(motion.t_s[m]) - table.u(0.0)
@@ -194,3 +194,60 @@ def test_a_long_log_is_fused_over_the_film_and_two_seconds():
     assert motion.t_s[0] == pytest.approx(video.t_s[0] - MARGIN_S, abs=1 / 256)
     assert motion.t_s[-1] <= video.t_s[-1] + MARGIN_S
     assert _rel_rms(motion.t_s, motion.ax_m_s2, table, T) <= 0.0105 and fusion.status == "ok"
+
+
+def _linear_bounds(name, sigma_a_m_s2=0.005 * 9.80665):
+    """The oracle linear smoothers' error on a table (``tests/_wiener.py``), on the demo's sensors
+    by default: the IMU's 5 mg per sample at 256 Hz, the film's 0.02 mm per frame at 50 fps; the
+    error over the span ``_rel_rms`` reads."""
+    from _wiener import linear_smoother_bounds
+
+    table, T = TABLES[name]
+    t = np.arange(-1.0, T + 1.0, 1 / 1024.0)
+    mask = (t >= 0) & (t <= T - 0.1)
+    return linear_smoother_bounds(table.a(t), 1024.0, mask, sigma_a_m_s2, 256.0, SIGMA_X_M, 50.0)
+
+
+def test_one_percent_is_below_what_any_linear_smoother_reaches_on_el_centro():
+    """The demo's El Centro table on the demo's sensors: the Wiener smoother knowing the record's
+    own spectrum (an oracle) leaves 1.89 % of the RMS; knowing its spectrum over every 0.25 / 0.5 s
+    of the run, 1.60 / 1.56 %. Most of it is at 5-25 Hz, where El Centro (2-15 Hz, high-passed at
+    2 Hz for the table's stroke) meets the IMU's noise (the film's twice-differentiated noise
+    passes the IMU's above 5 Hz). A sine pulse's energy sits at 1.7 Hz, where the film is exact:
+    0.44-0.71 %. With the x-IMU3's datasheet density (160 ug/sqrt(Hz), 2.8x below the synthetic
+    IMU's 440) El Centro's would be 0.92 % (stationary) / 0.79-0.81 % (local)."""
+    b = _linear_bounds("elcentro")
+    assert 0.017 < b["lti"] < 0.021 and b["lti_drawn"] == pytest.approx(b["lti"], rel=0.1)
+    assert min(b[0.25], b[0.5]) > 0.015  # 1 % is out of reach on these sensors
+    sine = _linear_bounds("sine")
+    assert max(sine["lti"], sine[0.25], sine[0.5]) < 0.008  # the same sensors reach 1 % on a pulse
+    # the reference responds to the sensors: a quieter IMU lowers it, no film raises it
+    quiet = _linear_bounds("elcentro", 160e-6 * 9.80665 * np.sqrt(128.0))
+    assert quiet["lti"] < 0.6 * b["lti"]
+
+
+@pytest.mark.parametrize("name, seed, factor", [("elcentro", 0, 1.5), ("elcentro", 1, 1.5), ("sine", 1, 1.3)])
+def test_fused_table_is_within_a_factor_of_the_local_oracle(name, seed, factor):
+    """The smoother knows neither the spectrum nor when the table moves; it comes within ``factor``
+    of the oracle knowing the true spectrum over every 0.25 s (measured: El Centro 1.27-1.37x, the
+    sine pulse 1.1-1.2x) and, having adapted to the run, beats the stationary oracle on a pulse
+    (0.49-0.51 % against 0.71 %); on El Centro it is within 1.15x of it."""
+    table, T, video, ti, ai, motion, fusion, diags = _fuse(name, seed)
+    e = _rel_rms(motion.t_s, motion.ax_m_s2, table, T)
+    b = _linear_bounds(name)
+    local = min(b[0.25], b[0.5])
+    assert local < e < factor * local  # above an oracle (else the reference is wrong), near it
+    assert e < (1.15 if name == "elcentro" else 0.8) * b["lti"]
+
+
+@pytest.mark.parametrize("name", ["elcentro", "sine"])
+def test_two_sigma_band_covers_the_true_error_on_an_unseen_seed(name):
+    """Seed 3 (no other test's, nothing tuned on it): the true acceleration lies within ±2σ of the
+    fused one on 95 % of the samples where the table moves (measured: El Centro 97.0 %, the sine
+    pulse 97.4 %; nominal 95.4 %); the same band at 0.6σ would not hold it."""
+    table, T, video, ti, ai, motion, fusion, diags = _fuse(name, 3)
+    at = table.a(motion.t_s)
+    m = (motion.t_s > 0) & (motion.t_s < T - 0.1) & (np.abs(at) > 0)
+    z = (motion.ax_m_s2 - at)[m] / motion.sigma_ax_m_s2[m]
+    assert 0.93 <= np.mean(np.abs(z) < 2) <= 0.995
+    assert np.mean(np.abs(z) < 1.2) < 0.9

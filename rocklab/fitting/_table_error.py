@@ -12,15 +12,14 @@ set-ups rendered at 960×540, 50 fps, H.264, and tracked as ``rocklab run`` trac
 0.6 s sine pulse, seeds 20 and 21, and B5L under El Centro, seeds 22 and 23). The error
 ``e = a_fused - a_true`` over the samples where the table moves, divided by σ, filtered into the
 bands of :data:`FUSED_ERROR_BANDS_HZ`, has in each band at most the variance of
-:data:`FUSED_ERROR_Z_VAR` (the largest of the four sessions: 2.8 in all, the error 1.7 σ RMS;
-the sessions' own band totals 2.0 and 2.5 on the pulses, 0.7 and 0.6 under El Centro; at rest
-the error is 0.2-0.5 σ). The drawn variance sits at 5-40 Hz, 2.8 % of it below 5 Hz (1-10 % in
-the sessions), with a peak at 7-10 Hz that is the sine pulses' (0.57-0.99 σ² there against 0.11-0.18 under El
-Centro: the smoother's signal model lags the pulse's start and end, where the error reaches
-2 σ). The smoother's own posterior (draws from its covariances) puts 1.5-7x less at 7-10 Hz
-and 1.5x more above 20 Hz, so it is not the error's shape. The largest session's variance, not
-the mean, is drawn: the kind of motion is not known to the ensemble, and the mean of the two
-kinds would draw a pulse's error at 0.8 of its RMS, which is what makes a band too narrow.
+:data:`FUSED_ERROR_Z_VAR` (the largest of the four sessions: 1.43 in all, the error 1.2 σ RMS;
+the sessions' own totals 1.16 and 0.63 on the pulses, 1.03 and 0.80 under El Centro). The drawn
+variance sits at 5-40 Hz, 8 % of it below 5 Hz, with peaks at 7-10 Hz (El Centro's, 0.31 σ²) and
+14-20 Hz (a pulse's, 0.36 σ²). The largest session's variance, not the mean, is drawn: the kind
+of motion is not known to the ensemble, and a mean would draw one kind's error too small, which
+is what makes a band too narrow. (Measured with the smoother of
+:func:`rocklab.tracking.fuse_table_motion` as it is: its local driving noise and film variance;
+the earlier one, without them, left 2.8 σ², peaking at the pulses' start and end.)
 
 :func:`fused_error_draw` draws that error: white noise shaped to the measured band variances
 (a piecewise flat spectrum), times σ at every sample.
@@ -39,7 +38,7 @@ FUSED_ERROR_BANDS_HZ = (
 )  # fmt: skip
 #: Variance of the fused table's error over its σ in each band of :data:`FUSED_ERROR_BANDS_HZ`
 #: while the table moves, the largest of the development sessions (see the module doc), -.
-FUSED_ERROR_Z_VAR = (1.7e-4, 6.9e-3, 3.19e-2, 3.94e-2, 1.51e-1, 9.91e-1, 2.54e-1, 4.09e-1, 7.34e-1, 1.65e-1)
+FUSED_ERROR_Z_VAR = (1.8e-3, 1.51e-2, 4.74e-2, 5.60e-2, 1.375e-1, 3.124e-1, 1.899e-1, 3.625e-1, 2.276e-1, 7.47e-2)
 
 
 def fused_error_draw(t_s, sigma_m_s2, rng, gain: float = 1.0) -> np.ndarray:

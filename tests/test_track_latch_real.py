@@ -38,6 +38,7 @@ def film(tmp_path_factory):
 def _track(film, objects):
     cfg = TrackConfig.from_dict(
         {
+            "video": {"stop_frame": 420},  # the latch starts at frame 299
             "targets": {"style": "markerless"},
             "reference": {"level": "none"},
             "objects": [{"id": k, "roi": list(v)} for k, v in objects.items()],
@@ -61,7 +62,7 @@ def test_a_puck_that_left_the_frame_on_the_other_ones_pixels_is_a_latch(film, sh
     if shift == (0, 0):
         # the reviewer's boxes: after the struck puck left (about frame 290) both trackers were ok on
         # the striker; the striker keeps its pixels
-        assert np.sum(a.status == "latch") > 400 and not np.any(b.status == "latch")
+        assert np.sum(a.status == "latch") > 100 and not np.any(b.status == "latch")
     # a latch is named; trackers that stay apart (the other boxes may) raise nothing
     assert len(latch) == int(latched), [x.message for x in latch]
     if latched:

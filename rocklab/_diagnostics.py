@@ -196,7 +196,8 @@ WARNING_CODES: dict[str, tuple[str, str]] = {
     "W-TRACK-LATCH": (
         "suspect",
         "a tracker follows another object: a table that turns, or two objects on the "
-        "same pixels; redraw the region (or fix the marker ids) of the named object",
+        "same pixels (the frames of the one that jumped there are status latch); redraw the "
+        "region (or fix the marker ids) of the named object",
     ),
     "W-VIDEO-SHORT": (
         "note",

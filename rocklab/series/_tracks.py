@@ -80,6 +80,7 @@ STATUSES = {
     "one_marker": "markers: only one of the object's small markers seen; no pose",
     "low_quality": "measured with a quality below targets.min_quality",
     "outlier": "an angle step no rocking block makes",
+    "latch": "on pixels another object's tracker keeps (it jumped there)",
     "interpolated": "filled between two ok frames (motion.interpolate_max_gap_frames)",
     "corrected": "set by hand from a corrections file",
     "dropped": "removed by hand from a corrections file",

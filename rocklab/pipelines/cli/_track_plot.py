@@ -21,6 +21,7 @@ STATUS_COLOURS = {
     "one_marker": "khaki",
     "low_quality": "tab:gray",
     "outlier": "gold",
+    "latch": "lightcoral",
     "interpolated": "tab:cyan",
     "corrected": "tab:blue",
     "dropped": "black",

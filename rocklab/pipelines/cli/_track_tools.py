@@ -93,7 +93,7 @@ def _propose(video, info, gray, start=0):
     duration = max((per * (info.n_frames or 0) - start) / (per * (info.fps or 50.0)), 0.0)
     for window in PROPOSE_WINDOWS_S:
         props = propose_objects(gray, _samples(video, info, window, start))
-        if props.blocks or duration <= window:
+        if props.blocks or duration <= window or props.camera_moves:
             break
     return props, min(window, duration) if duration else window
 
@@ -230,9 +230,18 @@ def _from_motion(video, info, gray, img, start, lead_note, preview, side):
         what = "nothing moves" if not props.still else _still_text(props.still) + ", and nothing else moves"
         if flat:
             what = f"what moves holds no texture to track ({', '.join(_box_text(b) for b in flat)})"
+        fix = ""
+        if props.camera_moves:  # every pixel changes: "nothing moves" would be false
+            what = (
+                f"the camera moves (the whole picture shifts, by a median {props.camera[1]:.3g} px, between "
+                f"{100 * props.camera[0]:.0f} % of the frames compared)"
+            )
+            fix = (
+                "positions in the picture are then not positions in the scene: film from a fixed camera (a tripod), or "
+            )
         raise InputError(
             f"{video}: no ArUco/AprilTag marker in frame {start} and {what} in the "
-            f"{window:.3g} s from it{' (' + lead_note + ')' if lead_note else ''}; give the objects as "
+            f"{window:.3g} s from it{' (' + lead_note + ')' if lead_note else ''}; {fix}give the objects as "
             "--object NAME=x,y,w,h (and --table x,y,w,h)"
             + (f", read off the pixel grid in {preview}" if preview is not None else "")
             + ", or --start-frame N where the motion starts"

@@ -274,6 +274,97 @@ def check_rate(given: float, info, path, where: str) -> None:
 TABLE_TURN_MAX_RAD = math.radians(1.0)
 
 
+def _first_sides(config) -> dict:
+    """Object id -> the smaller side of its first region (px), for objects given one."""
+    return {
+        o.id: min(float(o.roi[2]), float(o.roi[3]))
+        for o in (getattr(config, "objects", None) or ())
+        if getattr(o, "roi", None) is not None
+    }
+
+
+def latch_distance(sides: dict, a: str, b: str) -> float:
+    """Two objects' reference points closer than this (px) are on the same pixels: 3 px, or half
+    the smaller side of the smaller of their first regions (two objects side by side keep about a
+    size apart)."""
+    return max(3.0, 0.5 * min(sides.get(a, 0.0), sides.get(b, 0.0)))
+
+
+def _shared_runs(uv_a, uv_b, ok_a, ok_b, near: float) -> list:
+    """Runs (first, last index) of the frames both objects are ok within ``near`` px of each
+    other, consecutive among the frames both are ok (a frame either is not ok does not end one)."""
+    both = np.flatnonzero(ok_a & ok_b)
+    close = np.hypot(*(uv_a[both] - uv_b[both]).T) < near
+    runs, start = [], None
+    for j, c in enumerate(close):
+        if c and start is None:
+            start = j
+        if start is not None and (not c or j == len(close) - 1):
+            runs.append((int(both[start]), int(both[j if c else j - 1])))
+            start = None
+    return runs
+
+
+def _entry_miss(uv, ok, s: int) -> float:
+    """How far (px) an object's pose at index ``s`` lies from where its own ok frames before
+    ``s`` lead (the last one moved on at the velocity between the last two); NaN without one."""
+    before = np.flatnonzero(ok[:s])
+    if before.size == 0:
+        return math.nan
+    p1 = before[-1]
+    pred = uv[p1]
+    if before.size >= 2:
+        p0 = before[-2]
+        pred = pred + (uv[p1] - uv[p0]) * (s - p1) / (p1 - p0)
+    return float(np.hypot(*(uv[s] - pred)))
+
+
+def settle_latches(raw, config, plane_map, frames, source) -> None:
+    """Give pixels two trackers share to one object: where two objects are both ok within
+    :func:`latch_distance` of each other, the one whose own track runs on into those frames (its
+    pose where they start within that distance of where its ok frames before lead,
+    :func:`_entry_miss`) keeps them, and the other's ok frames of the run become ``latch`` (NaN
+    values); when both or neither run on (two trackers that drifted together, objects first seen
+    there), the one whose template correlates better over the run (median ``quality``) keeps
+    them. W-TRACK-LATCH names each run. Tables are left out.
+
+    ``raw``: object id -> ({"X", "Y", "th", "sig", "q", ...} arrays (n,) in plane units,
+    statuses (n,), metric), changed in place; ``frames``: the film frame of each index.
+    """
+    if plane_map is None:
+        return
+    sides = _first_sides(config)
+    # a table's region is a strip round its edge, under the blocks: its point need not keep a size
+    # apart from theirs (a table that follows a block turns: _check_latch)
+    ids = [o.id for o in config.objects if o.kind != "table" and o.id in raw]
+    uv = {k: plane_map.to_image(np.column_stack((raw[k][0]["X"], raw[k][0]["Y"]))) for k in ids}
+    for i, a in enumerate(ids):
+        for b in ids[i + 1 :]:
+            near = latch_distance(sides, a, b)
+            for s, e in _shared_runs(uv[a], uv[b], raw[a][1] == "ok", raw[b][1] == "ok", near):
+                on = {k: _entry_miss(uv[k], raw[k][1] == "ok", s) < near for k in (a, b)}
+                if on[a] != on[b]:
+                    lose = b if on[a] else a
+                else:
+                    both = (raw[a][1][s : e + 1] == "ok") & (raw[b][1][s : e + 1] == "ok")
+                    qa, qb = (float(np.median(raw[k][0]["q"][s : e + 1][both])) for k in (a, b))
+                    lose = b if qa >= qb else a
+                keep = b if lose == a else a
+                st = raw[lose][1]
+                hit = np.flatnonzero(st[s : e + 1] == "ok") + s
+                st[hit] = "latch"
+                for k in ("X", "Y", "th", "sig"):
+                    raw[lose][0][k][hit] = np.nan
+                uv[lose][hit] = np.nan
+                why = "its track runs on into them" if on[keep] != on[lose] else "its template matches them better"
+                warn(
+                    "W-TRACK-LATCH",
+                    f"{source}: object {lose!r} sits on the pixels of {keep!r} (within {near:.3g} px) from frame "
+                    f"{frames[s]} to {frames[e]}: those {hit.size} frames of {lose!r} are status latch; "
+                    f"{keep!r} keeps them ({why}); redraw the region of {lose!r}, or track it over the frames it is in view",
+                )
+
+
 def _check_latch(res, path, config=None) -> None:
     """W-TRACK-LATCH when a tracker has latched onto another object: a table that turns (tables
     translate), or two objects whose reference points coincide on more than 10 % of the frames
@@ -289,18 +380,14 @@ def _check_latch(res, path, config=None) -> None:
                     f"{path}: table {t.object!r} turns by {math.degrees(turn):.4g} deg over the video; "
                     "a table translates: its region or markers probably follow another object",
                 )
-    sides = {
-        o.id: min(float(o.roi[2]), float(o.roi[3]))
-        for o in (getattr(config, "objects", None) or ())
-        if getattr(o, "roi", None) is not None
-    }
+    sides = _first_sides(config)
     tr = [t for t in res.tracks if t.x_px is not None]
     for i, a in enumerate(tr):
         for b in tr[i + 1 :]:
             both = a.ok & b.ok
             if both.sum() < 5:
                 continue
-            near = max(3.0, 0.5 * min(sides.get(a.object, 0.0), sides.get(b.object, 0.0)))
+            near = latch_distance(sides, a.object, b.object)
             d = np.hypot(a.x_px[both] - b.x_px[both], a.y_px[both] - b.y_px[both])
             if np.mean(d < near) > 0.1:
                 warn(

@@ -32,6 +32,7 @@ from ._checks import (
     lost_status,
     region_leaves,
     ring_look,
+    settle_latches,
     small_grey,
     tee,
 )
@@ -82,7 +83,8 @@ class Observation:
         "ok" or the reason the values are NaN: "occluded" (the target's last
         window lost its contrast), "blur" (lost its fine detail but kept its
         contrast), "lost" (otherwise), "low_quality"; after assembly also
-        "outlier" (an impossible jump) or "interpolated" (when asked).
+        "outlier" (an impossible jump), "latch" (on pixels another object's tracker keeps) or
+        "interpolated" (when asked).
     metric : bool
         Whether ``scale`` is plane units per metre.
     plane : str
@@ -449,12 +451,14 @@ def assemble_tracks(
             f"{config.source or 'config'}: object {o!r} is never seen in "
             f"{source or 'the video'}; check its markers/dots/roi and the dictionary"
         )
-    m_per = _metres_per_unit(config, raw, metric_plane)
-    from ._level import level_from_reference, world_angle
-
     pm_px = plane_map
     if pm_px is None and plane == "image":  # observations in centred pixels: invert that
         pm_px = PlaneMap(width_px, height_px, config.video.camera_matrix, config.video.dist_coeffs)
+    # before the scale and the level: a latched tracker's frames are another object's
+    settle_latches(raw, config, pm_px, frames, source or "the video")
+    m_per = _metres_per_unit(config, raw, metric_plane)
+    from ._level import level_from_reference, world_angle
+
     level, level_src, level_sig = level_from_reference(config, raw, fps, metric_plane, pm_px)
     c, s = math.cos(-level), math.sin(-level)
     tracks = []

@@ -66,7 +66,10 @@ SIL_RADIUS_TOL = 0.12
 def _silhouette_circle(img, med, thr):
     """(u, v, r) px of the smallest circle round the largest blob differing from ``med`` by more
     than ``thr``; NaN without a blob of 200 px."""
-    d = cv2.GaussianBlur(np.abs(img.astype(np.int16) - med).max(axis=2).astype(np.uint8), (5, 5), 0)
+    # |img - med| per channel, then the largest of B, G, R (OpenCV's per-channel calls: numpy's
+    # max over the 3-long last axis took half of the reference's time)
+    b, g, r = cv2.split(cv2.absdiff(img, med))
+    d = cv2.GaussianBlur(cv2.max(cv2.max(b, g), r), (5, 5), 0)
     m = (d > thr).astype(np.uint8)
     m = cv2.morphologyEx(m, cv2.MORPH_CLOSE, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (11, 11)))
     m = cv2.morphologyEx(m, cv2.MORPH_OPEN, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (5, 5)))
@@ -95,7 +98,7 @@ def silhouette_track(path, scale=1.0):
         path,
         lambda img: img if scale == 1.0 else cv2.resize(img, None, fx=scale, fy=scale, interpolation=cv2.INTER_AREA),
     )
-    med = np.median(np.asarray(frames[::4]), axis=0).astype(np.int16)
+    med = np.median(np.asarray(frames[::4]), axis=0).astype(np.uint8)  # truncated, as before: same pixels
     first = np.array([_silhouette_circle(f, med, SIL_THRESHOLDS[0]) for f in frames])
     r0 = float(np.nanmedian(first[:, 2]))
     out = []

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import ast
+import functools
 from pathlib import Path
 
 import pytest
@@ -26,14 +27,29 @@ def _module_name(path: Path) -> str:
     return ".".join(parts)
 
 
+@functools.cache
+def _parse(path: Path, mtime_ns: int) -> ast.Module:
+    """One module's syntax tree, parsed once per test process (``mtime_ns`` keys an edited file anew)."""
+    return ast.parse(path.read_text(encoding="utf-8"))
+
+
+def _tree(path: Path) -> ast.Module:
+    return _parse(path, path.stat().st_mtime_ns)
+
+
 def _imports():
     """{module: set of imported rocklab modules and top-level third-party names}, every import (lazy ones too)."""
+    return {mod: set(deps) for mod, deps in _import_graph(tuple(sorted(PKG.rglob("*.py")))).items()}
+
+
+@functools.cache
+def _import_graph(paths):
     graph = {}
-    for path in PKG.rglob("*.py"):
+    for path in paths:
         mod = _module_name(path)
         pkg = mod if path.name == "__init__.py" else mod.rsplit(".", 1)[0]
         deps = set()
-        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        for node in ast.walk(_tree(path)):
             if isinstance(node, ast.ImportFrom):
                 if node.level:
                     base = pkg.split(".")
@@ -211,13 +227,14 @@ def _function_lengths():
     out, kernels = {}, set()
     for path in PKG.rglob("*.py"):
         mod = _module_name(path).removeprefix("rocklab.")
-        _source_lengths(path.read_text(encoding="utf-8"), mod, out, kernels)
+        _source_lengths(_tree(path), mod, out, kernels)
     return out, kernels
 
 
 def _source_lengths(source, mod, out, kernels):
-    """Add the functions of one module's ``source`` to ``out`` (whole lengths) and its kernels to ``kernels``."""
-    for node in ast.walk(ast.parse(source)):
+    """Add the functions of one module's ``source`` (text or syntax tree) to ``out`` (whole lengths) and its
+    kernels to ``kernels``."""
+    for node in ast.walk(ast.parse(source) if isinstance(source, str) else source):
         if not isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
             continue
         key = f"{mod}:{node.name}"
@@ -282,7 +299,7 @@ def _private_imports():
     for path in PKG.rglob("*.py"):
         mod = _module_name(path)
         pkg = mod if path.name == "__init__.py" else mod.rsplit(".", 1)[0]
-        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        for node in ast.walk(_tree(path)):
             if not isinstance(node, ast.ImportFrom):
                 continue
             if node.level:
@@ -383,7 +400,7 @@ def test_each_public_name_is_listed_by_one_face():
     faces = {_module_name(p): p for p in PKG.rglob("__init__.py")}
     copies = []
     for face, path in faces.items():
-        tree = ast.parse(path.read_text(encoding="utf-8"))
+        tree = _tree(path)
         by_hand = _listed_by_hand(tree)
         for node in tree.body:
             if not isinstance(node, ast.ImportFrom):

@@ -23,7 +23,8 @@ def test_demo_sessions_carry_the_stated_truth(tmp_path):
     from rocklab.pipelines.campaign._demo import ETA_MAT_TRUE, L_C_M
 
     runs = (("B3M_edge", "B3M", "edge", "none"), ("B5M_full", "B5M", "full", "none"))
-    cfgs = make_demo_campaign(tmp_path, size=(320, 180), progress=False, runs=runs)
+    # the configs and the truths are the subject, not the films: small frames, one process
+    cfgs = make_demo_campaign(tmp_path, size=(160, 90), progress=False, runs=runs, workers=1)
     edge, full = (load_experiment(c) for c in cfgs)
     assert edge.name == "B3M_edge" and edge.contact == "edge" and edge.l_c_m == L_C_M
     assert edge.block_id == "B3M" and edge.video_decimation == 5
@@ -37,7 +38,7 @@ def test_demo_sessions_carry_the_stated_truth(tmp_path):
     # the runs read the camcorder-like H.264 film, as a lab's footage is; --lossless the FFV1 one
     assert edge.video.path.name == "video.mp4" and edge.video.path.is_file()
     (lossless,) = make_demo_campaign(
-        tmp_path / "lossless", size=(320, 180), progress=False, runs=runs[:1], camcorder=False
+        tmp_path / "lossless", size=(160, 90), progress=False, runs=runs[:1], camcorder=False
     )
     assert load_experiment(lossless).video.path.name == "video.mkv"
 

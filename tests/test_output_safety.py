@@ -186,7 +186,19 @@ def test_oas_parquet_side_file_keeps_a_users_file(tmp_path, run_cli, shared_data
     recs = sorted((shared_data / "records").glob("*.AT2"))[:2]
     (tmp_path / "tab.parquet").write_text("my parquet")
     rc, out, err = run_cli(
-        "oas", *recs, "-o", tmp_path / "tab.csv", "--levels", 6, "--sizes", 6, "--refine", 2, "--no-progress"
+        "oas",
+        *recs,
+        "-o",
+        tmp_path / "tab.csv",
+        "--levels",
+        6,
+        "--sizes",
+        6,
+        "--refine",
+        2,
+        "--no-progress",
+        "--workers",
+        1,
     )
     assert rc == 0, err
     assert [p.read_text() for p in tmp_path.glob("tab.parquet.user-*")] == ["my parquet"]
@@ -250,7 +262,9 @@ def test_oas_output_in_its_record_folder_is_not_read_back(tmp_path, run_cli):
     recs.mkdir()
     _two_records(recs)
     inputs = _listing(recs)
+    # one process: a pool of two would import the package twice per run, and the outputs are the subject here
     argv = ("oas", recs, "-o", recs / "tI.csv", "--levels", 4, "--sizes", 4, "--refine", 1, "--no-progress")
+    argv += ("--workers", 1)
     tables = []
     for k in range(2):
         rc, out, err = run_cli(*argv)

@@ -171,7 +171,8 @@ WARNING_CODES: dict[str, tuple[str, str]] = {
     ),
     "W-LEVEL-NONE": (
         "suspect",
-        "levelling asked for a table that is missing or never seen: the camera's roll "
+        "levelling asked for a reference that is not there (a table missing or never seen, or a "
+        "block with no final rest: the message says what its angle did): the camera's roll "
         "stays in every angle; add a level reference or say the camera is level",
     ),
     "W-THETA0-REST": (
@@ -189,9 +190,10 @@ WARNING_CODES: dict[str, tuple[str, str]] = {
     "W-TRACK-THETA": (
         "suspect",
         "a block's appearance does not change when it turns (a disk, a plain ball, a region with "
-        "no edge or mark off its centre), or its outline is round and its texture leaves its first "
-        "view (a ball spinning in depth): its angle is not measured; theta_rad is NaN and x, y "
-        'are tracked. Set kind = "point" for a position only, or redraw the region',
+        "no edge or mark off its centre), or its outline is round and its region no longer matches "
+        "a turned copy of its first view: its angle is not measured; theta_rad is NaN and x, y "
+        'are tracked (for an appearance that tells no angle: its centre of symmetry). Set kind = "point" for a position '
+        "only, or redraw the region",
     ),
     "W-TRACK-LATCH": (
         "suspect",

@@ -65,12 +65,12 @@ def level_from_reference(config, raw, fps, metric_plane, plane_map):
             return 0.0, "none", math.nan
         a, st, _ = raw[oid]
         th = np.where(st == "ok", a["th"], np.nan)
-        rest = final_rest(th, fps)
+        rest, why = rest_finding(th, fps)
         if rest is None:
             warn(
                 "W-LEVEL-NONE",
-                f"{src}: level = 'rest' but {oid!r} does not come to rest at the end of the video "
-                "(1 s still needed); angles are not levelled",
+                f"{src}: level = 'rest' but no final rest of {oid!r} (1 s still) is found: {why}; "
+                'angles are not levelled; set reference.level = "line", "value" or "none"',
             )
             return 0.0, "none", math.nan
         # the frames' scatter understates a bias shared by all frames: one frame's σ is the floor
@@ -96,13 +96,20 @@ def level_from_reference(config, raw, fps, metric_plane, plane_map):
 
 
 def final_rest(th, fps, min_s=1.0):
-    """Whether a track comes to rest at its end, the one test of it: indices of the last still stretch of ``th`` (>= ``min_s`` long, ending at the last sample
-    seen), or None. Still: frame-to-frame steps within 4 sigma of the measurement noise, its scale
-    from the smallest fifth of the steps (the 20 % quantile of |N(0, s)| is 0.253 s), and a spread
-    within 5 % of the whole track's."""
+    """Whether a track comes to rest at its end, the one test of it: indices of the last still
+    stretch of ``th`` (>= ``min_s`` long, ending at the last sample seen), or None. Still:
+    frame-to-frame steps within 4 sigma of the measurement noise, its scale from the smallest
+    fifth of the steps (the 20 % quantile of |N(0, s)| is 0.253 s), and a spread within 5 % of
+    the whole track's. :func:`rest_finding` says what was measured when there is none."""
+    return rest_finding(th, fps, min_s)[0]
+
+
+def rest_finding(th, fps, min_s=1.0):
+    """(:func:`final_rest`'s indices or None, what was measured: a clause for a message, ``""``
+    when a rest was found)."""
     ok = np.flatnonzero(np.isfinite(th))
     if ok.size < 10:
-        return None
+        return None, f"its angle is measured on {ok.size} of {len(th)} frames (10 needed)"
     steps = np.abs(np.diff(th[ok]))
     # 4 / 0.253 = 16: a still step beyond it is one in 16 000 (at 5 quantiles, one in five, which
     # broke every tracked rest of more than a few frames)
@@ -111,11 +118,22 @@ def final_rest(th, fps, min_s=1.0):
     while k > 0 and steps[k - 1] <= still_rad:
         k -= 1
     idx = ok[k:]
+    need = max(10, int(min_s * fps))
+    if idx.size < need:
+        return None, (
+            f"its angle's last still stretch (steps within {math.degrees(still_rad):.3g} deg) is "
+            f"{idx.size} frames, {need} needed"
+        )
     # still against the motion before it: the noise scale above holds only when a fifth of the
     # steps are still, and a film that rocks to its end has no such fifth
-    if np.ptp(th[idx]) > 0.05 * np.ptp(th[ok]):
-        return None
-    return idx if idx.size >= max(10, int(min_s * fps)) else None
+    spread, whole = float(np.ptp(th[idx])), float(np.ptp(th[ok]))
+    if spread > 0.05 * whole:
+        return None, (
+            f"its angle over its last {idx.size} frames spreads {math.degrees(spread):.3g} deg, more "
+            f"than 5 % of its whole range ({math.degrees(whole):.3g} deg): no rest stands out from "
+            "its motion or noise"
+        )
+    return idx, ""
 
 
 def anchored(o, config) -> bool:

@@ -39,7 +39,7 @@ from ._checks import (
 from ...config import TrackConfig
 from ._camera_model import PlaneMap, fit_similarity
 from .targets import make_detector
-from .targets._observability import angle_free_objects, angle_note, warn_theta
+from .targets._observability import angle_free_objects, angle_note, warn_theta, warn_unmatched_angles
 from ._plane import make_plane_map
 from ._table_track import TableMotion, table_motion
 
@@ -90,6 +90,8 @@ class Observation:
     plane : str
         Source of the image -> plane mapping ("image": centred pixels; "homography",
         "board", "table": metres).
+    angle_dropped : bool
+        The angle of this frame alone is not a measurement (NaN), the object's angle otherwise is.
     """
 
     frame: int
@@ -104,6 +106,7 @@ class Observation:
     status: str
     metric: bool = True
     plane: str = "image"
+    angle_dropped: bool = False
 
 
 def track_frames(frames, config: TrackConfig, plane_map: PlaneMap | None = None):
@@ -176,7 +179,9 @@ def track_frames(frames, config: TrackConfig, plane_map: PlaneMap | None = None)
                         )
                     )
                     continue
-                th, sig = (np.nan, np.nan) if o.id in free else (f.theta_rad, d.combined_sigma(f.sigma_theta_rad))
+                th, sig = (f.theta_rad, d.combined_sigma(f.sigma_theta_rad))
+                if o.id in free or getattr(d, "theta_why", None) is not None:
+                    th, sig = np.nan, np.nan
                 obs.append(
                     Observation(
                         idx,
@@ -191,6 +196,7 @@ def track_frames(frames, config: TrackConfig, plane_map: PlaneMap | None = None)
                         "ok",
                         d.metric,
                         plane_map.source,
+                        getattr(d, "theta_why", None) is not None,
                     )
                 )
                 u, v = d.img_pts[:, 0], d.img_pts[:, 1]
@@ -210,6 +216,7 @@ def track_frames(frames, config: TrackConfig, plane_map: PlaneMap | None = None)
                 obs.append(Observation(idx, o.id, *(np.nan,) * 7, status, getattr(d, "metric", True), plane_map.source))
         yield obs
     check_cuts(steps, cuts, indices, config.source or "the film")
+    warn_unmatched_angles(config, det)
 
 
 @dataclass(frozen=True)
@@ -520,15 +527,17 @@ def _object_series(rows, pos, n):
     a = {k: np.full(n, np.nan) for k in ("X", "Y", "th", "sig", "scale", "q")}
     st = np.full(n, "lost", dtype=object)
     metric = False  # metres only where a measured frame says so: a lost frame's flag is a default
+    dropped = np.zeros(n, bool)  # frames whose angle alone is not a measurement
     for r in rows:
         i = pos[r.frame]
         a["X"][i], a["Y"][i], a["th"][i], a["sig"][i] = r.X, r.Y, r.theta_rad, r.sigma_theta_rad
         a["scale"][i], a["q"][i] = r.scale, r.quality
         st[i] = r.status
+        dropped[i] = r.angle_dropped
         metric = metric or (r.status == "ok" and r.metric)
     th = a["th"]
     okk = np.flatnonzero(st == "ok")
-    if np.isnan(th[okk]).any():  # found unmeasurable on the way: no frame's angle is measured
+    if np.isnan(th[okk[~dropped[okk]]]).any():  # found unmeasurable on the way: no frame's angle is measured
         th[:], a["sig"][:] = np.nan, np.nan
     # An angle step no rocking block makes between frames is a misdetection, not motion.
     for j0, j1 in zip(okk[:-1], okk[1:]):

@@ -31,15 +31,18 @@ class Detection:
         reported σ is ``hypot(σ_fit, sigma_rad)``; with several, the corner fit
         also carries their relative positions and the two are combined as
         independent estimates, ``(σ_fit⁻² + sigma_rad⁻²)^-1/2``.
+    theta_why : str or None
+        Why this frame's angle is not a measurement although the object's angle can be (the
+        parts of its region that tell the angle do not match the pose), or None.
     score : float or None
         How well the pose re-explains the image, 0..1 (a markerless object: the correlation of
         the frame, warped back, with its template); when given, it is the frame's quality
         (times the fraction of points found) instead of the fit residual's.
     """
 
-    __slots__ = ("img_pts", "obj_pts", "metric", "n_expected", "sigma_rad", "n_groups", "score")
+    __slots__ = ("img_pts", "obj_pts", "metric", "n_expected", "sigma_rad", "n_groups", "score", "theta_why")
 
-    def __init__(self, img_pts, obj_pts, metric, n_expected, sigma_rad=0.0, n_groups=1, score=None):
+    def __init__(self, img_pts, obj_pts, metric, n_expected, sigma_rad=0.0, n_groups=1, score=None, theta_why=None):
         self.img_pts = np.asarray(img_pts, float).reshape(-1, 2)
         self.obj_pts = np.asarray(obj_pts, float).reshape(-1, 2)
         self.metric = bool(metric)
@@ -47,6 +50,7 @@ class Detection:
         self.sigma_rad = float(sigma_rad) if np.isfinite(sigma_rad) else 0.0
         self.n_groups = int(n_groups)
         self.score = None if score is None else float(score)
+        self.theta_why = theta_why
 
     def combined_sigma(self, sigma_fit):
         """The reported 1-σ of θ given the rigid fit's own σ (rad)."""

@@ -22,8 +22,13 @@ of a 4 x 4 grid match, one does not: a hand, the thread), so the keyframe never 
 occluder; the covered frames then fail and are lost, and the object is found again after.
 
 The per-frame orientation uncertainty is the Gauss-Newton covariance of the fit
-(:func:`._observability.sigma_theta`). An object whose appearance tells no angle (a disk) is
-held upright about its centre of symmetry and reports no angle (:mod:`._observability`). A round
+(:func:`._observability.sigma_theta`), and on a keyframe the keyframe's own (the angle it was cut
+at was itself measured: a chain of keyframes walks, and its σ grows with it). A frame whose cells
+holding most of the turning information no longer match the pose while the rest do reports no
+angle (:func:`._observability.unmatched_turn_share`: the angle was set by the rest, a still
+background in the region's corners), nor does a pose on a keyframe cut at such a frame. An object
+whose appearance tells no angle (a disk) is held upright about its centre of symmetry, reports
+that centre, and no angle (:mod:`._observability`). A round
 object (a ball) reports the place of its disk's centre: its texture slides over it as it spins, so
 its points are moved to within :data:`DISK_AGREE_FRAC` of where the outline puts that centre.
 """
@@ -37,8 +42,8 @@ import numpy as np
 from ...._errors import InputError
 from ._detection import Detection
 from ._ic import ICAffine, ICRigid
-from ._observability import sigma_theta, theta_unobservable
-from ._occlusion import ROUND_MIN, cell_correlations, masked_fit, partly_covered
+from ._observability import MAX_UNMATCHED_TURN, cell_turn_info, sigma_theta, theta_unobservable, unmatched_turn_share
+from ._occlusion import CELL_CC, GRID, ROUND_MIN, cell_correlations, masked_fit, partly_covered
 from ._verify import PoseVerifier, best_turned_match
 
 __all__ = ["MarkerlessTracker", "MarkerlessDetector", "MIN_CC", "REKEY_CC", "ROUND_MIN"]
@@ -147,6 +152,9 @@ class MarkerlessTracker:
         self.origin = np.array([u0, v0], float)  # template pixel (0, 0) in the first frame
         self.tmpl0 = tmpl
         self.key = tmpl
+        #: 1-sigma of the angle at which the keyframe was cut from its frame, rad (inf: that
+        #: frame's angle was not a measurement); a pose registered on the keyframe inherits it
+        self.key_sigma_rad = 0.0
         self._ic: list = []  # (template, ICAffine): the first template's, then the keyframe's
         self.size = (u1 - u0, v1 - v0)
         self.poses: list = []  # last two accepted (theta, tx, ty): first-frame px -> image px
@@ -157,24 +165,32 @@ class MarkerlessTracker:
         # reference points: a 3x3 grid over the template, as plane points of the first frame
         gx, gy = np.meshgrid(np.linspace(0, self.size[0] - 1, 3), np.linspace(0, self.size[1] - 1, 3))
         self.grid = np.column_stack((gx.ravel(), gy.ravel()))
+        #: why this object's angle cannot be measured (its appearance does not change when it
+        #: turns), or None: then every pose is held upright about the template's centre
+        self.theta_note, sym = (None, None) if obj.kind == "table" else theta_unobservable(tmpl)
+        self.sym0 = None if sym is None else self.origin + sym  # the centre of symmetry, first-frame px
+        # the point reported: the region's centre; with no angle, any point but the centre of
+        # symmetry would be reported where it would be had the object not turned
+        ref_px = np.array([u + w / 2, v + h / 2], float)
+        if sym is not None and 0 <= sym[0] <= self.size[0] and 0 <= sym[1] <= self.size[1]:
+            ref_px = self.sym0
         q = plane_map.to_plane(self.grid + self.origin)
-        centre = plane_map.to_plane(np.array([[u + w / 2, v + h / 2]]))[0]
+        centre = plane_map.to_plane(ref_px[None, :])[0]
         th0 = obj.theta0_rad or 0.0
         c, s = math.cos(-th0), math.sin(-th0)
         self.obj_pts = (q - centre) @ np.array([[c, -s], [s, c]]).T
         self._cv2 = cv2
         self.centre0 = self.origin + np.array(self.size, float) / 2  # template centre, first-frame px
         self.verifier = PoseVerifier(first_gray, (u0, v0, u1, v1), self.size)
-        #: why this object's angle cannot be measured (its appearance does not change when it
-        #: turns), or None: then every pose is held upright about the template's centre
-        self.theta_note, sym = (None, None) if obj.kind == "table" else theta_unobservable(tmpl)
-        self.sym0 = None if sym is None else self.origin + sym  # the centre of symmetry, first-frame px
         self.verifier.check_turn = self.theta_note is None
         #: why the angle is not reported although the texture gives one (a round outline), or None
         self.round_note = None
         self.views = [0, 0]  # verified frames, and those not a turned copy of the first view
         self.reason = None  # why the last frame was lost ("mismatch", "jump", "background", "lost")
         self.min_cc = MIN_CC
+        self._turn_info: tuple = (None, None)  # (template, its cells' turning information)
+        #: verified frames, and those whose angle was not a measurement (:meth:`_angle_unmatched`)
+        self.theta_frames = [0, 0]
 
     # -- registration -------------------------------------------------------------
     def _window(self, gray, W, margin):
@@ -376,9 +392,10 @@ class MarkerlessTracker:
         return alt if self.verifier.verify(self, gray, alt[0], frame, alt[1]) is None else None
 
     def _round_check(self, first_view):
-        """Sets :attr:`round_note` once the outline is known to be round and the texture is no
-        longer a turned copy of the first view on :data:`OTHER_VIEW_SHARE` of the verified frames:
-        a ball spinning in depth (a disk with a mark turning in the plane keeps its first view)."""
+        """Sets :attr:`round_note` once the outline is known to be round and the region is no
+        longer a turned copy of its first view on :data:`OTHER_VIEW_SHARE` of the verified frames
+        (a ball spinning in depth; also a rolling disk whose region holds a background that does not
+        turn with it: the note says what was measured, not which)."""
         self.views[0] += 1
         self.views[1] += not first_view
         out = self.verifier.outline
@@ -387,8 +404,9 @@ class MarkerlessTracker:
         n, other = self.views
         if n >= ROUND_MIN_FRAMES and other >= OTHER_VIEW_SHARE * n:
             self.round_note = (
-                f"its outline is round (circularity {out.roundness:.2f}) and its texture is not a turned "
-                f"copy of its first view on {100 * other / n:.0f} % of the frames: a ball spinning in depth"
+                f"its outline is round (circularity {out.roundness:.2f}), so its angle would come from "
+                f"its texture alone, and on {100 * other / n:.0f} % of {n} frames its region does not "
+                f"match a turned copy of its first view (correlation under {REKEY_CC:g})"
             )
 
     def _held(self, W):
@@ -474,7 +492,8 @@ class MarkerlessTracker:
                 fit, tmpl, mask, visible, self.reason = (self._held(alt[0]), alt[1]), self.key, None, 1.0, None
             self.reason = self.reason or (None if fit is not None and fit[1] >= MIN_CC else "lost")
         if self.reason is not None:
-            self.key = self.tmpl0 if self.reason == "drift" else self.key  # the keyframe learned the slide
+            if self.reason == "drift":  # the keyframe learned the slide
+                self.key, self.key_sigma_rad = self.tmpl0, 0.0
             self.verifier.lost_frame(gray, frame, MIN_CC)
             if self.poses:
                 self.last = self.poses[-1]
@@ -482,19 +501,8 @@ class MarkerlessTracker:
             return None
         self.verifier.confirm(gray, self.size)
         self._round_check(first_view)
-        W, cc = fit
-        if cc < REKEY_CC and mask is None:
-            back = self._warp_back(gray, W)
-            if back is not None and partly_covered(cell_correlations(tmpl, back)):
-                # covered in part: no new keyframe from here (it would learn the occluder), and
-                # the pose from the cells still in view
-                part = masked_fit(self, tmpl, gray, W)
-                if part is not None:
-                    (W, cc), mask, visible = part[:2], part[2], part[3]
-            elif back is not None:  # appearance drifted from the first frame: renew the keyframe here
-                self.key = back
+        (W, cc), mask, visible, why, sig = self._settle(tmpl, gray, fit, mask, visible)
         self.poses = (self.poses + [self._centred(W)])[-2:]
-        sig = math.hypot(self._sigma_theta(tmpl, gray, W, mask), self.theta0_sigma_rad)
         pts = (self.grid + self.origin) @ W[:, :2].T.astype(float) + W[:, 2]
         at = self.verifier.disk_at
         if at is not None and mask is None:
@@ -508,7 +516,72 @@ class MarkerlessTracker:
         # a partial view: fewer points than a whole one would give (its quality says so, and the
         # rigid fit keeps the object's known scale)
         n_expected = len(self.grid) if mask is None else int(math.ceil(len(self.grid) / max(visible, 1e-3)))
-        return Detection(pts, self.obj_pts, False, n_expected, sigma_rad=sig, n_groups=1, score=cc)
+        return Detection(pts, self.obj_pts, False, n_expected, sigma_rad=sig, n_groups=1, score=cc, theta_why=why)
+
+    def _settle(self, tmpl, gray, fit, mask, visible):
+        """The verified fit ``(W, cc)`` on ``tmpl`` made final: ``((W, cc), mask, visible, why, σ)``.
+
+        A partly covered view is refitted on the cells still in view; a view drifted from the
+        first one (correlation under :data:`REKEY_CC`) becomes the keyframe. ``why``: why this
+        frame's angle is not a measurement (:meth:`_angle_unmatched`, or a keyframe cut where the
+        angle was not one), or None; σ: the angle's 1-sigma, rad, the keyframe's own included (a
+        chain of keyframes walks, and its σ grows with it).
+        """
+        W, cc = fit
+        why = self._angle_unmatched(tmpl, gray, W) if mask is None and self.theta_note is None else None
+        if why is None and tmpl is not self.tmpl0 and not math.isfinite(self.key_sigma_rad):
+            why = "keyframe"
+        if self.theta_note is None:
+            self.theta_frames[0] += 1
+            self.theta_frames[1] += why is not None
+        if cc < REKEY_CC and mask is None:
+            back = self._warp_back(gray, W)
+            if back is not None and partly_covered(cell_correlations(tmpl, back)):
+                # covered in part: no new keyframe from here (it would learn the occluder), and
+                # the pose from the cells still in view
+                part = masked_fit(self, tmpl, gray, W)
+                if part is not None:
+                    (W, cc), mask, visible = part[:2], part[2], part[3]
+            elif back is not None:  # appearance drifted from the first frame: renew the keyframe here
+                # a keyframe cut where the angle was no measurement carries no angle on
+                key_sig = self._chained_sigma(tmpl, gray, W) if why is None else math.inf
+                self.key, self.key_sigma_rad = back, key_sig
+        sig = self._chained_sigma(tmpl, gray, W, mask) if why is None else math.nan
+        return (W, cc), mask, visible, why, math.hypot(sig, self.theta0_sigma_rad)
+
+    def _chained_sigma(self, tmpl, gray, W, mask=None):
+        """σ of θ (rad) of the pose ``W`` registered on ``tmpl``: the fit's own, and on a keyframe
+        the keyframe's (its angle was itself measured)."""
+        sig = self._sigma_theta(tmpl, gray, W, mask)
+        return sig if tmpl is self.tmpl0 else math.hypot(sig, self.key_sigma_rad)
+
+    def _cells_seen(self, W, shape):
+        """(GRID, GRID) bool: the template's cells whose corners all fall inside a frame of ``shape``
+        under the pose ``W``."""
+        w, h = self.size
+        xs, ys = np.linspace(0, w, GRID + 1), np.linspace(0, h, GRID + 1)
+        gx, gy = np.meshgrid(xs, ys)
+        c = (np.column_stack((gx.ravel(), gy.ravel())) + self.origin) @ W[:, :2].T.astype(float) + W[:, 2]
+        inside = ((c[:, 0] >= 0) & (c[:, 0] <= shape[1]) & (c[:, 1] >= 0) & (c[:, 1] <= shape[0])).reshape(gy.shape)
+        return inside[:-1, :-1] & inside[1:, :-1] & inside[:-1, 1:] & inside[1:, 1:]
+
+    def _angle_unmatched(self, tmpl, gray, W):
+        """Why the pose ``W``'s angle is not a measurement on this frame, or None: the cells of the
+        template that hold more than :data:`._observability.MAX_UNMATCHED_TURN` of its turning
+        information do not match the frame warped back, while the rest does. Its Gauss-Newton
+        sigma then says nothing: the angle was set by the cells that still match (on the turning
+        disc, the still rod and wall in its region's corners, 28-177 deg from the mark's angle)."""
+        if self._turn_info[0] is not tmpl:
+            self._turn_info = (tmpl, cell_turn_info(tmpl, GRID))
+        back = self._warp_back(gray, W)
+        if back is None:
+            return None
+        share = unmatched_turn_share(
+            self._turn_info[1], cell_correlations(tmpl, back), self._cells_seen(W, gray.shape), CELL_CC
+        )
+        if share <= MAX_UNMATCHED_TURN:
+            return None
+        return f"{100 * share:.0f} %"
 
 
 class MarkerlessDetector:
@@ -545,6 +618,11 @@ class MarkerlessDetector:
         region, or once its outline is known, a round outline), or None."""
         t = self.trackers.get(oid)
         return None if t is None else t.theta_note or t.round_note
+
+    def theta_unmatched(self, oid):
+        """(frames verified, frames among them whose angle was not a measurement) of object ``oid``."""
+        t = self.trackers.get(oid)
+        return (0, 0) if t is None else tuple(t.theta_frames)
 
     def lost_reason(self, oid):
         """Why object ``oid`` was lost in the last frame (a status word), or None."""

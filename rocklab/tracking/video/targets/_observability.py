@@ -24,7 +24,12 @@ __all__ = [
     "angle_free_objects",
     "angle_note",
     "warn_theta",
+    "warn_unmatched_angles",
     "MIN_TURN_SHARE",
+    "cell_turn_info",
+    "unmatched_turn_share",
+    "CELL_TURN_GAP",
+    "MAX_UNMATCHED_TURN",
 ]
 
 #: Least share of turning information for an angle to count as measured: a plain disk on a
@@ -37,6 +42,17 @@ SMOOTH_PX = 1.0
 CORRELATION_INFLATION = 3.0
 #: Largest Sobel response of a region taken as flat (grey levels per pixel, x 8).
 FLAT_GRADIENT = 1e-3
+#: A cell of the region (a 4 x 4 grid) whose correlation with the frame, warped back by the
+#: pose, is this far under the median cell's does not match it.
+CELL_TURN_GAP = 0.05
+#: Share of the turning information in cells that do not match beyond which a frame's angle is
+#: not a measurement: most of what tells the angle is not where the pose puts it, and the angle was
+#: set by the rest (on PhysTrack's turning disc, the drawn box: the still rod's arm in a corner,
+#: once the hand turning the disc and then its mark have left their cells, 63-92 % unmatched and
+#: the angle 27-177 deg off with sigma 0.1 deg). Under it the cells that match hold the angle (a
+#: textured block whose region shows a moving table at its foot: under 50 %, the angle right to
+#: 0.05 deg).
+MAX_UNMATCHED_TURN = 0.5
 POINT_NOTE = 'kind = "point": a position only'
 UNOBSERVABLE_NOTE = "its appearance tells no angle (W-TRACK-THETA)"
 
@@ -112,6 +128,44 @@ def turn_share(region, centre=None) -> float:
     return _share_of(*g, _centre_of(*g) if centre is None else centre)
 
 
+def cell_turn_info(region, n_cells: int) -> np.ndarray:
+    """Each cell's share of ``region``'s turning information about its centre, shape
+    (n_cells, n_cells), summing to 1 (zeros for a flat region): which parts tell its angle.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> img = np.zeros((64, 64)); img[4:12, 4:12] = 255.0  # one mark, in the top-left cell
+    >>> info = cell_turn_info(img, 4)
+    >>> round(float(info[0, 0]), 2), round(float(info.sum()), 2)
+    (1.0, 1.0)
+    """
+    x, y, gx, gy = _gradients(region)
+    h, w = x.shape
+    tang = ((x - (w - 1) / 2) * gy - (y - (h - 1) / 2) * gx) ** 2
+    ys, xs = (np.linspace(0, k, n_cells + 1).astype(int) for k in (h, w))
+    out = np.array([[tang[ys[i] : ys[i + 1], xs[j] : xs[j + 1]].sum() for j in range(n_cells)] for i in range(n_cells)])
+    total = float(out.sum())
+    return out / total if total > 0 else out
+
+
+def unmatched_turn_share(info, cell_cc, seen=None, covered_cc: float = -1.0) -> float:
+    """The share of the turning information (:func:`cell_turn_info`) of the cells in view in those
+    whose correlation with the frame warped back by the pose, ``cell_cc`` (same shape), falls more
+    than :data:`CELL_TURN_GAP` under the median cell's: the parts that tell the angle and are not
+    re-explained by the pose as the rest of the region is (a look that changes as a whole, the
+    lighting or a blur, lowers every cell instead).
+
+    ``seen``: cells inside the picture (default all); a cell out of it is neither. A frame with a
+    cell under ``covered_cc`` is a covered view (the fit on the cells in view decides it): 0.
+    """
+    cell_cc = np.asarray(cell_cc)
+    info = np.asarray(info) * (1.0 if seen is None else np.asarray(seen, float))
+    if cell_cc.min() < covered_cc or info.sum() <= 0:
+        return 0.0
+    return float(np.sum(info[cell_cc < np.median(cell_cc) - CELL_TURN_GAP]) / info.sum())
+
+
 def theta_unobservable(region):
     """Why the angle of the object in ``region`` (h, w) cannot be measured and its centre of
     symmetry (px from pixel (0, 0), (2,)); ``(None, None)`` when the angle can be measured."""
@@ -157,6 +211,28 @@ def warn_theta(config, oid, why, frame=None):
         'theta_rad is NaN, x and y are tracked; set kind = "point" to track a position only, '
         "or draw the region round a part that shows the turn (an edge, a mark)",
     )
+
+
+def warn_unmatched_angles(config, detector) -> None:
+    """W-TRACK-THETA for each object whose angle was dropped on some frames because the parts of
+    its region that tell the angle did not match the pose (:func:`unmatched_turn_share`)."""
+    from ...._diagnostics import warn
+
+    if detector is None or not hasattr(detector, "theta_unmatched"):
+        return
+    for o in config.objects:
+        n, k = detector.theta_unmatched(o.id)
+        if k:
+            warn(
+                "W-TRACK-THETA",
+                f"{config.source or 'config'}: object {o.id!r}: theta not measured on {k} of {n} frames "
+                f"tracked: there, the parts of its region in view that hold over {100 * MAX_UNMATCHED_TURN:.0f} "
+                f"% of its turning information do not match the fitted pose as the rest of the region does "
+                f"(their correlation more than {CELL_TURN_GAP:g} under the median cell's), or it was "
+                "registered on a keyframe cut from such a frame; theta_rad is NaN on those frames, "
+                "x and y are tracked; draw the region round the object alone (no background or "
+                "other object in its corners)",
+            )
 
 
 def angle_note(obj, status, theta_rad) -> str:

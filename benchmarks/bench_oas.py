@@ -142,7 +142,68 @@ def main() -> int:
         f"1 thread: {1e3 * t_b1:.3f} ms/run -> {t_ivp / t_b1:.4g}x per core; verdicts agree on "
         f"{agree}/{len(sample)}; the full OAS by solve_ivp would take ~{t_ivp * n_runs / 60:.0f} CPU-min"
     )
+    where_the_time_goes(rec)
     return 0
+
+
+def where_the_time_goes(rec) -> None:
+    """One default OAS on one numba thread, CPU time of the calling thread (where a 1-thread parallel call
+    runs; process CPU would add the idle OpenMP worker's spinning): the batch kernel's share, the Python around it
+    (grid logic, bisection, order selection), and how evenly each parallel call's static split over 2
+    threads divides its runs (each run timed alone, best of 2; the split is the one numba's prange makes
+    of the batch's interleaved order)."""
+    import numba
+
+    import rocklab.models.rocking._batch as batch_mod
+    from rocklab.models.spectra import _oas
+
+    kernel = batch_mod.run_taylor_record
+    calls, k_cpu = [], [0.0]
+
+    def timed(*a):
+        c0 = time.thread_time()
+        out = kernel(*a)
+        k_cpu[0] += time.thread_time() - c0
+        calls.append(a)
+        return out
+
+    nt = numba.get_num_threads()
+    numba.set_num_threads(1)
+    totals, kernels = [], []
+    batch_mod.run_taylor_record = timed
+    try:
+        for _ in range(3):
+            calls.clear()
+            k_cpu[0] = 0.0
+            c0 = time.thread_time()
+            _oas.overturning_spectrum(rec, 12)
+            totals.append(time.thread_time() - c0)
+            kernels.append(k_cpu[0])
+    finally:
+        batch_mod.run_taylor_record = kernel
+    work = spans = 0.0
+    for a in calls:  # each run of each parallel call alone, in the call's order
+        cost = np.empty(a[0].size)
+        for i in range(cost.size):
+            one = tuple(x[i : i + 1] if isinstance(x, np.ndarray) and x.shape == a[0].shape else x for x in a)
+            best = np.inf
+            for _ in range(2):
+                c0 = time.thread_time()
+                kernel(*one)
+                best = min(best, time.thread_time() - c0)
+            cost[i] = best
+        half = (cost.size + 1) // 2
+        work += cost.sum()
+        spans += max(cost[:half].sum(), cost[half:].sum())
+    numba.set_num_threads(nt)
+    k = int(np.argmin(totals))
+    print(
+        f"where the time goes (one default OAS, 1 numba thread, thread CPU, best of 3): {totals[k]:.3f} CPU-s, "
+        f"of which the batch kernel {kernels[k]:.3f} ({100 * kernels[k] / totals[k]:.1f} %; {len(calls)} parallel "
+        f"calls), Python around it {totals[k] - kernels[k]:.3f}; static split of each call over 2 threads "
+        f"(its runs timed alone, best of 2): the longer halves hold {100 * spans / work:.1f} % of the work "
+        f"(balance {work / 2 / spans:.3f}); estimate on 2 idle cores {totals[k] * spans / work:.3f} s"
+    )
 
 
 if __name__ == "__main__":

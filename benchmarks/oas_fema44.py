@@ -3,7 +3,8 @@
 Measures, in one process on all cores:
 
 1. the adaptive OAS grid against the dense one (baseline: every grid point simulated):
-   verdicts identical (pooled and worst record), t_I / t'_I identical, runs, wall time;
+   verdicts identical (pooled and worst record), t_I / t'_I identical, runs, wall time; each
+   record whose t_I differs, with the cells behind both values;
 2. t_I bands (:func:`rocklab.models.t_I_band`, the default ensemble) of the 44 records:
    wall time, how many Table 4 t_I lie inside the 5-95 % band, median half-width;
 3. the candidate rules for t'_I and beta (thesis Eq. 28 does not say how the line was
@@ -142,6 +143,15 @@ def main(folder: Path, only_bands: bool = False, baseline: bool = False, skip_ba
         worst = min(worst, k / d.overturned.size)
         runs += a.n_runs
         eq_tI += a.t_I_s == d.t_I_s
+        if a.t_I_s != d.t_I_s:
+            (la, ra), (ld, rd) = a.f_min_at, d.f_min_at
+            i, j = int(np.argmin(np.abs(d.levels - ld))), int(np.argmin(np.abs(d.R_m - rd)))
+            print(
+                f"   t_I differs on {b.name}: adaptive {a.t_I_s:.4f} s (level {la:.3f}, R {ra:.3f} m), dense "
+                f"{d.t_I_s:.4f} s (level {ld:.3f}, R {rd:.3f} m; that cell simulated by the adaptive grid: "
+                f"{bool(a.evaluated[i, j])}; {int(np.argmax(a.overturned[i]) - np.argmax(d.overturned[i]))} sizes "
+                "before the adaptive row's first unsafe size)"
+            )
         eq_tIp += a.t_I_prime_s == d.t_I_prime_s
         oas[b.name] = a
     same = n_same / n_all

@@ -40,6 +40,23 @@ def test_adaptive_grid_reproduces_a_known_image_with_fewer_runs():
     assert known[60, 50] and over[60, 50]
 
 
+def test_lone_unsafe_point_beyond_the_frontier_is_missed_as_on_ff10():
+    """FEMA FF-10 (SortedEQFile_120612) is the one record whose adaptive t_I (0.516 s) differs from the
+    dense grid's (0.560 s): the dense t_I comes from one unsafe cell (a_p/a_p,min 1.68, R 6.53 m) 12
+    sizes before its row's first unsafe size, inside a cell whose corners are all safe; it is
+    chaotic (safe at 1 -/+ 1e-4 times the amplitude). The same pattern here: missed with the
+    default frontier of 8, found with 12."""
+    for row in (28, 35):
+        truth = _image()
+        first = int(np.argmax(truth[row]))
+        truth[row, first - 12] = True
+        over, known = adaptive_verdicts(lambda r, c: truth[r, c], *truth.shape)
+        assert not known[row, first - 12] and not over[row, first - 12]
+        assert np.count_nonzero(over != truth) == 1
+        over, known = adaptive_verdicts(lambda r, c: truth[r, c], *truth.shape, frontier=12)
+        assert np.array_equal(over, truth)
+
+
 def test_adaptive_grid_uniform_image_only_coarse_points():
     calls = []
 

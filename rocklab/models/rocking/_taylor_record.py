@@ -77,7 +77,7 @@ _INV_K = np.array([0.0] + [1.0 / k for k in range(1, MAX_ORDER + 1)])
 _INV_K12 = np.array([1.0 / ((k + 1) * (k + 2)) for k in range(MAX_ORDER + 1)])
 
 
-@njit(cache=True, fastmath={"contract"}, error_model="numpy")
+@njit(cache=True, inline="always", fastmath={"contract"}, error_model="numpy")
 def _coefficients(a, S, C, th, w, p2, sc0, cc0, u0, du, n):
     """Taylor coefficients a[0..n] of theta about (th, w) with ug = u0 + du tau; sc0, cc0 = sin, cos of
     c = alpha s - th."""
@@ -216,12 +216,17 @@ def run_one(p, alpha, eta, scale, th0, w0, acc, t0, dta, duration, order, max_p_
     sc = math.sin(alpha * s - th)
     cc = math.cos(alpha * s - th)
     n_steps = 0
+    L_prev = -1.0
+    n_sub = 1
+    h_sub = 0.0
     for k in range(-1, n_acc):
         ta, L, u_a, du = _segment(k, acc, t0, dta, duration, fac)
         if L <= 0.0:
             continue
-        n_sub = max(1, int(math.ceil(p * L / max_p_h - 1e-12)))
-        h_sub = L / n_sub
+        if L != L_prev:  # the record's intervals share one length: its division is done once
+            n_sub = max(1, int(math.ceil(p * L / max_p_h - 1e-12)))
+            h_sub = L / n_sub
+            L_prev = L
         tl = 0.0
         stall = 0
         while L - tl > 1e-13 * L:
@@ -264,7 +269,11 @@ def run_one(p, alpha, eta, scale, th0, w0, acc, t0, dta, duration, order, max_p_
             _coefficients(a, S, C, th, w, p2, sc, cc, u0, du, n)
             y_h = s * series_value(a, n, h)
             w_h = s * series_slope(a, n, h)
-            kind, tau = _step_event(a, da, n, h, th, w, s, fall_rad, y_h, w_h)
+            w_s = s * w
+            if 0.0 < y_h < fall_rad and not ((w_s > 0.0 and w_h < 0.0) or (w_s < 0.0 and w_h > 0.0)):
+                kind, tau = 0, h  # the common step: no root on it (what _step_event finds there too)
+            else:
+                kind, tau = _step_event(a, da, n, h, th, w, s, fall_rad, y_h, w_h)
             if t_over != t_over and fall_rad > alpha:
                 kind_a, tau_a = _step_event(a, da, n, h, th, w, s, alpha, y_h, w_h)
                 if kind_a == 2:

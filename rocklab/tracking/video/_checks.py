@@ -332,8 +332,8 @@ def _run_ends(ok, before: int) -> np.ndarray:
 def _reacquired_wrong(k, s, p, uv, trusted, size, wh) -> str | None:
     """Why object ``k`` found again at index ``s`` (last trusted ok at ``p``) is not ok, or None:
     "left" when it left through the frame's edge (its last pose within ``size`` of the border) and
-    comes back neither through an edge nor where it left; "latch" when it comes back where another
-    object's ok run ended and no ok frame of that object has been there since."""
+    comes back neither through an edge nor where it left; "ended" when it comes back where another
+    object's ok run ended and no ok frame of that object has been there since (this frame included)."""
     near = 0.5 * size
     if _near_edge(uv[k][p], *wh, size) and not _near_edge(uv[k][s], *wh, size):
         if np.hypot(*(uv[k][s] - uv[k][p])) > near:
@@ -344,7 +344,8 @@ def _reacquired_wrong(k, s, p, uv, trusted, size, wh) -> str | None:
         for e in _run_ends(trusted[o], s):
             if np.hypot(*(uv[o][e] - uv[k][s])) >= near:
                 continue
-            later = np.flatnonzero(trusted[o][e + 1 : s]) + e + 1
+            # the other object ok there now too: the shared-pixels rule (settle_latches) decides
+            later = np.flatnonzero(trusted[o][e + 1 : s + 1]) + e + 1
             if not np.any(np.hypot(*(uv[o][later] - uv[k][s]).T) < near):
                 return "ended"
     return None
@@ -385,7 +386,7 @@ def settle_reacquisitions(raw, config, plane_map, frames, source, width_px: int,
             why, p, s, _ = bad[0]
             where = (
                 "through no edge and away from where it left the frame"
-                if why == "lost"
+                if why == "left"
                 else "where another object's track ended"
             )
             n = sum(e - s for _, _, s, e in bad)

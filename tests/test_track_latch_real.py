@@ -66,4 +66,6 @@ def test_a_puck_that_left_the_frame_on_the_other_ones_pixels_is_a_latch(film, sh
     # a latch is named; trackers that stay apart (the other boxes may) raise nothing
     assert len(latch) == int(latched), [x.message for x in latch]
     if latched:
-        assert "'puck_a' sits on the pixels of 'puck_b'" in latch[0].message
+        # the struck puck's tracker found the striker after its puck left: its frames are latch,
+        # by the re-acquisition rule or by the shared-pixels rule
+        assert "'puck_a'" in latch[0].message and "latch" in latch[0].message

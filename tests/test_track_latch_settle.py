@@ -66,4 +66,6 @@ def test_the_struck_puck_on_the_strikers_pixels_is_latch_and_the_striker_keeps_t
     # the struck puck's own frames stay ok: it is followed until it leaves
     assert a.ok[(a.frame >= 141) & (a.frame < 270)].mean() >= 0.95
     said = [w.message for w in found if w.code == "W-TRACK-LATCH"]
-    assert len(said) == 1 and "'puck_a' sits on the pixels of 'puck_b'" in said[0], said
+    # named once: by the re-acquisition rule (it left through the right edge and came back on the
+    # striker) or, when that does not apply, by the shared-pixels rule
+    assert len(said) == 1 and "'puck_a'" in said[0] and "latch" in said[0], said

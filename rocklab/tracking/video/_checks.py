@@ -319,6 +319,85 @@ def _entry_miss(uv, ok, s: int) -> float:
     return float(np.hypot(*(uv[s] - pred)))
 
 
+def _near_edge(c, width_px: int, height_px: int, reach: float) -> bool:
+    """Whether a centre ``c`` (u, v px) lies within ``reach`` px of the frame's border."""
+    return bool(min(c[0], c[1], width_px - c[0], height_px - c[1]) < reach)
+
+
+def _run_ends(ok, before: int) -> np.ndarray:
+    """Indices where an object's ok runs ended (the next frame not ok) before index ``before``."""
+    return np.flatnonzero(ok[: before - 1] & ~ok[1:before])
+
+
+def _reacquired_wrong(k, s, p, uv, trusted, size, wh) -> str | None:
+    """Why object ``k`` found again at index ``s`` (last trusted ok at ``p``) is not ok, or None:
+    "left" when it left through the frame's edge (its last pose within ``size`` of the border) and
+    comes back neither through an edge nor where it left; "ended" when it comes back where another
+    object's ok run ended and no ok frame of that object has been there since (this frame included)."""
+    near = 0.5 * size
+    if _near_edge(uv[k][p], *wh, size) and not _near_edge(uv[k][s], *wh, size):
+        if np.hypot(*(uv[k][s] - uv[k][p])) > near:
+            return "left"
+    for o in uv:
+        if o == k:
+            continue
+        for e in _run_ends(trusted[o], s):
+            if np.hypot(*(uv[o][e] - uv[k][s])) >= near:
+                continue
+            # the other object ok there now too: the shared-pixels rule (settle_latches) decides
+            later = np.flatnonzero(trusted[o][e + 1 : s + 1]) + e + 1
+            if not np.any(np.hypot(*(uv[o][later] - uv[k][s]).T) < near):
+                return "ended"
+    return None
+
+
+def settle_reacquisitions(raw, config, plane_map, frames, source, width_px: int, height_px: int) -> None:
+    """An object found again after frames it was not ok must be where it can be: one that left
+    the frame through an edge (its last ok centre within its first region's larger side of the
+    border) comes back through an edge or where it left; one found where another object's ok run
+    ended (within half that side), with that object not ok there since, has found the other
+    object (identical pucks, balls). Else the ok run that starts there, and every later one found
+    from the same last trusted pose, is ``latch`` (NaN values), named by W-TRACK-LATCH. Tables are left out. Arguments as :func:`settle_latches`."""
+    if plane_map is None:
+        return
+    regions = {o.id: o.roi for o in config.objects if getattr(o, "roi", None) is not None}
+    ids = [o.id for o in config.objects if o.kind != "table" and o.id in raw and o.id in regions]
+    uv = {k: plane_map.to_image(np.column_stack((raw[k][0]["X"], raw[k][0]["Y"]))) for k in ids}
+    trusted = {k: raw[k][1] == "ok" for k in ids}
+    for k in ids:
+        size = max(float(regions[k][2]), float(regions[k][3]))
+        ok = trusted[k]
+        starts = np.flatnonzero(ok[1:] & ~ok[:-1]) + 1
+        bad = []
+        for s in starts:
+            before = np.flatnonzero(trusted[k][:s])
+            if before.size == 0:
+                continue
+            why = _reacquired_wrong(k, int(s), int(before[-1]), uv, trusted, size, (width_px, height_px))
+            if why is None:
+                continue
+            e = s + (int(np.argmin(ok[s:])) if not ok[s:].all() else len(ok) - s)
+            raw[k][1][s:e] = "latch"
+            trusted[k][s:e] = False
+            for q in ("X", "Y", "th", "sig"):
+                raw[k][0][q][s:e] = np.nan
+            bad.append((why, int(before[-1]), int(s), int(e)))
+        if bad:
+            why, p, s, _ = bad[0]
+            where = (
+                "through no edge and away from where it left the frame"
+                if why == "left"
+                else "where another object's track ended"
+            )
+            n = sum(e - s for _, _, s, e in bad)
+            warn(
+                "W-TRACK-LATCH",
+                f"{source}: object {k!r} found again at frame {frames[s]} {where} (last ok at frame {frames[p]}): "
+                f"{n} frames from {frames[s]} to {frames[bad[-1][3] - 1]} are status latch, not ok; "
+                "its tracker follows something else there",
+            )
+
+
 def settle_latches(raw, config, plane_map, frames, source) -> None:
     """Give pixels two trackers share to one object: where two objects are both ok within
     :func:`latch_distance` of each other, the one whose own track runs on into those frames (its

@@ -33,6 +33,7 @@ from ._checks import (
     region_leaves,
     ring_look,
     settle_latches,
+    settle_reacquisitions,
     small_grey,
     tee,
 )
@@ -462,6 +463,7 @@ def assemble_tracks(
     if pm_px is None and plane == "image":  # observations in centred pixels: invert that
         pm_px = PlaneMap(width_px, height_px, config.video.camera_matrix, config.video.dist_coeffs)
     # before the scale and the level: a latched tracker's frames are another object's
+    settle_reacquisitions(raw, config, pm_px, frames, source or "the video", width_px, height_px)
     settle_latches(raw, config, pm_px, frames, source or "the video")
     m_per = _metres_per_unit(config, raw, metric_plane)
     from ._level import level_from_reference, world_angle

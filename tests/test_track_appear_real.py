@@ -34,12 +34,23 @@ REFS = Path(__file__).parent / "data" / "video_refs"
 MIRRORS = Path("/work/.mirror")
 
 
+#: the commits the references were made on
+COMMITS = {
+    "arantxax+pendulumtracker": "7b0fa91c54ebcf8a057bf1bccdec5e006b81913e",
+    "OpenSourcePhysics+tracker": "cc8888206d5b15b968716d4014c999d431630d16",
+    "umartechboy+PhysTrack": "64b079af92f664de5cb6d4e5d11837090f0d7d89",
+}
+
+
 def _film(tmp_path, repo, path):
-    """The film ``path`` of the mirrored repository ``repo`` as a local file, or a skip."""
+    """The film ``path`` of the mirrored repository ``repo`` (at :data:`COMMITS`) as a local
+    file, or a skip."""
     git = MIRRORS / repo / "repo"
     if not git.is_dir():
         pytest.skip(f"{repo} is not mirrored here")
-    got = subprocess.run(["git", f"--git-dir={git}", "show", f"HEAD:{path}"], capture_output=True, check=False)
+    got = subprocess.run(
+        ["git", f"--git-dir={git}", "show", f"{COMMITS[repo]}:{path}"], capture_output=True, check=False
+    )
     if got.returncode != 0 or not got.stdout:
         pytest.skip(f"{path} is not in the {repo} mirror")
     out = tmp_path / Path(path).name

@@ -56,9 +56,11 @@ def test_a_puck_that_left_the_frame_on_the_other_ones_pixels_is_a_latch(film, sh
     d = np.hypot(a.x_px - b.x_px, a.y_px - b.y_px)[both]
     latched = np.mean(d < 9.0) > 0.3
     if shift == (0, 0):
-        # the reviewer's boxes: after the struck puck left (about frame 290) both trackers report ok
-        # on one puck
-        assert latched
+        # the reviewer's boxes: after the struck puck left (about frame 290) its tracker went on ok
+        # on the striker, which had come to rest by the struck puck's start place; the verifier's
+        # scene snapshots (the striker stood there while the struck puck was elsewhere) now lose
+        # it as background: either way the struck puck is never ok on the striker unnamed
+        assert latched or not np.any(a.ok[300:]), int(a.ok[300:].sum())
     # a latch is named; trackers that stay apart (the other boxes may) raise nothing
     assert len(latch) == int(latched), [x.message for x in latch]
     if latched:

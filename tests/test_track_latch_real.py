@@ -61,8 +61,10 @@ def test_a_puck_that_left_the_frame_on_the_other_ones_pixels_is_a_latch(film, sh
     latched = np.any(a.status == "latch") or np.any(b.status == "latch")
     if shift == (0, 0):
         # the reviewer's boxes: after the struck puck left (about frame 290) both trackers were ok on
-        # the striker; the striker keeps its pixels
-        assert np.sum(a.status == "latch") > 100 and not np.any(b.status == "latch")
+        # the striker. Now the struck puck's tracker is either "latch" there (the striker keeps its
+        # pixels) or lost as background (the striker came to rest by the struck puck's start place,
+        # which the verifier's scene snapshots saw empty): never ok on the striker
+        assert not np.any(a.ok[300:]) and not np.any(b.status == "latch"), int(a.ok[300:].sum())
     # a latch is named; trackers that stay apart (the other boxes may) raise nothing
     assert len(latch) == int(latched), [x.message for x in latch]
     if latched:

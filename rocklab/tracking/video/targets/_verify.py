@@ -8,7 +8,9 @@ and, for the outline, its own first frame:
 * **appearance** (``mismatch``): its correlation with the first template or the last verified
   keyframe must reach the median of the verified frames' correlations less
   :data:`APPEARANCE_MADS` robust deviations (at least :data:`MIN_DEVIATION`; never below
-  :data:`MIN_SCORE`);
+  :data:`MIN_SCORE`); and while that limit is not learned yet, a pose found after lost frames
+  must be a turned copy of the first view (:data:`COLD_FIRST_CC`): a keyframe renewed from a
+  lamp or a hand that the template half matched would otherwise follow it at 0.99;
 * **motion** (``jump``): the pose may leave the constant-velocity prediction by no more than
   the verified frames' residuals allow (:data:`MOTION_FACTOR` times their 99th percentile, at
   least :data:`MIN_RESIDUAL_FRAC` of the template; after ``g`` lost frames the prediction is
@@ -24,6 +26,9 @@ and, for the outline, its own first frame:
   frames in which the object was lost (:data:`LOST_SAMPLES`), once the object's template
   registers nowhere in that median (the object has gone from its first place: a bob hanging
   still before it was shot off would otherwise make its own empty place look like the object);
+  and the patch must not be what the latest scene snapshot taken while the object stood
+  elsewhere showed there (one every :data:`SNAP_FRAMES` verified frames): a pose left on the
+  object's empty start place, whose look the keyframe learned, matches its keyframe at 0.998;
 * **outline** (``drift``): once the background behind the object's first region is known, the
   object's silhouette against it, registered round the pose (:mod:`._occlusion`), must lie where
   the pose puts it, within :data:`._occlusion.DRIFT_FRAC` of the template: a spinning object's
@@ -94,6 +99,15 @@ LOST_SAMPLES = (3, 15)
 #: Turns of the template tried in that median (degrees): a median that holds the object turned
 #: (a block lost while it rocked) is not its background.
 MEDIAN_TURNS_DEG = (0.0, -5.0, 5.0, -10.0, 10.0)
+#: Correlation with the first view that a pose found after lost frames must reach while the limits
+#: are cold (fewer than :data:`WARMUP_FRAMES` verified frames): a turned copy of the first view
+#: (the markerless tracker's keyframe rule). Nothing learned yet says how far the object's look may
+#: stray from it, and a lamp or a hand that the template half matches (0.6-0.85) is not the object.
+COLD_FIRST_CC = 0.9
+#: Scene snapshots for the background check: one every :data:`SNAP_FRAMES` verified frames, the
+#: last :data:`SNAPS` kept (a grey frame each).
+SNAP_FRAMES = 10
+SNAPS = 8
 
 
 class PoseVerifier:
@@ -142,6 +156,10 @@ class PoseVerifier:
         self.recent: list = []
         #: whether the angle is checked (False for an object whose appearance tells no angle)
         self.check_turn = True
+        #: (grey frame, the object's footprint in it grown by the margin (x0, y0, x1, y1) px) of
+        #: verified frames: what the scene shows where the object was not
+        self.snaps: collections.deque = collections.deque(maxlen=SNAPS)
+        self._snap_at = -SNAP_FRAMES
 
     def motion_context(self, frame: int):
         """(last verified (centre, theta, frame) or None, frames since it (1 without one), the
@@ -343,6 +361,8 @@ class PoseVerifier:
                 known = np.ones_like(bg)
         last2 = None if last is None else last[:2]
         reason = self.check(float(score), centre, theta, pred, last2, gap, bg, back, known)
+        if reason is None:
+            reason = self._look_again(tr, gray, W, centre, float(score), gap)
         self.learn_outline()
         if reason is None and self.outline is not None and back is not None and self._in_frame(tr, W, gray.shape):
             # the object's outline against the background is not where the pose puts it: the
@@ -360,6 +380,29 @@ class PoseVerifier:
                 self.disk_at = self.outline.disk_centre(tr, W, (back_g, bg_g))
         self._pending = (float(score), centre, theta, pred, last2, gap, frame)
         return reason
+
+    def _look_again(self, tr, gray, W, centre, score, gap):
+        """The checks a template that adapts cannot pass by adapting: ``mismatch`` for a pose found
+        after lost frames that is no turned copy of the first view while the limits are cold
+        (:data:`COLD_FIRST_CC`); ``background`` for a patch that the latest snapshot taken while
+        the object stood elsewhere already showed there (unchanged on :data:`BG_FRACTION` of its
+        pixels, or correlating with it at least as well as with the object): a pose left on the
+        object's empty start place, or on a detail of the scene the keyframe has learned."""
+        now = None
+        if gap > 1 and len(self.scores) < WARMUP_FRAMES:
+            now = tr._warp_back(gray, W)
+            if now is None or _ncc(now, tr.tmpl0) < COLD_FIRST_CC:
+                return "mismatch"
+        half = 0.5 * math.hypot(*self.size) + self.margin
+        for snap, (x0, y0, x1, y1) in reversed(self.snaps):
+            if centre[0] + half < x0 or centre[0] - half > x1 or centre[1] + half < y0 or centre[1] - half > y1:
+                now = tr._warp_back(gray, W) if now is None else now
+                then = tr._warp_back(snap, W)
+                if now is None or then is None:
+                    return None
+                same = float(np.mean(np.abs(now - then) < BG_TOL))
+                return "background" if same >= BG_FRACTION or _ncc(now, then) >= score else None
+        return None
 
     @staticmethod
     def _texture_outweighs(tr, gray, at, score) -> bool:
@@ -427,6 +470,10 @@ class PoseVerifier:
             (centre[0] - hx, centre[1] - hy, centre[0] + hx, centre[1] + hy),
         )
         self.recent = (self.recent + [(centre, theta, frame)])[-2:]
+        if self.n_verified - self._snap_at >= SNAP_FRAMES:
+            m = half + self.margin
+            self.snaps.append((np.array(gray), (centre[0] - m, centre[1] - m, centre[0] + m, centre[1] + m)))
+            self._snap_at = self.n_verified
 
 
 def _ncc(a, b):

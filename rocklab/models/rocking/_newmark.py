@@ -49,6 +49,9 @@ from ._newmark_lean import forced_steps, free_steps, sdcd
 ROCKING, REST, OVERTURNED, NO_UPLIFT = 0, 1, 2, 3
 STATUS_NAMES = ("rocking", "rest", "overturned", "no_uplift")
 _HALF_PI = 0.5 * math.pi
+#: Sub-steps in a row that leave the time unchanged before the rest of the step is skipped
+#: (an honest sequence has at most two: a lift-off at the step's start, then the flight).
+_MAX_STALLED = 8
 
 
 @njit(cache=True, inline="always")
@@ -340,10 +343,19 @@ def run_block(
         w_beg = w
         u_c = u_prev
         n_sub = 0
+        tc_seen = -1.0
+        stalled = 0
         while tc < t1:
             rem = t1 - tc
             if rem <= 1e-12 * h:
                 break
+            # a cycle that makes no progress in time ends the step: lift-off with |ug| = tan(alpha)
+            # to the ulp, a contact after tau ~ 1e-30 s (tc unchanged) with omega+ = 0, rest,
+            # lift-off again, for ever (a point of tests/test_single_batch.py)
+            stalled = stalled + 1 if tc == tc_seen else 0
+            if stalled > _MAX_STALLED:
+                break
+            tc_seen = tc
             n_sub += 1
             if resting:
                 if abs(u1) > tan_a:

@@ -351,13 +351,43 @@ def _reacquired_wrong(k, s, p, uv, trusted, size, wh) -> str | None:
     return None
 
 
+#: The share of an object's own ok frames (before a loss) whose registration quality may lie below
+#: the threshold a re-acquisition far out of reach must reach (the low tail: impacts, blur).
+REACH_Q_TAIL = 0.01
+
+
+def _out_of_reach(s, p, uv, ok, q, size) -> bool:
+    """Whether a re-acquisition at index ``s`` (last trusted ok at ``p``) is out of the object's
+    reach and not confirmed by its view. Out of reach: farther from its last trusted pose than its
+    speed there (px per frame, between its last two trusted ok frames) times the gap, plus its
+    first region's larger side ``size`` (px): a resting object cannot jump across the frame.
+    Not confirmed: the registration quality of that first frame, against the template or keyframe
+    the object was last verified with, lies below all but the lowest :data:`REACH_Q_TAIL` of its
+    own ok frames before the loss (a pendulum re-found across its swing re-explains its view)."""
+    before = np.flatnonzero(ok[: p + 1])
+    if before.size < 5 or not np.isfinite(q[s]):
+        return False
+    v = 0.0
+    if before.size >= 2:
+        p0 = before[-2]
+        v = float(np.hypot(*(uv[p] - uv[p0]))) / (p - p0)
+    reach = v * (s - p) + size
+    if np.hypot(*(uv[s] - uv[p])) <= reach:
+        return False
+    q_ok = q[before][np.isfinite(q[before])]
+    return bool(q_ok.size >= 5 and q[s] < np.quantile(q_ok, REACH_Q_TAIL))
+
+
 def settle_reacquisitions(raw, config, plane_map, frames, source, width_px: int, height_px: int) -> None:
     """An object found again after frames it was not ok must be where it can be: one that left
     the frame through an edge (its last ok centre within its first region's larger side of the
     border) comes back through an edge or where it left; one found where another object's ok run
     ended (within half that side), with that object not ok there since, has found the other
-    object (identical pucks, balls). Else the ok run that starts there, and every later one found
-    from the same last trusted pose, is ``latch`` (NaN values), named by W-TRACK-LATCH. Tables are left out. Arguments as :func:`settle_latches`."""
+    object (identical pucks, balls); one found out of its reach on a patch that does not re-explain
+    its view (:func:`_out_of_reach`) has found something else, and so has every later run found
+    where that one was (its keyframe learnt the other thing). Else the ok run that starts there,
+    and every later one found from the same last trusted pose, is ``latch`` (NaN values), named
+    by W-TRACK-LATCH. Tables are left out. Arguments as :func:`settle_latches`."""
     if plane_map is None:
         return
     regions = {o.id: o.roi for o in config.objects if getattr(o, "roi", None) is not None}
@@ -368,15 +398,23 @@ def settle_reacquisitions(raw, config, plane_map, frames, source, width_px: int,
         size = max(float(regions[k][2]), float(regions[k][3]))
         ok = trusted[k]
         starts = np.flatnonzero(ok[1:] & ~ok[:-1]) + 1
-        bad = []
+        bad, reached = [], []
         for s in starts:
             before = np.flatnonzero(trusted[k][:s])
             if before.size == 0:
                 continue
-            why = _reacquired_wrong(k, int(s), int(before[-1]), uv, trusted, size, (width_px, height_px))
+            p = int(before[-1])
+            why = _reacquired_wrong(k, int(s), p, uv, trusted, size, (width_px, height_px))
+            if why is None and _out_of_reach(int(s), p, uv[k], trusted[k], raw[k][0]["q"], size):
+                why = "reach"
+            e = s + (int(np.argmin(ok[s:])) if not ok[s:].all() else len(ok) - s)
+            if why is None and reached:  # found again where it was followed out of reach: same object
+                if np.any(np.hypot(*(uv[k][reached] - uv[k][s]).T) < 0.5 * size):
+                    why = "reach"
             if why is None:
                 continue
-            e = s + (int(np.argmin(ok[s:])) if not ok[s:].all() else len(ok) - s)
+            if why == "reach":
+                reached.extend(range(s, e))
             raw[k][1][s:e] = "latch"
             trusted[k][s:e] = False
             for q in ("X", "Y", "th", "sig"):
@@ -384,11 +422,11 @@ def settle_reacquisitions(raw, config, plane_map, frames, source, width_px: int,
             bad.append((why, int(before[-1]), int(s), int(e)))
         if bad:
             why, p, s, _ = bad[0]
-            where = (
-                "through no edge and away from where it left the frame"
-                if why == "left"
-                else "where another object's track ended"
-            )
+            where = {
+                "left": "through no edge and away from where it left the frame",
+                "ended": "where another object's track ended",
+                "reach": "farther than it could move in the gap, its view not confirming it",
+            }[why]
             n = sum(e - s for _, _, s, e in bad)
             warn(
                 "W-TRACK-LATCH",

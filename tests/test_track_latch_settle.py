@@ -12,32 +12,22 @@ striker at rest at (134.7, 81.9) px, the struck puck out of the picture from fra
 
 from __future__ import annotations
 
-import subprocess
-from pathlib import Path
 
 import numpy as np
 import pytest
+
+from _mirror import mirror_file
 
 from rocklab._diagnostics import collecting
 from rocklab.config import TrackConfig
 from rocklab.tracking import track_video
 
-MIRROR = Path("/work/.mirror/umartechboy+PhysTrack/repo")
 STRIKER_AT_REST_PX = (134.7, 81.9)  # from frame 190 to the end
 
 
 @pytest.fixture(scope="module")
 def film(tmp_path_factory):
-    if not MIRROR.exists():
-        pytest.skip("umartechboy/PhysTrack is not mirrored here")
-    out = subprocess.run(
-        ["git", f"--git-dir={MIRROR}", "show", "HEAD:SampleVideos/CaromPuck/HeadOn.MP4"], capture_output=True
-    )
-    if out.returncode != 0:
-        pytest.skip("the mirror does not hold SampleVideos/CaromPuck/HeadOn.MP4")
-    p = tmp_path_factory.mktemp("puck") / "HeadOn.mp4"
-    p.write_bytes(out.stdout)
-    return p
+    return mirror_file(tmp_path_factory, "umartechboy/PhysTrack", "SampleVideos/CaromPuck/HeadOn.MP4")
 
 
 def test_the_struck_puck_on_the_strikers_pixels_is_latch_and_the_striker_keeps_them(film):

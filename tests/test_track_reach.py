@@ -12,11 +12,11 @@ code frames 224-239 were ``ok`` there."""
 
 from __future__ import annotations
 
-import subprocess
-from pathlib import Path
 
 import numpy as np
 import pytest
+
+from _mirror import mirror_file
 
 from rocklab._diagnostics import collecting
 from rocklab.config import TrackConfig
@@ -24,22 +24,12 @@ from rocklab.tracking import track_video
 from rocklab.tracking.video import PlaneMap
 from rocklab.tracking.video._checks import settle_reacquisitions
 
-MIRROR = Path("/work/.mirror/umartechboy+PhysTrack/repo")
 STRIKER_AT_REST_PX = (134.7, 81.9)  # from frame 189 on
 
 
 @pytest.fixture(scope="module")
 def film(tmp_path_factory):
-    if not MIRROR.exists():
-        pytest.skip("umartechboy/PhysTrack is not mirrored here")
-    out = subprocess.run(
-        ["git", f"--git-dir={MIRROR}", "show", "HEAD:SampleVideos/CaromPuck/HeadOn.MP4"], capture_output=True
-    )
-    if out.returncode != 0:
-        pytest.skip("the mirror does not hold SampleVideos/CaromPuck/HeadOn.MP4")
-    p = tmp_path_factory.mktemp("puck") / "HeadOn.mp4"
-    p.write_bytes(out.stdout)
-    return p
+    return mirror_file(tmp_path_factory, "umartechboy/PhysTrack", "SampleVideos/CaromPuck/HeadOn.MP4")
 
 
 def test_a_resting_puck_is_not_ok_on_a_fingertip_124_px_away(film):

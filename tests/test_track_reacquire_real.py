@@ -15,31 +15,20 @@ struck puck's frames there are latch too (by this rule now, by the shared-pixels
 
 from __future__ import annotations
 
-import subprocess
-from pathlib import Path
 
 import numpy as np
 import pytest
+
+from _mirror import mirror_file
 
 from rocklab._diagnostics import collecting
 from rocklab.config import TrackConfig
 from rocklab.tracking import track_video
 
-MIRROR = Path("/work/.mirror/umartechboy+PhysTrack/repo")
-
 
 @pytest.fixture(scope="module")
 def film(tmp_path_factory):
-    if not MIRROR.exists():
-        pytest.skip("umartechboy/PhysTrack is not mirrored here")
-    out = subprocess.run(
-        ["git", f"--git-dir={MIRROR}", "show", "HEAD:SampleVideos/CaromPuck/HeadOn.MP4"], capture_output=True
-    )
-    if out.returncode != 0:
-        pytest.skip("the mirror does not hold SampleVideos/CaromPuck/HeadOn.MP4")
-    p = tmp_path_factory.mktemp("puck") / "HeadOn.mp4"
-    p.write_bytes(out.stdout)
-    return p
+    return mirror_file(tmp_path_factory, "umartechboy/PhysTrack", "SampleVideos/CaromPuck/HeadOn.MP4")
 
 
 @pytest.mark.slow

@@ -11,12 +11,13 @@ from __future__ import annotations
 
 import math
 import re
-import subprocess
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 import pytest
+
+from _mirror import mirror_file
 
 from rocklab._diagnostics import collecting
 from rocklab.config import TrackConfig
@@ -30,23 +31,8 @@ DATA = Path(__file__).parent / "data" / "phystrack"
 @pytest.fixture(scope="module")
 def phystrack(tmp_path_factory):
     """A function: the film ``name`` of PhysTrack's ``SampleVideos/`` as a local file (skips without the mirror)."""
-    repo, commit = PHYSTRACK
-    if not Path(repo).is_dir():
-        pytest.skip("umartechboy/PhysTrack (GPL-2.0, not shipped) is not mirrored here")
-    out = tmp_path_factory.mktemp("phystrack")
-
-    def get(name):
-        path = out / name.replace("/", "_")
-        if not path.exists():
-            r = subprocess.run(
-                ["git", f"--git-dir={repo}", "show", f"{commit}:SampleVideos/{name}"], capture_output=True
-            )
-            if r.returncode != 0:
-                pytest.skip(f"SampleVideos/{name} is not in the PhysTrack mirror")
-            path.write_bytes(r.stdout)
-        return path
-
-    return get
+    commit = PHYSTRACK[1]
+    return lambda name: mirror_file(tmp_path_factory, "umartechboy/PhysTrack", f"SampleVideos/{name}", commit)
 
 
 def _track(path, box, stop, level="none"):

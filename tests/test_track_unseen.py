@@ -9,13 +9,13 @@ pendulum's pivot.
 
 from __future__ import annotations
 
-import subprocess
-from pathlib import Path
 
 import numpy as np
 import pytest
 
 from _blob import perturbed_boxes
+from _mirror import mirror_file
+
 from rocklab._diagnostics import collecting
 from rocklab.config import TrackConfig
 from rocklab.tracking import track_video
@@ -26,21 +26,8 @@ TRACKLAB = ("/work/.mirror/OpenPhysics+TrackLab/repo", "05c707992ed42cff8f6ecb32
 @pytest.fixture(scope="module")
 def tracklab(tmp_path_factory):
     """A function: the film ``name`` of TrackLab's ``videos/`` as a local file (skips without the mirror)."""
-    repo, commit = TRACKLAB
-    if not Path(repo).is_dir():
-        pytest.skip("OpenPhysics/TrackLab (AGPL-3.0, not shipped) is not mirrored here")
-    out = tmp_path_factory.mktemp("tracklab")
-
-    def get(name):
-        path = out / name
-        if not path.exists():
-            r = subprocess.run(["git", f"--git-dir={repo}", "show", f"{commit}:videos/{name}"], capture_output=True)
-            if r.returncode != 0:
-                pytest.skip(f"videos/{name} is not in the TrackLab mirror")
-            path.write_bytes(r.stdout)
-        return path
-
-    return get
+    commit = TRACKLAB[1]
+    return lambda name: mirror_file(tmp_path_factory, "OpenPhysics/TrackLab", f"videos/{name}", commit)
 
 
 def _track(path, box, stop=None):

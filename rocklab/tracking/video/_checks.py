@@ -274,6 +274,14 @@ def check_rate(given: float, info, path, where: str) -> None:
 TABLE_TURN_MAX_RAD = math.radians(1.0)
 
 
+def _as_latch(series, idx) -> None:
+    """Mark the frames ``idx`` (index array or slice) of one object's raw series (as
+    :func:`settle_latches` takes it) ``latch``, their measured values NaN: another object's pixels."""
+    series[1][idx] = "latch"
+    for q in ("X", "Y", "th", "sig"):
+        series[0][q][idx] = np.nan
+
+
 def _first_sides(config) -> dict:
     """Object id -> the smaller side of its first region (px), for objects given one."""
     return {
@@ -415,10 +423,8 @@ def settle_reacquisitions(raw, config, plane_map, frames, source, width_px: int,
                 continue
             if why == "reach":
                 reached.extend(range(s, e))
-            raw[k][1][s:e] = "latch"
+            _as_latch(raw[k], slice(s, e))
             trusted[k][s:e] = False
-            for q in ("X", "Y", "th", "sig"):
-                raw[k][0][q][s:e] = np.nan
             bad.append((why, int(before[-1]), int(s), int(e)))
         if bad:
             why, p, s, _ = bad[0]
@@ -469,9 +475,7 @@ def settle_latches(raw, config, plane_map, frames, source) -> None:
                 keep = b if lose == a else a
                 st = raw[lose][1]
                 hit = np.flatnonzero(st[s : e + 1] == "ok") + s
-                st[hit] = "latch"
-                for k in ("X", "Y", "th", "sig"):
-                    raw[lose][0][k][hit] = np.nan
+                _as_latch(raw[lose], hit)
                 uv[lose][hit] = np.nan
                 why = "its track runs on into them" if on[keep] != on[lose] else "its template matches them better"
                 warn(

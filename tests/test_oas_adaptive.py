@@ -120,3 +120,84 @@ def test_boundary_grid_gives_the_adaptive_grids_t_I(shared_data):
     assert fast.n_runs < 0.7 * full.n_runs
     with pytest.raises(InputError, match="guide"):
         overturning_spectrum(r, 12, grid="boundary")
+
+
+def test_boundary_search_by_key_finds_the_smallest_key_with_fewer_runs():
+    truth = _image()
+    first = truth.argmax(axis=1)
+    n_rows, n_cols = truth.shape
+    # key = level x p, as f = A p: the smallest key sits at one row of the staircase
+    key = np.linspace(1.0, 10.0, n_rows)[:, None] * 1.04 ** np.arange(n_cols)[None, :]
+    runs = {"all": 0, "key": 0}
+
+    def counted(name):
+        def run(r, c):
+            runs[name] += len(r)
+            return truth[r, c]
+
+        return run
+
+    for shift in (-3, 2):  # the guess a few columns off, both ways
+        guess = first + shift
+        full, _ = boundary_verdicts(counted("all"), n_rows, n_cols, guess)
+        fast, known = boundary_verdicts(counted("key"), n_rows, n_cols, guess, key=key)
+        f_full = key[np.arange(n_rows), full.argmax(axis=1)]
+        has = fast.any(axis=1)
+        f_fast = key[np.flatnonzero(has), fast[has].argmax(axis=1)]
+        assert f_fast.min() == f_full.min() == key[np.arange(n_rows), first].min()
+        # rows searched hold their true first unsafe point; the others are left without a boundary
+        assert np.array_equal(fast[has].argmax(axis=1), first[has]) and not has.all()
+    assert runs["key"] < 0.5 * runs["all"]
+    # a key whose minimum lies at the last rows (larger levels cheaper) is found there too
+    key2 = key[::-1]
+    fast, _ = boundary_verdicts(counted("key"), n_rows, n_cols, first - 3, key=key2)
+    has = fast.any(axis=1)
+    assert key2[np.flatnonzero(has), fast[has].argmax(axis=1)].min() == key2[np.arange(n_rows), first].min()
+
+
+def test_bisecting_only_the_levels_behind_t_I_and_the_line_changes_neither(shared_data, monkeypatch):
+    import rocklab.models.spectra._oas as oas
+
+    r = load_base_motion(shared_data / FF1, units="g")
+    kw = dict(levels=30, sizes=45, refine=8)
+    n = {"runs": 0}
+    real = oas.batch_runs
+
+    def counted(base, scale, p, args):
+        n["runs"] += np.size(scale)
+        return real(base, scale, p, args)
+
+    monkeypatch.setattr(oas, "batch_runs", counted)
+    full = overturning_spectrum(r, 12, **kw)
+    runs_full, n["runs"] = n["runs"], 0
+    fit = overturning_spectrum(r, 12, refine_where="fit", verdicts=full, **kw)
+    runs_fit, n["runs"] = n["runs"], 0
+    only = overturning_spectrum(r, 12, refine_where="t_I", verdicts=full, **kw)
+    runs_only = n["runs"]
+    assert fit.t_I_s == full.t_I_s and only.t_I_s == full.t_I_s
+    assert fit.t_I_prime_s == pytest.approx(full.t_I_prime_s, rel=1e-12)
+    assert fit.beta == pytest.approx(full.beta, rel=1e-12)
+    assert np.isnan(only.t_I_prime_s) and np.isnan(only.beta)
+    # the bisection alone: every level with a boundary x 8 steps, against a few levels
+    n_levels = int(np.isfinite(full.p_min_rad_s).sum())
+    assert runs_only < runs_fit < 0.5 * 8 * n_levels < runs_full
+    with pytest.raises(InputError, match="refine_where"):
+        overturning_spectrum(r, 12, refine_where="some", **kw)
+
+
+def test_inclined_line_without_the_solver_matches_linprog():
+    from rocklab.models.spectra._oas import _line_of, fit_inclined_line
+
+    rng = np.random.default_rng(3)
+    for _ in range(300):
+        lv = np.linspace(1.0, 10.0, 40)
+        f = 3.0 + rng.uniform(0, 1, lv.size) * rng.uniform(0, 3) + lv * rng.uniform(-0.5, 0.8)
+        f = np.abs(np.where(rng.uniform(size=lv.size) < 0.1, np.nan, f)) + 0.01
+        tIp, beta = fit_inclined_line(f, lv)  # scipy's HiGHS
+        c0, s0 = (1 / tIp if np.isfinite(tIp) else 0.0), (1 / beta if np.isfinite(beta) else 0.0)
+        c, s = _line_of(f, lv)
+        ok = np.isfinite(f)
+        mid = 0.5 * (lv[ok].min() + lv[ok].max())
+        # the same optimum (height at the middle of the range); both lines below every point
+        assert c + s * mid == pytest.approx(c0 + s0 * mid, rel=1e-9)
+        assert np.all(c + s * lv[ok] <= f[ok] * (1 + 1e-9)) and c >= 0 and s >= 0

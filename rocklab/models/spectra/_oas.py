@@ -266,6 +266,7 @@ def overturning_spectrum(
     R_max_m: float = 1000.0,
     R_min_m: float = 0.1,
     refine: int = 10,
+    refine_where: str = "all",
     criterion: str = "angle",
     free="energy",
     search: str = "scan",
@@ -294,17 +295,19 @@ def overturning_spectrum(
     refine : int
         Bisection steps (in log R) between the largest unsafe grid size and its
         safe neighbour; 10 steps resolve the boundary to ~0.01 % in p.
+    refine_where : {"all", "fit", "t_I"}
+        ``"fit"``: bisect only the levels that can set t_I or touch the inclined line (:func:`_bisect`;
+        t_I, t'_I, beta as with ``"all"``); ``"t_I"``: t_I only (t'_I, beta NaN), and ``grid="boundary"``
+        searches only the levels that can set it.
     criterion, free, search, eta : see the module docstring.
     alpha_I : float
         Inertia coefficient I_O/(m R^2) (thesis Eq. 22).
     max_p_dt : float
-        For ``method="newmark"``: largest step times p. Against p h = 0.00025 the grid at
-        0.001 keeps 99.82 % of the verdicts on FF-1 (30 s), 98.06 % on FF-30 (46 s) and
-        96.02 % on FF-9 (100 s): long rocking near the boundary amplifies step errors.
+        For ``method="newmark"``: largest step times p (against p h = 0.00025 the grid at 0.001 keeps
+        99.82 % of the verdicts on FF-1, 96.02 % on FF-9: long rocking amplifies step errors).
     level_offset, size_offset : float
-        Shift of the level grid and of the (log) size grid by this fraction of one
-        step, in [0, 1): the same resolution placed elsewhere, to see how much t_I
-        owes to where the grid falls (:func:`t_I_band`).
+        Shift of the level grid and of the (log) size grid by this fraction of one step, in [0, 1):
+        the same resolution placed elsewhere, to see how much t_I owes to where the grid falls.
     grid : {"adaptive", "dense", "boundary"}
         ``"adaptive"`` simulates a coarse grid and refines only where verdicts
         change (:func:`~rocklab.models.spectra._oas_grid.adaptive_verdicts`);
@@ -313,20 +316,17 @@ def overturning_spectrum(
         (:func:`~rocklab.models.spectra._oas_grid.boundary_verdicts`): t_I, t'_I
         and beta come out as from a full grid, the map away from the boundary is a fill.
     verdicts : OASResult, optional
-        An earlier result on the same grid and runs (every option equal but
-        ``search`` and ``refine``): its verdicts are reused and only the
-        boundary is searched and bisected again.
+        An earlier result on the same grid and runs (every option equal but ``search`` and
+        ``refine``): its verdicts are reused and only the boundary is searched and bisected again.
     guide : OASResult, optional
-        For ``grid="boundary"``: an OAS of the same record whose boundary is
-        close to this one's (e.g. the default grid for a shifted or coarser one).
+        For ``grid="boundary"``: an OAS of the same record whose boundary is close to this
+        one's (e.g. the default grid for a shifted or coarser one).
     method : {"taylor", "newmark"}
         Integrator of the runs (:func:`~rocklab.models.simulate_batch`): ``"taylor"`` a Taylor
         step per record interval (``p h <= 0.25``, order from ``p h``, truncation below 1e-16),
-        impacts and overturning as roots of the series: converged verdicts, the reference's own
-        (:func:`~rocklab.models.oas_reference`; on the 44 FEMA far-field records the adaptive grid
-        agrees with it on >= 99.9 % of the cells that are not chaotic, the Newmark grid at p h =
-        0.001 on 98.8 %); ``"newmark"`` trapezoidal steps of ``p h <= max_p_dt`` (the default
-        before session 13).
+        exact events: converged verdicts (:func:`~rocklab.models.oas_reference`; on the 44 FEMA
+        far-field records >= 99.9 % of the cells that are not chaotic, the Newmark grid at p h =
+        0.001 98.8 %); ``"newmark"`` trapezoidal steps of ``p h <= max_p_dt`` (before session 13).
 
     Returns
     -------
@@ -343,7 +343,7 @@ def overturning_spectrum(
     """
     sl = check_opts(slenderness, levels, sizes, R_max_m, R_min_m, level_max, alpha_I)
     base = _checked_record(base, levels, sizes)
-    _check_choices(criterion, search, grid, guide, method)
+    _check_choices(criterion, search, grid, guide, method, refine_where)
     _check_steps(level_offset, size_offset, max_p_dt)
     free_code, free_s = free_after_code(free)
     alpha, eta_v = _block_restitution(sl, alpha_I, eta)
@@ -354,6 +354,7 @@ def overturning_spectrum(
         R_max_m=float(R_max_m),
         R_min_m=float(R_min_m),
         refine=int(refine),
+        refine_where=refine_where,
         criterion=criterion,
         free=free,
         search=search,
@@ -369,10 +370,11 @@ def overturning_spectrum(
     if verdicts is not None:
         over, evaluated = _reused_verdicts(verdicts, opts, (eta_v, alpha, float(alpha_I)), base.name)
     else:
-        over, evaluated = _grid_verdicts(grid, lambda i, j: batch_runs(base, scales[i], p[j], args), lv, p, guide)
+        run = lambda i, j: batch_runs(base, scales[i], p[j], args)  # noqa: E731
+        over, evaluated = _grid_verdicts(grid, run, lv, p, guide, refine_where == "t_I")
 
     p_hi, p_lo = first_unsafe(over, p, search)
-    p_hi, p_lo = _bisect(base, scales, p_hi, p_lo, refine, args)
+    p_hi, p_lo = _bisect(base, scales, p_hi, p_lo, refine, args, None if refine_where == "all" else lv, refine_where)
     return oas_result(base.name, lv, R, p, over, evaluated, p_hi, (alpha, float(alpha_I), eta_v), opts)
 
 
@@ -402,8 +404,10 @@ def _check_steps(level_offset, size_offset, max_p_dt):
         raise InputError(f"max_p_dt={max_p_dt!r}: step times p must be in (0, 0.5]")
 
 
-def _check_choices(criterion, search, grid, guide, method="newmark"):
+def _check_choices(criterion, search, grid, guide, method="newmark", refine_where="all"):
     """The OAS's definition choices are among the known ones (module docstring)."""
+    if refine_where not in ("all", "fit", "t_I"):
+        raise InputError(f"refine_where={refine_where!r}: use 'all' (every level), 'fit' (t_I, t'_I, beta) or 't_I'")
     if method not in METHODS_OAS:
         raise InputError(
             f"method={method!r}: use 'newmark' (trapezoidal steps) or 'taylor' (series per record interval)"
@@ -446,7 +450,7 @@ def _reused_verdicts(verdicts, opts, block, name):
     """(overturned, evaluated) of an earlier OAS on the same grid, runs and block (alpha, eta, alpha_I)."""
 
     def grid_of(o):
-        return {k: v for k, v in o.items() if k not in ("search", "refine")}
+        return {k: v for k, v in o.items() if k not in ("search", "refine", "refine_where")}
 
     eta_v, alpha, alpha_I = block
     if (
@@ -458,14 +462,15 @@ def _reused_verdicts(verdicts, opts, block, name):
     return verdicts.overturned, verdicts.evaluated
 
 
-def _grid_verdicts(grid, run, lv, p, guide):
+def _grid_verdicts(grid, run, lv, p, guide, t_I_only=False):
     """(overturned, evaluated), each (levels, sizes): ``run(i, j)`` simulated where ``grid`` says."""
     if grid == "dense":
         i, j = np.repeat(np.arange(lv.size), p.size), np.tile(np.arange(p.size), lv.size)
         over = run(i, j).reshape(lv.size, p.size)
         return over, np.ones_like(over)
     if grid == "boundary":
-        return boundary_verdicts(run, lv.size, p.size, _guess_first(guide, lv, p))
+        key = lv[:, None] * p[None, :] if t_I_only else None  # f: only the rows that can set t_I
+        return boundary_verdicts(run, lv.size, p.size, _guess_first(guide, lv, p), key=key)
     return adaptive_verdicts(run, lv.size, p.size)
 
 
@@ -476,7 +481,7 @@ def oas_result(name, lv, R, p, over, evaluated, p_hi, block, opts):
     icr = normalised_critical_impulse(alpha)
     f_min = float(np.nanmin(f)) if np.isfinite(f).any() else float("nan")
     t_I = icr / f_min if math.isfinite(f_min) else float("nan")
-    tIp, beta = fit_inclined_line(f, lv)
+    tIp, beta = fit_inclined_line(f, lv) if opts.get("refine_where") != "t_I" else (math.nan, math.nan)
     return OASResult(
         levels=lv,
         R_m=R,
@@ -571,20 +576,66 @@ def batch_runs(base, scale, p, args):
     return out
 
 
-def _bisect(base, scales, p_hi, p_lo, n, args):
-    """Geometric bisection of every level's bracket [p_lo safe, p_hi unsafe] at once."""
+def _bisect(base, scales, p_hi, p_lo, n, args, lv=None, where="fit"):
+    """Geometric bisection of every level's bracket [p_lo safe, p_hi unsafe] at once, ``n`` steps.
+
+    With ``lv`` (the levels a_p/a_p,min): only the levels that can still set t_I or touch the inclined
+    line. f = lv p lies in (lv p_lo, lv p_hi]; a level whose lower end is at or above the smallest upper
+    end cannot hold f_min, and one whose lower end lies on or above the line fitted to the upper ends
+    (the final f of the others) leaves that line feasible and hence optimal for the exact values too.
+    The line is checked again once the others are done, and the levels below it bisected in turn;
+    ``where="t_I"``: no line, only f_min.
+    """
     p_hi = p_hi.copy()
     p_lo = p_lo.copy()
     m = np.isfinite(p_hi) & np.isfinite(p_lo)
     if not m.any():
         return p_hi, p_lo
-    idx = np.flatnonzero(m)
-    for _ in range(int(n)):
+    left = np.where(m, int(n), 0)
+    want = left > 0 if lv is None else _fit_levels(lv, p_hi, p_lo, left, m, where == "fit")
+    while want.any():
+        idx = np.flatnonzero(want)
         pm = np.sqrt(p_hi[idx] * p_lo[idx])
         o = batch_runs(base, scales[idx], pm, args)
         p_hi[idx] = np.where(o, pm, p_hi[idx])
         p_lo[idx] = np.where(o, p_lo[idx], pm)
+        left[idx] -= 1
+        want = left > 0 if lv is None else _fit_levels(lv, p_hi, p_lo, left, m, where == "fit")
     return p_hi, p_lo
+
+
+def _fit_levels(lv, p_hi, p_lo, left, m, lines=True):
+    """Levels still to bisect for t_I and the inclined line (see :func:`_bisect`)."""
+    f_hi, f_lo = lv * p_hi, lv * p_lo
+    todo = m & (left > 0)
+    need = f_lo < np.nanmin(f_hi)
+    if (todo & need).any() or not lines:
+        return todo & need  # f_min first: its level is a point of the line too
+    c, s = _line_of(f_hi, lv)
+    return todo & (f_lo < c + s * lv)
+
+
+def _line_of(f, lv):
+    """(c, s) of the inclined line f = c + s A of :func:`fit_inclined_line` (zeros when undefined), without
+    the LP solver: maximising the line's integral over [A_min, A_max] is maximising its height at the
+    range's middle, so the optimum is the lower convex hull's edge over the middle (from the end of the
+    lowest chord there), or one of the lines c = 0, s = 0 where that edge leaves c, s >= 0."""
+    ok = np.isfinite(f)
+    if ok.sum() < 2:
+        return 0.0, 0.0
+    A, y = lv[ok], f[ok]
+    mid = 0.5 * (A.min() + A.max())
+    left, right = A <= mid, A > mid
+    al, yl, ar, yr = A[left][:, None], y[left][:, None], A[right][None, :], y[right][None, :]
+    sl = (yr - yl) / (ar - al)
+    i = np.unravel_index(np.argmin(yl + sl * (mid - al)), sl.shape)[0]  # a hull vertex at or left of mid
+    s_i = np.min(sl[i])  # the hull's edge to its right (supporting even when the vertex sits at mid)
+    c = np.array([yl[i, 0] - s_i * al[i, 0], y.min(), 0.0])
+    s = np.array([s_i, 0.0, np.min(y / A)])
+    tol = 1e-12 * max(1.0, float(np.abs(y).max()))
+    feasible = (c >= -tol) & (s >= -tol) & np.all(c[:, None] + s[:, None] * A[None, :] <= y[None, :] + tol, axis=1)
+    best = int(np.argmax(np.where(feasible, c + s * mid, -np.inf)))
+    return max(float(c[best]), 0.0), max(float(s[best]), 0.0)
 
 
 def fit_inclined_line(f, levels):

@@ -129,10 +129,12 @@ def adaptive_verdicts(
     return over, known
 
 
-def _check_frontier(run, over, known, width):
-    """Simulate the ``width`` points before each row's first unsafe one until none turns unsafe."""
+def _check_frontier(run, over, known, width, only=None):
+    """Simulate the ``width`` points before each row's first unsafe one until none turns unsafe (rows in
+    the mask ``only``, all by default)."""
     while True:
-        rows = np.flatnonzero(over.any(axis=1))  # rows without an unsafe point have no boundary
+        has = over.any(axis=1) if only is None else over.any(axis=1) & only
+        rows = np.flatnonzero(has)  # rows without an unsafe point have no boundary
         j = over[rows].argmax(axis=1)[:, None] - np.arange(1, width + 1)[None, :]
         i = np.broadcast_to(rows[:, None], j.shape)
         ok = j >= 0
@@ -148,6 +150,23 @@ def _check_frontier(run, over, known, width):
             return
 
 
+def _windows(run, over, known, lo, hi, frontier):
+    """Simulate each row's window [lo, hi); rows with no unsafe point there move on to the right in steps of
+    ``frontier`` until one is found or the row ends (``lo``, ``hi`` updated in place)."""
+    n_cols = over.shape[1]
+    active = hi > lo
+    while active.any():
+        i = np.concatenate([np.full(hi[r] - lo[r], r) for r in np.flatnonzero(active)]).astype(int)
+        j = np.concatenate([np.arange(lo[r], hi[r]) for r in np.flatnonzero(active)]).astype(int)
+        todo = ~known[i, j]
+        if todo.any():
+            over[i[todo], j[todo]] = np.asarray(run(i[todo], j[todo]), bool)
+            known[i[todo], j[todo]] = True
+        active = ~over.any(axis=1) & (hi < n_cols) & (hi > lo)
+        lo[active] = hi[active]
+        hi[active] = np.minimum(hi[active] + max(1, int(frontier)), n_cols)
+
+
 def boundary_verdicts(
     run: Callable[[np.ndarray, np.ndarray], np.ndarray],
     n_rows: int,
@@ -156,6 +175,7 @@ def boundary_verdicts(
     *,
     frontier: int = ADAPTIVE_FRONTIER,
     ahead: int = 2,
+    key: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Each row's first unsafe point, searched near a guess (a neighbouring OAS's boundary).
 
@@ -177,6 +197,12 @@ def boundary_verdicts(
         expected to hold no unsafe point.
     frontier, ahead : int
         Columns simulated before and after the guess.
+    key : ndarray, shape (n_rows, n_cols), optional
+        Only the smallest ``key`` at a row's first unsafe point is wanted (t_I: key = f = level p):
+        only the rows whose window start has a key below the smallest found so far are searched
+        (first those below the smallest key at the windows' ends), until no other row has. The rows
+        left out could not have held the minimum, as no row's point before its window is looked at;
+        they stay safe (no boundary) in the map.
 
     Returns
     -------
@@ -191,20 +217,22 @@ def boundary_verdicts(
     none = g >= n_cols
     lo[none] = max(0, n_cols - int(frontier))
     hi[none] = n_cols
-    active = np.ones(n_rows, bool)
-    while active.any():
-        i = np.concatenate([np.full(hi[r] - lo[r], r) for r in np.flatnonzero(active)]).astype(int)
-        j = np.concatenate([np.arange(lo[r], hi[r]) for r in np.flatnonzero(active)]).astype(int)
-        todo = ~known[i, j]
-        if todo.any():
-            over[i[todo], j[todo]] = np.asarray(run(i[todo], j[todo]), bool)
-            known[i[todo], j[todo]] = True
-        # rows whose window held no unsafe point look further right (smaller blocks)
-        active = ~over.any(axis=1) & (hi < n_cols)
-        lo = np.where(active, hi, lo)
-        hi = np.where(active, np.minimum(hi + int(frontier), n_cols), hi)
-    if frontier > 0:
-        _check_frontier(run, over, known, int(frontier))
+    done = np.zeros(n_rows, bool)
+    todo = np.ones(n_rows, bool)
+    if key is not None:  # the rows whose window could reach below the smallest key the guess expects
+        rows = np.arange(n_rows)
+        bound = key[rows, np.minimum(lo, n_cols - 1)]
+        todo = bound < np.min(key[rows, np.maximum(hi, 1) - 1])
+    while todo.any():
+        _windows(run, over, known, np.where(todo, lo, hi), hi, frontier)
+        done |= todo
+        if frontier > 0:
+            _check_frontier(run, over, known, int(frontier), done)
+        if key is None:
+            break
+        has = over.any(axis=1) & done
+        best = np.min(key[has, over[has].argmax(axis=1)]) if has.any() else np.inf
+        todo = ~done & (bound < best)
     # fill: unsafe after each row's simulated window (rows with an unsafe point only)
     for r in np.flatnonzero(over.any(axis=1)):
         last = np.flatnonzero(known[r]).max()

@@ -21,7 +21,15 @@ The ensemble (:data:`BAND_ENSEMBLE`), each member changing one choice of the def
 The first member's grid is computed in full (adaptive); members on the same
 grid reuse its verdicts, the others search each level's first unsafe size near
 its boundary only (``grid="boundary"``; on 12 FEMA records x 5 members t_I,
-t'_I and beta equal their own full adaptive grid's in 60/60).
+t'_I and beta equal their own full adaptive grid's in 60/60). The members after
+the first bisect only the levels that can set t_I or touch the inclined line
+(``refine_where="fit"``: the same t_I, t'_I and beta; on 6 FEMA records 27.3 ->
+17.4 CPU-s, one thread, loaded machine). With ``lines=False`` they compute t_I
+alone (``refine_where="t_I"``): each searches only the levels whose window could
+hold a smaller f than found so far and bisects only those that can set f_min, so
+the t'_I and beta bands are the first member's values; 44 FEMA records 70 CPU-s
+(one thread, load 44-49; 306 CPU-s for the default bands in session 15 at load 2-7),
+Table 4 inside the band 30/44, median half-width 9.3 %, as with every member whole.
 
 Measured with the Taylor runs (the default since session 13) on the 44 FEMA P695 far-field
 records at H/B = 12 against Table 4 (``benchmarks/oas_fema44.py --bands``): Table 4's t_I lies

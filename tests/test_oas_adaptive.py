@@ -201,3 +201,34 @@ def test_inclined_line_without_the_solver_matches_linprog():
         # the same optimum (height at the middle of the range); both lines below every point
         assert c + s * mid == pytest.approx(c0 + s0 * mid, rel=1e-9)
         assert np.all(c + s * lv[ok] <= f[ok] * (1 + 1e-9)) and c >= 0 and s >= 0
+
+
+def test_guide_bisected_only_where_the_members_windows_need_it(shared_data, monkeypatch):
+    import rocklab.models.spectra._oas as oas
+
+    r = load_base_motion(shared_data / FF1, units="g")
+    kw = dict(levels=30, sizes=45, refine=8)
+    full = overturning_spectrum(r, 12, **kw)
+    n = {"runs": 0}
+    real = oas.batch_runs
+
+    def counted(base, scale, p, args):
+        n["runs"] += np.size(scale)
+        return real(base, scale, p, args)
+
+    # three member grids: sizes shifted half a step, levels shifted, a coarser grid
+    places = [
+        oas.grid_axes(dict(full.options, **ch), full.alpha_I)[::2]
+        for ch in ({"size_offset": 0.5}, {"level_offset": 0.5}, {"levels": 22, "sizes": 34})
+    ]
+    coarse = overturning_spectrum(r, 12, verdicts=full, **dict(kw, refine=0))
+    monkeypatch.setattr(oas, "batch_runs", counted)
+    settled = oas.settle_guide(r, coarse, places, refine=8)
+    assert settled.t_I_s == full.t_I_s and settled.f_min_at == full.f_min_at
+    assert settled.t_I_prime_s == pytest.approx(full.t_I_prime_s, rel=1e-12)
+    for lv, p in places:
+        assert np.array_equal(oas._guess_first(settled, lv, p), oas._guess_first(full, lv, p))
+    # without the places only the fitted levels are bisected; the places need more, all levels far more
+    n_levels = int(np.isfinite(full.p_min_rad_s).sum())
+    assert n["runs"] < 0.8 * 8 * n_levels
+    assert not np.array_equal(oas._guess_first(coarse, *places[2]), oas._guess_first(full, *places[2]))

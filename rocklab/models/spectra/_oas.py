@@ -364,7 +364,7 @@ def overturning_spectrum(
         grid=grid,
         method=method,
     )
-    lv, R, p = _grid_axes(opts, alpha_I)
+    lv, R, p = grid_axes(opts, alpha_I)
     scales = lv * math.tan(alpha) * G / base.pga_m_s2  # record scaled to a_p = level g tan(alpha)
     args = (alpha, eta_v, CRIT[criterion], free_code, free_s, max_p_dt if method == "newmark" else TAYLOR_P_H, method)
     if verdicts is not None:
@@ -436,7 +436,7 @@ def _block_restitution(sl, alpha_I, eta):
     return alpha, eta_v
 
 
-def _grid_axes(opts, alpha_I):
+def grid_axes(opts, alpha_I):
     """(levels a_p/a_p,min, R m, p rad/s) of the grid ``opts`` describes, each shifted by its offset."""
     step = (opts["level_max"] - 1.0) / (opts["levels"] - 1)
     lv = 1.0 + (np.arange(opts["levels"]) + opts["level_offset"]) * step
@@ -522,6 +522,51 @@ def first_unsafe(over, p, search):
     p_hi = np.where(k >= 0, p[np.clip(k, 0, None)], np.nan)  # unsafe
     p_lo = np.where(k > 0, p[np.clip(k - 1, 0, None)], np.nan)  # safe neighbour (larger block)
     return p_hi, p_lo
+
+
+def settle_guide(base, o, places, refine=10):
+    """A guide OAS computed with ``refine=0``, bisected (``refine`` steps) on the levels that set its t_I
+    and inclined line and, elsewhere, only as far as :func:`_guess_first` needs to place the windows of
+    grids with the sizes ``places`` (each (levels, p) of a member grid): the guesses, t_I, t'_I and beta
+    come out as from the guide bisected on every level, with a fraction of the runs."""
+    opt = o.options
+    free_code, free_s = free_after_code(opt["free"])
+    args = (o.alpha_rad, o.eta, CRIT[opt["criterion"]], free_code, free_s)
+    args += (opt["max_p_dt"] if opt["method"] == "newmark" else TAYLOR_P_H, opt["method"])
+    scales = o.levels * math.tan(o.alpha_rad) * G / base.pga_m_s2
+    p_hi, p_lo = first_unsafe(o.overturned, o.p_rad_s, opt["search"])
+    m = np.isfinite(p_hi) & np.isfinite(p_lo)
+    left = np.where(m, int(refine), 0)
+    step = abs(o.levels[1] - o.levels[0]) if o.levels.size > 1 else 1.0
+
+    def wanted():
+        want = _fit_levels(o.levels, p_hi, p_lo, left, m)
+        live = np.isfinite(p_hi)
+        low = np.where(left > 0, p_lo, p_hi)  # the bisected value lies in (low, p_hi]
+        for lv, p in places:
+            for level in lv:
+                near = live & (np.abs(o.levels - level) <= step * (1 + 1e-9))
+                if not near.any():
+                    continue
+                top = p_hi[near].min()
+                ahead = np.searchsorted(p, np.array([low[near].min(), top]) * (1 - 1e-12))
+                if ahead[0] != ahead[1]:  # a grid point inside the bracket: the guess is not settled
+                    want |= near & (left > 0) & (low < top)
+        return want
+
+    want = wanted()
+    while want.any():
+        idx = np.flatnonzero(want)
+        pm = np.sqrt(p_hi[idx] * p_lo[idx])
+        v = batch_runs(base, scales[idx], pm, args)
+        p_hi[idx] = np.where(v, pm, p_hi[idx])
+        p_lo[idx] = np.where(v, p_lo[idx], pm)
+        left[idx] -= 1
+        want = wanted()
+    opts = dict(opt, refine=int(refine), refine_where="fit")
+    return oas_result(
+        o.name, o.levels, o.R_m, o.p_rad_s, o.overturned, o.evaluated, p_hi, (o.alpha_rad, o.alpha_I, o.eta), opts
+    )
 
 
 def _guess_first(guide, lv, p):

@@ -21,8 +21,10 @@ The ensemble (:data:`BAND_ENSEMBLE`), each member changing one choice of the def
 The first member's grid is computed in full (adaptive); members on the same
 grid reuse its verdicts, the others search each level's first unsafe size near
 its boundary only (``grid="boundary"``; on 12 FEMA records x 5 members t_I,
-t'_I and beta equal their own full adaptive grid's in 60/60). The members after
-the first bisect only the levels that can set t_I or touch the inclined line
+t'_I and beta equal their own full adaptive grid's in 60/60). The first member
+is bisected on the levels behind its t_I and line and elsewhere only as far as
+the others' search windows need (:func:`~rocklab.models.spectra._oas.settle_guide`).
+The members after the first bisect only the levels that can set t_I or touch the inclined line
 (``refine_where="fit"``: the same t_I, t'_I and beta; on 6 FEMA records 27.3 ->
 17.4 CPU-s, one thread, loaded machine). With ``lines=False`` they compute t_I
 alone (``refine_where="t_I"``): each searches only the levels whose window could
@@ -49,7 +51,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._oas import OASResult, overturning_spectrum
+from ._oas import OAS_DEFAULTS, OASResult, grid_axes, overturning_spectrum, settle_guide
 
 __all__ = ["BAND_ENSEMBLE", "TIBand", "t_I_band"]
 
@@ -118,6 +120,35 @@ class TIBand:
         return d
 
 
+#: Grid options :func:`grid_axes` reads, at the defaults of :func:`overturning_spectrum`.
+_AXES = {k: v for k, v in OAS_DEFAULTS.items() if k in ("levels", "level_max", "sizes", "R_max_m", "R_min_m")} | {
+    "level_offset": 0.0,
+    "size_offset": 0.0,
+}
+
+
+def _grid_key(kw):
+    """What makes two members' grids and runs the same (all options but the boundary search's)."""
+    return tuple(sorted((k, repr(v)) for k, v in kw.items() if k not in ("search", "refine", "refine_where")))
+
+
+def _member_options(ensemble, options, slenderness, lines):
+    """(name, options of :func:`overturning_spectrum`) of each member (``eta_factor`` applied)."""
+    out = []
+    for k, (name, change) in enumerate(ensemble.items()):
+        kw = dict(options)
+        kw.update({key: v for key, v in change.items() if key != "eta_factor"})
+        if "eta_factor" in change:
+            alpha_I = kw.get("alpha_I", 4.0 / 3.0)
+            alpha = math.atan(1.0 / slenderness)
+            eta0 = kw.get("eta") if kw.get("eta") is not None else 1.0 - 2.0 * math.sin(alpha) ** 2 / alpha_I
+            kw["eta"] = eta0 * change["eta_factor"]
+        if k:  # only the guide's boundary is used whole (it places the others' search)
+            kw.setdefault("refine_where", "fit" if lines else "t_I")
+        out.append((name, kw))
+    return out
+
+
 def _stats(v):
     v = np.asarray(v, float)
     v = v[~np.isnan(v)]
@@ -153,26 +184,25 @@ def t_I_band(base, slenderness: float = 12.0, ensemble: dict | None = None, *, l
     members = []
     grids: dict[tuple, OASResult] = {}  # members that differ only in search/refine share one grid's runs
     guide: OASResult | None = None
-    for name, change in (ensemble or BAND_ENSEMBLE).items():
-        kw = dict(options)
-        kw.update({k: v for k, v in change.items() if k != "eta_factor"})
-        if "eta_factor" in change:
-            alpha_I = kw.get("alpha_I", 4.0 / 3.0)
-            alpha = math.atan(1.0 / slenderness)
-            eta0 = kw.get("eta") if kw.get("eta") is not None else 1.0 - 2.0 * math.sin(alpha) ** 2 / alpha_I
-            kw["eta"] = eta0 * change["eta_factor"]
-        if guide is not None:  # only the guide's boundary is used whole (it places the others' search)
-            kw.setdefault("refine_where", "fit" if lines else "t_I")
-        key = tuple(sorted((k, repr(v)) for k, v in kw.items() if k not in ("search", "refine", "refine_where")))
+    todo = _member_options(ensemble or BAND_ENSEMBLE, options, slenderness, lines)
+    keys = [_grid_key(kw) for _, kw in todo]
+    # the grids whose search the first member's boundary places: it is bisected only as far as they need
+    places = [
+        grid_axes(dict(_AXES, **kw), kw.get("alpha_I", 4.0 / 3.0))[::2]
+        for k, (_, kw) in enumerate(todo)
+        if k and keys[k] not in keys[:k] and kw.get("search", "scan") == "scan"
+    ]
+    for (name, kw), key in zip(todo, keys):
         if key in grids:
             o = overturning_spectrum(base, slenderness, verdicts=grids[key], **kw)
         elif guide is not None and kw.get("search", "scan") == "scan":
             # the first member's boundary guides the others' search (t_I, t'_I, beta as from full grids)
             o = overturning_spectrum(base, slenderness, grid="boundary", guide=guide, **kw)
+        elif guide is None:
+            o = overturning_spectrum(base, slenderness, **dict(kw, refine=0))
+            o = guide = settle_guide(base, o, places, kw.get("refine", 10))
         else:
             o = overturning_spectrum(base, slenderness, **kw)
-            if guide is None:
-                guide = o
         grids.setdefault(key, o)
         lv, R = o.f_min_at
         members.append(

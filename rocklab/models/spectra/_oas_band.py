@@ -26,12 +26,13 @@ is bisected on the levels behind its t_I and line and elsewhere only as far as
 the others' search windows need (:func:`~rocklab.models.spectra._oas.settle_guide`).
 The members after the first bisect only the levels that can set t_I or touch the inclined line
 (``refine_where="fit"``: the same t_I, t'_I and beta; on 6 FEMA records 27.3 ->
-17.4 CPU-s, one thread, loaded machine). With ``lines=False`` they compute t_I
-alone (``refine_where="t_I"``): each searches only the levels whose window could
-hold a smaller f than found so far and bisects only those that can set f_min, so
-the t'_I and beta bands are the first member's values; 44 FEMA records 70 CPU-s
-(one thread, load 44-49; 306 CPU-s for the default bands in session 15 at load 2-7),
-Table 4 inside the band 30/44, median half-width 9.3 %, as with every member whole.
+15.5 CPU-s, one thread, loaded machine; 44 records 127 CPU-s at load 44-53 against
+306 CPU-s in session 15 at load 2-7). With ``lines=False`` they compute t_I alone
+(``refine_where="t_I"``): each searches only the levels whose window could hold a
+smaller f than found so far and bisects only those that can set f_min, so the t'_I
+and beta bands are the first member's values; 44 records 67 CPU-s (same load), one
+member's t_I of 352 differs from the default mode's, no band does; Table 4 inside the
+band 30/44, median half-width 9.3 % in both modes, as before.
 
 Measured with the Taylor runs (the default since session 13) on the 44 FEMA P695 far-field
 records at H/B = 12 against Table 4 (``benchmarks/oas_fema44.py --bands``): Table 4's t_I lies

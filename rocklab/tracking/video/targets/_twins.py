@@ -126,33 +126,35 @@ class TwinGuard:
         """A verified frame: its grey image and the object's centre (px) there."""
         self.seen.append((int(frame), np.array(gray), np.asarray(centre, float)))
 
-    def _state(self, tmpl, radius, min_cc, top):
-        """(frame, centre, velocity px/frame) of the object and (centre, velocity) of its nearest
-        look-alike (None) at the last verified frame: a match within :data:`TWIN_CC_GAP` of ``top``,
-        the best correlation now (the template is often cut from that frame: its own match is 1)."""
+    def _own(self):
+        """(frame, centre px, velocity px/frame) of the object at its last verified frame."""
+        p, _, c_p = self.seen[-1]
+        if len(self.seen) < 2:
+            return p, c_p, np.zeros(2)
+        p0, _, c0 = self.seen[0]
+        return p, c_p, (c_p - c0) / max(p - p0, 1)
+
+    def _lookalike(self, tmpl, radius, min_cc, top):
+        """(centre px, velocity px/frame) of the object's nearest look-alike at its last verified
+        frame, or None: a match within :data:`TWIN_CC_GAP` of ``top``, the best correlation now (the
+        template is often cut from that frame: its own match there is 1)."""
         p, g_p, c_p = self.seen[-1]
-        v_k = np.zeros(2)
-        if len(self.seen) == 2:
-            p0, _, c0 = self.seen[0]
-            v_k = (c_p - c0) / max(p - p0, 1)
         half = 0.5 * self.size
-        others = [
-            q[1] for q in _similar(match_peaks(g_p, tmpl, c_p, radius), min_cc, top) if np.hypot(*(q[1] - c_p)) > half
-        ]
+        peaks = _similar(match_peaks(g_p, tmpl, c_p, radius), min_cc, top)
+        others = [q[1] for q in peaks if np.hypot(*(q[1] - c_p)) > half]
         if not others:
-            return (p, c_p, v_k), None
+            return None
         o_p = min(others, key=lambda c: float(np.hypot(*(c - c_p))))
         v_o = np.zeros(2)
         if len(self.seen) == 2:
             p0, g0, c0 = self.seen[0]
-            before = [
-                q[1] for q in _similar(match_peaks(g0, tmpl, o_p, self.size), 0.0, top) if np.hypot(*(q[1] - c0)) > half
-            ]
+            peaks = _similar(match_peaks(g0, tmpl, o_p, self.size), 0.0, top)
+            before = [q[1] for q in peaks if np.hypot(*(q[1] - c0)) > half]
             if before:
                 o0 = min(before, key=lambda c: float(np.hypot(*(c - o_p))))
                 if np.hypot(*(o0 - o_p)) < self.size * (p - p0):
                     v_o = (o_p - o0) / max(p - p0, 1)
-        return (p, c_p, v_k), (o_p, v_o)
+        return o_p, v_o
 
     def judge(self, tmpl, gray, frame: int, found, min_cc: float):
         """Whether the object found again at ``found`` (centre px) in ``gray`` (frame ``frame``,
@@ -161,9 +163,7 @@ class TwinGuard:
         if not self.seen:
             return "keep", None
         found = np.asarray(found, float)
-        p, c_p, v_k = self.seen[-1][0], self.seen[-1][2], np.zeros(2)
-        if len(self.seen) == 2:
-            v_k = (c_p - self.seen[0][2]) / max(p - self.seen[0][0], 1)
+        p, c_p, v_k = self._own()
         gap = max(frame - p, 1)
         radius = float(np.hypot(*v_k)) * gap + 2.0 * self.size
         half = 0.5 * self.size
@@ -171,7 +171,7 @@ class TwinGuard:
         rivals = [q for q in now if np.hypot(*(q[1] - found)) > half]
         if not rivals:
             return "keep", None
-        (p, c_p, v_k), other = self._state(tmpl, radius, min_cc, now[0][0])
+        other = self._lookalike(tmpl, radius, min_cc, now[0][0])
         if other is None:  # no look-alike before the loss: the object's own path decides
             pred_k = c_p + v_k * gap
             rival = min(rivals, key=lambda q: float(np.hypot(*(q[1] - pred_k))))

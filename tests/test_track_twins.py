@@ -132,7 +132,6 @@ def rotation(tmp_path_factory):
     return mirror_file(tmp_path_factory, "umartechboy/PhysTrack", "SampleVideos/CaromPuck/Rotation.MP4")
 
 
-@pytest.mark.slow
 def test_the_striker_is_not_ok_on_the_struck_puck(rotation):
     """CaromPuck/Rotation.MP4 (GPL-2.0, not shipped), the striker tracked from frame 205 over the
     collision (~238) to 290: before, it was found again on the struck puck at frame 246 and ok

@@ -208,17 +208,84 @@ def _merge(boxes, joined):
 #: which it changed (it left for good; an edge a late jitter of the picture shakes comes and goes).
 LATE_SHARE = 0.25
 LATE_STAY = 0.9
+#: Such a late mover is proposed only apart from the others (late pixels never join parts), at
+#: most this share of the frame, and
+#: when its first-frame look is found elsewhere in the last sample (it moved, the light did not
+#: change over it).
+LATE_FRACTION = 0.05
 
 
-def _moved_off(moving) -> np.ndarray:
+def _moved_off(moving) -> tuple[np.ndarray, np.ndarray]:
     """Pixels (bool, shape of a mask) that changed in at least :data:`MOVING_FRACTION` of the
-    masks ``moving`` (bool, in time order), or in :data:`LATE_SHARE` of them and
-    :data:`LATE_STAY` of those from the first in which they changed."""
+    masks ``moving`` (bool, in time order), and those that changed in :data:`LATE_SHARE` of them
+    and :data:`LATE_STAY` of those from the first in which they changed."""
     stack = np.asarray(moving, dtype=bool)
     n = stack.shape[0]
     count = stack.sum(axis=0)
     since = n - np.argmax(stack, axis=0)
-    return (count >= MOVING_FRACTION * n) | ((count >= LATE_SHARE * n) & (count >= LATE_STAY * since))
+    return count >= MOVING_FRACTION * n, (count >= LATE_SHARE * n) & (count >= LATE_STAY * since)
+
+
+def _parts(mask, k, grad, floor) -> list:
+    """Boxes (x, y, w, h px) of the parts of ``mask`` (bool): gaps of ``k`` px closed, parts thinner
+    than :data:`THIN_PX`, smaller than :data:`MIN_FRACTION` or without outline or texture (95th
+    percentile of ``grad`` under ``floor``) dropped."""
+    import cv2
+
+    mask = cv2.morphologyEx(mask.astype(np.uint8), cv2.MORPH_OPEN, np.ones((3, 3), np.uint8))
+    mask = cv2.morphologyEx(mask, cv2.MORPH_CLOSE, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (k, k)))
+    # what is thinner than THIN_PX once the texture's gaps are closed is no object to track: a
+    # pendulum's string (it sweeps the wall, and merged with its bob it made the proposal a box
+    # from the pivot to the bob, mostly still wall)
+    mask = cv2.morphologyEx(mask, cv2.MORPH_OPEN, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (THIN_PX, THIN_PX)))
+    n, labels, stats, _ = cv2.connectedComponentsWithStats(mask, connectivity=8)
+    return [
+        tuple(stats[i, :4])
+        for i in range(1, n)
+        if stats[i, 4] >= MIN_FRACTION * mask.size and np.percentile(grad[labels == i], 95) >= floor
+    ]
+
+
+def _edges(img, box) -> float:
+    """Mean gradient magnitude of ``img`` (working grey) in ``box`` (working px): an object that
+    left its place shows a plainer background there than its own outline; one that came to
+    stand there (a cart pushed onto a bare track) shows more."""
+    import cv2
+
+    x, y, w, h = (int(v) for v in box)
+    a = img[y : y + h, x : x + w]
+    return float(np.mean(cv2.magnitude(cv2.Sobel(a, cv2.CV_32F, 1, 0), cv2.Sobel(a, cv2.CV_32F, 0, 1))))
+
+
+def _found_elsewhere(f0, last, box) -> bool:
+    """Whether the first frame's content of ``box`` (working px) is in ``last`` (working grey)
+    with a correlation of at least :data:`IN_PLACE_CC`, moved by at least half its smaller side."""
+    import cv2
+
+    x, y, w, h = (int(v) for v in box)
+    tmpl = f0[y : y + h, x : x + w]
+    if float(tmpl.std()) < 1e-3:
+        return False
+    _, cc, _, at = cv2.minMaxLoc(cv2.matchTemplate(last, tmpl, cv2.TM_CCOEFF_NORMED))
+    return cc >= IN_PLACE_CC and math.hypot(at[0] - x, at[1] - y) >= 0.5 * min(w, h)
+
+
+def _with_late(f0, last, main, both, gap) -> list:
+    """The parts ``main`` with the late movers: a part of ``both`` (main and late pixels) holding
+    no main part, more than ``gap`` px from every one, of at most :data:`LATE_FRACTION` of the
+    frame, whose first-frame look is found elsewhere in ``last`` and whose place there is plainer
+    than it was (:func:`_edges`: it left, nothing came); a part that grew round main parts stays
+    those parts: late pixels do not join things."""
+    late = [
+        u
+        for u in both
+        if not any(region_overlap(m, u)[0] > 0 for m in main)
+        and all(_box_gap(u, m) > gap for m in main)
+        and u[2] * u[3] <= LATE_FRACTION * f0.size
+        and _found_elsewhere(f0, last, u)
+        and _edges(f0, u) > _edges(last, u)
+    ]
+    return list(main) + late
 
 
 def moving_boxes(first_gray, samples, masks: bool = False) -> tuple[list, int]:
@@ -261,22 +328,12 @@ def moving_boxes(first_gray, samples, masks: bool = False) -> tuple[list, int]:
         return moving, scale
     if not moving:
         return [], 0
-    mask = _moved_off(moving).astype(np.uint8)
+    main, late = _moved_off(moving)
     k = max(3, int(round(CLOSE_FRACTION * min(f0.shape))) | 1)
-    mask = cv2.morphologyEx(mask, cv2.MORPH_OPEN, np.ones((3, 3), np.uint8))
-    mask = cv2.morphologyEx(mask, cv2.MORPH_CLOSE, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (k, k)))
-    # what is thinner than THIN_PX once the texture's gaps are closed is no object to track: a
-    # pendulum's string (it sweeps the wall, and merged with its bob it made the proposal a box
-    # from the pivot to the bob, mostly still wall)
-    mask = cv2.morphologyEx(mask, cv2.MORPH_OPEN, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (THIN_PX, THIN_PX)))
-    n, labels, stats, _ = cv2.connectedComponentsWithStats(mask, connectivity=8)
     grad = cv2.magnitude(cv2.Sobel(f0, cv2.CV_32F, 1, 0), cv2.Sobel(f0, cv2.CV_32F, 0, 1))
     floor = MIN_STRUCTURE * (float(np.median(grad)) + 1e-3)
-    boxes = [
-        tuple(stats[i, :4])
-        for i in range(1, n)
-        if stats[i, 4] >= MIN_FRACTION * n_px and np.percentile(grad[labels == i], 95) >= floor
-    ]
+    boxes = _parts(main, k, grad, floor)
+    boxes = _with_late(f0, _prepare(samples[-1], scale), boxes, _parts(main | late, k, grad, floor), k)
     merged = []
     for m in _merge(boxes, lambda a, b: _box_gap(a, b) <= k):
         if m[2] * m[3] <= MAX_FRACTION * n_px:
@@ -348,7 +405,7 @@ def turning_region(first_gray, changed, scale, box):
         return None
     if not (rx <= x and ry <= y and x + bw <= rx + rw and y + bh <= ry + rh):
         return None
-    moved = _moved_off(changed)
+    moved = np.logical_or(*_moved_off(changed))
     edge = c.reshape(-1, 2)
     if float(moved[edge[:, 1], edge[:, 0]].mean()) > TURN_EDGE_MOVES:
         return None

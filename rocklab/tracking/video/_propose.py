@@ -17,6 +17,11 @@ place in the samples (:func:`stays_in_place`): it is mostly still things round a
 first frame is the first of the film's scene: :func:`lead_in` finds blank, fading-in or title
 frames before it.
 
+Three movers are proposed as the object rather than as their change (:data:`LATE_SHARE`,
+:func:`turning_region`, :func:`without_intruder`): one that starts to move late in the window
+(a struck puck), a disc turning on a pin whose outline never moves (only its mark changes), and
+an object a hand reaching in from the frame's edge lets go of.
+
 The table is the long straight horizontal edge a block stands on: searched just below each
 proposal's bottom, on either side of it, and accepted only when
 :func:`~rocklab.tracking.video.targets._table_edge.table_top_edge` follows it over at least
@@ -146,6 +151,8 @@ class Proposals:
         Boxes round something that moves whose own content stays in place (:func:`stays_in_place`):
         the box, the share of the samples in which it did, its median correlation there. Not
         proposed: a tracker would follow the still things in them.
+    turning : tuple of (x, y, w, h)
+        The blocks that are discs turning on a pin (:func:`turning_region`): only their mark moves.
     camera : (float, float)
         :func:`camera_motion` of the frames compared: the share of consecutive pairs in which the
         whole picture moved, and the median motion (px); from :data:`CAMERA_SHARE` on nothing is
@@ -160,6 +167,7 @@ class Proposals:
     n_moving: int
     still: tuple = ()
     camera: tuple = (0.0, 0.0)
+    turning: tuple = ()
 
     @property
     def camera_moves(self) -> bool:
@@ -689,4 +697,5 @@ def propose_objects(first_gray, samples) -> Proposals:
             for b in boxes
             if not region_overlap(b, table)[1] or table[1] - b[1] >= MIN_SIDE_PX
         ]
-    return Proposals(tuple(boxes), table, edge, moves, len(samples), n_moving, still)
+    turning = tuple(b for b in boxes if b in turners)
+    return Proposals(tuple(boxes), table, edge, moves, len(samples), n_moving, still, turning=turning)

@@ -30,7 +30,9 @@ ok frames with a finite theta more than max(5 deg, 3 sigma) off, and more than 5
 its sigma; ok frames with theta NaN; the
 median |theta error| and median sigma on ok frames; the warning codes.
 
-``CaromPuck/Rotation.MP4`` (same repository and licence; validation too): a striker puck, spinning,
+``CaromPuck/Rotation.MP4`` (same repository and licence; a DEVELOPMENT film since the look-alike
+rule (status ``twin``) and the kept-angle-step rule were tuned on it; CaromPuck/HeadOn and bigCollision
+validated them): a striker puck, spinning,
 hits a resting one at frame ~238; both are white discs with two dark dots. Reference: the white
 blobs (grey over the local median by 60, 120-600 px) followed by nearest neighbour; where the
 two share a blob or are both near, the struck puck A is the right-hand one (seen on crops of

@@ -201,6 +201,12 @@ WARNING_CODES: dict[str, tuple[str, str]] = {
         "same pixels (the frames of the one that jumped there are status latch); redraw the "
         "region (or fix the marker ids) of the named object",
     ),
+    "W-TRACK-TWIN": (
+        "suspect",
+        "an object found again after lost frames beside a look-alike (identical pucks) whose motion "
+        "before the loss does not tell which of the two it is: those frames are status twin, not ok; "
+        "track the look-alike too, or track the object over the frames it is not beside it",
+    ),
     "W-VIDEO-SHORT": (
         "note",
         "the container's header counts more frames than the file holds: the file was cut, or its "

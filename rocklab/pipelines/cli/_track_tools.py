@@ -294,6 +294,13 @@ def _proposal_notes(props, window_s, frame_px) -> list:
                 "move together (a hand, its shadow); draw the object's own box with --object block_"
                 f"{k}=x,y,w,h (a large region also tracks slowly)"
             )
+    for k, b in enumerate(props.blocks, start=1):
+        if b in props.turning:
+            notes.append(
+                f"PROPOSED block_{k} is a disc turning on a pin: only its mark moves, its outline stays; check in "
+                "'rocklab track preview' that theta follows the mark (a small mark on a plain disc may not turn the "
+                f"region's registration), or draw a box round the mark with --object block_{k}=x,y,w,h"
+            )
     if props.table_edge is not None:
         e = props.table_edge
         what = (

@@ -233,6 +233,16 @@ def check_frames(res, expected: int, path, info=None, config=None) -> None:
     check_mirrored(info, path)
     _check_latch(res, path, config)
     for t in res.tracks:
+        twin = np.flatnonzero(t.status == "twin")
+        if twin.size:
+            warn(
+                "W-TRACK-TWIN",
+                f"{path}: object {t.object!r} found again beside a look-alike on {twin.size} frames from frame "
+                f"{t.frame[twin[0]]} (another match of its template as good, within its reach), and its motion "
+                "before the loss does not tell which is the object: those frames are status twin, not ok; "
+                "track the look-alike too, or track the object over the frames it is not beside it",
+            )
+    for t in res.tracks:
         lost = int(np.sum(~np.isin(t.status, ("ok", "interpolated"))))
         if lost > 0.01 * len(t.status):
             warn(

@@ -17,6 +17,11 @@ place in the samples (:func:`stays_in_place`): it is mostly still things round a
 first frame is the first of the film's scene: :func:`lead_in` finds blank, fading-in or title
 frames before it.
 
+Three movers are proposed as the object rather than as their change (:data:`LATE_SHARE`,
+:func:`turning_region`, :func:`without_intruder`): one that starts to move late in the window
+(a struck puck), a disc turning on a pin whose outline never moves (only its mark changes), and
+an object a hand reaching in from the frame's edge lets go of.
+
 The table is the long straight horizontal edge a block stands on: searched just below each
 proposal's bottom, on either side of it, and accepted only when
 :func:`~rocklab.tracking.video.targets._table_edge.table_top_edge` follows it over at least
@@ -146,6 +151,8 @@ class Proposals:
         Boxes round something that moves whose own content stays in place (:func:`stays_in_place`):
         the box, the share of the samples in which it did, its median correlation there. Not
         proposed: a tracker would follow the still things in them.
+    turning : tuple of (x, y, w, h)
+        The blocks that are discs turning on a pin (:func:`turning_region`): only their mark moves.
     camera : (float, float)
         :func:`camera_motion` of the frames compared: the share of consecutive pairs in which the
         whole picture moved, and the median motion (px); from :data:`CAMERA_SHARE` on nothing is
@@ -160,6 +167,7 @@ class Proposals:
     n_moving: int
     still: tuple = ()
     camera: tuple = (0.0, 0.0)
+    turning: tuple = ()
 
     @property
     def camera_moves(self) -> bool:
@@ -202,6 +210,92 @@ def _merge(boxes, joined):
     return boxes
 
 
+#: An object that starts to move late in the window (a puck at rest until another strikes it) has
+#: left its place in fewer than half the samples: a pixel changed in at least ``LATE_SHARE`` of
+#: them also moves when it changed in at least ``LATE_STAY`` of the samples from the first in
+#: which it changed (it left for good; an edge a late jitter of the picture shakes comes and goes).
+LATE_SHARE = 0.25
+LATE_STAY = 0.9
+#: Such a late mover is proposed only apart from the others (late pixels never join parts), at
+#: most this share of the frame, and
+#: when its first-frame look is found elsewhere in the last sample (it moved, the light did not
+#: change over it).
+LATE_FRACTION = 0.05
+
+
+def _moved_off(moving) -> tuple[np.ndarray, np.ndarray]:
+    """Pixels (bool, shape of a mask) that changed in at least :data:`MOVING_FRACTION` of the
+    masks ``moving`` (bool, in time order), and those that changed in :data:`LATE_SHARE` of them
+    and :data:`LATE_STAY` of those from the first in which they changed."""
+    stack = np.asarray(moving, dtype=bool)
+    n = stack.shape[0]
+    count = stack.sum(axis=0)
+    since = n - np.argmax(stack, axis=0)
+    return count >= MOVING_FRACTION * n, (count >= LATE_SHARE * n) & (count >= LATE_STAY * since)
+
+
+def _parts(mask, k, grad, floor) -> list:
+    """Boxes (x, y, w, h px) of the parts of ``mask`` (bool): gaps of ``k`` px closed, parts thinner
+    than :data:`THIN_PX`, smaller than :data:`MIN_FRACTION` or without outline or texture (95th
+    percentile of ``grad`` under ``floor``) dropped."""
+    import cv2
+
+    mask = cv2.morphologyEx(mask.astype(np.uint8), cv2.MORPH_OPEN, np.ones((3, 3), np.uint8))
+    mask = cv2.morphologyEx(mask, cv2.MORPH_CLOSE, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (k, k)))
+    # what is thinner than THIN_PX once the texture's gaps are closed is no object to track: a
+    # pendulum's string (it sweeps the wall, and merged with its bob it made the proposal a box
+    # from the pivot to the bob, mostly still wall)
+    mask = cv2.morphologyEx(mask, cv2.MORPH_OPEN, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (THIN_PX, THIN_PX)))
+    n, labels, stats, _ = cv2.connectedComponentsWithStats(mask, connectivity=8)
+    return [
+        tuple(stats[i, :4])
+        for i in range(1, n)
+        if stats[i, 4] >= MIN_FRACTION * mask.size and np.percentile(grad[labels == i], 95) >= floor
+    ]
+
+
+def _edges(img, box) -> float:
+    """Mean gradient magnitude of ``img`` (working grey) in ``box`` (working px): an object that
+    left its place shows a plainer background there than its own outline; one that came to
+    stand there (a cart pushed onto a bare track) shows more."""
+    import cv2
+
+    x, y, w, h = (int(v) for v in box)
+    a = img[y : y + h, x : x + w]
+    return float(np.mean(cv2.magnitude(cv2.Sobel(a, cv2.CV_32F, 1, 0), cv2.Sobel(a, cv2.CV_32F, 0, 1))))
+
+
+def _found_elsewhere(f0, last, box) -> bool:
+    """Whether the first frame's content of ``box`` (working px) is in ``last`` (working grey)
+    with a correlation of at least :data:`IN_PLACE_CC`, moved by at least half its smaller side."""
+    import cv2
+
+    x, y, w, h = (int(v) for v in box)
+    tmpl = f0[y : y + h, x : x + w]
+    if float(tmpl.std()) < 1e-3:
+        return False
+    _, cc, _, at = cv2.minMaxLoc(cv2.matchTemplate(last, tmpl, cv2.TM_CCOEFF_NORMED))
+    return cc >= IN_PLACE_CC and math.hypot(at[0] - x, at[1] - y) >= 0.5 * min(w, h)
+
+
+def _with_late(f0, last, main, both, gap) -> list:
+    """The parts ``main`` with the late movers: a part of ``both`` (main and late pixels) holding
+    no main part, more than ``gap`` px from every one, of at most :data:`LATE_FRACTION` of the
+    frame, whose first-frame look is found elsewhere in ``last`` and whose place there is plainer
+    than it was (:func:`_edges`: it left, nothing came); a part that grew round main parts stays
+    those parts: late pixels do not join things."""
+    late = [
+        u
+        for u in both
+        if not any(region_overlap(m, u)[0] > 0 for m in main)
+        and all(_box_gap(u, m) > gap for m in main)
+        and u[2] * u[3] <= LATE_FRACTION * f0.size
+        and _found_elsewhere(f0, last, u)
+        and _edges(f0, u) > _edges(last, u)
+    ]
+    return list(main) + late
+
+
 def moving_boxes(first_gray, samples, masks: bool = False) -> tuple[list, int]:
     """Boxes round what moves, where it is in the first frame.
 
@@ -242,22 +336,12 @@ def moving_boxes(first_gray, samples, masks: bool = False) -> tuple[list, int]:
         return moving, scale
     if not moving:
         return [], 0
-    mask = (np.mean(moving, axis=0) >= MOVING_FRACTION).astype(np.uint8)
+    main, late = _moved_off(moving)
     k = max(3, int(round(CLOSE_FRACTION * min(f0.shape))) | 1)
-    mask = cv2.morphologyEx(mask, cv2.MORPH_OPEN, np.ones((3, 3), np.uint8))
-    mask = cv2.morphologyEx(mask, cv2.MORPH_CLOSE, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (k, k)))
-    # what is thinner than THIN_PX once the texture's gaps are closed is no object to track: a
-    # pendulum's string (it sweeps the wall, and merged with its bob it made the proposal a box
-    # from the pivot to the bob, mostly still wall)
-    mask = cv2.morphologyEx(mask, cv2.MORPH_OPEN, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (THIN_PX, THIN_PX)))
-    n, labels, stats, _ = cv2.connectedComponentsWithStats(mask, connectivity=8)
     grad = cv2.magnitude(cv2.Sobel(f0, cv2.CV_32F, 1, 0), cv2.Sobel(f0, cv2.CV_32F, 0, 1))
     floor = MIN_STRUCTURE * (float(np.median(grad)) + 1e-3)
-    boxes = [
-        tuple(stats[i, :4])
-        for i in range(1, n)
-        if stats[i, 4] >= MIN_FRACTION * n_px and np.percentile(grad[labels == i], 95) >= floor
-    ]
+    boxes = _parts(main, k, grad, floor)
+    boxes = _with_late(f0, _prepare(samples[-1], scale), boxes, _parts(main | late, k, grad, floor), k)
     merged = []
     for m in _merge(boxes, lambda a, b: _box_gap(a, b) <= k):
         if m[2] * m[3] <= MAX_FRACTION * n_px:
@@ -273,6 +357,144 @@ def moving_boxes(first_gray, samples, masks: bool = False) -> tuple[list, int]:
             continue
         out.append(tuple(float(round(v)) for v in (x0, y0, x1 - x0, y1 - y0)))
     return sorted(out), len(moving)
+
+
+#: A mark turning on a disc: the mark moves, the disc's outline does not, so only the mark's
+#: first place is a proposal. Round a proposal, the first frame's region of one grey level (within
+#: ``TURN_GREY_DN`` of the grey just outside the proposal) is the object carrying it when that
+#: region is bounded (inside the frame, at most :data:`MAX_FRACTION` of it, at least
+#: ``TURN_AREA`` times the proposal), its outline stays in place (at most ``TURN_EDGE_MOVES`` of
+#: it changes), and what changes inside it keeps one distance from its centre (a mark turning
+#: round a pin there: the distances' quartiles within ``TURN_RING`` of their median, which is
+#: at least ``TURN_RADIUS`` of the region's radius). A block moving over a panel behind it fails
+#: the last test, a ball on a wall the first.
+TURN_GREY_DN = 14.0
+TURN_AREA = 6.0
+TURN_EDGE_MOVES = 0.2
+TURN_RING = 0.2
+TURN_RADIUS = 0.3
+
+
+def turning_region(first_gray, changed, scale, box):
+    """The box (x, y, w, h px, full frame) of the object a moving ``box`` turns on (a disc that a
+    mark turns with, its outline still), or None; see :data:`TURN_GREY_DN`. ``changed, scale``:
+    :func:`moving_boxes` with ``masks=True``."""
+    import cv2
+
+    if not changed:
+        return None
+    f0 = _prepare(first_gray, scale)
+    h, w = f0.shape
+    x, y, bw, bh = (int(round(v * scale)) for v in box)
+    pad = max(2, int(round(0.25 * max(bw, bh))))
+    x0, y0, x1, y1 = max(x - pad, 0), max(y - pad, 0), min(x + bw + pad, w), min(y + bh + pad, h)
+    ring = np.ones((y1 - y0, x1 - x0), bool)
+    ring[y - y0 : y - y0 + bh, x - x0 : x - x0 + bw] = False
+    grey = f0[y0:y1, x0:x1][ring]
+    if grey.size == 0:
+        return None
+    level = float(np.median(grey))
+    vs, us = np.nonzero(ring & (np.abs(f0[y0:y1, x0:x1] - level) <= 2.0))
+    if not vs.size:
+        return None
+    mask = np.zeros((h + 2, w + 2), np.uint8)
+    flags = 8 | cv2.FLOODFILL_FIXED_RANGE | cv2.FLOODFILL_MASK_ONLY | (1 << 8)
+    cv2.floodFill(f0.copy(), mask, (int(us[0] + x0), int(vs[0] + y0)), 0, TURN_GREY_DN, TURN_GREY_DN, flags)
+    region = mask[1:-1, 1:-1]
+    cnts, _ = cv2.findContours(region, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)
+    if not cnts:
+        return None
+    c = max(cnts, key=cv2.contourArea)
+    filled = np.zeros_like(region)
+    cv2.drawContours(filled, [c], -1, 1, -1)
+    rx, ry, rw, rh = cv2.boundingRect(c)
+    area = float(filled.sum())
+    if rx == 0 or ry == 0 or rx + rw == w or ry + rh == h or not TURN_AREA * bw * bh <= area <= MAX_FRACTION * h * w:
+        return None
+    if not (rx <= x and ry <= y and x + bw <= rx + rw and y + bh <= ry + rh):
+        return None
+    moved = np.logical_or(*_moved_off(changed))
+    edge = c.reshape(-1, 2)
+    if float(moved[edge[:, 1], edge[:, 0]].mean()) > TURN_EDGE_MOVES:
+        return None
+    # inside, away from the outline (it may wobble a little as the disc turns)
+    k = max(3, int(round(0.1 * math.sqrt(area))))
+    inner = cv2.erode(filled, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (k, k))).astype(bool)
+    vv, uu = np.nonzero(np.any(changed, axis=0) & inner)
+    if vv.size < 0.5 * bw * bh:
+        return None
+    m = cv2.moments(filled, binaryImage=True)
+    cx, cy = m["m10"] / m["m00"], m["m01"] / m["m00"]
+    r = np.hypot(uu - cx, vv - cy)
+    q1, med, q3 = np.percentile(r, [25, 50, 75])
+    if med < TURN_RADIUS * math.sqrt(area / math.pi) or max(med - q1, q3 - med) > TURN_RING * med:
+        return None
+    H, W = first_gray.shape[:2]
+    bx0, by0 = max(0.0, (rx - 1) / scale), max(0.0, (ry - 1) / scale)
+    bx1, by1 = min(float(W), (rx + rw + 1) / scale), min(float(H), (ry + rh + 1) / scale)
+    return tuple(float(round(v)) for v in (bx0, by0, bx1 - bx0, by1 - by0))
+
+
+#: A proposal that reaches the frame's edge may hold a hand or an arm reaching in with the object
+#: (it releases it, then leaves the frame). Late in the window, between samples ``LEFT_LAG`` apart,
+#: what still moves and is clear of the frame's edge is the object; its look there, found in the
+#: first frame inside the proposal with a normalised correlation of at least ``LEFT_CC``, is the
+#: proposal instead, when that is at most ``LEFT_AREA`` of the proposal's area.
+LEFT_LAG = 3
+LEFT_CC = 0.6
+LEFT_AREA = 0.8
+#: ... and at least this share of it (the object is no speck of the proposal: a corner of a puck
+#: the frame's edge cuts is no object let go of).
+LEFT_MIN_AREA = 0.15
+
+
+def touches_edge(box, shape) -> bool:
+    """Whether ``box`` (x, y, w, h px) reaches an edge of a frame of ``shape`` (H, W)."""
+    x, y, w, h = box
+    return x <= 0 or y <= 0 or x + w >= shape[1] or y + h >= shape[0]
+
+
+def without_intruder(first_gray, samples, box):
+    """``box`` without the hand or arm that reaches into it from the frame's edge (the object
+    alone, where it is in the first frame), or None; see :data:`LEFT_LAG`."""
+    import cv2
+
+    scale = min(1.0, WORK_WIDTH_PX / first_gray.shape[1])
+    f0 = _prepare(first_gray, scale)
+    h, w = f0.shape
+    bx, by, bw, bh = (v * scale for v in box)
+    prep = [_prepare(s, scale) for s in samples]
+    k_close = max(3, int(round(CLOSE_FRACTION * min(h, w))) | 1)
+    for k in range(len(prep) - 1, max(LEFT_LAG, len(prep) // 2) - 1, -1):
+        d = prep[k] - prep[k - LEFT_LAG]
+        d = np.abs(d - float(np.median(d)))
+        thr = max(DIFF_SIGMAS * float(np.median(d)) / 0.954, MIN_DIFF_DN)
+        m = cv2.morphologyEx((d > thr).astype(np.uint8), cv2.MORPH_OPEN, np.ones((3, 3), np.uint8))
+        m = cv2.morphologyEx(m, cv2.MORPH_CLOSE, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (k_close, k_close)))
+        n, _, stats, _ = cv2.connectedComponentsWithStats(m, connectivity=8)
+        parts = [
+            tuple(int(v) for v in stats[i, :4])
+            for i in range(1, n)
+            if stats[i, 4] >= MIN_FRACTION * h * w
+            and min(stats[i, 2], stats[i, 3]) >= 2 * THIN_PX
+            and not touches_edge(stats[i, :4], (h, w))
+        ]
+        if not parts:
+            continue
+        px, py, pw, ph = min(parts, key=lambda p: _box_gap(p, (bx, by, bw, bh)))
+        tmpl = prep[k][py : py + ph, px : px + pw]
+        u0, v0 = int(max(bx - pw // 2, 0)), int(max(by - ph // 2, 0))
+        area = f0[v0 : int(min(by + bh + ph // 2, h)), u0 : int(min(bx + bw + pw // 2, w))]
+        if area.shape[0] < ph or area.shape[1] < pw or float(tmpl.std()) < 1e-3:
+            return None
+        _, cc, _, at = cv2.minMaxLoc(cv2.matchTemplate(area, tmpl, cv2.TM_CCOEFF_NORMED))
+        found = (at[0] + u0, at[1] + v0, pw, ph)
+        if cc < LEFT_CC or not LEFT_MIN_AREA * bw * bh <= pw * ph <= LEFT_AREA * bw * bh:
+            return None
+        if region_overlap(found, (bx, by, bw, bh))[0] < 0.9 * pw * ph:
+            return None  # not the object let go of: that is inside the proposal
+        return tuple(float(round(v / scale)) for v in found)
+    return None
 
 
 #: A box "stays in place" when the first frame's content of it matches a sample best within
@@ -394,6 +616,27 @@ def camera_motion(frames) -> tuple[float, float]:
     return float(np.sum(moved)) / n_pairs, float(np.median(shift)) if shift else 0.0
 
 
+def _refine(first_gray, samples, boxes) -> tuple[list, list]:
+    """Each moving box as the object it belongs to: (boxes, turning objects). A mark's box becomes
+    the disc it turns on (:func:`turning_region`), a box reaching the frame's edge the object a
+    hand reaching in let go of (:func:`without_intruder`); boxes inside a turning object are part
+    of it."""
+    if not boxes:
+        return boxes, []
+    changed, scale = moving_boxes(first_gray, samples, masks=True)
+    out, turners = [], []
+    for b in boxes:
+        t = turning_region(first_gray, changed, scale, b)
+        if t is not None:
+            turners.append(t)
+            continue
+        if touches_edge(b, first_gray.shape[:2]):
+            b = without_intruder(first_gray, samples, b) or b
+        out.append(b)
+    inside = [b for b in out if any(region_overlap(b, t)[0] >= 0.5 * b[2] * b[3] for t in turners)]
+    return [b for b in out if b not in inside], _merge(turners, lambda a, b: region_overlap(a, b)[1])
+
+
 def propose_objects(first_gray, samples) -> Proposals:
     """Blocks (what moves) and the table (the edge they stand on) from the first frame and later
     samples; see the module docstring.
@@ -411,11 +654,13 @@ def propose_objects(first_gray, samples) -> Proposals:
     if share >= CAMERA_SHARE:  # every pixel moves with the camera: what differs is no object
         return Proposals((), None, None, False, len(samples), 0, camera=(share, shift))
     boxes, n_moving = moving_boxes(first_gray, samples)
+    boxes, turners = _refine(first_gray, samples, boxes)
     # a box round something that moves but mostly of still things is no object to track: the
-    # tracker follows the still things (a stand, the wall), and reports a still "object" as ok
+    # tracker follows the still things (a stand, the wall), and reports a still "object" as ok.
+    # A turning disc stays in place by its outline, and is the object.
     verdicts = [stays_in_place(first_gray, samples, b) for b in boxes]
     still = tuple((b, share, cc) for b, (yes, share, cc) in zip(boxes, verdicts) if yes)
-    boxes = [b for b, v in zip(boxes, verdicts) if not v[0]]
+    boxes = sorted([b for b, v in zip(boxes, verdicts) if not v[0]] + turners)
     table = edge = None
     moves = False
     for b in boxes:
@@ -452,4 +697,5 @@ def propose_objects(first_gray, samples) -> Proposals:
             for b in boxes
             if not region_overlap(b, table)[1] or table[1] - b[1] >= MIN_SIDE_PX
         ]
-    return Proposals(tuple(boxes), table, edge, moves, len(samples), n_moving, still)
+    turning = tuple(b for b in boxes if b in turners)
+    return Proposals(tuple(boxes), table, edge, moves, len(samples), n_moving, still, turning=turning)

@@ -451,7 +451,7 @@ def assemble_tracks(
     frames = np.array(sorted({r.frame for r in rows}), int)
     pos = {f: i for i, f in enumerate(frames)}
     n = len(frames)
-    raw = {o.id: _object_series(by[o.id], pos, n) for o in config.objects}
+    raw = {o.id: _object_series(by[o.id], pos, n, _shift_warning(config, o.id, frames)) for o in config.objects}
     unseen = [o.id for o in config.objects if not np.any(raw[o.id][1] == "ok")]
     if len(unseen) == len(config.objects) or (unseen and n > 1):
         o = unseen[0]
@@ -520,11 +520,19 @@ def assemble_tracks(
     )
 
 
-def _object_series(rows, pos, n):
+def _step_kept(th0: float, th1: float, th2: float) -> bool:
+    """Whether an angle that stepped from ``th0`` to ``th1`` (rad) stays stepped at ``th2``, the next
+    measured angle: nearer ``th1`` than ``th0`` (a misfit frame alone comes back)."""
+    return abs(math.remainder(th2 - th1, 2 * math.pi)) < abs(math.remainder(th2 - th0, 2 * math.pi))
+
+
+def _object_series(rows, pos, n, on_shift=None):
     """One object's observations laid on the frames (``pos``: frame -> row of ``n``).
 
     Returns ({"X", "Y", "th", "sig", "scale", "q"}: arrays (n,), NaN where not measured; statuses (n,);
-    whether a measured frame is in metres). An angle step no rocking block makes marks an outlier.
+    whether a measured frame is in metres). An angle step no rocking block makes marks an outlier;
+    when the angles after it go on from the step (:func:`_step_kept`), every angle from that frame on
+    is NaN and ``on_shift(index, ok frames from there)`` is called.
     """
     a = {k: np.full(n, np.nan) for k in ("X", "Y", "th", "sig", "scale", "q")}
     st = np.full(n, "lost", dtype=object)
@@ -542,13 +550,40 @@ def _object_series(rows, pos, n):
     if np.isnan(th[okk[~dropped[okk]]]).any():  # found unmeasurable on the way: no frame's angle is measured
         th[:], a["sig"][:] = np.nan, np.nan
     # An angle step no rocking block makes between frames is a misdetection, not motion.
-    for j0, j1 in zip(okk[:-1], okk[1:]):
+    shift = None
+    for j0, j1, j2 in zip(okk[:-1], okk[1:], list(okk[2:]) + [None]):
         if j1 - j0 == 1 and abs(math.remainder(th[j1] - th[j0], 2 * math.pi)) > MAX_STEP_RAD:
+            back = st[j0] != "ok"  # the step back from a lone misfit frame
             st[j1] = "outlier"
+            if shift is None and not back and j2 is not None and _step_kept(th[j0], th[j1], th[j2]):
+                shift = j1
+    if shift is not None:
+        # the frames after the step go on from it: one side of it is not the object's angle, and
+        # which the track cannot tell (a registration that settled a turn off); no angle from there
+        a["th"][shift:], a["sig"][shift:] = np.nan, np.nan
+        if on_shift is not None:
+            on_shift(shift, int(np.sum(st[shift:] == "ok")))
     bad = st != "ok"
     for k in ("X", "Y", "th", "sig"):
         a[k][bad] = np.nan
     return a, st, metric
+
+
+def _shift_warning(config, oid: str, frames):
+    """The ``on_shift`` of :func:`_object_series` for object ``oid``: W-TRACK-THETA naming the frame."""
+
+    def said(i: int, n_ok: int) -> None:
+        warn(
+            "W-TRACK-THETA",
+            f"{config.source or 'config'}: object {oid!r}: its angle steps by more than "
+            f"{math.degrees(MAX_STEP_RAD):.0f} deg between frames {frames[i] - 1} and {frames[i]} and the "
+            f"frames after go on from the step: the angle on one side of it is not the object's (a "
+            f"registration that settled a turn off); theta_rad is NaN from frame {frames[i]} on ({n_ok} ok "
+            "frames), x and y are tracked; draw the region round the object alone, or round a part that "
+            "shows the turn",
+        )
+
+    return said
 
 
 def _metres_per_unit(config, raw, metric_plane) -> dict:

@@ -44,6 +44,7 @@ from ._detection import Detection
 from ._ic import ICAffine, ICRigid
 from ._observability import MAX_UNMATCHED_TURN, cell_turn_info, sigma_theta, theta_unobservable, unmatched_turn_share
 from ._occlusion import CELL_CC, GRID, ROUND_MIN, cell_correlations, masked_fit, partly_covered
+from ._twins import TwinGuard
 from ._verify import PoseVerifier, best_turned_match
 
 __all__ = ["MarkerlessTracker", "MarkerlessDetector", "MIN_CC", "REKEY_CC", "ROUND_MIN"]
@@ -183,10 +184,11 @@ class MarkerlessTracker:
         self.centre0 = self.origin + np.array(self.size, float) / 2  # template centre, first-frame px
         self.verifier = PoseVerifier(first_gray, (u0, v0, u1, v1), self.size)
         self.verifier.check_turn = self.theta_note is None
+        self.twins = TwinGuard(self.size)  # the last verified frames, against a look-alike found instead
         #: why the angle is not reported although the texture gives one (a round outline), or None
         self.round_note = None
         self.views = [0, 0]  # verified frames, and those not a turned copy of the first view
-        self.reason = None  # why the last frame was lost ("mismatch", "jump", "background", "lost")
+        self.reason = None  # why the last frame was lost ("mismatch", "jump", "background", "twin", "lost")
         self.min_cc = MIN_CC
         self._turn_info: tuple = (None, None)  # (template, its cells' turning information)
         #: verified frames, and those whose angle was not a measurement (:meth:`_angle_unmatched`)
@@ -391,6 +393,28 @@ class MarkerlessTracker:
         alt = (self._held(alt[0]), alt[1])
         return alt if self.verifier.verify(self, gray, alt[0], frame, alt[1]) is None else None
 
+    def _twin_check(self, gray, frame, fit):
+        """The verified fit ``(W, cc)`` of a frame found again after lost frames, judged against a
+        look-alike (:class:`._twins.TwinGuard`): ``fit`` itself, the look-alike's match fitted and
+        verified in its place when continuity says that is the object, or None (cannot tell)."""
+        W = fit[0]
+        found = W[:, :2].astype(float) @ self.centre0 + W[:, 2]
+        verdict, rival = self.twins.judge(self.key, gray, frame, found, MIN_CC)
+        if verdict == "keep":
+            return fit
+        if verdict == "swap":
+            _, c, th = rival
+            R = np.array([[math.cos(th), -math.sin(th)], [math.sin(th), math.cos(th)]])
+            t = c - R @ self.centre0
+            alt = self._ecc(self.key, gray, _euclid(th, t[0], t[1]))
+            if alt is not None and alt[1] >= MIN_CC:
+                alt = (self._held(alt[0]), alt[1])
+                at = alt[0][:, :2].astype(float) @ self.centre0 + alt[0][:, 2]
+                near = np.hypot(*(at - c)) < 0.25 * max(self.size)
+                if near and self.verifier.verify(self, gray, alt[0], frame, alt[1]) is None:
+                    return alt
+        return None
+
     def _round_check(self, first_view):
         """Sets :attr:`round_note` once the outline is known to be round and the region is no
         longer a turned copy of its first view on :data:`OTHER_VIEW_SHARE` of the verified frames
@@ -491,6 +515,14 @@ class MarkerlessTracker:
             if alt is not None:
                 fit, tmpl, mask, visible, self.reason = (self._held(alt[0]), alt[1]), self.key, None, 1.0, None
             self.reason = self.reason or (None if fit is not None and fit[1] >= MIN_CC else "lost")
+        if self.reason is None and not self.poses and self.last is not None:
+            # found again after lost frames: a look-alike beside it (identical pucks) is told apart by
+            # continuity, or the frame is not trusted
+            twin = self._twin_check(gray, frame, fit)
+            if twin is None:
+                self.reason = "twin"
+            elif twin is not fit:
+                fit, tmpl, mask, visible = twin, self.key, None, 1.0
         if self.reason is not None:
             if self.reason == "drift":  # the keyframe learned the slide
                 self.key, self.key_sigma_rad = self.tmpl0, 0.0
@@ -503,6 +535,7 @@ class MarkerlessTracker:
         self._round_check(first_view)
         (W, cc), mask, visible, why, sig = self._settle(tmpl, gray, fit, mask, visible)
         self.poses = (self.poses + [self._centred(W)])[-2:]
+        self.twins.remember(frame, gray, W[:, :2].astype(float) @ self.centre0 + W[:, 2])
         pts = (self.grid + self.origin) @ W[:, :2].T.astype(float) + W[:, 2]
         at = self.verifier.disk_at
         if at is not None and mask is None:

@@ -201,3 +201,25 @@ def test_a_cut_file_loses_its_tail_not_frames_the_camera_dropped(tmp_path):
     got = [(i, _read_number(g)) for i, g in iter_video_frames(cut)]
     # every frame read shows its own slot's number: the frame index is its slot among the frames
     assert all(int(slots[i]) == k for i, k in got)
+
+
+def test_avi_frame_the_camera_dropped_keeps_the_times_true(tmp_path):
+    """An AVI with slot 7 left empty (FFmpeg's muxer writes the gap in its chunk numbers): the
+    frames are counted as decoded (frame 7 shows picture 8) and each is timed at its own slot,
+    the gap a dropped frame."""
+    path = tmp_path / "drop.avi"
+    with av.open(str(path), "w", format="avi") as c:
+        s = c.add_stream("mjpeg", rate=FPS)
+        s.width, s.height, s.pix_fmt = 128, 64, "yuvj420p"
+        for k in np.delete(np.arange(20), 7):
+            f = av.VideoFrame.from_ndarray(_numbered(int(k)), format="rgb24")
+            f.pts, f.time_base = int(k), 1 / FPS
+            for p in s.encode(f):
+                c.mux(p)
+        for p in s.encode():
+            c.mux(p)
+    info = probe_video(path)
+    assert info.n_frames == 19 and info.n_dropped == 1
+    shown = [_read_number(g) for _, g in iter_video_frames(path)]
+    assert shown == [k for k in range(20) if k != 7]
+    np.testing.assert_allclose(info.frame_times_s * float(FPS), shown, rtol=0, atol=1e-9)

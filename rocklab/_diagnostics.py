@@ -228,6 +228,12 @@ WARNING_CODES: dict[str, tuple[str, str]] = {
         "frames the container holds did not decode (damaged packets): the frames around them are "
         "measured at their own times, the gaps are in t_s; check the copy of the file",
     ),
+    "W-VIDEO-COUNT": (
+        "suspect",
+        "the reader delivered frames past the ones the container's times cover (a container whose "
+        "count or times are wrong): those frames are timed at the frame rate after the last "
+        "known time; check the film (convert it to .mkv/.mp4 with ffmpeg) or give --fps",
+    ),
     "W-VIDEO-FPS": (
         "suspect",
         "a frame rate given in the config or with --fps contradicts the container's own clock: "

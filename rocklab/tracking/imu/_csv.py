@@ -163,8 +163,9 @@ def inertial_columns(df, path: Path) -> dict[str, tuple[str, float]]:
     if missing:
         names = ", ".join(("Gyroscope " if r.startswith("gyro") else "Accelerometer ") + r[-1].upper() for r in missing)
         raise InputError(
-            f"{where(path, 1)}missing columns {names}; expected x-io headers "
-            "like 'Gyroscope X (deg/s)', 'Accelerometer X (g)' or pass a mapping"
+            f"{where(path, 1)}missing columns {names}; rename the header's columns to x-io's "
+            "'Gyroscope X (deg/s)' ... 'Accelerometer Z (g)' (with 'Time (s)'), or from Python read it "
+            "with rocklab.tracking.imu.read_imu(path, mapping={column: 'role:unit'})"
         )
     return found
 

@@ -146,7 +146,7 @@ def _read_timed(path: Path, rate_hz, full_scale_g, mapping) -> ImuLog:
         if tcol is None and rate_hz is None:
             raise InputError(
                 f"{where(path, 1)}no 'Time (s)' column and no rate; add the "
-                "column, pass a mapping, or give the rate with --rate / rate_hz="
+                "column 'Time (s)', or give the rate with --rate (read_imu(..., rate_hz=) from Python)"
             )
     gyro, acc = stack(df, cols, path)
     if tcol is None:

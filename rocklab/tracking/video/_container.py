@@ -22,6 +22,7 @@ __all__ = [
     "container_info",
     "frame_clock",
     "shown_pts",
+    "frame_pts",
     "frame_orientation",
     "orient",
     "UPRIGHT",
@@ -37,6 +38,10 @@ _FIELD_ORDER = {2: "tff", 4: "tff", 3: "bff", 5: "bff"}
 #: A constant clock must place at least this share of the intervals in one slot each; a file
 #: whose frames skip slots more often is variable-rate, not a constant rate with dropped frames.
 MIN_SINGLE_STEPS = 0.9
+#: Containers whose packet times are not presentation times: AVI numbers its chunks in decode
+#: order (FFmpeg's pts there is the chunk's number), so with B-frames a decoded frame's pts is
+#: the number of the chunk it was coded in, not its place on screen.
+_UNTIMED_FORMATS = frozenset({"avi"})
 
 
 @dataclass(frozen=True)
@@ -63,6 +68,10 @@ class ContainerInfo:
     pts : ndarray (n,) of int64 or None
         The packets' presentation times in stream ticks, sorted: a decoded frame's index is its
         place here.
+    timed : bool
+        The packets' times are the frames' presentation times, so a decoded frame is placed by
+        its pts (False: AVI, or packets without pts or with the same pts twice; the n-th frame
+        decoded is frame n, its time n / rate).
     orientation : tuple of 4 int
         The first frame's display matrix as a signed permutation (:func:`frame_orientation`).
     stored_size_px : tuple (width, height) or None
@@ -77,6 +86,7 @@ class ContainerInfo:
     n_dropped: int = 0
     n_header: int = 0
     pts: np.ndarray | None = None
+    timed: bool = True
     orientation: tuple = UPRIGHT
     stored_size_px: tuple | None = None
 
@@ -155,6 +165,28 @@ def _shown(packet) -> bool:
 def shown_pts(container, stream) -> np.ndarray:
     """The presentation times (stream ticks, sorted) of the frames a film shows, from its packets."""
     return np.sort(np.asarray([p.pts for p in container.demux(stream) if _shown(p)], np.int64))
+
+
+def pts_timed(format_name: str, pts, n_pictures: int) -> bool:
+    """Whether packet times ``pts`` (one per picture packet that has one, ``n_pictures`` such
+    packets) are presentation times a decoded frame can be placed by: not in an AVI (its pts
+    number the chunks in decode order), every picture timed, no time given twice."""
+    if set(str(format_name or "").split(",")) & _UNTIMED_FORMATS:
+        return False
+    return len(pts) == n_pictures and len(np.unique(np.asarray(pts, np.int64))) == len(pts)
+
+
+def frame_pts(container, stream) -> tuple[np.ndarray, bool]:
+    """The sorted packet times (stream ticks) of the frames a film shows, and whether a decoded
+    frame can be placed by its pts among them (:func:`pts_timed`)."""
+    pts, n = [], 0
+    for p in container.demux(stream):
+        if p.size and not getattr(p, "is_discard", False):
+            n += 1
+            if p.pts is not None:
+                pts.append(p.pts)
+    q = np.sort(np.asarray(pts, np.int64))
+    return q, pts_timed(container.format.name, q, n)
 
 
 def frame_orientation(frame) -> tuple[int, int, int, int]:
@@ -242,18 +274,22 @@ def container_info(path) -> ContainerInfo:
             rates = [s.average_rate, s.guessed_rate]
             n_header = int(s.frames or 0)
             duration_s = float(c.duration) / 1e6 if c.duration else 0.0
-            pts, first = [], None
+            fmt = c.format.name
+            pts, dts, n_pictures, first, broke = [], [], 0, None, False
             try:
                 for p in c.demux(s):
+                    if p.size and not getattr(p, "is_discard", False):
+                        n_pictures += 1
                     if _shown(p):
                         pts.append(p.pts)
+                        dts.append(p.pts if p.dts is None else p.dts)
                     if first is None and p.size:  # decode only until the first picture appears
                         try:
                             first = next(iter(p.decode()), None)
                         except av.error.FFmpegError:
                             pass
             except av.error.FFmpegError:  # damaged tail: the packets read so far stand
-                pass
+                broke = True
             fo = int(s.codec_context.field_order or 0)
     except Exception:  # noqa: BLE001 - PyAV raises many types; rate, square pixels stay the fallback
         return ContainerInfo()
@@ -262,15 +298,37 @@ def container_info(path) -> ContainerInfo:
     ori = frame_orientation(first) if first is not None else UPRIGHT
     rot = rotation_deg(ori)
     size = (int(first.width), int(first.height)) if first is not None else None
-    if not pts or tb is None:
-        return ContainerInfo(None, aspect, order, rot, n_header=n_header, orientation=ori, stored_size_px=size)
+    timed = pts_timed(fmt, pts, n_pictures)
+    if not pts or tb is None or not (timed or len(pts) == n_pictures == len(set(pts))):
+        # no times a frame can be placed by (raw streams, duplicated pts): counted, not timed
+        return ContainerInfo(
+            None, aspect, order, rot, n_header=n_header, timed=False, orientation=ori, stored_size_px=size
+        )
+    # an AVI's pts number its chunks: an empty chunk (a frame the camera dropped) leaves a gap
     q = np.sort(np.asarray(pts, np.int64))
     times, rate, dropped = frame_clock((q - q[0]) * float(tb), float(tb), rates)
     if not n_header and duration_s and rate:
         # Matroska and WebM count no frames but state the duration at the file's start: a file
         # cut short still claims its whole length
         n_header = int(round(duration_s * rate))
-    return ContainerInfo(times, aspect, order, rot, rate, dropped, n_header, q, ori, size)
+    if dropped and (broke or len(q) < n_header):
+        dropped -= _cut_slots(
+            times, rate, (max(dts) + min(int(a) - int(b) for a, b in zip(pts, dts)) - q[0]) * float(tb)
+        )
+    return ContainerInfo(times, aspect, order, rot, rate, max(dropped, 0), n_header, q, timed, ori, size)
+
+
+def _cut_slots(times_s: np.ndarray, rate_hz: float | None, t_cut_s: float) -> int:
+    """Empty slots of the clock after ``t_cut_s`` (the earliest time a frame coded after the last
+    packet read can be shown): in a file cut short these are frames lost with its tail (the
+    B-frames between the last pictures read), not frames the camera dropped."""
+    if not rate_hz:
+        return 0
+    k = np.rint(np.asarray(times_s) * rate_hz).astype(np.int64)
+    k_cut = max(int(np.ceil(t_cut_s * rate_hz - 1e-6)), 0)
+    if k_cut > k[-1]:
+        return 0
+    return int(k[-1] - k_cut + 1 - np.count_nonzero(k >= k_cut))
 
 
 def why_unopenable(p) -> str:

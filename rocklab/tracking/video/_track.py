@@ -470,6 +470,7 @@ def assemble_tracks(
 
     level, level_src, level_sig = level_from_reference(config, raw, fps, metric_plane, pm_px)
     c, s = math.cos(-level), math.sin(-level)
+    t_all = frame_times(frames, frame_times_s, fps, source)
     tracks = []
     for o in config.objects:
         a, st, _ = raw[o.id]
@@ -485,7 +486,7 @@ def assemble_tracks(
             u = v = np.full(n, np.nan)
         if config.motion.interpolate_max_gap_frames:
             interpolate([x, y, th, u, v], st, config.motion.interpolate_max_gap_frames)
-        t_s = np.asarray(frame_times_s, float)[frames] if frame_times_s is not None else frames / float(fps)
+        t_s = t_all
         tracks.append(
             ObjectTrack(
                 o.id,
@@ -712,6 +713,32 @@ def track_video(
     expected = (min(stop, n_expected) if stop else n_expected) - start
     check_frames(res, expected, path, info, config)
     return apply_corrections(res, fixes) if fixes else res  # the config's hand fixes
+
+
+def frame_times(frames: np.ndarray, frame_times_s, fps: float, source=None) -> np.ndarray:
+    """Each frame's time, s: the container's own (``frame_times_s``, indexed by frame number),
+    else ``frames / fps``.
+
+    A frame numbered past the container's times (a reader and a container that disagree on the
+    count) is timed at ``fps`` after the last known time, with W-VIDEO-COUNT: a warning, never an
+    index error.
+    """
+    frames = np.asarray(frames, int)
+    if frame_times_s is None:
+        return frames / float(fps)
+    t = np.asarray(frame_times_s, float)
+    over = frames >= len(t)
+    if not np.any(over):
+        return t[frames]
+    last = float(t[-1]) if len(t) else -1.0 / float(fps)
+    out = np.where(over, last + (frames - (len(t) - 1)) / float(fps), t[np.minimum(frames, max(len(t) - 1, 0))])
+    warn(
+        "W-VIDEO-COUNT",
+        f"{source or 'video'}: {int(np.sum(over))} frame(s) read past the {len(t)} the container's times "
+        f"cover (frame {int(frames[over][0])} on); they are timed at {float(fps):.6g} frames/s after "
+        "the last known time; check the film (convert it to .mkv/.mp4 with ffmpeg) or give --fps",
+    )
+    return out
 
 
 def _check_regions(config, info, path) -> None:

@@ -14,7 +14,9 @@ rows, so a rocking block is sampled at 50 Hz without combing.
 Frames are decoded with PyAV (OpenCV only where PyAV cannot open the file, e.g. image
 sequences), shown as the display matrix says (turned, and mirrored), each frame indexed by its
 packet: a packet that does not decode is skipped and counted, the frames after it keep their
-places and times. Decoding runs in a background thread (FFmpeg releases the GIL) so it overlaps
+places and times. Where the packets' times are not presentation times (an AVI numbers its
+chunks in decode order, so with B-frames a frame's pts is not its place; packets without a pts
+or with one pts twice) the n-th frame decoded is frame n. Decoding runs in a background thread (FFmpeg releases the GIL) so it overlaps
 with detection on a second core.
 """
 
@@ -30,7 +32,7 @@ from pathlib import Path
 import numpy as np
 
 from ..._errors import InputError
-from ._container import UPRIGHT, container_info, why_unopenable, frame_orientation, luma, orient, shown_pts
+from ._container import UPRIGHT, container_info, frame_orientation, frame_pts, luma, orient, why_unopenable
 from .sequences import FrameStoreReader, frame_store
 
 __all__ = ["VideoInfo", "probe_video", "iter_video_frames", "container_info"]
@@ -222,7 +224,8 @@ class _PyAVReader:
     Pictures are BGR, or grey straight from the luma plane with ``gray`` (no colour conversion:
     a third of OpenCV's decoding time at 1080p), as stored: ``orientation`` is the last frame's
     display matrix (:func:`._container.orient` shows it upright, after the pixels are made square).
-    Every frame is placed by its presentation time among the packets':
+    Every frame is placed by its presentation time among the packets' where these are
+    presentation times (:func:`._container.pts_timed`; else the n-th frame decoded is frame n):
     ``index`` is the last frame's place, so a packet that fails to decode (counted in
     ``n_broken``) leaves a gap instead of shifting the frames after it, and so does every frame
     predicted from it up to the next key frame. A start past frame 0
@@ -244,7 +247,7 @@ class _PyAVReader:
         # decode included, six runs of 480 frames each: 106-138 frames/s; FFmpeg's automatic
         # frame + slice threads 100-126, slices alone 86-101)
         s = self._c.streams.video[0]
-        self._pts = shown_pts(self._c, s)
+        self._pts, self._timed = frame_pts(self._c, s)
         self._c.seek(0, stream=s)
         s.thread_type, s.thread_count = "FRAME", 4
         self._it = self._decode(int(first))
@@ -269,6 +272,8 @@ class _PyAVReader:
                 frames = p.decode()
             except av.error.FFmpegError:
                 self.n_broken += 1
+                if not self._timed:  # no frame can be placed by its time: the loss is counted
+                    continue
                 # the damage may begin inside a packet before, which decoded without complaint
                 # (concealed); with frame threads the error surfaces a few packets late
                 at = [int(np.searchsorted(self._pts, q)) for q in (p.pts, *recent) if q is not None]
@@ -294,6 +299,9 @@ class _PyAVReader:
         c = self._c
         s = c.streams.video[0]
         pts = self._pts
+        if first > 0 and not self._timed:  # frames found by counting them from the start
+            yield from self._counted(first)
+            return
         if first > 0:
             if first >= len(pts):
                 return
@@ -306,21 +314,26 @@ class _PyAVReader:
                     yield f
                     yield from frames
                     return
-            c.seek(0, stream=s)
-            frames = self._frames()
-            self.index = -1
-            for _ in range(first):
-                if next(frames, None) is None:
-                    return
-                self.index += 1
-            yield from frames
+            yield from self._counted(first)
             return
         yield from self._frames()
+
+    def _counted(self, first: int):
+        """The frames from the ``first``-th decoded on, decoding from the start."""
+        s = self._c.streams.video[0]
+        self._c.seek(0, stream=s)
+        frames = self._frames()
+        self.index = -1
+        for _ in range(first):
+            if next(frames, None) is None:
+                return
+            self.index += 1
+        yield from frames
 
     def _place(self, f) -> int:
         """The frame's index: its packet's place by presentation time, else the next one."""
         nxt = self.index + 1
-        if f.pts is None or not len(self._pts):
+        if not self._timed or f.pts is None or not len(self._pts):
             return nxt
         k = int(np.searchsorted(self._pts, f.pts))
         return k if k >= nxt and k < len(self._pts) and self._pts[k] == f.pts else nxt

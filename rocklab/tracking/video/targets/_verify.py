@@ -25,10 +25,16 @@ and, for the outline, its own first frame:
   from a verified frame in which the object has left it, or, sooner, from the median of the
   frames in which the object was lost (:data:`LOST_SAMPLES`), once the object's template
   registers nowhere in that median (the object has gone from its first place: a bob hanging
-  still before it was shot off would otherwise make its own empty place look like the object);
+  still before it was shot off would otherwise make its own empty place look like the object),
+  and learned again from every later such median until a verified frame shows it (an object
+  that slides off slowly is lost while it still covers part of its place: the first median
+  holds it, and the empty place then passes against it);
   and the patch must not be what the latest scene snapshot taken while the object stood
   elsewhere showed there (one every :data:`SNAP_FRAMES` verified frames): a pose left on the
-  object's empty start place, whose look the keyframe learned, matches its keyframe at 0.998;
+  object's empty start place, whose look the keyframe learned, matches its keyframe at 0.998.
+  After lost frames the object's first view, not the keyframe, must explain the patch better
+  than that snapshot does: a keyframe renewed while the object tipped over a marker finds the
+  marker 170 frames later at 0.82, above the snapshot's 0.70 under a changed exposure;
 * **outline** (``drift``): once the background behind the object's first region is known, the
   object's silhouette against it, registered round the pose (:mod:`._occlusion`), must lie where
   the pose puts it, within :data:`._occlusion.DRIFT_FRAC` of the template: a spinning object's
@@ -160,6 +166,9 @@ class PoseVerifier:
         #: verified frames: what the scene shows where the object was not
         self.snaps: collections.deque = collections.deque(maxlen=SNAPS)
         self._snap_at = -SNAP_FRAMES
+        #: whether the last pose confirmed had a verified pose before it to vouch for its motion
+        #: (none after a slide off the outline): only such a pose may renew the keyframe
+        self.anchored = False
 
     def motion_context(self, frame: int):
         """(last verified (centre, theta, frame) or None, frames since it (1 without one), the
@@ -290,8 +299,10 @@ class PoseVerifier:
         """Keep ``gray``'s first region (once per frame) and, every first number of :data:`LOST_SAMPLES`
         samples, take their median as the background there when the object's template registers
         in it nowhere at ``min_cc`` and it differs from the first view (the object has left its
-        place). Decided on copies reduced until the template is about 40 px across."""
-        if self.filled or self.first_known or frame == self._sampled_at:
+        place); again at every later such median until a verified frame has shown the place (a
+        median taken while the object was leaving holds part of it). Decided on copies reduced
+        until the template is about 40 px across."""
+        if self.filled or frame == self._sampled_at:
             return
         self._sampled_at = frame
         import cv2
@@ -386,8 +397,9 @@ class PoseVerifier:
         after lost frames that is no turned copy of the first view while the limits are cold
         (:data:`COLD_FIRST_CC`); ``background`` for a patch that the latest snapshot taken while
         the object stood elsewhere already showed there (unchanged on :data:`BG_FRACTION` of its
-        pixels, or correlating with it at least as well as with the object): a pose left on the
-        object's empty start place, or on a detail of the scene the keyframe has learned."""
+        pixels, or correlating with it at least as well as with the object, after lost frames
+        with the object's first view): a pose left on the object's empty start place, or on a
+        detail of the scene the keyframe has learned."""
         now = None
         if gap > 1 and len(self.scores) < WARMUP_FRAMES:
             now = tr._warp_back(gray, W)
@@ -401,7 +413,10 @@ class PoseVerifier:
                 if now is None or then is None:
                     return None
                 same = float(np.mean(np.abs(now - then) < BG_TOL))
-                return "background" if same >= BG_FRACTION or _ncc(now, then) >= score else None
+                # after lost frames the keyframe may have learned the place (a pose renewed it
+                # there): the object's first view, not the keyframe, must beat the scene
+                ref = score if gap == 1 else min(score, _ncc(now, tr.tmpl0))
+                return "background" if same >= BG_FRACTION or _ncc(now, then) >= ref else None
         return None
 
     @staticmethod
@@ -469,6 +484,7 @@ class PoseVerifier:
             footprint,
             (centre[0] - hx, centre[1] - hy, centre[0] + hx, centre[1] + hy),
         )
+        self.anchored = bool(self.recent)
         self.recent = (self.recent + [(centre, theta, frame)])[-2:]
         if self.n_verified - self._snap_at >= SNAP_FRAMES:
             m = half + self.margin

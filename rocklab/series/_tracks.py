@@ -77,6 +77,7 @@ STATUSES = {
     "jump": "markerless: the pose leaves the motion of the verified frames",
     "background": "markerless: the pose sits on the still background",
     "drift": "markerless: the pose slid off the object's silhouette",
+    "roundtrip": "markerless: tracked back to the keyframe's frame, the pose's patch lands elsewhere",
     "one_marker": "markers: only one of the object's small markers seen; no pose",
     "low_quality": "measured with a quality below targets.min_quality",
     "outlier": "an angle step no rocking block makes",

@@ -17,6 +17,7 @@ STATUS_COLOURS = {
     "jump": "tab:orange",
     "background": "tab:purple",
     "drift": "tab:pink",
+    "roundtrip": "teal",
     "misaligned": "tab:green",
     "one_marker": "khaki",
     "low_quality": "tab:gray",

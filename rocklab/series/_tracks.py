@@ -78,6 +78,7 @@ STATUSES = {
     "background": "markerless: the pose sits on the still background",
     "drift": "markerless: the pose slid off the object's silhouette",
     "twin": "markerless: found again beside a look-alike that continuity cannot tell from it",
+    "roundtrip": "markerless: tracked back to the keyframe's frame, the pose's patch lands elsewhere",
     "one_marker": "markers: only one of the object's small markers seen; no pose",
     "low_quality": "measured with a quality below targets.min_quality",
     "outlier": "an angle step no rocking block makes",

@@ -18,6 +18,7 @@ STATUS_COLOURS = {
     "background": "tab:purple",
     "drift": "tab:pink",
     "twin": "tab:cyan",
+    "roundtrip": "teal",
     "misaligned": "tab:green",
     "one_marker": "khaki",
     "low_quality": "tab:gray",

@@ -188,6 +188,7 @@ class MarkerlessTracker:
         self.verifier = PoseVerifier(first_gray, (u0, v0, u1, v1), self.size)
         self.verifier.check_turn = self.theta_note is None
         self.twins = TwinGuard(self.size)  # the last verified frames, against a look-alike found instead
+        self.verifier.fb.keyframe(self, first_gray, _euclid(0.0, 0.0, 0.0))
         #: why the angle is not reported although the texture gives one (a round outline), or None
         self.round_note = None
         self.views = [0, 0]  # verified frames, and those not a turned copy of the first view
@@ -529,6 +530,7 @@ class MarkerlessTracker:
         if self.reason is not None:
             if self.reason == "drift":  # the keyframe learned the slide
                 self.key, self.key_sigma_rad = self.tmpl0, 0.0
+                self.verifier.fb.to_first()
             self.verifier.lost_frame(gray, frame, MIN_CC)
             if self.poses:
                 self.last = self.poses[-1]
@@ -584,6 +586,7 @@ class MarkerlessTracker:
                 # a keyframe cut where the angle was no measurement carries no angle on
                 key_sig = self._chained_sigma(tmpl, gray, W) if why is None else math.inf
                 self.key, self.key_sigma_rad = back, key_sig
+                self.verifier.fb.keyframe(self, gray, W)
         sig = self._chained_sigma(tmpl, gray, W, mask) if why is None else math.nan
         return (W, cc), mask, visible, why, math.hypot(sig, self.theta0_sigma_rad)
 

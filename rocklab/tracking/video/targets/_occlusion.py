@@ -47,7 +47,9 @@ __all__ = [
     "silhouette",
     "roundness",
     "disk",
+    "stable_disk",
     "warp_grown",
+    "subpixel_peak",
 ]
 
 #: Cells per side of the grid laid over the template.
@@ -234,6 +236,16 @@ def roundness(sil) -> float:
 #: of the window's strongest differences (at least :data:`BG_TOL`): lower than :data:`FG_REL`, as a
 #: ball's clear or pale half stands out less than its coloured half; holes inside are filled.
 DISK_REL = 0.2
+#: Thresholds tried in turn (as :data:`DISK_REL`) for a disk joined by something that stands out
+#: less than it: a ball's soft shadow on the wall beside it stands out by a fifth of the ball's
+#: strongest differences (development film: at the first threshold the first frame's disk has a
+#: radius of 38.6-42.5 px and its centre 4.4 px off the ball's silhouette, at the next two 32.7-33.7
+#: px and within 1 px; in later frames a blob of 46-57 px pulled the centre 6-8 px towards the
+#: shadow), while the clear half, dropped by a higher one, leaves the enclosing circle's radius.
+DISK_RELS = (DISK_REL, 0.25, 0.3)
+#: The first frame's disk is taken at the lowest threshold whose radius the next one keeps to
+#: this fraction (nothing that stands out less than the disk joined it).
+DISK_STABLE = 0.05
 #: The difference is smoothed first (px), and the mask closed (px: a clear half's pale gaps
 #: between the parts that stand out, the beads in it) and opened (px: a string or a thread
 #: hanging from the ball is no part of its disk), at the window's scale (:data:`DISK_SIDE_PX`).
@@ -242,7 +254,7 @@ DISK_CLOSE_PX = 9
 DISK_OPEN_PX = 5
 
 
-def disk(patch, bg):
+def disk(patch, bg, rel=DISK_REL):
     """The largest blob standing out of ``bg`` in ``patch`` (:data:`DISK_REL`, holes filled, thin
     parts opened away): its smallest enclosing circle's centre (x, y) px in ``patch``, radius px,
     and the circularity of its hull (:func:`roundness`); None when nothing stands out.
@@ -263,7 +275,7 @@ def disk(patch, bg):
     flat = d[::2, ::2].ravel()
     k = int(0.98 * (flat.size - 1))
     hi = float(np.partition(flat, k)[k])
-    lo = max(BG_TOL, DISK_REL * hi)
+    lo = max(BG_TOL, rel * hi)
     if hi <= lo:
         return None
     m = (d > lo).astype(np.uint8)
@@ -281,7 +293,26 @@ def disk(patch, bg):
     return np.array([x, y]), float(r), float(4 * math.pi * area / per**2)
 
 
-def _disk_match(patch, bg, r):
+def stable_disk(patch, bg):
+    """:func:`disk` at the lowest of :data:`DISK_RELS` whose radius the next threshold keeps to
+    :data:`DISK_STABLE` (a shadow joined at a lower one), else at :data:`DISK_REL`.
+
+    >>> yy, xx = np.mgrid[0:100, 0:100]
+    >>> bg = np.full((100, 100), 150.0, np.float32)
+    >>> img = np.where((xx - 45) ** 2 + (yy - 50) ** 2 < 20**2, 40.0, bg).astype(np.float32)
+    >>> img[30:70, 65:90] -= 25.0  # a soft shadow beside it: a fifth of the ball's difference
+    >>> (c, r, _), (c2, r2, _) = disk(img, bg), stable_disk(img, bg)
+    >>> bool(np.hypot(c[0] - 45, c[1] - 50) > 5 and np.hypot(c2[0] - 45, c2[1] - 50) < 1 and abs(r2 - 20) < 2.5)
+    True
+    """
+    found = [disk(patch, bg, rel) for rel in DISK_RELS]
+    for d, nxt in zip(found, found[1:]):
+        if d is not None and nxt is not None and abs(d[1] - nxt[1]) <= DISK_STABLE * nxt[1]:
+            return d
+    return found[0]
+
+
+def _disk_match(patch, bg, r, rel=DISK_REL):
     """Centre (x, y) px in ``patch`` of a disk of radius ``r`` px matched by normalised correlation
     to how far each pixel stands out of ``bg`` (0 below :data:`DISK_REL` of the strongest
     differences, 1 at them): a shadow or a change of the wall that joins the object's blob moves
@@ -292,18 +323,18 @@ def _disk_match(patch, bg, r):
     flat = d[::2, ::2].ravel()
     k = int(0.98 * (flat.size - 1))
     hi = float(np.partition(flat, k)[k])
-    lo = max(BG_TOL, DISK_REL * hi)
+    lo = max(BG_TOL, rel * hi)
     R = int(round(r))
     if hi <= lo or R < 2 or min(d.shape) <= 2 * R + 1:
         return None
     kern = np.zeros((2 * R + 1, 2 * R + 1), np.float32)
     cv2.circle(kern, (R, R), R, 1.0, -1)
     res = cv2.matchTemplate(np.clip((d - lo) * (1.0 / (hi - lo)), 0.0, 1.0), kern, cv2.TM_CCOEFF_NORMED)
-    pk, val = _peak(res)
+    pk, val = subpixel_peak(res)
     return pk + R if math.isfinite(val) else None
 
 
-def _peak(res):
+def subpixel_peak(res):
     """Sub-pixel location (x, y) of the maximum of ``res`` and its value (parabola through the
     neighbours where the maximum is inside)."""
     import cv2
@@ -359,7 +390,7 @@ class OutlineRef:
         #: the object's disk in the first frame (:func:`disk`): centre (first-frame px), radius px;
         #: None unless it is round (then its position is its disk's centre, not a texture point)
         self.disk0 = None
-        d = disk(first[y0:y1, x0:x1], bg[y0:y1, x0:x1]) if self.ref is not None else None
+        d = stable_disk(first[y0:y1, x0:x1], bg[y0:y1, x0:x1]) if self.ref is not None else None
         if d is not None:
             # a pale part of a ball that the outline's threshold drops is part of its disk
             self.roundness = max(self.roundness, d[2]) if math.isfinite(self.roundness) else d[2]
@@ -414,7 +445,7 @@ class OutlineRef:
             if s.shape[0] < self.ref.shape[0] or s.shape[1] < self.ref.shape[1]:
                 continue
             res = cv2.matchTemplate(s, self.ref, cv2.TM_CCOEFF_NORMED)
-            shift, cc = _peak(res)
+            shift, cc = subpixel_peak(res)
             if not math.isfinite(cc):  # a window all one value
                 continue
             # at the edge of the search: the outline lies farther than the margin
@@ -440,10 +471,15 @@ class OutlineRef:
         if f < 1.0:
             back, bgw = _reduce(back, f), _reduce(bgw, f)
         r0 = self.disk0[1] * f
-        c = _disk_match(back, bgw, r0)
+        for rel in DISK_RELS:
+            d = disk(back, bgw, rel)
+            if d is None or d[1] <= (1.0 + DISK_RADIUS_TOL) * r0:
+                break  # no blob larger than the disk: nothing joined it at this threshold
+        else:  # larger at every threshold (a hand joined it): as at the first
+            rel, d = DISK_REL, disk(back, bgw)
+        c = _disk_match(back, bgw, r0, rel)
         if c is None:
             return None
-        d = disk(back, bgw)
         if d is not None and abs(d[1] - r0) <= DISK_RADIUS_TOL * r0 and np.hypot(*(d[0] - c)) <= DISK_AGREE * r0:
             c = d[0]  # the blob is the disk alone: its circle is finer than the match
         p = c / f - 2 * self.margin + tr.origin  # first-frame px under the pose

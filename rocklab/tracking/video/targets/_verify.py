@@ -45,6 +45,10 @@ and, for the outline, its own first frame:
   region (the first frame round it as its background: the region is drawn round the object),
   and again once the region grown by the outline's margin is seen; a disk's centre stays where
   it was first placed.
+* **round trip** (``roundtrip``): the frame warped back by the pose, searched for in the
+  keyframe's own frame round the place the keyframe was cut from, must land there within a
+  limit learned from the object's verified frames (:mod:`._roundtrip`: the forward-backward
+  check); run on the frames the other checks find doubtful and on a sample of the rest.
 * **disk** (not a check: the position a ball reports): for a round outline, the centre of the
   object's disk against the background (:meth:`._occlusion.OutlineRef.disk_centre`), kept in
   :attr:`PoseVerifier.disk_at` for the tracker.
@@ -61,6 +65,7 @@ import math
 import numpy as np
 
 from ._occlusion import OUTLINE_MARGIN_FRAC, OutlineRef, warp_grown
+from ._roundtrip import RoundTrip
 
 __all__ = ["PoseVerifier", "search_whole_frame", "MIN_SCORE", "MAX_STEP_RAD"]
 
@@ -158,6 +163,10 @@ class PoseVerifier:
         self.speeds = collections.deque(maxlen=300)
         self.n_verified = 0
         self._limits, self._learned_at = None, 0
+        #: (median, robust deviation) of the verified correlations, once learned
+        self.score_stats: tuple | None = None
+        #: the forward-backward check (:mod:`._roundtrip`); its keyframe's frame is set by the tracker
+        self.fb = RoundTrip(size)
         #: (centre (2,), theta, frame) of the last two verified poses
         self.recent: list = []
         #: whether the angle is checked (False for an object whose appearance tells no angle)
@@ -192,6 +201,7 @@ class PoseVerifier:
         s = np.asarray(self.scores)
         med = float(np.median(s))
         dev = max(1.4826 * float(np.median(np.abs(s - med))), MIN_DEVIATION)
+        self.score_stats = (med, dev)
         return max(MIN_SCORE, med - APPEARANCE_MADS * dev)
 
     def residual_limit(self) -> float:
@@ -374,6 +384,11 @@ class PoseVerifier:
         reason = self.check(float(score), centre, theta, pred, last2, gap, bg, back, known)
         if reason is None:
             reason = self._look_again(tr, gray, W, centre, float(score), gap)
+        self.fb.last_miss = math.nan
+        if reason is None and self.fb.doubtful(float(score), *(self.score_stats or (None, None)), gap):
+            # tracked back to the keyframe's frame, the patch must land where the keyframe was cut
+            if self.fb.check(back if back is not None else tr._warp_back(gray, W)):
+                reason = "roundtrip"
         self.learn_outline()
         if reason is None and self.outline is not None and back is not None and self._in_frame(tr, W, gray.shape):
             # the object's outline against the background is not where the pose puts it: the
@@ -486,6 +501,7 @@ class PoseVerifier:
         )
         self.anchored = bool(self.recent)
         self.recent = (self.recent + [(centre, theta, frame)])[-2:]
+        self.fb.accept()
         if self.n_verified - self._snap_at >= SNAP_FRAMES:
             m = half + self.margin
             self.snaps.append((np.array(gray), (centre[0] - m, centre[1] - m, centre[0] + m, centre[1] + m)))

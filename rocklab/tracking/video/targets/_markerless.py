@@ -15,10 +15,7 @@ never chained frame to frame, so the pose does not drift:
 4. verify the pose (:mod:`._verify`: appearance, motion, background, limits learned from the
    object's own verified frames); a pose that fails, or no pose, sends the template over the
    whole frame; still nothing verified: the frame is lost (NaN, status ``lost`` or the failed
-   check's name) and the next frame searches. Only verified frames renew the keyframe, and only
-   those whose motion a verified pose vouched for: the first pose after a slide off the outline
-   (no motion anchor left) has been a patch 86 px off the object at 0.73, and a keyframe cut
-   there finds that patch, or the object's empty start place, from then on.
+   check's name) and the next frame searches. Only verified frames renew the keyframe.
 
 A keyframe is not renewed from a frame in which part of the object is covered (most cells
 of a 4 x 4 grid match, one does not: a hand, the thread), so the keyframe never learns an
@@ -580,9 +577,7 @@ class MarkerlessTracker:
                 part = masked_fit(self, tmpl, gray, W)
                 if part is not None:
                     (W, cc), mask, visible = part[:2], part[2], part[3]
-            elif (
-                back is not None and self.verifier.anchored
-            ):  # appearance drifted from the first frame: renew the keyframe here
+            elif back is not None:  # appearance drifted from the first frame: renew the keyframe here
                 # a keyframe cut where the angle was no measurement carries no angle on
                 key_sig = self._chained_sigma(tmpl, gray, W) if why is None else math.inf
                 self.key, self.key_sigma_rad = back, key_sig

@@ -175,9 +175,6 @@ class PoseVerifier:
         #: verified frames: what the scene shows where the object was not
         self.snaps: collections.deque = collections.deque(maxlen=SNAPS)
         self._snap_at = -SNAP_FRAMES
-        #: whether the last pose confirmed had a verified pose before it to vouch for its motion
-        #: (none after a slide off the outline): only such a pose may renew the keyframe
-        self.anchored = False
 
     def motion_context(self, frame: int):
         """(last verified (centre, theta, frame) or None, frames since it (1 without one), the
@@ -499,7 +496,6 @@ class PoseVerifier:
             footprint,
             (centre[0] - hx, centre[1] - hy, centre[0] + hx, centre[1] + hy),
         )
-        self.anchored = bool(self.recent)
         self.recent = (self.recent + [(centre, theta, frame)])[-2:]
         self.fb.accept()
         if self.n_verified - self._snap_at >= SNAP_FRAMES:

@@ -48,9 +48,14 @@ def test_a_resting_puck_is_not_ok_on_a_fingertip_124_px_away(film):
     assert not np.any(b.ok & rest & (off > 3.2)), "an ok frame away from the resting striker"
     # its own frames before the loss are kept: sliding in, stopping
     assert np.sum(b.ok & (b.frame <= 190)) >= 185
-    assert np.sum((b.status == "latch") & (b.frame >= 224)) >= 15
-    msgs = [d.message for d in found if d.code == "W-TRACK-LATCH" and "'puck_b'" in d.message]
-    assert msgs and "frame 224" in msgs[0]
+    # the fingertip is not the puck: refused by the verifier (found out of reach, no turned copy
+    # of the first view: ``mismatch``; off its outline: ``drift``) or, where that lets it through,
+    # by the track's reach rule
+    far = b.frame >= 224
+    assert np.sum(np.isin(b.status, ("latch", "mismatch", "drift")) & far) >= 15
+    if np.any((b.status == "latch") & far):
+        msgs = [d.message for d in found if d.code == "W-TRACK-LATCH" and "'puck_b'" in d.message]
+        assert msgs and "frame 224" in msgs[0]
 
 
 W, H, SIZE = 320, 240, 19

@@ -58,6 +58,7 @@ def test_a_puck_that_left_the_frame_is_not_ok_on_the_striker(film, shift):
     # way named (the constructed cases of tests/test_track_latch_rules.py test the rule itself)
     late = a.frame >= 290
     st = a.status[late]
-    assert np.sum((st == "latch") | (st == "background")) > 20
+    # (or mismatch: found out of its reach, the striker is no turned copy of its first view)
+    assert np.sum((st == "latch") | (st == "background") | (st == "mismatch")) > 20
     msgs = [d.message for d in found if d.code == "W-TRACK-LATCH" and "'puck_a'" in d.message]
     assert msgs or np.sum(st == "latch") == 0, "a latch run is named"

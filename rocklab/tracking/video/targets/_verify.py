@@ -10,7 +10,11 @@ and, for the outline, its own first frame:
   :data:`APPEARANCE_MADS` robust deviations (at least :data:`MIN_DEVIATION`; never below
   :data:`MIN_SCORE`); and while that limit is not learned yet, a pose found after lost frames
   must be a turned copy of the first view (:data:`COLD_FIRST_CC`): a keyframe renewed from a
-  lamp or a hand that the template half matched would otherwise follow it at 0.99;
+  lamp or a hand that the template half matched would otherwise follow it at 0.99. So must, at
+  any time, a pose found after lost frames (or after a slide) farther than the template's larger
+  side both from the last verified pose and from where its velocity carries it: the motion
+  vouches for nothing there, and a small ball's keyframe half matches a forearm or an edge;
+* **picture**: a pose whose reported point lies outside the picture is lost;
 * **motion** (``jump``): the pose may leave the constant-velocity prediction by no more than
   the verified frames' residuals allow (:data:`MOTION_FACTOR` times their 99th percentile, at
   least :data:`MIN_RESIDUAL_FRAC` of the template; after ``g`` lost frames the prediction is
@@ -169,6 +173,9 @@ class PoseVerifier:
         self.fb = RoundTrip(size)
         #: (centre (2,), theta, frame) of the last two verified poses
         self.recent: list = []
+        #: (centre (2,), velocity (2,) px/frame, frame) of the last verified pose, kept when a slide
+        #: makes the motion checks forget :attr:`recent`: where a re-found object may be
+        self.seen = None
         #: whether the angle is checked (False for an object whose appearance tells no angle)
         self.check_turn = True
         #: (grey frame, the object's footprint in it grown by the margin (x0, y0, x1, y1) px) of
@@ -369,6 +376,8 @@ class PoseVerifier:
             self._sample(gray, frame, tr.min_cc)
         bg = back = known = bg_g = back_g = None
         self.hint = self.disk_at = None
+        if not (0.0 <= centre[0] < gray.shape[1] and 0.0 <= centre[1] < gray.shape[0]):
+            return "lost"  # the point reported would lie outside the picture: no measurement
         # the background is known where the first frame did not show the object, and everywhere
         # once the object has left its first region: only then is the check worth its two warps
         if self.filled or self.early or self.first_known or self._clear(centre):
@@ -378,9 +387,10 @@ class PoseVerifier:
                 bg, back = bg_g[m:-m, m:-m], back_g[m:-m, m:-m]
                 known = np.ones_like(bg)
         last2 = None if last is None else last[:2]
+        far = self._far(centre, frame)
         reason = self.check(float(score), centre, theta, pred, last2, gap, bg, back, known)
         if reason is None:
-            reason = self._look_again(tr, gray, W, centre, float(score), gap)
+            reason = self._look_again(tr, gray, W, centre, float(score), gap, far)
         self.fb.last_miss = math.nan
         if reason is None and self.fb.doubtful(float(score), *(self.score_stats or (None, None)), gap):
             # tracked back to the keyframe's frame, the patch must land where the keyframe was cut
@@ -404,16 +414,29 @@ class PoseVerifier:
         self._pending = (float(score), centre, theta, pred, last2, gap, frame)
         return reason
 
-    def _look_again(self, tr, gray, W, centre, score, gap):
+    def _far(self, centre, frame) -> bool:
+        """Whether a pose centred at ``centre`` (px) in ``frame`` is found after lost frames farther
+        than the template's larger side both from the last verified pose and from where that
+        pose's velocity carries it over the gap: a re-acquisition that the object's motion does not
+        vouch for (a forearm or an edge that a small ball's keyframe half matches, hundreds of px
+        from where the ball was lost)."""
+        if self.seen is None or frame - self.seen[2] <= 1:
+            return False
+        c, v, f = self.seen
+        reach = max(self.size)
+        return min(float(np.hypot(*(centre - c))), float(np.hypot(*(centre - c - v * (frame - f))))) > reach
+
+    def _look_again(self, tr, gray, W, centre, score, gap, far=False):
         """The checks a template that adapts cannot pass by adapting: ``mismatch`` for a pose found
-        after lost frames that is no turned copy of the first view while the limits are cold
-        (:data:`COLD_FIRST_CC`); ``background`` for a patch that the latest snapshot taken while
+        after lost frames that is no turned copy of the first view (:data:`COLD_FIRST_CC`) while
+        the limits are cold, or out of the object's reach (``far``: :meth:`_far`) at any time;
+        ``background`` for a patch that the latest snapshot taken while
         the object stood elsewhere already showed there (unchanged on :data:`BG_FRACTION` of its
         pixels, or correlating with it at least as well as with the object, after lost frames
         with the object's first view): a pose left on the object's empty start place, or on a
         detail of the scene the keyframe has learned."""
         now = None
-        if gap > 1 and len(self.scores) < WARMUP_FRAMES:
+        if (gap > 1 and len(self.scores) < WARMUP_FRAMES) or far:
             now = tr._warp_back(gray, W)
             if now is None or _ncc(now, tr.tmpl0) < COLD_FIRST_CC:
                 return "mismatch"
@@ -496,6 +519,8 @@ class PoseVerifier:
             footprint,
             (centre[0] - hx, centre[1] - hy, centre[0] + hx, centre[1] + hy),
         )
+        v = np.zeros(2) if self.seen is None or frame - self.seen[2] != 1 else centre - self.seen[0]
+        self.seen = (np.asarray(centre, float), v, frame)
         self.recent = (self.recent + [(centre, theta, frame)])[-2:]
         self.fb.accept()
         if self.n_verified - self._snap_at >= SNAP_FRAMES:

@@ -138,9 +138,9 @@ ROLL_CENTRE0 = (292.5, 115.0)
 
 @pytest.mark.parametrize("which", [0, 3])
 def test_a_rolled_disc_is_not_ok_on_its_empty_start_place(tmp_path, which):
-    """Drawn box: the right frames stay ok. Box 20 % smaller: once the disc has rolled away, the
-    pose left on its start place (frames 287-299: ok at quality 0.998 before) is lost as
-    ``background``."""
+    """Drawn box: the right frames stay ok. Box 20 % smaller: once the disc has rolled away, its
+    empty start place (frames 287-299: ok at quality 0.998 before) is refused, as ``background``
+    or, found far from where the disc was lost, as ``jump``."""
     box = _boxes(ROLL[2])[which]
     tr, width = _track(_film(tmp_path, *ROLL[:2]), box, stop=300)
     wrong, right, _ = _judge(tr, width, REFS / "phystrack_rollingcylinder_disc.csv", box, first_ref=ROLL_CENTRE0)
@@ -150,7 +150,10 @@ def test_a_rolled_disc_is_not_ok_on_its_empty_start_place(tmp_path, which):
         # the old tracker: 0 wrong, 174 right on frames 0-299
         assert wrong == [] and len(right) >= 0.9 * 174, (wrong, len(right))
     else:
+        # since the first region's background is learned again from every lost-frame median, the
+        # small box follows the disc on to frame 280 (x 83 px) and the start place, found again
+        # 200 px from where the disc was lost, is refused as a `jump` before the background check
         away = st[frames >= 290]
-        assert not np.any(away == "ok") and np.mean(away == "background") > 0.9, dict(
+        assert not np.any(away == "ok") and np.mean(np.isin(away, ("background", "jump"))) > 0.9, dict(
             zip(*np.unique(away, return_counts=True))
         )

@@ -29,16 +29,10 @@ and, for the outline, its own first frame:
   from a verified frame in which the object has left it, or, sooner, from the median of the
   frames in which the object was lost (:data:`LOST_SAMPLES`), once the object's template
   registers nowhere in that median (the object has gone from its first place: a bob hanging
-  still before it was shot off would otherwise make its own empty place look like the object),
-  and learned again from every later such median until a verified frame shows it (an object
-  that slides off slowly is lost while it still covers part of its place: the first median
-  holds it, and the empty place then passes against it);
+  still before it was shot off would otherwise make its own empty place look like the object);
   and the patch must not be what the latest scene snapshot taken while the object stood
   elsewhere showed there (one every :data:`SNAP_FRAMES` verified frames): a pose left on the
-  object's empty start place, whose look the keyframe learned, matches its keyframe at 0.998.
-  After lost frames the object's first view, not the keyframe, must explain the patch better
-  than that snapshot does: a keyframe renewed while the object tipped over a marker finds the
-  marker 170 frames later at 0.82, above the snapshot's 0.70 under a changed exposure;
+  object's empty start place, whose look the keyframe learned, matches its keyframe at 0.998;
 * **outline** (``drift``): once the background behind the object's first region is known, the
   object's silhouette against it, registered round the pose (:mod:`._occlusion`), must lie where
   the pose puts it, within :data:`._occlusion.DRIFT_FRAC` of the template: a spinning object's
@@ -313,10 +307,8 @@ class PoseVerifier:
         """Keep ``gray``'s first region (once per frame) and, every first number of :data:`LOST_SAMPLES`
         samples, take their median as the background there when the object's template registers
         in it nowhere at ``min_cc`` and it differs from the first view (the object has left its
-        place); again at every later such median until a verified frame has shown the place (a
-        median taken while the object was leaving holds part of it). Decided on copies reduced
-        until the template is about 40 px across."""
-        if self.filled or frame == self._sampled_at:
+        place). Decided on copies reduced until the template is about 40 px across."""
+        if self.filled or self.first_known or frame == self._sampled_at:
             return
         self._sampled_at = frame
         import cv2
@@ -432,9 +424,8 @@ class PoseVerifier:
         the limits are cold, or out of the object's reach (``far``: :meth:`_far`) at any time;
         ``background`` for a patch that the latest snapshot taken while
         the object stood elsewhere already showed there (unchanged on :data:`BG_FRACTION` of its
-        pixels, or correlating with it at least as well as with the object, after lost frames
-        with the object's first view): a pose left on the object's empty start place, or on a
-        detail of the scene the keyframe has learned."""
+        pixels, or correlating with it at least as well as with the object): a pose left on the
+        object's empty start place, or on a detail of the scene the keyframe has learned."""
         now = None
         if (gap > 1 and len(self.scores) < WARMUP_FRAMES) or far:
             now = tr._warp_back(gray, W)
@@ -448,10 +439,7 @@ class PoseVerifier:
                 if now is None or then is None:
                     return None
                 same = float(np.mean(np.abs(now - then) < BG_TOL))
-                # after lost frames the keyframe may have learned the place (a pose renewed it
-                # there): the object's first view, not the keyframe, must beat the scene
-                ref = score if gap == 1 else min(score, _ncc(now, tr.tmpl0))
-                return "background" if same >= BG_FRACTION or _ncc(now, then) >= ref else None
+                return "background" if same >= BG_FRACTION or _ncc(now, then) >= score else None
         return None
 
     @staticmethod

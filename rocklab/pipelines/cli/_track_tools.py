@@ -167,12 +167,14 @@ def track_init(
     if marker_size_m is not None and not (math.isfinite(marker_size_m) and marker_size_m > 0):
         raise InputError(f"--marker-size {marker_size_m}: give the printed marker side in metres (> 0)")
     found, proposed, pnotes, line = None, (), [], None
+    turning: set = set()
     if not regions and troi is None:
         found = find_markers(gray)
         if found is None:
             regions, troi, line, proposed, pnotes = _from_motion(
                 video, info, gray, img, start, lead_note, preview, side
             )
+            turning = {n for n in regions if n in pnotes.turning}
     lens_rel = None
     if lens is not None:
         import os
@@ -191,7 +193,12 @@ def track_init(
         level_line_px=line,
         start_frame=start,
     )
-    notes = ([lead_note] if lead_note else []) + pnotes + notes
+    if turning:
+        # the whole disc's registration does not follow a small mark's turn (PhysTrack's turning
+        # disc: theta within 2 deg while it made 9.6 turns, every frame ok): a position only
+        objs = tuple(dataclasses.replace(o, kind="point") if o.id in turning else o for o in cfg.objects)
+        cfg = dataclasses.replace(cfg, objects=objs)
+    notes = ([lead_note] if lead_note else []) + list(pnotes) + notes
     if lens_rel is not None:
         cfg = dataclasses.replace(cfg, video=dataclasses.replace(cfg.video, calibration=lens_rel))
         notes.append(f"lens {lens_rel}: detected points are undistorted with it before any geometry")
@@ -253,13 +260,20 @@ def _from_motion(video, info, gray, img, start, lead_note, preview, side):
     proposed = tuple(f"--object {n}={_box_text(b)}" for n, b in regions.items())
     if troi is not None:
         proposed += (f"--table {_box_text(troi)}",)
-    pnotes = _proposal_notes(props, window, gray.size)
+    pnotes = _Notes(_proposal_notes(props, window, gray.size))
+    pnotes.turning = {f"block_{k}" for k, b in enumerate(props.blocks, start=1) if b in props.turning}
     pnotes += [
         f"a moving region at {_box_text(b)} not proposed: it holds no texture to track "
         f"(grey std {texture_std(gray, b):.3g} < {MIN_TEXTURE_STD:g})"
         for b in flat
     ]
     return regions, troi, line, proposed, pnotes
+
+
+class _Notes(list):
+    """Proposal notes (str), carrying the names of the proposed discs turning on a pin."""
+
+    turning: set = set()
 
 
 def _box_text(b) -> str:
@@ -297,9 +311,10 @@ def _proposal_notes(props, window_s, frame_px) -> list:
     for k, b in enumerate(props.blocks, start=1):
         if b in props.turning:
             notes.append(
-                f"PROPOSED block_{k} is a disc turning on a pin: only its mark moves, its outline stays; check in "
-                "'rocklab track preview' that theta follows the mark (a small mark on a plain disc may not turn the "
-                f"region's registration), or draw a box round the mark with --object block_{k}=x,y,w,h"
+                f"PROPOSED block_{k} is a disc turning on a pin: only its mark moves, its outline stays; it is "
+                'written as kind = "point" (its position only: the whole disc\'s registration does not follow a '
+                f"small mark's turn); for its angle draw a box round the mark with --object block_{k}=x,y,w,h "
+                "(the mark turns with the disc)"
             )
     if props.table_edge is not None:
         e = props.table_edge

@@ -556,12 +556,7 @@ def settle_guide(base, o, places, refine=10):
 
     want = wanted()
     while want.any():
-        idx = np.flatnonzero(want)
-        pm = np.sqrt(p_hi[idx] * p_lo[idx])
-        v = batch_runs(base, scales[idx], pm, args)
-        p_hi[idx] = np.where(v, pm, p_hi[idx])
-        p_lo[idx] = np.where(v, p_lo[idx], pm)
-        left[idx] -= 1
+        _halve(base, scales, args, p_hi, p_lo, left, np.flatnonzero(want))
         want = wanted()
     opts = dict(opt, refine=int(refine), refine_where="fit")
     return oas_result(
@@ -621,6 +616,17 @@ def batch_runs(base, scale, p, args):
     return out
 
 
+def _halve(base, scales, args, p_hi, p_lo, left, idx) -> None:
+    """One geometric bisection of the brackets ``idx``, in place: a run at sqrt(p_hi p_lo) of each
+    level ``scales[idx]`` (:func:`batch_runs`); where its verdict is true ``p_hi`` moves to it,
+    elsewhere ``p_lo``; one fewer bisection ``left``."""
+    pm = np.sqrt(p_hi[idx] * p_lo[idx])
+    v = batch_runs(base, scales[idx], pm, args)
+    p_hi[idx] = np.where(v, pm, p_hi[idx])
+    p_lo[idx] = np.where(v, p_lo[idx], pm)
+    left[idx] -= 1
+
+
 def _bisect(base, scales, p_hi, p_lo, n, args, lv=None, where="fit"):
     """Geometric bisection of every level's bracket [p_lo safe, p_hi unsafe] at once, ``n`` steps.
 
@@ -639,12 +645,7 @@ def _bisect(base, scales, p_hi, p_lo, n, args, lv=None, where="fit"):
     left = np.where(m, int(n), 0)
     want = left > 0 if lv is None else _fit_levels(lv, p_hi, p_lo, left, m, where == "fit")
     while want.any():
-        idx = np.flatnonzero(want)
-        pm = np.sqrt(p_hi[idx] * p_lo[idx])
-        o = batch_runs(base, scales[idx], pm, args)
-        p_hi[idx] = np.where(o, pm, p_hi[idx])
-        p_lo[idx] = np.where(o, p_lo[idx], pm)
-        left[idx] -= 1
+        _halve(base, scales, args, p_hi, p_lo, left, np.flatnonzero(want))
         want = left > 0 if lv is None else _fit_levels(lv, p_hi, p_lo, left, m, where == "fit")
     return p_hi, p_lo
 

@@ -154,6 +154,18 @@ def test_real_avi_frames_match_opencv():
     assert max(same) < 0.1 and np.median(nxt) > 0.3
 
 
+def _encode_slots(c, s, slots) -> None:
+    """Encode into stream ``s`` of container ``c`` one numbered picture per slot (its number drawn,
+    pts = the slot at 1/FPS), then flush: a slot left out is a frame the camera dropped."""
+    for k in slots:
+        f = av.VideoFrame.from_ndarray(_numbered(int(k)), format="rgb24")
+        f.pts, f.time_base = int(k), 1 / FPS
+        for p in s.encode(f):
+            c.mux(p)
+    for p in s.encode():
+        c.mux(p)
+
+
 def _write_mp4_slots(path: Path, slots) -> None:
     """Numbered frames at the given slots of a 29.97 fps clock (a missing slot: a frame the camera
     dropped), H.264 with B-frames, the index (moov) at the file's start as phones and editors
@@ -164,13 +176,7 @@ def _write_mp4_slots(path: Path, slots) -> None:
         s.codec_context.max_b_frames, s.codec_context.gop_size = 3, 24
         s.codec_context.time_base = 1 / FPS
         s.options = {"x264-params": "b-adapt=0:bframes=3", "crf": "18", "preset": "veryfast"}
-        for k in slots:
-            f = av.VideoFrame.from_ndarray(_numbered(int(k)), format="rgb24")
-            f.pts, f.time_base = int(k), 1 / FPS
-            for p in s.encode(f):
-                c.mux(p)
-        for p in s.encode():
-            c.mux(p)
+        _encode_slots(c, s, slots)
 
 
 def test_a_cut_file_loses_its_tail_not_frames_the_camera_dropped(tmp_path):
@@ -211,13 +217,7 @@ def test_avi_frame_the_camera_dropped_keeps_the_times_true(tmp_path):
     with av.open(str(path), "w", format="avi") as c:
         s = c.add_stream("mjpeg", rate=FPS)
         s.width, s.height, s.pix_fmt = 128, 64, "yuvj420p"
-        for k in np.delete(np.arange(20), 7):
-            f = av.VideoFrame.from_ndarray(_numbered(int(k)), format="rgb24")
-            f.pts, f.time_base = int(k), 1 / FPS
-            for p in s.encode(f):
-                c.mux(p)
-        for p in s.encode():
-            c.mux(p)
+        _encode_slots(c, s, np.delete(np.arange(20), 7))
     info = probe_video(path)
     assert info.n_frames == 19 and info.n_dropped == 1
     shown = [_read_number(g) for _, g in iter_video_frames(path)]

@@ -171,10 +171,9 @@ def track_init(
     if not regions and troi is None:
         found = find_markers(gray)
         if found is None:
-            regions, troi, line, proposed, pnotes = _from_motion(
+            regions, troi, line, proposed, pnotes, turning = _from_motion(
                 video, info, gray, img, start, lead_note, preview, side
             )
-            turning = {n for n in regions if n in pnotes.turning}
     lens_rel = None
     if lens is not None:
         import os
@@ -198,7 +197,7 @@ def track_init(
         # disc: theta within 2 deg while it made 9.6 turns, every frame ok): a position only
         objs = tuple(dataclasses.replace(o, kind="point") if o.id in turning else o for o in cfg.objects)
         cfg = dataclasses.replace(cfg, objects=objs)
-    notes = ([lead_note] if lead_note else []) + list(pnotes) + notes
+    notes = ([lead_note] if lead_note else []) + pnotes + notes
     if lens_rel is not None:
         cfg = dataclasses.replace(cfg, video=dataclasses.replace(cfg.video, calibration=lens_rel))
         notes.append(f"lens {lens_rel}: detected points are undistorted with it before any geometry")
@@ -218,7 +217,8 @@ def track_init(
 
 def _from_motion(video, info, gray, img, start, lead_note, preview, side):
     """Objects proposed from what moves after frame ``start`` (film without markers or regions):
-    (regions, table region, level line, proposals as options, notes); an InputError, after the
+    (regions, table region, level line, proposals as options, notes, names of the discs turning
+    on a pin); an InputError, after the
     pixel grid is written to ``preview``, when nothing trackable moves."""
     from .._plotting import save_bgr_png
 
@@ -260,20 +260,14 @@ def _from_motion(video, info, gray, img, start, lead_note, preview, side):
     proposed = tuple(f"--object {n}={_box_text(b)}" for n, b in regions.items())
     if troi is not None:
         proposed += (f"--table {_box_text(troi)}",)
-    pnotes = _Notes(_proposal_notes(props, window, gray.size))
-    pnotes.turning = {f"block_{k}" for k, b in enumerate(props.blocks, start=1) if b in props.turning}
+    pnotes = _proposal_notes(props, window, gray.size)
     pnotes += [
         f"a moving region at {_box_text(b)} not proposed: it holds no texture to track "
         f"(grey std {texture_std(gray, b):.3g} < {MIN_TEXTURE_STD:g})"
         for b in flat
     ]
-    return regions, troi, line, proposed, pnotes
-
-
-class _Notes(list):
-    """Proposal notes (str), carrying the names of the proposed discs turning on a pin."""
-
-    turning: set = set()
+    turning = {n for n, b in regions.items() if b in props.turning}
+    return regions, troi, line, proposed, pnotes, turning
 
 
 def _box_text(b) -> str:

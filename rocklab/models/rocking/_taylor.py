@@ -20,8 +20,10 @@ Steps are ``p h <= P_H`` (0.2) at order 12: on B6M (3.9 s of rocking, 90
 impacts) impact times agree with ``solve_ivp`` DOP853 at rtol 1e-13 within
 3.5e-11 s and theta within 3e-12 rad (the Newmark kernel at dt = 1e-4 s:
 2.2e-7 s, 1.2e-7 rad), at half the Newmark kernel's cost on a 1e-4 s output
-grid (0.21 ms against 0.41 ms, ``benchmarks/bench_single.py``). Free rocking only: a base record makes the right-hand side a
-piecewise-linear function of time, which the Newmark kernel handles.
+grid (0.21 ms against 0.41 ms, ``benchmarks/bench_single.py``). Longer steps
+are not free: at ``p h <= 0.3`` B6M's impact times move by 1.5e-11 s. Free
+rocking only: a base record makes the right-hand side a piecewise-linear
+function of time, which the Newmark kernel handles.
 """
 
 from __future__ import annotations

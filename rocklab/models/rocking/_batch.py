@@ -165,6 +165,20 @@ def _checked_span(base, dt_s, duration_s, free_after_s) -> float:
     return float(duration_s)
 
 
+#: The last record's :func:`safe_tail`: (samples, interval s, tail); an OAS runs one record in many batches.
+_TAIL_CACHE: list = [None]
+
+
+def _tail_of(acc, dt_s):
+    """:func:`~rocklab.models.rocking._taylor_record.safe_tail` of ``acc``, reused while the record is the same."""
+    c = _TAIL_CACHE[0]
+    if c is not None and c[1] == dt_s and c[0].shape == acc.shape and np.array_equal(c[0], acc):
+        return c[2]
+    tail = safe_tail(acc, dt_s)
+    _TAIL_CACHE[0] = (acc.copy(), dt_s, tail)
+    return tail
+
+
 def _taylor_batch(base, entries, duration_s, max_p_h, tol, rest_tol, stop_when_safe=False) -> BatchResult:
     """``simulate_batch(method="taylor")``: the entries (p, alpha, scale, theta0, omega0, eta, fall) run
     by :func:`~rocklab.models.rocking._taylor_record.run_taylor_record`."""
@@ -179,7 +193,7 @@ def _taylor_batch(base, entries, duration_s, max_p_h, tol, rest_tol, stop_when_s
         acc, t0, dta = np.ascontiguousarray(base.acc_m_s2, float), float(base.t_s[0]), float(base.dt_s)
     h = np.minimum(dta, max_p_h / p)  # longest step of each entry
     order = order_for(p * h, tol)
-    tail = safe_tail(acc, dta) if (stop_when_safe and base is not None) else np.zeros(0)
+    tail = _tail_of(acc, dta) if (stop_when_safe and base is not None) else np.zeros(0)
     with parallel_chunksize(RUNS_PER_CHUNK):
         status, t_over, th_end, w_end, t_end, nimp, mx = run_taylor_record(
             p, al, et, sc, th0, w0, acc, t0, dta, float(duration_s), order, float(max_p_h), float(rest_tol), fr, tail

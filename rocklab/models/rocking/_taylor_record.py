@@ -78,6 +78,8 @@ def order_for(p_h, tol: float) -> np.ndarray:
         hit = ~done & (term <= tol) & (n >= 4)
         out[hit] = n
         done |= hit
+        if n >= 4 and done.all():
+            break
     return out
 
 

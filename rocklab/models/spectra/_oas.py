@@ -614,9 +614,10 @@ def batch_runs(base, scale, p, args):
         stop_when_safe=method == "taylor",  # verdicts only: a run stops once it cannot reach alpha
     )
     over = np.asarray(b.overturned, bool)
-    if free_code == 1:
-        rocking = b.status == 0
-        over = over | (rocking & free_rocking_overturns(b.theta_end_rad, b.omega_end_rad_s, p[order], alpha, eta))
+    rocking = b.status == 0
+    if free_code == 1 and rocking.any():
+        ends = (b.theta_end_rad[rocking], b.omega_end_rad_s[rocking], p[order][rocking])
+        over[rocking] |= free_rocking_overturns(*ends, alpha, eta)
     out = np.empty_like(over)
     out[order] = over
     return out

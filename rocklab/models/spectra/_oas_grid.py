@@ -165,8 +165,8 @@ def _simulate(run, over, known, lo, hi, rows):
 def _windows(run, over, known, lo, hi, frontier, mid=None):
     """Simulate each row's window [lo, hi); rows with no unsafe point there move on to the right in steps of
     ``frontier`` until one is found or the row ends (``lo``, ``hi`` updated in place). With ``mid``: [lo, mid)
-    first and [mid, hi) only for the rows with no unsafe point yet (the first unsafe point is the same; the
-    points after it are not needed)."""
+    first and [mid, hi) only for the rows with no unsafe point yet; the later windows likewise in pieces of 2, 2
+    and the rest (the first unsafe point is the same; the points after it are not needed)."""
     n_cols = over.shape[1]
     active = hi > lo
     if mid is not None:
@@ -178,7 +178,9 @@ def _windows(run, over, known, lo, hi, frontier, mid=None):
         lo[active] = hi[active]
         hi[active] = np.minimum(hi[active] + max(1, int(frontier)), n_cols)
     while active.any():
-        _simulate(run, over, known, lo, hi, np.flatnonzero(active))
+        # left to right in pieces of 2, 2 and the rest, each for the rows with no unsafe point yet
+        for a, b in ((lo, np.minimum(lo + 2, hi)), (np.minimum(lo + 2, hi), np.minimum(lo + 4, hi)), (lo + 4, hi)):
+            _simulate(run, over, known, a, b, np.flatnonzero(active & ~over.any(axis=1)))
         active = ~over.any(axis=1) & (hi < n_cols) & (hi > lo)
         lo[active] = hi[active]
         hi[active] = np.minimum(hi[active] + max(1, int(frontier)), n_cols)

@@ -149,9 +149,9 @@ def main() -> int:
 def where_the_time_goes(rec) -> None:
     """One default OAS on one numba thread, CPU time of the calling thread (where a 1-thread parallel call
     runs; process CPU would add the idle OpenMP worker's spinning): the batch kernel's share, the Python around it
-    (grid logic, bisection, order selection), and how evenly each parallel call's static split over 2
-    threads divides its runs (each run timed alone, best of 2; the split is the one numba's prange makes
-    of the batch's interleaved order)."""
+    (grid logic, bisection, order selection), and how evenly each parallel call's runs divide over 2 threads
+    (each run timed alone, best of 2; dealt in chunks of ``RUNS_PER_CHUNK`` in the batch's interleaved order as the
+    threads free up, as numba's dynamic schedule does)."""
     import numba
 
     import rocklab.models.rocking._batch as batch_mod
@@ -192,18 +192,27 @@ def where_the_time_goes(rec) -> None:
                 kernel(*one)
                 best = min(best, time.thread_time() - c0)
             cost[i] = best
-        half = (cost.size + 1) // 2
         work += cost.sum()
-        spans += max(cost[:half].sum(), cost[half:].sum())
+        spans += _makespan(cost, batch_mod.RUNS_PER_CHUNK)
     numba.set_num_threads(nt)
     k = int(np.argmin(totals))
     print(
         f"where the time goes (one default OAS, 1 numba thread, thread CPU, best of 3): {totals[k]:.3f} CPU-s, "
         f"of which the batch kernel {kernels[k]:.3f} ({100 * kernels[k] / totals[k]:.1f} %; {len(calls)} parallel "
-        f"calls), Python around it {totals[k] - kernels[k]:.3f}; static split of each call over 2 threads "
-        f"(its runs timed alone, best of 2): the longer halves hold {100 * spans / work:.1f} % of the work "
-        f"(balance {work / 2 / spans:.3f}); estimate on 2 idle cores {totals[k] * spans / work:.3f} s"
+        f"calls), Python around it {totals[k] - kernels[k]:.3f}; each call's runs dealt to 2 threads in chunks of "
+        f"{batch_mod.RUNS_PER_CHUNK} as they free up (its runs timed alone, best of 2): the busier thread holds "
+        f"{100 * spans / work:.1f} % of the work (balance {work / 2 / spans:.3f}); estimate on 2 idle cores "
+        f"{totals[k] - kernels[k] + kernels[k] * spans / work:.3f} s (the Python part serial)"
     )
+
+
+def _makespan(cost, chunk: int, threads: int = 2) -> float:
+    """Time of one parallel call whose runs (``cost``, s, in the call's order) go to ``threads`` threads in chunks
+    of ``chunk``, each chunk to the thread that is free first (dynamic scheduling)."""
+    busy = np.zeros(threads)
+    for s in range(0, cost.size, chunk):
+        busy[np.argmin(busy)] += cost[s : s + chunk].sum()
+    return float(busy.max())
 
 
 if __name__ == "__main__":

@@ -224,7 +224,7 @@ class BatchResult:
         max |theta| / alpha over the run.
     n_impacts : ndarray of int, shape (m,)
     status : ndarray of int8, shape (m,)
-        0 rocking at the end, 1 rest, 2 overturned, 3 no uplift.
+        0 rocking at the end, 1 rest, 2 overturned, 3 no uplift, 4 stopped safe (``stop_when_safe``).
     p_rad_s, alpha_rad, scale, eta : ndarray, shape (m,)
         The broadcast inputs.
     dt_s : ndarray, shape (m,)

@@ -19,6 +19,15 @@ caller. Events are roots of the step's polynomial, not of a discretisation:
   impact inside the step);
 - uplift from rest: ``|ug| = tan(alpha)`` on the linear interval, in closed form.
 
+Safe stop (optional, for verdicts only): with E = omega^2/2 + p^2 cos(c) and the excess energy over
+rest on the corner K = E - p^2 cos(alpha) (>= 0 while |theta| <= alpha, = omega^2/2 at theta = 0),
+the equation gives dK/dt = -p^2 ug cos(c) omega, and omega^2 <= 2K, so d sqrt(K)/dt <= p^2 |ug| / sqrt(2);
+an impact multiplies K by eta^2 and rest keeps K = 0. Reaching |theta| = alpha needs K >= p^2 (1 - cos
+alpha), and so does overturning in free rocking after the record (:func:`free_rocking_overturns`). So at
+a record sample where sqrt(K) + p^2 / sqrt(2) * int |ug| dt over the rest of the record stays below
+p sqrt(1 - cos(alpha)), the block can neither reach alpha nor overturn later: the run stops there with
+status 4 (safe), its verdict known without the rest of the record.
+
 Same rest and overturning rules as the Newmark batch kernel
 (:func:`~rocklab.models.rocking._newmark.run_batch`): rest when ``omega+^2 <= rest_w2``
 with the base below uplift, the run ends at rest after the record's last sample above
@@ -38,12 +47,12 @@ from ...blocks import G
 from ._newmark_lean import sdcd
 from ._taylor import series_root, series_slope, series_value
 
-__all__ = ["run_taylor_record", "order_for", "MAX_ORDER"]
+__all__ = ["run_taylor_record", "order_for", "safe_tail", "MAX_ORDER"]
 
 #: Highest order a step may use.
 MAX_ORDER = 40
 
-_ROCKING, _REST, _OVERTURNED, _NO_UPLIFT = 0, 1, 2, 3
+_ROCKING, _REST, _OVERTURNED, _NO_UPLIFT, _SAFE = 0, 1, 2, 3, 4
 
 
 def order_for(p_h, tol: float) -> np.ndarray:
@@ -69,7 +78,37 @@ def order_for(p_h, tol: float) -> np.ndarray:
         hit = ~done & (term <= tol) & (n >= 4)
         out[hit] = n
         done |= hit
+        if n >= 4 and done.all():
+            break
     return out
+
+
+def safe_tail(acc, dt_s: float) -> np.ndarray:
+    """Per sample k, the integral of |acc| from sample k to the last one (acc's unit times s), acc linear between
+    samples, rounded up.
+
+    Parameters
+    ----------
+    acc : array_like, shape (n,)
+        Samples of the (piecewise linear) base acceleration.
+    dt_s : float
+        Sample interval, s.
+
+    Returns
+    -------
+    ndarray, shape (n,)
+        Non-increasing, 0 at the last sample.
+    """
+    a = np.asarray(acc, float)
+    a0, a1 = np.abs(a[:-1]), np.abs(a[1:])
+    same = a[:-1] * a[1:] >= 0.0
+    total = a0 + a1
+    # an interval that crosses zero holds two triangles: (a0^2 + a1^2) / (2 (|a0| + |a1|)) dt
+    cross = np.divide(a0 * a0 + a1 * a1, total, out=np.zeros_like(total), where=total > 0)
+    seg = 0.5 * np.where(same, total, cross) * float(dt_s)
+    out = np.zeros(a.size)
+    out[:-1] = np.cumsum(seg[::-1])[::-1]
+    return out * (1.0 + 1e-12)  # rounding of the sums stays on the safe side
 
 
 #: 1/k and 1/((k+1)(k+2)): multiplications instead of divisions in the recurrence's dependency chain.
@@ -185,8 +224,12 @@ def _segment(k, acc, t0, dta, duration, fac):
 
 
 @njit(cache=True, fastmath={"contract"})
-def run_one(p, alpha, eta, scale, th0, w0, acc, t0, dta, duration, order, max_p_h, rest_w2, fall_rad):
+def run_one(p, alpha, eta, scale, th0, w0, acc, t0, dta, duration, order, max_p_h, rest_w2, fall_rad, tail):
     """One block under ``acc * scale`` (m/s^2, samples every ``dta`` s from ``t0``) until ``duration`` s.
+
+    ``tail``: empty, or per sample k a bound on the integral of |acc| from sample k to the record's end
+    (:func:`safe_tail`): the run then stops (status 4) at the first record sample where the energy the rest of
+    the record can give cannot lift the block to ``alpha`` (the module docstring's safe stop).
 
     Returns (status, t_over s, theta_end rad, omega_end rad/s, t_end s, n_impacts, max |theta| rad).
     """
@@ -219,10 +262,22 @@ def run_one(p, alpha, eta, scale, th0, w0, acc, t0, dta, duration, order, max_p_
     L_prev = -1.0
     n_sub = 1
     h_sub = 0.0
+    # the safe stop (module docstring): sqrt(K) + c_tail * tail[k] < sqrt(K_alpha), K the excess energy
+    k_alpha = math.sqrt(p2 * (1.0 - cos_a))
+    c_tail = p2 * abs(fac) / math.sqrt(2.0)
+    check = tail.shape[0] == n_acc
     for k in range(-1, n_acc):
         ta, L, u_a, du = _segment(k, acc, t0, dta, duration, fac)
         if L <= 0.0:
             continue
+        if check and k >= 0 and not (resting and ta >= t_last_up):  # (a rest there ends the run anyway)
+            room = k_alpha - c_tail * tail[k]
+            if room > 0.0:
+                excess = 0.0 if resting else 0.5 * w * w + p2 * (cc - cos_a)
+                if excess + 1e-12 * p2 < room * room * (1.0 - 1e-9):  # margins above the rounding of K
+                    t = ta
+                    status = _SAFE
+                    break
         if L != L_prev:  # the record's intervals share one length: its division is done once
             n_sub = max(1, int(math.ceil(p * L / max_p_h - 1e-12)))
             h_sub = L / n_sub
@@ -340,14 +395,17 @@ def run_one(p, alpha, eta, scale, th0, w0, acc, t0, dta, duration, order, max_p_
             break
     if status == _OVERTURNED:
         return status, t_over, th, w, t_over, n_imp, max_abs
+    if status == _SAFE:
+        return status, t_over, (0.0 if resting else th), (0.0 if resting else w), t, n_imp, max_abs
     if status == _REST or resting:
         return (_REST if ever_moved else _NO_UPLIFT), t_over, 0.0, 0.0, t, n_imp, max_abs
     return _ROCKING, t_over, th, w, duration, n_imp, max_abs
 
 
 @njit(cache=True, parallel=True)
-def run_taylor_record(p, alpha, eta, scale, th0, w0, acc, t0, dta, duration, order, max_p_h, rest_tol, fall_rad):
-    """m independent blocks in parallel by :func:`run_one` (summaries only; see ``simulate_batch``).
+def run_taylor_record(p, alpha, eta, scale, th0, w0, acc, t0, dta, duration, order, max_p_h, rest_tol, fall_rad, tail):
+    """m independent blocks in parallel by :func:`run_one` (summaries only; see ``simulate_batch``); ``tail``
+    empty or :func:`safe_tail` of ``acc`` (the safe stop).
 
     Returns ``status`` (int8), ``t_over``, ``theta_end``, ``omega_end``, ``t_end``, ``n_imp``, ``max_abs``, each (m,).
     """
@@ -364,7 +422,21 @@ def run_taylor_record(p, alpha, eta, scale, th0, w0, acc, t0, dta, duration, ord
         p2 = p[i] * p[i]
         rest_w2 = 2.0 * p2 * (math.cos(a - rest_tol * a) - math.cos(a))
         r = run_one(
-            p[i], a, eta[i], scale[i], th0[i], w0[i], acc, t0, dta, duration, order[i], max_p_h, rest_w2, fall_rad[i]
+            p[i],
+            a,
+            eta[i],
+            scale[i],
+            th0[i],
+            w0[i],
+            acc,
+            t0,
+            dta,
+            duration,
+            order[i],
+            max_p_h,
+            rest_w2,
+            fall_rad[i],
+            tail,
         )
         status[i] = r[0]
         t_over[i] = r[1]

@@ -539,19 +539,24 @@ def settle_guide(base, o, places, refine=10):
     left = np.where(m, int(refine), 0)
     step = abs(o.levels[1] - o.levels[0]) if o.levels.size > 1 else 1.0
 
+    # per member grid, which guide levels lie within one guide step of each of its levels (_guess_first)
+    nears = [(np.abs(o.levels[None, :] - np.asarray(lv)[:, None]) <= step * (1 + 1e-9), p) for lv, p in places]
+
     def wanted():
         want = _fit_levels(o.levels, p_hi, p_lo, left, m)
         live = np.isfinite(p_hi)
         low = np.where(left > 0, p_lo, p_hi)  # the bisected value lies in (low, p_hi]
-        for lv, p in places:
-            for level in lv:
-                near = live & (np.abs(o.levels - level) <= step * (1 + 1e-9))
-                if not near.any():
-                    continue
-                top = p_hi[near].min()
-                ahead = np.searchsorted(p, np.array([low[near].min(), top]) * (1 - 1e-12))
-                if ahead[0] != ahead[1]:  # a grid point inside the bracket: the guess is not settled
-                    want |= near & (left > 0) & (low < top)
+        for near0, p in nears:
+            near = near0 & live[None, :]  # (member levels, guide levels)
+            rows = near.any(axis=1)
+            if not rows.any():
+                continue
+            near = near[rows]
+            top = np.where(near, p_hi[None, :], np.inf).min(axis=1)
+            bottom = np.where(near, low[None, :], np.inf).min(axis=1)
+            ahead = np.searchsorted(p, bottom * (1 - 1e-12)) != np.searchsorted(p, top * (1 - 1e-12))
+            # a grid point inside a bracket: that guess is not settled
+            want |= (near[ahead] & (low[None, :] < top[ahead, None])).any(axis=0) & (left > 0)
         return want
 
     want = wanted()
@@ -606,11 +611,13 @@ def batch_runs(base, scale, p, args):
         max_p_dt=max_p_dt,
         method=method,
         taylor_tol=tol,
+        stop_when_safe=method == "taylor",  # verdicts only: a run stops once it cannot reach alpha
     )
     over = np.asarray(b.overturned, bool)
-    if free_code == 1:
-        rocking = b.status == 0
-        over = over | (rocking & free_rocking_overturns(b.theta_end_rad, b.omega_end_rad_s, p[order], alpha, eta))
+    rocking = b.status == 0
+    if free_code == 1 and rocking.any():
+        ends = (b.theta_end_rad[rocking], b.omega_end_rad_s[rocking], p[order][rocking])
+        over[rocking] |= free_rocking_overturns(*ends, alpha, eta)
     out = np.empty_like(over)
     out[order] = over
     return out

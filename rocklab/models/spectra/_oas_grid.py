@@ -150,18 +150,37 @@ def _check_frontier(run, over, known, width, only=None):
             return
 
 
-def _windows(run, over, known, lo, hi, frontier):
+def _simulate(run, over, known, lo, hi, rows):
+    """Simulate the columns [lo[r], hi[r]) of each row r in ``rows`` that are not known yet."""
+    if not rows.size:
+        return
+    i = np.concatenate([np.full(max(0, hi[r] - lo[r]), r) for r in rows]).astype(int)
+    j = np.concatenate([np.arange(lo[r], hi[r]) for r in rows]).astype(int)
+    todo = ~known[i, j]
+    if todo.any():
+        over[i[todo], j[todo]] = np.asarray(run(i[todo], j[todo]), bool)
+        known[i[todo], j[todo]] = True
+
+
+def _windows(run, over, known, lo, hi, frontier, mid=None):
     """Simulate each row's window [lo, hi); rows with no unsafe point there move on to the right in steps of
-    ``frontier`` until one is found or the row ends (``lo``, ``hi`` updated in place)."""
+    ``frontier`` until one is found or the row ends (``lo``, ``hi`` updated in place). With ``mid``: [lo, mid)
+    first and [mid, hi) only for the rows with no unsafe point yet; the later windows likewise in pieces of 2, 2
+    and the rest (the first unsafe point is the same; the points after it are not needed)."""
     n_cols = over.shape[1]
     active = hi > lo
+    if mid is not None:
+        mid = np.clip(mid, lo, hi)
+        _simulate(run, over, known, lo, mid, np.flatnonzero(active))
+        rest = active & ~over.any(axis=1)
+        _simulate(run, over, known, mid, hi, np.flatnonzero(rest))
+        active = rest & ~over.any(axis=1) & (hi < n_cols)
+        lo[active] = hi[active]
+        hi[active] = np.minimum(hi[active] + max(1, int(frontier)), n_cols)
     while active.any():
-        i = np.concatenate([np.full(hi[r] - lo[r], r) for r in np.flatnonzero(active)]).astype(int)
-        j = np.concatenate([np.arange(lo[r], hi[r]) for r in np.flatnonzero(active)]).astype(int)
-        todo = ~known[i, j]
-        if todo.any():
-            over[i[todo], j[todo]] = np.asarray(run(i[todo], j[todo]), bool)
-            known[i[todo], j[todo]] = True
+        # left to right in pieces of 2, 2 and the rest, each for the rows with no unsafe point yet
+        for a, b in ((lo, np.minimum(lo + 2, hi)), (np.minimum(lo + 2, hi), np.minimum(lo + 4, hi)), (lo + 4, hi)):
+            _simulate(run, over, known, a, b, np.flatnonzero(active & ~over.any(axis=1)))
         active = ~over.any(axis=1) & (hi < n_cols) & (hi > lo)
         lo[active] = hi[active]
         hi[active] = np.minimum(hi[active] + max(1, int(frontier)), n_cols)
@@ -180,7 +199,8 @@ def boundary_verdicts(
     """Each row's first unsafe point, searched near a guess (a neighbouring OAS's boundary).
 
     Per row, the points from ``first_guess - frontier`` to ``first_guess + ahead``
-    are simulated; a row with no unsafe point there moves on to the right in
+    are simulated (those after the guess only where none before it is unsafe: the row's first
+    unsafe point is all that is used); a row with no unsafe point there moves on to the right in
     steps of ``frontier`` until one is found or the row ends; then the frontier
     check of :func:`adaptive_verdicts` runs. Only the boundary (and hence t_I,
     t'_I and beta) is resolved: the map elsewhere is filled, safe before each
@@ -224,7 +244,8 @@ def boundary_verdicts(
         bound = key[rows, np.minimum(lo, n_cols - 1)]
         todo = bound < np.min(key[rows, np.maximum(hi, 1) - 1])
     while todo.any():
-        _windows(run, over, known, np.where(todo, lo, hi), hi, frontier)
+        # up to the guess first: a row whose first unsafe point lies there needs none of the points after it
+        _windows(run, over, known, np.where(todo, lo, hi), hi, frontier, mid=np.where(none, hi, g + 1))
         done |= todo
         if frontier > 0:
             _check_frontier(run, over, known, int(frontier), done)

@@ -44,6 +44,7 @@ from ._detection import Detection
 from ._ic import ICAffine, ICRigid
 from ._observability import MAX_UNMATCHED_TURN, cell_turn_info, sigma_theta, theta_unobservable, unmatched_turn_share
 from ._occlusion import CELL_CC, GRID, ROUND_MIN, cell_correlations, masked_fit, partly_covered
+from ._turn_search import PolarRings
 from ._twins import TwinGuard
 from ._verify import PoseVerifier, best_turned_match
 
@@ -79,6 +80,16 @@ FAST_CC = 0.97
 CC_ROUNDING = 1e-6
 #: Turns of the template tried round the predicted angle when re-acquiring, degrees.
 SEARCH_TURNS_DEG = (0.0, -2.0, 2.0, -4.0, 4.0, -6.0, 6.0, -8.0, 8.0)
+#: The rotation search (:mod:`._turn_search`) looks this far round the predicted angle, rad.
+TURN_SEARCH_RAD = math.radians(45.0)
+#: A fitted angle fails the rotation check when a turn of the template's inscribed disc within
+#: :data:`TURN_SEARCH_RAD` of the prediction correlates better than the fitted angle's by this
+#: much (normalised correlation) ...
+TURN_SCORE_GAP = 0.1
+#: ... and lies more than this from it, rad.
+TURN_DIFF_RAD = math.radians(3.0)
+#: Least correlation of the best turn for the search to replace a fitted angle.
+MIN_TURN_SCORE = 0.5
 #: ECC stopping rule: 60 iterations or a correlation gain below 1e-5.
 ECC_CRITERIA = (3, 60, 1e-5)  # cv2.TERM_CRITERIA_EPS | cv2.TERM_CRITERIA_COUNT
 
@@ -106,6 +117,13 @@ def _params(W):
 def _rigid(W):
     """The rigid warp nearest to ``W`` (same translation, the polar rotation)."""
     return _euclid(*_params(W))
+
+
+def _turned_about(theta, c, c0):
+    """The rigid pose turned by ``theta`` (rad) that puts the first-frame point ``c0`` on the image
+    point ``c`` (px)."""
+    R = np.array([[math.cos(theta), -math.sin(theta)], [math.sin(theta), math.cos(theta)]])
+    return _euclid(theta, *(np.asarray(c, float) - R @ np.asarray(c0, float)))
 
 
 def _near_rigid(W, tol=0.05):
@@ -194,6 +212,8 @@ class MarkerlessTracker:
         self._turn_info: tuple = (None, None)  # (template, its cells' turning information)
         #: verified frames, and those whose angle was not a measurement (:meth:`_angle_unmatched`)
         self.theta_frames = [0, 0]
+        self._rings: tuple = (None, None, None)  # (template, its PolarRings, its inscribed-disc mask)
+        self._turn_sigma = 0.0  # the rotation search's and the disc fit's angles apart this frame, rad
 
     # -- registration -------------------------------------------------------------
     def _window(self, gray, W, margin):
@@ -471,12 +491,16 @@ class MarkerlessTracker:
     def detect(self, gray, frame):
         """The object's reference points in ``gray``: a :class:`Detection`, or None (lost)."""
         if len(self.poses) >= 2:
-            (a0, x0, y0), (a1, x1, y1) = self.poses[-2], self.poses[-1]
-            W_pred = _euclid(2 * a1 - a0, 2 * x1 - x0, 2 * y1 - y0)
+            # the region's centre and its angle at constant velocity (its corner's translation is
+            # not linear in a turning object's angle)
+            a0, a1 = self.poses[-2][0], self.poses[-1][0]
+            c_0, c_1 = (_euclid(*p)[:, :2].astype(float) @ self.centre0 + p[1:] for p in self.poses[-2:])
+            W_pred = _turned_about(2 * a1 - a0, 2 * c_1 - c_0, self.centre0)
         elif self.poses:
             W_pred = _euclid(*self.poses[-1])
         else:
             W_pred = _euclid(0.0, 0.0, 0.0)
+        self._turn_sigma = 0.0
         fit = self._ecc(self.tmpl0, gray, W_pred, direct=len(self.poses) >= 2)
         tmpl = self.tmpl0
         first_view = fit is not None and fit[1] >= REKEY_CC  # the frame is a turned copy of the first
@@ -501,6 +525,10 @@ class MarkerlessTracker:
             if part is not None:
                 fit, tmpl, mask, visible = part[:2], self.key, part[2], part[3]
         self.reason = None
+        if fit is not None and fit[1] >= MIN_CC and mask is None and self.theta_note is None:
+            turned = self._turn_check(tmpl, gray, fit, W_pred)
+            if turned is not None:
+                fit, mask, visible = turned[:2], turned[2], 1.0
         if fit is not None and fit[1] >= MIN_CC:
             fit = (self._held(fit[0]), fit[1])
             self.reason = self.verifier.verify(self, gray, fit[0], frame, fit[1])
@@ -553,6 +581,99 @@ class MarkerlessTracker:
         n_expected = len(self.grid) if mask is None else int(math.ceil(len(self.grid) / max(visible, 1e-3)))
         return Detection(pts, self.obj_pts, False, n_expected, sigma_rad=sig, n_groups=1, score=cc, theta_why=why)
 
+    def _turn_check(self, tmpl, gray, fitted, W_pred):
+        """The rotation check of the fitted pose ``fitted = (W, cc)`` on ``tmpl``
+        (:mod:`._turn_search`), and its fallback.
+
+        The template's inscribed disc is turned about the point ``W`` puts its centre on (and about
+        the point the prediction puts it on: a fit pulled to the wrong angle is pulled off the
+        centre too); when a turn within :data:`TURN_SEARCH_RAD` of the predicted angle (none
+        there: anywhere round) matches better than the fitted angle by :data:`TURN_SCORE_GAP`,
+        the fitted angle was set by the rest of the region (a still background in its corners,
+        while a mark on the object turned): the pose is fitted again from that turn on the
+        inscribed disc alone. The frame's angle is then not reported unless that fit agrees with
+        the turn found to :data:`TURN_DIFF_RAD` (and its σ holds their difference).
+
+        Returns
+        -------
+        (W, cc, mask) or None
+            The pose refitted on the disc, the fit's correlation (the template is found here:
+            what the verifier and the quality know) and the disc's pixel mask; None when the
+            fitted angle passes, the disc tells no angle or leaves the frame, or no turn is refound
+            (then, or where the disc matches at no turn, this frame's angle is not reported).
+        """
+        W, cc = fitted
+        found = self._best_turn(tmpl, gray, W, W_pred)
+        if found is None:
+            return None
+        th, best, s_fit, c, c0 = found
+        th_fit = _params(W)[0]
+        gap = abs(math.remainder(th - th_fit, 2 * math.pi))
+        if best < MIN_TURN_SCORE and s_fit < MIN_TURN_SCORE:
+            # the disc matches at no turn (its mark smeared, or out of the disc): no angle here
+            self._turn_sigma = math.inf
+            return None
+        if best - s_fit < TURN_SCORE_GAP or gap < TURN_DIFF_RAD:
+            return None
+        self._turn_sigma = math.inf  # the fitted angle failed the check: no angle unless refound
+        if best < MIN_TURN_SCORE:
+            return None
+        rigid, _ = self._ic_for(tmpl)
+        disc = self._rings[2]
+
+        def fit(window, Ww):
+            got = rigid.refine(window, self._to_tmpl(Ww), mask=disc)
+            return None if got is None else (self._from_tmpl(got[0]), got[1])
+
+        r = self.fit_near(gray, _turned_about(th, c, c0), fit)
+        if r is None:
+            return None
+        # the disc fit places the turn's centre; its angle and the search's are two measurements
+        # of one angle: the angle is known no better than they agree
+        miss = abs(math.remainder(_params(r[0])[0] - th, 2 * math.pi))
+        if miss > TURN_DIFF_RAD or r[1] <= self._disc_cc(tmpl, gray, W):
+            return None  # (a fitted pose the disc itself matches about as well: a hand over part of it)
+        self._turn_sigma = miss
+        return r[0], cc, disc
+
+    def _disc_cc(self, tmpl, gray, W) -> float:
+        """Correlation of ``tmpl``'s inscribed disc with ``gray`` warped back by the pose ``W``."""
+        back = self._warp_back(gray, W)
+        if back is None:
+            return -1.0
+        disc = self._rings[2]
+        a, b = tmpl[disc] - tmpl[disc].mean(), back[disc] - back[disc].mean()
+        return float((a * b).sum() / (math.sqrt(float((a * a).sum()) * float((b * b).sum())) + 1e-9))
+
+    def _best_turn(self, tmpl, gray, W, W_pred):
+        """The best turn of ``tmpl``'s inscribed disc in ``gray``: ``(θ rad, its score, the fitted
+        angle's score, the centre turned about (image px), that centre in first-frame px)``,
+        about the better of the centres ``W`` and ``W_pred`` give; None when the disc tells no
+        angle or leaves the frame."""
+        if self._rings[0] is not tmpl:
+            rings = PolarRings(tmpl)
+            h, w = tmpl.shape
+            yy, xx = np.mgrid[0:h, 0:w]
+            disc = np.hypot(xx - rings.centre[0], yy - rings.centre[1]) <= rings.radius
+            self._rings = (tmpl, rings, disc)
+        rings = self._rings[1]
+        if not rings.tells_angle:
+            return None
+        c0 = self.origin + np.asarray(rings.centre)
+        th_fit, th_pred = _params(W)[0], _params(W_pred)[0]
+        out = None
+        for Wc in (W, W_pred) if self.poses else (W,):
+            c = Wc[:, :2].astype(float) @ c0 + Wc[:, 2].astype(float)
+            scores = rings.scores(gray, c)
+            if not np.isfinite(scores).all():
+                continue
+            th, best = PolarRings.best_near(scores, th_pred, TURN_SEARCH_RAD)
+            if best < MIN_TURN_SCORE:  # not near the prediction (after lost frames): anywhere round
+                th, best = PolarRings.best_near(scores, th_fit, math.pi)
+            if out is None or best > out[1]:
+                out = (th, best, PolarRings.at(scores, th_fit), c, c0)
+        return out
+
     def _settle(self, tmpl, gray, fit, mask, visible):
         """The verified fit ``(W, cc)`` on ``tmpl`` made final: ``((W, cc), mask, visible, why, σ)``.
 
@@ -566,6 +687,8 @@ class MarkerlessTracker:
         why = self._angle_unmatched(tmpl, gray, W) if mask is None and self.theta_note is None else None
         if why is None and tmpl is not self.tmpl0 and not math.isfinite(self.key_sigma_rad):
             why = "keyframe"
+        if why is None and not math.isfinite(self._turn_sigma):
+            why = "turn"  # the rotation check failed the fitted angle and found no other
         if self.theta_note is None:
             self.theta_frames[0] += 1
             self.theta_frames[1] += why is not None
@@ -577,13 +700,19 @@ class MarkerlessTracker:
                 part = masked_fit(self, tmpl, gray, W)
                 if part is not None:
                     (W, cc), mask, visible = part[:2], part[2], part[3]
-            elif back is not None:  # appearance drifted from the first frame: renew the keyframe here
+            elif back is not None and why != "turn":  # appearance drifted from the first frame: renew the keyframe here
                 # a keyframe cut where the angle was no measurement carries no angle on
                 key_sig = self._chained_sigma(tmpl, gray, W) if why is None else math.inf
                 self.key, self.key_sigma_rad = back, key_sig
                 self.verifier.fb.keyframe(self, gray, W)
         sig = self._chained_sigma(tmpl, gray, W, mask) if why is None else math.nan
-        return (W, cc), mask, visible, why, math.hypot(sig, self.theta0_sigma_rad)
+        # an angle from the turn search matched the first frame's sharp mark to one smeared over
+        # the angle swept in the exposure (up to a frame's time): it is that sweep's midpoint to
+        # within the sweep's standard deviation
+        sweep = 0.0
+        if self.poses and mask is not None and self._turn_sigma > 0.0:
+            sweep = abs(math.remainder(_params(W)[0] - self.poses[-1][0], 2 * math.pi)) / math.sqrt(12)
+        return (W, cc), mask, visible, why, math.hypot(sig, self.theta0_sigma_rad, self._turn_sigma, sweep)
 
     def _chained_sigma(self, tmpl, gray, W, mask=None):
         """σ of θ (rad) of the pose ``W`` registered on ``tmpl``: the fit's own, and on a keyframe

@@ -92,3 +92,42 @@ def test_disc_turning_behind_a_region_drawn_inside_it_reports_the_marks_angle():
         exp = np.stack([PIN[0] + cs * c0[0] - sn * c0[1], PIN[1] + sn * c0[0] + cs * c0[1]], 1)
         off = np.hypot(d.x_px - exp[:, 0], d.y_px - exp[:, 1])
         assert np.all(off[ok] < 0.01 * W), (roi, off[ok].max())
+
+
+def test_a_turn_the_whole_region_follows_is_not_searched(monkeypatch):
+    """The rotation search is for doubtful fits only: a textured round plate turning under a region
+    drawn inside it (nothing still in its corners) matches the fitted pose on its inscribed disc as well as
+    on the whole region, so no frame is searched (each search costs 1.4-6.5 ms) and every angle is
+    kept (on the development pendulum film the search had dropped 86-271 right angles per box)."""
+    from rocklab.tracking.video.targets import _markerless
+
+    rng = np.random.default_rng(5)
+    plate = cv2.GaussianBlur(rng.normal(128, 40, (H, W)).astype(np.float32), (0, 0), 2.5)
+    plate = 128 + (plate - plate.mean()) * (45 / plate.std())
+    truth = _turns(40)
+    yy, xx = np.mgrid[0:H, 0:W]
+    inside = np.hypot(xx - PIN[0], yy - PIN[1]) < R_DISC
+    frames = []
+    for a in truth:
+        M = cv2.getRotationMatrix2D(PIN, -math.degrees(a), 1.0)  # image angle, y down
+        img = cv2.warpAffine(plate, M, (W, H), flags=cv2.INTER_LINEAR, borderMode=cv2.BORDER_REFLECT)
+        img = np.where(inside, img, 90.0)  # a round plate of R_DISC px on a plain wall
+        frames.append(np.clip(img + rng.normal(0, 1.5, img.shape), 0, 255).astype(np.uint8))
+    searched = []
+    best_turn = _markerless.MarkerlessTracker._best_turn
+    monkeypatch.setattr(
+        _markerless.MarkerlessTracker, "_best_turn", lambda self, *a: searched.append(1) or best_turn(self, *a)
+    )
+    cfg = TrackConfig.from_dict(
+        {
+            "targets": {"style": "markerless"},
+            "reference": {"level": "none", "m_per_px": 1e-3},
+            "objects": [{"id": "d", "kind": "block", "roi": [112, 72, 97, 97]}],
+        }
+    )
+    d = assemble_tracks(track_frames(frames, cfg), cfg, FPS, W, H)["d"]
+    th = np.asarray(d.theta_rad, float)
+    assert np.all(np.asarray(d.status) == "ok") and np.isfinite(th).all()
+    err = np.abs(np.remainder(th - th[0] + truth + math.pi, 2 * math.pi) - math.pi)
+    assert err.max() < math.radians(0.5), np.degrees(err.max())
+    assert len(searched) == 0, len(searched)

@@ -42,9 +42,16 @@ import numpy as np
 from ...._errors import InputError
 from ._detection import Detection
 from ._ic import ICAffine, ICRigid
-from ._observability import MAX_UNMATCHED_TURN, cell_turn_info, sigma_theta, theta_unobservable, unmatched_turn_share
+from ._observability import (
+    CELL_TURN_GAP,
+    MAX_UNMATCHED_TURN,
+    cell_turn_info,
+    sigma_theta,
+    theta_unobservable,
+    unmatched_turn_share,
+)
 from ._occlusion import CELL_CC, GRID, ROUND_MIN, cell_correlations, masked_fit, partly_covered
-from ._turn_search import PolarRings
+from ._turn_search import MIN_DISC_RADIUS_PX, PolarRings, inscribed_disc
 from ._twins import TwinGuard
 from ._verify import PoseVerifier, best_turned_match
 
@@ -212,7 +219,10 @@ class MarkerlessTracker:
         self._turn_info: tuple = (None, None)  # (template, its cells' turning information)
         #: verified frames, and those whose angle was not a measurement (:meth:`_angle_unmatched`)
         self.theta_frames = [0, 0]
-        self._rings: tuple = (None, None, None)  # (template, its PolarRings, its inscribed-disc mask)
+        self._rings: tuple = (None, None)  # (template, its PolarRings)
+        self._disc = inscribed_disc(tmpl.shape)  # the templates' inscribed disc: centre, radius, mask
+        self._back: tuple = (None, None, None)  # (image, pose bytes, the last _warp_back)
+        self._disc_tmpl: tuple = (None, None)  # (template, its disc's pixels normalised for _disc_cc)
         self._turn_sigma = 0.0  # the rotation search's and the disc fit's angles apart this frame, rad
 
     # -- registration -------------------------------------------------------------
@@ -477,6 +487,9 @@ class MarkerlessTracker:
 
     def _warp_back(self, gray, W):
         """The current image resampled onto the template grid by the pose W (float32), or None."""
+        key = W.tobytes()
+        if self._back[0] is gray and self._back[1] == key:  # the checks of one pose share it
+            return self._back[2]
         cv2 = self._cv2
         crop, off = self._window(gray, W, 4)
         if crop is None:
@@ -484,23 +497,23 @@ class MarkerlessTracker:
         Wfull = W.copy()
         Wfull[:, 2] += (W[:, :2] @ self.origin).astype(np.float32) - off
         h, w = self.tmpl0.shape
-        return cv2.warpAffine(
+        back = cv2.warpAffine(
             crop, Wfull, (w, h), flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP, borderMode=cv2.BORDER_REPLICATE
         )
+        self._back = (gray, key, back)
+        return back
 
     def detect(self, gray, frame):
         """The object's reference points in ``gray``: a :class:`Detection`, or None (lost)."""
         if len(self.poses) >= 2:
-            # the region's centre and its angle at constant velocity (its corner's translation is
-            # not linear in a turning object's angle)
-            a0, a1 = self.poses[-2][0], self.poses[-1][0]
-            c_0, c_1 = (_euclid(*p)[:, :2].astype(float) @ self.centre0 + p[1:] for p in self.poses[-2:])
-            W_pred = _turned_about(2 * a1 - a0, 2 * c_1 - c_0, self.centre0)
+            (a0, x0, y0), (a1, x1, y1) = self.poses[-2], self.poses[-1]
+            W_pred = _euclid(2 * a1 - a0, 2 * x1 - x0, 2 * y1 - y0)
         elif self.poses:
             W_pred = _euclid(*self.poses[-1])
         else:
             W_pred = _euclid(0.0, 0.0, 0.0)
         self._turn_sigma = 0.0
+        self._back = (None, None, None)  # a frame's buffer may be reused for the next frame
         fit = self._ecc(self.tmpl0, gray, W_pred, direct=len(self.poses) >= 2)
         tmpl = self.tmpl0
         first_view = fit is not None and fit[1] >= REKEY_CC  # the frame is a turned copy of the first
@@ -525,7 +538,13 @@ class MarkerlessTracker:
             if part is not None:
                 fit, tmpl, mask, visible = part[:2], self.key, part[2], part[3]
         self.reason = None
-        if fit is not None and fit[1] >= MIN_CC and mask is None and self.theta_note is None:
+        if (
+            fit is not None
+            and fit[1] >= MIN_CC
+            and mask is None
+            and self.theta_note is None
+            and self.round_note is None
+        ):
             turned = self._turn_check(tmpl, gray, fit, W_pred)
             if turned is not None:
                 fit, mask, visible = turned[:2], turned[2], 1.0
@@ -603,14 +622,21 @@ class MarkerlessTracker:
             (then, or where the disc matches at no turn, this frame's angle is not reported).
         """
         W, cc = fitted
+        disc_cc = self._disc_cc(tmpl, gray, W) if self._disc[1] >= MIN_DISC_RADIUS_PX else math.inf
+        if disc_cc > cc - CELL_TURN_GAP:
+            # the region's disc matches the fitted pose as well as the whole region does (as a
+            # cell that matches, :data:`._observability.CELL_TURN_GAP`): nothing to doubt
+            return None
         found = self._best_turn(tmpl, gray, W, W_pred)
         if found is None:
             return None
         th, best, s_fit, c, c0 = found
         th_fit = _params(W)[0]
         gap = abs(math.remainder(th - th_fit, 2 * math.pi))
-        if best < MIN_TURN_SCORE and s_fit < MIN_TURN_SCORE:
-            # the disc matches at no turn (its mark smeared, or out of the disc): no angle here
+        if best < MIN_TURN_SCORE and s_fit < MIN_TURN_SCORE and gap > TURN_SEARCH_RAD:
+            # the disc matches at no turn (its mark smeared, or out of the disc), and its best
+            # turn is far from the fitted angle (near it, the fit agrees with the disc: a ball's
+            # texture changing as it spins in depth): no angle here
             self._turn_sigma = math.inf
             return None
         if best - s_fit < TURN_SCORE_GAP or gap < TURN_DIFF_RAD:
@@ -619,7 +645,7 @@ class MarkerlessTracker:
         if best < MIN_TURN_SCORE:
             return None
         rigid, _ = self._ic_for(tmpl)
-        disc = self._rings[2]
+        disc = self._disc[2]
 
         def fit(window, Ww):
             got = rigid.refine(window, self._to_tmpl(Ww), mask=disc)
@@ -631,32 +657,36 @@ class MarkerlessTracker:
         # the disc fit places the turn's centre; its angle and the search's are two measurements
         # of one angle: the angle is known no better than they agree
         miss = abs(math.remainder(_params(r[0])[0] - th, 2 * math.pi))
-        if miss > TURN_DIFF_RAD or r[1] <= self._disc_cc(tmpl, gray, W):
+        if miss > TURN_DIFF_RAD or r[1] <= disc_cc:
             return None  # (a fitted pose the disc itself matches about as well: a hand over part of it)
         self._turn_sigma = miss
         return r[0], cc, disc
+
+    def _rings_of(self, tmpl) -> PolarRings:
+        """``tmpl``'s :class:`PolarRings` (kept for the last template)."""
+        if self._rings[0] is not tmpl:
+            self._rings = (tmpl, PolarRings(tmpl))
+        return self._rings[1]
 
     def _disc_cc(self, tmpl, gray, W) -> float:
         """Correlation of ``tmpl``'s inscribed disc with ``gray`` warped back by the pose ``W``."""
         back = self._warp_back(gray, W)
         if back is None:
             return -1.0
-        disc = self._rings[2]
-        a, b = tmpl[disc] - tmpl[disc].mean(), back[disc] - back[disc].mean()
-        return float((a * b).sum() / (math.sqrt(float((a * a).sum()) * float((b * b).sum())) + 1e-9))
+        w = self._disc[2].ravel().astype(np.float64)
+        if self._disc_tmpl[0] is not tmpl:  # the template's disc at zero mean and unit norm (it runs every frame)
+            a = (tmpl.ravel() - float(tmpl.ravel() @ w) / w.sum()) * w
+            self._disc_tmpl = (tmpl, a / (math.sqrt(float(a @ a)) + 1e-12))
+        b = back.ravel().astype(np.float64)
+        s1, s2 = float(b @ w), float((b * b) @ w)
+        return float(self._disc_tmpl[1] @ b) / (math.sqrt(max(s2 - s1 * s1 / w.sum(), 0.0)) + 1e-9)
 
     def _best_turn(self, tmpl, gray, W, W_pred):
         """The best turn of ``tmpl``'s inscribed disc in ``gray``: ``(θ rad, its score, the fitted
         angle's score, the centre turned about (image px), that centre in first-frame px)``,
         about the better of the centres ``W`` and ``W_pred`` give; None when the disc tells no
         angle or leaves the frame."""
-        if self._rings[0] is not tmpl:
-            rings = PolarRings(tmpl)
-            h, w = tmpl.shape
-            yy, xx = np.mgrid[0:h, 0:w]
-            disc = np.hypot(xx - rings.centre[0], yy - rings.centre[1]) <= rings.radius
-            self._rings = (tmpl, rings, disc)
-        rings = self._rings[1]
+        rings = self._rings_of(tmpl)
         if not rings.tells_angle:
             return None
         c0 = self.origin + np.asarray(rings.centre)

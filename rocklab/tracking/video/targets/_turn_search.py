@@ -18,7 +18,7 @@ import math
 
 import numpy as np
 
-__all__ = ["PolarRings", "N_ANGLES", "MIN_RADIUS_PX", "MIN_DISC_RADIUS_PX", "MIN_ENERGY"]
+__all__ = ["PolarRings", "inscribed_disc", "N_ANGLES", "MIN_RADIUS_PX", "MIN_DISC_RADIUS_PX", "MIN_ENERGY"]
 
 #: Samples round a ring (1 degree apart).
 N_ANGLES = 360
@@ -39,6 +39,15 @@ MIN_DISC_RADIUS_PX = 16.0
 MIN_ENERGY = 1.0
 
 
+def inscribed_disc(shape):
+    """The disc a template of ``shape`` (h, w) is searched on: its centre (x, y px from pixel
+    (0, 0)), its radius px (a pixel in from the template's edge) and its pixel mask (h, w) bool."""
+    h, w = shape[:2]
+    centre, radius = ((w - 1) / 2.0, (h - 1) / 2.0), 0.5 * min(w, h) - 1.0
+    yy, xx = np.mgrid[0:h, 0:w]
+    return centre, radius, np.hypot(xx - centre[0], yy - centre[1]) <= radius
+
+
 class PolarRings:
     """A template's inscribed disc on polar rings, to score its turns in a frame.
 
@@ -52,11 +61,9 @@ class PolarRings:
         import cv2
 
         self._cv2 = cv2
-        h, w = tmpl.shape
-        #: radius of the inscribed disc used, px (a pixel in from the template's edge)
-        self.radius = 0.5 * min(w, h) - 1.0
+        #: centre (x, y px) and radius (px) of the inscribed disc used, and its pixel mask
+        self.centre, self.radius, self.mask = inscribed_disc(tmpl.shape)
         self.n_r = max(int(round(self.radius)), 4)
-        self.centre = ((w - 1) / 2.0, (h - 1) / 2.0)
         rings = self._rings(tmpl, self.centre)
         r = (np.arange(self.n_r) + 0.5) * self.radius / self.n_r
         self.weight = np.where(r >= max(MIN_RADIUS_PX, MIN_RADIUS_FRAC * self.radius), r, 0.0)

@@ -87,7 +87,8 @@ FAST_CC = 0.97
 CC_ROUNDING = 1e-6
 #: Turns of the template tried round the predicted angle when re-acquiring, degrees.
 SEARCH_TURNS_DEG = (0.0, -2.0, 2.0, -4.0, 4.0, -6.0, 6.0, -8.0, 8.0)
-#: The rotation search (:mod:`._turn_search`) looks this far round the predicted angle, rad.
+#: The rotation search (:mod:`._turn_search`) looks this far round the predicted angle, rad; a
+#: best turn farther than this from the fitted angle fails the fit's angle whatever its score.
 TURN_SEARCH_RAD = math.radians(45.0)
 #: A fitted angle fails the rotation check when a turn of the template's inscribed disc within
 #: :data:`TURN_SEARCH_RAD` of the prediction correlates better than the fitted angle's by this
@@ -95,7 +96,8 @@ TURN_SEARCH_RAD = math.radians(45.0)
 TURN_SCORE_GAP = 0.1
 #: ... and lies more than this from it, rad.
 TURN_DIFF_RAD = math.radians(3.0)
-#: Least correlation of the best turn for the search to replace a fitted angle.
+#: Least correlation of the best turn near the predicted angle; under it the disc's turn is
+#: looked for all round.
 MIN_TURN_SCORE = 0.5
 #: ECC stopping rule: 60 iterations or a correlation gain below 1e-5.
 ECC_CRITERIA = (3, 60, 1e-5)  # cv2.TERM_CRITERIA_EPS | cv2.TERM_CRITERIA_COUNT
@@ -124,13 +126,6 @@ def _params(W):
 def _rigid(W):
     """The rigid warp nearest to ``W`` (same translation, the polar rotation)."""
     return _euclid(*_params(W))
-
-
-def _turned_about(theta, c, c0):
-    """The rigid pose turned by ``theta`` (rad) that puts the first-frame point ``c0`` on the image
-    point ``c`` (px)."""
-    R = np.array([[math.cos(theta), -math.sin(theta)], [math.sin(theta), math.cos(theta)]])
-    return _euclid(theta, *(np.asarray(c, float) - R @ np.asarray(c0, float)))
 
 
 def _near_rigid(W, tol=0.05):
@@ -223,7 +218,7 @@ class MarkerlessTracker:
         self._disc = inscribed_disc(tmpl.shape)  # the templates' inscribed disc: centre, radius, mask
         self._back: tuple = (None, None, None)  # (image, pose bytes, the last _warp_back)
         self._disc_tmpl: tuple = (None, None)  # (template, its disc's pixels normalised for _disc_cc)
-        self._turn_sigma = 0.0  # the rotation search's and the disc fit's angles apart this frame, rad
+        self._turn_failed = False  # this frame's fitted angle failed the rotation check (:meth:`_turn_check`)
 
     # -- registration -------------------------------------------------------------
     def _window(self, gray, W, margin):
@@ -512,7 +507,7 @@ class MarkerlessTracker:
             W_pred = _euclid(*self.poses[-1])
         else:
             W_pred = _euclid(0.0, 0.0, 0.0)
-        self._turn_sigma = 0.0
+        self._turn_failed = False
         self._back = (None, None, None)  # a frame's buffer may be reused for the next frame
         fit = self._ecc(self.tmpl0, gray, W_pred, direct=len(self.poses) >= 2)
         tmpl = self.tmpl0
@@ -545,9 +540,7 @@ class MarkerlessTracker:
             and self.theta_note is None
             and self.round_note is None
         ):
-            turned = self._turn_check(tmpl, gray, fit, W_pred)
-            if turned is not None:
-                fit, mask, visible = turned[:2], turned[2], 1.0
+            self._turn_check(tmpl, gray, fit, W_pred)
         if fit is not None and fit[1] >= MIN_CC:
             fit = (self._held(fit[0]), fit[1])
             self.reason = self.verifier.verify(self, gray, fit[0], frame, fit[1])
@@ -600,67 +593,36 @@ class MarkerlessTracker:
         n_expected = len(self.grid) if mask is None else int(math.ceil(len(self.grid) / max(visible, 1e-3)))
         return Detection(pts, self.obj_pts, False, n_expected, sigma_rad=sig, n_groups=1, score=cc, theta_why=why)
 
-    def _turn_check(self, tmpl, gray, fitted, W_pred):
-        """The rotation check of the fitted pose ``fitted = (W, cc)`` on ``tmpl``
-        (:mod:`._turn_search`), and its fallback.
+    def _turn_check(self, tmpl, gray, fitted, W_pred) -> None:
+        """The rotation check of the fitted pose ``fitted = (W, cc)`` on ``tmpl`` (:mod:`._turn_search`):
+        sets :attr:`_turn_failed` (this frame's angle is not reported) when the template's
+        inscribed disc, turned about the point ``W`` (or the prediction) puts its centre on, matches
+        best more than :data:`TURN_SEARCH_RAD` from the fitted angle, or more than
+        :data:`TURN_DIFF_RAD` from it and :data:`TURN_SCORE_GAP` better than at it.
 
-        The template's inscribed disc is turned about the point ``W`` puts its centre on (and about
-        the point the prediction puts it on: a fit pulled to the wrong angle is pulled off the
-        centre too); when a turn within :data:`TURN_SEARCH_RAD` of the predicted angle (none
-        there: anywhere round) matches better than the fitted angle by :data:`TURN_SCORE_GAP`,
-        the fitted angle was set by the rest of the region (a still background in its corners,
-        while a mark on the object turned): the pose is fitted again from that turn on the
-        inscribed disc alone. The frame's angle is then not reported unless that fit agrees with
-        the turn found to :data:`TURN_DIFF_RAD` (and its σ holds their difference).
-
-        Returns
-        -------
-        (W, cc, mask) or None
-            The pose refitted on the disc, the fit's correlation (the template is found here:
-            what the verifier and the quality know) and the disc's pixel mask; None when the
-            fitted angle passes, the disc tells no angle or leaves the frame, or no turn is refound
-            (then, or where the disc matches at no turn, this frame's angle is not reported).
+        Run only where the disc matches the fitted pose :data:`._observability.CELL_TURN_GAP` worse
+        than the whole region (a still background in the region's corners held the fit while a mark
+        on the object turned). The fit itself is kept, and so is all the tracker learns from the
+        frame: a pose refitted from the turn found changed the keyframes and the outline learned
+        (PhysTrack RollingCylinder, a 37 px region: its first outline 0.76 round instead of a round
+        one, so its angle was not known to be unmeasurable, and 253 later angles were over 5 deg
+        off). Near the fitted angle and no better there the disc agrees with the fit (the
+        development pendulum's ball, its texture changing as it spins in depth: best turn within
+        7.4 deg of the fit).
         """
         W, cc = fitted
         disc_cc = self._disc_cc(tmpl, gray, W) if self._disc[1] >= MIN_DISC_RADIUS_PX else math.inf
         if disc_cc > cc - CELL_TURN_GAP:
             # the region's disc matches the fitted pose as well as the whole region does (as a
             # cell that matches, :data:`._observability.CELL_TURN_GAP`): nothing to doubt
-            return None
+            return
         found = self._best_turn(tmpl, gray, W, W_pred)
         if found is None:
-            return None
-        th, best, s_fit, c, c0 = found
-        th_fit = _params(W)[0]
-        gap = abs(math.remainder(th - th_fit, 2 * math.pi))
-        if best < MIN_TURN_SCORE and s_fit < MIN_TURN_SCORE and gap > TURN_SEARCH_RAD:
-            # the disc matches at no turn (its mark smeared, or out of the disc), and its best
-            # turn is far from the fitted angle (near it, the fit agrees with the disc: a ball's
-            # texture changing as it spins in depth): no angle here
-            self._turn_sigma = math.inf
-            return None
-        if best - s_fit < TURN_SCORE_GAP or gap < TURN_DIFF_RAD:
-            return None
-        self._turn_sigma = math.inf  # the fitted angle failed the check: no angle unless refound
-        if best < MIN_TURN_SCORE:
-            return None
-        rigid, _ = self._ic_for(tmpl)
-        disc = self._disc[2]
-
-        def fit(window, Ww):
-            got = rigid.refine(window, self._to_tmpl(Ww), mask=disc)
-            return None if got is None else (self._from_tmpl(got[0]), got[1])
-
-        r = self.fit_near(gray, _turned_about(th, c, c0), fit)
-        if r is None:
-            return None
-        # the disc fit places the turn's centre; its angle and the search's are two measurements
-        # of one angle: the angle is known no better than they agree
-        miss = abs(math.remainder(_params(r[0])[0] - th, 2 * math.pi))
-        if miss > TURN_DIFF_RAD or r[1] <= disc_cc:
-            return None  # (a fitted pose the disc itself matches about as well: a hand over part of it)
-        self._turn_sigma = miss
-        return r[0], cc, disc
+            return
+        th, best, s_fit = found[:3]
+        gap = abs(math.remainder(th - _params(W)[0], 2 * math.pi))
+        if gap > TURN_SEARCH_RAD or (best - s_fit >= TURN_SCORE_GAP and gap >= TURN_DIFF_RAD):
+            self._turn_failed = True
 
     def _rings_of(self, tmpl) -> PolarRings:
         """``tmpl``'s :class:`PolarRings` (kept for the last template)."""
@@ -717,8 +679,8 @@ class MarkerlessTracker:
         why = self._angle_unmatched(tmpl, gray, W) if mask is None and self.theta_note is None else None
         if why is None and tmpl is not self.tmpl0 and not math.isfinite(self.key_sigma_rad):
             why = "keyframe"
-        if why is None and not math.isfinite(self._turn_sigma):
-            why = "turn"  # the rotation check failed the fitted angle and found no other
+        if why is None and self._turn_failed:
+            why = "turn"  # the inscribed disc's best turn is far from the fitted angle
         if self.theta_note is None:
             self.theta_frames[0] += 1
             self.theta_frames[1] += why is not None
@@ -730,19 +692,13 @@ class MarkerlessTracker:
                 part = masked_fit(self, tmpl, gray, W)
                 if part is not None:
                     (W, cc), mask, visible = part[:2], part[2], part[3]
-            elif back is not None and why != "turn":  # appearance drifted from the first frame: renew the keyframe here
+            elif back is not None:  # appearance drifted from the first frame: renew the keyframe here
                 # a keyframe cut where the angle was no measurement carries no angle on
                 key_sig = self._chained_sigma(tmpl, gray, W) if why is None else math.inf
                 self.key, self.key_sigma_rad = back, key_sig
                 self.verifier.fb.keyframe(self, gray, W)
         sig = self._chained_sigma(tmpl, gray, W, mask) if why is None else math.nan
-        # an angle from the turn search matched the first frame's sharp mark to one smeared over
-        # the angle swept in the exposure (up to a frame's time): it is that sweep's midpoint to
-        # within the sweep's standard deviation
-        sweep = 0.0
-        if self.poses and mask is not None and self._turn_sigma > 0.0:
-            sweep = abs(math.remainder(_params(W)[0] - self.poses[-1][0], 2 * math.pi)) / math.sqrt(12)
-        return (W, cc), mask, visible, why, math.hypot(sig, self.theta0_sigma_rad, self._turn_sigma, sweep)
+        return (W, cc), mask, visible, why, math.hypot(sig, self.theta0_sigma_rad)
 
     def _chained_sigma(self, tmpl, gray, W, mask=None):
         """σ of θ (rad) of the pose ``W`` registered on ``tmpl``: the fit's own, and on a keyframe

@@ -15,6 +15,7 @@ from ._edges import EdgeDetector, refine_rectangle
 from ._markerless import MarkerlessDetector, MarkerlessTracker
 from ._region import RegionDetector, RegionTracker
 from ._table_edge import table_top_edge
+from ._turn_search import PolarRings
 
 
 __all__ = [
@@ -30,4 +31,5 @@ __all__ = [
     "MarkerlessDetector",
     "MarkerlessTracker",
     "table_top_edge",
+    "PolarRings",
 ]

@@ -42,8 +42,16 @@ import numpy as np
 from ...._errors import InputError
 from ._detection import Detection
 from ._ic import ICAffine, ICRigid
-from ._observability import MAX_UNMATCHED_TURN, cell_turn_info, sigma_theta, theta_unobservable, unmatched_turn_share
+from ._observability import (
+    CELL_TURN_GAP,
+    MAX_UNMATCHED_TURN,
+    cell_turn_info,
+    sigma_theta,
+    theta_unobservable,
+    unmatched_turn_share,
+)
 from ._occlusion import CELL_CC, GRID, ROUND_MIN, cell_correlations, masked_fit, partly_covered
+from ._turn_search import MIN_DISC_RADIUS_PX, PolarRings, inscribed_disc
 from ._twins import TwinGuard
 from ._verify import PoseVerifier, best_turned_match
 
@@ -79,6 +87,18 @@ FAST_CC = 0.97
 CC_ROUNDING = 1e-6
 #: Turns of the template tried round the predicted angle when re-acquiring, degrees.
 SEARCH_TURNS_DEG = (0.0, -2.0, 2.0, -4.0, 4.0, -6.0, 6.0, -8.0, 8.0)
+#: The rotation search (:mod:`._turn_search`) looks this far round the predicted angle, rad; a
+#: best turn farther than this from the fitted angle fails the fit's angle whatever its score.
+TURN_SEARCH_RAD = math.radians(45.0)
+#: A fitted angle fails the rotation check when a turn of the template's inscribed disc within
+#: :data:`TURN_SEARCH_RAD` of the prediction correlates better than the fitted angle's by this
+#: much (normalised correlation) ...
+TURN_SCORE_GAP = 0.1
+#: ... and lies more than this from it, rad.
+TURN_DIFF_RAD = math.radians(3.0)
+#: Least correlation of the best turn near the predicted angle; under it the disc's turn is
+#: looked for all round.
+MIN_TURN_SCORE = 0.5
 #: ECC stopping rule: 60 iterations or a correlation gain below 1e-5.
 ECC_CRITERIA = (3, 60, 1e-5)  # cv2.TERM_CRITERIA_EPS | cv2.TERM_CRITERIA_COUNT
 
@@ -194,6 +214,11 @@ class MarkerlessTracker:
         self._turn_info: tuple = (None, None)  # (template, its cells' turning information)
         #: verified frames, and those whose angle was not a measurement (:meth:`_angle_unmatched`)
         self.theta_frames = [0, 0]
+        self._rings: tuple = (None, None)  # (template, its PolarRings)
+        self._disc = inscribed_disc(tmpl.shape)  # the templates' inscribed disc: centre, radius, mask
+        self._back: tuple = (None, None, None)  # (image, pose bytes, the last _warp_back)
+        self._disc_tmpl: tuple = (None, None)  # (template, its disc's pixels normalised for _disc_cc)
+        self._turn_failed = False  # this frame's fitted angle failed the rotation check (:meth:`_turn_check`)
 
     # -- registration -------------------------------------------------------------
     def _window(self, gray, W, margin):
@@ -457,6 +482,9 @@ class MarkerlessTracker:
 
     def _warp_back(self, gray, W):
         """The current image resampled onto the template grid by the pose W (float32), or None."""
+        key = W.tobytes()
+        if self._back[0] is gray and self._back[1] == key:  # the checks of one pose share it
+            return self._back[2]
         cv2 = self._cv2
         crop, off = self._window(gray, W, 4)
         if crop is None:
@@ -464,9 +492,11 @@ class MarkerlessTracker:
         Wfull = W.copy()
         Wfull[:, 2] += (W[:, :2] @ self.origin).astype(np.float32) - off
         h, w = self.tmpl0.shape
-        return cv2.warpAffine(
+        back = cv2.warpAffine(
             crop, Wfull, (w, h), flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP, borderMode=cv2.BORDER_REPLICATE
         )
+        self._back = (gray, key, back)
+        return back
 
     def detect(self, gray, frame):
         """The object's reference points in ``gray``: a :class:`Detection`, or None (lost)."""
@@ -477,6 +507,8 @@ class MarkerlessTracker:
             W_pred = _euclid(*self.poses[-1])
         else:
             W_pred = _euclid(0.0, 0.0, 0.0)
+        self._turn_failed = False
+        self._back = (None, None, None)  # a frame's buffer may be reused for the next frame
         fit = self._ecc(self.tmpl0, gray, W_pred, direct=len(self.poses) >= 2)
         tmpl = self.tmpl0
         first_view = fit is not None and fit[1] >= REKEY_CC  # the frame is a turned copy of the first
@@ -501,6 +533,14 @@ class MarkerlessTracker:
             if part is not None:
                 fit, tmpl, mask, visible = part[:2], self.key, part[2], part[3]
         self.reason = None
+        if (
+            fit is not None
+            and fit[1] >= MIN_CC
+            and mask is None
+            and self.theta_note is None
+            and self.round_note is None
+        ):
+            self._turn_check(tmpl, gray, fit, W_pred)
         if fit is not None and fit[1] >= MIN_CC:
             fit = (self._held(fit[0]), fit[1])
             self.reason = self.verifier.verify(self, gray, fit[0], frame, fit[1])
@@ -553,6 +593,79 @@ class MarkerlessTracker:
         n_expected = len(self.grid) if mask is None else int(math.ceil(len(self.grid) / max(visible, 1e-3)))
         return Detection(pts, self.obj_pts, False, n_expected, sigma_rad=sig, n_groups=1, score=cc, theta_why=why)
 
+    def _turn_check(self, tmpl, gray, fitted, W_pred) -> None:
+        """The rotation check of the fitted pose ``fitted = (W, cc)`` on ``tmpl`` (:mod:`._turn_search`):
+        sets :attr:`_turn_failed` (this frame's angle is not reported) when the template's
+        inscribed disc, turned about the point ``W`` (or the prediction) puts its centre on, matches
+        best more than :data:`TURN_SEARCH_RAD` from the fitted angle, or more than
+        :data:`TURN_DIFF_RAD` from it and :data:`TURN_SCORE_GAP` better than at it.
+
+        Run only where the disc matches the fitted pose :data:`._observability.CELL_TURN_GAP` worse
+        than the whole region (a still background in the region's corners held the fit while a mark
+        on the object turned). The fit itself is kept, and so is all the tracker learns from the
+        frame: a pose refitted from the turn found changed the keyframes and the outline learned
+        (PhysTrack RollingCylinder, a 37 px region: its first outline 0.76 round instead of a round
+        one, so its angle was not known to be unmeasurable, and 253 later angles were over 5 deg
+        off). Near the fitted angle and no better there the disc agrees with the fit (the
+        development pendulum's ball, its texture changing as it spins in depth: best turn within
+        7.4 deg of the fit).
+        """
+        W, cc = fitted
+        disc_cc = self._disc_cc(tmpl, gray, W) if self._disc[1] >= MIN_DISC_RADIUS_PX else math.inf
+        if disc_cc > cc - CELL_TURN_GAP:
+            # the region's disc matches the fitted pose as well as the whole region does (as a
+            # cell that matches, :data:`._observability.CELL_TURN_GAP`): nothing to doubt
+            return
+        found = self._best_turn(tmpl, gray, W, W_pred)
+        if found is None:
+            return
+        th, best, s_fit = found[:3]
+        gap = abs(math.remainder(th - _params(W)[0], 2 * math.pi))
+        if gap > TURN_SEARCH_RAD or (best - s_fit >= TURN_SCORE_GAP and gap >= TURN_DIFF_RAD):
+            self._turn_failed = True
+
+    def _rings_of(self, tmpl) -> PolarRings:
+        """``tmpl``'s :class:`PolarRings` (kept for the last template)."""
+        if self._rings[0] is not tmpl:
+            self._rings = (tmpl, PolarRings(tmpl))
+        return self._rings[1]
+
+    def _disc_cc(self, tmpl, gray, W) -> float:
+        """Correlation of ``tmpl``'s inscribed disc with ``gray`` warped back by the pose ``W``."""
+        back = self._warp_back(gray, W)
+        if back is None:
+            return -1.0
+        w = self._disc[2].ravel().astype(np.float64)
+        if self._disc_tmpl[0] is not tmpl:  # the template's disc at zero mean and unit norm (it runs every frame)
+            a = (tmpl.ravel() - float(tmpl.ravel() @ w) / w.sum()) * w
+            self._disc_tmpl = (tmpl, a / (math.sqrt(float(a @ a)) + 1e-12))
+        b = back.ravel().astype(np.float64)
+        s1, s2 = float(b @ w), float((b * b) @ w)
+        return float(self._disc_tmpl[1] @ b) / (math.sqrt(max(s2 - s1 * s1 / w.sum(), 0.0)) + 1e-9)
+
+    def _best_turn(self, tmpl, gray, W, W_pred):
+        """The best turn of ``tmpl``'s inscribed disc in ``gray``: ``(θ rad, its score, the fitted
+        angle's score, the centre turned about (image px), that centre in first-frame px)``,
+        about the better of the centres ``W`` and ``W_pred`` give; None when the disc tells no
+        angle or leaves the frame."""
+        rings = self._rings_of(tmpl)
+        if not rings.tells_angle:
+            return None
+        c0 = self.origin + np.asarray(rings.centre)
+        th_fit, th_pred = _params(W)[0], _params(W_pred)[0]
+        out = None
+        for Wc in (W, W_pred) if self.poses else (W,):
+            c = Wc[:, :2].astype(float) @ c0 + Wc[:, 2].astype(float)
+            scores = rings.scores(gray, c)
+            if not np.isfinite(scores).all():
+                continue
+            th, best = PolarRings.best_near(scores, th_pred, TURN_SEARCH_RAD)
+            if best < MIN_TURN_SCORE:  # not near the prediction (after lost frames): anywhere round
+                th, best = PolarRings.best_near(scores, th_fit, math.pi)
+            if out is None or best > out[1]:
+                out = (th, best, PolarRings.at(scores, th_fit), c, c0)
+        return out
+
     def _settle(self, tmpl, gray, fit, mask, visible):
         """The verified fit ``(W, cc)`` on ``tmpl`` made final: ``((W, cc), mask, visible, why, σ)``.
 
@@ -566,6 +679,8 @@ class MarkerlessTracker:
         why = self._angle_unmatched(tmpl, gray, W) if mask is None and self.theta_note is None else None
         if why is None and tmpl is not self.tmpl0 and not math.isfinite(self.key_sigma_rad):
             why = "keyframe"
+        if why is None and self._turn_failed:
+            why = "turn"  # the inscribed disc's best turn is far from the fitted angle
         if self.theta_note is None:
             self.theta_frames[0] += 1
             self.theta_frames[1] += why is not None

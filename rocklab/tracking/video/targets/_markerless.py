@@ -194,6 +194,9 @@ class MarkerlessTracker:
         self._turn_info: tuple = (None, None)  # (template, its cells' turning information)
         #: verified frames, and those whose angle was not a measurement (:meth:`_angle_unmatched`)
         self.theta_frames = [0, 0]
+        #: the last angle measured (first-frame px -> image px), rad: a pose whose angle is not a
+        #: measurement is held at it
+        self.theta_hold = 0.0
 
     # -- registration -------------------------------------------------------------
     def _window(self, gray, W, margin):
@@ -563,9 +566,18 @@ class MarkerlessTracker:
         chain of keyframes walks, and its σ grows with it).
         """
         W, cc = fit
-        why = self._angle_unmatched(tmpl, gray, W) if mask is None and self.theta_note is None else None
+        why, turn_at, share = None, None, 0.0
+        if mask is None and self.theta_note is None:
+            why, turn_at, share = self._angle_unmatched(tmpl, gray, W, cc)
         if why is None and tmpl is not self.tmpl0 and not math.isfinite(self.key_sigma_rad):
             why = "keyframe"
+        if why is not None and turn_at is not None:
+            # the fitted angle was set by what does not move with the object (a still background in
+            # the region): so was the place of every point off the one the matching part turns
+            # about. The pose is held there at the last angle measured
+            W = self._held_about(W, turn_at)
+        elif why is None and mask is None:
+            self.theta_hold = _params(W)[0]
         if self.theta_note is None:
             self.theta_frames[0] += 1
             self.theta_frames[1] += why is not None
@@ -582,7 +594,8 @@ class MarkerlessTracker:
                 key_sig = self._chained_sigma(tmpl, gray, W) if why is None else math.inf
                 self.key, self.key_sigma_rad = back, key_sig
                 self.verifier.fb.keyframe(self, gray, W)
-        sig = self._chained_sigma(tmpl, gray, W, mask) if why is None else math.nan
+        # the angle's information is that of the cells the pose re-explains, not the whole region's
+        sig = self._chained_sigma(tmpl, gray, W, mask) / math.sqrt(1.0 - share) if why is None else math.nan
         return (W, cc), mask, visible, why, math.hypot(sig, self.theta0_sigma_rad)
 
     def _chained_sigma(self, tmpl, gray, W, mask=None):
@@ -601,7 +614,16 @@ class MarkerlessTracker:
         inside = ((c[:, 0] >= 0) & (c[:, 0] <= shape[1]) & (c[:, 1] >= 0) & (c[:, 1] <= shape[0])).reshape(gy.shape)
         return inside[:-1, :-1] & inside[1:, :-1] & inside[:-1, 1:] & inside[1:, 1:]
 
-    def _angle_unmatched(self, tmpl, gray, W):
+    def _held_about(self, W, at):
+        """``W`` turned to the last angle measured about the template point ``at`` (px from the
+        template's centre), which stays where ``W`` puts it."""
+        c = self.centre0 - 0.5 + np.asarray(at, float)
+        p = W[:, :2].astype(float) @ c + W[:, 2].astype(float)
+        th = self.theta_hold
+        t = p - np.array([[math.cos(th), -math.sin(th)], [math.sin(th), math.cos(th)]]) @ c
+        return _euclid(th, t[0], t[1])
+
+    def _angle_unmatched(self, tmpl, gray, W, cc):
         """Why the pose ``W``'s angle is not a measurement on this frame, or None: the cells of the
         template that hold more than :data:`._observability.MAX_UNMATCHED_TURN` of its turning
         information do not match the frame warped back, while the rest does. Its Gauss-Newton
@@ -611,13 +633,18 @@ class MarkerlessTracker:
             self._turn_info = (tmpl, cell_turn_info(tmpl, GRID))
         back = self._warp_back(gray, W)
         if back is None:
-            return None
-        share = unmatched_turn_share(
-            self._turn_info[1], cell_correlations(tmpl, back), self._cells_seen(W, gray.shape), CELL_CC
+            return None, None, 0.0
+        ccs = cell_correlations(tmpl, back)
+        # only a view refitted on its cells in view (:meth:`_settle`) is judged by that fit; a cell
+        # that matches nothing while the pose stands as fitted (a still background's corner the
+        # object left) is the part that set its angle
+        covered = cc < REKEY_CC and partly_covered(ccs)
+        share, at = unmatched_turn_share(
+            self._turn_info[1], ccs, self._cells_seen(W, gray.shape), CELL_CC if covered else -1.0
         )
         if share <= MAX_UNMATCHED_TURN:
-            return None
-        return f"{100 * share:.0f} %"
+            return None, at, share
+        return f"{100 * share:.0f} %", at, share
 
 
 class MarkerlessDetector:

@@ -41,6 +41,8 @@ MIN_TURN_SHARE = 0.05
 SMOOTH_PX = 1.0
 #: Pixels are correlated over about a 3 x 3 neighbourhood: the covariance's σ is scaled by 3.
 CORRELATION_INFLATION = 3.0
+#: Cells a side over which the residual's pull on the angle is summed for its robust σ.
+SANDWICH_GRID = 4
 #: Largest Sobel response of a region taken as flat (grey levels per pixel, x 8).
 FLAT_GRADIENT = 1e-3
 #: A cell of the region (a 4 x 4 grid) whose correlation with the frame, warped back by the
@@ -355,7 +357,23 @@ def sigma_theta(tmpl, warped, mask=None, tmpl_normalised=None) -> float:
     rr = r.ravel().astype(float)
     s2 = float(np.dot(rr, rr)) / max(n_used - 3, 1)
     try:
-        cov = s2 * np.linalg.inv(JTJ)
+        inv = np.linalg.inv(JTJ)
     except np.linalg.LinAlgError:
         return math.inf
-    return CORRELATION_INFLATION * math.sqrt(max(cov[0, 0], 0.0))
+    gn = CORRELATION_INFLATION * math.sqrt(max(s2 * inv[0, 0], 0.0))
+    return max(gn, _cell_robust_sigma(cols, rr, r.shape, inv, k))
+
+
+def _cell_robust_sigma(cols, rr, shape, inv, k) -> float:
+    """The angle's 1-sigma, rad, from how the residual pulls on it cell by cell (a cluster-robust
+    sandwich over a :data:`SANDWICH_GRID` grid): about the Gauss-Newton σ where the residual is
+    noise, larger where parts of the region pull the angle different ways and the fit is their
+    balance (a still background in the region against the object's own edge)."""
+    import math
+
+    g = SANDWICH_GRID
+    score = (np.stack(cols).astype(float) * rr[None, :]).reshape(3, *shape)
+    ys, xs = (np.linspace(0, n, g + 1).astype(int)[:-1] for n in shape)
+    per_cell = np.add.reduceat(np.add.reduceat(score, ys, axis=1), xs, axis=2).reshape(3, -1) * (k * k)
+    B = per_cell @ per_cell.T * (g * g / (g * g - 1))
+    return math.sqrt(max(float((inv @ B @ inv)[0, 0]), 0.0))

@@ -26,7 +26,9 @@ The per-frame orientation uncertainty is the Gauss-Newton covariance of the fit
 at was itself measured: a chain of keyframes walks, and its σ grows with it). A frame whose cells
 holding most of the turning information no longer match the pose while the rest do reports no
 angle (:func:`._observability.unmatched_turn_share`: the angle was set by the rest, a still
-background in the region's corners), nor does a pose on a keyframe cut at such a frame. An object
+background in the region's corners), nor does a pose on a keyframe cut at such a frame; such a
+pose is held at the last angle measured about the point its matching cells turn about (a disk's
+centre), so the point reported does not follow the background's turn. An object
 whose appearance tells no angle (a disk) is held upright about its centre of symmetry, reports
 that centre, and no angle (:mod:`._observability`). A round
 object (a ball) reports the place of its disk's centre: its texture slides over it as it spins, so
@@ -628,7 +630,12 @@ class MarkerlessTracker:
         template that hold more than :data:`._observability.MAX_UNMATCHED_TURN` of its turning
         information do not match the frame warped back, while the rest does. Its Gauss-Newton
         sigma then says nothing: the angle was set by the cells that still match (on the turning
-        disc, the still rod and wall in its region's corners, 28-177 deg from the mark's angle)."""
+        disc, the still rod and wall in its region's corners, 28-177 deg from the mark's angle).
+
+        Returns ``(why, at, share)``: ``at`` the template point the matching cells turn about (px
+        from the template's centre, :func:`._observability.turn_information`), where the pose is
+        held when the angle is not a measurement; ``share`` the unmatched share (its σ is that of
+        the rest: divided by ``sqrt(1 - share)``)."""
         if self._turn_info[0] is not tmpl:
             self._turn_info = (tmpl, cell_turn_info(tmpl, GRID))
         back = self._warp_back(gray, W)

@@ -303,7 +303,8 @@ def angle_note(obj, status, theta_rad) -> str:
 def sigma_theta(tmpl, warped, mask=None, tmpl_normalised=None) -> float:
     """Gauss-Newton 1-sigma of a registration's angle, rad: ``σ² (JᵀJ)⁻¹`` with σ the intensity
     residual, inflated by :data:`CORRELATION_INFLATION` because neighbouring pixels are not
-    independent (optics, codec, the registration's smoothing).
+    independent (optics, codec, the registration's smoothing); at least the cluster-robust σ
+    from how the residual pulls the angle cell by cell (:func:`_cell_robust_sigma`).
 
     Parameters
     ----------

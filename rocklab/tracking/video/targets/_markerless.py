@@ -540,16 +540,16 @@ class MarkerlessTracker:
             return None
         self.verifier.confirm(gray, self.size)
         self._round_check(first_view)
-        (W, cc), mask, visible, why, sig = self._settle(tmpl, gray, fit, mask, visible)
+        (W, cc), mask, visible, why, sig, W_pts = self._settle(tmpl, gray, fit, mask, visible)
         self.poses = (self.poses + [self._centred(W)])[-2:]
         self.twins.remember(frame, gray, W[:, :2].astype(float) @ self.centre0 + W[:, 2])
-        pts = (self.grid + self.origin) @ W[:, :2].T.astype(float) + W[:, 2]
+        pts = (self.grid + self.origin) @ W_pts[:, :2].T.astype(float) + W_pts[:, 2]
         at = self.verifier.disk_at
         if at is not None and mask is None:
             # a disk (a ball): its texture slides over it as it spins, its outline does not. The
             # texture places the disk's centre more finely while it holds; beyond the outline's
             # own noise the points are moved to within it of the disk's centre
-            gap = W[:, :2].astype(float) @ self.verifier.outline.disk0[0] + W[:, 2] - at
+            gap = W_pts[:, :2].astype(float) @ self.verifier.outline.disk0[0] + W_pts[:, 2] - at
             n, lim = float(np.hypot(*gap)), DISK_AGREE_FRAC * max(self.size)
             if n > lim:
                 pts = pts - gap * (1.0 - lim / n)
@@ -559,7 +559,7 @@ class MarkerlessTracker:
         return Detection(pts, self.obj_pts, False, n_expected, sigma_rad=sig, n_groups=1, score=cc, theta_why=why)
 
     def _settle(self, tmpl, gray, fit, mask, visible):
-        """The verified fit ``(W, cc)`` on ``tmpl`` made final: ``((W, cc), mask, visible, why, σ)``.
+        """The verified fit ``(W, cc)`` on ``tmpl`` made final: ``((W, cc), mask, visible, why, σ, W_pts)``.
 
         A partly covered view is refitted on the cells still in view; a view drifted from the
         first one (correlation under :data:`REKEY_CC`) becomes the keyframe. ``why``: why this
@@ -568,7 +568,7 @@ class MarkerlessTracker:
         chain of keyframes walks, and its σ grows with it).
         """
         W, cc = fit
-        why, turn_at, share = None, None, 0.0
+        why, turn_at, share, held = None, None, 0.0, None
         if mask is None and self.theta_note is None:
             why, turn_at, share = self._angle_unmatched(tmpl, gray, W, cc)
         if why is None and tmpl is not self.tmpl0 and not math.isfinite(self.key_sigma_rad):
@@ -576,8 +576,9 @@ class MarkerlessTracker:
         if why is not None and turn_at is not None:
             # the fitted angle was set by what does not move with the object (a still background in
             # the region): so was the place of every point off the one the matching part turns
-            # about. The pose is held there at the last angle measured
-            W = self._held_about(W, turn_at)
+            # about. The points are reported from the pose held there at the last angle measured
+            # (the fitted pose stays the registration's: its prediction and keyframe)
+            held = self._held_about(W, turn_at)
         elif why is None and mask is None:
             self.theta_hold = _params(W)[0]
         if self.theta_note is None:
@@ -598,7 +599,7 @@ class MarkerlessTracker:
                 self.verifier.fb.keyframe(self, gray, W)
         # the angle's information is that of the cells the pose re-explains, not the whole region's
         sig = self._chained_sigma(tmpl, gray, W, mask) / math.sqrt(1.0 - share) if why is None else math.nan
-        return (W, cc), mask, visible, why, math.hypot(sig, self.theta0_sigma_rad)
+        return (W, cc), mask, visible, why, math.hypot(sig, self.theta0_sigma_rad), W if held is None else held
 
     def _chained_sigma(self, tmpl, gray, W, mask=None):
         """σ of θ (rad) of the pose ``W`` registered on ``tmpl``: the fit's own, and on a keyframe

@@ -173,4 +173,6 @@ def test_hand_held_pendulum_film_angle_right_or_nan_and_place_right(tmp_path_fac
         if np.isfinite(th[k]):
             n_theta += 1
             assert abs(th[k] - (-d)) <= max(3 * sg[k], math.radians(2.0)), (k, math.degrees(th[k]), -rod)
-    assert n_theta >= 2  # the first frame's and at least one more: the angle is not dropped everywhere
+    assert n_theta >= 1
+    # the angle is not dropped everywhere: it is kept where what tells it still matches
+    assert np.sum(np.isfinite(th[status == "ok"])) >= 5

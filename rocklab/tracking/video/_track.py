@@ -556,7 +556,9 @@ def _object_series(rows, pos, n, on_shift=None):
         if j1 - j0 == 1 and abs(math.remainder(th[j1] - th[j0], 2 * math.pi)) > MAX_STEP_RAD:
             back = st[j0] != "ok"  # the step back from a lone misfit frame
             st[j1] = "outlier"
-            if shift is None and not back and j2 is not None and _step_kept(th[j0], th[j1], th[j2]):
+            # the frames after it: the next whose angle was measured (frames between may have none)
+            later = okk[(okk >= (j2 if j2 is not None else n)) & np.isfinite(th[okk])]
+            if shift is None and not back and len(later) and _step_kept(th[j0], th[j1], th[later[0]]):
                 shift = j1
     if shift is not None:
         # the frames after the step go on from it: one side of it is not the object's angle, and

@@ -26,7 +26,9 @@ The per-frame orientation uncertainty is the Gauss-Newton covariance of the fit
 at was itself measured: a chain of keyframes walks, and its σ grows with it). A frame whose cells
 holding most of the turning information no longer match the pose while the rest do reports no
 angle (:func:`._observability.unmatched_turn_share`: the angle was set by the rest, a still
-background in the region's corners), nor does a pose on a keyframe cut at such a frame. An object
+background in the region's corners), nor does a pose on a keyframe cut at such a frame; such a
+pose is held at the last angle measured about the point its matching cells turn about (a disk's
+centre), so the point reported does not follow the background's turn. An object
 whose appearance tells no angle (a disk) is held upright about its centre of symmetry, reports
 that centre, and no angle (:mod:`._observability`). A round
 object (a ball) reports the place of its disk's centre: its texture slides over it as it spins, so
@@ -219,6 +221,9 @@ class MarkerlessTracker:
         self._back: tuple = (None, None, None)  # (image, pose bytes, the last _warp_back)
         self._disc_tmpl: tuple = (None, None)  # (template, its disc's pixels normalised for _disc_cc)
         self._turn_failed = False  # this frame's fitted angle failed the rotation check (:meth:`_turn_check`)
+        #: the last angle measured (first-frame px -> image px), rad: a pose whose angle is not a
+        #: measurement is held at it
+        self.theta_hold = 0.0
 
     # -- registration -------------------------------------------------------------
     def _window(self, gray, W, margin):
@@ -575,16 +580,16 @@ class MarkerlessTracker:
             return None
         self.verifier.confirm(gray, self.size)
         self._round_check(first_view)
-        (W, cc), mask, visible, why, sig = self._settle(tmpl, gray, fit, mask, visible)
+        (W, cc), mask, visible, why, sig, W_pts = self._settle(tmpl, gray, fit, mask, visible)
         self.poses = (self.poses + [self._centred(W)])[-2:]
         self.twins.remember(frame, gray, W[:, :2].astype(float) @ self.centre0 + W[:, 2])
-        pts = (self.grid + self.origin) @ W[:, :2].T.astype(float) + W[:, 2]
+        pts = (self.grid + self.origin) @ W_pts[:, :2].T.astype(float) + W_pts[:, 2]
         at = self.verifier.disk_at
         if at is not None and mask is None:
             # a disk (a ball): its texture slides over it as it spins, its outline does not. The
             # texture places the disk's centre more finely while it holds; beyond the outline's
             # own noise the points are moved to within it of the disk's centre
-            gap = W[:, :2].astype(float) @ self.verifier.outline.disk0[0] + W[:, 2] - at
+            gap = W_pts[:, :2].astype(float) @ self.verifier.outline.disk0[0] + W_pts[:, 2] - at
             n, lim = float(np.hypot(*gap)), DISK_AGREE_FRAC * max(self.size)
             if n > lim:
                 pts = pts - gap * (1.0 - lim / n)
@@ -667,7 +672,7 @@ class MarkerlessTracker:
         return out
 
     def _settle(self, tmpl, gray, fit, mask, visible):
-        """The verified fit ``(W, cc)`` on ``tmpl`` made final: ``((W, cc), mask, visible, why, σ)``.
+        """The verified fit ``(W, cc)`` on ``tmpl`` made final: ``((W, cc), mask, visible, why, σ, W_pts)``.
 
         A partly covered view is refitted on the cells still in view; a view drifted from the
         first one (correlation under :data:`REKEY_CC`) becomes the keyframe. ``why``: why this
@@ -676,11 +681,21 @@ class MarkerlessTracker:
         chain of keyframes walks, and its σ grows with it).
         """
         W, cc = fit
-        why = self._angle_unmatched(tmpl, gray, W) if mask is None and self.theta_note is None else None
+        why, turn_at, share, held = None, None, 0.0, None
+        if mask is None and self.theta_note is None:
+            why, turn_at, share = self._angle_unmatched(tmpl, gray, W, cc)
         if why is None and tmpl is not self.tmpl0 and not math.isfinite(self.key_sigma_rad):
             why = "keyframe"
         if why is None and self._turn_failed:
             why = "turn"  # the inscribed disc's best turn is far from the fitted angle
+        if why is not None and turn_at is not None:
+            # the fitted angle was set by what does not move with the object (a still background in
+            # the region): so was the place of every point off the one the matching part turns
+            # about. The points are reported from the pose held there at the last angle measured
+            # (the fitted pose stays the registration's: its prediction and keyframe)
+            held = self._held_about(W, turn_at)
+        elif why is None and mask is None:
+            self.theta_hold = _params(W)[0]
         if self.theta_note is None:
             self.theta_frames[0] += 1
             self.theta_frames[1] += why is not None
@@ -697,8 +712,9 @@ class MarkerlessTracker:
                 key_sig = self._chained_sigma(tmpl, gray, W) if why is None else math.inf
                 self.key, self.key_sigma_rad = back, key_sig
                 self.verifier.fb.keyframe(self, gray, W)
-        sig = self._chained_sigma(tmpl, gray, W, mask) if why is None else math.nan
-        return (W, cc), mask, visible, why, math.hypot(sig, self.theta0_sigma_rad)
+        # the angle's information is that of the cells the pose re-explains, not the whole region's
+        sig = self._chained_sigma(tmpl, gray, W, mask) / math.sqrt(1.0 - share) if why is None else math.nan
+        return (W, cc), mask, visible, why, math.hypot(sig, self.theta0_sigma_rad), W if held is None else held
 
     def _chained_sigma(self, tmpl, gray, W, mask=None):
         """σ of θ (rad) of the pose ``W`` registered on ``tmpl``: the fit's own, and on a keyframe
@@ -716,23 +732,42 @@ class MarkerlessTracker:
         inside = ((c[:, 0] >= 0) & (c[:, 0] <= shape[1]) & (c[:, 1] >= 0) & (c[:, 1] <= shape[0])).reshape(gy.shape)
         return inside[:-1, :-1] & inside[1:, :-1] & inside[:-1, 1:] & inside[1:, 1:]
 
-    def _angle_unmatched(self, tmpl, gray, W):
+    def _held_about(self, W, at):
+        """``W`` turned to the last angle measured about the template point ``at`` (px from the
+        template's centre), which stays where ``W`` puts it."""
+        c = self.centre0 - 0.5 + np.asarray(at, float)
+        p = W[:, :2].astype(float) @ c + W[:, 2].astype(float)
+        th = self.theta_hold
+        t = p - np.array([[math.cos(th), -math.sin(th)], [math.sin(th), math.cos(th)]]) @ c
+        return _euclid(th, t[0], t[1])
+
+    def _angle_unmatched(self, tmpl, gray, W, cc):
         """Why the pose ``W``'s angle is not a measurement on this frame, or None: the cells of the
         template that hold more than :data:`._observability.MAX_UNMATCHED_TURN` of its turning
         information do not match the frame warped back, while the rest does. Its Gauss-Newton
         sigma then says nothing: the angle was set by the cells that still match (on the turning
-        disc, the still rod and wall in its region's corners, 28-177 deg from the mark's angle)."""
+        disc, the still rod and wall in its region's corners, 28-177 deg from the mark's angle).
+
+        Returns ``(why, at, share)``: ``at`` the template point the matching cells turn about (px
+        from the template's centre, :func:`._observability.turn_information`), where the pose is
+        held when the angle is not a measurement; ``share`` the unmatched share (its σ is that of
+        the rest: divided by ``sqrt(1 - share)``)."""
         if self._turn_info[0] is not tmpl:
             self._turn_info = (tmpl, cell_turn_info(tmpl, GRID))
         back = self._warp_back(gray, W)
         if back is None:
-            return None
-        share = unmatched_turn_share(
-            self._turn_info[1], cell_correlations(tmpl, back), self._cells_seen(W, gray.shape), CELL_CC
+            return None, None, 0.0
+        ccs = cell_correlations(tmpl, back)
+        # only a view refitted on its cells in view (:meth:`_settle`) is judged by that fit; a cell
+        # that matches nothing while the pose stands as fitted (a still background's corner the
+        # object left) is the part that set its angle
+        covered = cc < REKEY_CC and partly_covered(ccs)
+        share, at = unmatched_turn_share(
+            self._turn_info[1], ccs, self._cells_seen(W, gray.shape), CELL_CC if covered else -1.0, ccs.min() < CELL_CC
         )
         if share <= MAX_UNMATCHED_TURN:
-            return None
-        return f"{100 * share:.0f} %"
+            return None, at, share
+        return f"{100 * share:.0f} %", at, share
 
 
 class MarkerlessDetector:

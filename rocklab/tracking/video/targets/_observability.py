@@ -27,6 +27,7 @@ __all__ = [
     "warn_unmatched_angles",
     "MIN_TURN_SHARE",
     "cell_turn_info",
+    "turn_information",
     "unmatched_turn_share",
     "CELL_TURN_GAP",
     "MAX_UNMATCHED_TURN",
@@ -40,6 +41,8 @@ MIN_TURN_SHARE = 0.05
 SMOOTH_PX = 1.0
 #: Pixels are correlated over about a 3 x 3 neighbourhood: the covariance's σ is scaled by 3.
 CORRELATION_INFLATION = 3.0
+#: Cells a side over which the residual's pull on the angle is summed for its robust σ.
+SANDWICH_GRID = 4
 #: Largest Sobel response of a region taken as flat (grey levels per pixel, x 8).
 FLAT_GRADIENT = 1e-3
 #: A cell of the region (a 4 x 4 grid) whose correlation with the frame, warped back by the
@@ -129,41 +132,85 @@ def turn_share(region, centre=None) -> float:
 
 
 def cell_turn_info(region, n_cells: int) -> np.ndarray:
-    """Each cell's share of ``region``'s turning information about its centre, shape
-    (n_cells, n_cells), summing to 1 (zeros for a flat region): which parts tell its angle.
+    """Each cell's Gauss-Newton information on (a turn about the region's centre, a shift in x, a
+    shift in y), shape (n_cells, n_cells, 3, 3): what each part of ``region`` (h, w) tells of its
+    pose; summed over a set of cells, :func:`turn_information` takes the turn's part of it.
 
     Examples
     --------
     >>> import numpy as np
     >>> img = np.zeros((64, 64)); img[4:12, 4:12] = 255.0  # one mark, in the top-left cell
     >>> info = cell_turn_info(img, 4)
-    >>> round(float(info[0, 0]), 2), round(float(info.sum()), 2)
-    (1.0, 1.0)
+    >>> round(float(info[0, 0, 0, 0] / info[..., 0, 0].sum()), 2)
+    1.0
     """
     x, y, gx, gy = _gradients(region)
     h, w = x.shape
-    tang = ((x - (w - 1) / 2) * gy - (y - (h - 1) / 2) * gx) ** 2
+    cols = np.stack((((x - (w - 1) / 2) * gy - (y - (h - 1) / 2) * gx), gx, gy))
     ys, xs = (np.linspace(0, k, n_cells + 1).astype(int) for k in (h, w))
-    out = np.array([[tang[ys[i] : ys[i + 1], xs[j] : xs[j + 1]].sum() for j in range(n_cells)] for i in range(n_cells)])
-    total = float(out.sum())
-    return out / total if total > 0 else out
+    out = np.zeros((n_cells, n_cells, 3, 3))
+    for i in range(n_cells):
+        for j in range(n_cells):
+            c = cols[:, ys[i] : ys[i + 1], xs[j] : xs[j + 1]].reshape(3, -1)
+            out[i, j] = c @ c.T
+    return out
 
 
-def unmatched_turn_share(info, cell_cc, seen=None, covered_cc: float = -1.0) -> float:
-    """The share of the turning information (:func:`cell_turn_info`) of the cells in view in those
-    whose correlation with the frame warped back by the pose, ``cell_cc`` (same shape), falls more
-    than :data:`CELL_TURN_GAP` under the median cell's: the parts that tell the angle and are not
-    re-explained by the pose as the rest of the region is (a look that changes as a whole, the
-    lighting or a blur, lowers every cell instead).
+def turn_information(info, cells=None) -> tuple:
+    """The information on a turn left once a shift is free, and the point it turns about, of the
+    cells ``cells`` (bool, shape of ``info``'s first two axes; default all) of
+    :func:`cell_turn_info`'s ``info``.
+
+    A turn about any point is a turn about the region's centre and a shift, so what a set of cells
+    tells of the angle is the turn's information with the shift's part taken out (a Schur
+    complement): a disk's cells tell none whatever the region's centre, a rod or an edge off the
+    disk's centre does. Its least is about the point returned (template px, from the region's
+    centre, (2,)): where the cells change least when turned, a disk's centre.
+
+    Returns
+    -------
+    (float, ndarray)
+        Information (grey level² px², as the gradients), and the point (px, x right, y down).
+    """
+    sel = np.ones(info.shape[:2], bool) if cells is None else np.asarray(cells, bool)
+    M = info[sel].sum(axis=0) if sel.any() else np.zeros((3, 3))
+    sol, *_ = np.linalg.lstsq(M[1:, 1:], M[1:, 0], rcond=None)
+    return max(float(M[0, 0] - M[0, 1:] @ sol), 0.0), np.array([sol[1], -sol[0]])
+
+
+def unmatched_turn_share(info, cell_cc, seen=None, covered_cc: float = -1.0, about_matched: bool = False) -> tuple:
+    """The share of the turning information (:func:`turn_information` of :func:`cell_turn_info`'s
+    ``info``) of the cells in view lost when the cells whose correlation with the frame warped back
+    by the pose, ``cell_cc`` (same shape), falls more than :data:`CELL_TURN_GAP` under the median
+    cell's are left out: the parts that tell the angle and are not re-explained by the pose as the
+    rest of the region is (a look that changes as a whole, the lighting or a blur, lowers every
+    cell instead). Taken with the shift free, so a disk's outline that the pose re-explains tells no
+    angle wherever the region's centre is.
 
     ``seen``: cells inside the picture (default all); a cell out of it is neither. A frame with a
     cell under ``covered_cc`` is a covered view (the fit on the cells in view decides it): 0.
+    ``about_matched``: the turn is taken about the point the matching cells turn about
+    (:func:`turn_information`) rather than the region's centre, so that a disk's outline the pose
+    re-explains tells no angle wherever the region's centre is.
+
+    Returns
+    -------
+    (float, ndarray)
+        The share (0 to 1), and the point the matching cells turn about (:func:`turn_information`,
+        px from the region's centre): a disk's centre, where its place does not hang on the angle.
     """
     cell_cc = np.asarray(cell_cc)
-    info = np.asarray(info) * (1.0 if seen is None else np.asarray(seen, float))
-    if cell_cc.min() < covered_cc or info.sum() <= 0:
-        return 0.0
-    return float(np.sum(info[cell_cc < np.median(cell_cc) - CELL_TURN_GAP]) / info.sum())
+    seen = np.ones(cell_cc.shape, bool) if seen is None else np.asarray(seen, bool)
+    matched = seen & (cell_cc >= np.median(cell_cc) - CELL_TURN_GAP)
+    _, centre = turn_information(info, matched)
+    # each cell's tangential energy about the region's centre, or about the point the matching
+    # cells turn about when some cell matches nothing (a part the object left behind, a still
+    # background): there a turn of the region moves only what does not match
+    v = np.array([1.0, centre[1], -centre[0]]) if about_matched else np.array([1.0, 0.0, 0.0])
+    energy = np.einsum("i,...ij,j->...", v, info, v) * seen
+    if cell_cc.min() < covered_cc or energy.sum() <= 0:
+        return 0.0, centre
+    return float(np.sum(energy[~matched]) / energy.sum()), centre
 
 
 def theta_unobservable(region):
@@ -256,7 +303,8 @@ def angle_note(obj, status, theta_rad) -> str:
 def sigma_theta(tmpl, warped, mask=None, tmpl_normalised=None) -> float:
     """Gauss-Newton 1-sigma of a registration's angle, rad: ``σ² (JᵀJ)⁻¹`` with σ the intensity
     residual, inflated by :data:`CORRELATION_INFLATION` because neighbouring pixels are not
-    independent (optics, codec, the registration's smoothing).
+    independent (optics, codec, the registration's smoothing); at least the cluster-robust σ
+    from how the residual pulls the angle cell by cell (:func:`_cell_robust_sigma`).
 
     Parameters
     ----------
@@ -310,7 +358,23 @@ def sigma_theta(tmpl, warped, mask=None, tmpl_normalised=None) -> float:
     rr = r.ravel().astype(float)
     s2 = float(np.dot(rr, rr)) / max(n_used - 3, 1)
     try:
-        cov = s2 * np.linalg.inv(JTJ)
+        inv = np.linalg.inv(JTJ)
     except np.linalg.LinAlgError:
         return math.inf
-    return CORRELATION_INFLATION * math.sqrt(max(cov[0, 0], 0.0))
+    gn = CORRELATION_INFLATION * math.sqrt(max(s2 * inv[0, 0], 0.0))
+    return max(gn, _cell_robust_sigma(cols, rr, r.shape, inv, k))
+
+
+def _cell_robust_sigma(cols, rr, shape, inv, k) -> float:
+    """The angle's 1-sigma, rad, from how the residual pulls on it cell by cell (a cluster-robust
+    sandwich over a :data:`SANDWICH_GRID` grid): about the Gauss-Newton σ where the residual is
+    noise, larger where parts of the region pull the angle different ways and the fit is their
+    balance (a still background in the region against the object's own edge)."""
+    import math
+
+    g = SANDWICH_GRID
+    score = (np.stack(cols).astype(float) * rr[None, :]).reshape(3, *shape)
+    ys, xs = (np.linspace(0, n, g + 1).astype(int)[:-1] for n in shape)
+    per_cell = np.add.reduceat(np.add.reduceat(score, ys, axis=1), xs, axis=2).reshape(3, -1) * (k * k)
+    B = per_cell @ per_cell.T * (g * g / (g * g - 1))
+    return math.sqrt(max(float((inv @ B @ inv)[0, 0]), 0.0))

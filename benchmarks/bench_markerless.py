@@ -13,7 +13,9 @@ plain script reading the file with ``cv2.VideoCapture``.
 Last, the cost of verifying every pose (issue 25: at most 15 % of the markerless speed): the
 same tracker on the same frames with :class:`~rocklab.tracking.video.targets._verify.PoseVerifier`
 accepting every pose unchecked, 1 thread; on the rendered frames and, when it is there, on the
-real pendulum film of ``../shared`` (decoded to memory first).
+real pendulum film of ``../shared`` (decoded to memory first). Verified and unverified runs
+alternate in pairs and are timed in process CPU time; the figure is the median of the pairs'
+costs, with their spread (a machine loaded by other processes moves single runs by +-5 %).
 """
 
 from __future__ import annotations
@@ -184,9 +186,18 @@ def _unverified():
     return stack
 
 
-def verification_cost(frames, roi, repeats: int = 3) -> None:
-    """Frames/s with and without pose verification, same process, same frames, 1 thread (best of
-    ``repeats``, alternating so that drift in the machine's load hits both)."""
+#: Frames tracked in each timed run of :func:`verification_cost` at least (a short film is tracked
+#: again from its start as many times as it takes).
+MIN_RUN_FRAMES = 600
+
+
+def verification_cost(frames, roi, pairs: int = 5) -> None:
+    """Cost of pose verification, same process, same frames, 1 thread: ``pairs`` verified and
+    unverified runs alternated (each pair in the other order than the last, so that a drift of
+    the machine's load hits both), timed in process CPU time (what other processes on a loaded
+    machine change least); each pair's cost is ``1 - t_unverified / t_verified``, the share of
+    the verified run's time that verification takes, and the figure is their median and spread.
+    """
     from pathlib import Path
 
     films = [("rendered 1920x1080", frames, roi)]
@@ -196,23 +207,35 @@ def verification_cost(frames, roi, repeats: int = 3) -> None:
         films.append((f"real pendulum film {got[0].shape[1]}x{got[0].shape[0]}", got, (310, 66, 70, 74)))
     else:
         print(f"  (real film not found at {real}: rendered frames only)")
-    print(f"verification cost: the same tracker with every pose accepted unchecked, 1 thread, best of {repeats}")
+    print(
+        "verification cost: the same tracker with every pose accepted unchecked, 1 thread, "
+        f"{pairs} alternated pairs, process CPU time; median of the pairs' costs [min-max]"
+    )
     cv2.setNumThreads(1)
     for name, fr, r in films:
-        best = {"verified": np.inf, "unverified": np.inf}
+        costs, times = [], {"verified": [], "unverified": []}
+        # a short film is tracked a few times over in each run: a run of a second or two is
+        # moved by the load as much as the figure measured
+        reps = max(1, math.ceil(MIN_RUN_FRAMES / len(fr)))
         with threadpool_limits(1):
             ours(fr[:3], r)  # warm-up
-            for _ in range(repeats):
-                for label in best:
+            for i in range(pairs):
+                order = ("verified", "unverified") if i % 2 == 0 else ("unverified", "verified")
+                t = {}
+                for label in order:
                     with _unverified() if label == "unverified" else _nullcontext():
-                        t0 = time.perf_counter()
-                        ours(fr, r)
-                        best[label] = min(best[label], time.perf_counter() - t0)
+                        t0 = time.process_time()
+                        for _ in range(reps):
+                            ours(fr, r)
+                        t[label] = (time.process_time() - t0) / reps
+                    times[label].append(t[label])
+                costs.append(100 * (1 - t["unverified"] / t["verified"]))
         n = len(fr)
-        v, u = n / best["verified"], n / best["unverified"]
+        v, u = n / np.median(times["verified"]), n / np.median(times["unverified"])
         print(
-            f"  {name} ({n} frames): verified {v:7.1f} frames/s, unverified {u:7.1f} frames/s, "
-            f"verification costs {100 * (1 - v / u):.1f} % of the speed"
+            f"  {name} ({n} frames{f' x {reps}' if reps > 1 else ''}): verified {v:7.1f} frames/s, unverified {u:7.1f} frames/s (medians), "
+            f"verification costs {np.median(costs):.1f} % of the speed "
+            f"[{min(costs):.1f}-{max(costs):.1f}; pairs: {', '.join(f'{c:.1f}' for c in costs)}]"
         )
 
 

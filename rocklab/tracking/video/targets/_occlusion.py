@@ -33,6 +33,7 @@ where a change of the wall joins the blob) is the position of a ball, whose text
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -201,7 +202,7 @@ def silhouette(patch, bg):
     lo = max(BG_TOL, FG_REL * hi)
     if hi <= lo:
         return None
-    return np.clip((d - lo) * (1.0 / (hi - lo)), 0.0, 1.0)
+    return _ramp(d, lo, hi)
 
 
 def roundness(sil) -> float:
@@ -254,10 +255,30 @@ DISK_CLOSE_PX = 9
 DISK_OPEN_PX = 5
 
 
-def disk(patch, bg, rel=DISK_REL):
+def _ramp(d, lo, hi):
+    """``(d - lo) / (hi - lo)`` clipped to 0..1 (float32, a new array; ``d`` is left as it is)."""
+    out = np.subtract(d, np.float32(lo), dtype=np.float32)
+    out *= np.float32(1.0 / (hi - lo))
+    return np.clip(out, 0.0, 1.0, out=out)
+
+
+def _disk_diff(patch, bg):
+    """How far ``patch`` differs from ``bg``, smoothed by :data:`DISK_SMOOTH_PX` (float32), and the
+    98th percentile of a quarter of it (grey levels): what :func:`disk` and :func:`_disk_match`
+    threshold, computed once for both."""
+    import cv2
+
+    d = cv2.GaussianBlur(cv2.absdiff(np.asarray(patch, np.float32), np.asarray(bg, np.float32)), (0, 0), DISK_SMOOTH_PX)
+    flat = d[::2, ::2].ravel()
+    k = int(0.98 * (flat.size - 1))
+    return d, float(np.partition(flat, k)[k])
+
+
+def disk(patch, bg, rel=DISK_REL, diff=None):
     """The largest blob standing out of ``bg`` in ``patch`` (:data:`DISK_REL`, holes filled, thin
     parts opened away): its smallest enclosing circle's centre (x, y) px in ``patch``, radius px,
-    and the circularity of its hull (:func:`roundness`); None when nothing stands out.
+    and the circularity of its hull (:func:`roundness`); None when nothing stands out. ``diff``:
+    :func:`_disk_diff` of the two, when already computed.
 
     A ball's outline does not slide as its texture does: the centre of its disk is the position
     it tells (its texture slides over it as it spins).
@@ -271,16 +292,13 @@ def disk(patch, bg, rel=DISK_REL):
     """
     import cv2
 
-    d = cv2.GaussianBlur(cv2.absdiff(np.asarray(patch, np.float32), np.asarray(bg, np.float32)), (0, 0), DISK_SMOOTH_PX)
-    flat = d[::2, ::2].ravel()
-    k = int(0.98 * (flat.size - 1))
-    hi = float(np.partition(flat, k)[k])
+    d, hi = _disk_diff(patch, bg) if diff is None else diff
     lo = max(BG_TOL, rel * hi)
     if hi <= lo:
         return None
     m = (d > lo).astype(np.uint8)
     for op, size in ((cv2.MORPH_CLOSE, DISK_CLOSE_PX), (cv2.MORPH_OPEN, DISK_OPEN_PX)):
-        m = cv2.morphologyEx(m, op, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (size, size)))
+        m = cv2.morphologyEx(m, op, _ellipse(size))
     cs, _ = cv2.findContours(m, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)
     if not cs:
         return None
@@ -312,24 +330,41 @@ def stable_disk(patch, bg):
     return found[0]
 
 
-def _disk_match(patch, bg, r, rel=DISK_REL):
+@functools.lru_cache(maxsize=8)
+def _ellipse(size):
+    """The elliptic structuring element of ``size`` px (read only)."""
+    import cv2
+
+    k = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (size, size))
+    k.flags.writeable = False
+    return k
+
+
+@functools.lru_cache(maxsize=8)
+def _disk_kernel(R):
+    """A filled disk of radius ``R`` px in a (2R + 1)-px square, float32 (read only)."""
+    import cv2
+
+    kern = np.zeros((2 * R + 1, 2 * R + 1), np.float32)
+    cv2.circle(kern, (R, R), R, 1.0, -1)
+    kern.flags.writeable = False
+    return kern
+
+
+def _disk_match(patch, bg, r, rel=DISK_REL, diff=None):
     """Centre (x, y) px in ``patch`` of a disk of radius ``r`` px matched by normalised correlation
     to how far each pixel stands out of ``bg`` (0 below :data:`DISK_REL` of the strongest
     differences, 1 at them): a shadow or a change of the wall that joins the object's blob moves
-    the match little; None when nothing stands out or the window is smaller than the disk."""
+    the match little; None when nothing stands out or the window is smaller than the disk.
+    ``diff``: :func:`_disk_diff` of the two, when already computed."""
     import cv2
 
-    d = cv2.GaussianBlur(cv2.absdiff(np.asarray(patch, np.float32), np.asarray(bg, np.float32)), (0, 0), DISK_SMOOTH_PX)
-    flat = d[::2, ::2].ravel()
-    k = int(0.98 * (flat.size - 1))
-    hi = float(np.partition(flat, k)[k])
+    d, hi = _disk_diff(patch, bg) if diff is None else diff
     lo = max(BG_TOL, rel * hi)
     R = int(round(r))
     if hi <= lo or R < 2 or min(d.shape) <= 2 * R + 1:
         return None
-    kern = np.zeros((2 * R + 1, 2 * R + 1), np.float32)
-    cv2.circle(kern, (R, R), R, 1.0, -1)
-    res = cv2.matchTemplate(np.clip((d - lo) * (1.0 / (hi - lo)), 0.0, 1.0), kern, cv2.TM_CCOEFF_NORMED)
+    res = cv2.matchTemplate(_ramp(d, lo, hi), _disk_kernel(R), cv2.TM_CCOEFF_NORMED)
     pk, val = subpixel_peak(res)
     return pk + R if math.isfinite(val) else None
 
@@ -348,7 +383,7 @@ def subpixel_peak(res):
             )
             den = a - 2 * b + c
             if den < 0:
-                out[axis] += float(np.clip(0.5 * (a - c) / den, -0.5, 0.5))
+                out[axis] += float(min(max(0.5 * (a - c) / den, -0.5), 0.5))
     return np.array(out), float(val)
 
 
@@ -471,13 +506,14 @@ class OutlineRef:
         if f < 1.0:
             back, bgw = _reduce(back, f), _reduce(bgw, f)
         r0 = self.disk0[1] * f
+        diff = _disk_diff(back, bgw)  # what every threshold below cuts
         for rel in DISK_RELS:
-            d = disk(back, bgw, rel)
+            d = disk(back, bgw, rel, diff)
             if d is None or d[1] <= (1.0 + DISK_RADIUS_TOL) * r0:
                 break  # no blob larger than the disk: nothing joined it at this threshold
         else:  # larger at every threshold (a hand joined it): as at the first
-            rel, d = DISK_REL, disk(back, bgw)
-        c = _disk_match(back, bgw, r0, rel)
+            rel, d = DISK_REL, disk(back, bgw, diff=diff)
+        c = _disk_match(back, bgw, r0, rel, diff)
         if c is None:
             return None
         if d is not None and abs(d[1] - r0) <= DISK_RADIUS_TOL * r0 and np.hypot(*(d[0] - c)) <= DISK_AGREE * r0:
@@ -499,21 +535,30 @@ def _reduce(img, f):
     return cv2.resize(img, None, fx=f, fy=f, interpolation=cv2.INTER_AREA)
 
 
-def warp_grown(tr, img, W, margin):
+def warp_grown(tr, img, W, margin, also=None):
     """``img`` resampled by the pose ``W`` onto the template's grid grown by ``margin`` px on
-    every side (float32), or None off the frame."""
+    every side (float32), or None off the frame. ``also``: a second image of ``img``'s shape
+    resampled the same way (the window placed once); then the pair, (None, None) off the frame."""
     import cv2
 
     crop, off = tr._window(img, W, margin + 4)
     if crop is None:
-        return None
+        return None if also is None else (None, None)
     Wd = np.asarray(W, np.float32).copy()
     Wd[:, 2] += (Wd[:, :2].astype(float) @ (tr.origin - margin)).astype(np.float32) - off
     w, h = tr.size
-    return cv2.warpAffine(
-        crop,
-        Wd,
-        (w + 2 * margin, h + 2 * margin),
-        flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP,
-        borderMode=cv2.BORDER_REPLICATE,
-    )
+    crops = [crop]
+    if also is not None:  # the same window of the second image (what tr._window cuts from it)
+        x0, y0 = int(off[0]), int(off[1])
+        crops.append(also[y0 : y0 + crop.shape[0], x0 : x0 + crop.shape[1]].astype(np.float32))
+    out = [
+        cv2.warpAffine(
+            c,
+            Wd,
+            (w + 2 * margin, h + 2 * margin),
+            flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP,
+            borderMode=cv2.BORDER_REPLICATE,
+        )
+        for c in crops
+    ]
+    return out[0] if also is None else tuple(out)

@@ -270,11 +270,14 @@ class PoseVerifier:
                 return "jump"  # no farther than the fastest verified motion allows
         if bg_back is not None and known_back is not None:
             k = known_back > 0.5
-            if k.mean() >= BG_KNOWN and (
-                float(np.mean(np.abs(back[k] - bg_back[k]) < BG_TOL)) >= BG_FRACTION
+            # the known pixels, taken once (all of them, in the same order, when all are known)
+            known = k.mean()
+            kb, kg = (back.ravel(), bg_back.ravel()) if known == 1.0 else (back[k], bg_back[k])
+            if known >= BG_KNOWN and (
+                float(np.mean(np.abs(kb - kg) < BG_TOL)) >= BG_FRACTION
                 # the still background explains the patch at least as well as the object does (a
                 # detail of the scene that looks like a small object, under compression noise)
-                or _ncc(back[k], bg_back[k]) >= score
+                or _ncc(kb, kg) >= score
             ):
                 return "background"
         return None
@@ -389,7 +392,7 @@ class PoseVerifier:
         # once the object has left its first region: only then is the check worth its two warps
         if self.filled or self.early or self.first_known or self._clear(centre):
             m = 2 * self.margin
-            bg_g, back_g = warp_grown(tr, self.bg, W, m), warp_grown(tr, gray, W, m)
+            bg_g, back_g = warp_grown(tr, self.bg, W, m, also=gray)
             if bg_g is not None and back_g is not None:
                 bg, back = bg_g[m:-m, m:-m], back_g[m:-m, m:-m]
                 known = np.ones_like(bg)

@@ -20,10 +20,11 @@ import pytest
 
 from _mirror import mirror_file
 
+from rocklab._diagnostics import collecting
 from rocklab.config import TrackConfig
 from rocklab.tracking import iter_video_frames, track_video
 
-START, STOP, BOX = 140, 260, (840, 270, 110, 125)
+START, STOP, BOX = 140, 261, (840, 270, 110, 125)
 
 
 @pytest.fixture(scope="module")
@@ -56,7 +57,8 @@ def test_a_thrown_ball_is_never_ok_off_the_ball(film):
             "objects": [{"id": "ball", "roi": list(BOX)}],
         }
     )
-    ball = track_video(film, cfg)["ball"]
+    with collecting():  # lost frames and unmeasured angles are warned of: not what is checked here
+        ball = track_video(film, cfg)["ball"]
     blobs = _green_blobs(film)
     # the reference agrees with the review kit's (ref/trflorian_ball4.csv, whose cross the reviewer
     # checked on the ball by eye on these frames)

@@ -83,3 +83,89 @@ def test_taylor_refuses_what_it_does_not_integrate():
         simulate(B6M, 0.1, duration_s=1.0, method="taylor", linearized=True)
     with pytest.raises(InputError, match="taylor"):
         simulate(B6M, 0.1, duration_s=1.0, method="rk4")
+
+
+def test_block_output_equals_the_per_sample_series():
+    # the output grid is evaluated in blocks of re-expanded low-degree polynomials; against one
+    # order-12 evaluation per sample (the previous path) on the same series: equal to the rounding
+    # (measured <= 2.5e-16 of alpha and of p alpha), for p dt from 1e-4 up to the blocks' bound
+    from rocklab.models.rocking._taylor import ORDER, _coefficients, _recurrence_factors
+    from rocklab.models.rocking._taylor_dense import block_scratch, blocks_fit, dense_blocks, dense_samples
+
+    n = ORDER
+
+    def both(p, alpha, dt, th_f, w_f, s):
+        inv, q = _recurrence_factors(p * p, n)
+        a, S, C, jc = (np.zeros(n + 1) for _ in range(4))
+        _coefficients(a, S, C, jc, th_f * alpha, w_f * p * alpha, s, p * p, alpha, n, inv, q)
+        t = 0.123456789
+        k0, k1 = int(t / dt) + 1, int((t + 0.2 / p) / dt) + 1  # one full step of p h = 0.2
+        one, blk = ([np.zeros(k1 + 40) for _ in range(3)] for _ in range(2))
+        dense_samples(a, n, *one, k0, k1, dt, t, 1.5)
+        dense_blocks(a, n, *blk, k0, k1, dt, t, 1.5, *block_scratch(n, dt))
+        assert np.array_equal(one[2], blk[2])
+        return np.abs(one[0] - blk[0]).max() / alpha, np.abs(one[1] - blk[1]).max() / (p * alpha)
+
+    states = ((0.9, 0.0, 1.0), (0.0, 1.0, 1.0), (-0.5, -0.7, -1.0), (0.01, -0.05, 1.0))
+    for p, alpha, dt in ((8.42, 0.218, 1e-4), (20.0, 0.3, 5e-5), (17.0, 0.1, 1e-4), (8.42, 0.218, 2.29e-4)):
+        assert blocks_fit(p, dt)
+        for st in states:
+            e_th, e_w = both(p, alpha, dt, *st)
+            assert e_th < 1e-15 and e_w < 1e-15
+    # perturbed: blocks ten times wider than the bound lose accuracy (the bound is what keeps it)
+    assert not blocks_fit(8.42, 2.29e-3)
+    assert max(both(8.42, 0.218, 2.29e-3, *st)[1] for st in states) > 1e-12
+
+
+def test_block_output_run_equals_the_per_sample_run():
+    # whole runs: the 1e-4 s grid (blocks) against a 2.5e-3 s grid (too coarse for blocks:
+    # one order-12 evaluation per sample) at their common times
+    th0 = 0.8 * B6M.alpha_rad
+    fine = simulate(B6M, th0, method="taylor", duration_s=4.0, dt_s=1e-4)
+    coarse = simulate(B6M, th0, method="taylor", duration_s=4.0, dt_s=2.5e-3)
+    assert np.array_equal(fine.impacts_array, coarse.impacts_array)
+    n = coarse.t_s.size - 1  # the last sample of a run at rest is the rest sample
+    assert np.abs(fine.t_s[: 25 * n : 25] - coarse.t_s[:n]).max() < 1e-15
+    assert np.abs(fine.theta_rad[: 25 * n : 25] - coarse.theta_rad[:n]).max() < 1e-15  # measured 6e-17 rad
+    assert np.abs(fine.omega_rad_s[: 25 * n : 25] - coarse.omega_rad_s[:n]).max() < 1e-14  # 1.6e-15 rad/s
+
+
+def _impact_times_by_quadrature(block, theta0_rad, eta, n):
+    """Impact times of free rocking released at rest, from the energy integral (no time stepping).
+
+    Between impacts energy is conserved, so a half-cycle from theta = 0 up to the turning point
+    tm and back lasts 2 int_0^tm dtheta / sqrt(2 p^2 (cos(alpha - tm) - cos(alpha - theta)));
+    after impact k, omega = eta^k omega_1 sets the next tm. The 1/sqrt singularity at tm is
+    quadpack's algebraic weight.
+    """
+    from scipy.integrate import quad
+
+    a, p = block.alpha_rad, block.p_rad_s
+
+    def quarter(tm):
+        def smooth(th):
+            x = 0.5 * (tm - th)
+            r = 2.0 if x == 0.0 else 2.0 * x / math.sin(x)
+            return math.sqrt(r / (4 * p * p * math.sin(a - 0.5 * (th + tm))))
+
+        return quad(smooth, 0.0, tm, weight="alg", wvar=(0.0, -0.5), epsabs=0, epsrel=1.2e-14, limit=200)[0]
+
+    w1 = math.sqrt(2 * p * p * (math.cos(a - theta0_rad) - math.cos(a)))
+    t = [quarter(theta0_rad)]
+    for k in range(1, n):
+        w = w1 * eta**k
+        t.append(t[-1] + 2 * quarter(a - math.acos(math.cos(a) + w * w / (2 * p * p))))
+    return np.array(t)
+
+
+def test_taylor_impact_times_match_the_energy_quadrature(b6m_runs):
+    # an independent reference without time steps: 90 impact times from the energy integral.
+    # Measured: Taylor 2.4e-12 s; DOP853 with events at rtol 1e-13 3.4e-11 to 4.7e-11 s at any
+    # rtol from 1e-11 to 3e-14 (its impact location, not its step, limits it)
+    tay, ref, _ = b6m_runs
+    t_q = _impact_times_by_quadrature(B6M, 0.8 * B6M.alpha_rad, B6M.eta_H, 90)
+    err_tay = np.abs(tay.impacts.t_s.to_numpy() - t_q).max()
+    assert err_tay < 1e-11
+    # perturbed: the same quadrature with eta off by 1e-9 (relative) is far outside that bound
+    t_p = _impact_times_by_quadrature(B6M, 0.8 * B6M.alpha_rad, B6M.eta_H * (1 + 1e-9), 90)
+    assert np.abs(tay.impacts.t_s.to_numpy() - t_p).max() > 10 * err_tay

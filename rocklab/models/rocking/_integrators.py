@@ -26,6 +26,7 @@ from ..._errors import InputError
 from ...blocks import G
 from ._newmark import STATUS_NAMES, run_single
 from ._result import KernelResult
+from ._taylor import run_taylor
 
 if TYPE_CHECKING:
     from ...blocks import Block
@@ -218,8 +219,6 @@ class Taylor(Integrator):
             )
 
     def run(self, problem: RockingProblem) -> KernelResult:
-        from ._taylor import run_taylor
-
         pb, law = problem.block, problem.law
         odt = problem.dt_s * problem.output_every if problem.resample_dt_s is None else problem.resample_dt_s
         t, th, w, E, imp, n_imp, st, t_over, t_fall, max_abs = run_taylor(

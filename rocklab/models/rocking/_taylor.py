@@ -11,16 +11,19 @@ builds the Taylor series of theta about the step's start to order
 - the impact is the root of the polynomial theta(tau) = 0 (Newton, bracketed),
   so contact stays exact: the step ends there and the restitution law applies;
 - the output samples inside the step are the polynomial and its derivative at
-  their times (dense output of the same order);
+  their times (dense output of the same order), evaluated in blocks of samples by
+  :mod:`._taylor_dense`;
 - the energy above rest is constant between impacts (the equation conserves it),
   so it is computed once per half-cycle.
 
 Steps are ``p h <= P_H`` (0.2) at order 12: on B6M (3.9 s of rocking, 90
 impacts) impact times agree with ``solve_ivp`` DOP853 at rtol 1e-13 within
 3.5e-11 s and theta within 3e-12 rad (the Newmark kernel at dt = 1e-4 s:
-2.2e-7 s, 1.2e-7 rad), at about the Newmark kernel's cost on a 1e-4 s output
-grid. Free rocking only: a base record makes the right-hand side a
-piecewise-linear function of time, which the Newmark kernel handles.
+2.2e-7 s, 1.2e-7 rad), at half the Newmark kernel's cost on a 1e-4 s output
+grid (0.21 ms against 0.41 ms, ``benchmarks/bench_single.py``). Longer steps
+are not free: at ``p h <= 0.3`` B6M's impact times move by 1.5e-11 s. Free
+rocking only: a base record makes the right-hand side a piecewise-linear
+function of time, which the Newmark kernel handles.
 """
 
 from __future__ import annotations
@@ -31,6 +34,7 @@ import numpy as np
 from numba import njit
 
 from ._newmark_contact import restitution_at, store_impact
+from ._taylor_dense import block_scratch, blocks_fit, dense_blocks, dense_samples
 
 __all__ = ["run_taylor", "ORDER", "P_H"]
 
@@ -60,86 +64,53 @@ def series_slope(a, n, x):
     return v
 
 
-@njit(cache=True, fastmath={"contract"})
-def _dense(a, out_th, out_w, out_e, k0, k1, out_dt, t, energy):
-    """theta, omega and energy at the output samples k0 <= k < k1 from one step's series.
+@njit(cache=True)
+def _recurrence_factors(p2, n):
+    """``inv[k] = 1/k`` and ``q[k] = p2 / ((k + 1)(k + 2))`` (k < n) of :func:`_coefficients`: one
+    multiplication each per term instead of a division."""
+    inv = np.zeros(n)
+    q = np.zeros(n)
+    for k in range(1, n):
+        inv[k] = 1.0 / k
+        q[k] = p2 / ((k + 1) * (k + 2))
+    return inv, q
 
-    Four samples per pass: their Horner chains are independent, so they overlap in the
-    pipeline instead of waiting on one chain's latency.
+
+@njit(cache=True, fastmath={"contract"})
+def _coefficients(a, S, C, jc, th, w, s, p2, alpha, n, inv, q):
+    """Taylor coefficients a[0..n] of theta about (th, w) on side s.
+
+    ``S, C``: the series of sin c and cos c (c = alpha s - theta); ``jc[j] = j c_j``;
+    ``inv, q`` from :func:`_recurrence_factors`.
     """
-    n = ORDER
-    i = k0
-    while i + 4 <= k1:
-        x0 = i * out_dt - t
-        x1 = x0 + out_dt
-        x2 = x1 + out_dt
-        x3 = x2 + out_dt
-        an = a[n]
-        v0 = an
-        v1 = an
-        v2 = an
-        v3 = an
-        dn = n * an
-        d0 = dn
-        d1 = dn
-        d2 = dn
-        d3 = dn
-        for j in range(n - 1, 0, -1):
-            aj = a[j]
-            jaj = j * aj
-            v0 = v0 * x0 + aj
-            v1 = v1 * x1 + aj
-            v2 = v2 * x2 + aj
-            v3 = v3 * x3 + aj
-            d0 = d0 * x0 + jaj
-            d1 = d1 * x1 + jaj
-            d2 = d2 * x2 + jaj
-            d3 = d3 * x3 + jaj
-        a0 = a[0]
-        out_th[i] = v0 * x0 + a0
-        out_th[i + 1] = v1 * x1 + a0
-        out_th[i + 2] = v2 * x2 + a0
-        out_th[i + 3] = v3 * x3 + a0
-        out_w[i] = d0
-        out_w[i + 1] = d1
-        out_w[i + 2] = d2
-        out_w[i + 3] = d3
-        out_e[i] = energy
-        out_e[i + 1] = energy
-        out_e[i + 2] = energy
-        out_e[i + 3] = energy
-        i += 4
-    while i < k1:
-        x = i * out_dt - t
-        out_th[i] = series_value(a, n, x)
-        out_w[i] = series_slope(a, n, x)
-        out_e[i] = energy
-        i += 1
-
-
-@njit(cache=True, fastmath={"contract"})
-def _coefficients(a, S, C, c, th, w, s, p2, alpha, n):
-    """Taylor coefficients a[0..n] of theta about (th, w) on side s."""
     a[0] = th
     a[1] = w
     c0 = alpha * s - th
     S[0] = math.sin(c0)
     C[0] = math.cos(c0)
-    c[0] = c0
-    c[1] = -w
+    jc[1] = -w
     a[2] = -0.5 * p2 * S[0]
-    c[2] = -a[2]
+    jc[2] = -2.0 * a[2]
     for k in range(1, n - 1):
-        ss = 0.0
-        cc = 0.0
-        for j in range(1, k + 1):
-            jc = j * c[j]
-            ss += jc * C[k - j]
-            cc -= jc * S[k - j]
-        S[k] = ss / k
-        C[k] = cc / k
-        a[k + 2] = -p2 * S[k] / ((k + 1) * (k + 2))
-        c[k + 2] = -a[k + 2]
+        # two partial sums per series: half the dependent chain of one
+        s0 = 0.0
+        s1 = 0.0
+        c0_ = 0.0
+        c1_ = 0.0
+        j = 1
+        while j + 1 <= k:
+            s0 += jc[j] * C[k - j]
+            c0_ -= jc[j] * S[k - j]
+            s1 += jc[j + 1] * C[k - j - 1]
+            c1_ -= jc[j + 1] * S[k - j - 1]
+            j += 2
+        if j == k:
+            s0 += jc[j] * C[0]
+            c0_ -= jc[j] * S[0]
+        S[k] = (s0 + s1) * inv[k]
+        C[k] = (c0_ + c1_) * inv[k]
+        a[k + 2] = -q[k] * S[k]
+        jc[k + 2] = -(k + 2) * a[k + 2]
 
 
 @njit(cache=True, fastmath={"contract"})
@@ -167,10 +138,51 @@ def series_root(a, n, lo, hi, target, s, rel_tol, max_iter):
     return x
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", fastmath={"contract"})
+def _value_slope(a, n, x):
+    """The series ``a[0..n]`` and its derivative at ``x`` (one Horner pass)."""
+    v = a[n]
+    d = 0.0
+    for k in range(n - 1, -1, -1):
+        d = d * x + v
+        v = v * x + a[k]
+    return v, d
+
+
+@njit(cache=True, fastmath={"contract"})
 def _root(a, n, lo, hi, target, s):
-    """tau in (lo, hi] where s*theta(tau) = target, with s*theta(lo) > target >= s*theta(hi)."""
-    return series_root(a, n, lo, hi, target, s, 1e-15, 100)
+    """tau in (lo, hi] where s*theta(tau) = target, with s*theta(lo) > target >= s*theta(hi).
+
+    Newton steps from the secant inside a shrinking bracket. Once a step is below 1e-9 of tau,
+    one more step has converged (quadratically, to ~1e-18 of tau) and the run stops: a
+    tolerance on the step alone would chase the rounding of theta, which near a small-amplitude
+    impact moves tau by more than 1e-15 of itself, for dozens of iterations.
+    """
+    f_lo = s * series_value(a, n, lo) - target
+    f_hi = s * series_value(a, n, hi) - target
+    x = lo + (hi - lo) * f_lo / (f_lo - f_hi) if f_lo != f_hi else hi
+    last = False
+    for _ in range(100):
+        v, d = _value_slope(a, n, x)
+        f = s * v - target
+        if f > 0.0:
+            lo = x
+        else:
+            hi = x
+        d = s * d
+        xn = x - f / d if d != 0.0 else 0.5 * (lo + hi)
+        small = abs(xn - x) <= 1e-9 * abs(x)
+        if not (lo < xn < hi):
+            if small:
+                return x  # a step to the bracket's end: x is already at the rounding of theta
+            xn = 0.5 * (lo + hi)
+        elif last:
+            return xn
+        last = small
+        if hi - lo <= 1e-15 * hi:
+            return xn
+        x = xn
+    return x
 
 
 @njit(cache=True, fastmath={"contract"})
@@ -190,7 +202,10 @@ def run_taylor(
     a = np.zeros(n + 1)
     S = np.zeros(n + 1)
     C = np.zeros(n + 1)
-    c = np.zeros(n + 1)
+    jc = np.zeros(n + 1)
+    inv, qk = _recurrence_factors(p2, n)
+    blocks = blocks_fit(p, out_dt)
+    binom, ab, u, vb, db = block_scratch(n, out_dt)
     # uninitialised: the grid after rest is never written (zeroing all of it cost a quarter of a
     # B6M run); the samples the loop does not write are zeroed at the end
     out_th = np.empty(n_out)
@@ -216,7 +231,7 @@ def run_taylor(
     energy = (0.5 * w * w + p2 * (math.cos(alpha - abs(th)) - cos_a)) * e_scale
     t_end = (n_out - 1) * out_dt
     while s != 0.0 and k < n_out:
-        _coefficients(a, S, C, c, th, w, s, p2, alpha, n)
+        _coefficients(a, S, C, jc, th, w, s, p2, alpha, n, inv, qk)
         h = min(h_max, t_end - t) if t < t_end else h_max
         if h <= 0.0:
             h = h_max
@@ -228,16 +243,13 @@ def run_taylor(
             tau = _root(a, n, 0.0, h, -fall_rad, -s)  # s*theta rises through fall_rad
         elif s * th_h <= 0.0:
             event = 1
-            lo = 0.0
             if th == 0.0:
-                # leaving the corner: theta ~ w tau; start the bracket where it is clearly on side s
-                lo = h
-                for _ in range(60):
-                    lo *= 0.5
-                    if s * series_value(a, n, lo) > 0.0:
-                        break
-            tau = _root(a, n, lo, h, 0.0, s)
-        if t_over != t_over and (event == 2 or s * series_value(a, n, tau) >= alpha):
+                # leaving the corner: theta = tau (w + a_2 tau + ...), and the bracket
+                # of the series in parentheses starts at tau = 0, where it is w (on side s)
+                tau = _root(a[1:], n - 1, 0.0, h, 0.0, s)
+            else:
+                tau = _root(a, n, 0.0, h, 0.0, s)
+        if t_over != t_over and (event == 2 or (event == 0 and s * th_h >= alpha)):
             t_over = t + _root(a, n, 0.0, tau, -alpha, -s)
         # output samples in (t, t + tau]: a counted loop of independent evaluations (vectorised)
         k_end = min(n_out, int(math.floor((t + tau) / out_dt)) + 1)
@@ -246,7 +258,10 @@ def run_taylor(
         while k_end > k and (k_end - 1) * out_dt > t + tau:
             k_end -= 1
         if k_end > k:
-            _dense(a, out_th, out_w, out_e, k, k_end, out_dt, t, energy)
+            if blocks:
+                dense_blocks(a, n, out_th, out_w, out_e, k, k_end, out_dt, t, energy, binom, ab, u, vb, db)
+            else:
+                dense_samples(a, n, out_th, out_w, out_e, k, k_end, out_dt, t, energy)
             k = k_end
             k_dense = k
         # the turning point inside the step (omega = 0) sets max |theta|: there the (conserved)
@@ -257,7 +272,8 @@ def run_taylor(
             m = alpha - math.acos(q)
             if m > max_abs:
                 max_abs = m
-        th = series_value(a, n, tau)
+        # at an impact theta(tau) is 0 (set below); a full step ends at th_h
+        th = th_h if event == 0 else series_value(a, n, tau)
         w = w_tau
         t = t + tau
         if abs(th) > max_abs and event != 1:

@@ -9,8 +9,10 @@ and, for the outline, its own first frame:
   keyframe must reach the median of the verified frames' correlations less
   :data:`APPEARANCE_MADS` robust deviations (at least :data:`MIN_DEVIATION`; never below
   :data:`MIN_SCORE`); and while that limit is not learned yet, a pose found after lost frames
-  must be a turned copy of the first view (:data:`COLD_FIRST_CC`): a keyframe renewed from a
-  lamp or a hand that the template half matched would otherwise follow it at 0.99. So must, at
+  must be a turned copy of the first view (:data:`COLD_FIRST_CC`), or of the first view smeared
+  along the object's last verified velocity by up to its fastest verified speed (a ball swinging
+  20 px a frame is a streak that matches its still first view at 0.83-0.88): a keyframe renewed
+  from a lamp or a hand that the template half matched would otherwise follow it at 0.99. So must, at
   any time, a pose found after lost frames (or after a slide) farther than the template's larger
   side both from the last verified pose and from where its velocity carries it: the motion
   vouches for nothing there, and a small ball's keyframe half matches a forearm or an edge;
@@ -34,7 +36,13 @@ and, for the outline, its own first frame:
   from a verified frame in which the object has left it, or, sooner, from the median of the
   frames in which the object was lost (:data:`LOST_SAMPLES`), once the object's template
   registers nowhere in that median (the object has gone from its first place: a bob hanging
-  still before it was shot off would otherwise make its own empty place look like the object);
+  still before it was shot off would otherwise make its own empty place look like the object),
+  and again from every later such median of the same run of lost frames: an object that slides
+  off slowly is lost while it still covers part of its place, so the run's first median holds
+  part of it, and its later ones show the empty place once it has gone. An object that stayed
+  under a hand is found again when the hand leaves; that verified frame ends the run, and the
+  background is not learned again until the next lost frame, so medians of the object back in
+  view (a rocking block the turned template does not register in) never become its background;
   and the patch must not be what the latest scene snapshot taken while the object stood
   elsewhere showed there (one every :data:`SNAP_FRAMES` verified frames): a pose left on the
   object's empty start place, whose look the keyframe learned, matches its keyframe at 0.998;
@@ -118,6 +126,9 @@ MEDIAN_TURNS_DEG = (0.0, -5.0, 5.0, -10.0, 10.0)
 #: (the markerless tracker's keyframe rule). Nothing learned yet says how far the object's look may
 #: stray from it, and a lamp or a hand that the template half matches (0.6-0.85) is not the object.
 COLD_FIRST_CC = 0.9
+#: Smear lengths tried on the first view for that rule, as fractions of the fastest verified speed
+#: (px/frame): the exposure's share of the frame interval is not known.
+SMEAR_FRACS = (0.33, 0.67, 1.0)
 #: Least contrast of a verified patch, as a fraction of the median contrast of the object's verified
 #: frames (grey standard deviation of the frame warped back by the pose over the first template's).
 #: The correlation normalises contrast away: a shadow, or a bare wall's faint gradient, correlates
@@ -164,6 +175,8 @@ class PoseVerifier:
         self.first_known = False
         self.lost_crops: collections.deque = collections.deque(maxlen=LOST_SAMPLES[1])
         self.n_lost, self._sampled_at, self.since_lost = 0, -1, False
+        #: lost since the last verified frame: each median of the run may replace the last one
+        self.lost_run = False
         self.first_outer = first_gray[self.outer[1] : self.outer[3], self.outer[0] : self.outer[2]].astype(np.float32)
         self.tmpl0 = first_gray[box[1] : box[3], box[0] : box[2]].astype(np.float32)
         self.size = size
@@ -315,15 +328,17 @@ class PoseVerifier:
     def lost_frame(self, gray, frame, min_cc):
         """Learn from a frame in which the object was lost: from then on every frame's first
         region is a sample of what stands there (:meth:`_sample`)."""
-        self.since_lost = True
+        self.since_lost = self.lost_run = True
         self._sample(gray, frame, min_cc)
 
     def _sample(self, gray, frame, min_cc):
         """Keep ``gray``'s first region (once per frame) and, every first number of :data:`LOST_SAMPLES`
         samples, take their median as the background there when the object's template registers
         in it nowhere at ``min_cc`` and it differs from the first view (the object has left its
-        place). Decided on copies reduced until the template is about 40 px across."""
-        if self.filled or self.first_known or frame == self._sampled_at:
+        place); again at every such median until a frame is verified (:attr:`lost_run`: a median
+        taken while the object was sliding off holds part of it). Decided on copies reduced until
+        the template is about 40 px across."""
+        if self.filled or (self.first_known and not self.lost_run) or frame == self._sampled_at:
             return
         self._sampled_at = frame
         import cv2
@@ -452,16 +467,22 @@ class PoseVerifier:
 
     def _look_again(self, tr, gray, W, centre, score, gap, far=False):
         """The checks a template that adapts cannot pass by adapting: ``mismatch`` for a pose found
-        after lost frames that is no turned copy of the first view (:data:`COLD_FIRST_CC`) while
-        the limits are cold, or out of the object's reach (``far``: :meth:`_far`) at any time;
+        after lost frames that is no turned copy of the first view (:data:`COLD_FIRST_CC`), nor of
+        the first view smeared by the object's verified motion (:meth:`_smeared`), while the
+        limits are cold, or no turned copy of the sharp first view when out of the object's reach
+        (``far``: :meth:`_far`) at any time;
         ``background`` for a patch that the latest snapshot taken while
         the object stood elsewhere already showed there (unchanged on :data:`BG_FRACTION` of its
         pixels, or correlating with it at least as well as with the object): a pose left on the
         object's empty start place, or on a detail of the scene the keyframe has learned."""
         now = None
-        if (gap > 1 and len(self.scores) < WARMUP_FRAMES) or far:
+        cold = gap > 1 and len(self.scores) < WARMUP_FRAMES
+        if cold or far:
             now = tr._warp_back(gray, W)
-            if now is None or _ncc(now, tr.tmpl0) < COLD_FIRST_CC:
+            # while cold, the first view may be smeared by the object's own verified motion (a
+            # swinging ball is a streak across the frame); a far pose has no motion to vouch for it
+            views = self._smeared(tr.tmpl0, W) if cold and not far else [tr.tmpl0]
+            if now is None or max(_ncc(now, v) for v in views) < COLD_FIRST_CC:
                 return "mismatch"
         half = 0.5 * math.hypot(*self.size) + self.margin
         for snap, (x0, y0, x1, y1) in reversed(self.snaps):
@@ -473,6 +494,29 @@ class PoseVerifier:
                 same = float(np.mean(np.abs(now - then) < BG_TOL))
                 return "background" if same >= BG_FRACTION or _ncc(now, then) >= score else None
         return None
+
+    def _smeared(self, tmpl, W):
+        """``tmpl`` and its copies smeared along the last verified velocity by :data:`SMEAR_FRACS`
+        of the fastest verified speed (turned into the template's frame by the pose ``W``): how the
+        first view looks on a frame exposed while the object moved."""
+        import cv2
+
+        if self.seen is None or not self.speeds:
+            return [tmpl]
+        v = np.asarray(self.seen[1], float)
+        top = float(np.percentile(self.speeds, 99))
+        if not np.any(v) or top < 2.0:
+            return [tmpl]
+        Wd = np.asarray(W, float)
+        ang = math.atan2(v[1], v[0]) - math.atan2(Wd[1, 0] - Wd[0, 1], Wd[0, 0] + Wd[1, 1])
+        out = [tmpl]
+        for frac in SMEAR_FRACS:
+            n = max(int(round(frac * top)), 2)
+            k = np.zeros((2 * n + 1, 2 * n + 1), np.float32)
+            t = np.linspace(-0.5 * n, 0.5 * n, 4 * n + 1)
+            k[np.round(n + t * math.sin(ang)).astype(int), np.round(n + t * math.cos(ang)).astype(int)] = 1.0
+            out.append(cv2.filter2D(tmpl, -1, k / k.sum(), borderType=cv2.BORDER_REPLICATE))
+        return out
 
     @staticmethod
     def _texture_outweighs(tr, gray, at, score) -> bool:
@@ -545,6 +589,7 @@ class PoseVerifier:
         self.seen = (np.asarray(centre, float), v, frame)
         self.recent = (self.recent + [(centre, theta, frame)])[-2:]
         self.fb.accept()
+        self.lost_run = False
         if self.n_verified - self._snap_at >= SNAP_FRAMES:
             m = half + self.margin
             self.snaps.append((np.array(gray), (centre[0] - m, centre[1] - m, centre[0] + m, centre[1] + m)))

@@ -16,6 +16,11 @@ and, for the outline, its own first frame:
   any time, a pose found after lost frames (or after a slide) farther than the template's larger
   side both from the last verified pose and from where its velocity carries it: the motion
   vouches for nothing there, and a small ball's keyframe half matches a forearm or an edge;
+  and the patch's contrast (its grey standard deviation over the first template's) must reach
+  :data:`CONTRAST_FRACTION` of the median of the verified frames' (of the first template's own
+  until :data:`WARMUP_FRAMES` are learned): the correlation is blind to contrast, so the ball's
+  soft shadow on the wall, or a faint gradient of a bare wall, matches a dark ball's keyframe at
+  0.84-0.99 with a tenth of its contrast;
 * **picture**: a pose whose reported point lies outside the picture is lost;
 * **motion** (``jump``): the pose may leave the constant-velocity prediction by no more than
   the verified frames' residuals allow (:data:`MOTION_FACTOR` times their 99th percentile, at
@@ -124,6 +129,12 @@ COLD_FIRST_CC = 0.9
 #: Smear lengths tried on the first view for that rule, as fractions of the fastest verified speed
 #: (px/frame): the exposure's share of the frame interval is not known.
 SMEAR_FRACS = (0.33, 0.67, 1.0)
+#: Least contrast of a verified patch, as a fraction of the median contrast of the object's verified
+#: frames (grey standard deviation of the frame warped back by the pose over the first template's).
+#: The correlation normalises contrast away: a shadow, or a bare wall's faint gradient, correlates
+#: with a dark object's template as well as the object does, with a tenth of its contrast. Motion
+#: blur and a change of light lower it by far less (a ball falling 120 px a frame kept 0.78 of it).
+CONTRAST_FRACTION = 1.0 / 3.0
 #: Scene snapshots for the background check: one every :data:`SNAP_FRAMES` verified frames, the
 #: last :data:`SNAPS` kept (a grey frame each).
 SNAP_FRAMES = 10
@@ -170,6 +181,10 @@ class PoseVerifier:
         self.tmpl0 = first_gray[box[1] : box[3], box[0] : box[2]].astype(np.float32)
         self.size = size
         self.scores = collections.deque(maxlen=300)
+        #: the verified frames' contrast over the first template's (:meth:`faint`)
+        self.contrasts = collections.deque(maxlen=300)
+        self._tmpl0_std = float(self.tmpl0.std())
+        self._contrast = math.nan  # the pose being verified's
         self.residuals = collections.deque(maxlen=300)
         self.speeds = collections.deque(maxlen=300)
         self.n_verified = 0
@@ -398,11 +413,16 @@ class PoseVerifier:
                 known = np.ones_like(bg)
         last2 = None if last is None else last[:2]
         far = self._far(centre, frame)
+        # frames since the last verified one: after a slide the motion checks have no anchor
+        # (``gap`` is then 1), but the pose is still one found after lost frames
+        since = gap if self.seen is None else max(gap, frame - self.seen[2])
         reason = self.check(float(score), centre, theta, pred, last2, gap, bg, back, known)
+        if reason is None and self.faint(back if back is not None else tr._warp_back(gray, W)):
+            reason = "mismatch"
         if reason is None:
             reason = self._look_again(tr, gray, W, centre, float(score), gap, far)
         self.fb.last_miss = math.nan
-        if reason is None and self.fb.doubtful(float(score), *(self.score_stats or (None, None)), gap):
+        if reason is None and self.fb.doubtful(float(score), *(self.score_stats or (None, None)), since):
             # tracked back to the keyframe's frame, the patch must land where the keyframe was cut
             if self.fb.check(back if back is not None else tr._warp_back(gray, W)):
                 reason = "roundtrip"
@@ -423,6 +443,18 @@ class PoseVerifier:
                 self.disk_at = self.outline.disk_centre(tr, W, (back_g, bg_g))
         self._pending = (float(score), centre, theta, pred, last2, gap, frame)
         return reason
+
+    def faint(self, patch) -> bool:
+        """Whether ``patch`` (the frame warped back by the pose onto the template's grid) has less
+        than :data:`CONTRAST_FRACTION` of the contrast the object shows on its verified frames
+        (the first template's own until :data:`WARMUP_FRAMES` are learned): a shadow or a bare
+        wall that the correlation, blind to contrast, matches. Remembers the patch's contrast for
+        :meth:`confirm`."""
+        self._contrast = math.nan if patch is None else float(patch.std()) / max(self._tmpl0_std, 1e-6)
+        if not math.isfinite(self._contrast):
+            return False
+        usual = float(np.median(self.contrasts)) if len(self.contrasts) >= WARMUP_FRAMES else 1.0
+        return self._contrast < CONTRAST_FRACTION * usual
 
     def _far(self, centre, frame) -> bool:
         """Whether a pose centred at ``centre`` (px) in ``frame`` is found after lost frames farther
@@ -539,6 +571,8 @@ class PoseVerifier:
     def confirm(self, gray, size):
         """Learn from the pose just verified (its correlation, motion and the background it uncovers)."""
         score, centre, theta, pred, last, gap, frame = self._pending
+        if math.isfinite(self._contrast):
+            self.contrasts.append(self._contrast)
         w, h = size
         half = 0.5 * math.hypot(w, h)
         footprint = (centre[0] - half, centre[1] - half, centre[0] + half, centre[1] + half)

@@ -26,7 +26,7 @@ from scipy.integrate import solve_ivp
 
 from rocklab import Block
 from rocklab.models import bundled_record, simulate, simulate_batch
-from rocklab.models.rocking import Newmark
+from rocklab.models.rocking import Newmark, free_rocking_impact_times
 
 
 def plain_dop853(blk, theta0, eta, t_grid, n_impacts, rtol=1e-10):
@@ -57,29 +57,6 @@ def plain_dop853(blk, theta0, eta, t_grid, n_impacts, rtol=1e-10):
         impacts.append(t)
         y, s = [0.0, eta * float(sol.y_events[0][0][1])], -s
     return np.array(impacts), theta
-
-
-def quadrature_impacts(blk, theta0, eta, n):
-    """Impact times of free rocking released at rest from the energy integral (no time steps): a
-    half-cycle to the turning point tm and back lasts 2 int_0^tm dtheta / sqrt(2 p^2 (cos(alpha - tm) -
-    cos(alpha - theta))), and omega = eta^k omega_1 after impact k sets the next tm."""
-    from scipy.integrate import quad
-
-    a, p = blk.alpha_rad, blk.p_rad_s
-
-    def quarter(tm):
-        def smooth(th):  # the integrand times sqrt(tm - theta); quadpack weighs the 1/sqrt
-            x = 0.5 * (tm - th)
-            return math.sqrt((2.0 if x == 0.0 else 2.0 * x / math.sin(x)) / (4 * p * p * math.sin(a - 0.5 * (th + tm))))
-
-        return quad(smooth, 0.0, tm, weight="alg", wvar=(0.0, -0.5), epsabs=0, epsrel=1.2e-14, limit=200)[0]
-
-    w1 = math.sqrt(2 * p * p * (math.cos(a - theta0) - math.cos(a)))
-    t = [quarter(theta0)]
-    for k in range(1, n):
-        w = w1 * eta**k
-        t.append(t[-1] + 2 * quarter(a - math.acos(math.cos(a) + w * w / (2 * p * p))))
-    return np.array(t)
 
 
 def best(f, n):
@@ -152,7 +129,7 @@ def main():
     )
     # the rtol 1e-13 loop is itself a few 1e-11 s off: against impact times without time steps
     # (the energy integral by quadrature) the Taylor method is closer than any rtol of the loop
-    t_q = quadrature_impacts(blk, th0, blk.eta_H, n)
+    t_q = free_rocking_impact_times(blk, th0, blk.eta_H, n)
     print(
         f"  impact times against the energy-integral quadrature ({n} impacts): taylor "
         f"{np.abs(ty.impacts.t_s.to_numpy()[:n] - t_q).max():.2e} s, newmark {np.abs(nm.impacts.t_s.to_numpy()[:n] - t_q).max():.2e} s, "

@@ -11,6 +11,7 @@ import pytest
 from rocklab import Block
 from rocklab._errors import InputError
 from rocklab.models import bundled_record, simulate
+from rocklab.models.rocking import free_rocking_impact_times
 
 B6M = Block(0.045, 0.2025, name="B6M")
 
@@ -130,42 +131,14 @@ def test_block_output_run_equals_the_per_sample_run():
     assert np.abs(fine.omega_rad_s[: 25 * n : 25] - coarse.omega_rad_s[:n]).max() < 1e-14  # 1.6e-15 rad/s
 
 
-def _impact_times_by_quadrature(block, theta0_rad, eta, n):
-    """Impact times of free rocking released at rest, from the energy integral (no time stepping).
-
-    Between impacts energy is conserved, so a half-cycle from theta = 0 up to the turning point
-    tm and back lasts 2 int_0^tm dtheta / sqrt(2 p^2 (cos(alpha - tm) - cos(alpha - theta)));
-    after impact k, omega = eta^k omega_1 sets the next tm. The 1/sqrt singularity at tm is
-    quadpack's algebraic weight.
-    """
-    from scipy.integrate import quad
-
-    a, p = block.alpha_rad, block.p_rad_s
-
-    def quarter(tm):
-        def smooth(th):
-            x = 0.5 * (tm - th)
-            r = 2.0 if x == 0.0 else 2.0 * x / math.sin(x)
-            return math.sqrt(r / (4 * p * p * math.sin(a - 0.5 * (th + tm))))
-
-        return quad(smooth, 0.0, tm, weight="alg", wvar=(0.0, -0.5), epsabs=0, epsrel=1.2e-14, limit=200)[0]
-
-    w1 = math.sqrt(2 * p * p * (math.cos(a - theta0_rad) - math.cos(a)))
-    t = [quarter(theta0_rad)]
-    for k in range(1, n):
-        w = w1 * eta**k
-        t.append(t[-1] + 2 * quarter(a - math.acos(math.cos(a) + w * w / (2 * p * p))))
-    return np.array(t)
-
-
 def test_taylor_impact_times_match_the_energy_quadrature(b6m_runs):
     # an independent reference without time steps: 90 impact times from the energy integral.
     # Measured: Taylor 2.4e-12 s; DOP853 with events at rtol 1e-13 3.4e-11 to 4.7e-11 s at any
     # rtol from 1e-11 to 3e-14 (its impact location, not its step, limits it)
     tay, ref, _ = b6m_runs
-    t_q = _impact_times_by_quadrature(B6M, 0.8 * B6M.alpha_rad, B6M.eta_H, 90)
+    t_q = free_rocking_impact_times(B6M, 0.8 * B6M.alpha_rad, B6M.eta_H, 90)
     err_tay = np.abs(tay.impacts.t_s.to_numpy() - t_q).max()
     assert err_tay < 1e-11
     # perturbed: the same quadrature with eta off by 1e-9 (relative) is far outside that bound
-    t_p = _impact_times_by_quadrature(B6M, 0.8 * B6M.alpha_rad, B6M.eta_H * (1 + 1e-9), 90)
+    t_p = free_rocking_impact_times(B6M, 0.8 * B6M.alpha_rad, B6M.eta_H * (1 + 1e-9), 90)
     assert np.abs(tay.impacts.t_s.to_numpy() - t_p).max() > 10 * err_tay

@@ -19,11 +19,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rocklab.config import TrackConfig
-from rocklab.tracking.video import PlaneMap
-from rocklab.tracking.video.targets import MarkerlessTracker
-
-W, H, R = 320, 240, 14
+from _ball_scene import PATH, H, R, W, watched_tracker
+from _ball_scene import pose as _pose
 
 
 def _wall(seed=0):
@@ -49,10 +46,6 @@ def _frame(wall, centre, seed=1, ball=1.0, shadow=0.0):
     return np.clip(img, 0, 255).astype(np.uint8)
 
 
-def _pose(tr, centre):
-    return np.array([[1, 0, centre[0] - tr.centre0[0]], [0, 1, centre[1] - tr.centre0[1]]], np.float32)
-
-
 def _cc(tr, gray, centre):
     back = tr._warp_back(gray, _pose(tr, centre))
     return float(np.corrcoef(back.ravel(), tr.tmpl0.ravel())[0, 1])
@@ -62,21 +55,8 @@ def _cc(tr, gray, centre):
 def lost():
     """A tracker that verified 16 frames of the ball moving 3 px a frame, then lost it for 20."""
     wall = _wall()
-    path = [(60.0 + 3 * k, 120.0 + 0.5 * k) for k in range(16)]
-    cfg = TrackConfig.from_dict(
-        {
-            "targets": {"style": "markerless"},
-            "reference": {"level": "none"},
-            "objects": [{"id": "ball", "roi": [42, 102, 36, 36]}],
-        }
-    )
-    tr = MarkerlessTracker(cfg.objects[0], PlaneMap(W, H), _frame(wall, path[0]))
-    v = tr.verifier
-    for k, c in enumerate(path):
-        g = _frame(wall, c, seed=k + 2)
-        assert v.verify(tr, g, _pose(tr, c), k, _cc(tr, g, c)) is None, k
-        v.confirm(g, tr.size)
-    return tr, wall, path[-1], 16 + 20
+    tr = watched_tracker(lambda c, seed: _frame(wall, c, seed=seed), _cc)
+    return tr, wall, PATH[-1], 16 + 20
 
 
 @pytest.mark.parametrize("depth", [20.0, 30.0, 40.0])

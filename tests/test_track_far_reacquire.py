@@ -18,58 +18,19 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rocklab.config import TrackConfig
-from rocklab.tracking.video import PlaneMap
-from rocklab.tracking.video.targets import MarkerlessTracker
+from _ball_scene import H, R, W, striped_ball, striped_wall, watched_tracker
+from _ball_scene import pose as _pose
 
-W, H, R = 320, 240, 14
-
-
-def _wall(seed=0):
-    import cv2
-
-    rng = np.random.default_rng(seed)
-    return cv2.GaussianBlur((rng.random((H, W)) * 30 + 140).astype(np.float32), (0, 0), 5)
-
-
-def _frame(wall, centre, look=0.0, seed=1):
-    """The wall with a ball at ``centre`` (px): shaded top to bottom, its texture stripes turned
-    by ``look`` (0: the ball; 1: a look-alike of the same size and shading, other stripes; 0.5: half of each)."""
-    import cv2
-
-    yy, xx = np.mgrid[0:H, 0:W].astype(np.float32)
-    nx, ny = (xx - centre[0]) / R, (yy - centre[1]) / R
-    stripes = (1 - look) * (np.sin(4 * nx + 2 * ny) > 0) + look * (np.cos(5 * ny - 3 * nx) > 0)
-    img = np.where(nx**2 + ny**2 < 1, 60 + 40 * (1 - ny) + 60 * stripes, wall)
-    img = cv2.GaussianBlur(img, (0, 0), 0.7) + np.random.default_rng(seed).normal(0, 1.5, (H, W))
-    return np.clip(img, 0, 255).astype(np.uint8)
-
-
-def _pose(tr, centre):
-    """The upright pose that puts the template's centre at ``centre`` (px)."""
-    return np.array([[1, 0, centre[0] - tr.centre0[0]], [0, 1, centre[1] - tr.centre0[1]]], np.float32)
+_frame = striped_ball
 
 
 @pytest.fixture()
 def warm():
     """A tracker whose verifier has seen 16 frames of the ball moving 3 px a frame, then a slide
     (the motion checks forget those poses, as after a ``drift``), then 12 lost frames."""
-    wall = _wall()
-    path = [(60.0 + 3 * k, 120.0 + 0.5 * k) for k in range(16)]
-    cfg = TrackConfig.from_dict(
-        {
-            "targets": {"style": "markerless"},
-            "reference": {"level": "none"},
-            "objects": [{"id": "ball", "roi": [42, 102, 36, 36]}],
-        }
-    )
-    tr = MarkerlessTracker(cfg.objects[0], PlaneMap(W, H), _frame(wall, path[0]))
-    v = tr.verifier
-    for k, c in enumerate(path):
-        g = _frame(wall, c, seed=k + 2)
-        assert v.verify(tr, g, _pose(tr, c), k, 0.97) is None, k
-        v.confirm(g, tr.size)
-    v.recent = []  # a slide: the motion checks forget its poses
+    wall = striped_wall()
+    tr = watched_tracker(lambda c, seed: striped_ball(wall, c, seed=seed))
+    tr.verifier.recent = []  # a slide: the motion checks forget its poses
     return tr, wall, 16 + 12
 
 

@@ -14,56 +14,22 @@ that pose is ``roundtrip``, the same pose with a keyframe frame that agrees pass
 
 from __future__ import annotations
 
-import numpy as np
 import pytest
 
-from rocklab.config import TrackConfig
-from rocklab.tracking.video import PlaneMap
-from rocklab.tracking.video.targets import MarkerlessTracker
-
-W, H, R = 320, 240, 14
-
-
-def _wall(seed=0):
-    import cv2
-
-    rng = np.random.default_rng(seed)
-    return cv2.GaussianBlur((rng.random((H, W)) * 30 + 140).astype(np.float32), (0, 0), 5)
+from _ball_scene import PATH, striped_ball, striped_wall, watched_tracker
+from _ball_scene import pose as _pose
 
 
 def _frame(wall, centre, seed=1):
-    import cv2
-
-    yy, xx = np.mgrid[0:H, 0:W].astype(np.float32)
-    nx, ny = (xx - centre[0]) / R, (yy - centre[1]) / R
-    img = np.where(nx**2 + ny**2 < 1, 60 + 40 * (1 - ny) + 60 * (np.sin(4 * nx + 2 * ny) > 0), wall)
-    img = cv2.GaussianBlur(img, (0, 0), 0.7) + np.random.default_rng(seed).normal(0, 1.5, (H, W))
-    return np.clip(img, 0, 255).astype(np.uint8)
-
-
-def _pose(tr, centre):
-    return np.array([[1, 0, centre[0] - tr.centre0[0]], [0, 1, centre[1] - tr.centre0[1]]], np.float32)
+    return striped_ball(wall, centre, seed=seed)
 
 
 @pytest.fixture()
 def slid():
-    wall = _wall()
-    path = [(60.0 + 3 * k, 120.0 + 0.5 * k) for k in range(16)]
-    cfg = TrackConfig.from_dict(
-        {
-            "targets": {"style": "markerless"},
-            "reference": {"level": "none"},
-            "objects": [{"id": "ball", "roi": [42, 102, 36, 36]}],
-        }
-    )
-    tr = MarkerlessTracker(cfg.objects[0], PlaneMap(W, H), _frame(wall, path[0]))
-    v = tr.verifier
-    for k, c in enumerate(path):
-        g = _frame(wall, c, seed=k + 2)
-        assert v.verify(tr, g, _pose(tr, c), k, 0.97) is None, k
-        v.confirm(g, tr.size)
-    v.recent = []  # a slide (``drift``): the motion checks forget its poses
-    return tr, wall, path[-1], 16 + 3
+    wall = striped_wall()
+    tr = watched_tracker(lambda c, seed: _frame(wall, c, seed))
+    tr.verifier.recent = []  # a slide (``drift``): the motion checks forget its poses
+    return tr, wall, PATH[-1], 16 + 3
 
 
 @pytest.mark.parametrize("aside", [(6.0, 0.0), (0.0, -7.0), (5.0, 5.0)])

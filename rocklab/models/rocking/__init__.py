@@ -8,6 +8,7 @@ of :data:`METHODS`, one contract, :class:`Integrator`); :func:`simulate_batch` m
 """
 
 from ._batch import free_rocking_overturns, simulate_batch
+from ._energy_integral import free_rocking_impact_times
 from ._integrators import METHODS, Event, Integrator, Newmark, RockingProblem, Taylor
 from ._restitution import (
     RESTITUTION_LAWS,
@@ -34,6 +35,7 @@ __all__ = [
     "Event",
     "simulate_batch",
     "free_rocking_overturns",
+    "free_rocking_impact_times",
     "RockingResult",
     "BatchResult",
     "block_energy",

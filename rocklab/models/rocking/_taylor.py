@@ -34,7 +34,7 @@ import numpy as np
 from numba import njit
 
 from ._newmark_contact import restitution_at, store_impact
-from ._taylor_dense import block_scratch, blocks_fit, dense_blocks, dense_samples
+from ._taylor_dense import block_scratch, blocks_fit, dense_blocks, dense_samples, series_slope, series_value
 
 __all__ = ["run_taylor", "ORDER", "P_H"]
 
@@ -44,24 +44,6 @@ ORDER = 12
 P_H = 0.2
 
 _ROCKING, _REST, _OVERTURNED, _NO_UPLIFT = 0, 1, 2, 3
-
-
-@njit(cache=True, inline="always", fastmath={"contract"})
-def series_value(a, n, x):
-    """The series ``a[0..n]`` at ``x`` (Horner)."""
-    v = a[n]
-    for k in range(n - 1, -1, -1):
-        v = v * x + a[k]
-    return v
-
-
-@njit(cache=True, inline="always", fastmath={"contract"})
-def series_slope(a, n, x):
-    """The derivative of the series ``a[0..n]`` at ``x`` (Horner)."""
-    v = n * a[n]
-    for k in range(n - 1, 0, -1):
-        v = v * x + k * a[k]
-    return v
 
 
 @njit(cache=True)

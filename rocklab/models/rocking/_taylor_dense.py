@@ -22,7 +22,17 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-__all__ = ["BLOCK", "DEGREE", "R_BLOCK", "blocks_fit", "dense_blocks", "dense_samples", "block_scratch"]
+__all__ = [
+    "BLOCK",
+    "DEGREE",
+    "R_BLOCK",
+    "blocks_fit",
+    "dense_blocks",
+    "dense_samples",
+    "block_scratch",
+    "series_value",
+    "series_slope",
+]
 
 #: Samples per block.
 BLOCK = 32
@@ -103,7 +113,8 @@ def _chain(ab, m, n, x):
 
 
 @njit(cache=True, inline="always", fastmath={"contract"})
-def _value(a, n, x):
+def series_value(a, n, x):
+    """The series ``a[0..n]`` at ``x`` (Horner)."""
     v = a[n]
     for k in range(n - 1, -1, -1):
         v = v * x + a[k]
@@ -111,7 +122,8 @@ def _value(a, n, x):
 
 
 @njit(cache=True, inline="always", fastmath={"contract"})
-def _slope(a, n, x):
+def series_slope(a, n, x):
+    """The derivative of the series ``a[0..n]`` at ``x`` (Horner)."""
     v = n * a[n]
     for k in range(n - 1, 0, -1):
         v = v * x + k * a[k]
@@ -169,7 +181,7 @@ def dense_samples(a, n, out_th, out_w, out_e, k0, k1, out_dt, t, energy):
         i += 4
     while i < k1:
         x = i * out_dt - t
-        out_th[i] = _value(a, n, x)
-        out_w[i] = _slope(a, n, x)
+        out_th[i] = series_value(a, n, x)
+        out_w[i] = series_slope(a, n, x)
         out_e[i] = energy
         i += 1

@@ -45,9 +45,12 @@ from ...blocks import G
 from ._newmark_contact import contact_tau, cross_fraction, restitution_at, store_impact
 from ._newmark_lean import forced_steps, free_steps, sdcd
 
-#: Status codes returned by the kernel.
-ROCKING, REST, OVERTURNED, NO_UPLIFT = 0, 1, 2, 3
-STATUS_NAMES = ("rocking", "rest", "overturned", "no_uplift")
+#: Status codes returned by the kernel (``SAFE``: stopped by the safe stop, batch runs only).
+ROCKING, REST, OVERTURNED, NO_UPLIFT, SAFE = 0, 1, 2, 3, 4
+STATUS_NAMES = ("rocking", "rest", "overturned", "no_uplift", "safe")
+#: Share of the energy room the safe stop leaves to the trapezoidal rule: its energy error relative to the
+#: exact motion's, which the bound is for, is of order (p h)^2 / 12 (3e-5 at p h = 0.02), far below 1 %.
+SAFE_ROOM = 0.99
 _HALF_PI = 0.5 * math.pi
 #: Sub-steps in a row that leave the time unchanged before the rest of the step is skipped
 #: (an honest sequence has at most two: a lift-off at the step's start, then the flight).
@@ -149,6 +152,23 @@ def _energy(th, w, cc, cos_a, p2, alpha, lin):
     return 0.5 * w * w + p2 * (cc - cos_a)
 
 
+@njit(cache=True)
+def _safe_from(t, th, w, resting, tail, acc_t0, inv_dta, k_alpha, c_tail, p2, alpha, cos_a, stop_at_rest, t_last):
+    """True where the rest of the record cannot lift the block (|theta| < alpha at ``t`` s) to alpha: sqrt(K)
+    plus ``c_tail`` times the |acc| integral from the record sample at or before ``t`` (``tail``) below
+    ``k_alpha`` = p sqrt(1 - cos alpha), with the margins of ``SAFE_ROOM``; never for a block at rest after the
+    last uplift sample (that run ends at rest anyway)."""
+    if resting and stop_at_rest and t >= t_last:
+        return False
+    x = (t - acc_t0) * inv_dta
+    k = 0 if x <= 0.0 else min(int(x), tail.shape[0] - 1)
+    room = k_alpha - c_tail * tail[k]
+    if room <= 0.0:
+        return False
+    excess = 0.0 if resting else 0.5 * w * w + p2 * (math.cos(alpha - abs(th)) - cos_a)
+    return excess + 1e-12 * p2 < room * room * SAFE_ROOM
+
+
 @njit(cache=True, fastmath={"contract"})
 def run_block(
     p,
@@ -174,6 +194,7 @@ def run_block(
     stop_on_fall=True,
     e_scale=1.0,
     lean=True,
+    tail=None,
 ):
     """Integrate one block for n_steps steps of h (s).
 
@@ -190,6 +211,11 @@ def run_block(
         ``t_end``, rad and rad/s; 0, 0 at rest). The run always ends when |theta|
         reaches pi/2 (the side hits the ground), and at fall_rad when stop_on_fall.
         ``lean=False`` takes every step in the general loop (reference for tests).
+        ``tail``: empty, or per record sample k a bound on the integral of |acc| from sample k to the
+        record's end (:func:`~rocklab.models.rocking._taylor_record.safe_tail`): the run then stops (status
+        ``SAFE``) where the energy the rest of the record can give cannot lift the block to alpha (the bound
+        of :mod:`~rocklab.models.rocking._taylor_record`, its room cut to ``SAFE_ROOM`` for the rule's energy
+        error), checked between the lean loops' stretches (at impacts, uplifts, the record's end).
     """
     p2 = p * p
     tan_a = math.tan(alpha)
@@ -251,7 +277,34 @@ def run_block(
     if acc.shape[0] > 1:
         L = 0.25 * h * h * p2 * (1.0 + np.max(np.abs(acc)) * abs(fac))
         lip = L / (1.0 - L) if L < 0.5 else 1.0
+    n_acc = acc.shape[0]
+    check = tail is not None and tail.shape[0] == n_acc and n_acc > 1 and not lin
+    k_alpha = math.sqrt(p2 * (1.0 - cos_a))
+    c_tail = p2 * abs(fac) / math.sqrt(2.0)
     while step < n_steps:
+        if (
+            check
+            and abs(th) < alpha
+            and _safe_from(
+                step * h,
+                th,
+                w,
+                resting,
+                tail,
+                acc_t0,
+                inv_dta,
+                k_alpha,
+                c_tail,
+                p2,
+                alpha,
+                cos_a,
+                stop_at_rest,
+                t_last_uplift,
+            )
+        ):
+            status = SAFE
+            t_end = step * h
+            break
         if lean and not lin and not resting and abs(th) < alpha:
             if step * h > t_free:
                 th, w, a, sc, cc, step, max_abs, n_out, countdown = free_steps(
@@ -459,7 +512,7 @@ def run_block(
         if resting and stop_at_rest and t1 >= t_last_uplift:
             status = REST
             break
-    if status != OVERTURNED:
+    if status != OVERTURNED and status != SAFE:
         if resting:
             status = REST if ever_moved else NO_UPLIFT
         else:
@@ -538,6 +591,7 @@ def run_single(
         np.bool_(True),
         e_scale,
         np.bool_(lean),
+        np.zeros(0),
     )
     t = np.empty(n_out)
     dto = h * out_every
@@ -556,8 +610,9 @@ def _last_over(acc, t0, dta, thr):
 
 
 @njit(cache=True, parallel=True)
-def run_batch(p, alpha, th0, w0, eta, h, n_steps, acc, acc_t0, acc_dt, scale, rest_tol, fall_rad, stop_on_fall):
-    """m independent blocks in parallel (summaries only); see ``simulate_batch``.
+def run_batch(p, alpha, th0, w0, eta, h, n_steps, acc, acc_t0, acc_dt, scale, rest_tol, fall_rad, stop_on_fall, tail):
+    """m independent blocks in parallel (summaries only); see ``simulate_batch``. ``tail``: empty, or the
+    record's :func:`~rocklab.models.rocking._taylor_record.safe_tail` (the safe stop of :func:`run_block`).
 
     Lives in this module so that numba's on-disk cache of this caller is
     invalidated together with :func:`run_block` (the cache only tracks the
@@ -610,6 +665,7 @@ def run_batch(p, alpha, th0, w0, eta, h, n_steps, acc, acc_t0, acc_dt, scale, re
             stop_on_fall,
             1.0,
             yes,
+            tail,
         )
         nimp[i] = r[5]
         status[i] = r[6]

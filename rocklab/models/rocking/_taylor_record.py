@@ -270,7 +270,8 @@ def run_one(p, alpha, eta, scale, th0, w0, acc, t0, dta, duration, order, max_p_
         ta, L, u_a, du = _segment(k, acc, t0, dta, duration, fac)
         if L <= 0.0:
             continue
-        if check and k >= 0 and not (resting and ta >= t_last_up):  # (a rest there ends the run anyway)
+        # (a rest there ends the run anyway; past alpha, with fall_rad > alpha, the bound does not hold)
+        if check and k >= 0 and not (resting and ta >= t_last_up) and abs(th) < alpha:
             room = k_alpha - c_tail * tail[k]
             if room > 0.0:
                 excess = 0.0 if resting else 0.5 * w * w + p2 * (cc - cos_a)

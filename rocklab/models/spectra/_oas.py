@@ -611,7 +611,7 @@ def batch_runs(base, scale, p, args):
         max_p_dt=max_p_dt,
         method=method,
         taylor_tol=tol,
-        stop_when_safe=method == "taylor",  # verdicts only: a run stops once it cannot reach alpha
+        stop_when_safe=True,  # verdicts only: a run stops once it cannot reach alpha
     )
     over = np.asarray(b.overturned, bool)
     rocking = b.status == 0

@@ -33,7 +33,7 @@ smaller f than found so far and bisects only those that can set f_min, so the t'
 and beta bands are the first member's values; 44 records 67 CPU-s (same load), one
 member's t_I of 352 differs from the default mode's, no band does; Table 4 inside the
 band 30/44, median half-width 9.3 % in both modes, as before. Since session 17 the runs stop
-once the rest of the record cannot lift the block to alpha (the Taylor kernel's safe stop), a
+once the rest of the record cannot lift the block to alpha (the Taylor and Newmark kernels' safe stop), a
 member's search window simulates the points after its guess only where none before it is
 unsafe, and the guide's settling check is vectorised: every member's t_I, t'_I and beta are
 unchanged (11 of the records, every 4th from FF-1), with 1.21x less CPU for the default bands

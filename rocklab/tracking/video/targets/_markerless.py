@@ -763,7 +763,7 @@ class MarkerlessTracker:
         # object left) is the part that set its angle
         covered = cc < REKEY_CC and partly_covered(ccs)
         share, at = unmatched_turn_share(
-            self._turn_info[1], ccs, self._cells_seen(W, gray.shape), CELL_CC if covered else -1.0, ccs.min() < CELL_CC
+            self._turn_info[1], ccs, self._cells_seen(W, gray.shape), CELL_CC if covered else -1.0
         )
         if share <= MAX_UNMATCHED_TURN:
             return None, at, share

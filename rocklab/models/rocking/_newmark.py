@@ -44,6 +44,7 @@ from numba import njit, prange
 from ...blocks import G
 from ._newmark_contact import contact_tau, cross_fraction, restitution_at, store_impact
 from ._newmark_lean import forced_steps, free_steps, sdcd
+from ._taylor_record import safe_bound
 
 #: Status codes returned by the kernel (``SAFE``: stopped by the safe stop, batch runs only).
 ROCKING, REST, OVERTURNED, NO_UPLIFT, SAFE = 0, 1, 2, 3, 4
@@ -162,11 +163,8 @@ def _safe_from(t, th, w, resting, tail, acc_t0, inv_dta, k_alpha, c_tail, p2, al
         return False
     x = (t - acc_t0) * inv_dta
     k = 0 if x <= 0.0 else min(int(x), tail.shape[0] - 1)
-    room = k_alpha - c_tail * tail[k]
-    if room <= 0.0:
-        return False
     excess = 0.0 if resting else 0.5 * w * w + p2 * (math.cos(alpha - abs(th)) - cos_a)
-    return excess + 1e-12 * p2 < room * room * SAFE_ROOM
+    return safe_bound(excess, tail[k], k_alpha, c_tail, p2, SAFE_ROOM)
 
 
 @njit(cache=True, fastmath={"contract"})

@@ -47,7 +47,7 @@ from ...blocks import G
 from ._newmark_lean import sdcd
 from ._taylor import series_root, series_slope, series_value
 
-__all__ = ["run_taylor_record", "order_for", "safe_tail", "MAX_ORDER"]
+__all__ = ["run_taylor_record", "order_for", "safe_tail", "safe_bound", "MAX_ORDER"]
 
 #: Highest order a step may use.
 MAX_ORDER = 40
@@ -81,6 +81,16 @@ def order_for(p_h, tol: float) -> np.ndarray:
         if n >= 4 and done.all():
             break
     return out
+
+
+@njit(cache=True, inline="always")
+def safe_bound(excess, tail_k, k_alpha, c_tail, p2, room_share):
+    """The safe stop's test (module docstring): True when sqrt(``excess``) (K, the energy over rest on
+    the corner) plus ``c_tail`` times ``tail_k`` (the |acc| integral over the rest of the record) stays
+    below ``k_alpha`` = p sqrt(1 - cos alpha), the squared room cut to ``room_share`` and K's rounding
+    (1e-12 p^2) counted against it."""
+    room = k_alpha - c_tail * tail_k
+    return room > 0.0 and excess + 1e-12 * p2 < room * room * room_share
 
 
 def safe_tail(acc, dt_s: float) -> np.ndarray:
@@ -272,13 +282,11 @@ def run_one(p, alpha, eta, scale, th0, w0, acc, t0, dta, duration, order, max_p_
             continue
         # (a rest there ends the run anyway; past alpha, with fall_rad > alpha, the bound does not hold)
         if check and k >= 0 and not (resting and ta >= t_last_up) and abs(th) < alpha:
-            room = k_alpha - c_tail * tail[k]
-            if room > 0.0:
-                excess = 0.0 if resting else 0.5 * w * w + p2 * (cc - cos_a)
-                if excess + 1e-12 * p2 < room * room * (1.0 - 1e-9):  # margins above the rounding of K
-                    t = ta
-                    status = _SAFE
-                    break
+            excess = 0.0 if resting else 0.5 * w * w + p2 * (cc - cos_a)
+            if safe_bound(excess, tail[k], k_alpha, c_tail, p2, 1.0 - 1e-9):  # margin above the rounding of K
+                t = ta
+                status = _SAFE
+                break
         if L != L_prev:  # the record's intervals share one length: its division is done once
             n_sub = max(1, int(math.ceil(p * L / max_p_h - 1e-12)))
             h_sub = L / n_sub

@@ -101,12 +101,11 @@ METHODS_OAS = ("newmark", "taylor")
 TAYLOR_P_H = 0.25
 _GOLDEN = 0.5 * (math.sqrt(5.0) - 1.0)
 #: ``refine_where="curve"``: every level's boundary is bisected until its bracket spans at most this relative
-#: width in p (6 of the 10 steps on the default grid, whose neighbouring sizes lie 3.9 % apart in p): the step
-#: of amplitude at which the converged reference calls a cell chaotic (issue 27 item 1); finer, the boundary
-#: of one level follows chaotic verdicts, not the record. t_I, t'_I, beta and the verdicts stay those of
-#: ``"all"``, with 40 % fewer bisection runs (FF-1's default OAS: 770 -> 474; 44 FEMA records, H/B 12:
-#: 30.35 -> 24.91 CPU-s on one thread, bitwise the same t_I, t'_I, beta and verdicts, the other levels'
-#: boundary at most 5.7e-4 above the full bisection's).
+#: width in p (6 of the 10 steps on the default grid, whose neighbouring sizes lie 3.9 % apart in p), the
+#: amplitude step under which the converged reference calls a cell chaotic when its verdict flips. t_I, t'_I,
+#: beta and the verdicts are those of ``"all"`` with 474 bisection runs instead of 770 on FF-1's default OAS
+#: (44 FEMA records, H/B 12: bitwise the same, 18 % less CPU; the other levels' boundary at most 5.7e-4 above
+#: the full bisection's).
 CURVE_REL_P = 1e-3
 
 

@@ -168,7 +168,7 @@ def test_bisecting_only_the_levels_behind_t_I_and_the_line_changes_neither(share
         return real(base, scale, p, args)
 
     monkeypatch.setattr(oas, "batch_runs", counted)
-    full = overturning_spectrum(r, 12, **kw)
+    full = overturning_spectrum(r, 12, refine_where="all", **kw)
     runs_full, n["runs"] = n["runs"], 0
     fit = overturning_spectrum(r, 12, refine_where="fit", verdicts=full, **kw)
     runs_fit, n["runs"] = n["runs"], 0
@@ -183,6 +183,34 @@ def test_bisecting_only_the_levels_behind_t_I_and_the_line_changes_neither(share
     assert runs_only < runs_fit < 0.5 * 8 * n_levels < runs_full
     with pytest.raises(InputError, match="refine_where"):
         overturning_spectrum(r, 12, refine_where="some", **kw)
+
+
+def test_default_bisects_every_level_to_the_curve_resolution_and_t_I_and_the_line_in_full(shared_data, monkeypatch):
+    import rocklab.models.spectra._oas as oas
+
+    r = load_base_motion(shared_data / FF1, units="g")
+    kw = dict(levels=30, sizes=45, refine=8)
+    n = {"runs": 0}
+    real = oas.batch_runs
+
+    def counted(base, scale, p, args):
+        n["runs"] += np.size(scale)
+        return real(base, scale, p, args)
+
+    full = overturning_spectrum(r, 12, refine_where="all", **kw)
+    monkeypatch.setattr(oas, "batch_runs", counted)
+    curve = overturning_spectrum(r, 12, verdicts=full, **kw)  # the default: refine_where="curve"
+    assert curve.options["refine_where"] == "curve"
+    assert curve.t_I_s == full.t_I_s and curve.f_min_at == full.f_min_at
+    assert curve.t_I_prime_s == full.t_I_prime_s and curve.beta == full.beta
+    # every level's boundary: the first steps of its full bisection, so the full value lies inside the last bracket
+    # (at most CURVE_REL_P below); here neighbouring sizes lie 11 % apart in p, 1e-3 takes 7 of the 8 steps
+    ok = np.isfinite(full.p_min_rad_s)
+    assert np.array_equal(ok, np.isfinite(curve.p_min_rad_s))
+    rel = curve.p_min_rad_s[ok] / full.p_min_rad_s[ok] - 1.0
+    assert rel.min() >= 0.0 and 0.0 < rel.max() <= oas.CURVE_REL_P
+    assert np.count_nonzero(rel) > ok.sum() // 4  # most levels stop early, some happen to end where the full one does
+    assert n["runs"] < 8 * ok.sum() and n["runs"] >= 7 * ok.sum()
 
 
 def test_inclined_line_without_the_solver_matches_linprog():

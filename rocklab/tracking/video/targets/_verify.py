@@ -78,7 +78,7 @@ import numpy as np
 from ._occlusion import OUTLINE_MARGIN_FRAC, OutlineRef, warp_grown
 from ._roundtrip import RoundTrip
 
-__all__ = ["PoseVerifier", "search_whole_frame", "whole_frame_peaks", "MIN_SCORE", "MAX_STEP_RAD"]
+__all__ = ["PoseVerifier", "search_whole_frame", "MIN_SCORE", "MAX_STEP_RAD"]
 
 #: Lowest correlation of the warped frame with the template that can ever count as the object.
 MIN_SCORE = 0.2
@@ -135,18 +135,6 @@ SMEAR_FRACS = (0.33, 0.67, 1.0)
 #: with a dark object's template as well as the object does, with a tenth of its contrast. Motion
 #: blur and a change of light lower it by far less (a ball falling 120 px a frame kept 0.78 of it).
 CONTRAST_FRACTION = 1.0 / 3.0
-#: Matches of the whole-frame search (:func:`whole_frame_peaks`) fitted and verified in turn, best
-#: first, when the object is searched for anywhere: the best one may be a patch of the scene that
-#: the keyframe half matches while the object, in plain view, is the next (necros_ball, a 35x48 px
-#: box: a wall patch beat the ball on 177 frames in a row).
-REACQUIRE_PEAKS = 4
-#: Two peaks closer than this fraction of the reduced template's smaller side are one place.
-PEAK_SEPARATION = 0.5
-#: Least share of a whole-frame match's footprint that differs from the still background: half of
-#: what the background check needs (:data:`BG_FRACTION`), as the search runs on a reduced copy.
-PEAK_CHANGED = 0.5 * (1.0 - BG_FRACTION)
-#: Turns of the template tried by the whole-frame search round the last verified angle, degrees.
-WHOLE_FRAME_TURNS_DEG = (0.0, -5.0, 5.0, -10.0, 10.0)
 #: Scene snapshots for the background check: one every :data:`SNAP_FRAMES` verified frames, the
 #: last :data:`SNAPS` kept (a grey frame each).
 SNAP_FRAMES = 10
@@ -574,32 +562,11 @@ class PoseVerifier:
             if self.verify(tr, gray, hint, frame, cc) is None:
                 return hint, cc, cc
         th = self.recent[-1][1] if self.recent else 0.0
-        before, after = self.recent, None
-        changed = self._changed(gray)
-        for W_s in whole_frame_peaks(tr, tr.key, gray, th, n_peaks=REACQUIRE_PEAKS, changed=changed):
-            alt = tr._ecc(tr.key, gray, W_s)
-            if alt is None or alt[1] < min_cc:
-                continue
-            # each peak is judged as if it were the only one: a peak that failed (a slide off the
-            # outline forgets the motion anchors) does not loosen the checks of the next
-            self.recent, self.hint = before, None
-            if self.verify(tr, gray, alt[0], frame, alt[1]) is None:
-                return alt[0], alt[1], alt[1]
-            after = after or (self.recent, self.hint)
-        if after is not None:  # nothing verified: as the best peak's check left it
-            self.recent, self.hint = after
-        return None
-
-    def _changed(self, gray):
-        """Where ``gray`` differs from the still background (:data:`BG_TOL`), float32 (H, W) 0/1: 1
-        also where the background is not known (the first region before the object left it)."""
-        import cv2
-
-        out = (cv2.absdiff(np.asarray(gray, np.float32), self.bg) >= BG_TOL).astype(np.float32)
-        if not (self.filled or self.early or self.first_known):
-            u0, v0, u1, v1 = self.box
-            out[v0:v1, u0:u1] = 1.0
-        return out
+        W_s = search_whole_frame(tr, tr.key, gray, th)
+        alt = tr._ecc(tr.key, gray, W_s) if W_s is not None else None
+        if alt is None or alt[1] < min_cc:
+            return None
+        return None if self.verify(tr, gray, alt[0], frame, alt[1]) is not None else (alt[0], alt[1], alt[1])
 
     def confirm(self, gray, size):
         """Learn from the pose just verified (its correlation, motion and the background it uncovers)."""
@@ -676,47 +643,10 @@ def best_turned_match(image, tmpl, theta, turns_deg, min_cc):
     return best
 
 
-def search_whole_frame(tr, tmpl, gray, theta, turns_deg=WHOLE_FRAME_TURNS_DEG, min_cc=0.5):
-    """Re-acquire anywhere in the frame: the best match of :func:`whole_frame_peaks`, its pose
-    (first-frame px -> image px), or None below ``min_cc``."""
-    found = whole_frame_peaks(tr, tmpl, gray, theta, turns_deg, min_cc, n_peaks=1)
-    return found[0] if found else None
-
-
-def whole_frame_peaks(
-    tr, tmpl, gray, theta, turns_deg=WHOLE_FRAME_TURNS_DEG, min_cc=0.5, n_peaks=REACQUIRE_PEAKS, changed=None
-):
-    """The template anywhere in the frame, turned round ``theta`` (rad) by ``turns_deg``, matched by
-    normalised cross-correlation on a copy reduced until the template is about 40 px across.
-
-    ``changed`` (float (H, W), 1 where the frame differs from the still background, optional): a
-    place where under :data:`PEAK_CHANGED` of the template's footprint changed is no match (the
-    background check would refuse it: unchanged on :data:`BG_FRACTION` of its pixels). A template
-    that is mostly a smooth shading (a red ball on a beige wall, in grey) matches bare wall at
-    0.86-0.88, better than the ball itself, hundreds of places over.
-
-    Returns
-    -------
-    list of ndarray (2, 3)
-        The poses (first-frame px -> image px) of up to ``n_peaks`` matches at or above ``min_cc``,
-        best first, each farther than :data:`PEAK_SEPARATION` of the template's smaller side from
-        every better one (the best match's neighbours are the same place); empty when none.
-
-    Examples
-    --------
-    A bar, and a copy of it cut in two, on a plain frame: the whole bar first, then the cut
-    copy (their centres, px):
-
-    >>> import numpy as np
-    >>> class Tr:  # what the search needs of a tracker: the template's centre in the first frame
-    ...     centre0 = np.array([10.0, 10.0])
-    >>> mark = np.zeros((20, 20), np.float32); mark[5:15, 8:12] = 200.0
-    >>> cut = mark.copy(); cut[9:11] = 0.0
-    >>> frame = np.full((120, 160), 30.0, np.float32)
-    >>> frame[70:90, 30:50] += cut; frame[20:40, 100:120] += mark
-    >>> [[int(round(v)) for v in W[:, 2] + 10.0] for W in whole_frame_peaks(Tr(), mark, frame, 0.0)]
-    [[110, 30], [40, 80]]
-    """
+def search_whole_frame(tr, tmpl, gray, theta, turns_deg=(0.0, -5.0, 5.0, -10.0, 10.0), min_cc=0.5):
+    """Re-acquire anywhere in the frame: the template, turned round ``theta`` (rad) by ``turns_deg``,
+    matched by normalised cross-correlation on a copy reduced until the template is about 40 px
+    across; the best match's pose (first-frame px -> image px), or None below ``min_cc``."""
     import cv2
 
     h, w = tmpl.shape
@@ -725,40 +655,12 @@ def whole_frame_peaks(
     t_small = cv2.resize(tmpl, None, fx=f, fy=f, interpolation=cv2.INTER_AREA)
     hs, ws = t_small.shape
     if small.shape[0] <= hs or small.shape[1] <= ws:
-        return []
-    best, turn = None, None  # the best correlation over the turns at each place, and its turn
-    for dt in turns_deg:
-        th = theta + math.radians(dt)
-        rot = cv2.warpAffine(
-            t_small,
-            cv2.getRotationMatrix2D((ws / 2, hs / 2), -math.degrees(th), 1.0),
-            (ws, hs),
-            borderMode=cv2.BORDER_REPLICATE,
-        )
-        res = np.nan_to_num(cv2.matchTemplate(small, rot, cv2.TM_CCOEFF_NORMED), nan=-1.0)
-        if best is None:
-            best, turn = res, np.full(res.shape, th)
-        else:
-            better = res > best
-            best, turn = np.where(better, res, best), np.where(better, th, turn)
-    if changed is not None:
-        # the changed share of each footprint (the same windows as the correlation's), from sums
-        c = cv2.integral(
-            cv2.resize(np.asarray(changed, np.float32), (small.shape[1], small.shape[0]), interpolation=cv2.INTER_AREA)
-        )
-        rh, rw = best.shape
-        share = (c[hs : hs + rh, ws : ws + rw] - c[:rh, ws : ws + rw] - c[hs : hs + rh, :rw] + c[:rh, :rw]) / (hs * ws)
-        best = np.where(share >= PEAK_CHANGED, best, -1.0)
-    out = []
-    r = max(1, int(PEAK_SEPARATION * min(ws, hs)))
-    for _ in range(n_peaks):
-        _, val, _, (x, y) = cv2.minMaxLoc(best)
-        if val < min_cc:
-            break
-        th = float(turn[y, x])
-        new_ctr = np.array([(x + ws / 2) / f, (y + hs / 2) / f])
-        c, s = math.cos(th), math.sin(th)
-        t = new_ctr - np.array([[c, -s], [s, c]]) @ tr.centre0
-        out.append(np.array([[c, -s, t[0]], [s, c, t[1]]], np.float32))
-        best[max(y - r, 0) : y + r + 1, max(x - r, 0) : x + r + 1] = -1.0
-    return out
+        return None
+    best = best_turned_match(small, t_small, theta, turns_deg, min_cc)
+    if best is None:
+        return None
+    _, th, loc = best
+    new_ctr = np.array([(loc[0] + ws / 2) / f, (loc[1] + hs / 2) / f])
+    c, s = math.cos(th), math.sin(th)
+    t = new_ctr - np.array([[c, -s], [s, c]]) @ tr.centre0
+    return np.array([[c, -s, t[0]], [s, c, t[1]]], np.float32)

@@ -125,17 +125,26 @@ def _yellow_dot(frame_bgr, near):
     return np.array([xs[keep].mean(), ys[keep].mean()])
 
 
-def test_hand_held_pendulum_film_angle_right_or_nan_and_place_right(tmp_path_factory):
+#: The reviewer's box and the same box 0.8x about its centre (review 16's ``small80``: the disc's
+#: bottom cut off, the rod and the wall at the top), and the least share of frames ``ok`` (measured
+#: 81/81 and 65/81: the small box is lost where the disc swings past the post).
+KATIE_BOXES = {"base": ((287, 205, 46, 73), 0.9), "small80": ((292, 212, 37, 58), 0.75)}
+
+
+@pytest.mark.parametrize("which", sorted(KATIE_BOXES))
+def test_hand_held_pendulum_film_angle_right_or_nan_and_place_right(tmp_path_factory, which):
     """The reviewer's box round the right pendulum's disc (287, 205, 46, 73) holds the disc, a
     stretch of its rod and the wall's bracket and post. Before: every frame ``ok``, theta 20-50
     deg off the hand labels with sigma 0.5 deg, the box's centre up to 11.6 px off (2 % of the
     width). Now, on the labelled frames: theta within max(3 sigma, 2 deg) of the hand labels or
     NaN with W-TRACK-THETA, and the point within 1 % of the width of where the disc's yellow dot
-    (a colour threshold) and the hand-labelled turn put the box's centre."""
+    (a colour threshold) and the hand-labelled turn put the box's centre. The smaller box's round
+    disc matched the pose turned 13-43 deg off while its rod did not (frame 20: theta 24 deg off,
+    the point 6.4 px off): the matching part's own turning information tells it from a block."""
     import av
 
     path = mirror_file(tmp_path_factory, *KATIE)
-    box = (287, 205, 46, 73)
+    box, min_ok = KATIE_BOXES[which]
     cfg = TrackConfig.from_dict(
         {
             "video": {"stop_frame": 81},
@@ -151,7 +160,7 @@ def test_hand_held_pendulum_film_angle_right_or_nan_and_place_right(tmp_path_fac
     tr = res["p"]
     assert "W-TRACK-THETA" in {d.code for d in diags}
     status, th, sg = np.asarray(tr.status), np.asarray(tr.theta_rad), np.asarray(tr.sigma_theta_rad)
-    assert (status == "ok").mean() >= 0.9
+    assert (status == "ok").mean() >= min_ok
     frames = {}
     with av.open(str(path)) as c:
         for k, f in enumerate(c.decode(video=0)):
@@ -176,3 +185,61 @@ def test_hand_held_pendulum_film_angle_right_or_nan_and_place_right(tmp_path_fac
     assert n_theta >= 1
     # the angle is not dropped everywhere: it is kept where what tells it still matches
     assert np.sum(np.isfinite(th[status == "ok"])) >= 5
+
+
+def _disc_region(dy, r, seed):
+    """A 48 x 64 region round a dark disc of radius ``r`` px, ``dy`` px under the region's centre,
+    its rod up to the top edge and a still corner in the top-left, grey levels."""
+    img = np.full((64, 48), 200.0, np.float32)
+    img[:8, :10] = 150.0
+    c = (24, 32 + dy)
+    cv2.line(img, (24, 0), c, 60.0, 2, cv2.LINE_AA)
+    cv2.circle(img, c, r, 35.0, -1, cv2.LINE_AA)
+    return img + np.random.default_rng(seed).normal(0, 1.0, img.shape)
+
+
+def _block_region(margin, seed, side=64):
+    """A ``side`` px region round a textured block, ``margin`` px of plain wall round it."""
+    rng = np.random.default_rng(seed)
+    img = np.full((side, side), 200.0, np.float32)
+    face = rng.uniform(40, 160, (side - 2 * margin,) * 2).astype(np.float32)
+    img[margin : side - margin, margin : side - margin] = cv2.GaussianBlur(face, (0, 0), 2.0)
+    return img + rng.normal(0, 1.0, img.shape)
+
+
+def test_a_round_disc_matching_under_a_rod_that_does_not_is_told_from_a_blocks_corners():
+    """The rule on arrays. A round disc low in its region, its rod and a still corner in the top row
+    of cells, that row not matching: about the region's centre the row holds 0.39-0.54 of the turning
+    information (under :data:`MAX_UNMATCHED_TURN` on most: the angle kept, as on the hand-held
+    film's small box), about the point the disc's cells turn about 0.73-0.83 (the disc's own outline
+    tells none). A textured block with 1-3 of its corner cells not matching (wall leaving as it
+    turns): the block's face turns about the region's centre, the two shares are about equal, and
+    the second never exceeds :data:`MAX_UNMATCHED_ABOUT_MATCHED` where the first is within
+    :data:`MAX_UNMATCHED_TURN`."""
+    import itertools
+
+    from rocklab.tracking.video.targets._observability import (
+        MAX_UNMATCHED_ABOUT_MATCHED,
+        MAX_UNMATCHED_TURN,
+        cell_turn_info,
+        unmatched_turn_share,
+    )
+
+    top_row = np.ones((4, 4))
+    top_row[0, :] = 0.0
+    about_centre = []
+    for dy, r, seed in itertools.product((12, 14, 16), (18, 21, 23), (0, 1)):
+        share, share_at, _ = unmatched_turn_share(cell_turn_info(_disc_region(dy, r, seed), 4), top_row)
+        assert share_at > MAX_UNMATCHED_ABOUT_MATCHED, (dy, r, share, share_at)
+        about_centre.append(share)
+    assert np.mean(np.array(about_centre) <= MAX_UNMATCHED_TURN) >= 0.5, about_centre
+    corners = [(0, 0), (0, 3), (3, 0), (3, 3)]
+    for margin, seed in itertools.product((6, 10, 14), (0, 1)):
+        info = cell_turn_info(_block_region(margin, seed), 4)
+        for k in (1, 2, 3):
+            for cells in itertools.combinations(corners, k):
+                cc = np.ones((4, 4))
+                cc[tuple(np.array(cells).T)] = 0.0
+                share, share_at, _ = unmatched_turn_share(info, cc)
+                assert abs(share_at - share) < 0.1, (margin, cells, share, share_at)
+                assert share > MAX_UNMATCHED_TURN or share_at <= MAX_UNMATCHED_ABOUT_MATCHED, (margin, cells)

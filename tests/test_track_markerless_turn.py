@@ -105,13 +105,6 @@ def test_disc_turning_behind_a_region_drawn_inside_it_reports_the_marks_angle(di
     assert not bad.any(), (roi, np.degrees(err[bad])[:8], np.degrees(sig[bad])[:8])
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="known wrong ok (issue 25, open): the points of a frame whose angle is not measured are "
-    "held at the last angle measured about the point the matching cells turn about (right on the "
-    "hand-held pendulum film, tests/test_track_background_angle.py), but here the disc turns on "
-    "5 deg a frame while its angle is lost, so frames 45-49 are ok 9-13 px from the truth",
-)
 def test_disc_turning_behind_a_region_drawn_inside_it_places_its_point(disc_track):
     d, _, truth = disc_track
     ok = np.asarray(d.status) == "ok"

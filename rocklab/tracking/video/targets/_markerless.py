@@ -28,7 +28,8 @@ holding most of the turning information no longer match the pose while the rest 
 angle (:func:`._observability.unmatched_turn_share`: the angle was set by the rest, a still
 background in the region's corners), nor does a pose on a keyframe cut at such a frame; such a
 pose is held at the last angle measured about the point its matching cells turn about (a disk's
-centre), so the point reported does not follow the background's turn. An object
+centre; on such a keyframe, the point the frame it was cut at was held about), so the point
+reported does not follow the background's turn. An object
 whose appearance tells no angle (a disk) is held upright about its centre of symmetry, reports
 that centre, and no angle (:mod:`._observability`). A round
 object (a ball) reports the place of its disk's centre: its texture slides over it as it spins, so
@@ -46,6 +47,7 @@ from ._detection import Detection
 from ._ic import ICAffine, ICRigid
 from ._observability import (
     CELL_TURN_GAP,
+    MAX_UNMATCHED_ABOUT_MATCHED,
     MAX_UNMATCHED_TURN,
     cell_turn_info,
     sigma_theta,
@@ -178,6 +180,9 @@ class MarkerlessTracker:
         #: 1-sigma of the angle at which the keyframe was cut from its frame, rad (inf: that
         #: frame's angle was not a measurement); a pose registered on the keyframe inherits it
         self.key_sigma_rad = 0.0
+        #: the template point (px from its centre) the pose was held about on the frame the keyframe
+        #: was cut at, when that frame's angle was not a measurement (:meth:`_settle`), else None
+        self.key_at = None
         self._ic: list = []  # (template, ICAffine): the first template's, then the keyframe's
         self.size = (u1 - u0, v1 - v0)
         self.poses: list = []  # last two accepted (theta, tx, ty): first-frame px -> image px
@@ -571,7 +576,7 @@ class MarkerlessTracker:
                 fit, tmpl, mask, visible = twin, self.key, None, 1.0
         if self.reason is not None:
             if self.reason == "drift":  # the keyframe learned the slide
-                self.key, self.key_sigma_rad = self.tmpl0, 0.0
+                self.key, self.key_sigma_rad, self.key_at = self.tmpl0, 0.0, None
                 self.verifier.fb.to_first()
             self.verifier.lost_frame(gray, frame, MIN_CC)
             if self.poses:
@@ -688,6 +693,12 @@ class MarkerlessTracker:
             why = "keyframe"
         if why is None and self._turn_failed:
             why = "turn"  # the inscribed disc's best turn is far from the fitted angle
+        if why == "keyframe" and self.key_at is not None:
+            # registered on a keyframe cut where the angle was no measurement: the keyframe's own
+            # cells turn about a point of that wrong view, not the object's; the point the cut frame
+            # was held about is the object's (a turning disc: its centre, 9-13 px from the
+            # keyframe's point on tests/test_track_markerless_turn.py), carried by the fit since
+            turn_at = self.key_at
         if why is not None and turn_at is not None:
             # the fitted angle was set by what does not move with the object (a still background in
             # the region): so was the place of every point off the one the matching part turns
@@ -711,6 +722,7 @@ class MarkerlessTracker:
                 # a keyframe cut where the angle was no measurement carries no angle on
                 key_sig = self._chained_sigma(tmpl, gray, W) if why is None else math.inf
                 self.key, self.key_sigma_rad = back, key_sig
+                self.key_at = None if held is None else turn_at
                 self.verifier.fb.keyframe(self, gray, W)
         # the angle's information is that of the cells the pose re-explains, not the whole region's
         sig = self._chained_sigma(tmpl, gray, W, mask) / math.sqrt(1.0 - share) if why is None else math.nan
@@ -744,7 +756,9 @@ class MarkerlessTracker:
     def _angle_unmatched(self, tmpl, gray, W, cc):
         """Why the pose ``W``'s angle is not a measurement on this frame, or None: the cells of the
         template that hold more than :data:`._observability.MAX_UNMATCHED_TURN` of its turning
-        information do not match the frame warped back, while the rest does. Its Gauss-Newton
+        information (more than :data:`._observability.MAX_UNMATCHED_ABOUT_MATCHED` about the point
+        the rest turns about: a round disc matching before a still corner) do not match the frame
+        warped back, while the rest does. Its Gauss-Newton
         sigma then says nothing: the angle was set by the cells that still match (on the turning
         disc, the still rod and wall in its region's corners, 28-177 deg from the mark's angle).
 
@@ -762,12 +776,14 @@ class MarkerlessTracker:
         # that matches nothing while the pose stands as fitted (a still background's corner the
         # object left) is the part that set its angle
         covered = cc < REKEY_CC and partly_covered(ccs)
-        share, at = unmatched_turn_share(
+        share, share_at, at = unmatched_turn_share(
             self._turn_info[1], ccs, self._cells_seen(W, gray.shape), CELL_CC if covered else -1.0
         )
-        if share <= MAX_UNMATCHED_TURN:
+        if share <= MAX_UNMATCHED_TURN and share_at <= MAX_UNMATCHED_ABOUT_MATCHED:
             return None, at, share
-        return f"{100 * share:.0f} %", at, share
+        if share > MAX_UNMATCHED_TURN:
+            return f"{100 * share:.0f} %", at, share
+        return f"{100 * share_at:.0f} % about the matching part's turning point", at, share
 
 
 class MarkerlessDetector:

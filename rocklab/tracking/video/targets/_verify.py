@@ -373,7 +373,9 @@ class PoseVerifier:
         if self.first is None or not (self.filled or self.early) or (self.outline is not None and not self.filled):
             return
         ref = OutlineRef(self.first, self.bg, self.box)
-        if self.outline is not None and self.outline.disk0 is not None and ref.disk0 is not None:
+        if self.outline is not None and self.outline.disk0 is not None:
+            # a disk stays one where the filled-in background's outline does not find it (a hand
+            # that held it in the first frame joins it there)
             ref.disk0 = self.outline.disk0
         self.outline = ref
         if self.filled:

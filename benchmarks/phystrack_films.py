@@ -42,8 +42,13 @@ frames 0 and 120). A is tracked from frame 0 (drawn box and the box moved by 10 
 from frame 205 (drawn box); theta is compared mod 180 with the dots' line (ccw against the image's
 cw angle), relative to the first frame.
 
+``RollingCylinder.MP4`` (``Roll [BOX]``; a DEVELOPMENT film): the white disc with two dots rolls
+down the ramp and rests at its foot; its angle is dropped (a round outline), so the point judged is
+the box centre carried by the disc's centre (``tests/data/video_refs/phystrack_rollingcylinder_disc.csv``),
+for the reviewer's four boxes and four random ones (:func:`roll_boxes`).
+
 Run: ``PYTHONPATH=. python benchmarks/phystrack_films.py [FILM [BOX]]`` (e.g. ``R3 base``,
-``Rotation A shift+10``) (from the
+``Rotation A shift+10``, ``Roll shift+10``) (from the
 repository root, so that this checkout's ``rocklab`` is the one measured).
 """
 
@@ -253,6 +258,75 @@ def pucks(tmp, only=""):
             print("Rotation", who, name, box, count_puck(tr, ref[who], box, width), " ".join(codes), flush=True)
 
 
+#: RollingCylinder.MP4: the box drawn round the disc in frame 0, and the disc's centre there read by
+#: hand (the reference's blob merges it with the hand in that frame)
+ROLL_BOX, ROLL_CENTRE0 = (277, 100, 31, 31), (292.5, 115.0)
+
+
+def roll_boxes(seed=7, n=4):
+    """The reviewer's four boxes round :data:`ROLL_BOX` and ``n`` random ones (size x0.8-1.2,
+    centre moved by up to 10 % of the size each way)."""
+    x, y, w, h = ROLL_BOX
+    out = {
+        "base": ROLL_BOX,
+        "shift+10": (round(x + 0.1 * w), round(y + 0.1 * h), w, h),
+        "big120": (round(x - 0.2 * w), round(y - 0.2 * h), round(1.2 * w), round(1.2 * h)),
+        "small80": (round(x + 0.1 * w), round(y + 0.1 * h), round(0.8 * w), round(0.8 * h)),
+    }
+    rng = np.random.default_rng(seed)
+    for i in range(n):
+        s = rng.uniform(0.8, 1.2)
+        dx, dy = rng.uniform(-0.1, 0.1, 2)
+        out[f"rnd{i}"] = (
+            round(x + w / 2 * (1 - s) + dx * w),
+            round(y + h / 2 * (1 - s) + dy * h),
+            round(s * w),
+            round(s * h),
+        )
+    return out
+
+
+def rolling(tmp, only=""):
+    """RollingCylinder, whole film, per box of :func:`roll_boxes`: ok frames, ok frames judged
+    (where ``tests/data/video_refs/phystrack_rollingcylinder_disc.csv`` has the disc alone), those
+    more than 1 % of the width from the box centre carried by the disc's centre, their max and
+    median error (px)."""
+    path = _film("SampleVideos/RollingCylinder.MP4", Path(tmp) / "RollingCylinder.mp4")
+    csv = Path(__file__).parents[1] / "tests" / "data" / "video_refs" / "phystrack_rollingcylinder_disc.csv"
+    ref = np.genfromtxt(csv, delimiter=",", names=True)
+    at = {int(f): i for i, f in enumerate(ref["frame"])}
+    for name, box in roll_boxes().items():
+        if only not in f"Roll {name}":
+            continue
+        cfg = TrackConfig.from_dict(
+            {
+                "targets": {"style": "markerless"},
+                "reference": {"level": "none"},
+                "objects": [{"id": "o", "roi": list(box)}],
+            }
+        )
+        with collecting():
+            res = track_video(path, cfg)
+        tr = res["o"]
+        off0 = np.array([box[0] + box[2] / 2, box[1] + box[3] / 2]) - np.array(ROLL_CENTRE0)
+        ok = np.asarray(tr.status) == "ok"
+        err = np.array(
+            [
+                np.hypot(x - ref["x"][at[f]] - off0[0], y - ref["y"][at[f]] - off0[1])
+                for f, x, y, k in zip(np.asarray(tr.frame, int), tr.x_px, tr.y_px, ok)
+                if k and f in at
+            ]
+        )
+        got = {
+            "ok": int(ok.sum()),
+            "judged": len(err),
+            "ok_off": int((err > 0.01 * res.width_px).sum()),
+            "max_px": round(float(err.max()), 1) if len(err) else None,
+            "median_px": round(float(np.median(err)), 2) if len(err) else None,
+        }
+        print("Roll", name, box, got, flush=True)
+
+
 def main(only=""):
     if not GIT.exists():
         print(f"skipped: no PhysTrack mirror at {GIT} (set PHYSTRACK_GIT)")
@@ -260,6 +334,9 @@ def main(only=""):
     with tempfile.TemporaryDirectory() as tmp:
         if only.startswith("Rotation"):
             pucks(tmp, only)
+            return
+        if only.startswith("Roll"):
+            rolling(tmp, only)
             return
         for film, drawn in FILMS.items():
             if only.split(" ")[0] not in film:

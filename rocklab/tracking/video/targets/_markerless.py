@@ -33,7 +33,9 @@ reported does not follow the background's turn. An object
 whose appearance tells no angle (a disk) is held upright about its centre of symmetry, reports
 that centre, and no angle (:mod:`._observability`). A round
 object (a ball) reports the place of its disk's centre: its texture slides over it as it spins, so
-its points are moved to within :data:`DISK_AGREE_FRAC` of where the outline puts that centre.
+its points are moved to within :data:`DISK_AGREE_FRAC` of where the outline puts that centre; once
+its angle is known not to be reported (a round outline), its points come from the pose turned back
+to the first angle about that centre, so that no point hangs on the texture's angle.
 """
 
 from __future__ import annotations
@@ -229,6 +231,8 @@ class MarkerlessTracker:
         #: the last angle measured (first-frame px -> image px), rad: a pose whose angle is not a
         #: measurement is held at it
         self.theta_hold = 0.0
+        #: the disk's centre in the first frame (first-frame px) once an outline found it, or None
+        self.disk_c0 = None
 
     # -- registration -------------------------------------------------------------
     def _window(self, gray, W, margin):
@@ -476,6 +480,23 @@ class MarkerlessTracker:
             return W
         return _euclid(0.0, *(W[:, :2].astype(float) @ self.sym0 + W[:, 2] - self.sym0))
 
+    def _upright_disk(self, W, W_pts):
+        """The pose the points of a round object whose angle is not reported (:attr:`round_note`)
+        come from: ``W`` turned back to the first frame's angle about its disk's centre, which
+        stays where ``W`` puts it; else ``W_pts``. The reported point is then where the region's
+        centre would be had the disk not turned: the angle it would hang on is its texture's,
+        not reported (PhysTrack RollingCylinder, a region 10 % off the disk's centre: held at a
+        texture angle stopped near -90 deg while the disk rolled on, 8-9 px from where the box
+        centre carried by the disk's centre was)."""
+        out = self.verifier.outline
+        if out is not None and out.disk0 is not None:
+            # kept: an outline learned again over a filled-in background may not find the disk
+            self.disk_c0 = np.asarray(out.disk0[0], float)
+        if self.round_note is None or self.disk_c0 is None:
+            return W_pts
+        c = self.disk_c0
+        return _euclid(0.0, *(W[:, :2].astype(float) @ c + W[:, 2] - c))
+
     def _sigma_theta(self, tmpl, gray, W, mask=None):
         """Gauss-Newton σ of θ (rad) of ``tmpl`` registered by ``W`` (:func:`._observability.sigma_theta`)."""
         warped = self._warp_back(gray, W)
@@ -586,6 +607,7 @@ class MarkerlessTracker:
         self.verifier.confirm(gray, self.size)
         self._round_check(first_view)
         (W, cc), mask, visible, why, sig, W_pts = self._settle(tmpl, gray, fit, mask, visible)
+        W_pts = self._upright_disk(W, W_pts)
         self.poses = (self.poses + [self._centred(W)])[-2:]
         self.twins.remember(frame, gray, W[:, :2].astype(float) @ self.centre0 + W[:, 2])
         pts = (self.grid + self.origin) @ W_pts[:, :2].T.astype(float) + W_pts[:, 2]

@@ -75,7 +75,7 @@ import math
 
 import numpy as np
 
-from ._occlusion import OUTLINE_MARGIN_FRAC, OutlineRef, warp_grown
+from ._occlusion import OUTLINE_MARGIN_FRAC, ROUND_MIN, OutlineRef, warp_grown
 from ._roundtrip import RoundTrip
 
 __all__ = ["PoseVerifier", "search_whole_frame", "MIN_SCORE", "MAX_STEP_RAD"]
@@ -373,7 +373,15 @@ class PoseVerifier:
         if self.first is None or not (self.filled or self.early) or (self.outline is not None and not self.filled):
             return
         ref = OutlineRef(self.first, self.bg, self.box)
-        if self.outline is not None and self.outline.disk0 is not None and ref.disk0 is not None:
+        if (
+            self.outline is not None
+            and self.outline.disk0 is not None
+            and (ref.disk0 is not None or not ref.roundness >= ROUND_MIN)
+        ):
+            # a disk stays one where the filled-in background's outline is not round (a hand that
+            # held it in the first frame joins it there: it tells nothing of the disk); a round
+            # outline without a disk overrides the first (a disk drawn too large against the first
+            # frame round the region)
             ref.disk0 = self.outline.disk0
         self.outline = ref
         if self.filled:

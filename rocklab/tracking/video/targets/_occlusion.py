@@ -507,12 +507,14 @@ class OutlineRef:
             back, bgw = _reduce(back, f), _reduce(bgw, f)
         r0 = self.disk0[1] * f
         diff = _disk_diff(back, bgw)  # what every threshold below cuts
+        found = []
         for rel in DISK_RELS:
             d = disk(back, bgw, rel, diff)
+            found.append(d)
             if d is None or d[1] <= (1.0 + DISK_RADIUS_TOL) * r0:
                 break  # no blob larger than the disk: nothing joined it at this threshold
         else:  # larger at every threshold (a hand joined it): as at the first
-            rel, d = DISK_REL, disk(back, bgw, diff=diff)
+            rel, d = DISK_RELS[0], found[0]
         c = _disk_match(back, bgw, r0, rel, diff)
         if c is None:
             return None

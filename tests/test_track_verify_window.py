@@ -73,3 +73,22 @@ def test_snapshot_warp_keeps_the_frames_patch():
     assert np.abs(other - patch).mean() > 5.0  # the snapshot shows the wall there, not the ball
     tr._back = (None, None, None)
     assert np.array_equal(tr._warp_back(gray, W), patch)
+
+
+def test_patch_statistics_are_numpys():
+    """The patch statistics the verifier takes every frame (a patch's contrast, its correlation
+    with another, the share of unchanged pixels) are numpy's ``std``, ``mean`` and sums of the
+    float32 arrays, bit for bit, on whole patches and on windows cut from a larger one."""
+    from rocklab.tracking.video.targets._verify import _ncc, _share, _std
+
+    rng = np.random.default_rng(7)
+    for k in range(300):
+        big = (rng.random((94, 90)) * rng.uniform(0.01, 255)).astype(np.float32)
+        a = big[10:-10, 10:-10] if k % 2 else big[10:-10, 10:-10].ravel()
+        b = (rng.random(a.shape) * rng.uniform(0.01, 255)).astype(np.float32) + np.float32(rng.uniform(-1, 1)) * a
+        da, db = a - a.mean(), b - b.mean()
+        ref = float((da * db).sum() / (math.sqrt(float((da * da).sum()) * float((db * db).sum())) + 1e-9))
+        assert _ncc(a, b) == ref
+        assert _std(a) == float(a.std())
+        m = np.abs(a - b) < 10.0
+        assert _share(m) == float(np.mean(m))

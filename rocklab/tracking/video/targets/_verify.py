@@ -76,7 +76,7 @@ import math
 
 import numpy as np
 
-from ._occlusion import OUTLINE_MARGIN_FRAC, OutlineRef, warp_grown
+from ._occlusion import OUTLINE_MARGIN_FRAC, OutlineRef, pair, warp_grown
 from ._roundtrip import RoundTrip
 
 __all__ = ["PoseVerifier", "Window", "search_whole_frame", "MIN_SCORE", "MAX_STEP_RAD"]
@@ -351,7 +351,7 @@ class PoseVerifier:
             known = 1.0 if k is None else k.mean()
             kb, kg = (back.ravel(), bg_back.ravel()) if known == 1.0 else (back[k], bg_back[k])
             if known >= BG_KNOWN and (
-                float(np.mean(np.abs(kb - kg) < BG_TOL)) >= BG_FRACTION
+                _share(np.abs(kb - kg) < BG_TOL) >= BG_FRACTION
                 # the still background explains the patch at least as well as the object does (a
                 # detail of the scene that looks like a small object, under compression noise)
                 or _ncc(kb, kg) >= score
@@ -492,7 +492,8 @@ class PoseVerifier:
             # the object's outline against the background is not where the pose puts it: the
             # pose slid off the object (a spinning object's texture, a keyframe that learned a
             # still edge of the wall)
-            found = self.outline.locate(tr, gray, self.bg, W, (back_g, bg_g))
+            grown = pair(back_g, bg_g)  # shared by the outline and the disk
+            found = self.outline.locate(tr, gray, self.bg, W, grown)
             if (
                 found is not None
                 and self.outline.moved(found)
@@ -501,7 +502,7 @@ class PoseVerifier:
                 # the poses since the last frame checked here were the slide: no anchor for motion
                 reason, self.hint, self.recent = "drift", found[2], []
             elif found is not None:
-                self.disk_at = self.outline.disk_centre(tr, W, (back_g, bg_g))
+                self.disk_at = self.outline.disk_centre(tr, W, grown)
         self._pending = (float(score), centre, theta, pred, last2, gap, frame)
         return reason
 
@@ -511,7 +512,7 @@ class PoseVerifier:
         (the first template's own until :data:`WARMUP_FRAMES` are learned): a shadow or a bare
         wall that the correlation, blind to contrast, matches. Remembers the patch's contrast for
         :meth:`confirm`."""
-        self._contrast = math.nan if patch is None else float(patch.std()) / max(self._tmpl0_std, 1e-6)
+        self._contrast = math.nan if patch is None else _std(patch) / max(self._tmpl0_std, 1e-6)
         if not math.isfinite(self._contrast):
             return False
         usual = self.contrasts.median() if len(self.contrasts) >= WARMUP_FRAMES else 1.0
@@ -555,7 +556,7 @@ class PoseVerifier:
                 then = tr._warp_back(snap, W, keep=False)  # the frame's patch stays for the tracker
                 if now is None or then is None:
                     return None
-                same = float(np.mean(np.abs(now - then) < BG_TOL))
+                same = _share(np.abs(now - then) < BG_TOL)
                 return "background" if same >= BG_FRACTION or _ncc(now, then) >= score else None
         return None
 
@@ -665,10 +666,36 @@ class PoseVerifier:
             self._snap_at = self.n_verified
 
 
+def _mean32(a):
+    """``a.mean()`` of a float32 array, as numpy takes it (a float32 sum over the count), without
+    its generic wrapper: the verifier takes a few means every frame."""
+    return np.float32(float(np.add.reduce(a, axis=None)) / a.size)
+
+
+def _std(a) -> float:
+    """``float(a.std())`` of a float32 array, as numpy takes it (float32 sums), in fewer calls."""
+    n = np.intp(a.size)
+    m = np.add.reduce(a, axis=None, keepdims=True)
+    np.true_divide(m, n, out=m, casting="unsafe")
+    x = a - m
+    np.multiply(x, x, out=x)
+    v = np.add.reduce(x, axis=None)
+    return float(np.sqrt(v.dtype.type(v / n)))
+
+
+def _share(mask) -> float:
+    """``float(np.mean(mask))`` of a boolean array: the share of its true pixels."""
+    return np.count_nonzero(mask) / mask.size
+
+
 def _ncc(a, b):
     """Zero-mean normalised correlation of two images of one shape."""
-    a, b = a - a.mean(), b - b.mean()
-    return float((a * b).sum() / (math.sqrt(float((a * a).sum()) * float((b * b).sum())) + 1e-9))
+    a, b = a - _mean32(a), b - _mean32(b)
+    add = np.add.reduce
+    # the float32 sum over a Python float: a float32 quotient, as numpy's scalars divide
+    return float(
+        add(a * b, axis=None) / (math.sqrt(float(add(a * a, axis=None)) * float(add(b * b, axis=None))) + 1e-9)
+    )
 
 
 def best_turned_match(image, tmpl, theta, turns_deg, min_cc):

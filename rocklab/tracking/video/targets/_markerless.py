@@ -236,7 +236,8 @@ class MarkerlessTracker:
 
     # -- registration -------------------------------------------------------------
     def _window(self, gray, W, margin):
-        """The part of ``gray`` round the template's footprint under W (float32) and its offset (px)."""
+        """The part of ``gray`` round the template's footprint under W (float32: a copy, or a view
+        to read only when ``gray`` is float32 already) and its offset (px)."""
         w, h = self.size
         corners = (np.array([[0, 0], [w, 0], [0, h], [w, h]], float) + self.origin) @ W[:, :2].T.astype(float) + W[
             :, 2
@@ -246,7 +247,7 @@ class MarkerlessTracker:
         x1, y1 = int(min(np.ceil(corners[:, 0].max() + margin), Wd)), int(min(np.ceil(corners[:, 1].max() + margin), H))
         if x1 - x0 < 8 or y1 - y0 < 8:
             return None, None
-        return gray[y0:y1, x0:x1].astype(np.float32), np.array([x0, y0], np.float32)
+        return np.asarray(gray[y0:y1, x0:x1], np.float32), np.array([x0, y0], np.float32)
 
     def _ecc(self, tmpl, gray, W0, levels=3, direct=False):
         """ECC of ``tmpl`` in ``gray`` from the warp W0 (first-frame px -> image px); (W, cc) or None.
@@ -511,8 +512,10 @@ class MarkerlessTracker:
             self._norm = hit = (tmpl, (tmpl - tmpl.mean()) / (tmpl.std() + 1e-9))
         return hit[1]
 
-    def _warp_back(self, gray, W):
-        """The current image resampled onto the template grid by the pose W (float32), or None."""
+    def _warp_back(self, gray, W, keep=True):
+        """The current image resampled onto the template grid by the pose W (float32), or None.
+        ``keep``: remembered for the next call with this image and pose (False for another image
+        than the frame's, as a scene snapshot, that would push the frame's patch out)."""
         key = W.tobytes()
         if self._back[0] is gray and self._back[1] == key:  # the checks of one pose share it
             return self._back[2]
@@ -526,7 +529,8 @@ class MarkerlessTracker:
         back = cv2.warpAffine(
             crop, Wfull, (w, h), flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP, borderMode=cv2.BORDER_REPLICATE
         )
-        self._back = (gray, key, back)
+        if keep:
+            self._back = (gray, key, back)
         return back
 
     def detect(self, gray, frame):

@@ -50,6 +50,7 @@ __all__ = [
     "disk",
     "stable_disk",
     "warp_grown",
+    "pair",
     "subpixel_peak",
 ]
 
@@ -441,9 +442,9 @@ class OutlineRef:
             Gives the template's place in the first frame (``origin``, ``centre0``) and windows.
         frame, bg : ndarray (H, W)
             The frame and the background.
-        grown : tuple of ndarray, optional
-            (frame, background) already resampled by ``W`` onto the template's grid grown by
-            twice :attr:`margin`.
+        grown : ndarray (h, w, 2) float32, optional
+            The frame and the background already resampled by ``W`` onto the template's grid
+            grown by twice :attr:`margin`, stacked on the last axis (:func:`pair`).
 
         Returns
         -------
@@ -467,14 +468,14 @@ class OutlineRef:
         m2 = 2 * self.margin
         for k, Wc in enumerate(cands):
             if k == 0 and grown is not None:
-                back, bgw = grown
+                both = grown
             else:
-                back, bgw = (warp_grown(tr, img, Wc.astype(np.float32), m2) for img in (frame, bg))
-            if back is None or bgw is None:
+                both = pair(*warp_grown(tr, frame, Wc.astype(np.float32), m2, also=bg))
+            if both is None:
                 continue
             if self.scale < 1.0:
-                back, bgw = _reduce(back, self.scale), _reduce(bgw, self.scale)
-            s = silhouette(back, bgw)
+                both = _reduce(both, self.scale)  # both images in one pass, each as alone
+            s = silhouette(both[..., 0], both[..., 1])
             if s is None:
                 continue
             if s.shape[0] < self.ref.shape[0] or s.shape[1] < self.ref.shape[1]:
@@ -495,24 +496,26 @@ class OutlineRef:
         return worst
 
     def disk_centre(self, tr, W, grown):
-        """The object's disk centre in the image (px, (2,)) from ``grown`` (frame, background)
-        resampled by the pose ``W`` onto the template's grid grown by twice :attr:`margin`;
-        None for an object that is not a disk, or a disk whose size changed (a shadow or a
-        hand joined it)."""
+        """The object's disk centre in the image (px, (2,)) from ``grown`` (frame and background
+        resampled by the pose ``W`` onto the template's grid grown by twice :attr:`margin`,
+        stacked on the last axis: :func:`pair`); None for an object that is not a disk, or a disk
+        whose size changed (a shadow or a hand joined it)."""
         if self.disk0 is None:
             return None
-        back, bgw = grown
-        f = min(1.0, DISK_SIDE_PX / max(back.shape))
+        f = min(1.0, DISK_SIDE_PX / max(grown.shape[:2]))
         if f < 1.0:
-            back, bgw = _reduce(back, f), _reduce(bgw, f)
+            grown = _reduce(grown, f)
+        back, bgw = grown[..., 0], grown[..., 1]
         r0 = self.disk0[1] * f
         diff = _disk_diff(back, bgw)  # what every threshold below cuts
+        found = []
         for rel in DISK_RELS:
             d = disk(back, bgw, rel, diff)
+            found.append(d)
             if d is None or d[1] <= (1.0 + DISK_RADIUS_TOL) * r0:
                 break  # no blob larger than the disk: nothing joined it at this threshold
         else:  # larger at every threshold (a hand joined it): as at the first
-            rel, d = DISK_REL, disk(back, bgw, diff=diff)
+            rel, d = DISK_RELS[0], found[0]
         c = _disk_match(back, bgw, r0, rel, diff)
         if c is None:
             return None
@@ -533,6 +536,17 @@ def _reduce(img, f):
     import cv2
 
     return cv2.resize(img, None, fx=f, fy=f, interpolation=cv2.INTER_AREA)
+
+
+def pair(a, b):
+    """The images ``a`` and ``b`` of one shape (h, w) stacked on a last axis, (h, w, 2) float32;
+    None when either is None. Reduced by :func:`_reduce` in one pass, each channel exactly as
+    alone (the frame and its background are reduced together, twice a frame)."""
+    import cv2
+
+    if a is None or b is None:
+        return None
+    return cv2.merge((np.asarray(a, np.float32), np.asarray(b, np.float32)))
 
 
 def warp_grown(tr, img, W, margin, also=None):

@@ -70,15 +70,16 @@ the limits, so a wrong lock cannot teach the tracker to accept itself.
 
 from __future__ import annotations
 
+import bisect
 import collections
 import math
 
 import numpy as np
 
-from ._occlusion import OUTLINE_MARGIN_FRAC, ROUND_MIN, OutlineRef, warp_grown
+from ._occlusion import OUTLINE_MARGIN_FRAC, ROUND_MIN, OutlineRef, pair, warp_grown
 from ._roundtrip import RoundTrip
 
-__all__ = ["PoseVerifier", "search_whole_frame", "MIN_SCORE", "MAX_STEP_RAD"]
+__all__ = ["PoseVerifier", "Window", "search_whole_frame", "MIN_SCORE", "MAX_STEP_RAD"]
 
 #: Lowest correlation of the warped frame with the template that can ever count as the object.
 MIN_SCORE = 0.2
@@ -141,6 +142,66 @@ SNAP_FRAMES = 10
 SNAPS = 8
 
 
+class Window:
+    """The last ``maxlen`` values appended, kept in order of arrival and sorted: their median and
+    percentiles without a sort of the whole window each time (the verifier asks for them every
+    frame). Equal to ``np.median`` and ``np.percentile`` (its default, linear) of the window's
+    values: NaN when one is NaN.
+
+    >>> w = Window(3)
+    >>> for x in (5.0, 1.0, 4.0, 2.0):
+    ...     w.append(x)
+    >>> list(w), w.median(), w.percentile(50.0)
+    ([1.0, 4.0, 2.0], 2.0, 2.0)
+    """
+
+    def __init__(self, maxlen: int):
+        self._order: collections.deque = collections.deque(maxlen=maxlen)
+        self._sorted: list = []  # the values but NaN, ascending
+        self._nans = 0
+
+    def append(self, x: float) -> None:
+        x = float(x)
+        if len(self._order) == self._order.maxlen:
+            old = self._order[0]
+            if old != old:
+                self._nans -= 1
+            else:
+                del self._sorted[bisect.bisect_left(self._sorted, old)]
+        self._order.append(x)
+        if x != x:
+            self._nans += 1
+        else:
+            bisect.insort(self._sorted, x)
+
+    def __len__(self) -> int:
+        return len(self._order)
+
+    def __iter__(self):
+        return iter(self._order)
+
+    def median(self) -> float:
+        """``np.median`` of the values (NaN when empty)."""
+        s, n = self._sorted, len(self._sorted)
+        if self._nans or n == 0:
+            return math.nan
+        # numpy's mean of the two middle values: their sum over 2
+        return s[n // 2] if n % 2 else (s[n // 2 - 1] + s[n // 2]) / 2
+
+    def percentile(self, q: float) -> float:
+        """``np.percentile`` of the values at ``q`` (0-100; linear interpolation, NaN when empty)."""
+        s, n = self._sorted, len(self._sorted)
+        if self._nans or n == 0:
+            return math.nan
+        v = (n - 1) * (q / 100)
+        if v >= n - 1:
+            return s[-1]
+        i = math.floor(v)
+        t, a, b = v - i, s[i], s[i + 1]
+        # numpy's lerp: from the nearer end
+        return b - (b - a) * (1 - t) if t >= 0.5 else a + (b - a) * t
+
+
 class PoseVerifier:
     """One markerless object's checks (see the module's description).
 
@@ -180,13 +241,13 @@ class PoseVerifier:
         self.first_outer = first_gray[self.outer[1] : self.outer[3], self.outer[0] : self.outer[2]].astype(np.float32)
         self.tmpl0 = first_gray[box[1] : box[3], box[0] : box[2]].astype(np.float32)
         self.size = size
-        self.scores = collections.deque(maxlen=300)
+        self.scores = Window(300)
         #: the verified frames' contrast over the first template's (:meth:`faint`)
-        self.contrasts = collections.deque(maxlen=300)
+        self.contrasts = Window(300)
         self._tmpl0_std = float(self.tmpl0.std())
         self._contrast = math.nan  # the pose being verified's
-        self.residuals = collections.deque(maxlen=300)
-        self.speeds = collections.deque(maxlen=300)
+        self.residuals = Window(300)
+        self.speeds = Window(300)
         self.n_verified = 0
         self._limits, self._learned_at = None, 0
         #: (median, robust deviation) of the verified correlations, once learned
@@ -224,8 +285,8 @@ class PoseVerifier:
         """The lowest correlation accepted now."""
         if len(self.scores) < WARMUP_FRAMES:
             return MIN_SCORE
-        s = np.asarray(self.scores)
-        med = float(np.median(s))
+        s = np.fromiter(self.scores, float, len(self.scores))
+        med = self.scores.median()
         dev = max(1.4826 * float(np.median(np.abs(s - med))), MIN_DEVIATION)
         self.score_stats = (med, dev)
         return max(MIN_SCORE, med - APPEARANCE_MADS * dev)
@@ -235,7 +296,7 @@ class PoseVerifier:
         floor = MIN_RESIDUAL_FRAC * max(self.size) + 1.0
         if len(self.residuals) < WARMUP_FRAMES:
             return max(floor, 0.25 * max(self.size))
-        return max(floor, MOTION_FACTOR * float(np.percentile(self.residuals, 99)))
+        return max(floor, MOTION_FACTOR * self.residuals.percentile(99))
 
     # -- the checks ------------------------------------------------------------------
     def limits(self):
@@ -268,7 +329,8 @@ class PoseVerifier:
         gap : int
             Frames since the last verified one (1: the previous frame).
         bg_back, back, known_back : ndarray (h, w), optional
-            The background, the frame and the background's known mask, warped onto the template.
+            The background, the frame and the background's known mask, warped onto the template
+            (no mask: the background is known on every pixel).
         """
         score_lim, lim, speed_lim = self.limits()
         if score < score_lim:
@@ -283,13 +345,13 @@ class PoseVerifier:
                 return "jump"
             if (pred is None or gap > 1) and float(np.hypot(*(centre - last[0]))) > (lim + speed_lim) * gap:
                 return "jump"  # no farther than the fastest verified motion allows
-        if bg_back is not None and known_back is not None:
-            k = known_back > 0.5
+        if bg_back is not None:
+            k = None if known_back is None else known_back > 0.5
             # the known pixels, taken once (all of them, in the same order, when all are known)
-            known = k.mean()
+            known = 1.0 if k is None else k.mean()
             kb, kg = (back.ravel(), bg_back.ravel()) if known == 1.0 else (back[k], bg_back[k])
             if known >= BG_KNOWN and (
-                float(np.mean(np.abs(kb - kg) < BG_TOL)) >= BG_FRACTION
+                _share(np.abs(kb - kg) < BG_TOL) >= BG_FRACTION
                 # the still background explains the patch at least as well as the object does (a
                 # detail of the scene that looks like a small object, under compression noise)
                 or _ncc(kb, kg) >= score
@@ -300,7 +362,7 @@ class PoseVerifier:
     def speed_limit(self) -> float:
         """Largest believable motion per frame, px: three times the fastest verified one, at
         least a tenth of the template."""
-        top = float(np.percentile(self.speeds, 99)) if self.speeds else 0.0
+        top = self.speeds.percentile(99) if len(self.speeds) else 0.0
         return max(3.0 * top, 0.1 * max(self.size))
 
     def accept(self, score, centre, pred, last, gap, gray=None, footprint=None, tight=None):
@@ -407,7 +469,7 @@ class PoseVerifier:
         last, gap, pred = self.motion_context(frame)
         if self.since_lost:  # what stands in the first region now, the frame checked included
             self._sample(gray, frame, tr.min_cc)
-        bg = back = known = bg_g = back_g = None
+        bg = back = bg_g = back_g = None
         self.hint = self.disk_at = None
         if not (0.0 <= centre[0] < gray.shape[1] and 0.0 <= centre[1] < gray.shape[0]):
             return "lost"  # the point reported would lie outside the picture: no measurement
@@ -417,14 +479,13 @@ class PoseVerifier:
             m = 2 * self.margin
             bg_g, back_g = warp_grown(tr, self.bg, W, m, also=gray)
             if bg_g is not None and back_g is not None:
-                bg, back = bg_g[m:-m, m:-m], back_g[m:-m, m:-m]
-                known = np.ones_like(bg)
+                bg, back = bg_g[m:-m, m:-m], back_g[m:-m, m:-m]  # known on every pixel
         last2 = None if last is None else last[:2]
         far = self._far(centre, frame)
         # frames since the last verified one: after a slide the motion checks have no anchor
         # (``gap`` is then 1), but the pose is still one found after lost frames
         since = gap if self.seen is None else max(gap, frame - self.seen[2])
-        reason = self.check(float(score), centre, theta, pred, last2, gap, bg, back, known)
+        reason = self.check(float(score), centre, theta, pred, last2, gap, bg, back)
         if reason is None and self.faint(back if back is not None else tr._warp_back(gray, W)):
             reason = "mismatch"
         if reason is None:
@@ -439,7 +500,8 @@ class PoseVerifier:
             # the object's outline against the background is not where the pose puts it: the
             # pose slid off the object (a spinning object's texture, a keyframe that learned a
             # still edge of the wall)
-            found = self.outline.locate(tr, gray, self.bg, W, (back_g, bg_g))
+            grown = pair(back_g, bg_g)  # shared by the outline and the disk
+            found = self.outline.locate(tr, gray, self.bg, W, grown)
             if (
                 found is not None
                 and self.outline.moved(found)
@@ -448,7 +510,7 @@ class PoseVerifier:
                 # the poses since the last frame checked here were the slide: no anchor for motion
                 reason, self.hint, self.recent = "drift", found[2], []
             elif found is not None:
-                self.disk_at = self.outline.disk_centre(tr, W, (back_g, bg_g))
+                self.disk_at = self.outline.disk_centre(tr, W, grown)
         self._pending = (float(score), centre, theta, pred, last2, gap, frame)
         return reason
 
@@ -458,10 +520,10 @@ class PoseVerifier:
         (the first template's own until :data:`WARMUP_FRAMES` are learned): a shadow or a bare
         wall that the correlation, blind to contrast, matches. Remembers the patch's contrast for
         :meth:`confirm`."""
-        self._contrast = math.nan if patch is None else float(patch.std()) / max(self._tmpl0_std, 1e-6)
+        self._contrast = math.nan if patch is None else _std(patch) / max(self._tmpl0_std, 1e-6)
         if not math.isfinite(self._contrast):
             return False
-        usual = float(np.median(self.contrasts)) if len(self.contrasts) >= WARMUP_FRAMES else 1.0
+        usual = self.contrasts.median() if len(self.contrasts) >= WARMUP_FRAMES else 1.0
         return self._contrast < CONTRAST_FRACTION * usual
 
     def _far(self, centre, frame) -> bool:
@@ -499,10 +561,10 @@ class PoseVerifier:
         for snap, (x0, y0, x1, y1) in reversed(self.snaps):
             if centre[0] + half < x0 or centre[0] - half > x1 or centre[1] + half < y0 or centre[1] - half > y1:
                 now = tr._warp_back(gray, W) if now is None else now
-                then = tr._warp_back(snap, W)
+                then = tr._warp_back(snap, W, keep=False)  # the frame's patch stays for the tracker
                 if now is None or then is None:
                     return None
-                same = float(np.mean(np.abs(now - then) < BG_TOL))
+                same = _share(np.abs(now - then) < BG_TOL)
                 return "background" if same >= BG_FRACTION or _ncc(now, then) >= score else None
         return None
 
@@ -512,10 +574,10 @@ class PoseVerifier:
         first view looks on a frame exposed while the object moved."""
         import cv2
 
-        if self.seen is None or not self.speeds:
+        if self.seen is None or not len(self.speeds):
             return [tmpl]
         v = np.asarray(self.seen[1], float)
-        top = float(np.percentile(self.speeds, 99))
+        top = self.speeds.percentile(99)
         if not np.any(v) or top < 2.0:
             return [tmpl]
         Wd = np.asarray(W, float)
@@ -544,9 +606,14 @@ class PoseVerifier:
         (an object partly out of the picture has no whole outline to place)."""
         m = self.margin
         w, h = self.size
-        grid = np.array([[-m, -m], [w + m, -m], [-m, h + m], [w + m, h + m]], float) + tr.origin
-        c = grid @ np.asarray(W, float)[:, :2].T + np.asarray(W, float)[:, 2]
-        return bool(c.min() >= 0 and c[:, 0].max() <= shape[1] and c[:, 1].max() <= shape[0])
+        (a, b, tx), (c, d, ty) = np.asarray(W, float).tolist()
+        ox, oy = float(tr.origin[0]), float(tr.origin[1])
+        for x in (ox - m, ox + (w + m)):  # the grid's four corners, in plain floats (it runs every frame)
+            for y in (oy - m, oy + (h + m)):
+                u, v = x * a + y * b + tx, x * c + y * d + ty
+                if not (0 <= u <= shape[1] and 0 <= v <= shape[0]):
+                    return False
+        return True
 
     def _clear(self, centre):
         """Whether a pose centred at ``centre`` (px) keeps the template off the first region."""
@@ -607,10 +674,36 @@ class PoseVerifier:
             self._snap_at = self.n_verified
 
 
+def _mean32(a):
+    """``a.mean()`` of a float32 array, as numpy takes it (a float32 sum over the count), without
+    its generic wrapper: the verifier takes a few means every frame."""
+    return np.float32(float(np.add.reduce(a, axis=None)) / a.size)
+
+
+def _std(a) -> float:
+    """``float(a.std())`` of a float32 array, as numpy takes it (float32 sums), in fewer calls."""
+    n = np.intp(a.size)
+    m = np.add.reduce(a, axis=None, keepdims=True)
+    np.true_divide(m, n, out=m, casting="unsafe")
+    x = a - m
+    np.multiply(x, x, out=x)
+    v = np.add.reduce(x, axis=None)
+    return float(np.sqrt(v.dtype.type(v / n)))
+
+
+def _share(mask) -> float:
+    """``float(np.mean(mask))`` of a boolean array: the share of its true pixels."""
+    return np.count_nonzero(mask) / mask.size
+
+
 def _ncc(a, b):
     """Zero-mean normalised correlation of two images of one shape."""
-    a, b = a - a.mean(), b - b.mean()
-    return float((a * b).sum() / (math.sqrt(float((a * a).sum()) * float((b * b).sum())) + 1e-9))
+    a, b = a - _mean32(a), b - _mean32(b)
+    add = np.add.reduce
+    # the float32 sum over a Python float: a float32 quotient, as numpy's scalars divide
+    return float(
+        add(a * b, axis=None) / (math.sqrt(float(add(a * a, axis=None)) * float(add(b * b, axis=None))) + 1e-9)
+    )
 
 
 def best_turned_match(image, tmpl, theta, turns_deg, min_cc):

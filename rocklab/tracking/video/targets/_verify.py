@@ -12,7 +12,10 @@ and, for the outline, its own first frame:
   must be a turned copy of the first view (:data:`COLD_FIRST_CC`), or of the first view smeared
   along the object's last verified velocity by up to its fastest verified speed (a ball swinging
   20 px a frame is a streak that matches its still first view at 0.83-0.88): a keyframe renewed
-  from a lamp or a hand that the template half matched would otherwise follow it at 0.99. So must, at
+  from a lamp or a hand that the template half matched would otherwise follow it at 0.99; on the
+  frame after a verified one, while cold, it must still match that first view or its smear at
+  :data:`COLD_STEP_CC` (a ball let go from the fingers drawn into its region leaves the keyframe
+  on the fingers, renewed there, with nothing learned to refuse them). So must, at
   any time, a pose found after lost frames (or after a slide) farther than the template's larger
   side both from the last verified pose and from where its velocity carries it: the motion
   vouches for nothing there, and a small ball's keyframe half matches a forearm or an edge;
@@ -127,6 +130,11 @@ MEDIAN_TURNS_DEG = (0.0, -5.0, 5.0, -10.0, 10.0)
 #: (the markerless tracker's keyframe rule). Nothing learned yet says how far the object's look may
 #: stray from it, and a lamp or a hand that the template half matches (0.6-0.85) is not the object.
 COLD_FIRST_CC = 0.9
+#: Correlation with the first view (or its smear, as for :data:`COLD_FIRST_CC`) that a pose on the
+#: frame after a verified one must reach while the limits are cold: a ball let go from the hand
+#: drawn into its region leaves the fingers, half the template, matching it at 0.46-0.68 (the
+#: keyframe at 0.77-0.96); the ball itself in the hand, turning and blurring, kept 0.79-1.0.
+COLD_STEP_CC = 0.75
 #: Smear lengths tried on the first view for that rule, as fractions of the fastest verified speed
 #: (px/frame): the exposure's share of the frame interval is not known.
 SMEAR_FRACS = (0.33, 0.67, 1.0)
@@ -542,20 +550,27 @@ class PoseVerifier:
         """The checks a template that adapts cannot pass by adapting: ``mismatch`` for a pose found
         after lost frames that is no turned copy of the first view (:data:`COLD_FIRST_CC`), nor of
         the first view smeared by the object's verified motion (:meth:`_smeared`), while the
-        limits are cold, or no turned copy of the sharp first view when out of the object's reach
+        limits are cold, for a pose on the frame after a verified one that matches neither at
+        :data:`COLD_STEP_CC` while they are cold, or no turned copy of the sharp first view when out of the object's reach
         (``far``: :meth:`_far`) at any time;
         ``background`` for a patch that the latest snapshot taken while
         the object stood elsewhere already showed there (unchanged on :data:`BG_FRACTION` of its
         pixels, or correlating with it at least as well as with the object): a pose left on the
         object's empty start place, or on a detail of the scene the keyframe has learned."""
         now = None
-        cold = gap > 1 and len(self.scores) < WARMUP_FRAMES
-        if cold or far:
+        warming = len(self.scores) < WARMUP_FRAMES
+        cold = gap > 1 and warming
+        # the next frame while cold: nothing learned bounds the keyframe's correlation yet (the
+        # floor is :data:`MIN_SCORE`), so a ball released from a hand drawn into its region would
+        # leave the keyframe on the fingers, renewed there at 0.95-0.99
+        step = warming and gap == 1 and bool(self.recent)
+        if cold or far or step:
             now = tr._warp_back(gray, W)
             # while cold, the first view may be smeared by the object's own verified motion (a
             # swinging ball is a streak across the frame); a far pose has no motion to vouch for it
-            views = self._smeared(tr.tmpl0, W) if cold and not far else [tr.tmpl0]
-            if now is None or max(_ncc(now, v) for v in views) < COLD_FIRST_CC:
+            views = self._smeared(tr.tmpl0, W) if (cold or step) and not far else [tr.tmpl0]
+            need = COLD_STEP_CC if step and not far else COLD_FIRST_CC
+            if now is None or max(_ncc(now, v) for v in views) < need:
                 return "mismatch"
         half = 0.5 * math.hypot(*self.size) + self.margin
         for snap, (x0, y0, x1, y1) in reversed(self.snaps):

@@ -105,3 +105,37 @@ def test_an_object_found_where_another_ones_track_ended_is_a_latch():
     a_xy[40:] = (60.0, 150.0)
     raw = {"a": _series(a_xy, (t < 10) | (t >= 40)), "b": _series(b_xy, t < 30)}
     assert _settle(config, raw) == [] and np.all(raw["a"][1][40:] == "ok")
+
+
+def _two_bobs(found_at, b_ok):
+    """Two bobs swinging side by side (sborquez/Pendulum-Tracking video2's layout, scaled to this
+    frame): a about x = 80 px by +-40 px, b about x = 240 px by +-20 px, 20 frames a period. a is
+    lost over frames 40-59 and found again at ``found_at`` (px) from frame 60; b is ok where
+    ``b_ok`` says (never, on the film: its region too small to hold it)."""
+    t = np.arange(N)
+    a_xy = np.column_stack((80.0 + 40.0 * np.sin(2 * np.pi * t / 20), np.full(N, 120.0)))
+    b_xy = np.column_stack((240.0 + 20.0 * np.sin(2 * np.pi * t / 20), np.full(N, 120.0)))
+    a_xy[60:] = found_at
+    config = SimpleNamespace(objects=[_obj("a", 80, 120), _obj("b", 240, 120)])
+    raw = {"a": _series(a_xy, (t < 40) | (t >= 60)), "b": _series(b_xy, b_ok)}
+    return config, raw
+
+
+@pytest.mark.parametrize("b_seen", ["never", "until 30", "always"])
+def test_a_bob_found_again_on_the_other_bob_is_not_ok(b_seen):
+    # a is found again on b's place (b at its swing's right end): never ok for a, whether b is
+    # tracked there, was last seen near there, or was only ever given as its first region
+    t = np.arange(N)
+    b_ok = {"never": t < 0, "until 30": t < 30, "always": t >= 0}[b_seen]
+    config, raw = _two_bobs((255.0, 120.0), b_ok)
+    said = _settle(config, raw)
+    assert np.all(raw["a"][1][60:] == "latch") and np.all(raw["a"][1][:40] == "ok")
+    assert np.all(raw["b"][1][b_ok] == "ok")
+    assert len(said) == 1 and "'a' found again at frame 60" in said[0], said
+
+
+@pytest.mark.parametrize("found_at", [(45.0, 121.0), (118.0, 119.0), (150.0, 120.0)])
+def test_a_bob_found_again_across_its_own_swing_stays_ok(found_at):
+    # found at either end of its own swing, or beyond it but nearer its last place than b's: ok
+    config, raw = _two_bobs(found_at, np.arange(N) < 0)
+    assert _settle(config, raw) == [] and np.all(raw["a"][1][60:] == "ok")

@@ -347,6 +347,54 @@ def _run_ends(ok, before: int) -> np.ndarray:
     return np.flatnonzero(ok[: before - 1] & ~ok[1:before])
 
 
+def _place_of(o, s: int, uv, trusted, regions) -> np.ndarray | None:
+    """Where object ``o`` is at index ``s``: its centre there when it is ok, else where it was last
+    seen (its last ok centre before ``s``, or its first region's centre when it has none)."""
+    if trusted[o][s]:
+        return uv[o][s]
+    before = np.flatnonzero(trusted[o][:s])
+    if before.size:
+        return uv[o][before[-1]]
+    roi = regions.get(o)
+    if roi is None:
+        return None
+    return np.array([float(roi[0]) + 0.5 * float(roi[2]), float(roi[1]) + 0.5 * float(roi[3])])
+
+
+#: A re-acquisition this many times nearer to another object's place than to its own last trusted
+#: pose has found the other object (two identical bobs side by side: 47 px from the other's place,
+#: over 190 px from its own).
+OTHER_NEARER = 2.0
+
+
+def _on_other(k, s, p, uv, trusted, regions, size) -> bool:
+    """Whether object ``k`` found again at index ``s`` (last trusted ok at ``p``) has jumped onto
+    another object of the config (a look-alike: two identical bobs, pucks, balls): outside the span
+    of its own trusted ok centres before ``s`` grown by ``size`` (a pendulum re-found across its
+    swing stays inside it), and :data:`OTHER_NEARER` times nearer to another object's place
+    (:func:`_place_of`) than to its own last trusted pose. Its view cannot tell: a look-alike
+    re-explains it. Where the other object is ok within half ``size`` of it, :func:`settle_latches`
+    decides which of the two keeps the pixels."""
+    before = np.flatnonzero(trusted[k][: p + 1])
+    c = uv[k][s]
+    seen = uv[k][before]
+    if np.all((c >= np.nanmin(seen, axis=0) - size) & (c <= np.nanmax(seen, axis=0) + size)):
+        return False
+    d_own = float(np.hypot(*(c - uv[k][p])))
+    for o in uv:
+        if o == k:
+            continue
+        at = _place_of(o, s, uv, trusted, regions)
+        if at is None or not np.all(np.isfinite(at)):
+            continue
+        d = float(np.hypot(*(c - at)))
+        if trusted[o][s] and d < 0.5 * size:
+            continue  # both ok on the same pixels: the shared-pixels rule (settle_latches) decides
+        if OTHER_NEARER * d < d_own:
+            return True
+    return False
+
+
 def _reacquired_wrong(k, s, p, uv, trusted, size, wh) -> str | None:
     """Why object ``k`` found again at index ``s`` (last trusted ok at ``p``) is not ok, or None:
     "left" when it left through the frame's edge (its last pose within ``size`` of the border) and
@@ -423,6 +471,8 @@ def settle_reacquisitions(raw, config, plane_map, frames, source, width_px: int,
                 continue
             p = int(before[-1])
             why = _reacquired_wrong(k, int(s), p, uv, trusted, size, (width_px, height_px))
+            if why is None and _on_other(k, int(s), p, uv, trusted, regions, size):
+                why = "other"
             if why is None and _out_of_reach(int(s), p, uv[k], trusted[k], raw[k][0]["q"], size):
                 why = "reach"
             e = s + (int(np.argmin(ok[s:])) if not ok[s:].all() else len(ok) - s)
@@ -431,7 +481,7 @@ def settle_reacquisitions(raw, config, plane_map, frames, source, width_px: int,
                     why = "reach"
             if why is None:
                 continue
-            if why == "reach":
+            if why in ("reach", "other"):
                 reached.extend(range(s, e))
             _as_latch(raw[k], slice(s, e))
             trusted[k][s:e] = False
@@ -442,6 +492,7 @@ def settle_reacquisitions(raw, config, plane_map, frames, source, width_px: int,
                 "left": "through no edge and away from where it left the frame",
                 "ended": "where another object's track ended",
                 "reach": "farther than it could move in the gap, its view not confirming it",
+                "other": "outside the span of its own track, nearer to where another object is (or was last seen) than to its own last place",
             }[why]
             n = sum(e - s for _, _, s, e in bad)
             warn(

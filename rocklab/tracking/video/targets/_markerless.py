@@ -321,9 +321,12 @@ class MarkerlessTracker:
 
     def _ecc_coarse(self, tmpl, gray_f, W0, levels=3):
         """Rigid ECC on the reduced pyramid levels (robust, 3 parameters); W0 and the result map
-        first-frame px -> ``gray_f`` px. None when a level fails."""
+        first-frame px -> ``gray_f`` px. None when every level tried fails; a level that fails
+        while a finer one converges is passed over (a dark disc with little texture, 8 px across
+        at the coarsest level, gives ECC a NaN there and fits at the next)."""
         cv2 = self._cv2
         W = self._to_tmpl(_rigid(W0))
+        tried, fitted = 0, 0
         for lvl in range(levels - 1, 0, -1):
             f = 0.5**lvl
             t = cv2.resize(tmpl, None, fx=f, fy=f, interpolation=cv2.INTER_AREA)
@@ -332,13 +335,14 @@ class MarkerlessTracker:
             img = cv2.resize(gray_f, None, fx=f, fy=f, interpolation=cv2.INTER_AREA)
             Wl = W.copy()
             Wl[:, 2] *= f
+            tried += 1
             try:
                 _, Wl = cv2.findTransformECC(t, img, Wl, cv2.MOTION_EUCLIDEAN, ECC_CRITERIA, None, 3)
             except cv2.error:
-                return None
+                continue
             Wl[:, 2] /= f
-            W = Wl
-        return self._from_tmpl(W)
+            W, fitted = Wl, fitted + 1
+        return None if tried and not fitted else self._from_tmpl(W)
 
     def _ic_fine(self, tmpl, gray_f, W0):
         """Full-resolution inverse-compositional fit (:mod:`._ic`) from the coarse pose: (W, cc),

@@ -155,11 +155,10 @@ def test_boundary_search_by_key_finds_the_smallest_key_with_fewer_runs():
     assert key2[np.flatnonzero(has), fast[has].argmax(axis=1)].min() == key2[np.arange(n_rows), first].min()
 
 
-def test_bisecting_only_the_levels_behind_t_I_and_the_line_changes_neither(shared_data, monkeypatch):
+def _count_batch_runs(monkeypatch):
+    """Count the runs the OAS hands its batch kernel from now on: ``n["runs"]``."""
     import rocklab.models.spectra._oas as oas
 
-    r = load_base_motion(shared_data / FF1, units="g")
-    kw = dict(levels=30, sizes=45, refine=8)
     n = {"runs": 0}
     real = oas.batch_runs
 
@@ -168,6 +167,13 @@ def test_bisecting_only_the_levels_behind_t_I_and_the_line_changes_neither(share
         return real(base, scale, p, args)
 
     monkeypatch.setattr(oas, "batch_runs", counted)
+    return n
+
+
+def test_bisecting_only_the_levels_behind_t_I_and_the_line_changes_neither(shared_data, monkeypatch):
+    r = load_base_motion(shared_data / FF1, units="g")
+    kw = dict(levels=30, sizes=45, refine=8)
+    n = _count_batch_runs(monkeypatch)
     full = overturning_spectrum(r, 12, refine_where="all", **kw)
     runs_full, n["runs"] = n["runs"], 0
     fit = overturning_spectrum(r, 12, refine_where="fit", verdicts=full, **kw)
@@ -190,15 +196,8 @@ def test_default_bisects_every_level_to_the_curve_resolution_and_t_I_and_the_lin
 
     r = load_base_motion(shared_data / FF1, units="g")
     kw = dict(levels=30, sizes=45, refine=8)
-    n = {"runs": 0}
-    real = oas.batch_runs
-
-    def counted(base, scale, p, args):
-        n["runs"] += np.size(scale)
-        return real(base, scale, p, args)
-
     full = overturning_spectrum(r, 12, refine_where="all", **kw)
-    monkeypatch.setattr(oas, "batch_runs", counted)
+    n = _count_batch_runs(monkeypatch)
     curve = overturning_spectrum(r, 12, verdicts=full, **kw)  # the default: refine_where="curve"
     assert curve.options["refine_where"] == "curve"
     assert curve.t_I_s == full.t_I_s and curve.f_min_at == full.f_min_at
@@ -237,20 +236,13 @@ def test_guide_bisected_only_where_the_members_windows_need_it(shared_data, monk
     r = load_base_motion(shared_data / FF1, units="g")
     kw = dict(levels=30, sizes=45, refine=8)
     full = overturning_spectrum(r, 12, **kw)
-    n = {"runs": 0}
-    real = oas.batch_runs
-
-    def counted(base, scale, p, args):
-        n["runs"] += np.size(scale)
-        return real(base, scale, p, args)
-
     # three member grids: sizes shifted half a step, levels shifted, a coarser grid
     places = [
         oas.grid_axes(dict(full.options, **ch), full.alpha_I)[::2]
         for ch in ({"size_offset": 0.5}, {"level_offset": 0.5}, {"levels": 22, "sizes": 34})
     ]
     coarse = overturning_spectrum(r, 12, verdicts=full, **dict(kw, refine=0))
-    monkeypatch.setattr(oas, "batch_runs", counted)
+    n = _count_batch_runs(monkeypatch)
     settled = oas.settle_guide(r, coarse, places, refine=8)
     assert settled.t_I_s == full.t_I_s and settled.f_min_at == full.f_min_at
     assert settled.t_I_prime_s == pytest.approx(full.t_I_prime_s, rel=1e-12)

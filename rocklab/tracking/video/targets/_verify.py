@@ -133,7 +133,8 @@ COLD_FIRST_CC = 0.9
 #: Correlation with the first view (or its smear, as for :data:`COLD_FIRST_CC`) that a pose on the
 #: frame after a verified one must reach while the limits are cold: a ball let go from the hand
 #: drawn into its region leaves the fingers, half the template, matching it at 0.46-0.68 (the
-#: keyframe at 0.77-0.96); the ball itself in the hand, turning and blurring, kept 0.79-1.0.
+#: keyframe at 0.77-0.96); the ball itself in the hand, turning and blurring, kept 0.79-1.0. Asked
+#: only of a pose whose keyframe correlation is below :data:`COLD_FIRST_CC`.
 COLD_STEP_CC = 0.75
 #: Smear lengths tried on the first view for that rule, as fractions of the fastest verified speed
 #: (px/frame): the exposure's share of the frame interval is not known.
@@ -562,8 +563,11 @@ class PoseVerifier:
         cold = gap > 1 and warming
         # the next frame while cold: nothing learned bounds the keyframe's correlation yet (the
         # floor is :data:`MIN_SCORE`), so a ball released from a hand drawn into its region would
-        # leave the keyframe on the fingers, renewed there at 0.95-0.99
-        step = warming and gap == 1 and bool(self.recent)
+        # leave the keyframe on the fingers, renewed there at 0.95-0.99. Only a pose the keyframe
+        # itself half matches is asked (0.78-0.82 on the fingers): a 15 px bob crossing grid lines
+        # keeps the keyframe at 0.95 while its first view drops to 0.70, and refused there it
+        # would stay lost behind the rule for poses found after lost frames
+        step = warming and gap == 1 and bool(self.recent) and score < COLD_FIRST_CC
         if cold or far or step:
             now = tr._warp_back(gray, W)
             # while cold, the first view may be smeared by the object's own verified motion (a

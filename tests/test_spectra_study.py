@@ -162,14 +162,15 @@ def test_a_study_on_local_processes_stops_at_once(tmp_path, sig, rc_want):
     folder = tmp_path / "recs"
     folder.mkdir()
     t = np.arange(0.0, 20.0, 0.01)
-    # 24 records x 4 slenderness: long enough on a loaded machine that the study is still running
-    # when its first row is journalled (12 records finished before the signal once, at load 4)
-    for i in range(24):
+    for i in range(12):
         acc = 0.3 * np.sin(2 * np.pi * t / (0.4 + 0.1 * i)) * np.exp(-0.2 * t)
         np.savetxt(folder / f"r{i:02d}.txt", np.c_[t, acc], fmt="%.6f")
     out = tmp_path / "study.csv"
     journal = tmp_path / "study.csv.journal.json"
-    cli = [sys.executable, "-c", "import sys; from rocklab.pipelines import main; sys.exit(main())"]
+    # the command as a terminal's foreground job runs it: a job started in the background (make test
+    # under `&`, nohup) inherits SIGINT ignored, and Python then keeps ignoring it, as it should
+    start = "import signal, sys; signal.signal(signal.SIGINT, signal.default_int_handler); "
+    cli = [sys.executable, "-c", start + "from rocklab.pipelines import main; sys.exit(main())"]
     argv = ["oas", str(folder), "--slenderness", "3,5,8,12", "--band", "--units", "g", "--workers", "2"]
     proc = subprocess.Popen(
         cli + argv + ["-o", str(out), "--no-progress"],
@@ -195,6 +196,6 @@ def test_a_study_on_local_processes_stops_at_once(tmp_path, sig, rc_want):
     assert rc == rc_want, err
     assert stopped_s < 15, stopped_s  # measured 0.3-1 s; before: minutes
     assert "--resume" in err and not out.exists()
-    assert 1 <= len(json.loads(journal.read_text())["rows"]) < 96
+    assert 1 <= len(json.loads(journal.read_text())["rows"]) < 48
     time.sleep(0.5)
     assert not [w for w in workers if w.is_running() and w.status() != psutil.STATUS_ZOMBIE]

@@ -49,8 +49,11 @@ def test_init_markerless_regions_on_real_footage(shared_data, tmp_path, run_cli)
     assert rc == 0, err
     tr = pd.read_csv(tmp_path / "p.csv")
     assert (tr.status == "ok").mean() >= 0.99 and tr.x_m.isna().all() and tr.x_px.notna().mean() >= 0.99
-    # no table and no scale: both said, as warnings, never as made-up numbers
-    assert "W-LEVEL-NONE" in err and "W-TRACK-NOSCALE" in err
+    # no scale: a warning, never made-up metres. No table either, and the ball swings to the film's
+    # end: init writes level = "none" with a note saying so (it wrote "rest", which warned
+    # W-LEVEL-NONE on every run of its own config)
+    assert "W-TRACK-NOSCALE" in err and "W-LEVEL" not in err
+    assert 'level = "none"' in cfg.read_text() and "it still moves at the film's end" in cfg.read_text()
 
 
 def test_preview_sheet(session, tmp_path, run_cli):

@@ -85,6 +85,33 @@ def _samples(video, info, window_s, start=0):
     ]
 
 
+#: Frames compared over the film's last seconds for whether the first block rests there.
+REST_SAMPLES = 12
+
+
+def _end_frames(video, info, start=0):
+    """Grey frames spread over the film's last :data:`~rocklab.tracking.video.REST_WINDOW_S`
+    seconds (after frame ``start``), at most :data:`REST_SAMPLES`; empty when the film's length is
+    unknown."""
+    from ...tracking.video import REST_WINDOW_S, iter_video_frames
+
+    per = _per_frame(info)
+    n = per * (info.n_frames or 0)
+    first = max(n - int(round(REST_WINDOW_S * per * (info.fps or 50.0))), start)
+    if n - first < 2:
+        return []
+    step = max(1, (n - first - 1) // (REST_SAMPLES - 1))
+    out, last = [], None
+    for i, g in iter_video_frames(video, first, n, pixel_aspect=info.pixel_aspect, fields=info.field_order):
+        if (i - first) % step == 0:
+            out.append(g)
+        last = g
+    # the film's last frame is always one: a rest is judged against the film's end
+    if last is not None and (not out or out[-1] is not last):
+        out.append(last)
+    return out
+
+
 def _propose(video, info, gray, start=0):
     """Objects proposed from what moves after frame ``start``; (Proposals, window s)."""
     from ...tracking.video import propose_objects
@@ -150,7 +177,7 @@ def track_init(
         frame, is written first so the regions can be read off it).
     """
     from ..._io import write_text_atomic
-    from ...tracking.video import find_markers, parse_region, suggest_config
+    from ...tracking.video import find_markers, parse_region, rests_at_end, suggest_config
     from .._plotting import save_bgr_png
 
     video, out = Path(video), Path(out)
@@ -191,6 +218,7 @@ def track_init(
         found=found,
         level_line_px=line,
         start_frame=start,
+        rest_check=lambda box: rests_at_end(gray, box, _end_frames(video, info, start)),
     )
     if turning:
         # the whole disc's registration does not follow a small mark's turn (PhysTrack's turning

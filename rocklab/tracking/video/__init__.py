@@ -13,7 +13,7 @@
 
 from ._camera_model import PlaneMap, SimilarityFit, calibrate_camera, fit_similarity, load_calibration
 from ._init import find_markers, suggest_config
-from ._level import level_from_reference
+from ._level import REST_WINDOW_S, level_from_reference, rests_at_end
 from ._table_track import choose_sg_window, estimate_noise, table_motion
 from ._track import TRACK_COLUMNS, ObjectTrack, Observation, TrackResult, assemble_tracks, track_frames, track_video
 from ._video import VideoInfo, iter_video_frames, probe_video
@@ -39,6 +39,8 @@ __all__ = [
     "choose_sg_window",
     "estimate_noise",
     "level_from_reference",
+    "rests_at_end",
+    "REST_WINDOW_S",
     "VideoInfo",
     "probe_video",
     "iter_video_frames",

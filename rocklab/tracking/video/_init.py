@@ -130,6 +130,7 @@ def suggest_config(
     found: MarkerFinding | None = None,
     level_line_px=None,
     start_frame: int = 0,
+    rest_check=None,
 ) -> tuple[TrackConfig, list[str], MarkerFinding | None]:
     """A tracking config for a video from its first frame.
 
@@ -150,6 +151,12 @@ def suggest_config(
         Without a table: a horizontal line of the first frame (px) that levels the angles.
     start_frame : int
         The frame ``first_gray`` is (``[video] start_frame``: tracking starts there).
+    rest_check : callable, optional
+        ``rest_check(box) -> (bool, str)``: whether the first block, at ``box`` (x, y, w, h px), is at
+        rest at the end of the film, and what was measured
+        (:func:`~rocklab.tracking.video._level.rests_at_end`). Without a table or a level line the
+        level is ``"rest"`` when it is (or when not told), else ``"none"`` with a note: a pendulum or
+        a ball never rests, and ``"rest"`` would warn on every run of the config.
 
     Returns
     -------
@@ -181,8 +188,9 @@ def suggest_config(
         if level_line_px is not None and table_roi is None:
             level = "line"
         elif table_roi is None:
-            level = "rest"
-            notes.append(_REST_NOTE + "; a table levels instead: add --table x,y,w,h round its top edge")
+            first = next(iter(regions.values()), None) if regions else None
+            level, note = _rest_or_none(rest_check, first)
+            notes.append(note + "; a table levels instead: add --table x,y,w,h round its top edge")
         else:
             level = "table"
         if marker_size_m is None:
@@ -215,15 +223,17 @@ def suggest_config(
     notes.append(
         f"grouped as: table {table or '(none)'}; " + "; ".join(f"block_{k} {m}" for k, m in enumerate(blocks, start=1))
     )
+    level = "table"
     if not table:
-        notes.append("no table found (markers spread along the lowest row): " + _REST_NOTE)
+        level, note = _rest_or_none(rest_check, _marker_box(found, blocks[0]) if blocks else None)
+        notes.append("no table found (markers spread along the lowest row): " + note)
     if marker_size_m is None:
         notes.append("marker size unknown: x_m, y_m stay empty; set targets.marker_size_m (m)")
     cfg = TrackConfig(
         objects=tuple(objs),
         video=video,
         targets=TargetsConfig(style=style, dictionary=found.dictionary, marker_size_m=marker_size_m),
-        reference=ReferenceConfig(level="table" if table else "rest"),
+        reference=ReferenceConfig(level=level),
     )
     return cfg, notes, found
 
@@ -234,6 +244,30 @@ _REST_NOTE = (
     "ends upright; W-LEVEL-NONE when it does not come to rest in the film: then set reference.level "
     '= "line", "value" or "none")'
 )
+
+
+def _rest_or_none(rest_check, box) -> tuple[str, str]:
+    """(level, its note) without a table or a line: ``"rest"`` when the first block (at ``box``)
+    rests at the film's end by ``rest_check`` (or nothing says otherwise), else ``"none"``."""
+    if rest_check is None or box is None:
+        return "rest", _REST_NOTE
+    rests, why = rest_check(box)
+    if rests:
+        return "rest", f"{_REST_NOTE}; the first block: {why}"
+    return "none", (
+        f'level = "none": the angles are not levelled (the camera\'s roll stays in them). No table edge was '
+        f'found, and level = "rest" needs the first block at rest in view at the film\'s end (free rocking), '
+        f"but {why}: a pendulum or a ball that never rests would warn W-LEVEL-NONE on every run; to level, "
+        'add --table x,y,w,h round a horizontal edge or set reference.level = "line" with '
+        "level_line_px = [[u0, v0], [u1, v1]] on one"
+    )
+
+
+def _marker_box(found: MarkerFinding, ids) -> tuple:
+    """(x, y, w, h) px round the markers ``ids`` of ``found``."""
+    c = found.corners_px[[found.ids.index(i) for i in ids]].reshape(-1, 2)
+    lo, hi = c.min(axis=0), c.max(axis=0)
+    return (float(lo[0]), float(lo[1]), float(hi[0] - lo[0]), float(hi[1] - lo[1]))
 
 
 def _check_texture(first_gray, option: str, roi) -> None:

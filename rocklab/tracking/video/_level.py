@@ -15,7 +15,7 @@ import numpy as np
 from ..._diagnostics import warn
 from ..._errors import InputError
 
-__all__ = ["level_from_reference", "anchored", "world_angle", "final_rest"]
+__all__ = ["level_from_reference", "anchored", "world_angle", "final_rest", "rests_at_end", "REST_WINDOW_S"]
 
 
 def _robust_sem(x) -> float:
@@ -177,3 +177,102 @@ def world_angle(o, config, th, sig, fps, level, level_src, src="config"):
         "rocking ends upright); set theta0_rad if it really rests tilted",
     )
     return th - off
+
+
+#: ``level = "rest"`` needs the block still over its last second in view (:func:`final_rest`);
+#: ``track init`` looks at the film's last ``REST_WINDOW_S`` seconds for it (:func:`rests_at_end`).
+REST_WINDOW_S = 1.2
+#: Still there: at most ``REST_MOVING`` of the pixels round the object's first place (its box
+#: padded by half its larger side) change between the last frames (the noise rule of
+#: :func:`~._propose.moving_boxes`): 0 for rendered blocks at rest, 18-59 % for real pendulums and
+#: bouncing balls still moving at their films' ends.
+REST_MOVING = 0.01
+#: In place there: the middle of the first frame's box, turned by up to ``REST_TURN_DEG`` (in steps
+#: of ``REST_TURN_STEP_DEG``), is found in the last frame with a normalised correlation of at least
+#: ``REST_CC``, within ``REST_SHIFT`` of the box's larger side of its first place: a block rocks in
+#: place (rendered blocks, held tilted then at rest upright: 0.95-0.99 at 0.09-0.12 of the side; a
+#: still ball that rolled away, on real films: 0.29-0.88 at 0.42-0.96).
+REST_CC = 0.7
+REST_TURN_DEG = 20.0
+REST_TURN_STEP_DEG = 2.5
+REST_SHIFT = 0.25
+
+
+def rests_at_end(first_gray, box, end_frames) -> tuple[bool, str]:
+    """Whether the object in ``box`` (x, y, w, h px of ``first_gray``) is at rest, in view and in
+    place at the end of the film, the condition ``level = "rest"`` needs: (verdict, what was
+    measured, a clause for a note).
+
+    Still: at most :data:`REST_MOVING` of the pixels round the box change between ``end_frames``;
+    in place: its first look, turned by up to :data:`REST_TURN_DEG`, is found in the last of them
+    with a correlation of at least :data:`REST_CC`, within :data:`REST_SHIFT` of the box's larger
+    side of where it was.
+
+    Parameters
+    ----------
+    first_gray : ndarray (H, W) uint8
+        The first frame tracked.
+    box : (x, y, w, h)
+        The object there, px.
+    end_frames : sequence of ndarray (H, W) uint8
+        Frames spread over the film's last :data:`REST_WINDOW_S` seconds, in order.
+    """
+    import cv2
+
+    from ._propose import DIFF_SIGMAS, MIN_DIFF_DN, WORK_WIDTH_PX
+
+    def _prepare(g, scale):  # as the proposals see frames: at the working width, 1 px blur
+        g = g if scale == 1.0 else cv2.resize(g, None, fx=scale, fy=scale, interpolation=cv2.INTER_AREA)
+        return cv2.GaussianBlur(g.astype(np.float32), (0, 0), 1.0)
+
+    if len(end_frames) < 2:
+        return False, f"the film's last {REST_WINDOW_S:g} s could not be read"
+    scale = min(1.0, WORK_WIDTH_PX / first_gray.shape[1])
+    f0 = _prepare(first_gray, scale)
+    h_img, w_img = f0.shape
+    x, y, w, h = (int(round(v * scale)) for v in box)
+    m = max(w, h) // 2
+    u0, v0, u1, v1 = max(x - m, 0), max(y - m, 0), min(x + w + m, w_img), min(y + h + m, h_img)
+    ends = [_prepare(g, scale) for g in end_frames]
+    moving = 0.0
+    for e in ends[:-1]:
+        d = e - ends[-1]
+        d = np.abs(d - float(np.median(d)))
+        thr = max(DIFF_SIGMAS * float(np.median(d)) / 0.954, MIN_DIFF_DN)
+        moving = max(moving, float(np.mean(d[v0:v1, u0:u1] > thr)))
+    if moving > REST_MOVING:
+        return False, (
+            f"it still moves at the film's end ({100 * moving:.0f} % of the pixels round it change over the last "
+            f"{REST_WINDOW_S:g} s)"
+        )
+    cc, shift = _found_in_place(f0, ends[-1], (x, y, w, h), (u0, v0, u1, v1))
+    if cc < REST_CC or shift > REST_SHIFT * max(w, h):
+        return False, (
+            f"it is not found at rest in its place at the film's end (best match of its first look: correlation "
+            f"{cc:.2f}, {shift / scale:.0f} px away)"
+        )
+    return True, f"it is still, in its place, over the film's last {REST_WINDOW_S:g} s"
+
+
+def _found_in_place(f0, last, box, area_box) -> tuple[float, float]:
+    """(best correlation, its distance from the box's place, px) of the middle of ``box``'s content
+    in ``f0``, turned by up to :data:`REST_TURN_DEG`, searched in ``area_box`` (u0, v0, u1, v1) of
+    ``last`` (working grey)."""
+    import cv2
+
+    x, y, w, h = box
+    u0, v0, u1, v1 = area_box
+    area = last[v0:v1, u0:u1]
+    # the middle of the box: a turned box's corners hold the wall round it
+    mx, my = max(1, int(0.2 * w)), max(1, int(0.2 * h))
+    best, shift = -1.0, math.inf
+    centre = (x + w / 2.0, y + h / 2.0)
+    for deg in np.arange(-REST_TURN_DEG, REST_TURN_DEG + 1e-9, REST_TURN_STEP_DEG):
+        rot = cv2.warpAffine(f0, cv2.getRotationMatrix2D(centre, float(deg), 1.0), f0.shape[::-1])
+        tmpl = rot[y + my : y + h - my, x + mx : x + w - mx]
+        if min(tmpl.shape) < 3 or area.shape[0] < tmpl.shape[0] or area.shape[1] < tmpl.shape[1] or tmpl.std() < 1e-3:
+            continue
+        _, cc, _, at = cv2.minMaxLoc(cv2.matchTemplate(area, tmpl, cv2.TM_CCOEFF_NORMED))
+        if cc > best:
+            best, shift = float(cc), math.hypot(at[0] + u0 - x - mx, at[1] + v0 - y - my)
+    return best, shift

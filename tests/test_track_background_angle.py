@@ -243,3 +243,78 @@ def test_a_round_disc_matching_under_a_rod_that_does_not_is_told_from_a_blocks_c
                 share, share_at, _ = unmatched_turn_share(info, cc)
                 assert abs(share_at - share) < 0.1, (margin, cells, share, share_at)
                 assert share > MAX_UNMATCHED_TURN or share_at <= MAX_UNMATCHED_ABOUT_MATCHED, (margin, cells)
+
+
+def _red_knob(frame_bgr):
+    """The centroid of the red knob on the right pendulum's bracket (still in the lab: it carries
+    the hand-held camera's shake), px; the largest red blob in the film's top band above the pivot."""
+    hsv = cv2.cvtColor(frame_bgr[0:80, 300:380], cv2.COLOR_BGR2HSV)
+    m = cv2.inRange(hsv, (0, 120, 80), (10, 255, 255)) | cv2.inRange(hsv, (170, 120, 80), (180, 255, 255))
+    _, _, st, cen = cv2.connectedComponentsWithStats(m)
+    i = 1 + int(np.argmax(st[1:, cv2.CC_STAT_AREA]))
+    return cen[i] + np.array([300.0, 0.0])
+
+
+#: review 16's four boxes round the right pendulum's disc (drawn, shifted 10 %, 1.2x, 0.8x)
+KATIE_ALL_BOXES = {
+    "base": (287, 205, 46, 73),
+    "shift+10": (292, 212, 46, 73),
+    "big120": (282, 198, 55, 88),
+    "small80": (292, 212, 37, 58),
+}
+#: The pivot lies this far from the red knob, px (read by hand on frame 0 where the rod's line
+#: meets the bracket, review 16); the rod's angle is that of pivot -> yellow dot.
+KNOB_TO_PIVOT = np.array([1.0, 15.0])
+
+
+@pytest.mark.parametrize("which", sorted(KATIE_ALL_BOXES))
+def test_hand_held_pendulum_film_angle_at_its_turns_right_or_nan(tmp_path_factory, which):
+    """Every ``ok`` frame's angle over the film's first 70 frames (two left turns of the swing, where
+    the disc stands before the post's edge) against an independent reference: the rod's turn from
+    pivot (the bracket's red knob + 15 px, carrying the camera's shake) to the disc's yellow dot,
+    both colour thresholds. Before: at each left turn the fit turned the region to keep the post's
+    edge matched while the rod did not, 8-12 deg past the turn with sigma 0.5 deg (box ``base``:
+    frames 27-32 and 62-66; ``small80`` frame 32, 9 deg). Now the rotation check also runs where the
+    cells that do not match hold a quarter of the turning information (it fails frames 27 and 62),
+    and the fits that go on from a frame whose angle was no measurement, off the last angle measured,
+    report none until they come back to it or the check confirms them: those angles are NaN, and
+    every angle reported lies within max(3 sigma, 2.5 deg) of the reference (it agrees with hand
+    labels to 1.6 deg, review 16, so 2.5 deg is what it can tell apart; the errors before were 6-12)."""
+    import av
+
+    path = mirror_file(tmp_path_factory, *KATIE)
+    box = KATIE_ALL_BOXES[which]
+    n = 70
+    cfg = TrackConfig.from_dict(
+        {
+            "video": {"stop_frame": n},
+            "targets": {"style": "markerless"},
+            "reference": {"level": "none", "m_per_px": 1e-3},
+            "objects": [{"id": "p", "roi": list(box)}],
+        }
+    )
+    from rocklab.tracking import track_video
+
+    with collecting():
+        tr = track_video(path, cfg)["p"]
+    rod = []
+    with av.open(str(path)) as c:
+        for k, f in enumerate(c.decode(video=0)):
+            if k >= n:
+                break
+            img = f.to_ndarray(format="bgr24")
+            d = _yellow_dot(img, (310, 258) if not rod else rod[-1][1]) - (_red_knob(img) + KNOB_TO_PIVOT)
+            rod.append((math.atan2(d[1], d[0]), d + _red_knob(img) + KNOB_TO_PIVOT))
+    phi = np.array([a for a, _ in rod])
+    expected = -(phi - phi[0])  # ccw as seen: the image angle's change negated
+    ok = np.asarray(tr.status) == "ok"
+    th, sg = np.asarray(tr.theta_rad), np.asarray(tr.sigma_theta_rad)
+    measured = ok & np.isfinite(th)
+    err = np.abs(th - expected)
+    wrong = measured & ~(err <= np.maximum(3 * sg, math.radians(2.5)))
+    assert not wrong.any(), [
+        (k, round(math.degrees(err[k]), 1), round(math.degrees(sg[k]), 2)) for k in np.flatnonzero(wrong)
+    ]
+    # frames are kept, and the angle is kept where it is right (about the frame-0 place)
+    assert ok.mean() >= 0.7, ok.mean()
+    assert measured.sum() >= 5, measured.sum()

@@ -29,7 +29,9 @@ angle (:func:`._observability.unmatched_turn_share`: the angle was set by the re
 background in the region's corners), nor does a pose on a keyframe cut at such a frame; such a
 pose is held at the last angle measured about the point its matching cells turn about (a disk's
 centre; on such a keyframe, the point the frame it was cut at was held about), so the point
-reported does not follow the background's turn. An object
+reported does not follow the background's turn. The fits that follow such a frame off the last
+angle measured report none either (they go on along the same wrong turn) until they come back to
+it or the rotation check (:meth:`MarkerlessTracker._turn_check`) finds nothing to doubt. An object
 whose appearance tells no angle (a disk) is held upright about its centre of symmetry, reports
 that centre, and no angle (:mod:`._observability`). A round
 object (a ball) reports the place of its disk's centre: its texture slides over it as it spins, so
@@ -105,6 +107,13 @@ TURN_DIFF_RAD = math.radians(3.0)
 #: Least correlation of the best turn near the predicted angle; under it the disc's turn is
 #: looked for all round.
 MIN_TURN_SCORE = 0.5
+#: ... and also where the cells of the region that do not match the fitted pose hold at least this
+#: share of its turning information (:func:`._observability.unmatched_turn_share`, about the region's
+#: centre): part of what tells the angle disagrees with the fit.
+TURN_CHECK_SHARE = 0.25
+#: A turn found by the rotation check at least this well correlated, within :data:`TURN_DIFF_RAD`
+#: of the fitted angle, confirms that angle (it ends a branch, :meth:`MarkerlessTracker._settle`).
+TURN_CONFIRM_SCORE = REKEY_CC
 #: ECC stopping rule: 60 iterations or a correlation gain below 1e-5.
 ECC_CRITERIA = (3, 60, 1e-5)  # cv2.TERM_CRITERIA_EPS | cv2.TERM_CRITERIA_COUNT
 
@@ -227,6 +236,11 @@ class MarkerlessTracker:
         self._disc = inscribed_disc(tmpl.shape)  # the templates' inscribed disc: centre, radius, mask
         self._back: tuple = (None, None, None)  # (image, pose bytes, the last _warp_back)
         self._disc_tmpl: tuple = (None, None)  # (template, its disc's pixels normalised for _disc_cc)
+        #: the last frame's angle was not a measurement, its fit off the last angle measured by over
+        #: TURN_DIFF_RAD and not confirmed by the rotation check: the fits that follow are on its branch
+        self._off_branch = False
+        self._unmatched: tuple = (None, None, None, None)  # (image, template, (pose bytes, cc), _angle_unmatched)
+        self._turn_confirmed = False  # the rotation check found the fitted angle's turn, well correlated
         self._turn_failed = False  # this frame's fitted angle failed the rotation check (:meth:`_turn_check`)
         #: the last angle measured (first-frame px -> image px), rad: a pose whose angle is not a
         #: measurement is held at it
@@ -546,7 +560,7 @@ class MarkerlessTracker:
             W_pred = _euclid(*self.poses[-1])
         else:
             W_pred = _euclid(0.0, 0.0, 0.0)
-        self._turn_failed = False
+        self._turn_failed = self._turn_confirmed = False
         self._back = (None, None, None)  # a frame's buffer may be reused for the next frame
         fit = self._ecc(self.tmpl0, gray, W_pred, direct=len(self.poses) >= 2)
         tmpl = self.tmpl0
@@ -610,6 +624,7 @@ class MarkerlessTracker:
             self.verifier.lost_frame(gray, frame, MIN_CC)
             if self.poses:
                 self.last = self.poses[-1]
+            self._off_branch = False
             self.poses = []  # the next frame searches from the first frame's place, then the last seen
             return None
         self.verifier.confirm(gray, self.size)
@@ -642,19 +657,25 @@ class MarkerlessTracker:
 
         Run only where the disc matches the fitted pose :data:`._observability.CELL_TURN_GAP` worse
         than the whole region (a still background in the region's corners held the fit while a mark
-        on the object turned). The fit itself is kept, and so is all the tracker learns from the
-        frame: a pose refitted from the turn found changed the keyframes and the outline learned
-        (PhysTrack RollingCylinder, a 37 px region: its first outline 0.76 round instead of a round
-        one, so its angle was not known to be unmeasurable, and 253 later angles were over 5 deg
-        off). Near the fitted angle and no better there the disc agrees with the fit (the
-        development pendulum's ball, its texture changing as it spins in depth: best turn within
-        7.4 deg of the fit).
+        on the object turned), or where the cells that do not match it hold :data:`TURN_CHECK_SHARE`
+        of the turning information (the hand-held pendulum's disc before a post's edge: the rod's
+        cells unmatched, 0.45-0.50 of it, on the first frame of each wrong turn). Sets
+        :attr:`_turn_confirmed` where it finds nothing to doubt, or the fitted angle's turn within
+        :data:`TURN_DIFF_RAD` at :data:`TURN_CONFIRM_SCORE`. The fit itself is kept, and so is all
+        the tracker learns from the frame: a pose refitted from the turn found changed the keyframes
+        and the outline learned (PhysTrack RollingCylinder, a 37 px region: its first outline 0.76
+        round instead of a round one, so its angle was not known to be unmeasurable, and 253 later
+        angles were over 5 deg off). Near the fitted angle and no better there the disc agrees with
+        the fit (the development pendulum's ball, its texture changing as it spins in depth: best
+        turn within 7.4 deg of the fit).
         """
         W, cc = fitted
         disc_cc = self._disc_cc(tmpl, gray, W) if self._disc[1] >= MIN_DISC_RADIUS_PX else math.inf
-        if disc_cc > cc - CELL_TURN_GAP:
+        if disc_cc > cc - CELL_TURN_GAP and self._angle_unmatched(tmpl, gray, W, cc)[2] < TURN_CHECK_SHARE:
             # the region's disc matches the fitted pose as well as the whole region does (as a
-            # cell that matches, :data:`._observability.CELL_TURN_GAP`): nothing to doubt
+            # cell that matches, :data:`._observability.CELL_TURN_GAP`), and so do the cells that
+            # tell the angle: nothing to doubt
+            self._turn_confirmed = True
             return
         found = self._best_turn(tmpl, gray, W, W_pred)
         if found is None:
@@ -663,6 +684,7 @@ class MarkerlessTracker:
         gap = abs(math.remainder(th - _params(W)[0], 2 * math.pi))
         if gap > TURN_SEARCH_RAD or (best - s_fit >= TURN_SCORE_GAP and gap >= TURN_DIFF_RAD):
             self._turn_failed = True
+        self._turn_confirmed = gap < TURN_DIFF_RAD and best >= TURN_CONFIRM_SCORE
 
     def _rings_of(self, tmpl) -> PolarRings:
         """``tmpl``'s :class:`PolarRings` (kept for the last template)."""
@@ -723,6 +745,17 @@ class MarkerlessTracker:
             why = "keyframe"
         if why is None and self._turn_failed:
             why = "turn"  # the inscribed disc's best turn is far from the fitted angle
+        off = mask is None and abs(math.remainder(_params(W)[0] - self.theta_hold, 2 * math.pi)) > TURN_DIFF_RAD
+        if why is None and self._off_branch and off and not self._turn_confirmed:
+            # the fit goes on from a frame whose angle was no measurement and was off the last one
+            # measured: it is on that frame's branch (a still background's turn), not back on the
+            # object's, until it comes back within TURN_DIFF_RAD of that angle or the rotation check
+            # confirms it (the hand-held pendulum's left turns: 8-12 deg past, sigma 0.5 deg, on the
+            # 4 frames after the one the check failed; the check, its disc holding the post's edge
+            # too, scored their wrong turns best)
+            why = "branch"
+        if mask is None:
+            self._off_branch = off and why is not None and not self._turn_confirmed
         if why == "keyframe" and self.key_at is not None:
             # registered on a keyframe cut where the angle was no measurement: the keyframe's own
             # cells turn about a point of that wrong view, not the object's; the point the cut frame
@@ -796,6 +829,16 @@ class MarkerlessTracker:
         from the template's centre, :func:`._observability.turn_information`), where the pose is
         held when the angle is not a measurement; ``share`` the unmatched share (its σ is that of
         the rest: divided by ``sqrt(1 - share)``)."""
+        key = (W.tobytes(), cc)
+        m = self._unmatched
+        if m[0] is gray and m[1] is tmpl and m[2] == key:  # the rotation check's, then _settle's
+            return m[3]
+        out = self._unmatched_of(tmpl, gray, W, cc)
+        self._unmatched = (gray, tmpl, key, out)
+        return out
+
+    def _unmatched_of(self, tmpl, gray, W, cc):
+        """:meth:`_angle_unmatched` computed."""
         if self._turn_info[0] is not tmpl:
             self._turn_info = (tmpl, cell_turn_info(tmpl, GRID))
         back = self._warp_back(gray, W)

@@ -294,7 +294,9 @@ def warn_unmatched_angles(config, detector) -> None:
                 f"% of its turning information (over {100 * MAX_UNMATCHED_ABOUT_MATCHED:.0f} % about the point the "
                 "rest turns about) do not match the fitted pose as the rest of the region does "
                 f"(their correlation more than {CELL_TURN_GAP:g} under the median cell's), or it was "
-                "registered on a keyframe cut from such a frame; theta_rad is NaN on those frames, "
+                "registered on a keyframe cut from such a frame, or its inscribed disc turned best "
+                "elsewhere, or the fit went on from such a frame off the last angle measured; "
+                "theta_rad is NaN on those frames, "
                 "x and y are tracked; draw the region round the object alone (no background or "
                 "other object in its corners)",
             )

@@ -51,10 +51,12 @@ from ._observability import (
     CELL_TURN_GAP,
     MAX_UNMATCHED_ABOUT_MATCHED,
     MAX_UNMATCHED_TURN,
+    MIN_TURN_SHARE,
     cell_turn_info,
     sigma_theta,
     theta_unobservable,
     unmatched_turn_share,
+    unshaded_turn_share,
 )
 from ._occlusion import CELL_CC, GRID, ROUND_MIN, cell_correlations, masked_fit, partly_covered
 from ._turn_search import MIN_DISC_RADIUS_PX, PolarRings, inscribed_disc
@@ -217,6 +219,7 @@ class MarkerlessTracker:
         self.verifier.fb.keyframe(self, first_gray, _euclid(0.0, 0.0, 0.0))
         #: why the angle is not reported although the texture gives one (a round outline), or None
         self.round_note = None
+        self._shading_checked = False  # the first disk's texture was weighed against its shading
         self.views = [0, 0]  # verified frames, and those not a turned copy of the first view
         self.reason = None  # why the last frame was lost ("mismatch", "jump", "background", "twin", "lost")
         self.min_cc = MIN_CC
@@ -470,6 +473,20 @@ class MarkerlessTracker:
         out = self.verifier.outline
         if self.round_note is not None or self.theta_note is not None or out is None or out.roundness < ROUND_MIN:
             return
+        if out.disk0 is not None and not self._shading_checked:
+            # once, from the first frame's disk: a plain ball's dark and lit sides are the light's,
+            # and a turn of them tells no angle (checked before any count of frames: a ball thrown
+            # through the picture may be seen on a few frames only)
+            self._shading_checked = True
+            share = unshaded_turn_share(self.tmpl0, np.asarray(out.disk0[0], float) - self.origin, float(out.disk0[1]))
+            if not share >= MIN_TURN_SHARE:
+                self.round_note = (
+                    f"its outline is round (circularity {out.roundness:.2f}), so its angle would come from "
+                    f"its texture alone, and once a lit ball's shading is taken out its texture holds "
+                    f"{100 * share:.2g} % of its region's turning information (under {100 * MIN_TURN_SHARE:.3g} %: "
+                    "plain, or its marks too blurred or small)"
+                )
+                return
         n, other = self.views
         if n >= ROUND_MIN_FRAMES and other >= OTHER_VIEW_SHARE * n:
             self.round_note = (

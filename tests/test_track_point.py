@@ -259,7 +259,7 @@ def _lit_ball_film(seed=0, blur_px=2.5):
 def test_a_plain_lit_ball_has_no_angle(grow, shift):
     """Its shading turns 8 % of the region's gradients (over MIN_TURN_SHARE), so the
     registration gave an angle: about 0 while the ball turned with the swing, more than 3 sigma off
-    it on 82 of 90 frames. Once its round outline is known, the shading a lit sphere can show (nine
+    it on 80-82 of 90 frames (3 boxes, main). Once its round outline is known, the shading a lit sphere can show (nine
     spherical harmonics) is taken out and under 1 % is left: W-TRACK-THETA, theta NaN, and the
     position still within 0.5 px of the truth."""
     from rocklab.tracking.video.targets._observability import unshaded_turn_share

@@ -222,6 +222,9 @@ class MarkerlessTracker:
         #: why the angle is not reported although the texture gives one (a round outline), or None
         self.round_note = None
         self._shading_checked = False  # the first disk's texture was weighed against its shading
+        #: (why, frame found) while a round object's texture, its shading taken out, tells no angle
+        #: and it has been verified on fewer than ROUND_MIN_FRAMES frames; else None
+        self.shading_note = None
         self.views = [0, 0]  # verified frames, and those not a turned copy of the first view
         self.reason = None  # why the last frame was lost ("mismatch", "jump", "background", "twin", "lost")
         self.min_cc = MIN_CC
@@ -465,7 +468,7 @@ class MarkerlessTracker:
                     return alt
         return None
 
-    def _round_check(self, first_view):
+    def _round_check(self, first_view, frame):
         """Sets :attr:`round_note` once the outline is known to be round and the region is no
         longer a turned copy of its first view on :data:`OTHER_VIEW_SHARE` of the verified frames
         (a ball spinning in depth; also a rolling disk whose region holds a background that does not
@@ -477,19 +480,23 @@ class MarkerlessTracker:
             return
         if out.disk0 is not None and not self._shading_checked:
             # once, from the first frame's disk: a plain ball's dark and lit sides are the light's,
-            # and a turn of them tells no angle (checked before any count of frames: a ball thrown
-            # through the picture may be seen on a few frames only)
+            # and a turn of them tells no angle
             self._shading_checked = True
             share = unshaded_turn_share(self.tmpl0, np.asarray(out.disk0[0], float) - self.origin, float(out.disk0[1]))
             if not share >= MIN_TURN_SHARE:
-                self.round_note = (
+                self.shading_note = (
                     f"its outline is round (circularity {out.roundness:.2f}), so its angle would come from "
-                    f"its texture alone, and once a lit ball's shading is taken out its texture holds "
-                    f"{100 * share:.2g} % of its region's turning information (under {100 * MIN_TURN_SHARE:.3g} %: "
-                    "plain, or its marks too blurred or small)"
+                    f"its texture alone; once a lit ball's shading is taken out its texture holds "
+                    f"{100 * share:.2g} % of its region's turning information (under {100 * MIN_TURN_SHARE:.3g} %), "
+                    f"and it was verified on fewer than {ROUND_MIN_FRAMES} frames, too few for its views to tell "
+                    "whether its texture turns with it",
+                    frame,
                 )
-                return
         n, other = self.views
+        if n >= ROUND_MIN_FRAMES:
+            # its views judge from here on: a small mark (an ornament's cap) tells the angle though
+            # the share is low, and a ball spinning in depth is found by its views
+            self.shading_note = None
         if n >= ROUND_MIN_FRAMES and other >= OTHER_VIEW_SHARE * n:
             self.round_note = (
                 f"its outline is round (circularity {out.roundness:.2f}), so its angle would come from "
@@ -632,7 +639,7 @@ class MarkerlessTracker:
             self.poses = []  # the next frame searches from the first frame's place, then the last seen
             return None
         self.verifier.confirm(gray, self.size)
-        self._round_check(first_view)
+        self._round_check(first_view, frame)
         (W, cc), mask, visible, why, sig, W_pts = self._settle(tmpl, gray, fit, mask, visible)
         W_pts = self._upright_disk(W, W_pts)
         self.poses = (self.poses + [self._centred(W)])[-2:]
@@ -869,6 +876,13 @@ class MarkerlessDetector:
         region, or once its outline is known, a round outline), or None."""
         t = self.trackers.get(oid)
         return None if t is None else t.theta_note or t.round_note
+
+    def theta_pending(self, oid):
+        """``(why, frame)`` while object ``oid``'s angle is held for a verdict (a round object whose
+        texture, its shading taken out, tells none, verified on too few frames for its views to
+        judge), or None: if the film ends so, no frame's angle is reported."""
+        t = self.trackers.get(oid)
+        return None if t is None or t.theta_note or t.round_note else t.shading_note
 
     def theta_unmatched(self, oid):
         """(frames verified, frames among them whose angle was not a measurement) of object ``oid``."""

@@ -33,7 +33,8 @@ reported does not follow the background's turn. An object
 whose appearance tells no angle (a disk) is held upright about its centre of symmetry, reports
 that centre, and no angle (:mod:`._observability`); so is a round object whose texture, once a lit
 sphere's shading is taken out, tells none (:func:`._observability.unshaded_turn_share`: a plain
-ball's dark and lit sides stay with the light). A round
+ball's dark and lit sides stay with the light) when the film ends before its views can judge it
+(:attr:`MarkerlessTracker.shading_note`, ``theta_pending``). A round
 object (a ball) reports the place of its disk's centre: its texture slides over it as it spins, so
 its points are moved to within :data:`DISK_AGREE_FRAC` of where the outline puts that centre; once
 its angle is known not to be reported (a round outline), its points come from the pose turned back

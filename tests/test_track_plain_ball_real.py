@@ -9,7 +9,8 @@ shows how it turns but a faint seam on 50-53 that the first view (frame 16, the 
 does not hold. The angle rule passed it (the shading turns 6.7 % of the region's gradients, over
 the 5 % a turn needs), and the track gave theta 0 to 17.5 deg on its `ok` frames with no
 W-TRACK-THETA. Once its round outline is known the shading a lit sphere can show is taken out:
-1.6-1.9 % is left, theta is NaN with the reason, and the ball is still placed. Independent
+1.6-1.9 % is left, and the film ends before its 30th verified frame (6 here), too soon for its views
+to judge: theta is NaN with the reason, and the ball is still placed. Independent
 reference for the place (the session-18 review kit's ``reference.py``, checked by hand on frames
 16, 48, 52 and 53 to 1.2 px): the centroid of the largest red blob (HSV hue 0-12 or 165-180,
 saturation >= 70, value >= 40, opened by a 5 px ellipse), where it covers >= 900 px (smaller

@@ -191,7 +191,8 @@ WARNING_CODES: dict[str, tuple[str, str]] = {
         "suspect",
         "a block's appearance does not change when it turns (a disk, a plain ball, a region with "
         "no edge or mark off its centre), or its outline is round and its region no longer matches "
-        "a turned copy of its first view: its angle is not measured; theta_rad is NaN and x, y "
+        "a turned copy of its first view or, its shading taken out, its texture tells no angle and it "
+        "is seen too briefly to judge its views (a plain lit ball thrown through): its angle is not measured; theta_rad is NaN and x, y "
         'are tracked (for an appearance that tells no angle: its centre of symmetry). Set kind = "point" for a position '
         "only, or redraw the region",
     ),

@@ -13,7 +13,7 @@ from __future__ import annotations
 import collections
 import math
 import os
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -113,6 +113,11 @@ class Observation:
 def track_frames(frames, config: TrackConfig, plane_map: PlaneMap | None = None):
     """Track every configured object through a stream of frames.
 
+    A frame's observations are held back while an object's angle awaits a verdict (the detector's
+    ``theta_pending``: a round object whose texture, its shading taken out, tells no angle, seen on
+    too few frames yet for its views to judge); if the film ends so, the held frames carry no
+    angle for it, which drops its angle on every frame (:func:`_object_series`), with W-TRACK-THETA.
+
     Parameters
     ----------
     frames : iterable of (index, gray) or of gray images
@@ -125,6 +130,38 @@ def track_frames(frames, config: TrackConfig, plane_map: PlaneMap | None = None)
     ------
     list of Observation
         One per object (config order) for each frame.
+    """
+    held: list = []
+    det = None
+    for obs, det in _observed(frames, config, plane_map):
+        if _pending_angles(config, det):
+            held.append(obs)
+            continue
+        yield from held
+        held = []
+        yield obs
+    pending = _pending_angles(config, det)
+    for oid, (why, frame) in pending.items():
+        warn_theta(config, oid, why, frame)
+    for obs in held:
+        yield [replace(o, theta_rad=math.nan, sigma_theta_rad=math.nan) if o.object in pending else o for o in obs]
+
+
+def _pending_angles(config, det) -> dict:
+    """Object id -> (why, frame) of the objects whose angle awaits a verdict (``theta_pending``)."""
+    if det is None or not hasattr(det, "theta_pending"):
+        return {}
+    return {o.id: p for o in config.objects if (p := det.theta_pending(o.id)) is not None}
+
+
+def _observed(frames, config: TrackConfig, plane_map: PlaneMap | None = None):
+    """:func:`track_frames`' work, frame by frame (same parameters).
+
+    Yields
+    ------
+    (list of Observation, detector)
+        One observation per object (config order) for each frame, and the detector (its state
+        after the frame).
     """
     det = None
     min_q = config.targets.min_quality
@@ -215,7 +252,7 @@ def track_frames(frames, config: TrackConfig, plane_map: PlaneMap | None = None)
                 elif o.id in boxes and not cut:  # a cut shows another scene: only "lost" is true
                     status = lost_status(gray, boxes[o.id], sharp_ref.get(o.id), rings[o.id], seen[o.id], idx)
                 obs.append(Observation(idx, o.id, *(np.nan,) * 7, status, getattr(d, "metric", True), plane_map.source))
-        yield obs
+        yield obs, det
     check_cuts(steps, cuts, indices, config.source or "the film")
     warn_unmatched_angles(config, det)
 

@@ -33,7 +33,10 @@ reported does not follow the background's turn. The fits that follow such a fram
 angle measured report none either (they go on along the same wrong turn) until they come back to
 it or the rotation check (:meth:`MarkerlessTracker._turn_check`) finds nothing to doubt. An object
 whose appearance tells no angle (a disk) is held upright about its centre of symmetry, reports
-that centre, and no angle (:mod:`._observability`). A round
+that centre, and no angle (:mod:`._observability`); so is a round object whose texture, once a lit
+sphere's shading is taken out, tells none (:func:`._observability.unshaded_turn_share`: a plain
+ball's dark and lit sides stay with the light) when the film ends before its views can judge it
+(:attr:`MarkerlessTracker.shading_note`, ``theta_pending``). A round
 object (a ball) reports the place of its disk's centre: its texture slides over it as it spins, so
 its points are moved to within :data:`DISK_AGREE_FRAC` of where the outline puts that centre; once
 its angle is known not to be reported (a round outline), its points come from the pose turned back
@@ -53,10 +56,12 @@ from ._observability import (
     CELL_TURN_GAP,
     MAX_UNMATCHED_ABOUT_MATCHED,
     MAX_UNMATCHED_TURN,
+    MIN_TURN_SHARE,
     cell_turn_info,
     sigma_theta,
     theta_unobservable,
     unmatched_turn_share,
+    unshaded_turn_share,
 )
 from ._occlusion import CELL_CC, GRID, ROUND_MIN, cell_correlations, masked_fit, partly_covered
 from ._turn_search import MIN_DISC_RADIUS_PX, PolarRings, inscribed_disc
@@ -226,6 +231,10 @@ class MarkerlessTracker:
         self.verifier.fb.keyframe(self, first_gray, _euclid(0.0, 0.0, 0.0))
         #: why the angle is not reported although the texture gives one (a round outline), or None
         self.round_note = None
+        self._shading_checked = False  # the first disk's texture was weighed against its shading
+        #: (why, frame found) while a round object's texture, its shading taken out, tells no angle
+        #: and it has been verified on fewer than ROUND_MIN_FRAMES frames; else None
+        self.shading_note = None
         self.views = [0, 0]  # verified frames, and those not a turned copy of the first view
         self.reason = None  # why the last frame was lost ("mismatch", "jump", "background", "twin", "lost")
         self.min_cc = MIN_CC
@@ -474,7 +483,7 @@ class MarkerlessTracker:
                     return alt
         return None
 
-    def _round_check(self, first_view):
+    def _round_check(self, first_view, frame):
         """Sets :attr:`round_note` once the outline is known to be round and the region is no
         longer a turned copy of its first view on :data:`OTHER_VIEW_SHARE` of the verified frames
         (a ball spinning in depth; also a rolling disk whose region holds a background that does not
@@ -484,7 +493,25 @@ class MarkerlessTracker:
         out = self.verifier.outline
         if self.round_note is not None or self.theta_note is not None or out is None or out.roundness < ROUND_MIN:
             return
+        if out.disk0 is not None and not self._shading_checked:
+            # once, from the first frame's disk: a plain ball's dark and lit sides are the light's,
+            # and a turn of them tells no angle
+            self._shading_checked = True
+            share = unshaded_turn_share(self.tmpl0, np.asarray(out.disk0[0], float) - self.origin, float(out.disk0[1]))
+            if not share >= MIN_TURN_SHARE:
+                self.shading_note = (
+                    f"its outline is round (circularity {out.roundness:.2f}), so its angle would come from "
+                    f"its texture alone; once a lit ball's shading is taken out its texture holds "
+                    f"{100 * share:.2g} % of its region's turning information (under {100 * MIN_TURN_SHARE:.3g} %), "
+                    f"and it was verified on fewer than {ROUND_MIN_FRAMES} frames, too few for its views to tell "
+                    "whether its texture turns with it",
+                    frame,
+                )
         n, other = self.views
+        if n >= ROUND_MIN_FRAMES:
+            # its views judge from here on: a small mark (an ornament's cap) tells the angle though
+            # the share is low, and a ball spinning in depth is found by its views
+            self.shading_note = None
         if n >= ROUND_MIN_FRAMES and other >= OTHER_VIEW_SHARE * n:
             self.round_note = (
                 f"its outline is round (circularity {out.roundness:.2f}), so its angle would come from "
@@ -628,7 +655,7 @@ class MarkerlessTracker:
             self.poses = []  # the next frame searches from the first frame's place, then the last seen
             return None
         self.verifier.confirm(gray, self.size)
-        self._round_check(first_view)
+        self._round_check(first_view, frame)
         (W, cc), mask, visible, why, sig, W_pts = self._settle(tmpl, gray, fit, mask, visible)
         W_pts = self._upright_disk(W, W_pts)
         self.poses = (self.poses + [self._centred(W)])[-2:]
@@ -893,6 +920,13 @@ class MarkerlessDetector:
         region, or once its outline is known, a round outline), or None."""
         t = self.trackers.get(oid)
         return None if t is None else t.theta_note or t.round_note
+
+    def theta_pending(self, oid):
+        """``(why, frame)`` while object ``oid``'s angle is held for a verdict (a round object whose
+        texture, its shading taken out, tells none, verified on too few frames for its views to
+        judge), or None: if the film ends so, no frame's angle is reported."""
+        t = self.trackers.get(oid)
+        return None if t is None or t.theta_note or t.round_note else t.shading_note
 
     def theta_unmatched(self, oid):
         """(frames verified, frames among them whose angle was not a measurement) of object ``oid``."""

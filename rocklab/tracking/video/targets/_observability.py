@@ -21,6 +21,7 @@ __all__ = [
     "turn_share",
     "symmetry_centre",
     "theta_unobservable",
+    "unshaded_turn_share",
     "angle_free_objects",
     "angle_note",
     "warn_theta",
@@ -67,6 +68,11 @@ MAX_UNMATCHED_TURN = 0.5
 #: angle 10-43 deg off with 0.5-2.4 deg sigma where the share about the centre was 0.45-0.48). The
 #: bound lies between: two thirds, the unmatched part twice the matching part's.
 MAX_UNMATCHED_ABOUT_MATCHED = 2.0 / 3.0
+#: Inside a round object's disk, out to this fraction of its radius, its grey levels are split into
+#: a lit sphere's shading and the texture on it; from there to :data:`RIM_OUTER` the outline, blurred
+#: by the optics and the motion, whose change of contrast along it is shading as well.
+RIM_INNER = 0.8
+RIM_OUTER = 1.2
 POINT_NOTE = 'kind = "point": a position only'
 UNOBSERVABLE_NOTE = "its appearance tells no angle (W-TRACK-THETA)"
 
@@ -242,6 +248,61 @@ def theta_unobservable(region):
             f"{100 * share:.3g} %, under {100 * MIN_TURN_SHARE:.3g} %: symmetric or textureless)"
         ), c
     return None, None
+
+
+def _sphere_shading_basis(u, v):
+    """The nine real spherical harmonics up to second order of a sphere's normal seen at ``(u, v)``
+    (image offsets from its centre over its radius): the shading of a convex Lambertian object under
+    any distant lighting lies within 1-2 % of their span (Basri & Jacobs 2003, IEEE PAMI 25(2);
+    Ramamoorthi & Hanrahan 2001, JOSA A 18(10)), and it stays with the light, not with the object."""
+    z = np.sqrt(np.clip(1.0 - u * u - v * v, 0.0, None))
+    return [np.ones_like(u), u, v, z, u * v, u * z, v * z, u * u - v * v, 3.0 * z * z - 1.0]
+
+
+def unshaded_turn_share(region, centre, radius: float) -> float:
+    """The share of ``region``'s gradient information that a turn about a round object's disk
+    (``centre``, px from pixel (0, 0), (2,); ``radius``, px) moves, once the disk's shading is taken
+    out: :func:`turn_share` about the disk's centre with the tangential part of the gradients of the
+    disk's interior (to :data:`RIM_INNER` of the radius) taken from the grey levels less their
+    least-squares fit by a lit sphere's shading (:func:`_sphere_shading_basis`), and none from its
+    blurred outline (:data:`RIM_INNER` to :data:`RIM_OUTER`). A plain ball's dark and lit sides turn
+    no gradient with the ball: what is left is its marks, and what lies off the disk (a string).
+
+    Returns
+    -------
+    float
+        0 to about 0.5; NaN for a flat region or a disk with too few pixels inside.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> yy, xx = np.mgrid[0:81, 0:81].astype(float)
+    >>> u, v = (xx - 40) / 30, (yy - 40) / 30
+    >>> lit = np.clip(0.6 * np.sqrt(np.clip(1 - u * u - v * v, 0, None)) - 0.8 * u, 0, None)
+    >>> ball = np.where(u * u + v * v < 1, 40 + 180 * lit, 150.0)  # lit from the left
+    >>> round(turn_share(ball, (40, 40)), 3), round(unshaded_turn_share(ball, (40, 40), 30.0), 3)
+    (0.042, 0.001)
+    >>> ball[36:44, 22:58] -= 60.0  # a dark band across it
+    >>> round(unshaded_turn_share(ball, (40, 40), 30.0), 3)
+    0.02
+    """
+    x, y, gx, gy = _gradients(region)
+    if float(np.max(np.hypot(gx, gy))) < FLAT_GRADIENT:
+        return float("nan")
+    dx, dy = x - float(centre[0]), y - float(centre[1])
+    r = np.hypot(dx, dy)
+    inside = r < RIM_INNER * radius
+    basis = _sphere_shading_basis(dx / radius, dy / radius)
+    if int(inside.sum()) < 4 * len(basis):
+        return float("nan")
+    t = np.asarray(region, float)
+    coef, *_ = np.linalg.lstsq(np.stack([b[inside] for b in basis], 1), t[inside], rcond=None)
+    shading = sum(c * b for c, b in zip(coef, basis))
+    _, _, sx, sy = _gradients(shading)
+    tangential = np.where(inside, dx * (gy - sy) - dy * (gx - sx), dx * gy - dy * gx) ** 2
+    tangential[(r >= RIM_INNER * radius) & (r <= RIM_OUTER * radius)] = 0.0
+    total = float(np.sum((dx * gy - dy * gx) ** 2 + (dx * gx + dy * gy) ** 2))
+    return float(tangential.sum() / total)
 
 
 def angle_free_objects(config, detector) -> dict:

@@ -16,10 +16,11 @@ and, for the outline, its own first frame:
   frame after a verified one, while cold, it must still match that first view or its smear at
   :data:`COLD_STEP_CC` (a ball let go from the fingers drawn into its region leaves the keyframe
   on the fingers, renewed there, with nothing learned to refuse them). Once the limits are
-  learned, the same two rules hold a pose whose keyframe correlation is below
-  :data:`COLD_FIRST_CC` as far as the object's own verified views of its first one allow
-  (:meth:`PoseVerifier.view_limit`): a ball held still for longer than the warm-up taught a floor
-  that passes the fingers, but never strayed from its first view. So must, at
+  learned, a pose whose keyframe correlation is below :data:`COLD_FIRST_CC` must match the first
+  view (or its smear) as closely as the object's own verified frames did
+  (:meth:`PoseVerifier.view_limit`), at most at :data:`COLD_FIRST_CC`: a ball held still for
+  longer than the warm-up taught a floor that passes the fingers, but never strayed from its
+  first view. So must, at
   any time, a pose found after lost frames (or after a slide) farther than the template's larger
   side both from the last verified pose and from where its velocity carries it: the motion
   vouches for nothing there, and a small ball's keyframe half matches a forearm or an edge;
@@ -586,11 +587,12 @@ class PoseVerifier:
         # keeps the keyframe at 0.95 while its first view drops to 0.70, and refused there it
         # would stay lost behind the rule for poses found after lost frames
         step = warming and gap == 1 and bool(self.recent) and score < COLD_FIRST_CC
-        # once warm, the same two rules, as far as the object's own verified views of its first one
-        # allow (:meth:`view_limit`): the limits learned from a ball held in the fingers drawn into
-        # its region, matching its first view at 0.97-1.0, pass the fingers at 0.78 once it is let
-        # go (the floor is its median less :data:`APPEARANCE_MADS` times :data:`MIN_DEVIATION`,
-        # 0.69); an object verified in other views (a ball spinning, blurred) has taught a lower one
+        # once warm, a first view as close as the object's own verified views of it allow
+        # (:meth:`view_limit`), at most :data:`COLD_FIRST_CC`: the limits learned from a ball held
+        # in the fingers drawn into its region, matching its first view at 0.97-1.0, pass the
+        # fingers at 0.78 once it is let go (the floor is its median less :data:`APPEARANCE_MADS`
+        # times :data:`MIN_DEVIATION`, 0.69), and the fingers match the first view at 0.48-0.85;
+        # an object verified in other views (a ball spinning, blurred) has taught a lower limit
         kept = not warming and score < COLD_FIRST_CC and len(self.views) >= WARMUP_FRAMES
         if cold or far or step or kept:
             now = tr._warp_back(gray, W)
@@ -599,7 +601,7 @@ class PoseVerifier:
             views = self._smeared(tr.tmpl0, W) if (cold or step or kept) and not far else [tr.tmpl0]
             need = COLD_STEP_CC if step and not far else COLD_FIRST_CC
             if kept and not (cold or far or step):
-                need = min(COLD_STEP_CC if gap == 1 else COLD_FIRST_CC, self.view_limit())
+                need = min(COLD_FIRST_CC, self.view_limit())
             if now is None or max(_ncc(now, v) for v in views) < need:
                 return "mismatch"
         half = 0.5 * math.hypot(*self.size) + self.margin

@@ -49,6 +49,8 @@ __all__ = [
     "roundness",
     "disk",
     "stable_disk",
+    "SeenDisk",
+    "edge_circle",
     "warp_grown",
     "pair",
     "subpixel_peak",
@@ -529,6 +531,117 @@ class OutlineRef:
         """Whether a :meth:`locate` result says the pose has left the object."""
         slide, cc, _ = found
         return slide > DRIFT_FRAC * max(self.size) or cc < MIN_SIL_CC
+
+
+#: Verified frames looked at for the object's disk as the tracked frames show it (:class:`SeenDisk`):
+#: this many in a row must show one round blob for the disk to be learned from them ...
+SEEN_DISK_FRAMES = 10
+#: ... of one radius (each within this fraction of their median) ...
+SEEN_DISK_RADIUS = 0.05
+#: ... at one place on the object under the pose (each within this fraction of the radius of
+#: their median); and it is looked for on at most this many verified frames (a block's outline is
+#: never round: the look costs a few morphology passes a frame).
+SEEN_DISK_PLACE = 0.1
+SEEN_DISK_LOOKS = 90
+
+
+#: The circle of a disk's edge (:func:`edge_circle`) is looked for with radii from this fraction of
+#: its blob's enclosing circle's to a little over it: a shadow or a rim joined to the blob only
+#: enlarges its enclosing circle (the development film's disc: 19.5 px blob, 15.2 px edge).
+EDGE_RADIUS_RANGE = (0.6, 1.05)
+
+
+def edge_circle(img, near, r_blob):
+    """The circle of the strongest round edge of ``img`` (float32 grey, h x w) within half of
+    ``r_blob`` of ``near`` (x, y px), its radius within :data:`EDGE_RADIUS_RANGE` of ``r_blob``
+    (OpenCV's gradient Hough transform, the variant that scores each circle's completeness):
+    centre (2,) px and radius px, or None. A disk's edge against its background places it where
+    the blob standing out of the background does not: a soft shadow, or a hand holding it, joins
+    the blob and not the edge."""
+    import cv2
+
+    u8 = np.clip(img, 0, 255).astype(np.uint8)
+    lo, hi = (int(math.floor(k * r_blob)) for k in EDGE_RADIUS_RANGE)
+    if lo < 3:
+        return None
+    found = cv2.HoughCircles(
+        cv2.GaussianBlur(u8, (0, 0), 1.0), cv2.HOUGH_GRADIENT_ALT, 1, r_blob, param1=300, param2=0.7,
+        minRadius=lo, maxRadius=hi + 1,
+    )
+    if found is None:
+        return None
+    for x, y, r in found[0]:  # strongest first
+        if math.hypot(x - near[0], y - near[1]) <= 0.5 * r_blob:
+            return np.array([x, y], float), float(r)
+    return None
+
+
+class SeenDisk:
+    """An object's disk as its own verified frames show it, where its first frame did not.
+
+    The first frame may show a round object joined by what held it (a hand at the edge of a disc
+    about to roll: a blob of radius 19.9 px for a 16 px disc, its centre 3 px towards the hand),
+    or not round at all. Once :data:`SEEN_DISK_FRAMES` verified frames in a row show one round
+    blob (circularity at least :data:`ROUND_MIN`, :func:`stable_disk`) of one radius at one place
+    under the pose (first-frame px), that is the object's disk: its place under the pose is where
+    the first frame would have shown it alone. A blob that slides under the pose (a spinning
+    ball's texture carries the pose) or changes size (a hand, a shadow) teaches nothing.
+
+    Attributes
+    ----------
+    disk : tuple or None
+        ``(centre (2,) first-frame px, radius px, circularity)`` once learned.
+    """
+
+    def __init__(self):
+        self.disk = None
+        self.looks = 0
+        self._run: list = []
+
+    @property
+    def done(self) -> bool:
+        """Nothing more to look for: learned, or looked for on :data:`SEEN_DISK_LOOKS` frames."""
+        return self.disk is not None or self.looks >= SEEN_DISK_LOOKS
+
+    def look(self, tr, grown, margin2):
+        """The round blob in ``grown`` (frame and background resampled by the pose onto the
+        template's grid grown by ``margin2`` px, :func:`pair`): ``(centre first-frame px under the
+        pose, radius px, circularity)``, or None when it is not round."""
+        f = min(1.0, DISK_SIDE_PX / max(grown.shape[:2]))
+        if f < 1.0:
+            grown = _reduce(grown, f)
+        d = stable_disk(grown[..., 0], grown[..., 1])
+        if d is None or d[2] < ROUND_MIN:
+            return None
+        c = edge_circle(grown[..., 0], d[0], d[1])
+        if c is None:
+            return None
+        return c[0] / f - margin2 + tr.origin, c[1] / f, d[2]
+
+    def add(self, seen) -> bool:
+        """Count one verified frame's :meth:`look` (None: not round); True when the disk is
+        learned with it."""
+        self.looks += 1
+        self._run = [] if seen is None else (self._run + [seen])[-SEEN_DISK_FRAMES:]
+        if len(self._run) < SEEN_DISK_FRAMES:
+            return False
+        c = np.array([s[0] for s in self._run])
+        r = np.array([s[1] for s in self._run])
+        cm, rm = np.median(c, axis=0), float(np.median(r))
+        if np.all(np.abs(r - rm) <= SEEN_DISK_RADIUS * rm) and np.all(np.hypot(*(c - cm).T) <= SEEN_DISK_PLACE * rm):
+            self.disk = (cm, rm, float(np.median([s[2] for s in self._run])))
+            return True
+        return False
+
+    def teach(self, ref) -> None:
+        """Give the learned disk to the outline ``ref`` (an :class:`OutlineRef`) where its first
+        frame's disk is missing or of another size (:data:`DISK_RADIUS_TOL`)."""
+        if self.disk is None or ref is None:
+            return
+        c, r, circ = self.disk
+        if ref.disk0 is None or abs(ref.disk0[1] - r) > DISK_RADIUS_TOL * r:
+            ref.disk0 = (c, r)
+            ref.roundness = max(ref.roundness, circ) if math.isfinite(ref.roundness) else circ
 
 
 def _reduce(img, f):

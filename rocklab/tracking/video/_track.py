@@ -110,7 +110,7 @@ class Observation:
     angle_dropped: bool = False
 
 
-def track_frames(frames, config: TrackConfig, plane_map: PlaneMap | None = None):
+def track_frames(frames, config: TrackConfig, plane_map: PlaneMap | None = None, levers: dict | None = None):
     """Track every configured object through a stream of frames.
 
     Parameters
@@ -120,6 +120,10 @@ def track_frames(frames, config: TrackConfig, plane_map: PlaneMap | None = None)
     config : TrackConfig
     plane_map : PlaneMap, optional
         Default: built from ``config`` and the first frame.
+    levers : dict, optional
+        Filled once the frames are all tracked: object id -> its disk's lever for
+        :func:`assemble_tracks` (objects whose angle was found unmeasurable on the way, a round
+        outline: the frames before report the point the texture's angle turned).
 
     Yields
     ------
@@ -218,6 +222,8 @@ def track_frames(frames, config: TrackConfig, plane_map: PlaneMap | None = None)
         yield obs
     check_cuts(steps, cuts, indices, config.source or "the film")
     warn_unmatched_angles(config, det)
+    if levers is not None and hasattr(det, "disk_lever"):
+        levers.update({o.id: lv for o in config.objects if (lv := det.disk_lever(o.id)) is not None})
 
 
 @dataclass(frozen=True)
@@ -430,6 +436,7 @@ def assemble_tracks(
     plane_map: PlaneMap | None = None,
     source=None,
     frame_times_s=None,
+    levers: dict | None = None,
 ) -> TrackResult:
     """Convert per-frame observations (plane units) into a :class:`TrackResult` (m, levelled rad).
 
@@ -441,6 +448,8 @@ def assemble_tracks(
         Frame rate; ``t_s = frame / fps`` unless ``frame_times_s`` is given.
     frame_times_s : ndarray, optional
         Each frame's own time from the container, s (indexed by frame number).
+    levers : dict, optional
+        As filled by :func:`track_frames` (read once ``observations`` are consumed).
     """
     rows = [o for frame_obs in observations for o in frame_obs]
     if not rows:
@@ -451,7 +460,10 @@ def assemble_tracks(
     frames = np.array(sorted({r.frame for r in rows}), int)
     pos = {f: i for i, f in enumerate(frames)}
     n = len(frames)
-    raw = {o.id: _object_series(by[o.id], pos, n, _shift_warning(config, o.id, frames)) for o in config.objects}
+    raw = {
+        o.id: _object_series(by[o.id], pos, n, _shift_warning(config, o.id, frames), (levers or {}).get(o.id))
+        for o in config.objects
+    }
     unseen = [o.id for o in config.objects if not np.any(raw[o.id][1] == "ok")]
     if len(unseen) == len(config.objects) or (unseen and n > 1):
         o = unseen[0]
@@ -527,13 +539,16 @@ def _step_kept(th0: float, th1: float, th2: float) -> bool:
     return abs(math.remainder(th2 - th1, 2 * math.pi)) < abs(math.remainder(th2 - th0, 2 * math.pi))
 
 
-def _object_series(rows, pos, n, on_shift=None):
+def _object_series(rows, pos, n, on_shift=None, lever=None):
     """One object's observations laid on the frames (``pos``: frame -> row of ``n``).
 
     Returns ({"X", "Y", "th", "sig", "scale", "q"}: arrays (n,), NaN where not measured; statuses (n,);
     whether a measured frame is in metres). An angle step no rocking block makes marks an outlier;
     when the angles after it go on from the step (:func:`_step_kept`), every angle from that frame on
-    is NaN and ``on_shift(index, ok frames from there)`` is called.
+    is NaN and ``on_shift(index, ok frames from there)`` is called. An angle found unmeasurable on
+    the way drops every frame's; with the object's disk ``lever`` (``(d, th0)``,
+    :func:`track_frames`) the frames whose angle was measured report the point the disk's centre
+    carries without turning (:func:`_upright`), as the frames after do.
     """
     a = {k: np.full(n, np.nan) for k in ("X", "Y", "th", "sig", "scale", "q")}
     st = np.full(n, "lost", dtype=object)
@@ -549,6 +564,8 @@ def _object_series(rows, pos, n, on_shift=None):
     th = a["th"]
     okk = np.flatnonzero(st == "ok")
     if np.isnan(th[okk[~dropped[okk]]]).any():  # found unmeasurable on the way: no frame's angle is measured
+        if lever is not None:
+            _upright(a, *lever)
         th[:], a["sig"][:] = np.nan, np.nan
     # An angle step no rocking block makes between frames is a misdetection, not motion.
     shift = None
@@ -570,6 +587,17 @@ def _object_series(rows, pos, n, on_shift=None):
     for k in ("X", "Y", "th", "sig"):
         a[k][bad] = np.nan
     return a, st, metric
+
+
+def _upright(a, d, th0) -> None:
+    """Move, in place, each frame of ``a`` (:func:`_object_series`'s arrays) with a measured angle
+    to the point its disk's centre carries without turning: ``(X, Y) + (s R(th) - R(th0)) d``
+    (``d`` (2,) the disk's centre in the object's frame, plane units; ``th0`` its first angle, rad)."""
+    m = np.isfinite(a["th"]) & np.isfinite(a["X"])
+    th, sc = a["th"][m], np.where(np.isfinite(a["scale"][m]), a["scale"][m], 1.0)
+    c, s, c0, s0 = np.cos(th), np.sin(th), math.cos(th0), math.sin(th0)
+    a["X"][m] += sc * (c * d[0] - s * d[1]) - (c0 * d[0] - s0 * d[1])
+    a["Y"][m] += sc * (s * d[0] + c * d[1]) - (s0 * d[0] + c0 * d[1])
 
 
 def _shift_warning(config, oid: str, frames):
@@ -710,8 +738,11 @@ def track_video(
 
         total = (min(stop, n_expected) if stop else n_expected) - start
         frames = tqdm(frames, total=total if total > 0 else None, unit="frame", desc="track", leave=False)
-    obs = track_frames(frames, config, pm)
-    res = assemble_tracks(obs, config, rate, info.width_px, info.height_px, pm, path, frame_times_s=times)
+    levers: dict = {}
+    obs = track_frames(frames, config, pm, levers)
+    res = assemble_tracks(
+        obs, config, rate, info.width_px, info.height_px, pm, path, frame_times_s=times, levers=levers
+    )
     expected = (min(stop, n_expected) if stop else n_expected) - start
     check_frames(res, expected, path, info, config)
     return apply_corrections(res, fixes) if fixes else res  # the config's hand fixes

@@ -35,7 +35,8 @@ that centre, and no angle (:mod:`._observability`). A round
 object (a ball) reports the place of its disk's centre: its texture slides over it as it spins, so
 its points are moved to within :data:`DISK_AGREE_FRAC` of where the outline puts that centre; once
 its angle is known not to be reported (a round outline), its points come from the pose turned back
-to the first angle about that centre, so that no point hangs on the texture's angle.
+to the first angle about that centre, so that no point hangs on the texture's angle; the frames
+tracked before are moved the same way once the track is assembled (:meth:`MarkerlessTracker.disk_lever`).
 """
 
 from __future__ import annotations
@@ -209,6 +210,7 @@ class MarkerlessTracker:
         th0 = obj.theta0_rad or 0.0
         c, s = math.cos(-th0), math.sin(-th0)
         self.obj_pts = (q - centre) @ np.array([[c, -s], [s, c]]).T
+        self._obj_frame = (centre, th0)  # the point reported and the first angle, plane units
         self._cv2 = cv2
         self.centre0 = self.origin + np.array(self.size, float) / 2  # template centre, first-frame px
         self.verifier = PoseVerifier(first_gray, (u0, v0, u1, v1), self.size)
@@ -501,6 +503,23 @@ class MarkerlessTracker:
             return W_pts
         c = self.disk_c0
         return _euclid(0.0, *(W[:, :2].astype(float) @ c + W[:, 2] - c))
+
+    def disk_lever(self):
+        """``(d, th0)`` for an object whose angle was found unmeasurable on the way (a round
+        outline, :attr:`round_note`): its disk's centre ``d`` (2,) in the object's own frame (the
+        frame of :attr:`obj_pts`, plane units) and the first angle ``th0`` (rad); else None.
+
+        The frames tracked before the angle was dropped report the point as the texture turned
+        it; with no angle reported, the point is the one the disk's centre carries without
+        turning: ``t + (s R(theta) - R(th0)) d`` for a frame fitted at ``(t, theta, s)``
+        (PhysTrack RollingCylinder, the box moved by 10 %: 8-9 px off on the 35 frames before
+        the note)."""
+        if self.round_note is None or self.disk_c0 is None:
+            return None
+        centre, th0 = self._obj_frame
+        c, s = math.cos(-th0), math.sin(-th0)
+        d = (self.pm.to_plane(self.disk_c0[None, :])[0] - centre) @ np.array([[c, -s], [s, c]]).T
+        return d, th0
 
     def _sigma_theta(self, tmpl, gray, W, mask=None):
         """Gauss-Newton σ of θ (rad) of ``tmpl`` registered by ``W`` (:func:`._observability.sigma_theta`)."""
@@ -850,6 +869,11 @@ class MarkerlessDetector:
         region, or once its outline is known, a round outline), or None."""
         t = self.trackers.get(oid)
         return None if t is None else t.theta_note or t.round_note
+
+    def disk_lever(self, oid):
+        """:meth:`MarkerlessTracker.disk_lever` of object ``oid``."""
+        t = self.trackers.get(oid)
+        return None if t is None else t.disk_lever()
 
     def theta_unmatched(self, oid):
         """(frames verified, frames among them whose angle was not a measurement) of object ``oid``."""

@@ -28,7 +28,11 @@ round it.)
 
 **Disk**: a round outline's centre (:func:`disk`: the smallest circle round the blob standing out
 of the background, its pale parts included; a disk of the object's radius matched to the window
-where a change of the wall joins the blob) is the position of a ball, whose texture slides.
+where a change of the wall joins the blob) is the position of a ball, whose texture slides. A first
+frame that shows the disk joined by what held it, or not round at all, is corrected by the
+tracked frames (:class:`SeenDisk`): once several verified frames in a row show one round blob
+whose edge circle (:func:`edge_circle`: OpenCV's Hough transform on the frame itself, refined on
+the edge) keeps one radius at one place under the pose, that circle is the disk.
 """
 
 from __future__ import annotations
@@ -565,15 +569,57 @@ def edge_circle(img, near, r_blob):
     if lo < 3:
         return None
     found = cv2.HoughCircles(
-        cv2.GaussianBlur(u8, (0, 0), 1.0), cv2.HOUGH_GRADIENT_ALT, 1, r_blob, param1=300, param2=0.7,
-        minRadius=lo, maxRadius=hi + 1,
+        cv2.GaussianBlur(u8, (0, 0), 1.0),
+        cv2.HOUGH_GRADIENT_ALT,
+        1,
+        r_blob,
+        param1=300,
+        param2=0.7,
+        minRadius=lo,
+        maxRadius=hi + 1,
     )
     if found is None:
         return None
     for x, y, r in found[0]:  # strongest first
         if math.hypot(x - near[0], y - near[1]) <= 0.5 * r_blob:
-            return np.array([x, y], float), float(r)
+            return _refine_circle(u8, np.array([x, y], float), float(r))
     return None
+
+
+#: Rays cast from a circle's centre to refine it (:func:`_refine_circle`), the band searched along
+#: each (px either side of the circle) and the residual beyond which an edge point is left out.
+REFINE_RAYS = 48
+REFINE_BAND_PX = 3.0
+REFINE_OUT_PX = 1.5
+
+
+def _refine_circle(u8, c, r):
+    """The circle ``(c, r)`` (px; the Hough transform's, on whole pixels) fitted to the strongest
+    edge along :data:`REFINE_RAYS` rays within :data:`REFINE_BAND_PX` of it (least squares, the
+    points over :data:`REFINE_OUT_PX` off the first fit left out): to a tenth of a pixel where the
+    edge is clear; the Hough circle where the fit moves it by over a pixel or half the band."""
+    import cv2
+
+    g = cv2.GaussianBlur(u8, (0, 0), 1.0).astype(np.float32)
+    mag = cv2.magnitude(cv2.Sobel(g, cv2.CV_32F, 1, 0), cv2.Sobel(g, cv2.CV_32F, 0, 1))
+    a = np.linspace(0.0, 2 * math.pi, REFINE_RAYS, endpoint=False)[:, None]
+    rho = np.arange(r - REFINE_BAND_PX, r + REFINE_BAND_PX + 1e-9, 0.25)[None, :]
+    mx, my = (c[0] + rho * np.cos(a)).astype(np.float32), (c[1] + rho * np.sin(a)).astype(np.float32)
+    prof = cv2.remap(mag, mx, my, cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT, borderValue=0.0)
+    k = np.argmax(prof, axis=1)
+    keep = prof[np.arange(len(k)), k] > 0
+    pts = np.column_stack((mx[np.arange(len(k)), k], my[np.arange(len(k)), k]))[keep].astype(float)
+    fit = None
+    for _ in range(2):
+        if len(pts) < REFINE_RAYS // 2:
+            return c, r
+        A = np.column_stack((2 * pts, np.ones(len(pts))))
+        sol = np.linalg.lstsq(A, (pts**2).sum(1), rcond=None)[0]
+        fit = (sol[:2], math.sqrt(max(sol[2] + sol[0] ** 2 + sol[1] ** 2, 0.0)))
+        pts = pts[np.abs(np.hypot(*(pts - fit[0]).T) - fit[1]) <= REFINE_OUT_PX]
+    if fit is None or np.hypot(*(fit[0] - c)) > 1.0 or abs(fit[1] - r) > 0.5 * REFINE_BAND_PX:
+        return c, r
+    return fit[0], fit[1]
 
 
 class SeenDisk:

@@ -65,7 +65,9 @@ and, for the outline, its own first frame:
   check); run on the frames the other checks find doubtful and on a sample of the rest.
 * **disk** (not a check: the position a ball reports): for a round outline, the centre of the
   object's disk against the background (:meth:`._occlusion.OutlineRef.disk_centre`), kept in
-  :attr:`PoseVerifier.disk_at` for the tracker.
+  :attr:`PoseVerifier.disk_at` for the tracker; the disk itself is learned again from the
+  verified frames' edge circle where the first frame's is missing or of another size
+  (:class:`._occlusion.SeenDisk`: a hand held the disc in the first frame).
 
 A frame that fails is lost with that reason; only verified frames renew the keyframe and teach
 the limits, so a wrong lock cannot teach the tracker to accept itself.

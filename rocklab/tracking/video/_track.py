@@ -93,6 +93,9 @@ class Observation:
         "board", "table": metres).
     angle_dropped : bool
         The angle of this frame alone is not a measurement (NaN), the object's angle otherwise is.
+    fit_theta_rad : float
+        The angle the reported point was carried by, rad (the fitted pose's, also where
+        ``theta_rad`` is NaN: an angle held or not reported); NaN when not fitted.
     """
 
     frame: int
@@ -108,6 +111,7 @@ class Observation:
     metric: bool = True
     plane: str = "image"
     angle_dropped: bool = False
+    fit_theta_rad: float = math.nan
 
 
 def track_frames(frames, config: TrackConfig, plane_map: PlaneMap | None = None, levers: dict | None = None):
@@ -202,6 +206,7 @@ def track_frames(frames, config: TrackConfig, plane_map: PlaneMap | None = None,
                         d.metric,
                         plane_map.source,
                         getattr(d, "theta_why", None) is not None,
+                        float(f.theta_rad),
                     )
                 )
                 u, v = d.img_pts[:, 0], d.img_pts[:, 1]
@@ -542,7 +547,7 @@ def _step_kept(th0: float, th1: float, th2: float) -> bool:
 def _object_series(rows, pos, n, on_shift=None, lever=None):
     """One object's observations laid on the frames (``pos``: frame -> row of ``n``).
 
-    Returns ({"X", "Y", "th", "sig", "scale", "q"}: arrays (n,), NaN where not measured; statuses (n,);
+    Returns ({"X", "Y", "th", "sig", "scale", "q", "fit_th"}: arrays (n,), NaN where not measured; statuses (n,);
     whether a measured frame is in metres). An angle step no rocking block makes marks an outlier;
     when the angles after it go on from the step (:func:`_step_kept`), every angle from that frame on
     is NaN and ``on_shift(index, ok frames from there)`` is called. An angle found unmeasurable on
@@ -550,14 +555,14 @@ def _object_series(rows, pos, n, on_shift=None, lever=None):
     :func:`track_frames`) the frames whose angle was measured report the point the disk's centre
     carries without turning (:func:`_upright`), as the frames after do.
     """
-    a = {k: np.full(n, np.nan) for k in ("X", "Y", "th", "sig", "scale", "q")}
+    a = {k: np.full(n, np.nan) for k in ("X", "Y", "th", "sig", "scale", "q", "fit_th")}
     st = np.full(n, "lost", dtype=object)
     metric = False  # metres only where a measured frame says so: a lost frame's flag is a default
     dropped = np.zeros(n, bool)  # frames whose angle alone is not a measurement
     for r in rows:
         i = pos[r.frame]
         a["X"][i], a["Y"][i], a["th"][i], a["sig"][i] = r.X, r.Y, r.theta_rad, r.sigma_theta_rad
-        a["scale"][i], a["q"][i] = r.scale, r.quality
+        a["scale"][i], a["q"][i], a["fit_th"][i] = r.scale, r.quality, r.fit_theta_rad
         st[i] = r.status
         dropped[i] = r.angle_dropped
         metric = metric or (r.status == "ok" and r.metric)
@@ -592,9 +597,11 @@ def _object_series(rows, pos, n, on_shift=None, lever=None):
 def _upright(a, d, th0) -> None:
     """Move, in place, each frame of ``a`` (:func:`_object_series`'s arrays) with a measured angle
     to the point its disk's centre carries without turning: ``(X, Y) + (s R(th) - R(th0)) d``
-    (``d`` (2,) the disk's centre in the object's frame, plane units; ``th0`` its first angle, rad)."""
-    m = np.isfinite(a["th"]) & np.isfinite(a["X"])
-    th, sc = a["th"][m], np.where(np.isfinite(a["scale"][m]), a["scale"][m], 1.0)
+    (``d`` (2,) the disk's centre in the object's frame, plane units; ``th0`` its first angle, rad;
+    ``th`` the angle the point was carried by, ``fit_th``: also where it was held, not measured;
+    a frame already upright is fitted at ``th0`` and stays where it is)."""
+    m = np.isfinite(a["fit_th"]) & np.isfinite(a["X"])
+    th, sc = a["fit_th"][m], np.where(np.isfinite(a["scale"][m]), a["scale"][m], 1.0)
     c, s, c0, s0 = np.cos(th), np.sin(th), math.cos(th0), math.sin(th0)
     a["X"][m] += sc * (c * d[0] - s * d[1]) - (c0 * d[0] - s0 * d[1])
     a["Y"][m] += sc * (s * d[0] + c * d[1]) - (s0 * d[0] + c0 * d[1])

@@ -547,6 +547,10 @@ SEEN_DISK_RADIUS = 0.05
 #: never round: the look costs a few morphology passes a frame).
 SEEN_DISK_PLACE = 0.1
 SEEN_DISK_LOOKS = 90
+#: The learned disk is placed in the first frame by its edge circle there, of a radius within these
+#: fractions of the learned one (a pose whose angle was held, not measured, puts the disk's first
+#: place 3 px off where the first frame shows its edge: PhysTrack RollingCylinder, a 33 px box).
+FIRST_EDGE_RADII = (0.9, 1.1)
 
 
 #: The circle of a disk's edge (:func:`edge_circle`) is looked for with radii from this fraction of
@@ -555,9 +559,9 @@ SEEN_DISK_LOOKS = 90
 EDGE_RADIUS_RANGE = (0.6, 1.05)
 
 
-def edge_circle(img, near, r_blob):
+def edge_circle(img, near, r_blob, radii=EDGE_RADIUS_RANGE):
     """The circle of the strongest round edge of ``img`` (float32 grey, h x w) within half of
-    ``r_blob`` of ``near`` (x, y px), its radius within :data:`EDGE_RADIUS_RANGE` of ``r_blob``
+    ``r_blob`` of ``near`` (x, y px), its radius within ``radii`` (fractions) of ``r_blob``
     (OpenCV's gradient Hough transform, the variant that scores each circle's completeness):
     centre (2,) px and radius px, or None. A disk's edge against its background places it where
     the blob standing out of the background does not: a soft shadow, or a hand holding it, joins
@@ -565,7 +569,7 @@ def edge_circle(img, near, r_blob):
     import cv2
 
     u8 = np.clip(img, 0, 255).astype(np.uint8)
-    lo, hi = (int(math.floor(k * r_blob)) for k in EDGE_RADIUS_RANGE)
+    lo, hi = (int(math.floor(k * r_blob)) for k in radii)
     if lo < 3:
         return None
     found = cv2.HoughCircles(
@@ -678,6 +682,17 @@ class SeenDisk:
             self.disk = (cm, rm, float(np.median([s[2] for s in self._run])))
             return True
         return False
+
+    def place_first(self, first, at) -> None:
+        """Move the learned disk's centre to its edge circle in ``first`` (the first frame's part
+        whose corner is at ``at`` (x, y), first-frame px; float32), where one of its radius lies
+        near (:data:`FIRST_EDGE_RADII`); kept as learned otherwise."""
+        if self.disk is None:
+            return
+        c, r, circ = self.disk
+        e = edge_circle(first, c - np.asarray(at, float), r, FIRST_EDGE_RADII)
+        if e is not None:
+            self.disk = (e[0] + np.asarray(at, float), r, circ)
 
     def teach(self, ref) -> None:
         """Give the learned disk to the outline ``ref`` (an :class:`OutlineRef`) where its first

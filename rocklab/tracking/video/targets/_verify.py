@@ -674,6 +674,7 @@ class PoseVerifier:
         """Learn from the pose just verified (its correlation, motion and the background it uncovers)."""
         score, centre, theta, pred, last, gap, frame = self._pending
         if self._disk_look is not None and self.seen_disk.add(self._disk_look[0]):
+            self.seen_disk.place_first(self.first_outer, self.outer[:2])
             self.seen_disk.teach(self.outline)
         if math.isfinite(self._contrast):
             self.contrasts.append(self._contrast)

@@ -551,7 +551,7 @@ def _object_series(rows, pos, n, on_shift=None, lever=None):
     whether a measured frame is in metres). An angle step no rocking block makes marks an outlier;
     when the angles after it go on from the step (:func:`_step_kept`), every angle from that frame on
     is NaN and ``on_shift(index, ok frames from there)`` is called. An angle found unmeasurable on
-    the way drops every frame's; with the object's disk ``lever`` (``(d, th0)``,
+    the way drops every frame's; with the object's disk ``lever`` (:meth:`MarkerlessTracker.disk_lever`,
     :func:`track_frames`) the frames whose angle was measured report the point the disk's centre
     carries without turning (:func:`_upright`), as the frames after do.
     """
@@ -570,7 +570,8 @@ def _object_series(rows, pos, n, on_shift=None, lever=None):
     okk = np.flatnonzero(st == "ok")
     if np.isnan(th[okk[~dropped[okk]]]).any():  # found unmeasurable on the way: no frame's angle is measured
         if lever is not None:
-            _upright(a, *lever)
+            d_pose, d_first, th0, at = lever
+            _upright(a, d_pose, d_first, th0, pos.get(at, n) if at is not None else n)
         th[:], a["sig"][:] = np.nan, np.nan
     # An angle step no rocking block makes between frames is a misdetection, not motion.
     shift = None
@@ -594,17 +595,18 @@ def _object_series(rows, pos, n, on_shift=None, lever=None):
     return a, st, metric
 
 
-def _upright(a, d, th0) -> None:
-    """Move, in place, each frame of ``a`` (:func:`_object_series`'s arrays) with a measured angle
-    to the point its disk's centre carries without turning: ``(X, Y) + (s R(th) - R(th0)) d``
-    (``d`` (2,) the disk's centre in the object's frame, plane units; ``th0`` its first angle, rad;
-    ``th`` the angle the point was carried by, ``fit_th``: also where it was held, not measured;
-    a frame already upright is fitted at ``th0`` and stays where it is)."""
-    m = np.isfinite(a["fit_th"]) & np.isfinite(a["X"])
+def _upright(a, d_pose, d_first, th0, upto) -> None:
+    """Move, in place, each frame of ``a`` (:func:`_object_series`'s arrays) before row ``upto``
+    (the frames after report the point upright already) to the point its disk's centre carries
+    without turning: ``(X, Y) + s R(th) d_pose - R(th0) d_first`` (the disk's centre in the
+    object's frame where the poses put it and where the first frame shows it, plane units;
+    ``th0`` the first angle, rad; ``th`` the angle the point was carried by, ``fit_th``: also
+    where it was held, not measured)."""
+    m = np.isfinite(a["fit_th"]) & np.isfinite(a["X"]) & (np.arange(len(a["X"])) < upto)
     th, sc = a["fit_th"][m], np.where(np.isfinite(a["scale"][m]), a["scale"][m], 1.0)
     c, s, c0, s0 = np.cos(th), np.sin(th), math.cos(th0), math.sin(th0)
-    a["X"][m] += sc * (c * d[0] - s * d[1]) - (c0 * d[0] - s0 * d[1])
-    a["Y"][m] += sc * (s * d[0] + c * d[1]) - (s0 * d[0] + c0 * d[1])
+    a["X"][m] += sc * (c * d_pose[0] - s * d_pose[1]) - (c0 * d_first[0] - s0 * d_first[1])
+    a["Y"][m] += sc * (s * d_pose[0] + c * d_pose[1]) - (s0 * d_first[0] + c0 * d_first[1])
 
 
 def _shift_warning(config, oid: str, frames):

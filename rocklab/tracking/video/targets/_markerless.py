@@ -235,6 +235,7 @@ class MarkerlessTracker:
         self.theta_hold = 0.0
         #: the disk's centre in the first frame (first-frame px) once an outline found it, or None
         self.disk_c0 = None
+        self.round_at = None  # the frame :attr:`round_note` was set at
 
     # -- registration -------------------------------------------------------------
     def _window(self, gray, W, margin):
@@ -505,21 +506,27 @@ class MarkerlessTracker:
         return _euclid(0.0, *(W[:, :2].astype(float) @ c + W[:, 2] - c))
 
     def disk_lever(self):
-        """``(d, th0)`` for an object whose angle was found unmeasurable on the way (a round
-        outline, :attr:`round_note`): its disk's centre ``d`` (2,) in the object's own frame (the
-        frame of :attr:`obj_pts`, plane units) and the first angle ``th0`` (rad); else None.
+        """``(d_pose, d_first, th0, frame)`` for an object whose angle was found unmeasurable on
+        the way (a round outline, :attr:`round_note`, at ``frame``): its disk's centre in the
+        object's own frame (the frame of :attr:`obj_pts`, plane units) where the poses put it
+        (``d_pose``: :class:`._occlusion.SeenDisk` learned it under them) and where the first
+        frame shows it (``d_first``), and the first angle ``th0`` (rad); else None.
 
         The frames tracked before the angle was dropped report the point as the texture turned
         it; with no angle reported, the point is the one the disk's centre carries without
-        turning: ``t + (s R(theta) - R(th0)) d`` for a frame fitted at ``(t, theta, s)``
+        turning: ``t + s R(theta) d_pose - R(th0) d_first`` for a frame fitted at ``(t, theta, s)``
         (PhysTrack RollingCylinder, the box moved by 10 %: 8-9 px off on the 35 frames before
         the note)."""
         if self.round_note is None or self.disk_c0 is None:
             return None
         centre, th0 = self._obj_frame
         c, s = math.cos(-th0), math.sin(-th0)
-        d = (self.pm.to_plane(self.disk_c0[None, :])[0] - centre) @ np.array([[c, -s], [s, c]]).T
-        return d, th0
+        seen = self.verifier.seen_disk.pose_c
+        pose_c = self.disk_c0 if seen is None else seen
+        d_pose, d_first = (
+            (self.pm.to_plane(p[None, :])[0] - centre) @ np.array([[c, -s], [s, c]]).T for p in (pose_c, self.disk_c0)
+        )
+        return d_pose, d_first, th0, self.round_at
 
     def _sigma_theta(self, tmpl, gray, W, mask=None):
         """Gauss-Newton σ of θ (rad) of ``tmpl`` registered by ``W`` (:func:`._observability.sigma_theta`)."""
@@ -633,6 +640,8 @@ class MarkerlessTracker:
             return None
         self.verifier.confirm(gray, self.size)
         self._round_check(first_view)
+        if self.round_note is not None and self.round_at is None:
+            self.round_at = frame
         (W, cc), mask, visible, why, sig, W_pts = self._settle(tmpl, gray, fit, mask, visible)
         W_pts = self._upright_disk(W, W_pts)
         self.poses = (self.poses + [self._centred(W)])[-2:]

@@ -645,6 +645,9 @@ class SeenDisk:
 
     def __init__(self):
         self.disk = None
+        #: the learned disk's centre where the poses put it (first-frame px), before
+        #: :meth:`place_first` moved it to the first frame's edge circle
+        self.pose_c = None
         self.looks = 0
         self._run: list = []
 
@@ -690,6 +693,7 @@ class SeenDisk:
         if self.disk is None:
             return
         c, r, circ = self.disk
+        self.pose_c = c
         e = edge_circle(first, c - np.asarray(at, float), r, FIRST_EDGE_RADII)
         if e is not None:
             self.disk = (e[0] + np.asarray(at, float), r, circ)

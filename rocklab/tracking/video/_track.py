@@ -205,7 +205,8 @@ def track_frames(frames, config: TrackConfig, plane_map: PlaneMap | None = None,
                         "ok",
                         d.metric,
                         plane_map.source,
-                        getattr(d, "theta_why", None) is not None,
+                        # an object's angle dropped as a whole is not one frame's alone
+                        o.id not in free and getattr(d, "theta_why", None) is not None,
                         float(f.theta_rad),
                     )
                 )
@@ -571,7 +572,7 @@ def _object_series(rows, pos, n, on_shift=None, lever=None):
     if np.isnan(th[okk[~dropped[okk]]]).any():  # found unmeasurable on the way: no frame's angle is measured
         if lever is not None:
             d_pose, d_first, th0, at = lever
-            _upright(a, d_pose, d_first, th0, pos.get(at, n) if at is not None else n)
+            _upright(a, dropped, d_pose, d_first, th0, pos.get(at, n) if at is not None else n)
         th[:], a["sig"][:] = np.nan, np.nan
     # An angle step no rocking block makes between frames is a misdetection, not motion.
     shift = None
@@ -595,18 +596,20 @@ def _object_series(rows, pos, n, on_shift=None, lever=None):
     return a, st, metric
 
 
-def _upright(a, d_pose, d_first, th0, upto) -> None:
+def _upright(a, held, d_pose, d_first, th0, upto) -> None:
     """Move, in place, each frame of ``a`` (:func:`_object_series`'s arrays) before row ``upto``
     (the frames after report the point upright already) to the point its disk's centre carries
-    without turning: ``(X, Y) + s R(th) d_pose - R(th0) d_first`` (the disk's centre in the
-    object's frame where the poses put it and where the first frame shows it, plane units;
-    ``th0`` the first angle, rad; ``th`` the angle the point was carried by, ``fit_th``: also
-    where it was held, not measured)."""
+    without turning: ``(X, Y) + s R(th) d - R(th0) d_first``, ``th`` the angle the point was
+    carried by (``fit_th``), ``th0`` the first angle, rad; ``d`` the disk's centre in the object's
+    frame (plane units) where the first frame shows it (``d_first``), or where the poses put it
+    (``d_pose``) on the frames whose angle was ``held`` (bool (n,)), not measured: a held pose
+    places the disk's centre where it does not lie in the first frame."""
     m = np.isfinite(a["fit_th"]) & np.isfinite(a["X"]) & (np.arange(len(a["X"])) < upto)
     th, sc = a["fit_th"][m], np.where(np.isfinite(a["scale"][m]), a["scale"][m], 1.0)
+    d = np.where(held[m][:, None], np.asarray(d_pose, float), np.asarray(d_first, float))
     c, s, c0, s0 = np.cos(th), np.sin(th), math.cos(th0), math.sin(th0)
-    a["X"][m] += sc * (c * d_pose[0] - s * d_pose[1]) - (c0 * d_first[0] - s0 * d_first[1])
-    a["Y"][m] += sc * (s * d_pose[0] + c * d_pose[1]) - (s0 * d_first[0] + c0 * d_first[1])
+    a["X"][m] += sc * (c * d[:, 0] - s * d[:, 1]) - (c0 * d_first[0] - s0 * d_first[1])
+    a["Y"][m] += sc * (s * d[:, 0] + c * d[:, 1]) - (s0 * d_first[0] + c0 * d_first[1])
 
 
 def _shift_warning(config, oid: str, frames):

@@ -312,6 +312,7 @@ def test_a_disks_edge_circle_is_not_pulled_by_a_hand_or_a_shadow_joining_its_blo
         origin = np.array([100.0, 50.0])
 
     seen = SeenDisk()
+    seen.held = True  # the poses held an angle they did not measure
     look = (c + Tr.origin - 4, rr, 0.95)  # as SeenDisk.look gives it, a window grown by 4 px
     assert not any(seen.add(look) for _ in range(9))
     assert seen.add(look) and np.allclose(seen.disk[0], c + Tr.origin - 4) and seen.done
@@ -326,6 +327,12 @@ def test_a_disks_edge_circle_is_not_pulled_by_a_hand_or_a_shadow_joining_its_blo
     seen.disk = (np.array([cx - 3.0, cy + 1.0]) + Tr.origin, r, 0.95)
     seen.place_first(img, Tr.origin)
     assert np.hypot(*(seen.disk[0] - Tr.origin - (cx, cy))) < 0.3, seen.disk
+    # learned under measured poses: their place is kept (the hand biases the first frame's edge)
+    kept = SeenDisk()
+    for _ in range(10):
+        kept.add(look)
+    kept.place_first(img, Tr.origin)
+    assert np.allclose(kept.disk[0], c + Tr.origin - 4)
 
 
 def test_outline_check_sees_a_slide_a_turn_about_a_point_off_the_object_not_a_shadow():

@@ -643,6 +643,7 @@ class MarkerlessTracker:
         if self.round_note is not None and self.round_at is None:
             self.round_at = frame
         (W, cc), mask, visible, why, sig, W_pts = self._settle(tmpl, gray, fit, mask, visible)
+        self.verifier.seen_disk.held = why is not None  # the poses the next looks are taken under
         W_pts = self._upright_disk(W, W_pts)
         self.poses = (self.poses + [self._centred(W)])[-2:]
         self.twins.remember(frame, gray, W[:, :2].astype(float) @ self.centre0 + W[:, 2])

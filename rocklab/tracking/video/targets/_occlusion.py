@@ -547,9 +547,11 @@ SEEN_DISK_RADIUS = 0.05
 #: never round: the look costs a few morphology passes a frame).
 SEEN_DISK_PLACE = 0.1
 SEEN_DISK_LOOKS = 90
-#: The learned disk is placed in the first frame by its edge circle there, of a radius within these
-#: fractions of the learned one (a pose whose angle was held, not measured, puts the disk's first
-#: place 3 px off where the first frame shows its edge: PhysTrack RollingCylinder, a 33 px box).
+#: A disk learned under poses whose angle was mostly held, not measured, is placed in the first
+#: frame by its edge circle there, of a radius within these fractions of the learned one (a held
+#: pose puts the disk's first place 3 px off where the first frame shows its edge: PhysTrack
+#: RollingCylinder, a 33 px box); under measured poses its place under them is kept (the first
+#: frame's edge, a hand joining it, was 1 px off for a 37 px box, the poses' 0.7 px).
 FIRST_EDGE_RADII = (0.9, 1.1)
 
 
@@ -649,6 +651,9 @@ class SeenDisk:
         #: :meth:`place_first` moved it to the first frame's edge circle
         self.pose_c = None
         self.looks = 0
+        #: whether the poses the looks are now taken under hold an angle they did not measure
+        self.held = False
+        self._held_share = 0.0
         self._run: list = []
 
     @property
@@ -675,7 +680,7 @@ class SeenDisk:
         """Count one verified frame's :meth:`look` (None: not round); True when the disk is
         learned with it."""
         self.looks += 1
-        self._run = [] if seen is None else (self._run + [seen])[-SEEN_DISK_FRAMES:]
+        self._run = [] if seen is None else (self._run + [(*seen, self.held)])[-SEEN_DISK_FRAMES:]
         if len(self._run) < SEEN_DISK_FRAMES:
             return False
         c = np.array([s[0] for s in self._run])
@@ -683,17 +688,21 @@ class SeenDisk:
         cm, rm = np.median(c, axis=0), float(np.median(r))
         if np.all(np.abs(r - rm) <= SEEN_DISK_RADIUS * rm) and np.all(np.hypot(*(c - cm).T) <= SEEN_DISK_PLACE * rm):
             self.disk = (cm, rm, float(np.median([s[2] for s in self._run])))
+            self._held_share = float(np.mean([s[3] for s in self._run]))
             return True
         return False
 
     def place_first(self, first, at) -> None:
         """Move the learned disk's centre to its edge circle in ``first`` (the first frame's part
         whose corner is at ``at`` (x, y), first-frame px; float32), where one of its radius lies
-        near (:data:`FIRST_EDGE_RADII`); kept as learned otherwise."""
+        near (:data:`FIRST_EDGE_RADII`), when it was learned under poses mostly :attr:`held`;
+        kept as learned otherwise."""
         if self.disk is None:
             return
         c, r, circ = self.disk
         self.pose_c = c
+        if self._held_share <= 0.5:
+            return
         e = edge_circle(first, c - np.asarray(at, float), r, FIRST_EDGE_RADII)
         if e is not None:
             self.disk = (e[0] + np.asarray(at, float), r, circ)

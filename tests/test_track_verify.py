@@ -280,6 +280,61 @@ def test_a_disk_is_found_with_its_clear_half_and_past_a_shadow_strip_joining_it(
     assert np.hypot(*(disk(strip, bg)[0] - (47.3, 52.6))) > 3.0
 
 
+def test_a_disks_edge_circle_is_not_pulled_by_a_hand_or_a_shadow_joining_its_blob():
+    """:func:`edge_circle` on a white disc (radius 15.2 px, centre off the pixel grid, a dark rim)
+    on a grey wall, joined by a hand-like grey blob at its upper right and a soft shadow at its
+    lower right (both standing out of the wall less than the disc): the blob's enclosing circle
+    (:func:`stable_disk`) is pulled 2-3 px and grows; the edge circle keeps the disc to 0.3 px.
+    Then :class:`SeenDisk` learns the disc from ten such frames (its place under the pose) and
+    gives it to an outline whose first disk was the joined blob."""
+    import cv2
+
+    from rocklab.tracking.video.targets._occlusion import SeenDisk, edge_circle, stable_disk
+
+    cx, cy, r = 31.4, 29.7, 15.2
+    s = 8  # drawn 8x larger and reduced: an anti-aliased edge
+    big = np.full((60 * s, 62 * s), 170.0, np.float32)
+    cv2.circle(big, (int(cx * s), int(cy * s)), int((r + 0.6) * s), 120.0, -1)  # the rim
+    cv2.circle(big, (int(cx * s), int(cy * s)), int(r * s), 235.0, -1)
+    bg_big = np.full_like(big, 170.0)
+    cv2.ellipse(big, (int(47 * s), int(14 * s)), (9 * s, 5 * s), 35, 0, 360, 140.0, -1)  # a hand
+    cv2.ellipse(big, (int(44 * s), int(43 * s)), (8 * s, 4 * s), -30, 0, 360, 150.0, -1)  # a shadow
+    img = cv2.resize(big, (62, 60), interpolation=cv2.INTER_AREA)
+    bg = cv2.resize(bg_big, (62, 60), interpolation=cv2.INTER_AREA)
+    # the drawn centre in the reduced image's pixel coordinates (pixel centres at integers)
+    cx, cy = ((int(v * s) + 0.5) / s - 0.5 for v in (cx, cy))
+    blob_c, blob_r, _ = stable_disk(img, bg)
+    assert np.hypot(blob_c[0] - cx, blob_c[1] - cy) > 2.0 and blob_r > 1.15 * r, (blob_c, blob_r)
+    c, rr = edge_circle(img, blob_c, blob_r)
+    assert np.hypot(c[0] - cx, c[1] - cy) < 0.3 and abs(rr - r) < 0.8, (c, rr)
+
+    class Tr:
+        origin = np.array([100.0, 50.0])
+
+    seen = SeenDisk()
+    seen.held = True  # the poses held an angle they did not measure
+    look = (c + Tr.origin - 4, rr, 0.95)  # as SeenDisk.look gives it, a window grown by 4 px
+    assert not any(seen.add(look) for _ in range(9))
+    assert seen.add(look) and np.allclose(seen.disk[0], c + Tr.origin - 4) and seen.done
+
+    class Ref:
+        disk0, roundness = (blob_c + Tr.origin - 4, blob_r), 0.86
+
+    seen.teach(Ref)
+    assert np.allclose(Ref.disk0[0], c + Tr.origin - 4) and Ref.roundness == 0.95
+    # learned 3 px off (a pose held at an angle it did not measure): placed by its edge in the
+    # first frame, which the hand joins
+    seen.disk = (np.array([cx - 3.0, cy + 1.0]) + Tr.origin, r, 0.95)
+    seen.place_first(img, Tr.origin)
+    assert np.hypot(*(seen.disk[0] - Tr.origin - (cx, cy))) < 0.3, seen.disk
+    # learned under measured poses: their place is kept (the hand biases the first frame's edge)
+    kept = SeenDisk()
+    for _ in range(10):
+        kept.add(look)
+    kept.place_first(img, Tr.origin)
+    assert np.allclose(kept.disk[0], c + Tr.origin - 4)
+
+
 def test_outline_check_sees_a_slide_a_turn_about_a_point_off_the_object_not_a_shadow():
     """The outline check on a plain disk (its silhouette the same however it turns) over a
     textured wall: a pose on the disk passes (the disk's soft shadow beside it is no part of its

@@ -93,6 +93,9 @@ class Observation:
         "board", "table": metres).
     angle_dropped : bool
         The angle of this frame alone is not a measurement (NaN), the object's angle otherwise is.
+    fit_theta_rad : float
+        The angle the reported point was carried by, rad (the fitted pose's, also where
+        ``theta_rad`` is NaN: an angle held or not reported); NaN when not fitted.
     """
 
     frame: int
@@ -108,9 +111,10 @@ class Observation:
     metric: bool = True
     plane: str = "image"
     angle_dropped: bool = False
+    fit_theta_rad: float = math.nan
 
 
-def track_frames(frames, config: TrackConfig, plane_map: PlaneMap | None = None):
+def track_frames(frames, config: TrackConfig, plane_map: PlaneMap | None = None, levers: dict | None = None):
     """Track every configured object through a stream of frames.
 
     A frame's observations are held back while an object's angle awaits a verdict (the detector's
@@ -125,6 +129,10 @@ def track_frames(frames, config: TrackConfig, plane_map: PlaneMap | None = None)
     config : TrackConfig
     plane_map : PlaneMap, optional
         Default: built from ``config`` and the first frame.
+    levers : dict, optional
+        Filled once the frames are all tracked: object id -> its disk's lever for
+        :func:`assemble_tracks` (objects whose angle was found unmeasurable on the way, a round
+        outline: the frames before report the point the texture's angle turned).
 
     Yields
     ------
@@ -133,7 +141,7 @@ def track_frames(frames, config: TrackConfig, plane_map: PlaneMap | None = None)
     """
     held: list = []
     det = None
-    for obs, det in _observed(frames, config, plane_map):
+    for obs, det in _observed(frames, config, plane_map, levers):
         if _pending_angles(config, det):
             held.append(obs)
             continue
@@ -144,7 +152,12 @@ def track_frames(frames, config: TrackConfig, plane_map: PlaneMap | None = None)
     for oid, (why, frame) in pending.items():
         warn_theta(config, oid, why, frame)
     for obs in held:
-        yield [replace(o, theta_rad=math.nan, sigma_theta_rad=math.nan) if o.object in pending else o for o in obs]
+        # the angle is dropped as a whole (every frame's, the ones before the hold too), not one
+        # frame's alone: a frame held after a per-frame drop must not shield the rest
+        yield [
+            replace(o, theta_rad=math.nan, sigma_theta_rad=math.nan, angle_dropped=False) if o.object in pending else o
+            for o in obs
+        ]
 
 
 def _pending_angles(config, det) -> dict:
@@ -154,7 +167,7 @@ def _pending_angles(config, det) -> dict:
     return {o.id: p for o in config.objects if (p := det.theta_pending(o.id)) is not None}
 
 
-def _observed(frames, config: TrackConfig, plane_map: PlaneMap | None = None):
+def _observed(frames, config: TrackConfig, plane_map: PlaneMap | None = None, levers: dict | None = None):
     """:func:`track_frames`' work, frame by frame (same parameters).
 
     Yields
@@ -234,7 +247,9 @@ def _observed(frames, config: TrackConfig, plane_map: PlaneMap | None = None):
                         "ok",
                         d.metric,
                         plane_map.source,
-                        getattr(d, "theta_why", None) is not None,
+                        # an object's angle dropped as a whole is not one frame's alone
+                        o.id not in free and getattr(d, "theta_why", None) is not None,
+                        float(f.theta_rad),
                     )
                 )
                 u, v = d.img_pts[:, 0], d.img_pts[:, 1]
@@ -255,6 +270,8 @@ def _observed(frames, config: TrackConfig, plane_map: PlaneMap | None = None):
         yield obs, det
     check_cuts(steps, cuts, indices, config.source or "the film")
     warn_unmatched_angles(config, det)
+    if levers is not None and hasattr(det, "disk_lever"):
+        levers.update({o.id: lv for o in config.objects if (lv := det.disk_lever(o.id)) is not None})
 
 
 @dataclass(frozen=True)
@@ -467,6 +484,7 @@ def assemble_tracks(
     plane_map: PlaneMap | None = None,
     source=None,
     frame_times_s=None,
+    levers: dict | None = None,
 ) -> TrackResult:
     """Convert per-frame observations (plane units) into a :class:`TrackResult` (m, levelled rad).
 
@@ -478,6 +496,8 @@ def assemble_tracks(
         Frame rate; ``t_s = frame / fps`` unless ``frame_times_s`` is given.
     frame_times_s : ndarray, optional
         Each frame's own time from the container, s (indexed by frame number).
+    levers : dict, optional
+        As filled by :func:`track_frames` (read once ``observations`` are consumed).
     """
     rows = [o for frame_obs in observations for o in frame_obs]
     if not rows:
@@ -488,7 +508,10 @@ def assemble_tracks(
     frames = np.array(sorted({r.frame for r in rows}), int)
     pos = {f: i for i, f in enumerate(frames)}
     n = len(frames)
-    raw = {o.id: _object_series(by[o.id], pos, n, _shift_warning(config, o.id, frames)) for o in config.objects}
+    raw = {
+        o.id: _object_series(by[o.id], pos, n, _shift_warning(config, o.id, frames), (levers or {}).get(o.id))
+        for o in config.objects
+    }
     unseen = [o.id for o in config.objects if not np.any(raw[o.id][1] == "ok")]
     if len(unseen) == len(config.objects) or (unseen and n > 1):
         o = unseen[0]
@@ -564,28 +587,34 @@ def _step_kept(th0: float, th1: float, th2: float) -> bool:
     return abs(math.remainder(th2 - th1, 2 * math.pi)) < abs(math.remainder(th2 - th0, 2 * math.pi))
 
 
-def _object_series(rows, pos, n, on_shift=None):
+def _object_series(rows, pos, n, on_shift=None, lever=None):
     """One object's observations laid on the frames (``pos``: frame -> row of ``n``).
 
-    Returns ({"X", "Y", "th", "sig", "scale", "q"}: arrays (n,), NaN where not measured; statuses (n,);
+    Returns ({"X", "Y", "th", "sig", "scale", "q", "fit_th"}: arrays (n,), NaN where not measured; statuses (n,);
     whether a measured frame is in metres). An angle step no rocking block makes marks an outlier;
     when the angles after it go on from the step (:func:`_step_kept`), every angle from that frame on
-    is NaN and ``on_shift(index, ok frames from there)`` is called.
+    is NaN and ``on_shift(index, ok frames from there)`` is called. An angle found unmeasurable on
+    the way drops every frame's; with the object's disk ``lever`` (:meth:`MarkerlessTracker.disk_lever`,
+    :func:`track_frames`) the frames whose angle was measured report the point the disk's centre
+    carries without turning (:func:`_upright`), as the frames after do.
     """
-    a = {k: np.full(n, np.nan) for k in ("X", "Y", "th", "sig", "scale", "q")}
+    a = {k: np.full(n, np.nan) for k in ("X", "Y", "th", "sig", "scale", "q", "fit_th")}
     st = np.full(n, "lost", dtype=object)
     metric = False  # metres only where a measured frame says so: a lost frame's flag is a default
     dropped = np.zeros(n, bool)  # frames whose angle alone is not a measurement
     for r in rows:
         i = pos[r.frame]
         a["X"][i], a["Y"][i], a["th"][i], a["sig"][i] = r.X, r.Y, r.theta_rad, r.sigma_theta_rad
-        a["scale"][i], a["q"][i] = r.scale, r.quality
+        a["scale"][i], a["q"][i], a["fit_th"][i] = r.scale, r.quality, r.fit_theta_rad
         st[i] = r.status
         dropped[i] = r.angle_dropped
         metric = metric or (r.status == "ok" and r.metric)
     th = a["th"]
     okk = np.flatnonzero(st == "ok")
     if np.isnan(th[okk[~dropped[okk]]]).any():  # found unmeasurable on the way: no frame's angle is measured
+        if lever is not None:
+            d_pose, d_first, th0, at = lever
+            _upright(a, dropped, d_pose, d_first, th0, pos.get(at, n) if at is not None else n)
         th[:], a["sig"][:] = np.nan, np.nan
     # An angle step no rocking block makes between frames is a misdetection, not motion.
     shift = None
@@ -607,6 +636,22 @@ def _object_series(rows, pos, n, on_shift=None):
     for k in ("X", "Y", "th", "sig"):
         a[k][bad] = np.nan
     return a, st, metric
+
+
+def _upright(a, held, d_pose, d_first, th0, upto) -> None:
+    """Move, in place, each frame of ``a`` (:func:`_object_series`'s arrays) before row ``upto``
+    (the frames after report the point upright already) to the point its disk's centre carries
+    without turning: ``(X, Y) + s R(th) d - R(th0) d_first``, ``th`` the angle the point was
+    carried by (``fit_th``), ``th0`` the first angle, rad; ``d`` the disk's centre in the object's
+    frame (plane units) where the first frame shows it (``d_first``), or where the poses put it
+    (``d_pose``) on the frames whose angle was ``held`` (bool (n,)), not measured: a held pose
+    places the disk's centre where it does not lie in the first frame."""
+    m = np.isfinite(a["fit_th"]) & np.isfinite(a["X"]) & (np.arange(len(a["X"])) < upto)
+    th, sc = a["fit_th"][m], np.where(np.isfinite(a["scale"][m]), a["scale"][m], 1.0)
+    d = np.where(held[m][:, None], np.asarray(d_pose, float), np.asarray(d_first, float))
+    c, s, c0, s0 = np.cos(th), np.sin(th), math.cos(th0), math.sin(th0)
+    a["X"][m] += sc * (c * d[:, 0] - s * d[:, 1]) - (c0 * d_first[0] - s0 * d_first[1])
+    a["Y"][m] += sc * (s * d[:, 0] + c * d[:, 1]) - (s0 * d_first[0] + c0 * d_first[1])
 
 
 def _shift_warning(config, oid: str, frames):
@@ -747,8 +792,11 @@ def track_video(
 
         total = (min(stop, n_expected) if stop else n_expected) - start
         frames = tqdm(frames, total=total if total > 0 else None, unit="frame", desc="track", leave=False)
-    obs = track_frames(frames, config, pm)
-    res = assemble_tracks(obs, config, rate, info.width_px, info.height_px, pm, path, frame_times_s=times)
+    levers: dict = {}
+    obs = track_frames(frames, config, pm, levers)
+    res = assemble_tracks(
+        obs, config, rate, info.width_px, info.height_px, pm, path, frame_times_s=times, levers=levers
+    )
     expected = (min(stop, n_expected) if stop else n_expected) - start
     check_frames(res, expected, path, info, config)
     return apply_corrections(res, fixes) if fixes else res  # the config's hand fixes

@@ -35,6 +35,11 @@ class _MixedDetector:
         """Why object ``oid``'s angle cannot be measured, from its own style's detector, or None."""
         return self._ask("theta_note", oid)
 
+    def disk_lever(self, oid):
+        """Object ``oid``'s disk in its own frame once its angle was dropped, or None (its own
+        style's detector)."""
+        return self._ask("disk_lever", oid)
+
 
 def make_detector(config, pm, first_gray):
     """The detector for ``config``'s objects: one per target style, merged when styles mix."""

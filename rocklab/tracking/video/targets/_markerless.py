@@ -40,7 +40,8 @@ ball's dark and lit sides stay with the light) when the film ends before its vie
 object (a ball) reports the place of its disk's centre: its texture slides over it as it spins, so
 its points are moved to within :data:`DISK_AGREE_FRAC` of where the outline puts that centre; once
 its angle is known not to be reported (a round outline), its points come from the pose turned back
-to the first angle about that centre, so that no point hangs on the texture's angle.
+to the first angle about that centre, so that no point hangs on the texture's angle; the frames
+tracked before are moved the same way once the track is assembled (:meth:`MarkerlessTracker.disk_lever`).
 """
 
 from __future__ import annotations
@@ -223,6 +224,7 @@ class MarkerlessTracker:
         th0 = obj.theta0_rad or 0.0
         c, s = math.cos(-th0), math.sin(-th0)
         self.obj_pts = (q - centre) @ np.array([[c, -s], [s, c]]).T
+        self._obj_frame = (centre, th0)  # the point reported and the first angle, plane units
         self._cv2 = cv2
         self.centre0 = self.origin + np.array(self.size, float) / 2  # template centre, first-frame px
         self.verifier = PoseVerifier(first_gray, (u0, v0, u1, v1), self.size)
@@ -256,6 +258,7 @@ class MarkerlessTracker:
         self.theta_hold = 0.0
         #: the disk's centre in the first frame (first-frame px) once an outline found it, or None
         self.disk_c0 = None
+        self.round_at = None  # the frame :attr:`round_note` was set at
 
     # -- registration -------------------------------------------------------------
     def _window(self, gray, W, margin):
@@ -543,6 +546,29 @@ class MarkerlessTracker:
         c = self.disk_c0
         return _euclid(0.0, *(W[:, :2].astype(float) @ c + W[:, 2] - c))
 
+    def disk_lever(self):
+        """``(d_pose, d_first, th0, frame)`` for an object whose angle was found unmeasurable on
+        the way (a round outline, :attr:`round_note`, at ``frame``): its disk's centre in the
+        object's own frame (the frame of :attr:`obj_pts`, plane units) where the poses put it
+        (``d_pose``: :class:`._occlusion.SeenDisk` learned it under them) and where the first
+        frame shows it (``d_first``), and the first angle ``th0`` (rad); else None.
+
+        The frames tracked before the angle was dropped report the point as the texture turned
+        it; with no angle reported, the point is the one the disk's centre carries without
+        turning: ``t + s R(theta) d_pose - R(th0) d_first`` for a frame fitted at ``(t, theta, s)``
+        (PhysTrack RollingCylinder, the box moved by 10 %: 8-9 px off on the 35 frames before
+        the note)."""
+        if self.round_note is None or self.disk_c0 is None:
+            return None
+        centre, th0 = self._obj_frame
+        c, s = math.cos(-th0), math.sin(-th0)
+        seen = self.verifier.seen_disk.pose_c
+        pose_c = self.disk_c0 if seen is None else seen
+        d_pose, d_first = (
+            (self.pm.to_plane(p[None, :])[0] - centre) @ np.array([[c, -s], [s, c]]).T for p in (pose_c, self.disk_c0)
+        )
+        return d_pose, d_first, th0, self.round_at
+
     def _sigma_theta(self, tmpl, gray, W, mask=None):
         """Gauss-Newton σ of θ (rad) of ``tmpl`` registered by ``W`` (:func:`._observability.sigma_theta`)."""
         warped = self._warp_back(gray, W)
@@ -656,7 +682,10 @@ class MarkerlessTracker:
             return None
         self.verifier.confirm(gray, self.size)
         self._round_check(first_view, frame)
+        if self.round_note is not None and self.round_at is None:
+            self.round_at = frame
         (W, cc), mask, visible, why, sig, W_pts = self._settle(tmpl, gray, fit, mask, visible)
+        self.verifier.seen_disk.held = why is not None  # the poses the next looks are taken under
         W_pts = self._upright_disk(W, W_pts)
         self.poses = (self.poses + [self._centred(W)])[-2:]
         self.twins.remember(frame, gray, W[:, :2].astype(float) @ self.centre0 + W[:, 2])
@@ -927,6 +956,11 @@ class MarkerlessDetector:
         judge), or None: if the film ends so, no frame's angle is reported."""
         t = self.trackers.get(oid)
         return None if t is None or t.theta_note or t.round_note else t.shading_note
+
+    def disk_lever(self, oid):
+        """:meth:`MarkerlessTracker.disk_lever` of object ``oid``."""
+        t = self.trackers.get(oid)
+        return None if t is None else t.disk_lever()
 
     def theta_unmatched(self, oid):
         """(frames verified, frames among them whose angle was not a measurement) of object ``oid``."""

@@ -28,7 +28,11 @@ round it.)
 
 **Disk**: a round outline's centre (:func:`disk`: the smallest circle round the blob standing out
 of the background, its pale parts included; a disk of the object's radius matched to the window
-where a change of the wall joins the blob) is the position of a ball, whose texture slides.
+where a change of the wall joins the blob) is the position of a ball, whose texture slides. A first
+frame that shows the disk joined by what held it, or not round at all, is corrected by the
+tracked frames (:class:`SeenDisk`): once several verified frames in a row show one round blob
+whose edge circle (:func:`edge_circle`: OpenCV's Hough transform on the frame itself, refined on
+the edge) keeps one radius at one place under the pose, that circle is the disk.
 """
 
 from __future__ import annotations
@@ -49,6 +53,8 @@ __all__ = [
     "roundness",
     "disk",
     "stable_disk",
+    "SeenDisk",
+    "edge_circle",
     "warp_grown",
     "pair",
     "subpixel_peak",
@@ -529,6 +535,187 @@ class OutlineRef:
         """Whether a :meth:`locate` result says the pose has left the object."""
         slide, cc, _ = found
         return slide > DRIFT_FRAC * max(self.size) or cc < MIN_SIL_CC
+
+
+#: Verified frames looked at for the object's disk as the tracked frames show it (:class:`SeenDisk`):
+#: this many in a row must show one round blob for the disk to be learned from them ...
+SEEN_DISK_FRAMES = 10
+#: ... of one radius (each within this fraction of their median) ...
+SEEN_DISK_RADIUS = 0.05
+#: ... at one place on the object under the pose (each within this fraction of the radius of
+#: their median); and it is looked for on at most this many verified frames (a block's outline is
+#: never round: the look costs a few morphology passes a frame).
+SEEN_DISK_PLACE = 0.1
+SEEN_DISK_LOOKS = 90
+#: A disk learned under poses whose angle was mostly held, not measured, is placed in the first
+#: frame by its edge circle there, of a radius within these fractions of the learned one (a held
+#: pose puts the disk's first place 3 px off where the first frame shows its edge: PhysTrack
+#: RollingCylinder, a 33 px box); under measured poses its place under them is kept (the first
+#: frame's edge, a hand joining it, was 1 px off for a 37 px box, the poses' 0.7 px).
+FIRST_EDGE_RADII = (0.9, 1.1)
+
+
+#: The circle of a disk's edge (:func:`edge_circle`) is looked for with radii from this fraction of
+#: its blob's enclosing circle's to a little over it: a shadow or a rim joined to the blob only
+#: enlarges its enclosing circle (the development film's disc: 19.5 px blob, 15.2 px edge).
+EDGE_RADIUS_RANGE = (0.6, 1.05)
+
+
+def edge_circle(img, near, r_blob, radii=EDGE_RADIUS_RANGE):
+    """The circle of the strongest round edge of ``img`` (float32 grey, h x w) within half of
+    ``r_blob`` of ``near`` (x, y px), its radius within ``radii`` (fractions) of ``r_blob``
+    (OpenCV's gradient Hough transform, the variant that scores each circle's completeness):
+    centre (2,) px and radius px, or None. A disk's edge against its background places it where
+    the blob standing out of the background does not: a soft shadow, or a hand holding it, joins
+    the blob and not the edge."""
+    import cv2
+
+    u8 = np.clip(img, 0, 255).astype(np.uint8)
+    lo, hi = (int(math.floor(k * r_blob)) for k in radii)
+    if lo < 3:
+        return None
+    found = cv2.HoughCircles(
+        cv2.GaussianBlur(u8, (0, 0), 1.0),
+        cv2.HOUGH_GRADIENT_ALT,
+        1,
+        r_blob,
+        param1=300,
+        param2=0.7,
+        minRadius=lo,
+        maxRadius=hi + 1,
+    )
+    if found is None:
+        return None
+    for x, y, r in found[0]:  # strongest first
+        if math.hypot(x - near[0], y - near[1]) <= 0.5 * r_blob:
+            return _refine_circle(u8, np.array([x, y], float), float(r))
+    return None
+
+
+#: Rays cast from a circle's centre to refine it (:func:`_refine_circle`), the band searched along
+#: each (px either side of the circle) and the residual beyond which an edge point is left out.
+REFINE_RAYS = 48
+REFINE_BAND_PX = 3.0
+REFINE_OUT_PX = 1.5
+
+
+def _refine_circle(u8, c, r):
+    """The circle ``(c, r)`` (px; the Hough transform's, on whole pixels) fitted to the strongest
+    edge along :data:`REFINE_RAYS` rays within :data:`REFINE_BAND_PX` of it (least squares, the
+    points over :data:`REFINE_OUT_PX` off the first fit left out): to a tenth of a pixel where the
+    edge is clear; the Hough circle where the fit moves it by over a pixel or half the band."""
+    import cv2
+
+    g = cv2.GaussianBlur(u8, (0, 0), 1.0).astype(np.float32)
+    mag = cv2.magnitude(cv2.Sobel(g, cv2.CV_32F, 1, 0), cv2.Sobel(g, cv2.CV_32F, 0, 1))
+    a = np.linspace(0.0, 2 * math.pi, REFINE_RAYS, endpoint=False)[:, None]
+    rho = np.arange(r - REFINE_BAND_PX, r + REFINE_BAND_PX + 1e-9, 0.25)[None, :]
+    mx, my = (c[0] + rho * np.cos(a)).astype(np.float32), (c[1] + rho * np.sin(a)).astype(np.float32)
+    prof = cv2.remap(mag, mx, my, cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT, borderValue=0.0)
+    k = np.argmax(prof, axis=1)
+    keep = prof[np.arange(len(k)), k] > 0
+    pts = np.column_stack((mx[np.arange(len(k)), k], my[np.arange(len(k)), k]))[keep].astype(float)
+    fit = None
+    for _ in range(2):
+        if len(pts) < REFINE_RAYS // 2:
+            return c, r
+        A = np.column_stack((2 * pts, np.ones(len(pts))))
+        sol = np.linalg.lstsq(A, (pts**2).sum(1), rcond=None)[0]
+        fit = (sol[:2], math.sqrt(max(sol[2] + sol[0] ** 2 + sol[1] ** 2, 0.0)))
+        pts = pts[np.abs(np.hypot(*(pts - fit[0]).T) - fit[1]) <= REFINE_OUT_PX]
+    if fit is None or np.hypot(*(fit[0] - c)) > 1.0 or abs(fit[1] - r) > 0.5 * REFINE_BAND_PX:
+        return c, r
+    return fit[0], fit[1]
+
+
+class SeenDisk:
+    """An object's disk as its own verified frames show it, where its first frame did not.
+
+    The first frame may show a round object joined by what held it (a hand at the edge of a disc
+    about to roll: a blob of radius 19.9 px for a 16 px disc, its centre 3 px towards the hand),
+    or not round at all. Once :data:`SEEN_DISK_FRAMES` verified frames in a row show one round
+    blob (circularity at least :data:`ROUND_MIN`, :func:`stable_disk`) of one radius at one place
+    under the pose (first-frame px), that is the object's disk: its place under the pose is where
+    the first frame would have shown it alone. A blob that slides under the pose (a spinning
+    ball's texture carries the pose) or changes size (a hand, a shadow) teaches nothing.
+
+    Attributes
+    ----------
+    disk : tuple or None
+        ``(centre (2,) first-frame px, radius px, circularity)`` once learned.
+    """
+
+    def __init__(self):
+        self.disk = None
+        #: the learned disk's centre where the poses put it (first-frame px), before
+        #: :meth:`place_first` moved it to the first frame's edge circle
+        self.pose_c = None
+        self.looks = 0
+        #: whether the poses the looks are now taken under hold an angle they did not measure
+        self.held = False
+        self._held_share = 0.0
+        self._run: list = []
+
+    @property
+    def done(self) -> bool:
+        """Nothing more to look for: learned, or looked for on :data:`SEEN_DISK_LOOKS` frames."""
+        return self.disk is not None or self.looks >= SEEN_DISK_LOOKS
+
+    def look(self, tr, grown, margin2):
+        """The round blob in ``grown`` (frame and background resampled by the pose onto the
+        template's grid grown by ``margin2`` px, :func:`pair`): ``(centre first-frame px under the
+        pose, radius px, circularity)``, or None when it is not round."""
+        f = min(1.0, DISK_SIDE_PX / max(grown.shape[:2]))
+        if f < 1.0:
+            grown = _reduce(grown, f)
+        d = stable_disk(grown[..., 0], grown[..., 1])
+        if d is None or d[2] < ROUND_MIN:
+            return None
+        c = edge_circle(grown[..., 0], d[0], d[1])
+        if c is None:
+            return None
+        return c[0] / f - margin2 + tr.origin, c[1] / f, d[2]
+
+    def add(self, seen) -> bool:
+        """Count one verified frame's :meth:`look` (None: not round); True when the disk is
+        learned with it."""
+        self.looks += 1
+        self._run = [] if seen is None else (self._run + [(*seen, self.held)])[-SEEN_DISK_FRAMES:]
+        if len(self._run) < SEEN_DISK_FRAMES:
+            return False
+        c = np.array([s[0] for s in self._run])
+        r = np.array([s[1] for s in self._run])
+        cm, rm = np.median(c, axis=0), float(np.median(r))
+        if np.all(np.abs(r - rm) <= SEEN_DISK_RADIUS * rm) and np.all(np.hypot(*(c - cm).T) <= SEEN_DISK_PLACE * rm):
+            self.disk = (cm, rm, float(np.median([s[2] for s in self._run])))
+            self._held_share = float(np.mean([s[3] for s in self._run]))
+            return True
+        return False
+
+    def place_first(self, first, at) -> None:
+        """Move the learned disk's centre to its edge circle in ``first`` (the first frame's part
+        whose corner is at ``at`` (x, y), first-frame px; float32), where one of its radius lies
+        near (:data:`FIRST_EDGE_RADII`), when it was learned under poses mostly :attr:`held`;
+        kept as learned otherwise."""
+        if self.disk is None:
+            return
+        c, r, circ = self.disk
+        self.pose_c = c
+        if self._held_share <= 0.5:
+            return
+        e = edge_circle(first, c - np.asarray(at, float), r, FIRST_EDGE_RADII)
+        if e is not None:
+            self.disk = (e[0] + np.asarray(at, float), r, circ)
+
+    def teach(self, ref) -> None:
+        """Give the learned disk to the outline ``ref`` (an :class:`OutlineRef`) where its first
+        frame's disk is missing or of another size (:data:`DISK_RADIUS_TOL`)."""
+        if self.disk is None or ref is None:
+            return
+        c, r, circ = self.disk
+        if ref.disk0 is None or abs(ref.disk0[1] - r) > DISK_RADIUS_TOL * r:
+            ref.disk0 = (c, r)
+            ref.roundness = max(ref.roundness, circ) if math.isfinite(ref.roundness) else circ
 
 
 def _reduce(img, f):

@@ -70,7 +70,9 @@ and, for the outline, its own first frame:
   check); run on the frames the other checks find doubtful and on a sample of the rest.
 * **disk** (not a check: the position a ball reports): for a round outline, the centre of the
   object's disk against the background (:meth:`._occlusion.OutlineRef.disk_centre`), kept in
-  :attr:`PoseVerifier.disk_at` for the tracker.
+  :attr:`PoseVerifier.disk_at` for the tracker; the disk itself is learned again from the
+  verified frames' edge circle where the first frame's is missing or of another size
+  (:class:`._occlusion.SeenDisk`: a hand held the disc in the first frame).
 
 A frame that fails is lost with that reason; only verified frames renew the keyframe and teach
 the limits, so a wrong lock cannot teach the tracker to accept itself.
@@ -84,7 +86,7 @@ import math
 
 import numpy as np
 
-from ._occlusion import OUTLINE_MARGIN_FRAC, ROUND_MIN, OutlineRef, pair, warp_grown
+from ._occlusion import OUTLINE_MARGIN_FRAC, ROUND_MIN, OutlineRef, SeenDisk, pair, warp_grown
 from ._roundtrip import RoundTrip
 
 __all__ = ["PoseVerifier", "Window", "search_whole_frame", "MIN_SCORE", "MAX_STEP_RAD"]
@@ -240,6 +242,9 @@ class PoseVerifier:
         self.hint = None  # a pose that failed the outline, moved onto the outline
         #: a round object's disk centre in the last frame verified (image px), or None
         self.disk_at = None
+        #: the disk as the verified frames show it (a first frame joined by a hand, or not round)
+        self.seen_disk = SeenDisk()
+        self._disk_look: tuple | None = None  # the pose being verified's look for it
         H, W = first_gray.shape[:2]
         m = self.margin
         self.outer = (max(box[0] - m, 0), max(box[1] - m, 0), min(box[2] + m, W), min(box[3] + m, H))
@@ -470,6 +475,7 @@ class PoseVerifier:
             # outline without a disk overrides the first (a disk drawn too large against the first
             # frame round the region)
             ref.disk0 = self.outline.disk0
+        self.seen_disk.teach(ref)
         self.outline = ref
         if self.filled:
             self.first = None  # needed no more
@@ -495,7 +501,7 @@ class PoseVerifier:
         if self.since_lost:  # what stands in the first region now, the frame checked included
             self._sample(gray, frame, tr.min_cc)
         bg = back = bg_g = back_g = None
-        self.hint = self.disk_at = None
+        self.hint = self.disk_at = self._disk_look = None
         if not (0.0 <= centre[0] < gray.shape[1] and 0.0 <= centre[1] < gray.shape[0]):
             return "lost"  # the point reported would lie outside the picture: no measurement
         # the background is known where the first frame did not show the object, and everywhere
@@ -538,6 +544,8 @@ class PoseVerifier:
                 # the poses since the last frame checked here were the slide: no anchor for motion
                 reason, self.hint, self.recent = "drift", found[2], []
             elif found is not None:
+                if not self.seen_disk.done:
+                    self._disk_look = (self.seen_disk.look(tr, grown, 2 * self.margin),)
                 self.disk_at = self.outline.disk_centre(tr, W, grown)
         self._pending = (float(score), centre, theta, pred, last2, gap, frame)
         return reason
@@ -693,6 +701,9 @@ class PoseVerifier:
     def confirm(self, gray, size):
         """Learn from the pose just verified (its correlation, motion and the background it uncovers)."""
         score, centre, theta, pred, last, gap, frame = self._pending
+        if self._disk_look is not None and self.seen_disk.add(self._disk_look[0]):
+            self.seen_disk.place_first(self.first_outer, self.outer[:2])
+            self.seen_disk.teach(self.outline)
         if math.isfinite(self._contrast):
             self.contrasts.append(self._contrast)
         if math.isfinite(self._view):

@@ -199,3 +199,59 @@ def test_a_damaged_frame_in_the_middle_stops_the_run_naming_it(synth, run_cli, t
     rc, _, err = run_cli("track", folder, "--config", d / "track.toml", "--fps", 50, "-o", tmp_path / "t.csv")
     assert rc == 2 and "frame_00017.png: cannot decode the image" in err and len(err.strip().splitlines()) == 1
     assert not (tmp_path / "t.csv").exists()
+
+
+def _moving_patch_folder(tmp_path, n=8, step_px=2):
+    """PNG frames (160x120) of a random-textured 24x24 patch moving ``step_px`` right per frame."""
+    rng = np.random.default_rng(7)
+    patch = rng.integers(30, 230, (24, 24)).astype(np.uint8)
+    f = tmp_path / "frames"
+    f.mkdir()
+    for i in range(n):
+        g = np.full((120, 160), 128, np.uint8)
+        g[48:72, 40 + step_px * i : 64 + step_px * i] = patch
+        cv2.imwrite(str(f / f"f_{i:03d}.png"), g)
+    return f
+
+
+@pytest.mark.parametrize("rate", [12.5, 30.0])
+def test_track_init_on_a_folder_without_a_rate_exits_2_and_fps_sets_the_times(tmp_path, run_cli, rate):
+    f = _moving_patch_folder(tmp_path)
+    toml = tmp_path / "track.toml"
+    rc, _, err = run_cli("track", "init", f, "--object", "p=36,44,32,32", "-o", toml)
+    # no guessed 50 fps: every time, velocity and frequency would be off by 50 / rate
+    assert rc == 2 and not toml.exists()
+    assert err.count("\n") == 1 and str(f) in err and "no frame rate" in err and "--fps N" in err
+    assert "Traceback" not in err
+    rc, _, err = run_cli("track", "init", f, "--object", "p=36,44,32,32", "-o", toml, "--fps", rate)
+    assert rc == 0, err
+    rc, _, err = run_cli("track", f, "--config", toml, "-o", tmp_path / "t.csv")
+    assert rc == 0, err
+    t = pd.read_csv(tmp_path / "t.csv")
+    np.testing.assert_allclose(t.t_s.to_numpy(), t.frame.to_numpy() / rate, rtol=1e-12)
+    # the patch moves 2 px a frame: rate * 2 px/s, measured from the track
+    v = np.polyfit(t.t_s, t.x_px, 1)[0]
+    assert v == pytest.approx(2.0 * rate, rel=0.02)
+
+
+def test_an_old_configs_placeholder_fps_is_not_read_as_the_rate(tmp_path, run_cli):
+    from rocklab.config import FPS_PLACEHOLDER_NOTE, load_track_config
+
+    f = _moving_patch_folder(tmp_path)
+    toml = tmp_path / "track.toml"
+    assert run_cli("track", "init", f, "--object", "p=36,44,32,32", "-o", toml, "--fps", 50)[0] == 0
+    text = toml.read_text()
+    assert "fps = 50.0" in text and FPS_PLACEHOLDER_NOTE not in text  # a rate given is a rate
+    assert load_track_config(toml).video.fps == 50.0
+    old = tmp_path / "old.toml"  # as 'track init' wrote it for a film without a rate, before session 19
+    old.write_text(f"# {FPS_PLACEHOLDER_NOTE}\n" + text)
+    assert load_track_config(old).video.fps is None
+    rc, _, err = run_cli("track", f, "--config", old, "-o", tmp_path / "t.csv")
+    assert rc == 2 and err.count("\n") == 1 and str(old) in err and "--fps N" in err and "delete that note" in err
+    rc, _, err = run_cli("track", f, "--config", old, "-o", tmp_path / "t.csv", "--fps", 25)
+    assert rc == 0, err
+    t = pd.read_csv(tmp_path / "t.csv")
+    np.testing.assert_allclose(t.t_s.to_numpy(), t.frame.to_numpy() / 25.0, rtol=1e-12)
+    # another rate under the note is the user's correction: read
+    old.write_text(old.read_text().replace("fps = 50.0", "fps = 22.67"))
+    assert load_track_config(old).video.fps == 22.67

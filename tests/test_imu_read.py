@@ -319,3 +319,64 @@ def test_fusion_example_rest_bias_and_first_motion(shared_data):
         rot = block_rotation(read_imu(p))
     assert 12.0 < rot.release_t_s < 13.0
     assert np.allclose(np.rad2deg(rot.gyro_bias_rad_s), rest_mean, atol=0.02)
+
+
+def _phyphox(tmp_path, cols, n=300, end="", rate_hz=100.0):
+    """A phyphox-style export (quoted header, scientific values, no final newline by default):
+    gyroscope axes 0.5 sin, 0.3 cos, 0.1 (rad/s); accelerometer (0, 0, G) m/s^2."""
+    t = np.arange(n) / rate_hz
+    vals = {
+        "Gyroscope x (rad/s)": 0.5 * np.sin(2 * np.pi * t),
+        "Gyroscope y (rad/s)": 0.3 * np.cos(2 * np.pi * t),
+        "Gyroscope z (rad/s)": np.full(n, 0.1),
+        "Accelerometer X (m/s^2)": np.zeros(n),
+        "Accelerometer Y (m/s^2)": np.zeros(n),
+        "Accelerometer Z (m/s^2)": np.full(n, G),
+    }
+    names = ["Time (s)"] + cols
+    rows = [",".join(f"{v:.9E}" for v in [t[i]] + [vals[c][i] for c in cols]) for i in range(n)]
+    p = tmp_path / "Raw Data.csv"
+    p.write_text(",".join(f'"{c}"' for c in names) + "\n" + "\n".join(rows) + end)
+    return p, vals
+
+
+def test_a_gyroscope_only_log_is_refused_saying_an_accelerometer_is_needed(tmp_path):
+    p, _ = _phyphox(tmp_path, [f"Gyroscope {a} (rad/s)" for a in "xyz"])
+    with collecting() as found, pytest.raises(InputError) as e:
+        read_imu(p)
+    msg = str(e.value)
+    assert "\n" not in msg and str(p) in msg and "gyroscope only (rad/s)" in msg and "accelerometer" in msg
+    # no fix that cannot be done (renaming accelerometer columns there are none of), no deg/s names
+    assert "rename" not in msg and "deg/s" not in msg
+    assert [d.code for d in found] == []  # its last line is whole: not called incomplete
+
+
+def test_a_whole_last_line_without_newline_is_kept_and_rad_s_stays_rad_s(tmp_path):
+    cols = [f"Gyroscope {a} (rad/s)" for a in "xyz"] + [f"Accelerometer {a} (m/s^2)" for a in "XYZ"]
+    for end in ("", "\n"):
+        p, vals = _phyphox(tmp_path, cols, end=end)
+        with collecting() as found:
+            log = read_imu(p)
+        assert [d.code for d in found] == [] and log.n == 300
+        # the last row is read, in rad/s as written (deg/s would scale it by 1/57.3)
+        assert log.gyro_rad_s[-1, 0] == pytest.approx(vals["Gyroscope x (rad/s)"][-1], rel=1e-8)
+        assert log.gyro_rad_s[-1, 1] == pytest.approx(vals["Gyroscope y (rad/s)"][-1], rel=1e-8)
+        assert log.acc_m_s2[-1, 2] == pytest.approx(G, rel=1e-8)
+        assert log.rate_hz == pytest.approx(100.0, rel=1e-6)
+    text = p.read_text().rstrip("\n")
+    for cut, n_fields in ((text.rsplit(",", 2)[0], 5), (text.rsplit(",", 1)[0] + ",", 7)):
+        p.write_text(cut)  # the logger stopped mid-line: fields missing, or the last one empty
+        with collecting() as found:
+            log = read_imu(p)
+        assert [d.code for d in found] == ["W-IMU-TRUNCATED"] and log.n == 299
+        assert f"line 301: last line cut short ({n_fields} of 7 fields" in found[0].message
+
+
+def test_missing_columns_name_a_unit_for_each_suggested_column(tmp_path):
+    cols = [f"Gyroscope {a} (rad/s)" for a in "xyz"] + [f"Accelerometer {a} (m/s^2)" for a in "XY"]
+    p, _ = _phyphox(tmp_path, cols, end="\n")
+    with pytest.raises(InputError) as e:
+        read_imu(p)
+    msg = str(e.value)
+    assert "missing columns Accelerometer Z;" in msg
+    assert "'Gyroscope X (rad/s)' (or '(deg/s)')" in msg and "'Accelerometer Z (m/s^2)' (or '(g)')" in msg

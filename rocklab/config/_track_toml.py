@@ -68,6 +68,7 @@ __all__ = [
     "MotionConfig",
     "ObjectConfig",
     "load_track_config",
+    "FPS_PLACEHOLDER_NOTE",
     "schema_markdown",
     "TARGET_STYLES",
     "MARKER_STYLES",
@@ -412,6 +413,11 @@ def _known(cls) -> set:
     return {f.name for f in dataclasses.fields(cls)} - {"source"}
 
 
+#: The note under which 'rocklab track init' (up to session 18) wrote ``fps = 50`` for a film with
+#: no frame rate: a guess, not a rate, so such a config is read as giving none.
+FPS_PLACEHOLDER_NOTE = "the film has no frame rate: fps = 50 written; correct it (or give --fps)"
+
+
 # ---------------------------------------------------------------------- reading
 def _read(doc: TomlDoc) -> TrackConfig:
     d = doc.data
@@ -464,6 +470,8 @@ def _video(doc, d) -> VideoConfig:
     s = ("video",)
     doc.reject_unknown(s, d, _known(VideoConfig))
     fps = _get(doc, d, s, VideoConfig, "fps", positive=True)
+    if fps == 50.0 and doc.text is not None and FPS_PLACEHOLDER_NOTE in doc.text:
+        fps = None  # the placeholder: tracking asks for --fps unless the film has its own rate
     start = _get(doc, d, s, VideoConfig, "start_frame", integer=True)
     stop = _get(doc, d, s, VideoConfig, "stop_frame", integer=True)
     if start < 0 or (stop is not None and stop <= start):

@@ -22,14 +22,25 @@ def _per_frame(info) -> int:
     return 2 if info.field_order is not None else 1
 
 
-def _first_frame(video: Path, start_frame=None):
-    """(info, grey, BGR, start frame, note) of the first frame tracked: ``start_frame`` when given,
-    else the first frame after a lead-in of blank, fading-in or cut-away frames (a note says so)."""
+def _first_frame(video: Path, start_frame=None, fps=None):
+    """(info, grey, BGR, start frame, note, the film's own rate or None) of the first frame tracked:
+    ``start_frame`` when given, else the first frame after a lead-in of blank, fading-in or
+    cut-away frames (a note says so). ``info.fps`` is the film's own rate, else ``fps``; a film
+    with neither is refused."""
     from ...tracking.video import iter_video_frames, lead_in, probe_video
 
     if not video.exists():
         raise InputError(f"{video}: video not found; check the path")
     info = probe_video(video)
+    own_fps = info.fps
+    if not info.fps:
+        # a rate guessed here would scale every time, velocity and frequency of the run
+        if not fps:
+            raise InputError(
+                f"{video}: the film has no frame rate (an image folder has one only from its timestamps.csv); "
+                "give the rate it was filmed at: --fps N"
+            )
+        info = dataclasses.replace(info, fps=float(fps))
     per = _per_frame(info)
     n = per * (info.n_frames or 0)
     if start_frame is not None and n and not 0 <= start_frame < n:
@@ -50,7 +61,7 @@ def _first_frame(video: Path, start_frame=None):
     for _, gray, img in iter_video_frames(
         video, start_frame, start_frame + 1, color=True, pixel_aspect=info.pixel_aspect, fields=info.field_order
     ):
-        return info, gray, img, start_frame, note
+        return info, gray, img, start_frame, note, own_fps
     raise InputError(f"{video}: frame {start_frame} could not be decoded; check the file (or --start-frame)")
 
 
@@ -181,7 +192,7 @@ def track_init(
     from .._plotting import save_bgr_png
 
     video, out = Path(video), Path(out)
-    info, gray, img, start, lead_note = _first_frame(video, start_frame)
+    info, gray, img, start, lead_note, own_fps = _first_frame(video, start_frame, fps)
     regions = {}
     for spec in objects:
         name, sep, box = str(spec).partition("=")
@@ -213,7 +224,7 @@ def track_init(
         gray,
         regions=regions or None,
         table_roi=troi,
-        fps=fps if fps else (None if info.fps else 50.0),
+        fps=fps or None,
         marker_size_m=marker_size_m,
         found=found,
         level_line_px=line,
@@ -229,11 +240,11 @@ def track_init(
     if lens_rel is not None:
         cfg = dataclasses.replace(cfg, video=dataclasses.replace(cfg.video, calibration=lens_rel))
         notes.append(f"lens {lens_rel}: detected points are undistorted with it before any geometry")
-    if not info.fps and not fps:
-        notes.append("the film has no frame rate: fps = 50 written; correct it (or give --fps)")
+    if not own_fps:
+        notes.append(f"the film has no frame rate of its own: fps = {fps:g} written from --fps")
     head = [
         f"track.toml written by 'rocklab track init' from {video.name} ({info.width_px}x{info.height_px}, "
-        f"{info.n_frames} frames, {info.fps or 'unknown'} fps)" + (f", from frame {start}" if start else ""),
+        f"{info.n_frames} frames, {own_fps or 'unknown'} fps)" + (f", from frame {start}" if start else ""),
         "Schema: docs/track-toml.md",
         *notes,
     ]
@@ -489,7 +500,12 @@ def track_preview(
         fixes = load_corrections(fixes)
         cfg = replace(cfg, video=replace(cfg.video, corrections=None))
     # frames (fields) in the span: the container's rate, or the config's when it has none
-    rate = (fps or vinfo.fps or cfg.video.fps or 50.0) * (2 if vinfo.field_order is not None else 1)
+    if not (fps or vinfo.fps or cfg.video.fps):
+        raise InputError(
+            f"{video}: the film has no frame rate (an image folder has one only from its timestamps.csv); "
+            f"pass --fps N (or set [video] fps in {cfg.source or 'the config'})"
+        )
+    rate = (fps or vinfo.fps or cfg.video.fps) * (2 if vinfo.field_order is not None else 1)
     if at_s is not None:
         n_all = vinfo.n_frames * (2 if vinfo.field_order is not None else 1)
         if vinfo.frame_times_s is not None and not fps and len(vinfo.frame_times_s):

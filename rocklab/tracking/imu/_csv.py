@@ -106,7 +106,11 @@ def read_csv(path: Path):
 
 def _complete_rows(path: Path) -> int | None:
     """Data rows to read when the file's last line is incomplete (a logger stopped mid-write:
-    no final newline), else None. The cut line is dropped with ``W-IMU-TRUNCATED``."""
+    no final newline and fewer fields than the header, or an empty last field), else None. The
+    cut line is dropped with ``W-IMU-TRUNCATED``; a whole last line that only lacks its newline
+    (as phyphox writes its exports) is kept."""
+    import csv
+
     try:
         with open(path, "rb") as fh:
             fh.seek(0, 2)
@@ -117,14 +121,23 @@ def _complete_rows(path: Path) -> int | None:
             if fh.read(1) in (b"\n", b"\r"):
                 return None
             fh.seek(0)
-            n_lines = fh.read().count(b"\n")  # complete lines, header included
+            data = fh.read()
     except OSError:
         return None
+    n_lines = data.count(b"\n")  # complete lines, header included
     if n_lines < 2:
+        return None
+    head = data[: data.index(b"\n")].decode("utf-8", "replace").rstrip("\r")
+    last = data[data.rindex(b"\n") + 1 :].decode("utf-8", "replace")
+    names, fields = next(csv.reader([head]), []), next(csv.reader([last]), [])
+    if len(fields) == len(names) and (fields[-1].strip() or not names[-1].strip()):
         return None
     from ..._diagnostics import warn
 
-    warn("W-IMU-TRUNCATED", f"{path}, line {n_lines + 1}: incomplete last line (no newline) dropped")
+    warn(
+        "W-IMU-TRUNCATED",
+        f"{path}, line {n_lines + 1}: last line cut short ({len(fields)} of {len(names)} fields, no newline) dropped",
+    )
     return n_lines - 1
 
 
@@ -161,13 +174,26 @@ def inertial_columns(df, path: Path) -> dict[str, tuple[str, float]]:
         found[role] = (col, table[unit])
     missing = [r for r in ROLES if r not in found]
     if missing:
-        names = ", ".join(("Gyroscope " if r.startswith("gyro") else "Accelerometer ") + r[-1].upper() for r in missing)
-        raise InputError(
-            f"{where(path, 1)}missing columns {names}; rename the header's columns to x-io's "
-            "'Gyroscope X (deg/s)' ... 'Accelerometer Z (g)' (with 'Time (s)'), or from Python read it "
-            "with rocklab.tracking.imu.read_imu(path, mapping={column: 'role:unit'})"
-        )
+        raise InputError(_missing_message(path, found, missing))
     return found
+
+
+def _missing_message(path: Path, found: dict, missing: list) -> str:
+    """The one-line error for an inertial CSV without all six gyroscope/accelerometer columns."""
+    if all(r.startswith("acc_") for r in missing) and len(missing) == 3:
+        units = sorted({c.partition("(")[2].rstrip(") ") for c, _ in (found[f"gyro_{a}"] for a in "xyz")})
+        return (
+            f"{where(path, 1)}gyroscope only ({', '.join(units)}), no accelerometer column: rocklab reads no "
+            "gyroscope-only log, since a block's tilt and the gravity reference (a table's acceleration too) "
+            "come from a 3-axis accelerometer; record the accelerometer with the gyroscope in the same log"
+        )
+    names = ", ".join(("Gyroscope " if r.startswith("gyro") else "Accelerometer ") + r[-1].upper() for r in missing)
+    return (
+        f"{where(path, 1)}missing columns {names}; name the header's columns 'Gyroscope X (rad/s)' "
+        "(or '(deg/s)') ... 'Accelerometer Z (m/s^2)' (or '(g)'), each with the unit its values are in, "
+        "and 'Time (s)', or from Python read it with rocklab.tracking.imu.read_imu(path, "
+        "mapping={column: 'role:unit'})"
+    )
 
 
 def stack(df, cols, path) -> tuple[np.ndarray, np.ndarray]:

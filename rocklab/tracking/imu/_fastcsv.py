@@ -13,6 +13,7 @@ correctly); longer mantissas lose at most an ulp.
 
 from __future__ import annotations
 
+import csv
 from pathlib import Path
 
 import numpy as np
@@ -110,7 +111,8 @@ def parse_numeric_csv(path) -> tuple[list[str], np.ndarray] | None:
     if nl.size == 0:
         return None
     header = bytes(buf[: nl[0]]).decode("utf-8", errors="replace").rstrip("\r")
-    names = [h.strip() for h in header.split(",")]
+    # quoted names (phyphox: "Time (s)","Gyroscope x (rad/s)",...) read as pandas reads them
+    names = [h.strip() for h in next(csv.reader([header]), [])]
     start = int(nl[0]) + 1
     nrows = int(nl.size) - 1 + (1 if buf[-1] != 10 else 0)
     if nrows <= 0:

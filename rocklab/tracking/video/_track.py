@@ -37,7 +37,7 @@ from ._checks import (
     small_grey,
     tee,
 )
-from ...config import TrackConfig
+from ...config import FPS_PLACEHOLDER_NOTE, TrackConfig
 from ._camera_model import PlaneMap, fit_similarity
 from .targets import make_detector
 from .targets._observability import angle_free_objects, angle_note, warn_theta, warn_unmatched_angles
@@ -700,6 +700,24 @@ def _metres_per_unit(config, raw, metric_plane) -> dict:
     return m_per
 
 
+def _no_rate(path, config: TrackConfig) -> InputError:
+    """The one-line error for a film with no frame rate of its own and none given."""
+    where = config.source or "the config"
+    placeholder = False
+    if config.source is not None and os.path.isfile(config.source):
+        with open(config.source, encoding="utf-8", errors="replace") as f:
+            placeholder = FPS_PLACEHOLDER_NOTE in f.read()
+    told = (
+        f"; {where} has 'fps = 50' under the note '{FPS_PLACEHOLDER_NOTE}' (an older 'rocklab track init''s "
+        "guess, not read as the rate): pass --fps N, or set [video] fps to the rate and delete that note"
+        if placeholder
+        else f"; pass --fps N (or set [video] fps in {where})"
+    )
+    return InputError(
+        f"{path}: the film has no frame rate (an image folder has one only from its timestamps.csv){told}"
+    )
+
+
 def track_video(
     path, config: TrackConfig, fps: float | None = None, progress: bool = False, on_frame=None
 ) -> TrackResult:
@@ -763,10 +781,7 @@ def track_video(
             times = np.column_stack((times, times + half)).ravel()
         n_expected = 2 * info.n_frames
     if rate is None:
-        raise InputError(
-            f"{path}: the film has no frame rate (an image folder has one only from its timestamps.csv); "
-            "pass --fps N (or set [video] fps in the config)"
-        )
+        raise _no_rate(path, config)
     v = config.video
     fixes = load_corrections(v.corrections, [o.id for o in config.objects]) if v.corrections else ()  # errors first
     start, stop = v.start_frame, v.stop_frame

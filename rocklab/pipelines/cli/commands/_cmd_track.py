@@ -120,6 +120,8 @@ def run(args) -> int:
         raise InputError(f"--start-frame {args.start_frame}: give a frame number >= 0")
     if args.corrections is not None and args.video == "init":
         raise InputError("--corrections: applies to 'rocklab track' and 'track preview', not to 'track init'")
+    if args.fps is not None and not (math.isfinite(args.fps) and args.fps > 0):
+        raise InputError(f"--fps {args.fps}: must be a positive number of frames per second")
     if args.video in ("init", "preview"):
         return _tools(args)
     if args.video2 is not None:
@@ -140,8 +142,6 @@ def run(args) -> int:
     cfg_path = Path(args.config) if args.config else video.parent / "track.toml"
     if not cfg_path.exists():
         raise InputError(f"{cfg_path}: tracking config not found; pass --config track.toml")
-    if args.fps is not None and not (math.isfinite(args.fps) and args.fps > 0):
-        raise InputError(f"--fps {args.fps}: must be a positive number of frames per second")
     cfg = _with_corrections(load_track_config(cfg_path), args.corrections)
     res = track_video(video, cfg, fps=args.fps, progress=args.progress)
     out = Path(args.out) if args.out else video.parent / "tracks.csv"

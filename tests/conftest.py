@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import pytest
@@ -9,6 +10,37 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 SHARED = ROOT.parent / "shared"
 SHARED_DATA = SHARED / "data"
+
+#: the libraries' thread pools, sized from these variables when they load
+THREAD_VARS = (
+    "OPENCV_FOR_THREADS_NUM",
+    "OPENBLAS_NUM_THREADS",
+    "OMP_NUM_THREADS",
+    "MKL_NUM_THREADS",
+    "NUMBA_NUM_THREADS",
+)
+
+
+def _share_the_cores() -> None:
+    """Under pytest-xdist, size each worker's thread pools to its share of the cores.
+
+    Every library sizes its pool to the whole machine (OpenCV, three OpenBLAS copies, numba), so
+    N workers run N pools on the cores. A pool's waits spin: OpenCV's calling thread yields in a
+    loop until its helper, descheduled behind the other worker, finishes its stripe. In the suite
+    on 2 cores that turned 18 CPU-s of chessboard search (the test alone) into 107-219. Set here,
+    before any test imports them, and inherited by the CLI subprocesses the tests start; a
+    variable already set is kept, and a single process (``TEST_WORKERS=0``) keeps the defaults.
+    """
+    workers = int(os.environ.get("PYTEST_XDIST_WORKER_COUNT", "0") or 0)
+    if workers < 2:
+        return
+    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+    threads = max(1, cores // workers)
+    for var in THREAD_VARS:
+        os.environ.setdefault(var, str(threads))
+
+
+_share_the_cores()
 
 
 @pytest.fixture(scope="session")

@@ -340,14 +340,17 @@ def warn_theta(config, oid, why, frame=None):
 
 def warn_unmatched_angles(config, detector) -> None:
     """W-TRACK-THETA for each object whose angle was dropped on some frames because the parts of
-    its region that tell the angle did not match the pose (:func:`unmatched_turn_share`)."""
+    its region that tell the angle did not match the pose (:func:`unmatched_turn_share`). Not for
+    an object whose angle awaits the shading verdict at the film's end: its angle is dropped on
+    every frame, and that warning says why."""
     from ...._diagnostics import warn
 
     if detector is None or not hasattr(detector, "theta_unmatched"):
         return
+    pending = getattr(detector, "theta_pending", lambda oid: None)
     for o in config.objects:
         n, k = detector.theta_unmatched(o.id)
-        if k:
+        if k and pending(o.id) is None:
             warn(
                 "W-TRACK-THETA",
                 f"{config.source or 'config'}: object {o.id!r}: theta not measured on {k} of {n} frames "

@@ -15,12 +15,7 @@ and, for the outline, its own first frame:
   from a lamp or a hand that the template half matched would otherwise follow it at 0.99; on the
   frame after a verified one, while cold, it must still match that first view or its smear at
   :data:`COLD_STEP_CC` (a ball let go from the fingers drawn into its region leaves the keyframe
-  on the fingers, renewed there, with nothing learned to refuse them). Once the limits are
-  learned, a pose whose keyframe correlation is below :data:`COLD_FIRST_CC` must match the first
-  view (or its smear) as closely as the object's own verified frames did
-  (:meth:`PoseVerifier.view_limit`), at most at :data:`COLD_FIRST_CC`: a ball held still for
-  longer than the warm-up taught a floor that passes the fingers, but never strayed from its
-  first view. So must, at
+  on the fingers, renewed there, with nothing learned to refuse them). So must, at
   any time, a pose found after lost frames (or after a slide) farther than the template's larger
   side both from the last verified pose and from where its velocity carries it: the motion
   vouches for nothing there, and a small ball's keyframe half matches a forearm or an edge;
@@ -267,9 +262,6 @@ class PoseVerifier:
         self._contrast = math.nan  # the pose being verified's
         self.residuals = Window(300)
         self.speeds = Window(300)
-        #: the verified frames' correlation with the first view (:meth:`_look_again`)
-        self.views = Window(300)
-        self._view = math.nan  # the pose being verified's
         self.n_verified = 0
         self._limits, self._learned_at = None, 0
         #: (median, robust deviation) of the verified correlations, once learned
@@ -312,14 +304,6 @@ class PoseVerifier:
         dev = max(1.4826 * float(np.median(np.abs(s - med))), MIN_DEVIATION)
         self.score_stats = (med, dev)
         return max(MIN_SCORE, med - APPEARANCE_MADS * dev)
-
-    def view_limit(self) -> float:
-        """The lowest correlation with the first view that the object's verified frames vouch for:
-        their median less :data:`APPEARANCE_MADS` robust deviations (no :data:`MIN_DEVIATION`: the
-        rules that ask it never ask more than :data:`COLD_FIRST_CC`)."""
-        s = np.fromiter(self.views, float, len(self.views))
-        med = self.views.median()
-        return med - APPEARANCE_MADS * 1.4826 * float(np.median(np.abs(s - med)))
 
     def residual_limit(self) -> float:
         """Largest distance from the constant-velocity prediction accepted for one frame, px."""
@@ -521,9 +505,6 @@ class PoseVerifier:
             reason = "mismatch"
         if reason is None:
             reason = self._look_again(tr, gray, W, centre, float(score), gap, far)
-        if reason is None:  # what the views' rule learns (:meth:`_look_again`)
-            now = back if back is not None else tr._warp_back(gray, W)
-            self._view = math.nan if now is None else _ncc(now, tr.tmpl0)
         self.fb.last_miss = math.nan
         if reason is None and self.fb.doubtful(float(score), *(self.score_stats or (None, None)), since):
             # tracked back to the keyframe's frame, the patch must land where the keyframe was cut
@@ -595,21 +576,12 @@ class PoseVerifier:
         # keeps the keyframe at 0.95 while its first view drops to 0.70, and refused there it
         # would stay lost behind the rule for poses found after lost frames
         step = warming and gap == 1 and bool(self.recent) and score < COLD_FIRST_CC
-        # once warm, a first view as close as the object's own verified views of it allow
-        # (:meth:`view_limit`), at most :data:`COLD_FIRST_CC`: the limits learned from a ball held
-        # in the fingers drawn into its region, matching its first view at 0.97-1.0, pass the
-        # fingers at 0.78 once it is let go (the floor is its median less :data:`APPEARANCE_MADS`
-        # times :data:`MIN_DEVIATION`, 0.69), and the fingers match the first view at 0.48-0.85;
-        # an object verified in other views (a ball spinning, blurred) has taught a lower limit
-        kept = not warming and score < COLD_FIRST_CC and len(self.views) >= WARMUP_FRAMES
-        if cold or far or step or kept:
+        if cold or far or step:
             now = tr._warp_back(gray, W)
             # while cold, the first view may be smeared by the object's own verified motion (a
             # swinging ball is a streak across the frame); a far pose has no motion to vouch for it
-            views = self._smeared(tr.tmpl0, W) if (cold or step or kept) and not far else [tr.tmpl0]
+            views = self._smeared(tr.tmpl0, W) if (cold or step) and not far else [tr.tmpl0]
             need = COLD_STEP_CC if step and not far else COLD_FIRST_CC
-            if kept and not (cold or far or step):
-                need = min(COLD_FIRST_CC, self.view_limit())
             if now is None or max(_ncc(now, v) for v in views) < need:
                 return "mismatch"
         half = 0.5 * math.hypot(*self.size) + self.margin
@@ -706,9 +678,6 @@ class PoseVerifier:
             self.seen_disk.teach(self.outline)
         if math.isfinite(self._contrast):
             self.contrasts.append(self._contrast)
-        if math.isfinite(self._view):
-            self.views.append(self._view)
-        self._view = math.nan
         w, h = size
         half = 0.5 * math.hypot(w, h)
         footprint = (centre[0] - half, centre[1] - half, centre[0] + half, centre[1] + half)

@@ -250,6 +250,12 @@ WARNING_CODES: dict[str, tuple[str, str]] = {
         "the film's display matrix mirrors the picture: it is tracked as shown, so theta's sign is "
         "the mirrored picture's; check it against the lab, or re-mux the film without the mirror",
     ),
+    "W-VIDEO-CAMERA": (
+        "suspect",
+        "the camera moves: the background outside the objects' regions shifts, where they are, by more than "
+        "3 px from the first frame tracked in at least a quarter of the frames compared; positions in image pixels (and "
+        "metres and angles from them) include the camera's motion. Film from a fixed camera (a tripod)",
+    ),
     "W-VIDEO-LOST": ("suspect", "an object was lost on more than 1 % of the frames (see the status column)"),
     # 3D points and the assumption audit
     "W-3D-LOST": (

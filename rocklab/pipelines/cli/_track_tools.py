@@ -237,6 +237,8 @@ def track_init(
         objs = tuple(dataclasses.replace(o, kind="point") if o.id in turning else o for o in cfg.objects)
         cfg = dataclasses.replace(cfg, objects=objs)
     notes = ([lead_note] if lead_note else []) + pnotes + notes
+    if regions and not proposed:
+        notes += _camera_note(video, info, gray, start)
     if lens_rel is not None:
         cfg = dataclasses.replace(cfg, video=dataclasses.replace(cfg.video, calibration=lens_rel))
         notes.append(f"lens {lens_rel}: detected points are undistorted with it before any geometry")
@@ -252,6 +254,23 @@ def track_init(
     if preview is not None:
         save_bgr_png(Path(preview), draw_init_preview(img, cfg, found, grid=found is None), side=side[1])
     return cfg, notes, proposed
+
+
+def _camera_note(video, info, gray, start) -> list:
+    """Regions given by hand on a film whose camera moves: W-VIDEO-CAMERA, and a note in the config."""
+    from ..._diagnostics import warn
+    from ...tracking.video import CAMERA_SHARE, camera_motion
+
+    share, shift = camera_motion([gray, *_samples(video, info, PROPOSE_WINDOWS_S[0], start)])
+    if share < CAMERA_SHARE:
+        return []
+    what = (
+        f"the camera moves (the whole picture shifts, by a median {shift:.3g} px, between {100 * share:.0f} % "
+        f"of the frames compared over {PROPOSE_WINDOWS_S[0]:g} s): positions in the picture include the "
+        "camera's motion; film from a fixed camera (a tripod)"
+    )
+    warn("W-VIDEO-CAMERA", f"{video}: {what}")
+    return [what]
 
 
 def _from_motion(video, info, gray, img, start, lead_note, preview, side):

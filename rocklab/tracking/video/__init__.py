@@ -7,7 +7,8 @@
   (:class:`PlaneMap`, :func:`calibrate_camera`, :func:`fit_similarity`);
 - the tracker (:func:`track_video`, :class:`TrackResult`), levelling and the table's motion
   (:func:`table_motion`);
-- ``rocklab track init``'s first-frame detection (:func:`suggest_config`);
+- ``rocklab track init``'s first-frame detection (:func:`suggest_config`) and whether the camera
+  moves (:func:`camera_motion`);
 - the target detectors in :mod:`.targets`.
 """
 
@@ -18,6 +19,7 @@ from ._table_track import choose_sg_window, estimate_noise, table_motion
 from ._track import TRACK_COLUMNS, ObjectTrack, Observation, TrackResult, assemble_tracks, track_frames, track_video
 from ._video import VideoInfo, iter_video_frames, probe_video
 from ._propose import lead_in, propose_objects
+from ._camera_motion import CAMERA_SHARE, camera_motion
 from ._init import MIN_TEXTURE_STD, parse_region, texture_std
 from ._plane import make_plane_map
 
@@ -48,6 +50,8 @@ __all__ = [
     "suggest_config",
     "propose_objects",
     "lead_in",
+    "camera_motion",
+    "CAMERA_SHARE",
     "parse_region",
     "texture_std",
     "MIN_TEXTURE_STD",

@@ -39,6 +39,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ._camera_motion import CAMERA_PX, CAMERA_SHARE, CAMERA_SPREAD, camera_motion  # noqa: F401 (re-exported)
+
 from ._checks import cut_limit, region_overlap, small_grey
 
 __all__ = [
@@ -576,52 +578,6 @@ def find_table_below(first_gray, box):
     if edge is None or edge.u_span_px[1] - edge.u_span_px[0] < 2 * w or abs(edge.angle_rad) > math.radians(10):
         return None
     return roi, edge
-
-
-#: The camera moves when, between consecutive frames compared, one similarity transform carries
-#: features spread over at least ``CAMERA_SPREAD`` of the frame's width and height (RANSAC
-#: inliers; the whole scene, not an object) by at least ``CAMERA_PX`` px at a frame corner, in at
-#: least ``CAMERA_SHARE`` of the pairs. Measured on real films: a hand-held pan moves 31 of 36
-#: pairs (median 9.4 px); 18 films from a tripod 0-3 of 20-51 (median 0.0-1.0 px; a plain wall's only
-#: features on the swinging ball move 25 px but span a tenth of the frame).
-CAMERA_PX = 2.0
-CAMERA_SPREAD = 0.5
-CAMERA_SHARE = 0.3
-#: Frames are compared for camera motion at this width at most (px).
-CAMERA_WIDTH_PX = 320
-
-
-def camera_motion(frames) -> tuple[float, float]:
-    """How the camera moves over ``frames`` (grey uint8, in time order): (share of the consecutive
-    pairs in which the whole picture moves, median of that motion over the pairs, px at a frame
-    corner of the full frame); see :data:`CAMERA_PX`."""
-    import cv2
-
-    if len(frames) < 2:
-        return 0.0, 0.0
-    sc = min(1.0, CAMERA_WIDTH_PX / frames[0].shape[1])
-    small = [g if sc == 1.0 else cv2.resize(g, None, fx=sc, fy=sc, interpolation=cv2.INTER_AREA) for g in frames]
-    H, W = small[0].shape[:2]
-    corners = np.array([[0, 0], [W, 0], [0, H], [W, H]], np.float32)
-    moved, shift = [], []
-    for a, b in zip(small[:-1], small[1:]):
-        p = cv2.goodFeaturesToTrack(a, 300, 0.01, 6)
-        if p is None or len(p) < 10:
-            continue
-        q, st, _ = cv2.calcOpticalFlowPyrLK(a, b, p, None, winSize=(21, 21), maxLevel=3)
-        st = st.ravel() == 1
-        if st.sum() < 10:
-            continue
-        M, inl = cv2.estimateAffinePartial2D(p[st], q[st], method=cv2.RANSAC, ransacReprojThreshold=1.0)
-        if M is None:
-            continue
-        pin = p[st][inl.ravel() == 1].reshape(-1, 2)
-        spread = min(np.ptp(pin[:, 0]) / W, np.ptp(pin[:, 1]) / H) if len(pin) else 0.0
-        d = float(np.max(np.hypot(*(corners @ M[:, :2].T + M[:, 2] - corners).T))) / sc
-        shift.append(d)
-        moved.append(d >= CAMERA_PX and spread >= CAMERA_SPREAD)
-    n_pairs = len(small) - 1
-    return float(np.sum(moved)) / n_pairs, float(np.median(shift)) if shift else 0.0
 
 
 def _refine(first_gray, samples, boxes) -> tuple[list, list]:

@@ -21,6 +21,7 @@ from ..._blas import one_blas_thread
 from ..._diagnostics import warn
 from ..._errors import InputError
 from .._corrections import apply_corrections, load_corrections
+from ._camera_motion import FrameSampler, check_camera
 from ._checks import (
     check_cuts,
     is_cut,
@@ -342,6 +343,11 @@ class TrackResult:
         Where the image -> plane mapping came from: "image" (centred pixels times the
         measured scale; compare positions as displacements), "homography", "board" or
         "table" (metres in that plane).
+    camera_drift_px : float
+        The background's largest shift from the first frame tracked, px at a frame corner
+        (:func:`~rocklab.tracking.video._camera_motion.check_camera`).
+    camera_moves : bool
+        ``W-VIDEO-CAMERA`` was raised: positions include the camera's motion (status suspect).
     """
 
     tracks: tuple
@@ -357,6 +363,8 @@ class TrackResult:
     level_source: str = "none"
     level_sigma_rad: float = math.nan
     corrections: tuple = ()  # manual corrections applied (dicts: rocklab.tracking._corrections)
+    camera_drift_px: float = 0.0  # the background's largest shift from the first frame, px
+    camera_moves: bool = False  # W-VIDEO-CAMERA: positions include the camera's motion
 
     def __getitem__(self, oid: str) -> ObjectTrack:
         for t in self.tracks:
@@ -472,6 +480,8 @@ class TrackResult:
             "level_sigma_rad": self.level_sigma_rad,
             "objects": per,
             "corrections": list(self.corrections),
+            "camera_drift_px": self.camera_drift_px,
+            "status": "suspect" if self.camera_moves else "ok",
         }
 
 
@@ -807,13 +817,19 @@ def track_video(
 
         total = (min(stop, n_expected) if stop else n_expected) - start
         frames = tqdm(frames, total=total if total > 0 else None, unit="frame", desc="track", leave=False)
+    expected = (min(stop, n_expected) if stop else n_expected) - start
+    sampler = FrameSampler(expected)
     levers: dict = {}
-    obs = track_frames(frames, config, pm, levers)
+    obs = track_frames(sampler.wrap(frames), config, pm, levers)
     res = assemble_tracks(
         obs, config, rate, info.width_px, info.height_px, pm, path, frame_times_s=times, levers=levers
     )
-    expected = (min(stop, n_expected) if stop else n_expected) - start
     check_frames(res, expected, path, info, config)
+    boxes = [o.roi for o in config.objects if getattr(o, "roi", None) is not None]
+    if config.table is not None and getattr(config.table, "roi", None) is not None:
+        boxes.append(config.table.roi)  # a shake table moves: no background
+    drift, moves = check_camera(sampler.frames, boxes, path, info.width_px)
+    res = replace(res, camera_drift_px=drift, camera_moves=moves)
     return apply_corrections(res, fixes) if fixes else res  # the config's hand fixes
 
 

@@ -10,8 +10,9 @@ and, for the outline, its own first frame:
   :data:`APPEARANCE_MADS` robust deviations (at least :data:`MIN_DEVIATION`; never below
   :data:`MIN_SCORE`); and while that limit is not learned yet, a pose found after lost frames
   must be a turned copy of the first view (:data:`COLD_FIRST_CC`), or of the first view smeared
-  along the object's last verified velocity by up to its fastest verified speed (a ball swinging
-  20 px a frame is a streak that matches its still first view at 0.83-0.88): a keyframe renewed
+  along the object's last verified velocity by up to its fastest verified speed, on the scene behind
+  the pose (a ball swinging 20 px a frame is a streak that matches its still first view at
+  0.83-0.88; a ball's streak fades into the wall behind it): a keyframe renewed
   from a lamp or a hand that the template half matched would otherwise follow it at 0.99; on the
   frame after a verified one, while cold, it must still match that first view or its smear at
   :data:`COLD_STEP_CC` (a ball let go from the fingers drawn into its region leaves the keyframe
@@ -580,7 +581,7 @@ class PoseVerifier:
             now = tr._warp_back(gray, W)
             # while cold, the first view may be smeared by the object's own verified motion (a
             # swinging ball is a streak across the frame); a far pose has no motion to vouch for it
-            views = self._smeared(tr.tmpl0, W) if (cold or step) and not far else [tr.tmpl0]
+            views = self._smeared(tr, W) if (cold or step) and not far else [tr.tmpl0]
             need = COLD_STEP_CC if step and not far else COLD_FIRST_CC
             if now is None or max(_ncc(now, v) for v in views) < need:
                 return "mismatch"
@@ -595,12 +596,18 @@ class PoseVerifier:
                 return "background" if same >= BG_FRACTION or _ncc(now, then) >= score else None
         return None
 
-    def _smeared(self, tmpl, W):
-        """``tmpl`` and its copies smeared along the last verified velocity by :data:`SMEAR_FRACS`
-        of the fastest verified speed (turned into the template's frame by the pose ``W``): how the
-        first view looks on a frame exposed while the object moved."""
+    def _smeared(self, tr, W):
+        """The first template and its copies smeared along the last verified velocity by
+        :data:`SMEAR_FRACS` of the fastest verified speed (turned into the template's frame by the
+        pose ``W``): how the first view looks on a frame exposed while the object moved. The view
+        is smeared as it stands on the scene where the pose puts it (the background image round
+        the pose, the first view pasted on the template's grid): a moving object's streak fades
+        into the wall behind it, and a first view smeared on its own edges (a template cut inside
+        a ball is green to its borders) matched a falling ball at 0.73 where the pasted one
+        matched it at 0.89."""
         import cv2
 
+        tmpl = tr.tmpl0
         if self.seen is None or not len(self.speeds):
             return [tmpl]
         v = np.asarray(self.seen[1], float)
@@ -609,13 +616,20 @@ class PoseVerifier:
             return [tmpl]
         Wd = np.asarray(W, float)
         ang = math.atan2(v[1], v[0]) - math.atan2(Wd[1, 0] - Wd[0, 1], Wd[0, 0] + Wd[1, 1])
+        m = max(int(round(max(SMEAR_FRACS) * top)), 2)
+        scene = warp_grown(tr, self.bg, W, m)
+        h, w = tmpl.shape
+        if scene is not None:
+            scene[m : m + h, m : m + w] = tmpl
         out = [tmpl]
         for frac in SMEAR_FRACS:
             n = max(int(round(frac * top)), 2)
             k = np.zeros((2 * n + 1, 2 * n + 1), np.float32)
             t = np.linspace(-0.5 * n, 0.5 * n, 4 * n + 1)
             k[np.round(n + t * math.sin(ang)).astype(int), np.round(n + t * math.cos(ang)).astype(int)] = 1.0
-            out.append(cv2.filter2D(tmpl, -1, k / k.sum(), borderType=cv2.BORDER_REPLICATE))
+            src = tmpl if scene is None else scene
+            smeared = cv2.filter2D(src, -1, k / k.sum(), borderType=cv2.BORDER_REPLICATE)
+            out.append(smeared if scene is None else smeared[m : m + h, m : m + w])
         return out
 
     @staticmethod

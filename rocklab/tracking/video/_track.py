@@ -345,7 +345,8 @@ class TrackResult:
         "table" (metres in that plane).
     camera_drift_px : float
         The background's largest shift from the first frame tracked, px at a frame corner
-        (:func:`~rocklab.tracking.video._camera_motion.check_camera`).
+        (:func:`~rocklab.tracking.video._camera_motion.check_camera`); NaN when not measured (an
+        object found by its markers has no region to leave out of the background).
     camera_moves : bool
         ``W-VIDEO-CAMERA`` was raised: positions include the camera's motion (status suspect).
     """
@@ -828,7 +829,10 @@ def track_video(
     boxes = [o.roi for o in config.objects if getattr(o, "roi", None) is not None]
     if config.table is not None and getattr(config.table, "roi", None) is not None:
         boxes.append(config.table.roi)  # a shake table moves: no background
-    drift, moves = check_camera(sampler.frames, boxes, path, info.width_px)
+    if len(boxes) >= len(config.objects):
+        drift, moves = check_camera(sampler.frames, boxes, path, info.width_px)
+    else:  # an object without a region (markers) would move as the background does: not measured
+        drift, moves = math.nan, False
     res = replace(res, camera_drift_px=drift, camera_moves=moves)
     return apply_corrections(res, fixes) if fixes else res  # the config's hand fixes
 

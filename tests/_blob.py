@@ -180,6 +180,29 @@ def perturbed_boxes(box, n, seed=0, size_frac=0.2, pos_frac=0.1):
     return out
 
 
+def moved_box(box, dx=0.0, dy=0.0, scale=1.0):
+    """``box`` = (x, y, w, h) with its centre moved by (``dx``, ``dy``) of its sides and scaled by
+    ``scale`` about that centre: [x, y, w, h], int px."""
+    x, y, w, h = box
+    cx, cy = x + w / 2 + dx * w, y + h / 2 + dy * h
+    return [round(cx - scale * w / 2), round(cy - scale * h / 2), round(scale * w), round(scale * h)]
+
+
+def ball_config(box, **video):
+    """A markerless :class:`~rocklab.config.TrackConfig` of one object ``ball`` in ``box``, no
+    levelling, ``video`` the [video] table (start_frame, stop_frame)."""
+    from rocklab.config import TrackConfig
+
+    return TrackConfig.from_dict(
+        {
+            "video": video,
+            "targets": {"style": "markerless"},
+            "reference": {"level": "none"},
+            "objects": [{"id": "ball", "roi": list(box)}],
+        }
+    )
+
+
 def bright_blob_track(path, start_uv, thr=50, area_px=(12, 400), max_step_px=80.0):
     """A small bright object on a dark background (a bob in front of black cloth), px (u, v) per
     frame; NaN where none is found.

@@ -23,10 +23,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from _blob import ball_config, moved_box
 from _mirror import mirror_file
 
 from rocklab._diagnostics import collecting
-from rocklab.config import TrackConfig
 from rocklab.tracking import iter_video_frames, track_video
 
 START, BOX = 16, (432, 240, 53, 56)
@@ -61,17 +61,8 @@ def _red_blobs(film):
 @pytest.mark.slow
 @pytest.mark.parametrize("dx, dy, scale", [(0.0, 0.0, 1.0), (0.1, 0.1, 1.0), (0.0, 0.0, 1.2)])
 def test_a_plain_balls_angle_is_not_reported(film, dx, dy, scale):
-    x, y, w, h = BOX
-    cx, cy = x + w / 2 + dx * w, y + h / 2 + dy * h
-    box = [round(cx - scale * w / 2), round(cy - scale * h / 2), round(scale * w), round(scale * h)]
-    cfg = TrackConfig.from_dict(
-        {
-            "video": {"start_frame": START},
-            "targets": {"style": "markerless"},
-            "reference": {"level": "none"},
-            "objects": [{"id": "ball", "roi": box}],
-        }
-    )
+    box = moved_box(BOX, dx, dy, scale)
+    cfg = ball_config(box, start_frame=START)
     with collecting() as found:
         ball = track_video(film, cfg)["ball"]
     said = [d.message for d in found if d.code == "W-TRACK-THETA"]

@@ -19,10 +19,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from _blob import ball_config, moved_box
 from _mirror import mirror_file
 
 from rocklab._diagnostics import collecting
-from rocklab.config import TrackConfig
 from rocklab.tracking import iter_video_frames, track_video
 
 STOP, BOX = 30, (272, 67, 84, 84)
@@ -57,17 +57,8 @@ def _orange_blobs(film):
 @pytest.mark.slow
 @pytest.mark.parametrize("dx, dy, scale", [(0.0, 0.0, 1.0), (0.1, 0.1, 1.0), (0.0, 0.0, 1.2)])
 def test_a_ball_let_go_is_never_ok_on_the_fingers(film, dx, dy, scale):
-    x, y, w, h = BOX
-    cx, cy = x + w / 2 + dx * w, y + h / 2 + dy * h
-    box = [round(cx - scale * w / 2), round(cy - scale * h / 2), round(scale * w), round(scale * h)]
-    cfg = TrackConfig.from_dict(
-        {
-            "video": {"stop_frame": STOP},
-            "targets": {"style": "markerless"},
-            "reference": {"level": "none"},
-            "objects": [{"id": "ball", "roi": box}],
-        }
-    )
+    box = moved_box(BOX, dx, dy, scale)
+    cfg = ball_config(box, stop_frame=STOP)
     with collecting():  # lost frames and unmeasured angles are warned of: not what is checked here
         ball = track_video(film, cfg)["ball"]
     blobs = _orange_blobs(film)

@@ -217,29 +217,21 @@ def rests_at_end(first_gray, box, end_frames) -> tuple[bool, str]:
     end_frames : sequence of ndarray (H, W) uint8
         Frames spread over the film's last :data:`REST_WINDOW_S` seconds, in order.
     """
-    import cv2
 
-    from ._propose import DIFF_SIGMAS, MIN_DIFF_DN, WORK_WIDTH_PX
-
-    def _prepare(g, scale):  # as the proposals see frames: at the working width, 1 px blur
-        g = g if scale == 1.0 else cv2.resize(g, None, fx=scale, fy=scale, interpolation=cv2.INTER_AREA)
-        return cv2.GaussianBlur(g.astype(np.float32), (0, 0), 1.0)
+    from ._propose import WORK_WIDTH_PX, prepare_frame, changed_pixels  # frames as the proposals see them
 
     if len(end_frames) < 2:
         return False, f"the film's last {REST_WINDOW_S:g} s could not be read"
     scale = min(1.0, WORK_WIDTH_PX / first_gray.shape[1])
-    f0 = _prepare(first_gray, scale)
+    f0 = prepare_frame(first_gray, scale)
     h_img, w_img = f0.shape
     x, y, w, h = (int(round(v * scale)) for v in box)
     m = max(w, h) // 2
     u0, v0, u1, v1 = max(x - m, 0), max(y - m, 0), min(x + w + m, w_img), min(y + h + m, h_img)
-    ends = [_prepare(g, scale) for g in end_frames]
+    ends = [prepare_frame(g, scale) for g in end_frames]
     moving = 0.0
     for e in ends[:-1]:
-        d = e - ends[-1]
-        d = np.abs(d - float(np.median(d)))
-        thr = max(DIFF_SIGMAS * float(np.median(d)) / 0.954, MIN_DIFF_DN)
-        moving = max(moving, float(np.mean(d[v0:v1, u0:u1] > thr)))
+        moving = max(moving, float(np.mean(changed_pixels(e, ends[-1])[v0:v1, u0:u1])))
     if moving > REST_MOVING:
         return False, (
             f"it still moves at the film's end ({100 * moving:.0f} % of the pixels round it change over the last "

@@ -183,11 +183,22 @@ class Proposals:
         return self.camera[0] >= CAMERA_SHARE
 
 
-def _prepare(gray, scale):
+def prepare_frame(gray, scale):
+    """``gray`` as the proposals compare frames: resized by ``scale`` (area), float32, blurred by a
+    1 px Gaussian."""
     import cv2
 
     g = gray if scale == 1.0 else cv2.resize(gray, None, fx=scale, fy=scale, interpolation=cv2.INTER_AREA)
     return cv2.GaussianBlur(g.astype(np.float32), (0, 0), 1.0)
+
+
+def changed_pixels(a, b):
+    """Pixels that changed from ``b`` to ``a`` (float images of :func:`prepare_frame`): the difference,
+    its median (a global change of light) taken out, over :data:`DIFF_SIGMAS` times its own robust
+    noise (median / 0.954), at least :data:`MIN_DIFF_DN`; bool, the images' shape."""
+    d = a - b
+    d = np.abs(d - float(np.median(d)))
+    return d > max(DIFF_SIGMAS * float(np.median(d)) / 0.954, MIN_DIFF_DN)
 
 
 def _box_gap(a, b) -> float:
@@ -327,10 +338,10 @@ def moving_boxes(first_gray, samples, masks: bool = False) -> tuple[list, int]:
 
     H, W = first_gray.shape[:2]
     scale = min(1.0, WORK_WIDTH_PX / W)
-    f0 = _prepare(first_gray, scale)
+    f0 = prepare_frame(first_gray, scale)
     diffs = []
     for s in samples:
-        d = _prepare(s, scale) - f0
+        d = prepare_frame(s, scale) - f0
         diffs.append(np.abs(d - float(np.median(d))))
     if not diffs:
         return ([], scale) if masks else ([], 0)
@@ -348,7 +359,7 @@ def moving_boxes(first_gray, samples, masks: bool = False) -> tuple[list, int]:
     k = max(3, int(round(CLOSE_FRACTION * min(f0.shape))) | 1)
     grad = cv2.magnitude(cv2.Sobel(f0, cv2.CV_32F, 1, 0), cv2.Sobel(f0, cv2.CV_32F, 0, 1))
     floor = MIN_STRUCTURE * (float(np.median(grad)) + 1e-3)
-    last = _prepare(samples[-1], scale)
+    last = prepare_frame(samples[-1], scale)
     boxes = _with_late(f0, last, _parts(main, k, grad, floor), _parts(main | late, k, grad, floor), k)
     if not boxes:  # nothing larger moves: a small lone mover is the object (LONE_FRACTION)
         boxes = _parts(main, k, grad, floor, LONE_FRACTION)
@@ -393,7 +404,7 @@ def turning_region(first_gray, changed, scale, box):
 
     if not changed:
         return None
-    f0 = _prepare(first_gray, scale)
+    f0 = prepare_frame(first_gray, scale)
     h, w = f0.shape
     x, y, bw, bh = (int(round(v * scale)) for v in box)
     pad = max(2, int(round(0.25 * max(bw, bh))))
@@ -470,16 +481,15 @@ def without_intruder(first_gray, samples, box):
     import cv2
 
     scale = min(1.0, WORK_WIDTH_PX / first_gray.shape[1])
-    f0 = _prepare(first_gray, scale)
+    f0 = prepare_frame(first_gray, scale)
     h, w = f0.shape
     bx, by, bw, bh = (v * scale for v in box)
-    prep = [_prepare(s, scale) for s in samples]
+    prep = [prepare_frame(s, scale) for s in samples]
     k_close = max(3, int(round(CLOSE_FRACTION * min(h, w))) | 1)
     for k in range(len(prep) - 1, max(LEFT_LAG, len(prep) // 2) - 1, -1):
-        d = prep[k] - prep[k - LEFT_LAG]
-        d = np.abs(d - float(np.median(d)))
-        thr = max(DIFF_SIGMAS * float(np.median(d)) / 0.954, MIN_DIFF_DN)
-        m = cv2.morphologyEx((d > thr).astype(np.uint8), cv2.MORPH_OPEN, np.ones((3, 3), np.uint8))
+        m = cv2.morphologyEx(
+            changed_pixels(prep[k], prep[k - LEFT_LAG]).astype(np.uint8), cv2.MORPH_OPEN, np.ones((3, 3), np.uint8)
+        )
         m = cv2.morphologyEx(m, cv2.MORPH_CLOSE, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (k_close, k_close)))
         n, _, stats, _ = cv2.connectedComponentsWithStats(m, connectivity=8)
         parts = [
@@ -525,7 +535,7 @@ def stays_in_place(first_gray, samples, box) -> tuple[bool, float, float]:
     import cv2
 
     scale = min(1.0, WORK_WIDTH_PX / first_gray.shape[1])
-    f0 = _prepare(first_gray, scale)
+    f0 = prepare_frame(first_gray, scale)
     x, y, w, h = (int(round(v * scale)) for v in box)
     tmpl = f0[y : y + h, x : x + w]
     if not samples or min(tmpl.shape) < 3 or float(tmpl.std()) < 1e-3:
@@ -534,7 +544,7 @@ def stays_in_place(first_gray, samples, box) -> tuple[bool, float, float]:
     u0, v0 = max(x - m, 0), max(y - m, 0)
     shifts, ccs = [], []
     for smp in samples:
-        area = _prepare(smp, scale)[v0 : y + h + m, u0 : x + w + m]
+        area = prepare_frame(smp, scale)[v0 : y + h + m, u0 : x + w + m]
         _, cc, _, at = cv2.minMaxLoc(cv2.matchTemplate(area, tmpl, cv2.TM_CCOEFF_NORMED))
         shifts.append(math.hypot(at[0] + u0 - x, at[1] + v0 - y))
         ccs.append(cc)

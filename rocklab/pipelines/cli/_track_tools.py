@@ -520,10 +520,9 @@ def track_preview(
         cfg = replace(cfg, video=replace(cfg.video, corrections=None))
     # frames (fields) in the span: the container's rate, or the config's when it has none
     if not (fps or vinfo.fps or cfg.video.fps):
-        raise InputError(
-            f"{video}: the film has no frame rate (an image folder has one only from its timestamps.csv); "
-            f"pass --fps N (or set [video] fps in {cfg.source or 'the config'})"
-        )
+        from ...tracking.video import no_rate_error
+
+        raise no_rate_error(video, cfg)
     rate = (fps or vinfo.fps or cfg.video.fps) * (2 if vinfo.field_order is not None else 1)
     if at_s is not None:
         n_all = vinfo.n_frames * (2 if vinfo.field_order is not None else 1)

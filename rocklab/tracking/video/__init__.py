@@ -16,7 +16,16 @@ from ._camera_model import PlaneMap, SimilarityFit, calibrate_camera, fit_simila
 from ._init import find_markers, suggest_config
 from ._level import REST_WINDOW_S, level_from_reference, rests_at_end
 from ._table_track import choose_sg_window, estimate_noise, table_motion
-from ._track import TRACK_COLUMNS, ObjectTrack, Observation, TrackResult, assemble_tracks, track_frames, track_video
+from ._track import (
+    TRACK_COLUMNS,
+    ObjectTrack,
+    Observation,
+    TrackResult,
+    assemble_tracks,
+    no_rate_error,
+    track_frames,
+    track_video,
+)
 from ._video import VideoInfo, iter_video_frames, probe_video
 from ._propose import lead_in, propose_objects
 from ._camera_motion import CAMERA_SHARE, camera_motion
@@ -32,6 +41,7 @@ __all__ = [
     "calibrate_camera",
     "track_video",
     "track_frames",
+    "no_rate_error",
     "assemble_tracks",
     "TrackResult",
     "ObjectTrack",

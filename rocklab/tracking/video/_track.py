@@ -711,8 +711,18 @@ def _metres_per_unit(config, raw, metric_plane) -> dict:
     return m_per
 
 
-def _no_rate(path, config: TrackConfig) -> InputError:
-    """The one-line error for a film with no frame rate of its own and none given."""
+def no_rate_error(path, config: TrackConfig) -> InputError:
+    """The one-line error for a film with no frame rate of its own and none given (``track``,
+    ``track preview``).
+
+    Parameters
+    ----------
+    path : path-like
+        The film (an image folder without timestamps.csv).
+    config : TrackConfig
+        Its config; when its file keeps an older ``track init``'s placeholder note above
+        ``fps = 50``, the message says that value is not read as the rate.
+    """
     where = config.source or "the config"
     placeholder = False
     if config.source is not None and os.path.isfile(config.source):
@@ -792,7 +802,7 @@ def track_video(
             times = np.column_stack((times, times + half)).ravel()
         n_expected = 2 * info.n_frames
     if rate is None:
-        raise _no_rate(path, config)
+        raise no_rate_error(path, config)
     v = config.video
     fixes = load_corrections(v.corrections, [o.id for o in config.objects]) if v.corrections else ()  # errors first
     start, stop = v.start_frame, v.stop_frame

@@ -180,6 +180,8 @@ def test_a_step_onto_where_a_look_alike_stood_is_refused(shift):
     for step, refused in ((-20.0, False), (20.0, False), (-30.0, True), (30.0, True), (-45.0, True), (4.0, False)):
         # the look-alikes stood 50 px either side: a step over 25 px is nearer one of them
         assert g.nearer_lookalike(tmpl, c + (step, 0.0), 0.6) is refused, step
+    # a pose that matches better than any look-alike there did is the object's: no look-alike as good
+    assert not g.nearer_lookalike(tmpl, c + (30.0, 0.0), 1.01)
 
 
 def test_a_long_step_without_a_look_alike_is_not_refused():

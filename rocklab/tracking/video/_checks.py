@@ -420,12 +420,6 @@ def _reacquired_wrong(k, s, p, uv, trusted, size, wh) -> str | None:
 #: The share of an object's own ok frames (before a loss) whose registration quality may lie below
 #: the threshold a re-acquisition far out of reach must reach (the low tail: impacts, blur).
 REACH_Q_TAIL = 0.01
-#: ... unless it lies within this of their median: an object at rest matches its template to within
-#: 1e-4 on every frame (a building model's marker before its first release: 0.99915-0.99979 on 85
-#: frames), a tail that says nothing of what the same view loses once it moves (0.9948-0.9996 on its
-#: free vibration, 0.998 on the frame it was found again). A fingertip or a look-alike's edge that a
-#: template half matches lies tenths under it.
-REACH_Q_NOISE = 0.01
 
 
 def _out_of_reach(s, p, uv, ok, q, size) -> bool:
@@ -435,9 +429,7 @@ def _out_of_reach(s, p, uv, ok, q, size) -> bool:
     first region's larger side ``size`` (px): a resting object cannot jump across the frame.
     Not confirmed: the registration quality of that first frame, against the template or keyframe
     the object was last verified with, lies below all but the lowest :data:`REACH_Q_TAIL` of its
-    own ok frames before the loss (a pendulum re-found across its swing re-explains its view), and
-    more than :data:`REACH_Q_NOISE` under their median (an object at rest before the loss: its
-    frames' tail is its camera noise)."""
+    own ok frames before the loss (a pendulum re-found across its swing re-explains its view)."""
     before = np.flatnonzero(ok[: p + 1])
     if before.size < 5 or not np.isfinite(q[s]):
         return False
@@ -449,9 +441,7 @@ def _out_of_reach(s, p, uv, ok, q, size) -> bool:
     if np.hypot(*(uv[s] - uv[p])) <= reach:
         return False
     q_ok = q[before][np.isfinite(q[before])]
-    if q_ok.size < 5:
-        return False
-    return bool(q[s] < min(float(np.quantile(q_ok, REACH_Q_TAIL)), float(np.median(q_ok)) - REACH_Q_NOISE))
+    return bool(q_ok.size >= 5 and q[s] < np.quantile(q_ok, REACH_Q_TAIL))
 
 
 def settle_reacquisitions(raw, config, plane_map, frames, source, width_px: int, height_px: int) -> None:

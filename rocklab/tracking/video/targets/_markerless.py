@@ -670,12 +670,6 @@ class MarkerlessTracker:
                 self.reason = "twin"
             elif twin is not fit:
                 fit, tmpl, mask, visible = twin, self.key, None, 1.0
-        if self.reason is None and self.twins.nearer_lookalike(
-            self.key,
-            fit[0][:, :2].astype(float) @ self.centre0 + fit[0][:, 2],
-            max(MIN_CC, fit[1]),  # a place that matched as well as this pose does
-        ):
-            self.reason = "twin"  # a step onto where a look-alike stood: continuity cannot vouch for it
         if self.reason is not None:
             if self.reason == "drift":  # the keyframe learned the slide
                 self.key, self.key_sigma_rad, self.key_at = self.tmpl0, 0.0, None

@@ -156,29 +156,6 @@ class TwinGuard:
                     v_o = (o_p - o0) / max(p - p0, 1)
         return o_p, v_o
 
-    def nearer_lookalike(self, tmpl, found, min_cc: float) -> bool:
-        """Whether the object's pose now, centred at ``found`` (px), lies nearer to where a
-        look-alike stood in the last verified frame than to where the object stood: the step is
-        then more simply the look-alike's than the object's (a row of markers on a vibrating floor,
-        155 px apart: the floor moves 57-70 px a frame and reverses, so a constant-velocity
-        prediction between two of them let the fit converge on the next marker, 87 px off, at 0.74).
-        A look-alike is a match of ``tmpl`` there at ``min_cc`` or better: the correlation of the
-        pose found now, which a place that matched as well explains as well (the next marker, its
-        surroundings darker, matched at 0.75 against the object's own 0.97, and the pose found on it
-        at 0.74). A step of at most half the region's larger side is nearer the object's place than
-        any look-alike that does not overlap it, and is not looked at."""
-        if not self.seen:
-            return False
-        _, g_p, c_p = self.seen[-1]
-        found = np.asarray(found, float)
-        d_own = float(np.hypot(*(found - c_p)))
-        if d_own <= 0.5 * self.size:
-            return False
-        return any(
-            q[0] >= min_cc and np.hypot(*(q[1] - c_p)) > 0.5 * self.size and np.hypot(*(q[1] - found)) < d_own
-            for q in match_peaks(g_p, tmpl, c_p, 2.0 * d_own)
-        )
-
     def judge(self, tmpl, gray, frame: int, found, min_cc: float):
         """Whether the object found again at ``found`` (centre px) in ``gray`` (frame ``frame``,
         after lost frames) is the tracked one: ("keep", None); ("swap", (correlation, centre px,

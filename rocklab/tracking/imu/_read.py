@@ -27,6 +27,9 @@ Formats
 ``fusion``
     CSV with ``Time (s)``, gyroscope deg/s, accelerometer g (x-io Fusion
     example layout).
+``phyphox``
+    A phone's phyphox export (folder or ``.zip``): ``Accelerometer.csv`` and ``Gyroscope.csv``
+    with their own sample times, merged onto the faster sensor's times (``_phyphox.py``).
 ``mapped``
     Any CSV through ``mapping={column: "role:unit"}``, roles ``t``,
     ``gyro_x|y|z``, ``acc_x|y|z``; units ``s|ms|us``, ``deg/s|rad/s``,
@@ -58,6 +61,7 @@ from ._csv import (
     stack,
 )
 from ._log import ImuLog
+from ._phyphox import is_phyphox, phyphox_files, read_phyphox
 from ._ximu import read_ximu_gui, read_ximu_registers, ximu_rate_from_registers
 
 __all__ = ["ImuLog", "read_imu", "imu_log_files", "read_ximu_registers", "ximu_rate_from_registers"]
@@ -163,6 +167,8 @@ def _resolve(path: Path) -> Path:
     if path.is_file():
         return path
     if path.is_dir():
+        if is_phyphox(path):
+            return path
         pats = (
             "*_CalInertialAndMag.csv",
             "*_CalInertialMagnetic.csv",
@@ -201,6 +207,8 @@ def imu_log_files(path) -> list[Path]:
     Raises the same errors as :func:`read_imu` for a folder without one log, or a missing path.
     """
     p = _resolve(Path(path))
+    if is_phyphox(p):
+        return phyphox_files(p)
     companions = [p.with_name("HighGAccelerometer.csv")]
     for suffix in ("_CalInertialAndMag.csv", "_CalInertialMagnetic.csv"):
         if p.name.endswith(suffix):
@@ -216,8 +224,8 @@ def read_imu(
     Parameters
     ----------
     path : str or Path
-        An inertial CSV, a log folder (x-IMU GUI export, x-IMU3 device folder),
-        or an x-IMU base prefix (``.../00000``).
+        An inertial CSV, a log folder (x-IMU GUI export, x-IMU3 device folder,
+        phyphox export), a phyphox ``.zip``, or an x-IMU base prefix (``.../00000``).
     rate_hz : float, optional
         Sample rate, Hz.  Required for x-IMU GUI logs without a rate register
         and CSVs without a time column; for timestamped logs it is the nominal
@@ -300,6 +308,8 @@ def check_imu_log(log: ImuLog, rate_option_hz: float | None = None) -> ImuLog:
 def _read_any(p: Path, rate_hz, mapping, full_scale_g) -> ImuLog:
     if mapping:
         return _read_timed(p, rate_hz, full_scale_g, mapping)
+    if is_phyphox(p):
+        return read_phyphox(p, full_scale_g)
     if p.name.endswith(("_CalInertialAndMag.csv", "_CalInertialMagnetic.csv")):
         return read_ximu_gui(p, rate_hz, full_scale_g)
     with open(p, encoding="utf-8", errors="replace") as fh:

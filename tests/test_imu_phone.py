@@ -1,4 +1,5 @@
-"""phyphox exports (a phone on the block): one CSV per sensor, each with its own sample times.
+"""Phone exports (phyphox, Sensor Logger: a phone on the block): one CSV per sensor, each with its
+own sample times.
 
 Synthetic truth: a simulated rocking block's IMU log at 400 Hz; the phone's gyroscope writes
 every sample, its accelerometer every other one and starting 0.1 s later (phyphox starts the
@@ -147,3 +148,53 @@ def test_a_real_phone_bouncing_is_read_and_is_no_rocking_block(tmp_path_factory)
     with collecting() as found:
         rot = block_rotation(log)
     assert "W-IMU-NOT-ROCKING" in [d.code for d in found] and rot.status == "suspect"
+
+
+def _sensor_logger(folder, log: ImuLog, acc_name="TotalAcceleration.csv"):
+    """Sensor Logger's layout: time (epoch ns), seconds_elapsed, z, y, x; accelerometer every other sample."""
+    folder.mkdir(exist_ok=True)
+    t = log.t_s - log.t_s[0]
+    for name, vals, idx in (
+        ("Gyroscope.csv", log.gyro_rad_s, np.arange(len(t))),
+        (acc_name, log.acc_m_s2, np.arange(40, len(t), 2)),
+    ):
+        rows = [
+            f"{1717009637503447000 + int(round(t[i] * 1e9))},{float(t[i])!r},{float(vals[i, 2])!r},{float(vals[i, 1])!r},{float(vals[i, 0])!r}"
+            for i in idx
+        ]
+        (folder / name).write_text("time,seconds_elapsed,z,y,x\n" + "\n".join(rows) + "\n")
+    return folder
+
+
+def test_a_sensor_logger_export_reads_as_the_same_log_as_phyphox(tmp_path, truth):
+    a = read_imu(_export(tmp_path / "phyphox", truth))
+    b = read_imu(_sensor_logger(tmp_path / "logger", truth))
+    assert b.format == "sensor-logger" and b.n == a.n
+    np.testing.assert_allclose(b.t_s, a.t_s, atol=1e-9)
+    np.testing.assert_allclose(b.gyro_rad_s, a.gyro_rad_s, rtol=1e-7, atol=1e-9)  # z, y, x put back in order
+    np.testing.assert_allclose(b.acc_m_s2, a.acc_m_s2, rtol=1e-7, atol=1e-9)
+    # its Accelerometer.csv has gravity taken out: without TotalAcceleration.csv the export is refused
+    only = _sensor_logger(tmp_path / "linear", truth, acc_name="Accelerometer.csv")
+    with pytest.raises(InputError, match="without TotalAcceleration.csv: its Accelerometer.csv has gravity taken out"):
+        read_imu(only)
+
+
+@pytest.mark.parametrize(
+    "scale, unit, says",
+    [
+        (1.0 / G, "m/s^2", "values in g read as m/s^2"),  # g values under an m/s^2 header
+        (1.0, "g", "values in m/s^2 read as g"),  # m/s^2 values under a (g) header
+        (0.0, "m/s^2", "gravity is not in it"),  # a linear accelerometer (plus its noise below)
+    ],
+)
+def test_an_accelerometer_that_does_not_read_gravity_is_refused(tmp_path, truth, scale, unit, says):
+    t = truth.t_s - truth.t_s[0]
+    rng = np.random.default_rng(3)
+    acc = truth.acc_m_s2 * scale + (rng.normal(0, 0.05, truth.acc_m_s2.shape) if scale == 0 else 0)
+    cols = {f"Gyroscope {a} (rad/s)": truth.gyro_rad_s[:, k] for k, a in enumerate("xyz")}
+    cols |= {f"Accelerometer {a} ({unit})": acc[:, k] for k, a in enumerate("xyz")}
+    _write(tmp_path / "log.csv", t, cols)
+    with pytest.raises(InputError) as e:
+        read_imu(tmp_path / "log.csv")
+    msg = str(e.value)
+    assert "\n" not in msg and str(tmp_path / "log.csv") in msg and says in msg

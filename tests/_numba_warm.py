@@ -3,12 +3,12 @@
 A fresh clone has no cached machine code: every pytest-xdist worker, and every CLI subprocess a
 test starts, compiled the kernels it met first (~30 CPU-s for the Newmark loops alone), often the
 same kernels at the same time, and a subprocess killed on purpose (tests/test_kill.py) compiled
-them again each time. Here each group of kernels is compiled once, the groups in parallel, one
-process per core, through the public calls the tests make (the same argument types, so the
-same cached signatures). On a warm cache this takes the imports and a cache load (~2 CPU-s per
-group). A failure here is printed and ignored: the tests themselves then compile, and judge.
+them again each time. Here the kernels are compiled once, in groups shared out over one process
+per core, through the public calls the tests make (the same argument types, so the same cached
+signatures). On a warm cache this costs the imports and the cache loads: 6 CPU-s in all. A group
+that fails is printed and skipped: the tests then compile it themselves, and judge.
 
-Run: ``python tests/_numba_warm.py`` (all groups, in parallel) or ``... GROUP`` (one, in this process).
+Run: ``python tests/_numba_warm.py`` (all groups, in parallel) or ``... GROUP ...`` (in this process).
 """
 
 from __future__ import annotations
@@ -87,41 +87,59 @@ def tracking(tmp: Path) -> None:
     fuse_table_motion(video, ti, -((2 * np.pi) ** 2) * 1e-3 * np.sin(2 * np.pi * ti))
 
 
-#: groups, heaviest first; a process compiles one group at a time
-GROUPS = {"newmark": newmark, "batch": batch, "taylor": taylor, "column": column, "tracking": tracking}
+#: group -> (function, cold compile CPU-s measured with one thread), for sharing them out
+GROUPS = {
+    "newmark": (newmark, 47.0),
+    "column": (column, 35.0),
+    "batch": (batch, 28.0),
+    "taylor": (taylor, 14.0),
+    "tracking": (tracking, 3.0),
+}
 
 
-def _one(name: str) -> None:
+def _run_groups(names: list[str]) -> int:
+    """Compile the named groups in this process; a group that fails is named and skipped."""
     import tempfile
+    import traceback
 
     from rocklab._diagnostics import collecting
 
-    with tempfile.TemporaryDirectory() as tmp, collecting():
-        fn = GROUPS[name]
-        fn(Path(tmp)) if name == "tracking" else fn()
+    failed = 0
+    for name in names:
+        fn = GROUPS[name][0]
+        try:
+            with tempfile.TemporaryDirectory() as tmp, collecting():
+                fn(Path(tmp)) if name == "tracking" else fn()
+        except Exception:
+            failed += 1
+            print(f"numba warm-up: group {name!r} failed, the tests compile it:\n{traceback.format_exc()}")
+    return 1 if failed else 0
+
+
+def share(n: int) -> list[list[str]]:
+    """The groups in ``n`` lists of about equal compile time (longest first, each to the lightest list)."""
+    bins: list[list[str]] = [[] for _ in range(max(1, n))]
+    load = [0.0] * len(bins)
+    for name, (_, cpu_s) in sorted(GROUPS.items(), key=lambda kv: -kv[1][1]):
+        k = load.index(min(load))
+        bins[k].append(name)
+        load[k] += cpu_s
+    return [b for b in bins if b]
 
 
 def main(argv: list[str]) -> int:
     if argv:
-        for name in argv:
-            _one(name)
-        return 0
-    workers = max(1, len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1))
+        return _run_groups(argv)
+    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
     env = dict(os.environ, NUMBA_NUM_THREADS="1", OMP_NUM_THREADS="1", OPENBLAS_NUM_THREADS="1")
     root = Path(__file__).resolve().parents[1]
     env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(root), env.get("PYTHONPATH", "")]))
-    todo, running, t0 = list(GROUPS), {}, time.perf_counter()
-    while todo or running:
-        while todo and len(running) < workers:
-            name = todo.pop(0)
-            running[name] = subprocess.Popen([sys.executable, __file__, name], env=env)
-        for name, proc in list(running.items()):
-            if proc.poll() is not None:
-                del running[name]
-                if proc.returncode:
-                    print(f"numba warm-up: group {name!r} failed (exit {proc.returncode}); the tests compile it")
-        time.sleep(0.05)
-    print(f"numba warm-up: {len(GROUPS)} groups in {time.perf_counter() - t0:.0f} s")
+    t0 = time.perf_counter()
+    # one process per core, each importing rocklab once for its groups
+    procs = [subprocess.Popen([sys.executable, __file__, *names], env=env) for names in share(cores)]
+    for p in procs:
+        p.wait()
+    print(f"numba warm-up: {len(GROUPS)} groups in {len(procs)} processes, {time.perf_counter() - t0:.0f} s")
     return 0
 
 

@@ -3,8 +3,8 @@
 A fresh clone has no cached machine code: every pytest-xdist worker, and every CLI subprocess a
 test starts, compiled the kernels it met first (~30 CPU-s for the Newmark loops alone), often the
 same kernels at the same time, and a subprocess killed on purpose (tests/test_kill.py) compiled
-them again each time. Here the kernels are compiled once, in groups shared out over one process
-per core, through the public calls the tests make (the same argument types, so the same cached
+them again each time. Here the kernels are compiled once, in groups shared out over two
+processes, through the public calls the tests make (the same argument types, so the same cached
 signatures). On a warm cache this costs the imports and the cache loads: 6 CPU-s in all. A group
 that fails is printed and skipped: the tests then compile it themselves, and judge.
 
@@ -87,14 +87,13 @@ def tracking(tmp: Path) -> None:
     fuse_table_motion(video, ti, -((2 * np.pi) ** 2) * 1e-3 * np.sin(2 * np.pi * ti))
 
 
-#: group -> (function, cold compile CPU-s measured with one thread), for sharing them out
-GROUPS = {
-    "newmark": (newmark, 47.0),
-    "column": (column, 35.0),
-    "batch": (batch, 28.0),
-    "taylor": (taylor, 14.0),
-    "tracking": (tracking, 3.0),
-}
+GROUPS = {"newmark": newmark, "batch": batch, "column": column, "taylor": taylor, "tracking": tracking}
+
+#: The groups in two processes. A kernel's callees are compiled with it (or loaded, if cached),
+#: so ``batch`` follows ``newmark`` in one process: run in parallel, both compiled the Newmark
+#: step (run_block). Cold compile CPU-s measured one after another with one thread: newmark 47,
+#: batch 28, column 35, taylor 14 (2 after batch), tracking 3.
+CHAINS = (("newmark", "batch"), ("column", "taylor", "tracking"))
 
 
 def _run_groups(names: list[str]) -> int:
@@ -106,7 +105,7 @@ def _run_groups(names: list[str]) -> int:
 
     failed = 0
     for name in names:
-        fn = GROUPS[name][0]
+        fn = GROUPS[name]
         try:
             with tempfile.TemporaryDirectory() as tmp, collecting():
                 fn(Path(tmp)) if name == "tracking" else fn()
@@ -116,27 +115,16 @@ def _run_groups(names: list[str]) -> int:
     return 1 if failed else 0
 
 
-def share(n: int) -> list[list[str]]:
-    """The groups in ``n`` lists of about equal compile time (longest first, each to the lightest list)."""
-    bins: list[list[str]] = [[] for _ in range(max(1, n))]
-    load = [0.0] * len(bins)
-    for name, (_, cpu_s) in sorted(GROUPS.items(), key=lambda kv: -kv[1][1]):
-        k = load.index(min(load))
-        bins[k].append(name)
-        load[k] += cpu_s
-    return [b for b in bins if b]
-
-
 def main(argv: list[str]) -> int:
     if argv:
         return _run_groups(argv)
     cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+    chains = CHAINS if cores >= len(CHAINS) else (tuple(n for c in CHAINS for n in c),)
     env = dict(os.environ, NUMBA_NUM_THREADS="1", OMP_NUM_THREADS="1", OPENBLAS_NUM_THREADS="1")
     root = Path(__file__).resolve().parents[1]
     env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(root), env.get("PYTHONPATH", "")]))
     t0 = time.perf_counter()
-    # one process per core, each importing rocklab once for its groups
-    procs = [subprocess.Popen([sys.executable, __file__, *names], env=env) for names in share(cores)]
+    procs = [subprocess.Popen([sys.executable, __file__, *names], env=env) for names in chains]
     for p in procs:
         p.wait()
     print(f"numba warm-up: {len(GROUPS)} groups in {len(procs)} processes, {time.perf_counter() - t0:.0f} s")

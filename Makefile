@@ -17,8 +17,8 @@ $(STAMP): pyproject.toml
 # pytest exit code 5 (no tests collected) is a failure too. One worker per core (pytest-xdist), a
 # test file to one worker so its module fixtures are built once, the heavy files first (HEAVY_FIRST in
 # tests/conftest.py); TEST_WORKERS=0 runs in this process.
-# With workers, numba's cache is filled first (tests/_numba_warm.py): in a fresh clone the workers
-# and the CLI subprocesses each compiled the same kernels (~200 of the suite's ~1360 CPU-s).
+# With workers, numba's cache is filled first (tests/_numba_warm.py): in a fresh clone both workers
+# compiled the Newmark and column kernels (about 63 of the suite's 1364 CPU-s twice).
 TEST_WORKERS ?= auto
 test: $(STAMP)
 	$(if $(filter 0,$(TEST_WORKERS)),,$(PY) tests/_numba_warm.py)

@@ -15,10 +15,14 @@ $(STAMP): pyproject.toml
 	@touch $(STAMP)
 
 # pytest exit code 5 (no tests collected) is a failure too. One worker per core (pytest-xdist), a
-# test file to one worker so its module fixtures are built once; TEST_WORKERS=0 runs in this process.
+# test file to one worker so its module fixtures are built once, the heavy files first (HEAVY_FIRST in
+# tests/conftest.py); TEST_WORKERS=0 runs in this process.
+# With workers, numba's cache is filled first (tests/_numba_warm.py): in a fresh clone both workers
+# compiled the Newmark and column kernels (about 63 of the suite's 1364 CPU-s twice).
 TEST_WORKERS ?= auto
 test: $(STAMP)
-	$(PY) -m pytest -q $(if $(filter 0,$(TEST_WORKERS)),,-n $(TEST_WORKERS) --dist loadfile)
+	$(if $(filter 0,$(TEST_WORKERS)),,$(PY) tests/_numba_warm.py)
+	$(PY) -m pytest -q $(if $(filter 0,$(TEST_WORKERS)),,-n $(TEST_WORKERS) --dist loadfile --no-loadscope-reorder)
 
 # real-browser tests: Debian's Chromium (installed here when root and apt allow) driven by
 # Playwright from PyPI, pointed at that Chromium (no browser download). Skips, saying why,

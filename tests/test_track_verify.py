@@ -455,3 +455,42 @@ def test_the_shot_bob_case_reproduces_the_lock_on_its_empty_place(shot_bob):
     with mock.patch.object(PoseVerifier, "_sample", lambda *a, **k: None):
         tr, d = _track_bob(frames, truth, BOB_BOXES[0])
     assert (tr.ok & ~(d <= 5.0)).sum() >= 30
+
+
+def test_frames_whose_disk_edge_was_seen_report_its_centre_not_the_poses_place():
+    """:class:`SeenDisk` keeps each verified frame's edge circle in image px (its look's centre,
+    first-frame px under the pose, mapped by that pose); :meth:`SeenDisk.measured` keeps those of
+    the learned radius (5 %). The track's assembly (``_track._upright``) then reports, on those
+    frames, the disk's centre less the first frame's offset ``R(th0) d_first``, and on a frame
+    between two of them (at most ``SEEN_GAP_ROWS`` apart) the lever's point moved by their
+    misplacement interpolated; a frame beyond the gap keeps the lever's point."""
+    from rocklab.tracking.video._track import SEEN_GAP_ROWS, _upright
+    from rocklab.tracking.video.targets._occlusion import SeenDisk
+
+    seen = SeenDisk()
+    th = 0.3
+    W = np.array([[np.cos(th), -np.sin(th), 40.0], [np.sin(th), np.cos(th), -7.0]])
+    c_first = np.array([12.0, 9.0])  # the look's centre under the pose, first-frame px
+    truth = W[:, :2] @ c_first + W[:, 2]
+    assert not seen.add(None, 0, W) and not seen.seen_at  # not round: nothing kept
+    for f in range(1, 13):
+        seen.add((c_first, 15.0 if f != 2 else 17.0, 0.95), f, W)  # frame 2: another radius
+    assert seen.disk is not None and np.allclose(seen.seen_at[3][0], truth)
+    got = seen.measured()
+    assert sorted(got) == [1, *range(3, 13)] and np.allclose(got[7], truth)
+
+    n = 40
+    a = {k: np.zeros(n) for k in ("X", "Y", "fit_th", "scale")}
+    a["X"][:], a["Y"][:], a["scale"][:] = 100.0, 50.0, 1.0
+    d_first, th0 = np.array([3.0, -2.0]), 0.0
+    centres = {5: np.array([110.0, 60.0]), 9: np.array([114.0, 52.0]), 9 + SEEN_GAP_ROWS + 1: np.array([0.0, 0.0])}
+    _upright(a, np.zeros(n, bool), d_first, d_first, th0, upto=30, seen=centres)
+    # a seen frame: its edge's centre less the first offset
+    assert np.allclose((a["X"][5], a["Y"][5]), (107.0, 62.0)) and np.allclose((a["X"][9], a["Y"][9]), (111.0, 54.0))
+    # halfway between two seen frames: the lever's point (100 + 3, 50 - 2 -> moved back by d_first
+    # at zero angle: 100, 50) moved by their misplacements (7, 12) and (11, 4) averaged
+    assert np.allclose((a["X"][7], a["Y"][7]), (109.0, 58.0))
+    # beyond the gap, and outside the seen rows: the lever's point alone
+    assert np.allclose((a["X"][15], a["Y"][15]), (100.0, 50.0)) and np.allclose((a["X"][2], a["Y"][2]), (100.0, 50.0))
+    # from row `upto` on the frames report the point upright already: left as they are
+    assert np.allclose((a["X"][35], a["Y"][35]), (100.0, 50.0))

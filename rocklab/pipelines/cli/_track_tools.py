@@ -47,11 +47,11 @@ def _first_frame(video: Path, start_frame=None, fps=None):
         raise InputError(f"--start-frame {start_frame}: {video} holds frames 0-{n - 1}; give one of them")
     note = ""
     if start_frame is None:
-        n_lead = max(int(round(LEAD_IN_S * per * (info.fps or 50.0))), 3)
+        n_lead = max(int(round(LEAD_IN_S * per * info.fps)), 3)
         grays = [
             g for _, g in iter_video_frames(video, 0, n_lead, pixel_aspect=info.pixel_aspect, fields=info.field_order)
         ]
-        start_frame, what = lead_in(grays, per * (info.fps or 50.0))
+        start_frame, what = lead_in(grays, per * info.fps)
         if start_frame:
             note = (
                 (f"frames 0-{start_frame - 1} are" if start_frame > 1 else "frame 0 is")
@@ -86,7 +86,7 @@ def _samples(video, info, window_s, start=0):
 
     per = _per_frame(info)
     n = per * (info.n_frames or 0)
-    stop = start + int(round(window_s * per * (info.fps or 50.0)))
+    stop = start + int(round(window_s * per * info.fps))
     stop = min(stop, n) if n else stop
     step = max(1, (stop - start - 1) // PROPOSE_SAMPLES)
     return [
@@ -108,7 +108,7 @@ def _end_frames(video, info, start=0):
 
     per = _per_frame(info)
     n = per * (info.n_frames or 0)
-    first = max(n - int(round(REST_WINDOW_S * per * (info.fps or 50.0))), start)
+    first = max(n - int(round(REST_WINDOW_S * per * info.fps)), start)
     if n - first < 2:
         return []
     step = max(1, (n - first - 1) // (REST_SAMPLES - 1))
@@ -128,7 +128,7 @@ def _propose(video, info, gray, start=0):
     from ...tracking.video import propose_objects
 
     per = _per_frame(info)
-    duration = max((per * (info.n_frames or 0) - start) / (per * (info.fps or 50.0)), 0.0)
+    duration = max((per * (info.n_frames or 0) - start) / (per * info.fps), 0.0)
     for window in PROPOSE_WINDOWS_S:
         props = propose_objects(gray, _samples(video, info, window, start))
         if props.blocks or duration <= window or props.camera_moves:

@@ -20,7 +20,9 @@ GYRO_UNITS = {"deg/s": math.pi / 180.0, "dps": math.pi / 180.0, "°/s": math.pi 
 ACC_UNITS = {"g": G, "m/s2": 1.0, "m/s^2": 1.0, "m/s²": 1.0}
 TIME_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "µs": 1e-6}
 ROLES = ("gyro_x", "gyro_y", "gyro_z", "acc_x", "acc_y", "acc_z")
-_HEAD = re.compile(r"^\s*(gyroscope|accelerometer)\s+([xyz])\s*\(([^)]*)\)\s*$", re.I)
+# "Acceleration x (m/s^2)" is phyphox's accelerometer with gravity; its "Linear Acceleration"
+# (gravity taken out) does not match: it gives no tilt
+_HEAD = re.compile(r"^\s*(gyroscope|accelerometer|acceleration)\s+([xyz])\s*\(([^)]*)\)\s*$", re.I)
 
 #: Full scale of the x-IMU3 main accelerometer, g (HighGAccelerometer covers impacts).
 XIMU3_FULL_SCALE_G = 16.0
@@ -174,12 +176,18 @@ def inertial_columns(df, path: Path) -> dict[str, tuple[str, float]]:
         found[role] = (col, table[unit])
     missing = [r for r in ROLES if r not in found]
     if missing:
-        raise InputError(_missing_message(path, found, missing))
+        raise InputError(_missing_message(path, found, missing, df.columns))
     return found
 
 
-def _missing_message(path: Path, found: dict, missing: list) -> str:
+def _missing_message(path: Path, found: dict, missing: list, columns=()) -> str:
     """The one-line error for an inertial CSV without all six gyroscope/accelerometer columns."""
+    linear = [c for c in columns if str(c).strip().lower().startswith("linear acceleration")]
+    if linear and any(r.startswith("acc_") for r in missing):
+        return (
+            f"{where(path, 1)}'{linear[0]}' is an acceleration with gravity taken out (phyphox's Linear "
+            "Acceleration), which gives no tilt; record the accelerometer with gravity ('Acceleration with g')"
+        )
     if all(r.startswith("acc_") for r in missing) and len(missing) == 3:
         units = sorted({c.partition("(")[2].rstrip(") ") for c, _ in (found[f"gyro_{a}"] for a in "xyz")})
         return (

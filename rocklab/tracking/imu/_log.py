@@ -34,7 +34,7 @@ class ImuLog:
     source : str
         File the samples were read from (or ``"simulated"``/``"array"``).
     format : str
-        ``"ximu-gui" | "ximu3" | "fusion" | "mapped" | "simulated" | "array"``.
+        ``"ximu-gui" | "ximu3" | "fusion" | "phyphox" | "sensor-logger" | "mapped" | "simulated" | "array"``.
     packet : ndarray or None, shape (n,)
         x-IMU GUI packet numbers (unwrapped), else None.
     high_g_samples : int

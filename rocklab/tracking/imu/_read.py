@@ -27,6 +27,10 @@ Formats
 ``fusion``
     CSV with ``Time (s)``, gyroscope deg/s, accelerometer g (x-io Fusion
     example layout).
+``phyphox``, ``sensor-logger``
+    A phone app's export (folder or ``.zip``): the accelerometer (gravity included) and the
+    gyroscope in a CSV each with their own sample times, merged onto the faster sensor's times
+    (``_phone.py``).
 ``mapped``
     Any CSV through ``mapping={column: "role:unit"}``, roles ``t``,
     ``gyro_x|y|z``, ``acc_x|y|z``; units ``s|ms|us``, ``deg/s|rad/s``,
@@ -58,6 +62,7 @@ from ._csv import (
     stack,
 )
 from ._log import ImuLog
+from ._phone import phone_files, phone_layout, read_phone
 from ._ximu import read_ximu_gui, read_ximu_registers, ximu_rate_from_registers
 
 __all__ = ["ImuLog", "read_imu", "imu_log_files", "read_ximu_registers", "ximu_rate_from_registers"]
@@ -163,6 +168,8 @@ def _resolve(path: Path) -> Path:
     if path.is_file():
         return path
     if path.is_dir():
+        if phone_layout(path):
+            return path
         pats = (
             "*_CalInertialAndMag.csv",
             "*_CalInertialMagnetic.csv",
@@ -201,6 +208,9 @@ def imu_log_files(path) -> list[Path]:
     Raises the same errors as :func:`read_imu` for a folder without one log, or a missing path.
     """
     p = _resolve(Path(path))
+    layout = phone_layout(p)
+    if layout:
+        return phone_files(p, layout)
     companions = [p.with_name("HighGAccelerometer.csv")]
     for suffix in ("_CalInertialAndMag.csv", "_CalInertialMagnetic.csv"):
         if p.name.endswith(suffix):
@@ -216,8 +226,8 @@ def read_imu(
     Parameters
     ----------
     path : str or Path
-        An inertial CSV, a log folder (x-IMU GUI export, x-IMU3 device folder),
-        or an x-IMU base prefix (``.../00000``).
+        An inertial CSV, a log folder (x-IMU GUI export, x-IMU3 device folder,
+        phyphox or Sensor Logger export), such an export's ``.zip``, or an x-IMU base prefix (``.../00000``).
     rate_hz : float, optional
         Sample rate, Hz.  Required for x-IMU GUI logs without a rate register
         and CSVs without a time column; for timestamped logs it is the nominal
@@ -294,12 +304,50 @@ def check_imu_log(log: ImuLog, rate_option_hz: float | None = None) -> ImuLog:
             f"{log.source}: sample rate {log.rate_hz:.4g} Hz (rate register or --rate) is not "
             f"an IMU rate ({lo:g}-{hi:g} Hz); check the register or give --rate"
         )
+    _check_gravity(log)
     return log
+
+
+#: The accelerometer's median |a| over a log, in units of G, that a sensor on a block or a table
+#: reads: gravity, give or take the motion (a rocking block's or a shaking table's median stays
+#: within a few % of G; a phone bouncing on a trampoline: 1.003 G).
+GRAVITY_RANGE_G = (0.5, 2.0)
+
+
+def _check_gravity(log: ImuLog) -> None:
+    """:class:`InputError` when the accelerometer does not read gravity: a "linear" accelerometer
+    (gravity taken out by the phone or logger) gives no tilt, and values in g under an m/s^2
+    header (or the reverse) scale every acceleration by 9.81."""
+    if log.n == 0:
+        return
+    med = float(np.median(np.linalg.norm(log.acc_m_s2, axis=1))) / G
+    lo, hi = GRAVITY_RANGE_G
+    if lo <= med <= hi:
+        return
+    if abs(med * G - 1.0) < 0.07:
+        why = "values in g read as m/s^2 (or gravity taken out)"
+        fix = "name the accelerometer columns with '(g)'"
+    elif med < 0.2:
+        why = "gravity is not in it (a 'linear' or 'user' acceleration, gravity taken out), so it gives no tilt"
+        fix = "log the accelerometer with gravity (phyphox 'Acceleration with g', Sensor Logger 'TotalAcceleration')"
+    elif abs(med - G) < 0.5:
+        why = "values in m/s^2 read as g"
+        fix = "name the accelerometer columns with '(m/s^2)'"
+    else:
+        why = "far from gravity (an acceleration with gravity taken out, or a wrong unit)"
+        fix = "log the accelerometer with gravity and check its columns' units"
+    raise InputError(
+        f"{log.source}: the accelerometer reads {med * G:.4g} m/s^2 (median |a|) where a sensor at rest or "
+        f"rocking reads gravity, {G:.4g} m/s^2: {why}; {fix}"
+    )
 
 
 def _read_any(p: Path, rate_hz, mapping, full_scale_g) -> ImuLog:
     if mapping:
         return _read_timed(p, rate_hz, full_scale_g, mapping)
+    layout = phone_layout(p)
+    if layout:
+        return read_phone(p, layout, full_scale_g)
     if p.name.endswith(("_CalInertialAndMag.csv", "_CalInertialMagnetic.csv")):
         return read_ximu_gui(p, rate_hz, full_scale_g)
     with open(p, encoding="utf-8", errors="replace") as fh:

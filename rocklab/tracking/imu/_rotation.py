@@ -285,14 +285,12 @@ def block_rotation(
     t, gyro, acc, fs = log.t_s, log.gyro_rad_s, log.acc_m_s2, float(log.rate_hz)
     moving, forced, (i_move, i_end), status, msg = _motion_span(log, release, still_gyro_deg_s, still_acc_g)
     s0, s1, e0, e1, has_end, min_rest, status, msg = _rest_windows(n, fs, i_move, i_end, min_rest_s, status, msg)
-    bias = gyro[s0:s1].mean(axis=0)
-    w = gyro - bias
-    if axis is None:
-        mv = w[moving] if moving.any() else w
-        u = np.linalg.svd(mv, full_matrices=False)[2][0]
-    else:
-        u = axis_vector(axis)
-    omega = w @ u
+    restless = status == "no_rest_before" and not has_end
+    bias, w, u, omega = _bias_and_axis(t, gyro, moving, axis, (s0, s1), i_move if restless else None)
+    if restless:
+        # nothing rests: the whole motion stands in for the rests, for the bias and the tilt anchor
+        s0, s1 = i_move, n
+        msg = "no rest in the log: gyro bias from the motion's trend, tilt from its mean"
     if has_end:
         e0 = _strict_rest_start(omega, e0, e1, float(np.std(omega[s0:s1])), fs, min_rest)
         if forced:
@@ -358,6 +356,45 @@ def block_rotation(
     )
 
 
+def _bias_and_axis(t, gyro, moving, axis, rest, trend_from):
+    """(gyro bias (3,) rad/s, bias-free rates (n, 3), rocking axis (3,), rate about it (n,)).
+
+    The bias is the mean rate over the ``rest`` window ``(s0, s1)``; the axis the principal
+    direction of the moving rates unless ``axis`` names it. ``trend_from``: for a log with no
+    rest before or after its motion, its first moving sample, and the bias is then
+    :func:`_trend_bias` from there (the first 0.5 s move: their mean is no bias).
+    """
+    s0, s1 = rest
+    bias = gyro[s0:s1].mean(axis=0)
+    w = gyro - bias
+    if axis is None:
+        mv = w[moving] if moving.any() else w
+        u = np.linalg.svd(mv, full_matrices=False)[2][0]
+    else:
+        u = axis_vector(axis)
+    if trend_from is not None:
+        bias = _trend_bias(t, gyro, u, trend_from)
+        w = gyro - bias
+    return bias, w, u, w @ u
+
+
+def _trend_bias(t, gyro, u, i0: int) -> np.ndarray:
+    """Gyro bias (3,) rad/s of a log that moves from its start to its end, so no rest measures it.
+
+    Off the axis ``u``: the mean rate from sample ``i0`` on (the block turns about ``u`` only).
+    About ``u``: the slope of a straight line fitted to the integrated rate, since an oscillation's
+    angle (a rocking block's, a pendulum's) has no trend of its own over many cycles, while a bias
+    integrates to one. The first 0.5 s of such a log move: their mean rate is the motion's, not
+    the bias (a pendulum swinging 10 deg gave a 3.7 deg/s "bias" and a 170 deg ramp in 48 s).
+    """
+    g, tt = gyro[i0:], t[i0:] - t[i0]
+    if len(tt) < 3:
+        return gyro.mean(axis=0)
+    mean = g.mean(axis=0)
+    slope = float(np.polyfit(tt, cumtrapz(tt, g @ u), 1)[0])
+    return mean - float(mean @ u) * u + slope * u
+
+
 def _judge(log, motion, forced, span, anchoring, state, min_rest_s, push):
     """(rocking evidence, status, message) of a block's rotation, with its warnings.
 
@@ -388,7 +425,7 @@ def _judge(log, motion, forced, span, anchoring, state, min_rest_s, push):
         # a spinning or hand-held sensor: worse than any rest-window status
         status, msg = "suspect", warn_not_rocking(log.source, rocking) + ("; " + msg if msg else "")
     elif status in ("no_rest_before", "no_rest_after"):  # theta unanchored: a coded warning (run shows it)
-        msg = warn_no_rest(log.source, status, t, i_move, i_end, min_rest_s, omega)
+        msg = warn_no_rest(log.source, status, t, i_move, i_end, min_rest_s, omega, rest_after=has_end)
     return rocking, status, msg
 
 

@@ -624,8 +624,9 @@ def _object_series(rows, pos, n, on_shift=None, lever=None):
     okk = np.flatnonzero(st == "ok")
     if np.isnan(th[okk[~dropped[okk]]]).any():  # found unmeasurable on the way: no frame's angle is measured
         if lever is not None:
-            d_pose, d_first, th0, at = lever
-            _upright(a, dropped, d_pose, d_first, th0, pos.get(at, n) if at is not None else n)
+            d_pose, d_first, th0, at, measured = lever
+            seen = {pos[f]: c for f, c in measured.items() if f in pos}
+            _upright(a, dropped, d_pose, d_first, th0, pos.get(at, n) if at is not None else n, seen)
         th[:], a["sig"][:] = np.nan, np.nan
     # An angle step no rocking block makes between frames is a misdetection, not motion.
     shift = None
@@ -649,20 +650,46 @@ def _object_series(rows, pos, n, on_shift=None, lever=None):
     return a, st, metric
 
 
-def _upright(a, held, d_pose, d_first, th0, upto) -> None:
+#: Rows apart at most for two frames whose disk edge was measured to place the frames between
+#: (:func:`_upright`).
+SEEN_GAP_ROWS = 10
+
+
+def _upright(a, held, d_pose, d_first, th0, upto, seen=None) -> None:
     """Move, in place, each frame of ``a`` (:func:`_object_series`'s arrays) before row ``upto``
     (the frames after report the point upright already) to the point its disk's centre carries
     without turning: ``(X, Y) + s R(th) d - R(th0) d_first``, ``th`` the angle the point was
     carried by (``fit_th``), ``th0`` the first angle, rad; ``d`` the disk's centre in the object's
     frame (plane units) where the first frame shows it (``d_first``), or where the poses put it
     (``d_pose``) on the frames whose angle was ``held`` (bool (n,)), not measured: a held pose
-    places the disk's centre where it does not lie in the first frame."""
+    places the disk's centre where it does not lie in the first frame. ``seen``: row -> the disk's
+    centre (2,) plane units where its edge showed it on that frame: the frame reports it less
+    ``R(th0) d_first`` instead (the poses' place for the disk is the texture's); a frame between two
+    such rows at most :data:`SEEN_GAP_ROWS` apart is moved by their misplacement of the disk
+    interpolated (it changes only where a keyframe is cut)."""
     m = np.isfinite(a["fit_th"]) & np.isfinite(a["X"]) & (np.arange(len(a["X"])) < upto)
     th, sc = a["fit_th"][m], np.where(np.isfinite(a["scale"][m]), a["scale"][m], 1.0)
     d = np.where(held[m][:, None], np.asarray(d_pose, float), np.asarray(d_first, float))
     c, s, c0, s0 = np.cos(th), np.sin(th), math.cos(th0), math.sin(th0)
-    a["X"][m] += sc * (c * d[:, 0] - s * d[:, 1]) - (c0 * d_first[0] - s0 * d_first[1])
-    a["Y"][m] += sc * (s * d[:, 0] + c * d[:, 1]) - (s0 * d_first[0] + c0 * d_first[1])
+    off0 = np.array([c0 * d_first[0] - s0 * d_first[1], s0 * d_first[0] + c0 * d_first[1]])
+    a["X"][m] += sc * (c * d[:, 0] - s * d[:, 1]) - off0[0]
+    a["Y"][m] += sc * (s * d[:, 0] + c * d[:, 1]) - off0[1]
+    rows = np.array(sorted(i for i in (seen or {}) if m[i]), int)
+    if not len(rows):
+        return
+    miss = np.array([seen[i] - off0 for i in rows]) - np.column_stack((a["X"][rows], a["Y"][rows]))
+    gap = np.diff(rows)
+    for j in np.flatnonzero(m):
+        k = int(np.searchsorted(rows, j))
+        if k < len(rows) and rows[k] == j:
+            step = miss[k]
+        elif 0 < k < len(rows) and gap[k - 1] <= SEEN_GAP_ROWS:
+            w = (j - rows[k - 1]) / gap[k - 1]
+            step = (1.0 - w) * miss[k - 1] + w * miss[k]
+        else:
+            continue
+        a["X"][j] += step[0]
+        a["Y"][j] += step[1]
 
 
 def _shift_warning(config, oid: str, frames):

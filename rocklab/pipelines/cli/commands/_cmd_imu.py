@@ -123,7 +123,8 @@ def run(args) -> int:
 _STATUS_MEANING = {
     "ok": "rests found before and after, gyro and accelerometer agree, the rocking checks pass, no warning",
     "suspect": "a warning above: the numbers may be wrong; check before using them",
-    "no_rest_before": "no rest before the first motion: the gyro bias came from the first 0.5 s",
+    "no_rest_before": "no rest before the first motion: no release or theta0 measured, the gyro bias estimated "
+    "(from the first 0.5 s and the final rest's tilt, or without one from the motion's trend)",
     "no_rest_after": "still moving at the end: the gyro drift is not held by a final rest",
     "no_motion": "nothing moved above the stillness thresholds",
 }
@@ -194,6 +195,8 @@ def _block_text(res, release: str = "auto") -> str:
     if res.run_kind == "forced":
         why = "as --release none says" if release == "none" else "the table moved the block from rest upright"
         line += f"forced run, no release ({why}): upright = the rest at the start"
+    elif res.status == "no_rest_before":
+        line += "in motion from the log's start: no release and no theta0 measured"
     elif math.isfinite(res.release_t_s):
         said = " (--release thread)" if release == "thread" else ""
         line += f"release{said} at {res.release_t_s:.4f} s from theta0 {sig(math.degrees(res.theta0_rad))} deg"

@@ -258,7 +258,9 @@ class MarkerlessTracker:
         self.theta_hold = 0.0
         #: the disk's centre in the first frame (first-frame px) once an outline found it, or None
         self.disk_c0 = None
-        self.round_at = None  # the frame :attr:`round_note` was set at
+        #: the first frame whose points came from the pose turned upright about the disk's centre
+        #: (:meth:`_upright_disk`): the round note's, or later when the disk was learned after it
+        self.upright_at = None
 
     # -- registration -------------------------------------------------------------
     def _window(self, gray, W, margin):
@@ -547,17 +549,23 @@ class MarkerlessTracker:
         return _euclid(0.0, *(W[:, :2].astype(float) @ c + W[:, 2] - c))
 
     def disk_lever(self):
-        """``(d_pose, d_first, th0, frame)`` for an object whose angle was found unmeasurable on
-        the way (a round outline, :attr:`round_note`, at ``frame``): its disk's centre in the
+        """``(d_pose, d_first, th0, frame, measured)`` for an object whose angle was found unmeasurable on
+        the way (a round outline, :attr:`round_note`; ``frame``: the first whose points came
+        upright, :attr:`upright_at`): its disk's centre in the
         object's own frame (the frame of :attr:`obj_pts`, plane units) where the poses put it
         (``d_pose``: :class:`._occlusion.SeenDisk` learned it under them) and where the first
-        frame shows it (``d_first``), and the first angle ``th0`` (rad); else None.
+        frame shows it (``d_first``), the first angle ``th0`` (rad), and ``measured``: frame -> the
+        disk's centre (2,) in plane units where its own edge showed it in that frame
+        (:meth:`._occlusion.SeenDisk.measured`); else None.
 
         The frames tracked before the angle was dropped report the point as the texture turned
         it; with no angle reported, the point is the one the disk's centre carries without
         turning: ``t + s R(theta) d_pose - R(th0) d_first`` for a frame fitted at ``(t, theta, s)``
         (PhysTrack RollingCylinder, the box moved by 10 %: 8-9 px off on the 35 frames before
-        the note)."""
+        the note). So do the frames after the note tracked before the disk was known (a 25 px box
+        inside the disc learned it 57 frames after the note: 4-6 px off there). A frame whose
+        disk edge was measured reports that centre less ``R(th0) d_first``: held poses chained
+        over keyframes place the disk up to 6 px off where its edge lies."""
         if self.round_note is None or self.disk_c0 is None:
             return None
         centre, th0 = self._obj_frame
@@ -567,7 +575,9 @@ class MarkerlessTracker:
         d_pose, d_first = (
             (self.pm.to_plane(p[None, :])[0] - centre) @ np.array([[c, -s], [s, c]]).T for p in (pose_c, self.disk_c0)
         )
-        return d_pose, d_first, th0, self.round_at
+        seen_at = self.verifier.seen_disk.measured()
+        measured = dict(zip(seen_at, self.pm.to_plane(np.array(list(seen_at.values()), float)))) if seen_at else {}
+        return d_pose, d_first, th0, self.upright_at, measured
 
     def _sigma_theta(self, tmpl, gray, W, mask=None):
         """Gauss-Newton σ of θ (rad) of ``tmpl`` registered by ``W`` (:func:`._observability.sigma_theta`)."""
@@ -682,11 +692,11 @@ class MarkerlessTracker:
             return None
         self.verifier.confirm(gray, self.size)
         self._round_check(first_view, frame)
-        if self.round_note is not None and self.round_at is None:
-            self.round_at = frame
         (W, cc), mask, visible, why, sig, W_pts = self._settle(tmpl, gray, fit, mask, visible)
         self.verifier.seen_disk.held = why is not None  # the poses the next looks are taken under
         W_pts = self._upright_disk(W, W_pts)
+        if self.upright_at is None and self.round_note is not None and self.disk_c0 is not None:
+            self.upright_at = frame
         self.poses = (self.poses + [self._centred(W)])[-2:]
         self.twins.remember(frame, gray, W[:, :2].astype(float) @ self.centre0 + W[:, 2])
         pts = (self.grid + self.origin) @ W_pts[:, :2].T.astype(float) + W_pts[:, 2]

@@ -651,6 +651,8 @@ class SeenDisk:
         #: :meth:`place_first` moved it to the first frame's edge circle
         self.pose_c = None
         self.looks = 0
+        #: frame -> (centre (2,) image px, radius px) of each verified frame's round look (:meth:`add`)
+        self.seen_at: dict = {}
         #: whether the poses the looks are now taken under hold an angle they did not measure
         self.held = False
         self._held_share = 0.0
@@ -676,10 +678,14 @@ class SeenDisk:
             return None
         return c[0] / f - margin2 + tr.origin, c[1] / f, d[2]
 
-    def add(self, seen) -> bool:
+    def add(self, seen, frame=None, W=None) -> bool:
         """Count one verified frame's :meth:`look` (None: not round); True when the disk is
-        learned with it."""
+        learned with it. With the ``frame`` and the pose ``W`` (first-frame px -> image px) it was
+        looked under, the look's circle is kept in :attr:`seen_at` (:meth:`measured`)."""
         self.looks += 1
+        if seen is not None and frame is not None and W is not None:
+            Wd = np.asarray(W, float)
+            self.seen_at[frame] = (Wd[:, :2] @ np.asarray(seen[0], float) + Wd[:, 2], float(seen[1]))
         self._run = [] if seen is None else (self._run + [(*seen, self.held)])[-SEEN_DISK_FRAMES:]
         if len(self._run) < SEEN_DISK_FRAMES:
             return False
@@ -691,6 +697,16 @@ class SeenDisk:
             self._held_share = float(np.mean([s[3] for s in self._run]))
             return True
         return False
+
+    def measured(self) -> dict:
+        """frame -> the disk's centre (2,) image px, on the verified frames looked at whose edge
+        circle has the learned disk's radius (within :data:`SEEN_DISK_RADIUS`): the place its own
+        edge shows, which the poses of the frames before it was learned (their angle the
+        texture's, turning as it rolls) do not give; empty before it is learned."""
+        if self.disk is None:
+            return {}
+        r = self.disk[1]
+        return {f: c for f, (c, rf) in self.seen_at.items() if abs(rf - r) <= SEEN_DISK_RADIUS * r}
 
     def place_first(self, first, at) -> None:
         """Move the learned disk's centre to its edge circle in ``first`` (the first frame's part

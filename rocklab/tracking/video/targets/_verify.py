@@ -527,7 +527,7 @@ class PoseVerifier:
                 reason, self.hint, self.recent = "drift", found[2], []
             elif found is not None:
                 if not self.seen_disk.done:
-                    self._disk_look = (self.seen_disk.look(tr, grown, 2 * self.margin),)
+                    self._disk_look = (self.seen_disk.look(tr, grown, 2 * self.margin), W)
                 self.disk_at = self.outline.disk_centre(tr, W, grown)
         self._pending = (float(score), centre, theta, pred, last2, gap, frame)
         return reason
@@ -687,7 +687,8 @@ class PoseVerifier:
     def confirm(self, gray, size):
         """Learn from the pose just verified (its correlation, motion and the background it uncovers)."""
         score, centre, theta, pred, last, gap, frame = self._pending
-        if self._disk_look is not None and self.seen_disk.add(self._disk_look[0]):
+        look, W_look = self._disk_look if self._disk_look is not None else (None, None)
+        if self._disk_look is not None and self.seen_disk.add(look, frame, W_look):
             self.seen_disk.place_first(self.first_outer, self.outer[:2])
             self.seen_disk.teach(self.outline)
         if math.isfinite(self._contrast):

@@ -233,10 +233,12 @@ def test_a_ball_spinning_in_depth_has_no_angle():
     assert roundness((((xx - 30) / 28.0) ** 2 + ((yy - 30) / 14.0) ** 2 < 1).astype(np.float32)) < ROUND_MIN
 
 
-def _lit_ball_film(seed=0, blur_px=2.5, n=N):
+def _lit_ball_film(seed=0, blur_px=2.5, n=N, cap=False):
     """A plain ball (a Lambertian sphere, no mark) lit from the upper left, swinging on the
     pendulum arc over the wall, slightly out of focus: its dark and lit sides stay with the light
-    while the string turns it by the swing angle, so nothing in the picture shows that angle."""
+    while the string turns it by the swing angle, so nothing in the picture shows that angle. With
+    ``cap``, a dark cap (6 x 6 px, an ornament's) stands out of its top towards the pivot and turns
+    with the swing: the one thing that shows the angle."""
     import cv2
 
     rng = np.random.default_rng(seed)
@@ -245,11 +247,16 @@ def _lit_ball_film(seed=0, blur_px=2.5, n=N):
     yy, xx = np.mgrid[0:H, 0:W].astype(float)
     light = np.array([-0.7, -0.3, 0.65]) / np.linalg.norm([-0.7, -0.3, 0.65])
     frames = []
-    for uc, vc in zip(u, v):
+    for uc, vc, p in zip(u, v, phi):
         nx, ny = (xx - uc) / R, (yy - vc) / R
         nz = np.sqrt(np.clip(1.0 - nx * nx - ny * ny, 0.0, None))
         shade = 30.0 + 200.0 * np.clip(nx * light[0] + ny * light[1] + nz * light[2], 0.0, None)
         alpha = np.clip(R + 0.5 - np.hypot(xx - uc, yy - vc), 0.0, 1.0)
+        if cap:  # along the string (towards the pivot) and across it, px
+            along = (xx - uc) * math.sin(p) - (yy - vc) * math.cos(p)
+            across = (xx - uc) * math.cos(p) + (yy - vc) * math.sin(p)
+            on_cap = (np.abs(across) < 3) & (along > R - 1) & (along < R + 6)
+            shade, alpha = np.where(on_cap, 40.0, shade), np.where(on_cap, 1.0, alpha)
         f = cv2.GaussianBlur(wall * (1 - alpha) + shade * alpha, (0, 0), blur_px) + rng.normal(0, 1.5, (H, W))
         frames.append(np.clip(f, 0, 255).astype(np.uint8))
     return frames, np.column_stack((u, v)), phi
@@ -278,6 +285,55 @@ def test_a_plain_lit_ball_seen_briefly_has_no_angle(grow, shift):
     tr = res["ball"]
     assert "W-TRACK-THETA" in codes and tr.theta_note
     assert np.all(np.isnan(tr.theta_rad)) and np.all(np.isnan(tr.sigma_theta_rad))
+    d = np.column_stack((tr.x_px, tr.y_px)) - truth
+    d -= d[0]
+    assert tr.ok.mean() >= 0.95 and np.nanmax(np.hypot(*d[tr.ok].T)) < 0.5
+
+
+@pytest.mark.parametrize("cap, shift", [(False, 0.0), (False, 0.1), (True, 0.0)])
+def test_a_plain_lit_ball_seen_long_has_no_angle(cap, shift):
+    """The same plain ball seen on 40 frames, past the 30 after which the shading verdict used to
+    give way to its views, which a plain ball passes (its view stays its first, the light's): main
+    reported an angle on every frame, more than 3 sigma off the swing on 26-37 of 40 (90 frames:
+    79 of 90, 3 boxes). Its fitted angles span under 1 deg (about 4 sigma) while it swings 17 deg:
+    no turn seen, W-TRACK-THETA, theta NaN. With a cap standing out of its top and turning with
+    the swing, 2.4 % is left after the shading, under 5 %, and the fit still follows the shading
+    (main: 24 of 40 more than 3 sigma off, up to 17 deg): not reported either."""
+    frames, truth, phi = _lit_ball_film(n=40, cap=cap)
+    u0, v0 = truth[0]
+    half = R + 8
+    box = (u0 - half + 2 + shift * 2 * half, v0 - half - 1 + shift * 2 * half, 2 * half, 2 * half)
+    res, codes = _track(frames, box=box)
+    tr = res["ball"]
+    off = np.abs(tr.theta_rad - (phi - phi[0])) > 3 * tr.sigma_theta_rad
+    assert int(np.sum(off & tr.ok)) == 0
+    assert "W-TRACK-THETA" in codes and tr.theta_note and np.all(np.isnan(tr.theta_rad))
+    d = np.column_stack((tr.x_px, tr.y_px)) - truth
+    d -= d[0]
+    assert tr.ok.mean() >= 0.95 and np.nanmax(np.hypot(*d[tr.ok].T)) < (1.0 if cap else 0.5)
+
+
+@pytest.mark.parametrize("grow, shift", [(0.0, 0.0), (-0.1, 0.0), (0.0, 0.1)])
+def test_a_plain_lit_ball_whose_outline_is_never_learned_has_no_angle(grow, shift):
+    """The plain ball seen on 12 frames, too few to learn the background behind it, so its outline
+    (and its disk) is never known and the shading verdict never ran: main reported an angle on
+    every frame. The round edge round the box in the first frame stands for the disk: its texture,
+    the shading taken out, holds under 1 %: W-TRACK-THETA, theta NaN, the position as before."""
+    from rocklab.tracking.video.targets._occlusion import box_circle
+
+    frames, truth, phi = _lit_ball_film(n=12)
+    u0, v0 = truth[0]
+    half = (R + 8) * (1 + grow)
+    box = (u0 - half + 2 + shift * 2 * half, v0 - half - 1 + shift * 2 * half, 2 * half, 2 * half)
+    # the edge circle is the ball's (to a pixel: its blurred edge, lit on one side) whichever box
+    x0, y0 = (round(c) for c in box[:2])
+    c, r = box_circle(frames[0], (x0, y0, x0 + round(2 * half), y0 + round(2 * half)))
+    assert np.hypot(*(c - truth[0])) < 1.0 and abs(r - R) < 1.0
+    res, codes = _track(frames, box=box)
+    tr = res["ball"]
+    off = np.abs(tr.theta_rad - (phi - phi[0])) > 3 * tr.sigma_theta_rad
+    assert int(np.sum(off & tr.ok)) == 0
+    assert "W-TRACK-THETA" in codes and tr.theta_note and np.all(np.isnan(tr.theta_rad))
     d = np.column_stack((tr.x_px, tr.y_px)) - truth
     d -= d[0]
     assert tr.ok.mean() >= 0.95 and np.nanmax(np.hypot(*d[tr.ok].T)) < 0.5

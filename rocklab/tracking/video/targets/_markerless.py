@@ -64,7 +64,7 @@ from ._observability import (
     unmatched_turn_share,
     unshaded_turn_share,
 )
-from ._occlusion import CELL_CC, GRID, ROUND_MIN, cell_correlations, masked_fit, partly_covered
+from ._occlusion import CELL_CC, GRID, ROUND_MIN, box_circle, cell_correlations, masked_fit, partly_covered
 from ._turn_search import MIN_DISC_RADIUS_PX, PolarRings, inscribed_disc
 from ._twins import TwinGuard
 from ._verify import PoseVerifier, best_turned_match
@@ -81,6 +81,14 @@ REKEY_CC = 0.9
 #: correlates with the first view to REKEY_CC (a disk with a mark turning in the plane does).
 OTHER_VIEW_SHARE = 0.25
 ROUND_MIN_FRAMES = 30
+#: A round object whose texture, its shading taken out, holds under MIN_TURN_SHARE of the turning
+#: information keeps its angle after ROUND_MIN_FRAMES verified frames only if the angles fitted on
+#: them span more than this many times their median 1-sigma: a turn beyond the noise, which only
+#: something on it that turns with it (an ornament's cap) can show. Two angles each within 3 sigma
+#: of one value span at most 6 sigma. A plain lit ball swinging 17 deg on a pendulum: the fitted
+#: angles span 3.6 sigma (0.85 deg, its shading staying with the light); juangomez's ornament, 2.2 %
+#: left after its shading, 9.4 sigma on its first 17 frames (16 deg, following the swing).
+TURN_SEEN_SIGMAS = 6.0
 #: A disk's centre as its texture places it may be this far from its outline's, as a fraction of
 #: the template's larger side: where the texture holds it places the centre more finely than the
 #: outline (development film: within 2.6 px of the ball's silhouette on 99 % of the frames, the
@@ -238,6 +246,13 @@ class MarkerlessTracker:
         #: and it has been verified on fewer than ROUND_MIN_FRAMES frames; else None
         self.shading_note = None
         self.views = [0, 0]  # verified frames, and those not a turned copy of the first view
+        #: (angle, its 1-sigma), rad, of the first ROUND_MIN_FRAMES verified frames with a measured angle
+        self._turns: list = []
+        self._unshaded = math.nan  # the first disk's unshaded turn share (:func:`unshaded_turn_share`)
+        #: the round edge round the region in the first frame (:func:`._occlusion.box_circle`): the
+        #: disk weighed for its shading while no outline is known; and whether it was weighed
+        self._box_disk = box_circle(first_gray, (u0, v0, u1, v1))
+        self._box_checked = False
         self.reason = None  # why the last frame was lost ("mismatch", "jump", "background", "twin", "lost")
         self.min_cc = MIN_CC
         self._turn_info: tuple = (None, None)  # (template, its cells' turning information)
@@ -496,26 +511,32 @@ class MarkerlessTracker:
         self.views[0] += 1
         self.views[1] += not first_view
         out = self.verifier.outline
-        if self.round_note is not None or self.theta_note is not None or out is None or out.roundness < ROUND_MIN:
+        if self.round_note is not None or self.theta_note is not None:
+            return
+        if out is None and self._box_disk is not None:
+            # no outline yet (its background unseen): the first frame's round edge stands for it
+            self._shading_check(
+                self._box_disk, f"its first frame shows a round edge of radius {self._box_disk[1]:.0f} px", frame
+            )
+        elif out is not None and out.roundness < ROUND_MIN:
+            self.shading_note = None  # the outline is known and is not round
+        if out is None or out.roundness < ROUND_MIN:
+            if out is None and self.shading_note is not None and self.views[0] >= ROUND_MIN_FRAMES:
+                self.round_note = self._turn_unseen("its first frame shows a round edge")
+                self.shading_note = None
             return
         if out.disk0 is not None and not self._shading_checked:
-            # once, from the first frame's disk: a plain ball's dark and lit sides are the light's,
-            # and a turn of them tells no angle
-            self._shading_checked = True
-            share = unshaded_turn_share(self.tmpl0, np.asarray(out.disk0[0], float) - self.origin, float(out.disk0[1]))
-            if not share >= MIN_TURN_SHARE:
-                self.shading_note = (
-                    f"its outline is round (circularity {out.roundness:.2f}), so its angle would come from "
-                    f"its texture alone; once a lit ball's shading is taken out its texture holds "
-                    f"{100 * share:.2g} % of its region's turning information (under {100 * MIN_TURN_SHARE:.3g} %), "
-                    f"and it was verified on fewer than {ROUND_MIN_FRAMES} frames, too few for its views to tell "
-                    "whether its texture turns with it",
-                    frame,
-                )
+            self._shading_check(out.disk0, f"its outline is round (circularity {out.roundness:.2f})", frame)
         n, other = self.views
+        if n >= ROUND_MIN_FRAMES and self.shading_note is not None:
+            # a small mark (an ornament's cap) tells the angle though the share is low: it shows as
+            # a turn beyond the noise; a plain ball's fitted angle stays at its first, the light's
+            self.round_note = self._turn_unseen(f"its outline is round (circularity {out.roundness:.2f})")
+            self.shading_note = None
+            if self.round_note is not None:
+                return
         if n >= ROUND_MIN_FRAMES:
-            # its views judge from here on: a small mark (an ornament's cap) tells the angle though
-            # the share is low, and a ball spinning in depth is found by its views
+            # its views judge from here on: a ball spinning in depth is found by its views
             self.shading_note = None
         if n >= ROUND_MIN_FRAMES and other >= OTHER_VIEW_SHARE * n:
             self.round_note = (
@@ -523,6 +544,49 @@ class MarkerlessTracker:
                 f"its texture alone, and on {100 * other / n:.0f} % of {n} frames its region does not "
                 f"match a turned copy of its first view (correlation under {REKEY_CC:g})"
             )
+
+    def _shading_check(self, disk, what, frame):
+        """Once per disk source: sets :attr:`shading_note` when the first template's texture inside
+        ``disk`` (centre (2,) first-frame px, radius px), a lit sphere's shading taken out, holds
+        under :data:`._observability.MIN_TURN_SHARE` of its turning information (a plain ball's dark
+        and lit sides are the light's, and a turn of them tells no angle); clears it otherwise.
+        ``what``: how the disk is known, for the note. The outline's disk, once known, is weighed
+        again over the first frame's edge circle's (``_shading_checked``)."""
+        if self._shading_checked or (what.startswith("its first") and self._box_checked):
+            return
+        if what.startswith("its first"):
+            self._box_checked = True
+        else:
+            self._shading_checked = True
+        share = unshaded_turn_share(self.tmpl0, np.asarray(disk[0], float) - self.origin, float(disk[1]))
+        self._unshaded = share
+        self.shading_note = None
+        if not share >= MIN_TURN_SHARE:
+            self.shading_note = (
+                f"{what}, so its angle would come from its texture alone; once a lit ball's shading is "
+                f"taken out its texture holds {100 * share:.2g} % of its region's turning information "
+                f"(under {100 * MIN_TURN_SHARE:.3g} %), and it was verified on fewer than {ROUND_MIN_FRAMES} "
+                "frames, too few to tell whether its texture turns with it",
+                frame,
+            )
+
+    def _turn_unseen(self, what):
+        """Why a round object whose texture, its shading taken out, tells under
+        :data:`._observability.MIN_TURN_SHARE` has no angle after :data:`ROUND_MIN_FRAMES` verified
+        frames: its fitted angles (:attr:`_turns`) span no more than :data:`TURN_SEEN_SIGMAS` times
+        their median 1-sigma; None when they turned beyond that."""
+        th = np.array([a for a, _ in self._turns])
+        sig = float(np.median([s for _, s in self._turns])) if self._turns else math.inf
+        span = float(np.ptp(th)) if th.size else 0.0
+        if th.size >= 2 and span > TURN_SEEN_SIGMAS * sig:
+            return None
+        return (
+            f"{what}, so its angle would come from its "
+            f"texture alone, which, once a lit ball's shading is taken out, holds {100 * self._unshaded:.2g} % "
+            f"of its region's turning information (under {100 * MIN_TURN_SHARE:.3g} %), and over {self.views[0]} "
+            f"frames its fitted angle spans {math.degrees(span):.2g} deg, no more than "
+            f"{TURN_SEEN_SIGMAS:g} times its 1-sigma ({math.degrees(sig):.2g} deg): nothing on it shows a turn"
+        )
 
     def _held(self, W):
         """``W`` turned back upright about the object's centre of symmetry when its angle is not
@@ -694,6 +758,8 @@ class MarkerlessTracker:
         self._round_check(first_view, frame)
         (W, cc), mask, visible, why, sig, W_pts = self._settle(tmpl, gray, fit, mask, visible)
         self.verifier.seen_disk.held = why is not None  # the poses the next looks are taken under
+        if why is None and math.isfinite(sig) and len(self._turns) < ROUND_MIN_FRAMES:
+            self._turns.append((_params(W)[0], sig))
         W_pts = self._upright_disk(W, W_pts)
         if self.upright_at is None and self.round_note is not None and self.disk_c0 is not None:
             self.upright_at = frame

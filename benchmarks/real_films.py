@@ -64,8 +64,11 @@ KINDS = ["base", "shift+10", "s120", "s080"]
 
 
 def _commit():
-    r = subprocess.run(["git", "-C", str(ROOT), "describe", "--always", "--dirty"], capture_output=True, text=True)
-    return r.stdout.strip()
+    # the package's state, not the benchmark's: uncommitted edits under rocklab/ are said
+    git = ["git", "-C", str(ROOT)]
+    head = subprocess.run([*git, "rev-parse", "--short", "HEAD"], capture_output=True, text=True).stdout.strip()
+    dirty = subprocess.run([*git, "status", "--porcelain", "--", "rocklab"], capture_output=True, text=True).stdout
+    return head + ("+uncommitted rocklab/ edits" if dirty.strip() else "")
 
 
 def _cpu_children():
@@ -254,6 +257,9 @@ def main(argv=None):
         if path is None:
             print(f"{film.name}: mirror of {film.repo} absent and not in $ROCKLAB_FILMS: skipped", flush=True)
             continue
+        if a.eval_only and not (out / "runs" / film.name).exists():
+            print(f"{film.name}: no tracks in {out / 'runs'}: skipped", flush=True)
+            continue
         t0 = time.perf_counter()
         refs = references(film, path)
         print(f"{film.name} ({film.data_set}; {film.kit}): reference {time.perf_counter() - t0:.0f} s", flush=True)
@@ -270,9 +276,11 @@ def main(argv=None):
             table += rows
     wall, cpu = time.perf_counter() - t_all, time.process_time() + _cpu_children() - c_all
     out.mkdir(parents=True, exist_ok=True)
+    made = sorted({str(r.get("commit")) for r in table})
     md = (
         markdown(table)
-        + f"\n\nrocklab {_commit()}; wall {wall:.0f} s, CPU {cpu:.0f} s (this process and its children)\n"
+        + f"\n\ntracks made at rocklab {', '.join(made)}; this run: {'evaluation only, ' if a.eval_only else ''}"
+        + f"wall {wall:.0f} s, CPU {cpu:.0f} s (this process and its children)\n"
     )
     (out / "real_films.md").write_text(md)
     with (out / "real_films.csv").open("w", newline="") as fh:

@@ -142,6 +142,13 @@ def test_a_cart_found_again_after_a_bounce_in_view_is_not_a_latch(u_last):
     assert np.all(st[29:] == "ok") and said == []
 
 
+def test_a_fast_ball_a_long_step_from_the_edge_has_not_left():
+    # review 16's dropped ball: an 81 px region 145 px from the edge at 128 px/frame (the floor
+    # stops it): one step would cross the border, but its centre is more than a size from it
+    st, said = _settled(145.0, 128.0, 262.0 + 300.0, side=81.0, width=1920)
+    assert np.all(st[29:] == "ok") and said == []
+
+
 @pytest.mark.parametrize("u_last", [60.0, 90.0])
 def test_a_cart_whose_region_reaches_the_border_still_left(u_last):
     # its region (77.5 px each side) one 28 px step from the border or over it: it may have left

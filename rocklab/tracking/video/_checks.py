@@ -345,14 +345,17 @@ def _near_edge(c, width_px: int, height_px: int, reach: float) -> bool:
 def _leaving(uv, ok, p: int, size: float, wh) -> bool:
     """Whether an object last trusted ok at index ``p`` may have left the frame in the frames
     after: its region (half ``size`` about its centre) would cross the border one step on (its
-    speed between its last two trusted ok frames). A cart that bounces a size from an edge, its
-    whole region in view, has not left (a latch named "left the frame" for it says a false thing)."""
+    speed between its last two trusted ok frames), and its centre lies within ``size`` of it. A
+    cart that bounces a size from an edge, its whole region in view, has not left (a latch named
+    "left the frame" for it says a false thing)."""
     before = np.flatnonzero(ok[: p + 1])
     step = 0.0
     if before.size >= 2:
         p0 = int(before[-2])
         step = float(np.hypot(*(uv[p] - uv[p0]))) / (p - p0)
-    return _near_edge(uv[p], *wh, 0.5 * size + step)
+    # and never farther than its larger side: a fast ball hitting a floor near the bottom edge
+    # would be one long step from it without leaving
+    return _near_edge(uv[p], *wh, min(size, 0.5 * size + step))
 
 
 def _run_ends(ok, before: int) -> np.ndarray:

@@ -342,6 +342,22 @@ def _near_edge(c, width_px: int, height_px: int, reach: float) -> bool:
     return bool(min(c[0], c[1], width_px - c[0], height_px - c[1]) < reach)
 
 
+def _leaving(uv, ok, p: int, size: float, wh) -> bool:
+    """Whether an object last trusted ok at index ``p`` may have left the frame in the frames
+    after: its region (half ``size`` about its centre) would cross the border one step on (its
+    speed between its last two trusted ok frames), and its centre lies within ``size`` of it. A
+    cart that bounces a size from an edge, its whole region in view, has not left (a latch named
+    "left the frame" for it says a false thing)."""
+    before = np.flatnonzero(ok[: p + 1])
+    step = 0.0
+    if before.size >= 2:
+        p0 = int(before[-2])
+        step = float(np.hypot(*(uv[p] - uv[p0]))) / (p - p0)
+    # and never farther than its larger side: a fast ball hitting a floor near the bottom edge
+    # would be one long step from it without leaving
+    return _near_edge(uv[p], *wh, min(size, 0.5 * size + step))
+
+
 def _run_ends(ok, before: int) -> np.ndarray:
     """Indices where an object's ok runs ended (the next frame not ok) before index ``before``."""
     return np.flatnonzero(ok[: before - 1] & ~ok[1:before])
@@ -397,11 +413,11 @@ def _on_other(k, s, p, uv, trusted, regions, size) -> bool:
 
 def _reacquired_wrong(k, s, p, uv, trusted, size, wh) -> str | None:
     """Why object ``k`` found again at index ``s`` (last trusted ok at ``p``) is not ok, or None:
-    "left" when it left through the frame's edge (its last pose within ``size`` of the border) and
+    "left" when it may have left through the frame's edge (:func:`_leaving`) and
     comes back neither through an edge nor where it left; "ended" when it comes back where another
     object's ok run ended and no ok frame of that object has been there since (this frame included)."""
     near = 0.5 * size
-    if _near_edge(uv[k][p], *wh, size) and not _near_edge(uv[k][s], *wh, size):
+    if _leaving(uv[k], trusted[k], p, size, wh) and not _near_edge(uv[k][s], *wh, size):
         if np.hypot(*(uv[k][s] - uv[k][p])) > near:
             return "left"
     for o in uv:
@@ -445,9 +461,8 @@ def _out_of_reach(s, p, uv, ok, q, size) -> bool:
 
 
 def settle_reacquisitions(raw, config, plane_map, frames, source, width_px: int, height_px: int) -> None:
-    """An object found again after frames it was not ok must be where it can be: one that left
-    the frame through an edge (its last ok centre within its first region's larger side of the
-    border) comes back through an edge or where it left; one found where another object's ok run
+    """An object found again after frames it was not ok must be where it can be: one that may
+    have left the frame through an edge (its region one step from the border, :func:`_leaving`) comes back through an edge or where it left; one found where another object's ok run
     ended (within half that side), with that object not ok there since, has found the other
     object (identical pucks, balls); one found out of its reach on a patch that does not re-explain
     its view (:func:`_out_of_reach`) has found something else, and so has every later run found
@@ -489,7 +504,7 @@ def settle_reacquisitions(raw, config, plane_map, frames, source, width_px: int,
         if bad:
             why, p, s, _ = bad[0]
             where = {
-                "left": "through no edge and away from where it left the frame",
+                "left": "away from the frame's edge where it was last seen leaving (its region one step from the border), not through an edge",
                 "ended": "where another object's track ended",
                 "reach": "farther than it could move in the gap, its view not confirming it",
                 "other": "outside the span of its own track, nearer to where another object is (or was last seen) than to its own last place",

@@ -30,7 +30,10 @@ and, for the outline, its own first frame:
   the verified frames' residuals allow (:data:`MOTION_FACTOR` times their 99th percentile, at
   least :data:`MIN_RESIDUAL_FRAC` of the template; after ``g`` lost frames the prediction is
   carried over them and the allowance is ``g (g + 1) / 2`` times that: a change of velocity each
-  frame), nor turn by more than :data:`MAX_STEP_RAD` a frame since the last verified pose;
+  frame), unless it lies no farther from the last verified pose than the prediction does plus
+  that allowance (an impact on a spring, a wall or the floor stops or turns the object at once
+  but gains it no speed), nor turn by more than :data:`MAX_STEP_RAD` a frame since the last
+  verified pose;
 * **background** (``background``): the warped patch must not match the still background
   (the first frame, with the object's first region filled in once the object has left it)
   on nearly all of its pixels, nor correlate with it as well as with the object's template:
@@ -354,7 +357,14 @@ class PoseVerifier:
             turn = abs(math.remainder(theta - last[1], 2 * math.pi))
             if self.check_turn and turn > min(MAX_STEP_RAD * gap, MAX_TURN_RAD):
                 return "jump"
-            if pred is not None and float(np.hypot(*(centre - pred[0]))) > lim * gap * (gap + 1) / 2:
+            slack = lim * gap * (gap + 1) / 2
+            if (
+                pred is not None
+                and float(np.hypot(*(centre - pred[0]))) > slack
+                # an impact (a spring, a wall, the floor) stops or turns the object at once but
+                # gains it no speed: within its own motion of the last pose it may be anywhere
+                and float(np.hypot(*(centre - last[0]))) > float(np.hypot(*(pred[0] - last[0]))) + slack
+            ):
                 # off the constant-velocity prediction by more than the largest change of
                 # velocity the verified frames allow in each frame since (its sum over the gap)
                 return "jump"

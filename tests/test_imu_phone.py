@@ -175,8 +175,62 @@ def test_a_sensor_logger_export_reads_as_the_same_log_as_phyphox(tmp_path, truth
     np.testing.assert_allclose(b.acc_m_s2, a.acc_m_s2, rtol=1e-7, atol=1e-9)
     # its Accelerometer.csv has gravity taken out: without TotalAcceleration.csv the export is refused
     only = _sensor_logger(tmp_path / "linear", truth, acc_name="Accelerometer.csv")
-    with pytest.raises(InputError, match="without TotalAcceleration.csv: its Accelerometer.csv has gravity taken out"):
+    with pytest.raises(
+        InputError, match=r"without TotalAcceleration.csv \(its Accelerometer.csv has gravity taken out"
+    ):
         read_imu(only)
+    # iOS: user acceleration + CoreMotion's gravity estimate add up to the accelerometer's reading
+    ios = _sensor_logger(tmp_path / "ios", truth, acc_name="Accelerometer.csv")
+    grav = np.zeros_like(truth.acc_m_s2)
+    grav[:, 2] = G
+    user = ImuLog(truth.t_s, truth.gyro_rad_s, truth.acc_m_s2 - grav, FS)
+    _sensor_logger(ios, user, acc_name="Accelerometer.csv")
+    g_only = ImuLog(truth.t_s, truth.gyro_rad_s, grav, FS)
+    _sensor_logger(tmp_path / "g", g_only, acc_name="Gravity.csv")
+    (ios / "Gravity.csv").write_text((tmp_path / "g" / "Gravity.csv").read_text())
+    c = read_imu(ios)
+    assert c.format == "sensor-logger" and c.n == a.n
+    np.testing.assert_allclose(c.acc_m_s2, a.acc_m_s2, rtol=1e-7, atol=1e-9)
+
+
+def test_phyphox_headers_separators_and_decimal_commas_of_other_app_versions(tmp_path, truth):
+    """Older phyphox versions name the axes 'X (m/s^2)' / 'X (rad/s)'; its export options give tab-
+    and semicolon-separated files with a decimal point or comma."""
+    ref = read_imu(_export(tmp_path / "ref", truth))
+    for sep, dec in ((",", "."), (";", "."), (";", ","), ("\t", ",")):
+        folder = _export(tmp_path / f"v{ord(sep)}{ord(dec)}", truth)
+        for name, unit in (("Accelerometer.csv", "m/s^2"), ("Gyroscope.csv", "rad/s")):
+            lines = (folder / name).read_text().splitlines()
+            head = f'"Time (s)"{sep}"X ({unit})"{sep}"Y ({unit})"{sep}"Z ({unit})"'
+            rows = [r.replace(",", sep).replace(".", dec) if dec == "," else r.replace(",", sep) for r in lines[1:]]
+            (folder / name).write_text("\n".join([head, *rows]))
+        log = read_imu(folder)
+        np.testing.assert_allclose(log.acc_m_s2, ref.acc_m_s2, rtol=1e-8, err_msg=f"{sep!r} {dec!r}")
+        np.testing.assert_allclose(log.gyro_rad_s, ref.gyro_rad_s, rtol=1e-8, err_msg=f"{sep!r} {dec!r}")
+
+
+def test_phone_exports_missing_a_sensor_say_which_and_sensors_from_two_recordings_are_flagged(tmp_path, truth):
+    folder = _export(tmp_path / "gyro_only", truth)
+    (folder / "Accelerometer.csv").unlink()
+    with pytest.raises(InputError, match="a phyphox export without Accelerometer.csv"):
+        read_imu(folder)
+    (folder / "Linear Acceleration.csv").write_text('"Time (s)","Linear Acceleration x (m/s^2)"\n0,0\n')
+    with pytest.raises(InputError, match="with Linear Acceleration.csv but no Accelerometer.csv: .*gravity taken out"):
+        read_imu(folder)
+    acc_only = _export(tmp_path / "acc_only", truth)
+    (acc_only / "Gyroscope.csv").unlink()
+    with zipfile.ZipFile(tmp_path / "acc_only.zip", "w") as zf:
+        zf.write(acc_only / "Accelerometer.csv", "Accelerometer.csv")
+    for p in (acc_only, tmp_path / "acc_only.zip"):
+        with pytest.raises(InputError, match="without Gyroscope.csv"):
+            read_imu(p)
+    # a paused recording: the gyroscope stops after a third of the accelerometer's span
+    paused = _export(tmp_path / "paused", truth)
+    lines = (paused / "Gyroscope.csv").read_text().splitlines()
+    (paused / "Gyroscope.csv").write_text("\n".join(lines[: len(lines) // 3]))
+    with collecting() as found:
+        read_imu(paused)
+    assert [d.code for d in found] == ["W-IMU-CLOCK"] and "only the" in found[0].message
 
 
 @pytest.mark.parametrize(

@@ -38,7 +38,7 @@ _MAGIC = (
     (b"\xff\xd8\xff", "a JPEG image"),
     (b"GIF8", "a GIF image"),
     (b"%PDF", "a PDF document"),
-    (b"PK\x03\x04", "a ZIP archive (or an .xlsx workbook)"),
+    (b"PK\x03\x04", "a ZIP archive (or an .xlsx workbook) holding no phone export (phyphox, Sensor Logger)"),
     (b"\x1f\x8b", "a gzip archive"),
     (b"\x1a\x45\xdf\xa3", "a Matroska/WebM film"),
     (b"RIFF", "a RIFF file (AVI, WAV)"),

@@ -47,17 +47,36 @@ def motion_mask(
     A sample moves when, averaged over ``smooth_s``, the bias-removed gyro
     norm exceeds ``gyro_thr`` or the accelerometer norm departs from the
     local gravity level by more than ``acc_thr``.  ``bias`` defaults to the
-    median rate of the first 0.5 s (logs start at rest).
+    median rate of the first 0.5 s (logs start at rest), or of the log's stillest 0.5 s when
+    the first move (:func:`still_window`).
     """
     n = len(t_s)
     w = max(1, int(round(smooth_s * rate_hz)))
+    k = max(3, int(0.5 * rate_hz))
+    i0 = still_window(gyro, k, gyro_thr)
     if bias is None:
-        bias = np.median(gyro[: max(3, int(0.5 * rate_hz))], axis=0)
+        bias = np.median(gyro[i0 : i0 + k], axis=0)
     gm = moving_average(rownorm(gyro - bias), w)
     an = rownorm(acc)
-    g_level = np.median(an[: max(3, int(0.5 * rate_hz))]) if n else G
+    g_level = np.median(an[i0 : i0 + k]) if n else G
     am = moving_average(np.abs(an - g_level), w)
     return (gm > gyro_thr) | (am > acc_thr)
+
+
+def still_window(gyro, k: int, gyro_thr: float) -> int:
+    """First sample of the ``k`` samples the gyro bias and the gravity level are read from.
+
+    The log's start (0) when its rate spreads by at most ``gyro_thr`` there (rad/s, per axis),
+    else the start of the stillest ``k`` samples (least summed variance, searched every ``k // 4``):
+    a log that starts in motion (a phone picked up, a logger started late) would otherwise call
+    its motion the bias and every later rest motion.
+    """
+    n = len(gyro)
+    if n < 2 * k or float(np.max(np.std(gyro[:k], axis=0))) <= gyro_thr:
+        return 0
+    starts = np.arange(0, n - k + 1, max(1, k // 4))
+    spread = [float(np.sum(np.var(gyro[i : i + k], axis=0))) for i in starts]
+    return int(starts[int(np.argmin(spread))])
 
 
 def acc_departure(acc, f_ref, rate_hz, smooth_s=SMOOTH_S):

@@ -3,19 +3,24 @@
 Two apps a lab reaches for, each a folder (or the ``.zip`` the app shares):
 
 ``phyphox`` (RWTH Aachen)
-    ``Accelerometer.csv`` (``"Time (s)","Acceleration x (m/s^2)",...``, gravity included:
-    "Acceleration with g") and ``Gyroscope.csv`` (``"Time (s)","Gyroscope x (rad/s)",...``).
-    ``Linear Acceleration`` (gravity taken out by the phone) gives no tilt and is not read.
+    ``Accelerometer.csv`` (gravity included: "Acceleration with g") and ``Gyroscope.csv``, each
+    ``"Time (s)"`` then the axes, named ``"Acceleration x (m/s^2)"`` / ``"Gyroscope x (rad/s)"``
+    or, in other app versions, ``"X (m/s^2)"`` / ``"X (rad/s)"``; separated by commas, tabs or
+    semicolons, with a decimal point or comma (the app's export options). ``Linear
+    Acceleration`` (gravity taken out by the phone) gives no tilt and is refused.
 ``sensor-logger`` (Sensor Logger, Kelvin Choi)
-    ``TotalAcceleration.csv`` (gravity included) and ``Gyroscope.csv``, each
-    ``time,seconds_elapsed,z,y,x`` (epoch ns, s, m/s^2 or rad/s). Its ``Accelerometer.csv``
-    has gravity taken out: a folder with only that one is refused.
+    ``TotalAcceleration.csv`` (gravity included; Android) or ``Accelerometer.csv`` +
+    ``Gravity.csv`` (iOS: CoreMotion's user acceleration and its gravity estimate, summed back
+    into the accelerometer's reading), and ``Gyroscope.csv``, each ``time,seconds_elapsed,z,y,x``
+    (epoch ns, s, m/s^2 or rad/s). ``Accelerometer.csv`` alone has gravity taken out: refused.
 
 The two sensors are sampled by separate clocks of the same phone; their times share one
 origin. The sensor with the higher rate sets the sample times (the gyroscope on a tie: it
 carries the rotation history), the other is interpolated linearly onto them, over the span
 both cover. Linear interpolation of a 100 Hz signal onto 400 Hz times adds no information:
-an impact's jump in the slower sensor is spread over one of its own periods.
+an impact's jump in the slower sensor is spread over one of its own periods. Sensors whose
+spans share less than :data:`MIN_SPAN_SHARE` of the longer one are ``W-IMU-CLOCK`` (a paused
+recording exports one sensor longer than the other).
 """
 
 from __future__ import annotations
@@ -40,32 +45,49 @@ class PhoneLayout:
 
     Attributes
     ----------
-    acc_file, gyro_file : str
-        The accelerometer's (gravity included) and the gyroscope's CSV names.
+    format : str
+        The :attr:`ImuLog.format` of its logs.
+    acc_files : tuple of str
+        The accelerometer's CSV, or CSVs whose axes add up to it (gravity included), m/s^2.
+    gyro_file : str
+        The gyroscope's CSV, rad/s.
     time_col : str
         Time column, s.
-    acc_cols, gyro_cols : tuple of str
-        x, y, z columns, m/s^2 and rad/s.
+    acc_cols, gyro_cols : tuple of (str, str, str)
+        x, y, z column names, each triple one naming the app uses (the first found is read).
     """
 
-    acc_file: str
+    format: str
+    acc_files: tuple[str, ...]
     gyro_file: str
     time_col: str
-    acc_cols: tuple[str, str, str]
-    gyro_cols: tuple[str, str, str]
+    acc_cols: tuple[tuple[str, str, str], ...]
+    gyro_cols: tuple[tuple[str, str, str], ...]
 
 
-#: The phone apps read, by the name :class:`~rocklab.tracking.ImuLog` gives their format.
+_XYZ = (("x", "y", "z"),)
+
+#: The phone export layouts read, by name.
 PHONE_LAYOUTS = {
     "phyphox": PhoneLayout(
-        "Accelerometer.csv",
+        "phyphox",
+        ("Accelerometer.csv",),
         "Gyroscope.csv",
         "Time (s)",
-        ("Acceleration x (m/s^2)", "Acceleration y (m/s^2)", "Acceleration z (m/s^2)"),
-        ("Gyroscope x (rad/s)", "Gyroscope y (rad/s)", "Gyroscope z (rad/s)"),
+        (
+            ("Acceleration x (m/s^2)", "Acceleration y (m/s^2)", "Acceleration z (m/s^2)"),
+            ("X (m/s^2)", "Y (m/s^2)", "Z (m/s^2)"),
+        ),
+        (
+            ("Gyroscope x (rad/s)", "Gyroscope y (rad/s)", "Gyroscope z (rad/s)"),
+            ("X (rad/s)", "Y (rad/s)", "Z (rad/s)"),
+        ),
     ),
     "sensor-logger": PhoneLayout(
-        "TotalAcceleration.csv", "Gyroscope.csv", "seconds_elapsed", ("x", "y", "z"), ("x", "y", "z")
+        "sensor-logger", ("TotalAcceleration.csv",), "Gyroscope.csv", "seconds_elapsed", _XYZ, _XYZ
+    ),
+    "sensor-logger-ios": PhoneLayout(
+        "sensor-logger", ("Accelerometer.csv", "Gravity.csv"), "Gyroscope.csv", "seconds_elapsed", _XYZ, _XYZ
     ),
 }
 
@@ -73,12 +95,20 @@ PHONE_LAYOUTS = {
 #: interpolated axes are too coarse to be mixed in silently.
 MIN_RATE_SHARE = 0.25
 
+#: The span both sensors cover, as a share of the longer sensor's span, below which the export
+#: is ``W-IMU-CLOCK``.
+MIN_SPAN_SHARE = 0.8
+
+#: Names a phone app gives its gravity-free acceleration (no tilt in it).
+_LINEAR = ("Linear Acceleration.csv", "Linear Accelerometer.csv", "LinearAcceleration.csv")
+
 
 def _header(text: bytes) -> list[str]:
     import csv
 
     line = text.decode("utf-8", "replace").splitlines()[0] if text else ""
-    return [c.strip() for c in next(csv.reader([line]), [])]
+    sep = ";" if line.count(";") > line.count(",") else "\t" if "\t" in line else ","
+    return [c.strip() for c in next(csv.reader([line], delimiter=sep), [])]
 
 
 def _members(names: list[str]) -> dict[str, str]:
@@ -106,47 +136,93 @@ def _first_bytes(path: Path, name: str) -> bytes | None:
 
 
 def phone_layout(path: Path) -> str | None:
-    """The phone app whose export ``path`` (a folder or a zip) is, or None.
+    """The phone export layout (a key of :data:`PHONE_LAYOUTS`) of the folder or zip ``path``, or None.
 
     Raises
     ------
     InputError
-        A Sensor Logger export without ``TotalAcceleration.csv`` (its ``Accelerometer.csv``
-        has gravity taken out).
+        A phone export that cannot give a tilt and a rotation: no gyroscope file beside an
+        accelerometer's, or only a gravity-free acceleration (one line saying which and the fix).
     """
     if not (path.is_dir() or (path.is_file() and path.suffix.lower() == ".zip" and zipfile.is_zipfile(path))):
         return None
+    has = {n: _first_bytes(path, n) is not None for n in ("Accelerometer.csv", "TotalAcceleration.csv", "Gravity.csv")}
+    linear = next((n for n in _LINEAR if _first_bytes(path, n) is not None), None)
     gyro = _first_bytes(path, "Gyroscope.csv")
     if gyro is None:
+        if any(has.values()) or linear:
+            raise InputError(
+                f"{path}: a phone export (phyphox, Sensor Logger) without Gyroscope.csv: rocklab needs the "
+                "gyroscope with the accelerometer; record both in one session"
+            )
         return None
     if "seconds_elapsed" in _header(gyro):
-        if _first_bytes(path, "TotalAcceleration.csv") is None:
-            raise InputError(
-                f"{path}: a Sensor Logger export without TotalAcceleration.csv: its Accelerometer.csv has "
-                "gravity taken out, which gives no tilt; record 'Total Acceleration' with the gyroscope"
-            )
-        return "sensor-logger"
-    return "phyphox" if _first_bytes(path, "Accelerometer.csv") is not None else None
+        if has["TotalAcceleration.csv"]:
+            return "sensor-logger"
+        if has["Accelerometer.csv"] and has["Gravity.csv"]:
+            return "sensor-logger-ios"
+        what = (
+            "its Accelerometer.csv has gravity taken out and no Gravity.csv"
+            if has["Accelerometer.csv"]
+            else ("no accelerometer file")
+        )
+        raise InputError(
+            f"{path}: a Sensor Logger export without TotalAcceleration.csv ({what}), so no tilt; record "
+            "'Total Acceleration' (or Accelerometer with Gravity) with the gyroscope"
+        )
+    if has["Accelerometer.csv"]:
+        return "phyphox"
+    if linear:
+        raise InputError(
+            f"{path}: a phyphox export with {linear} but no Accelerometer.csv: linear acceleration has gravity "
+            "taken out, which gives no tilt; record 'Acceleration with g' with the gyroscope"
+        )
+    raise InputError(
+        f"{path}: a phyphox export without Accelerometer.csv; record 'Acceleration with g' with the gyroscope"
+    )
 
 
 def phone_files(path: Path, layout: str) -> list[Path]:
-    """The input files read for a phone export (the two CSVs, or the zip)."""
+    """The input files read for a phone export (its CSVs, or the zip)."""
     lay = PHONE_LAYOUTS[layout]
-    return [path / lay.acc_file, path / lay.gyro_file] if path.is_dir() else [path]
+    return [path / f for f in (*lay.acc_files, lay.gyro_file)] if path.is_dir() else [path]
 
 
-def _sensor(path: Path, lay: PhoneLayout, cols: tuple[str, ...], shown: str) -> tuple[np.ndarray, np.ndarray]:
+def _frame(path: Path):
+    """The CSV as a DataFrame: comma files through rocklab's reader, tab- and semicolon-separated
+    ones (phyphox's other export options, perhaps with a decimal comma) through pandas."""
+    import pandas as pd
+
+    with open(path, "rb") as fh:
+        head = fh.read(4096).decode("utf-8", "replace").splitlines()
+    first = head[0] if head else ""
+    sep = ";" if first.count(";") > first.count(",") else "\t" if "\t" in first else ","
+    if sep == ",":
+        return read_csv(path)
+    data = head[1] if len(head) > 1 else ""
+    decimal = "," if "," in data else "."
+    df = pd.read_csv(path, sep=sep, decimal=decimal)
+    df.columns = [str(c).strip() for c in df.columns]
+    return df
+
+
+def _sensor(path: Path, lay: PhoneLayout, cands, shown: str) -> tuple[np.ndarray, np.ndarray]:
     """Times (s) and the three axes (SI as the app writes them) of one sensor's CSV."""
-    df = read_csv(path)
-    tcol = next((c for c in df.columns if c.lower() == lay.time_col.lower()), None)
-    missing = [c for c in (tcol or lay.time_col,) + cols if c not in df.columns]
-    if missing:
-        linear = any(c.lower().startswith("linear acceleration") for c in df.columns)
+    df = _frame(path)
+    lower = {str(c).lower(): c for c in df.columns}
+    tcol = lower.get(lay.time_col.lower())
+    cols = next(
+        (tuple(lower[c.lower()] for c in trio) for trio in cands if all(c.lower() in lower for c in trio)), None
+    )
+    if tcol is None or cols is None:
+        missing = [lay.time_col] if tcol is None else []
+        missing += [c for c in cands[0] if c.lower() not in lower] if cols is None else []
+        linear = any(str(c).lower().startswith("linear acceleration") for c in df.columns)
         hint = (
             "this is phyphox's 'Linear Acceleration' (gravity taken out by the phone), which gives no tilt: "
             "record 'Acceleration with g' (Accelerometer.csv)"
             if linear
-            else f"expected the header {', '.join(repr(c) for c in (lay.time_col,) + cols)}"
+            else "expected the header " + " or ".join(", ".join(repr(c) for c in (lay.time_col, *t)) for t in cands)
         )
         raise InputError(f"{where(shown, 1)}missing columns {', '.join(missing)}; {hint}")
     t = numeric_column(df, tcol, path)
@@ -155,11 +231,15 @@ def _sensor(path: Path, lay: PhoneLayout, cols: tuple[str, ...], shown: str) -> 
 
 
 def _read_pair(paths: list[Path], shown: tuple[str, ...], source: str, layout: str, full_scale_g) -> ImuLog:
+    """One log from an export's accelerometer CSV(s) (``paths[:-1]``, summed) and gyroscope CSV (``paths[-1]``)."""
     from ..._diagnostics import warn
 
     lay = PHONE_LAYOUTS[layout]
     t_a, acc = _sensor(paths[0], lay, lay.acc_cols, shown[0])
-    t_g, gyro = _sensor(paths[1], lay, lay.gyro_cols, shown[1])
+    for p, sh in zip(paths[1:-1], shown[1:-1]):  # iOS: user acceleration + gravity
+        t_x, extra = _sensor(p, lay, lay.acc_cols, sh)
+        acc = acc + np.column_stack([np.interp(t_a, t_x, extra[:, k]) for k in range(3)])
+    t_g, gyro = _sensor(paths[-1], lay, lay.gyro_cols, shown[-1])
     if len(t_a) < 2 or len(t_g) < 2:
         raise InputError(f"{source}: fewer than 2 samples of a sensor; record longer")
     rate_a, rate_g = 1.0 / float(np.median(np.diff(t_a))), 1.0 / float(np.median(np.diff(t_g)))
@@ -168,6 +248,14 @@ def _read_pair(paths: list[Path], shown: tuple[str, ...], source: str, layout: s
         raise InputError(
             f"{source}: the accelerometer ({t_a[0]:.4g}-{t_a[-1]:.4g} s) and the gyroscope "
             f"({t_g[0]:.4g}-{t_g[-1]:.4g} s) share no time span; export both sensors of one recording"
+        )
+    longer = max(t_a[-1] - t_a[0], t_g[-1] - t_g[0])
+    if hi - lo < MIN_SPAN_SHARE * longer:
+        warn(
+            "W-IMU-CLOCK",
+            f"{source}: the accelerometer covers {t_a[0]:.4g}-{t_a[-1]:.4g} s and the gyroscope "
+            f"{t_g[0]:.4g}-{t_g[-1]:.4g} s; only the {hi - lo:.4g} s both cover is read (a paused recording "
+            "or files from two recordings: export both sensors of one)",
         )
     slow, fast = sorted((rate_a, rate_g))
     if slow < MIN_RATE_SHARE * fast:
@@ -187,7 +275,7 @@ def _read_pair(paths: list[Path], shown: tuple[str, ...], source: str, layout: s
         acc = acc[(t_a >= lo) & (t_a <= hi)]
         gyro = np.column_stack([np.interp(t, t_g, gyro[:, k]) for k in range(3)])
         rate = rate_a
-    return ImuLog(t, gyro, acc, rate, gap_drops(t, 1.0 / rate), saturation(acc, full_scale_g), source, layout)
+    return ImuLog(t, gyro, acc, rate, gap_drops(t, 1.0 / rate), saturation(acc, full_scale_g), source, lay.format)
 
 
 def read_phone(path: Path, layout: str, full_scale_g: float | None = None) -> ImuLog:
@@ -197,15 +285,15 @@ def read_phone(path: Path, layout: str, full_scale_g: float | None = None) -> Im
     ----------
     path : Path
         The export's folder, or the ``.zip`` the app shares.
-    layout : {"phyphox", "sensor-logger"}
-        The app (:func:`phone_layout` tells it).
+    layout : str
+        A key of :data:`PHONE_LAYOUTS` (:func:`phone_layout` tells it).
     full_scale_g : float, optional
         The phone accelerometer's full scale, g, for saturation flags (else a clipping plateau).
 
     Returns
     -------
     ImuLog
-        ``format = layout``; times of the faster sensor within the span both cover, s;
+        ``format`` the app's name; times of the faster sensor within the span both cover, s;
         gyroscope rad/s; accelerometer m/s^2 (gravity included).
 
     Raises
@@ -215,7 +303,7 @@ def read_phone(path: Path, layout: str, full_scale_g: float | None = None) -> Im
         non-increasing times, sensors without a common time span.
     """
     lay = PHONE_LAYOUTS[layout]
-    names = (lay.acc_file, lay.gyro_file)
+    names = (*lay.acc_files, lay.gyro_file)
     if path.is_dir():
         paths = [path / f for f in names]
         return _read_pair(paths, tuple(str(p) for p in paths), str(path), layout, full_scale_g)

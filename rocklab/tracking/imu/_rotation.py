@@ -70,6 +70,7 @@ from ._motion_windows import (
     quat_mul,
     rownorm,
     still_acc_start,
+    still_window,
     table_push,
     tilt_about,
     twist_angle,
@@ -285,7 +286,10 @@ def block_rotation(
     t, gyro, acc, fs = log.t_s, log.gyro_rad_s, log.acc_m_s2, float(log.rate_hz)
     moving, forced, (i_move, i_end), status, msg = _motion_span(log, release, still_gyro_deg_s, still_acc_g)
     s0, s1, e0, e1, has_end, min_rest, status, msg = _rest_windows(n, fs, i_move, i_end, min_rest_s, status, msg)
-    restless = status == "no_rest_before" and not has_end
+    inner = None
+    if status == "no_rest_before":
+        s0, s1, inner = _inner_rest(t, gyro, moving, fs, (s0, s1), e0 if has_end else n, np.deg2rad(still_gyro_deg_s))
+    restless = status == "no_rest_before" and not has_end and inner is None
     bias, w, u, omega = _bias_and_axis(t, gyro, moving, axis, (s0, s1), i_move if restless else None)
     if restless:
         # nothing rests: the whole motion stands in for the rests, for the bias and the tilt anchor
@@ -315,7 +319,7 @@ def block_rotation(
             min_rest_s=min_rest_s,
         )  # fmt: skip
     rocking, status, msg = _judge(
-        log, (w, u, theta, omega, moving), forced, (i_move, i_end, has_end), (f_start, th_start, drift, changes),
+        log, (w, u, theta, omega, moving), forced, (i_move, i_end, has_end, inner), (f_start, th_start, drift, changes),
         (status, msg), min_rest_s, push,
     )  # fmt: skip
     if axis is None:
@@ -378,6 +382,17 @@ def _bias_and_axis(t, gyro, moving, axis, rest, trend_from):
     return bias, w, u, w @ u
 
 
+def _inner_rest(t, gyro, moving, fs, rest, stop, thr):
+    """(s0, s1, its time span or None): for a log in motion from its start, the stillest 0.5 s
+    before sample ``stop`` (the final rest, or the end), when the motion mask calls it still, stands
+    in for the rest before (gyro bias, start tilt); else ``rest`` unchanged and None."""
+    k = max(3, int(round(0.5 * fs)))
+    i0 = still_window(gyro[:stop], k, thr)
+    if i0 > 0 and i0 + k <= stop and not moving[i0 : i0 + k].any():
+        return i0, i0 + k, (float(t[i0]), float(t[i0 + k - 1]))
+    return rest[0], rest[1], None
+
+
 def _trend_bias(t, gyro, u, i0: int) -> np.ndarray:
     """Gyro bias (3,) rad/s of a log that moves from its start to its end, so no rest measures it.
 
@@ -399,13 +414,14 @@ def _judge(log, motion, forced, span, anchoring, state, min_rest_s, push):
     """(rocking evidence, status, message) of a block's rotation, with its warnings.
 
     ``motion`` = (bias-free rates (n, 3), axis, theta, omega, moving mask); ``span`` = (first
-    moving sample, end of the motion, a rest after?);
+    moving sample, end of the motion, a rest after?, the still span (s, s) inside the motion that
+    stood in for a missing rest before, or None);
     ``anchoring`` = (accelerometer mean at the start rest (3,), tilt there, drift, (gyro change,
     tilt change) between the rests or None); ``state`` = (status, message); ``push`` the table's
     push before the rotation (:func:`table_push`; None without a rest before), judged for a forced run.
     """
     w, u, theta, omega, moving = motion
-    i_move, i_end, has_end = span
+    i_move, i_end, has_end, inner = span
     f_start, th_start, drift, changes = anchoring
     status, msg = state
     t, acc, fs = log.t_s, log.acc_m_s2, float(log.rate_hz)
@@ -425,7 +441,7 @@ def _judge(log, motion, forced, span, anchoring, state, min_rest_s, push):
         # a spinning or hand-held sensor: worse than any rest-window status
         status, msg = "suspect", warn_not_rocking(log.source, rocking) + ("; " + msg if msg else "")
     elif status in ("no_rest_before", "no_rest_after"):  # theta unanchored: a coded warning (run shows it)
-        msg = warn_no_rest(log.source, status, t, i_move, i_end, min_rest_s, omega, rest_after=has_end)
+        msg = warn_no_rest(log.source, status, t, i_move, i_end, min_rest_s, omega, rest_after=has_end, inner=inner)
     return rocking, status, msg
 
 

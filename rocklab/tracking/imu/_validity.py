@@ -284,18 +284,30 @@ NO_REST_DRIFT_RAD_S = np.deg2rad(0.1)
 
 
 def warn_no_rest(
-    source: str, status: str, t, i_move: int, i_end: int, min_rest_s: float, omega=None, rest_after: bool = True
+    source: str,
+    status: str,
+    t,
+    i_move: int,
+    i_end: int,
+    min_rest_s: float,
+    omega=None,
+    rest_after: bool = True,
+    inner=None,
 ) -> str:
     """Emit ``W-IMU-NO-REST`` for a log without a rest before its first motion (``status``
     ``"no_rest_before"``) or after its last (``"no_rest_after"``); returns its message.
 
     ``omega`` (rad/s, the rate about the axis) names the rate still seen at the end of a log
     whose motion runs to its last sample; ``rest_after`` says whether a rest after the motion
-    anchors the drift (else the bias is the motion's trend)."""
+    anchors the drift (else the bias is the motion's trend); ``inner`` the still span (s, s) inside
+    the motion the bias came from, if any."""
     if status == "no_rest_before":
         start = f"motion starts {t[min(i_move, len(t) - 1)] - t[0]:.3g} s into the log, before a {min_rest_s:g} s rest"
         how = (
-            ": the gyro bias and the starting tilt come from the first 0.5 s, which move, and the final rest's "
+            f": the gyro bias and the tilt anchor come from the still {inner[0]:.4g}-{inner[1]:.4g} s inside the "
+            "motion" + (" and the final rest" if rest_after else "")
+            if inner is not None
+            else ": the gyro bias and the starting tilt come from the first 0.5 s, which move, and the final rest's "
             "tilt corrects the drift"
             if rest_after
             else ", and no rest follows: the gyro bias is the trend of the integrated rate over the motion "

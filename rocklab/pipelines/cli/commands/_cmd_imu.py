@@ -24,11 +24,12 @@ def register(sub):
     p = sub.add_parser(
         "imu",
         help="IMU log -> block rotation / table acceleration",
-        description="Read an IMU log (x-IMU GUI export, x-IMU3 folder, Fusion CSV) "
+        description="Read an IMU log (x-IMU GUI export, x-IMU3 folder, Fusion CSV, a phone's phyphox or "
+        "Sensor Logger export: folder or .zip) "
         "and estimate the block rotation about the rocking axis "
         "(or, with --table, the table acceleration).",
     )
-    p.add_argument("path", help="IMU CSV or log folder")
+    p.add_argument("path", help="IMU CSV, log folder, or a phone export's folder or .zip")
     p.add_argument(
         "--axis",
         default=None,

@@ -313,32 +313,6 @@ def test_a_plain_lit_ball_seen_long_has_no_angle(cap, shift):
     assert tr.ok.mean() >= 0.95 and np.nanmax(np.hypot(*d[tr.ok].T)) < (1.0 if cap else 0.5)
 
 
-@pytest.mark.parametrize("grow, shift", [(0.0, 0.0), (-0.1, 0.0), (0.0, 0.1)])
-def test_a_plain_lit_ball_whose_outline_is_never_learned_has_no_angle(grow, shift):
-    """The plain ball seen on 12 frames, too few to learn the background behind it, so its outline
-    (and its disk) is never known and the shading verdict never ran: main reported an angle on
-    every frame. The round edge round the box in the first frame stands for the disk: its texture,
-    the shading taken out, holds under 1 %: W-TRACK-THETA, theta NaN, the position as before."""
-    from rocklab.tracking.video.targets._occlusion import box_circle
-
-    frames, truth, phi = _lit_ball_film(n=12)
-    u0, v0 = truth[0]
-    half = (R + 8) * (1 + grow)
-    box = (u0 - half + 2 + shift * 2 * half, v0 - half - 1 + shift * 2 * half, 2 * half, 2 * half)
-    # the edge circle is the ball's (to a pixel: its blurred edge, lit on one side) whichever box
-    x0, y0 = (round(c) for c in box[:2])
-    c, r = box_circle(frames[0], (x0, y0, x0 + round(2 * half), y0 + round(2 * half)))
-    assert np.hypot(*(c - truth[0])) < 1.0 and abs(r - R) < 1.0
-    res, codes = _track(frames, box=box)
-    tr = res["ball"]
-    off = np.abs(tr.theta_rad - (phi - phi[0])) > 3 * tr.sigma_theta_rad
-    assert int(np.sum(off & tr.ok)) == 0
-    assert "W-TRACK-THETA" in codes and tr.theta_note and np.all(np.isnan(tr.theta_rad))
-    d = np.column_stack((tr.x_px, tr.y_px)) - truth
-    d -= d[0]
-    assert tr.ok.mean() >= 0.95 and np.nanmax(np.hypot(*d[tr.ok].T)) < 0.5
-
-
 def test_unshaded_share_keeps_marks_and_drops_shading():
     """The split on which a round object's angle hangs: a lit sphere's shading (any of the nine
     harmonics, here a light from three sides) leaves under 1 % of the turning information; a

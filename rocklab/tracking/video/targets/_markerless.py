@@ -64,7 +64,7 @@ from ._observability import (
     unmatched_turn_share,
     unshaded_turn_share,
 )
-from ._occlusion import CELL_CC, GRID, ROUND_MIN, box_circle, cell_correlations, masked_fit, partly_covered
+from ._occlusion import CELL_CC, GRID, ROUND_MIN, cell_correlations, masked_fit, partly_covered
 from ._turn_search import MIN_DISC_RADIUS_PX, PolarRings, inscribed_disc
 from ._twins import TwinGuard
 from ._verify import PoseVerifier, best_turned_match
@@ -249,10 +249,6 @@ class MarkerlessTracker:
         #: (angle, its 1-sigma), rad, of the first ROUND_MIN_FRAMES verified frames with a measured angle
         self._turns: list = []
         self._unshaded = math.nan  # the first disk's unshaded turn share (:func:`unshaded_turn_share`)
-        #: the round edge round the region in the first frame (:func:`._occlusion.box_circle`): the
-        #: disk weighed for its shading while no outline is known; and whether it was weighed
-        self._box_disk = box_circle(first_gray, (u0, v0, u1, v1))
-        self._box_checked = False
         self.reason = None  # why the last frame was lost ("mismatch", "jump", "background", "twin", "lost")
         self.min_cc = MIN_CC
         self._turn_info: tuple = (None, None)  # (template, its cells' turning information)
@@ -511,27 +507,28 @@ class MarkerlessTracker:
         self.views[0] += 1
         self.views[1] += not first_view
         out = self.verifier.outline
-        if self.round_note is not None or self.theta_note is not None:
-            return
-        if out is None and self._box_disk is not None:
-            # no outline yet (its background unseen): the first frame's round edge stands for it
-            self._shading_check(
-                self._box_disk, f"its first frame shows a round edge of radius {self._box_disk[1]:.0f} px", frame
-            )
-        elif out is not None and out.roundness < ROUND_MIN:
-            self.shading_note = None  # the outline is known and is not round
-        if out is None or out.roundness < ROUND_MIN:
-            if out is None and self.shading_note is not None and self.views[0] >= ROUND_MIN_FRAMES:
-                self.round_note = self._turn_unseen("its first frame shows a round edge")
-                self.shading_note = None
+        if self.round_note is not None or self.theta_note is not None or out is None or out.roundness < ROUND_MIN:
             return
         if out.disk0 is not None and not self._shading_checked:
-            self._shading_check(out.disk0, f"its outline is round (circularity {out.roundness:.2f})", frame)
+            # once, from the first frame's disk: a plain ball's dark and lit sides are the light's,
+            # and a turn of them tells no angle
+            self._shading_checked = True
+            share = unshaded_turn_share(self.tmpl0, np.asarray(out.disk0[0], float) - self.origin, float(out.disk0[1]))
+            self._unshaded = share
+            if not share >= MIN_TURN_SHARE:
+                self.shading_note = (
+                    f"its outline is round (circularity {out.roundness:.2f}), so its angle would come from "
+                    f"its texture alone; once a lit ball's shading is taken out its texture holds "
+                    f"{100 * share:.2g} % of its region's turning information (under {100 * MIN_TURN_SHARE:.3g} %), "
+                    f"and it was verified on fewer than {ROUND_MIN_FRAMES} frames, too few for its views to tell "
+                    "whether its texture turns with it",
+                    frame,
+                )
         n, other = self.views
         if n >= ROUND_MIN_FRAMES and self.shading_note is not None:
             # a small mark (an ornament's cap) tells the angle though the share is low: it shows as
             # a turn beyond the noise; a plain ball's fitted angle stays at its first, the light's
-            self.round_note = self._turn_unseen(f"its outline is round (circularity {out.roundness:.2f})")
+            self.round_note = self._turn_unseen(out.roundness)
             self.shading_note = None
             if self.round_note is not None:
                 return
@@ -545,32 +542,7 @@ class MarkerlessTracker:
                 f"match a turned copy of its first view (correlation under {REKEY_CC:g})"
             )
 
-    def _shading_check(self, disk, what, frame):
-        """Once per disk source: sets :attr:`shading_note` when the first template's texture inside
-        ``disk`` (centre (2,) first-frame px, radius px), a lit sphere's shading taken out, holds
-        under :data:`._observability.MIN_TURN_SHARE` of its turning information (a plain ball's dark
-        and lit sides are the light's, and a turn of them tells no angle); clears it otherwise.
-        ``what``: how the disk is known, for the note. The outline's disk, once known, is weighed
-        again over the first frame's edge circle's (``_shading_checked``)."""
-        if self._shading_checked or (what.startswith("its first") and self._box_checked):
-            return
-        if what.startswith("its first"):
-            self._box_checked = True
-        else:
-            self._shading_checked = True
-        share = unshaded_turn_share(self.tmpl0, np.asarray(disk[0], float) - self.origin, float(disk[1]))
-        self._unshaded = share
-        self.shading_note = None
-        if not share >= MIN_TURN_SHARE:
-            self.shading_note = (
-                f"{what}, so its angle would come from its texture alone; once a lit ball's shading is "
-                f"taken out its texture holds {100 * share:.2g} % of its region's turning information "
-                f"(under {100 * MIN_TURN_SHARE:.3g} %), and it was verified on fewer than {ROUND_MIN_FRAMES} "
-                "frames, too few to tell whether its texture turns with it",
-                frame,
-            )
-
-    def _turn_unseen(self, what):
+    def _turn_unseen(self, roundness):
         """Why a round object whose texture, its shading taken out, tells under
         :data:`._observability.MIN_TURN_SHARE` has no angle after :data:`ROUND_MIN_FRAMES` verified
         frames: its fitted angles (:attr:`_turns`) span no more than :data:`TURN_SEEN_SIGMAS` times
@@ -581,7 +553,7 @@ class MarkerlessTracker:
         if th.size >= 2 and span > TURN_SEEN_SIGMAS * sig:
             return None
         return (
-            f"{what}, so its angle would come from its "
+            f"its outline is round (circularity {roundness:.2f}), so its angle would come from its "
             f"texture alone, which, once a lit ball's shading is taken out, holds {100 * self._unshaded:.2g} % "
             f"of its region's turning information (under {100 * MIN_TURN_SHARE:.3g} %), and over {self.views[0]} "
             f"frames its fitted angle spans {math.degrees(span):.2g} deg, no more than "

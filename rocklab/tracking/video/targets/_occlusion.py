@@ -44,7 +44,6 @@ import numpy as np
 
 __all__ = [
     "GRID",
-    "box_circle",
     "cell_correlations",
     "partly_covered",
     "cell_pixels",
@@ -562,14 +561,13 @@ FIRST_EDGE_RADII = (0.9, 1.1)
 EDGE_RADIUS_RANGE = (0.6, 1.05)
 
 
-def edge_circle(img, near, r_blob, radii=EDGE_RADIUS_RANGE, canny=300):
+def edge_circle(img, near, r_blob, radii=EDGE_RADIUS_RANGE):
     """The circle of the strongest round edge of ``img`` (float32 grey, h x w) within half of
     ``r_blob`` of ``near`` (x, y px), its radius within ``radii`` (fractions) of ``r_blob``
     (OpenCV's gradient Hough transform, the variant that scores each circle's completeness):
     centre (2,) px and radius px, or None. A disk's edge against its background places it where
     the blob standing out of the background does not: a soft shadow, or a hand holding it, joins
-    the blob and not the edge. ``canny``: the edge detector's upper threshold (OpenCV's
-    ``param1``), lower for a faint edge."""
+    the blob and not the edge."""
     import cv2
 
     u8 = np.clip(img, 0, 255).astype(np.uint8)
@@ -581,7 +579,7 @@ def edge_circle(img, near, r_blob, radii=EDGE_RADIUS_RANGE, canny=300):
         cv2.HOUGH_GRADIENT_ALT,
         1,
         r_blob,
-        param1=canny,
+        param1=300,
         param2=0.7,
         minRadius=lo,
         maxRadius=hi + 1,
@@ -592,36 +590,6 @@ def edge_circle(img, near, r_blob, radii=EDGE_RADIUS_RANGE, canny=300):
         if math.hypot(x - near[0], y - near[1]) <= 0.5 * r_blob:
             return _refine_circle(u8, np.array([x, y], float), float(r))
     return None
-
-
-#: A circle round a box's centre (:func:`box_circle`) is looked for with radii of this range of
-#: fractions of the box's larger side: a box drawn round a ball (1/2), 20 % larger (0.42) or 20 %
-#: smaller (0.62), with room either side.
-BOX_CIRCLE_RADII = (0.3, 0.7)
-#: ... on edges down to a third of :func:`edge_circle`'s threshold: with no background known, a
-#: ball's edge against a wall of its own grey (izhan's orange ball on a brown wall) is all there is.
-BOX_CIRCLE_CANNY = 100
-
-
-def box_circle(gray, box):
-    """The strongest round edge (:func:`edge_circle`) in ``gray`` (h x w, the first frame) round
-    the user's region ``box`` (u0, v0, u1, v1 px) with its centre within a third of the box's larger
-    side of the box's centre and its radius in :data:`BOX_CIRCLE_RADII` of that side (edges over
-    :data:`BOX_CIRCLE_CANNY`): centre (2,)
-    frame px and radius px, or None. The disk of a ball whose outline is not known (its background
-    never seen): a box drawn inside the ball or shifted off it still holds most of it."""
-    u0, v0, u1, v1 = box
-    side = float(max(u1 - u0, v1 - v0))
-    H, W = gray.shape[:2]
-    m = int(math.ceil(0.75 * side))
-    x0, y0 = max(int(u0) - m, 0), max(int(v0) - m, 0)
-    win = np.asarray(gray[y0 : min(int(v1) + m, H), x0 : min(int(u1) + m, W)], np.float32)
-    near = (0.5 * (u0 + u1) - x0, 0.5 * (v0 + v1) - y0)
-    r_mid = 0.5 * sum(BOX_CIRCLE_RADII) * side
-    found = edge_circle(win, near, r_mid, tuple(k * side / r_mid for k in BOX_CIRCLE_RADII), BOX_CIRCLE_CANNY)
-    if found is None or math.hypot(found[0][0] - near[0], found[0][1] - near[1]) > side / 3:
-        return None
-    return np.asarray(found[0], float) + (x0, y0), float(found[1])
 
 
 #: Rays cast from a circle's centre to refine it (:func:`_refine_circle`), the band searched along

@@ -103,12 +103,10 @@ MIN_SPAN_SHARE = 0.8
 _LINEAR = ("Linear Acceleration.csv", "Linear Accelerometer.csv", "LinearAcceleration.csv")
 
 
-def _header(text: bytes) -> list[str]:
-    import csv
-
-    line = text.decode("utf-8", "replace").splitlines()[0] if text else ""
-    sep = ";" if line.count(";") > line.count(",") else "\t" if "\t" in line else ","
-    return [c.strip() for c in next(csv.reader([line], delimiter=sep), [])]
+def _separator(line: str) -> str:
+    """The field separator of a CSV whose first line is ``line``: phyphox's export options write
+    commas, tabs or semicolons (the latter two with a decimal point or comma)."""
+    return ";" if line.count(";") > line.count(",") else "\t" if "\t" in line else ","
 
 
 def _members(names: list[str]) -> dict[str, str]:
@@ -119,20 +117,26 @@ def _members(names: list[str]) -> dict[str, str]:
     return found
 
 
-def _first_bytes(path: Path, name: str) -> bytes | None:
-    """The first 4 kB of ``name`` in the folder or zip ``path``, or None."""
+def _files(path: Path) -> dict[str, str]:
+    """``{base name: member}`` of the files in the folder or zip ``path`` (one listing)."""
     if path.is_dir():
-        p = path / name
-        if not p.is_file():
-            return None
-        with open(p, "rb") as fh:
-            return fh.read(4096)
+        return {p.name: p.name for p in path.iterdir() if p.is_file()}
     with zipfile.ZipFile(path) as zf:
-        member = _members(zf.namelist()).get(name)
-        if member is None:
-            return None
-        with zf.open(member) as fh:
-            return fh.read(4096)
+        return _members(zf.namelist())
+
+
+def _header(path: Path, member: str) -> list[str]:
+    """The column names on the first line of ``member`` in the folder or zip ``path``."""
+    import csv
+
+    if path.is_dir():
+        with open(path / member, "rb") as fh:
+            text = fh.read(4096)
+    else:
+        with zipfile.ZipFile(path) as zf, zf.open(member) as fh:
+            text = fh.read(4096)
+    line = text.decode("utf-8", "replace").splitlines()[0] if text else ""
+    return [c.strip() for c in next(csv.reader([line], delimiter=_separator(line)), [])]
 
 
 def phone_layout(path: Path) -> str | None:
@@ -146,17 +150,17 @@ def phone_layout(path: Path) -> str | None:
     """
     if not (path.is_dir() or (path.is_file() and path.suffix.lower() == ".zip" and zipfile.is_zipfile(path))):
         return None
-    has = {n: _first_bytes(path, n) is not None for n in ("Accelerometer.csv", "TotalAcceleration.csv", "Gravity.csv")}
-    linear = next((n for n in _LINEAR if _first_bytes(path, n) is not None), None)
-    gyro = _first_bytes(path, "Gyroscope.csv")
-    if gyro is None:
+    files = _files(path)
+    has = {n: n in files for n in ("Accelerometer.csv", "TotalAcceleration.csv", "Gravity.csv")}
+    linear = next((n for n in _LINEAR if n in files), None)
+    if "Gyroscope.csv" not in files:
         if any(has.values()) or linear:
             raise InputError(
                 f"{path}: a phone export (phyphox, Sensor Logger) without Gyroscope.csv: rocklab needs the "
                 "gyroscope with the accelerometer; record both in one session"
             )
         return None
-    if "seconds_elapsed" in _header(gyro):
+    if "seconds_elapsed" in _header(path, files["Gyroscope.csv"]):
         if has["TotalAcceleration.csv"]:
             return "sensor-logger"
         if has["Accelerometer.csv"] and has["Gravity.csv"]:
@@ -195,8 +199,7 @@ def _frame(path: Path):
 
     with open(path, "rb") as fh:
         head = fh.read(4096).decode("utf-8", "replace").splitlines()
-    first = head[0] if head else ""
-    sep = ";" if first.count(";") > first.count(",") else "\t" if "\t" in first else ","
+    sep = _separator(head[0] if head else "")
     if sep == ",":
         return read_csv(path)
     data = head[1] if len(head) > 1 else ""
@@ -266,15 +269,13 @@ def _read_pair(paths: list[Path], shown: tuple[str, ...], source: str, layout: s
             "(set both sensors' rates alike in the app)",
         )
     if rate_g >= rate_a:
-        t = t_g[(t_g >= lo) & (t_g <= hi)]
-        gyro = gyro[(t_g >= lo) & (t_g <= hi)]
+        keep = (t_g >= lo) & (t_g <= hi)
+        t, gyro, rate = t_g[keep], gyro[keep], rate_g
         acc = np.column_stack([np.interp(t, t_a, acc[:, k]) for k in range(3)])
-        rate = rate_g
     else:
-        t = t_a[(t_a >= lo) & (t_a <= hi)]
-        acc = acc[(t_a >= lo) & (t_a <= hi)]
+        keep = (t_a >= lo) & (t_a <= hi)
+        t, acc, rate = t_a[keep], acc[keep], rate_a
         gyro = np.column_stack([np.interp(t, t_g, gyro[:, k]) for k in range(3)])
-        rate = rate_a
     return ImuLog(t, gyro, acc, rate, gap_drops(t, 1.0 / rate), saturation(acc, full_scale_g), source, lay.format)
 
 

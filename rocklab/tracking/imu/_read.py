@@ -163,13 +163,18 @@ def _read_timed(path: Path, rate_hz, full_scale_g, mapping) -> ImuLog:
     return ImuLog(t, gyro, acc, 1.0 / period, gap_drops(t, period), saturation(acc, full_scale_g), str(path), fmt)
 
 
-def _resolve(path: Path) -> Path:
+def _resolve(path: Path) -> tuple[Path, str | None]:
+    """``(path, its layout)`` for a phone export's folder or zip (:func:`._phone.phone_layout`),
+    else ``(the inertial CSV, None)`` for a CSV, a log folder or a base prefix."""
+    layout = phone_layout(path)
+    return (path, layout) if layout else (_inertial_csv(path), None)
+
+
+def _inertial_csv(path: Path) -> Path:
     """A log folder or base prefix -> the inertial CSV inside it."""
     if path.is_file():
         return path
     if path.is_dir():
-        if phone_layout(path):
-            return path
         pats = (
             "*_CalInertialAndMag.csv",
             "*_CalInertialMagnetic.csv",
@@ -207,8 +212,7 @@ def imu_log_files(path) -> list[Path]:
 
     Raises the same errors as :func:`read_imu` for a folder without one log, or a missing path.
     """
-    p = _resolve(Path(path))
-    layout = phone_layout(p)
+    p, layout = _resolve(Path(path))
     if layout:
         return phone_files(p, layout)
     companions = [p.with_name("HighGAccelerometer.csv")]
@@ -251,10 +255,10 @@ def read_imu(
         Empty file, missing columns, unknown units, non-numeric values,
         non-increasing times, no rate.
     """
-    p = _resolve(Path(path))
+    p, layout = _resolve(Path(path))
     if rate_hz is not None and not (np.isfinite(rate_hz) and rate_hz > 0):
         raise InputError(f"rate_hz={rate_hz!r}: the sample rate must be a positive number of Hz")
-    return check_imu_log(_read_any(p, rate_hz, mapping, full_scale_g), rate_hz)
+    return check_imu_log(_read_any(p, layout, rate_hz, mapping, full_scale_g), rate_hz)
 
 
 #: Sample rates an inertial logger can have, Hz; outside them the timestamps' or the rate
@@ -342,10 +346,9 @@ def _check_gravity(log: ImuLog) -> None:
     )
 
 
-def _read_any(p: Path, rate_hz, mapping, full_scale_g) -> ImuLog:
+def _read_any(p: Path, layout: str | None, rate_hz, mapping, full_scale_g) -> ImuLog:
     if mapping:
         return _read_timed(p, rate_hz, full_scale_g, mapping)
-    layout = phone_layout(p)
     if layout:
         return read_phone(p, layout, full_scale_g)
     if p.name.endswith(("_CalInertialAndMag.csv", "_CalInertialMagnetic.csv")):

@@ -303,17 +303,22 @@ def warn_no_rest(
     the motion the bias came from, if any."""
     if status == "no_rest_before":
         start = f"motion starts {t[min(i_move, len(t) - 1)] - t[0]:.3g} s into the log, before a {min_rest_s:g} s rest"
-        how = (
-            f": the gyro bias and the tilt anchor come from the still {inner[0]:.4g}-{inner[1]:.4g} s inside the "
-            "motion" + (" and the final rest" if rest_after else "")
-            if inner is not None
-            else ": the gyro bias and the starting tilt come from the first 0.5 s, which move, and the final rest's "
-            "tilt corrects the drift"
-            if rest_after
-            else ", and no rest follows: the gyro bias is the trend of the integrated rate over the motion "
-            "(an oscillation has none of its own) and the tilt the motion's mean (about 1 deg RMS on simulated "
-            "rocking), so a slow real drift of the block is not seen"
-        )
+        if inner is not None:
+            how = (
+                f": the gyro bias and the tilt anchor come from the still {inner[0]:.4g}-{inner[1]:.4g} s inside "
+                "the motion" + (" and the final rest" if rest_after else "")
+            )
+        elif rest_after:
+            how = (
+                ": the gyro bias and the starting tilt come from the first 0.5 s, which move, and the final "
+                "rest's tilt corrects the drift"
+            )
+        else:
+            how = (
+                ", and no rest follows: the gyro bias is the trend of the integrated rate over the motion "
+                "(an oscillation has none of its own) and the tilt the motion's mean (about 1 deg RMS on "
+                "simulated rocking), so a slow real drift of the block is not seen"
+            )
         what = f"{start}{how}; theta0 and the release are not measured (start the logger before the release)"
         return warn("W-IMU-NO-REST", f"{source}: {what}").message
     span = float(t[-1] - t[0])

@@ -697,8 +697,7 @@ class PoseVerifier:
     def confirm(self, gray, size):
         """Learn from the pose just verified (its correlation, motion and the background it uncovers)."""
         score, centre, theta, pred, last, gap, frame = self._pending
-        look, W_look = self._disk_look if self._disk_look is not None else (None, None)
-        if self._disk_look is not None and self.seen_disk.add(look, frame, W_look):
+        if self._disk_look is not None and self.seen_disk.add(self._disk_look[0], frame, self._disk_look[1]):
             self.seen_disk.place_first(self.first_outer, self.outer[:2])
             self.seen_disk.teach(self.outline)
         if math.isfinite(self._contrast):
